@@ -1,0 +1,249 @@
+#include "atmosphere.h"
+
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "irradiance_ground.spv.h"
+#include "irradiance_sky.spv.h"
+#include "log.h"
+#include "multiscattering.spv.h"
+#include "transmittance.spv.h"
+
+#define BIT(p) (1u << (p))
+
+static const struct sb_atmosphere_product products[SB_PRODUCT_COUNT] = {
+    [SB_PRODUCT_TRANSMITTANCE] = {
+        .id = SB_PRODUCT_TRANSMITTANCE,
+        .width = SB_TRANSMITTANCE_WIDTH,
+        .height = SB_TRANSMITTANCE_HEIGHT,
+        .channel_count = SB_TRANSMITTANCE_CHANNELS,
+        .channel_names = "r,g,b",
+        .parameterization = "transmittance-hillaire2020-v1",
+    },
+    [SB_PRODUCT_MULTISCATTERING] = {
+        .id = SB_PRODUCT_MULTISCATTERING,
+        .width = SB_MULTISCATTERING_SIZE,
+        .height = SB_MULTISCATTERING_SIZE,
+        .channel_count = SB_MULTISCATTERING_CHANNELS,
+        .channel_names = "r,g,b",
+        .parameterization = "multiscattering-hillaire2020-subtexel-v1",
+        .depends_on = BIT(SB_PRODUCT_TRANSMITTANCE),
+        .defaults = {.directions_mu = 16, .directions_phi = 16},
+    },
+    [SB_PRODUCT_IRRADIANCE_GROUND] = {
+        .id = SB_PRODUCT_IRRADIANCE_GROUND,
+        .width = SB_IRRADIANCE_WIDTH,
+        .height = SB_IRRADIANCE_HEIGHT,
+        .channel_count = SB_IRRADIANCE_GROUND_CHANNELS,
+        .channel_names = "direct.r,direct.g,direct.b,sky.r,sky.g,sky.b",
+        .parameterization = "irradiance-bruneton2017-subtexel-v1",
+        .depends_on = BIT(SB_PRODUCT_TRANSMITTANCE) | BIT(SB_PRODUCT_MULTISCATTERING),
+        .defaults = {.directions_mu = 16, .directions_phi = 16},
+    },
+    [SB_PRODUCT_IRRADIANCE_SKY] = {
+        .id = SB_PRODUCT_IRRADIANCE_SKY,
+        .width = SB_IRRADIANCE_WIDTH,
+        .height = SB_IRRADIANCE_HEIGHT,
+        .channel_count = SB_IRRADIANCE_SKY_CHANNELS,
+        .channel_names = "rayleigh.r,rayleigh.g,rayleigh.b,mie.r,mie.g,mie.b,ground.r,ground.g,ground.b",
+        .parameterization = "irradiance-bruneton2017-subtexel-v1",
+        .depends_on = BIT(SB_PRODUCT_TRANSMITTANCE) | BIT(SB_PRODUCT_MULTISCATTERING) |
+                      BIT(SB_PRODUCT_IRRADIANCE_GROUND),
+        .defaults = {.directions_mu = 16, .directions_phi = 16},
+    },
+};
+
+static const struct {
+    const uint32_t *words;
+    size_t size;
+} shaders[SB_PRODUCT_COUNT] = {
+    [SB_PRODUCT_TRANSMITTANCE] = {sb_spv_transmittance, sizeof(sb_spv_transmittance)},
+    [SB_PRODUCT_MULTISCATTERING] = {sb_spv_multiscattering, sizeof(sb_spv_multiscattering)},
+    [SB_PRODUCT_IRRADIANCE_GROUND] = {sb_spv_irradiance_ground, sizeof(sb_spv_irradiance_ground)},
+    [SB_PRODUCT_IRRADIANCE_SKY] = {sb_spv_irradiance_sky, sizeof(sb_spv_irradiance_sky)},
+};
+
+const struct sb_atmosphere_product *sb_atmosphere_product(enum sb_product_id id)
+{
+    return &products[id];
+}
+
+int sb_atmosphere_levels(const struct sb_atmosphere_params *p, double levels[SB_MAX_LEVELS])
+{
+    double thickness = p->top_radius_km - p->ground_radius_km;
+    double level = 0.5 * fmin(p->rayleigh_scale_height_km, p->mie_scale_height_km);
+    int n = 0;
+    while (n < SB_MAX_LEVELS && level < thickness) {
+        levels[n++] = level;
+        level *= M_SQRT2;
+    }
+    return n;
+}
+
+static void put3(float dst[4], const double src[3], double w)
+{
+    dst[0] = (float)src[0];
+    dst[1] = (float)src[1];
+    dst[2] = (float)src[2];
+    dst[3] = (float)w;
+}
+
+void sb_atmosphere_gpu_pack(const struct sb_atmosphere_params *p, struct sb_atmosphere_gpu *g)
+{
+    memset(g, 0, sizeof(*g));
+    double mie_ext[3];
+    for (int c = 0; c < 3; c++)
+        mie_ext[c] = p->mie_scattering_per_km[c] + p->mie_absorption_per_km[c];
+    put3(g->rayleigh_scattering, p->rayleigh_scattering_per_km, p->rayleigh_scale_height_km);
+    put3(g->mie_scattering, p->mie_scattering_per_km, p->mie_scale_height_km);
+    put3(g->mie_extinction, mie_ext, p->mie_g);
+    put3(g->ozone_absorption, p->ozone_absorption_per_km, p->ozone_center_km);
+    put3(g->ground_albedo, p->ground_albedo, p->ozone_half_width_km);
+    put3(g->solar_irradiance, p->solar_irradiance, 0.0);
+    double R = p->ground_radius_km, top = p->top_radius_km;
+    double thickness = top - R;
+    g->radii[0] = (float)R;
+    g->radii[1] = (float)top;
+    g->radii[2] = (float)sqrt(thickness * (top + R)); /* sqrt(top^2 - R^2) without cancellation */
+    g->radii[3] = (float)thickness;
+    double levels[SB_MAX_LEVELS];
+    int n = sb_atmosphere_levels(p, levels);
+    float *dst[4] = {g->levels_a, g->levels_b, g->levels_c, g->levels_d};
+    for (int i = 0; i < SB_MAX_LEVELS; i++)
+        dst[i / 4][i % 4] = i < n ? (float)levels[i] : (float)(2.0 * thickness);
+    g->level_count[0] = (uint32_t)n;
+}
+
+struct sb_atmosphere_baker {
+    struct sb_vk *vk;
+    struct sb_buffer params;
+    struct sb_buffer dummy;
+    struct sb_buffer outputs[SB_PRODUCT_COUNT];
+};
+
+enum sb_result sb_atmosphere_baker_create(struct sb_vk *vk, const struct sb_atmosphere_params *params,
+                                          struct sb_atmosphere_baker **out)
+{
+    *out = NULL;
+    struct sb_atmosphere_baker *b = calloc(1, sizeof(*b));
+    if (!b)
+        return SB_ERR_NOMEM;
+    b->vk = vk;
+    struct sb_atmosphere_gpu gpu;
+    sb_atmosphere_gpu_pack(params, &gpu);
+    enum sb_result res = sb_buffer_create(vk, sizeof(gpu), "atmosphere parameters", &b->params);
+    if (!res)
+        res = sb_buffer_create(vk, 16, "unused input", &b->dummy);
+    if (res) {
+        sb_atmosphere_baker_destroy(&b);
+        return res;
+    }
+    memcpy(b->params.mapped, &gpu, sizeof(gpu));
+    *out = b;
+    return SB_OK;
+}
+
+void sb_atmosphere_baker_destroy(struct sb_atmosphere_baker **pb)
+{
+    struct sb_atmosphere_baker *b = *pb;
+    if (!b)
+        return;
+    for (int p = 0; p < SB_PRODUCT_COUNT; p++)
+        sb_buffer_destroy(b->vk, &b->outputs[p]);
+    sb_buffer_destroy(b->vk, &b->params);
+    sb_buffer_destroy(b->vk, &b->dummy);
+    free(b);
+    *pb = NULL;
+}
+
+enum sb_result sb_atmosphere_bake(struct sb_atmosphere_baker *b, enum sb_product_id id,
+                                  const struct sb_atmosphere_settings *settings, struct sb_image *image,
+                                  struct sb_atmosphere_settings *used, double *gpu_ms)
+{
+    const struct sb_atmosphere_product *prod = &products[id];
+    struct sb_pipeline pipeline = {0};
+    struct sb_atmosphere_settings s = prod->defaults;
+    if (settings && settings->directions_mu)
+        s.directions_mu = settings->directions_mu;
+    if (settings && settings->directions_phi)
+        s.directions_phi = settings->directions_phi;
+    if (used)
+        *used = s;
+    for (int dep = 0; dep < SB_PRODUCT_COUNT; dep++)
+        if ((prod->depends_on & BIT(dep)) && !b->outputs[dep].buffer) {
+            sb_error("%s: needs %s, which has not been baked", sb_product_name(id),
+                     sb_product_name((enum sb_product_id)dep));
+            return SB_ERR_USAGE;
+        }
+
+    enum sb_result res = sb_image_init(image, prod->width, prod->height, prod->channel_count);
+    if (res)
+        return res;
+    sb_image_set_channel_names(image, prod->channel_names);
+    sb_buffer_destroy(b->vk, &b->outputs[id]);
+    size_t bytes = sb_image_float_count(image) * sizeof(float);
+    if ((res = sb_buffer_create(b->vk, bytes, sb_product_name(id), &b->outputs[id])))
+        goto cleanup;
+
+    struct sb_pipeline_params pp = {
+        .spirv = shaders[id].words,
+        .spirv_size = shaders[id].size,
+        .binding_count = SB_BINDING_COUNT,
+        .push_size = sizeof(struct sb_bake_push),
+        .name = sb_product_name(id),
+    };
+    if ((res = sb_pipeline_create(b->vk, &pp, &pipeline)))
+        goto cleanup;
+    const struct sb_buffer *bindings[SB_BINDING_COUNT] = {
+        [SB_BINDING_ATMOSPHERE] = &b->params,
+        [SB_BINDING_TRANSMITTANCE] = &b->dummy,
+        [SB_BINDING_MULTISCATTERING] = &b->dummy,
+        [SB_BINDING_IRRADIANCE_GROUND] = &b->dummy,
+        [SB_BINDING_OUTPUT] = &b->outputs[id],
+    };
+    if (b->outputs[SB_PRODUCT_TRANSMITTANCE].buffer && id != SB_PRODUCT_TRANSMITTANCE)
+        bindings[SB_BINDING_TRANSMITTANCE] = &b->outputs[SB_PRODUCT_TRANSMITTANCE];
+    if (b->outputs[SB_PRODUCT_MULTISCATTERING].buffer && id != SB_PRODUCT_MULTISCATTERING)
+        bindings[SB_BINDING_MULTISCATTERING] = &b->outputs[SB_PRODUCT_MULTISCATTERING];
+    if (b->outputs[SB_PRODUCT_IRRADIANCE_GROUND].buffer && id != SB_PRODUCT_IRRADIANCE_GROUND)
+        bindings[SB_BINDING_IRRADIANCE_GROUND] = &b->outputs[SB_PRODUCT_IRRADIANCE_GROUND];
+    sb_pipeline_bind(b->vk, &pipeline, bindings);
+
+    struct sb_bake_push push = {
+        .width = prod->width,
+        .height = prod->height,
+        .directions_mu = s.directions_mu,
+        .directions_phi = s.directions_phi,
+    };
+    res = sb_dispatch(b->vk, &pipeline, &push, (prod->width + SB_WORKGROUP_X - 1) / SB_WORKGROUP_X,
+                      (prod->height + SB_WORKGROUP_Y - 1) / SB_WORKGROUP_Y, 1, gpu_ms);
+    if (res)
+        goto cleanup;
+    memcpy(image->data, b->outputs[id].mapped, bytes);
+
+cleanup:
+    sb_pipeline_destroy(b->vk, &pipeline);
+    if (res)
+        sb_image_finish(image);
+    return res;
+}
+
+void sb_atmosphere_settings_json(enum sb_product_id id, const struct sb_atmosphere_settings *s, char *out,
+                                 size_t size)
+{
+    if (id == SB_PRODUCT_TRANSMITTANCE) {
+        snprintf(out, size,
+                 "{\"quadrature\":\"gauss-legendre-8, pieces cut at the ozone corners and the tangent fold\","
+                 "\"max_samples\":40}");
+        return;
+    }
+    snprintf(out, size,
+             "{\"directions_mu\":%u,\"directions_phi\":%u,\"directions\":%u,"
+             "\"ray_segments\":\"altitude levels, geometric from half the smallest scale height\","
+             "\"segment_quadrature\":\"gauss-legendre-%d\"}",
+             s->directions_mu, s->directions_phi,
+             s->directions_mu * s->directions_phi * (id == SB_PRODUCT_IRRADIANCE_GROUND ? 1u : 2u),
+             SB_RAY_GL_ORDER);
+}

@@ -1,0 +1,64 @@
+/*
+ * The atmosphere LUT products (transmittance, multiscattering,
+ * irradiance_ground, irradiance_sky) baked with Vulkan compute. Each product
+ * is one compute dispatch over its texels; its inputs are the products it
+ * depends on, kept on the GPU between dispatches.
+ */
+#ifndef SB_BAKER_ATMOSPHERE_H
+#define SB_BAKER_ATMOSPHERE_H
+
+#include <stdint.h>
+
+#include "compute.h"
+#include "config.h"
+#include "image.h"
+#include "pack.h"
+#include "scene.h"
+
+/* Settings of one product's bake. Zero fields take the product's defaults. */
+struct sb_atmosphere_settings {
+    uint32_t directions_mu;  /* Gauss-Legendre nodes in cos(zenith) per interval */
+    uint32_t directions_phi; /* azimuth nodes over [0, pi] */
+};
+
+struct sb_atmosphere_product {
+    enum sb_product_id id;
+    uint32_t width, height, channel_count;
+    const char *channel_names;    /* comma-separated */
+    const char *parameterization; /* id recorded in the manifest */
+    uint32_t depends_on;          /* bit mask of sb_product_id */
+    struct sb_atmosphere_settings defaults;
+};
+
+/* The descriptor of a product. */
+const struct sb_atmosphere_product *sb_atmosphere_product(enum sb_product_id id);
+
+/* Pack parameters for the shaders (fp64 -> fp32, derived radii, levels). */
+void sb_atmosphere_gpu_pack(const struct sb_atmosphere_params *params, struct sb_atmosphere_gpu *gpu);
+
+/* Altitude levels that cut rays into segments: geometric from half the
+ * smallest scale height up to the top, at most SB_MAX_LEVELS. Returns the count. */
+int sb_atmosphere_levels(const struct sb_atmosphere_params *params, double levels[SB_MAX_LEVELS]);
+
+/* Baking state: the device, the parameters and every product baked so far. */
+struct sb_atmosphere_baker;
+
+enum sb_result sb_atmosphere_baker_create(struct sb_vk *vk, const struct sb_atmosphere_params *params,
+                                          struct sb_atmosphere_baker **baker);
+void sb_atmosphere_baker_destroy(struct sb_atmosphere_baker **baker);
+
+/*
+ * Bake one product into `image` (initialised here; the caller finishes it).
+ * Its dependencies must have been baked by this baker first. `settings` may
+ * be NULL for the defaults; the settings used are written to *used (may be
+ * NULL) and the GPU time to *gpu_ms.
+ */
+enum sb_result sb_atmosphere_bake(struct sb_atmosphere_baker *baker, enum sb_product_id id,
+                                  const struct sb_atmosphere_settings *settings, struct sb_image *image,
+                                  struct sb_atmosphere_settings *used, double *gpu_ms);
+
+/* The manifest's settings object for a product baked with `settings`. */
+void sb_atmosphere_settings_json(enum sb_product_id id, const struct sb_atmosphere_settings *settings, char *out,
+                                 size_t size);
+
+#endif

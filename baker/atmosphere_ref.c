@@ -1,0 +1,469 @@
+#include "atmosphere_ref.h"
+
+#include <math.h>
+#include <pthread.h>
+#include <stdbool.h>
+#include <string.h>
+
+#define REF_PI 3.14159265358979323846
+#define MAX_BREAKS 96
+
+/* ---- Gauss-Legendre tables, computed once in fp64 ------------------------------ */
+
+struct gl_rule {
+    int n;
+    double x[32], w[32]; /* on [-1, 1], ascending */
+    double s[32][32];    /* s[i][j] = integral from -1 to x_i of Lagrange basis j */
+};
+
+static struct gl_rule gl8, gl16;
+static pthread_once_t gl_once = PTHREAD_ONCE_INIT;
+
+static void gl_compute(struct gl_rule *g, int n)
+{
+    g->n = n;
+    for (int i = 0; i < n; i++) {
+        double z = cos(REF_PI * (i + 0.75) / (n + 0.5)), dp = 1;
+        for (int it = 0; it < 100; it++) {
+            double p0 = 1, p1 = 0;
+            for (int j = 1; j <= n; j++) {
+                double p2 = p1;
+                p1 = p0;
+                p0 = ((2.0 * j - 1) * z * p1 - (j - 1.0) * p2) / j;
+            }
+            dp = n * (z * p0 - p1) / (z * z - 1);
+            double dz = p0 / dp;
+            z -= dz;
+            if (fabs(dz) < 1e-16)
+                break;
+        }
+        g->x[n - 1 - i] = z;
+        g->w[n - 1 - i] = 2 / ((1 - z * z) * dp * dp);
+    }
+}
+
+static void gl_init(void)
+{
+    gl_compute(&gl8, 8);
+    gl_compute(&gl16, 16);
+    /* Collocation matrix of gl8 by exact 16-point integration of each
+     * degree-7 Lagrange polynomial over [-1, x_i]. */
+    for (int i = 0; i < 8; i++)
+        for (int j = 0; j < 8; j++) {
+            double a = -1, b = gl8.x[i], sum = 0;
+            for (int k = 0; k < 16; k++) {
+                double t = 0.5 * (a + b) + 0.5 * (b - a) * gl16.x[k], l = 1;
+                for (int m = 0; m < 8; m++)
+                    if (m != j)
+                        l *= (t - gl8.x[m]) / (gl8.x[j] - gl8.x[m]);
+                sum += gl16.w[k] * l * 0.5 * (b - a);
+            }
+            gl8.s[i][j] = sum;
+        }
+}
+
+/* ---- Medium ------------------------------------------------------------------ */
+
+struct medium {
+    double rayleigh[3], mie[3], extinction[3];
+};
+
+static void medium(const struct sb_atmosphere_params *p, double h, struct medium *m)
+{
+    double dr = exp(-h / p->rayleigh_scale_height_km);
+    double dm = exp(-h / p->mie_scale_height_km);
+    double dozone = 1.0 - fabs(h - p->ozone_center_km) / p->ozone_half_width_km;
+    if (dozone < 0)
+        dozone = 0;
+    for (int c = 0; c < 3; c++) {
+        m->rayleigh[c] = p->rayleigh_scattering_per_km[c] * dr;
+        m->mie[c] = p->mie_scattering_per_km[c] * dm;
+        m->extinction[c] = m->rayleigh[c] + (p->mie_scattering_per_km[c] + p->mie_absorption_per_km[c]) * dm +
+                           p->ozone_absorption_per_km[c] * dozone;
+    }
+}
+
+static double phase_rayleigh(double nu)
+{
+    return 3.0 / (16.0 * REF_PI) * (1.0 + nu * nu);
+}
+
+static double phase_mie(double g, double nu)
+{
+    double k = 3.0 / (8.0 * REF_PI) * (1.0 - g * g) / (2.0 + g * g);
+    return k * (1.0 + nu * nu) / pow(1.0 + g * g - 2.0 * g * nu, 1.5);
+}
+
+/* ---- Geometry (plain fp64) --------------------------------------------------- */
+
+static double radius_at(double r0, double mu, double t)
+{
+    return sqrt(fmax(r0 * r0 + t * t + 2.0 * r0 * mu * t, 0.0));
+}
+
+static double dist_top(const struct sb_atmosphere_params *p, double r, double mu)
+{
+    double top = p->top_radius_km;
+    double disc = r * r * (mu * mu - 1.0) + top * top;
+    return fmax(-r * mu + sqrt(fmax(disc, 0.0)), 0.0);
+}
+
+static bool hits_ground(const struct sb_atmosphere_params *p, double r, double mu)
+{
+    double R = p->ground_radius_km;
+    return mu < 0.0 && r * r * (mu * mu - 1.0) + R * R >= 0.0;
+}
+
+static double dist_ground(const struct sb_atmosphere_params *p, double r, double mu)
+{
+    double R = p->ground_radius_km;
+    double disc = r * r * (mu * mu - 1.0) + R * R;
+    return fmax(-r * mu - sqrt(fmax(disc, 0.0)), 0.0);
+}
+
+static void sort_doubles(double *v, int n)
+{
+    for (int i = 1; i < n; i++) {
+        double x = v[i];
+        int j = i - 1;
+        while (j >= 0 && v[j] > x) {
+            v[j + 1] = v[j];
+            j--;
+        }
+        v[j + 1] = x;
+    }
+}
+
+/* Distances in (0, t_end) where the ray's altitude equals `level`. */
+static int level_crossings(const struct sb_atmosphere_params *p, double r0, double mu, double t_end, double level,
+                           double *out)
+{
+    double rl = p->ground_radius_km + level;
+    double b = r0 * mu, c = r0 * r0 - rl * rl;
+    double disc = b * b - c;
+    int n = 0;
+    if (disc < 0)
+        return 0;
+    double s = sqrt(disc);
+    double roots[2] = {-b - s, -b + s};
+    for (int i = 0; i < 2; i++)
+        if (roots[i] > 0 && roots[i] < t_end)
+            out[n++] = roots[i];
+    return n;
+}
+
+/* ---- Transmittance ----------------------------------------------------------- */
+
+void sb_ref_transmittance(const struct sb_atmosphere_params *p, double r, double mu, int subdivisions, double out[3])
+{
+    pthread_once(&gl_once, gl_init);
+    double t_end = dist_top(p, r, mu);
+    double br[16];
+    int n = 0;
+    br[n++] = 0;
+    double corners[3] = {p->ozone_center_km - p->ozone_half_width_km, p->ozone_center_km,
+                         p->ozone_center_km + p->ozone_half_width_km};
+    for (int k = 0; k < 3; k++)
+        if (corners[k] > 0)
+            n += level_crossings(p, r, mu, t_end, corners[k], br + n);
+    if (-r * mu > 0 && -r * mu < t_end)
+        br[n++] = -r * mu;
+    br[n++] = t_end;
+    sort_doubles(br, n);
+    double tau[3] = {0, 0, 0};
+    for (int i = 0; i + 1 < n; i++) {
+        double step = (br[i + 1] - br[i]) / subdivisions;
+        for (int s = 0; s < subdivisions; s++) {
+            double a = br[i] + s * step, half = 0.5 * step;
+            for (int k = 0; k < 16; k++) {
+                double t = a + half * (1.0 + gl16.x[k]);
+                struct medium m;
+                medium(p, radius_at(r, mu, t) - p->ground_radius_km, &m);
+                for (int c = 0; c < 3; c++)
+                    tau[c] += half * gl16.w[k] * m.extinction[c];
+            }
+        }
+    }
+    for (int c = 0; c < 3; c++)
+        out[c] = exp(-tau[c]);
+}
+
+void sb_ref_transmittance_texel_geometry(const struct sb_atmosphere_params *p, uint32_t x, uint32_t y,
+                                         uint32_t width, uint32_t height, double *r_out, double *mu_out)
+{
+    double R = p->ground_radius_km, top = p->top_radius_km;
+    double H = sqrt(top * top - R * R);
+    double x_mu = (x + 0.5) / width, x_r = (y + 0.5) / height;
+    double rho = H * x_r;
+    double r = sqrt(rho * rho + R * R);
+    double d_min = top - r, d_max = rho + H;
+    double d = d_min + x_mu * (d_max - d_min);
+    double mu = d == 0.0 ? 1.0 : (H * H - rho * rho - d * d) / (2.0 * r * d);
+    *r_out = r;
+    *mu_out = fmax(-1.0, fmin(1.0, mu));
+}
+
+/* ---- LUT lookups ------------------------------------------------------------- */
+
+void sb_ref_lut_subtexel(const struct sb_image *lut, double x_u, double x_v, double *out)
+{
+    double fx = fmin(fmax(x_u, 0.0), 1.0) * (lut->width - 1);
+    double fy = fmin(fmax(x_v, 0.0), 1.0) * (lut->height - 1);
+    uint32_t x0 = (uint32_t)fx, y0 = (uint32_t)fy;
+    if (x0 > lut->width - 2)
+        x0 = lut->width - 2;
+    if (lut->height < 2)
+        y0 = 0;
+    else if (y0 > lut->height - 2)
+        y0 = lut->height - 2;
+    double ax = fx - x0, ay = lut->height < 2 ? 0 : fy - y0;
+    uint32_t y1 = lut->height < 2 ? y0 : y0 + 1;
+    uint32_t n = lut->channel_count;
+    for (uint32_t c = 0; c < n; c++) {
+        double v00 = lut->data[(y0 * lut->width + x0) * n + c];
+        double v10 = lut->data[(y0 * lut->width + x0 + 1) * n + c];
+        double v01 = lut->data[(y1 * lut->width + x0) * n + c];
+        double v11 = lut->data[(y1 * lut->width + x0 + 1) * n + c];
+        out[c] = (v00 * (1 - ax) + v10 * ax) * (1 - ay) + (v01 * (1 - ax) + v11 * ax) * ay;
+    }
+}
+
+/* ---- Scattering along a ray ------------------------------------------------- */
+
+struct ray_sums {
+    double sun_rayleigh[3], sun_mie[3], ms_rayleigh[3], ms_mie[3], scattering[3], transmittance[3];
+    double t_end;
+};
+
+static void integrate_ray(const struct sb_atmosphere_params *p, double r0, double mu, double mu_s, double nu,
+                          bool toward_ground, const struct sb_image *ms_lut, const struct sb_ref_quality *q,
+                          struct ray_sums *o)
+{
+    memset(o, 0, sizeof(*o));
+    double R = p->ground_radius_km, thickness = p->top_radius_km - R;
+    double t_end = toward_ground ? dist_ground(p, r0, mu) : dist_top(p, r0, mu);
+    o->t_end = t_end;
+    double br[MAX_BREAKS];
+    int n = 0;
+    br[n++] = 0;
+    double level = 0.25 * fmin(p->rayleigh_scale_height_km, p->mie_scale_height_km);
+    double factor = pow(2.0, 1.0 / q->level_steps);
+    while (level < thickness && n < MAX_BREAKS - 8) {
+        n += level_crossings(p, r0, mu, t_end, level, br + n);
+        level *= factor;
+    }
+    if (-r0 * mu > 0 && -r0 * mu < t_end)
+        br[n++] = -r0 * mu;
+    /* Where the planet starts or stops hiding the sun along the ray. */
+    double a = r0 * mu_s, b = nu;
+    double qa = 1 - b * b, qb = 2 * r0 * mu - 2 * a * b, qc = r0 * r0 - a * a - R * R;
+    double roots[2];
+    int nroots = 0;
+    if (fabs(qa) > 1e-12) {
+        double disc = qb * qb - 4 * qa * qc;
+        if (disc >= 0) {
+            roots[nroots++] = (-qb - sqrt(disc)) / (2 * qa);
+            roots[nroots++] = (-qb + sqrt(disc)) / (2 * qa);
+        }
+    } else if (fabs(qb) > 1e-12) {
+        roots[nroots++] = -qc / qb;
+    }
+    for (int i = 0; i < nroots; i++)
+        if (roots[i] > 0 && roots[i] < t_end && a + b * roots[i] < 0)
+            br[n++] = roots[i];
+    br[n++] = t_end;
+    sort_doubles(br, n);
+
+    double tau[3] = {0, 0, 0};
+    for (int s = 0; s + 1 < n; s++) {
+        double half = 0.5 * (br[s + 1] - br[s]);
+        if (half <= 0)
+            continue;
+        struct medium m[8];
+        double sun[8][3], psi[8][3];
+        for (int j = 0; j < 8; j++) {
+            double t = br[s] + half * (1 + gl8.x[j]);
+            double rt = radius_at(r0, mu, t);
+            double h = fmax(rt - R, 0.0);
+            double mus = fmax(-1.0, fmin(1.0, (r0 * mu_s + t * nu) / rt));
+            medium(p, h, &m[j]);
+            if (hits_ground(p, rt, mus)) {
+                sun[j][0] = sun[j][1] = sun[j][2] = 0;
+            } else {
+                sb_ref_transmittance(p, fmax(rt, R), mus, q->transmittance_subdivisions, sun[j]);
+            }
+            if (ms_lut)
+                sb_ref_lut_subtexel(ms_lut, mus * 0.5 + 0.5, h / thickness, psi[j]);
+        }
+        for (int i = 0; i < 8; i++)
+            for (int c = 0; c < 3; c++) {
+                double depth = tau[c];
+                for (int j = 0; j < 8; j++)
+                    depth += half * gl8.s[i][j] * m[j].extinction[c];
+                double tw = exp(-depth) * half * gl8.w[i];
+                o->sun_rayleigh[c] += tw * m[i].rayleigh[c] * sun[i][c];
+                o->sun_mie[c] += tw * m[i].mie[c] * sun[i][c];
+                o->scattering[c] += tw * (m[i].rayleigh[c] + m[i].mie[c]);
+                if (ms_lut) {
+                    o->ms_rayleigh[c] += tw * m[i].rayleigh[c] * psi[i][c];
+                    o->ms_mie[c] += tw * m[i].mie[c] * psi[i][c];
+                }
+            }
+        for (int j = 0; j < 8; j++)
+            for (int c = 0; c < 3; c++)
+                tau[c] += half * gl8.w[j] * m[j].extinction[c];
+    }
+    for (int c = 0; c < 3; c++)
+        o->transmittance[c] = exp(-tau[c]);
+}
+
+static struct sb_ref_quality resolve(const struct sb_ref_quality *q)
+{
+    struct sb_ref_quality r = q ? *q : (struct sb_ref_quality){0};
+    if (!r.directions_mu)
+        r.directions_mu = 24;
+    if (!r.directions_phi)
+        r.directions_phi = 24;
+    if (!r.level_steps)
+        r.level_steps = 2;
+    if (!r.transmittance_subdivisions)
+        r.transmittance_subdivisions = 2;
+    return r;
+}
+
+/* Gauss-Legendre node k of n on [a, b], fp64, for any n (<= 256). */
+static void gl_node(int k, int n, double a, double b, double *x, double *w)
+{
+    double z = cos(REF_PI * (k + 0.75) / (n + 0.5)), dp = 1;
+    for (int it = 0; it < 100; it++) {
+        double p0 = 1, p1 = 0;
+        for (int j = 1; j <= n; j++) {
+            double p2 = p1;
+            p1 = p0;
+            p0 = ((2.0 * j - 1) * z * p1 - (j - 1.0) * p2) / j;
+        }
+        dp = n * (z * p0 - p1) / (z * z - 1);
+        double dz = p0 / dp;
+        z -= dz;
+        if (fabs(dz) < 1e-16)
+            break;
+    }
+    *x = 0.5 * (a + b) - 0.5 * (b - a) * z;
+    *w = (b - a) / ((1 - z * z) * dp * dp);
+}
+
+void sb_ref_multiscattering(const struct sb_atmosphere_params *p, double h, double mu_s,
+                            const struct sb_ref_quality *quality, double out[3])
+{
+    pthread_once(&gl_once, gl_init);
+    struct sb_ref_quality q = resolve(quality);
+    double R = p->ground_radius_km, r = R + h;
+    double mu_h = -sqrt(fmax(1.0 - (R / r) * (R / r), 0.0));
+    double sin_s = sqrt(fmax(1 - mu_s * mu_s, 0.0));
+    double l2[3] = {0, 0, 0}, f[3] = {0, 0, 0};
+    for (int part = 0; part < 2; part++) {
+        bool ground = part == 1;
+        double a = ground ? -1.0 : mu_h, b = ground ? mu_h : 1.0;
+        for (int k = 0; k < q.directions_mu; k++) {
+            double mu, w_mu;
+            gl_node(k, q.directions_mu, a, b, &mu, &w_mu);
+            double sin_v = sqrt(fmax(1 - mu * mu, 0.0));
+            for (int ip = 0; ip < q.directions_phi; ip++) {
+                double phi = (ip + 0.5) * REF_PI / q.directions_phi;
+                double w = w_mu * 2 * REF_PI / q.directions_phi;
+                double nu = fmax(-1.0, fmin(1.0, sin_v * sin_s * cos(phi) + mu * mu_s));
+                struct ray_sums rs;
+                integrate_ray(p, r, mu, mu_s, nu, ground, NULL, &q, &rs);
+                double ground_term[3] = {0, 0, 0};
+                if (ground) {
+                    double mu_sp = fmax(-1.0, fmin(1.0, (r * mu_s + rs.t_end * nu) / R));
+                    if (mu_sp > 0) {
+                        double ts[3];
+                        sb_ref_transmittance(p, R, mu_sp, q.transmittance_subdivisions, ts);
+                        for (int c = 0; c < 3; c++)
+                            ground_term[c] = rs.transmittance[c] * p->ground_albedo[c] / REF_PI * mu_sp * ts[c];
+                    }
+                }
+                for (int c = 0; c < 3; c++) {
+                    l2[c] += w * ((rs.sun_rayleigh[c] + rs.sun_mie[c]) / (4 * REF_PI) + ground_term[c]);
+                    f[c] += w * rs.scattering[c];
+                }
+            }
+        }
+    }
+    for (int c = 0; c < 3; c++) {
+        double L2 = l2[c] / (4 * REF_PI), fms = f[c] / (4 * REF_PI);
+        out[c] = p->solar_irradiance[c] * L2 / (1 - fms);
+    }
+}
+
+void sb_ref_irradiance_ground(const struct sb_atmosphere_params *p, double h, double mu_s,
+                              const struct sb_image *ms_lut, const struct sb_ref_quality *quality, double direct[3],
+                              double sky[3])
+{
+    pthread_once(&gl_once, gl_init);
+    struct sb_ref_quality q = resolve(quality);
+    double r = p->ground_radius_km + h;
+    double t[3] = {0, 0, 0};
+    if (mu_s > 0)
+        sb_ref_transmittance(p, r, mu_s, 8, t);
+    for (int c = 0; c < 3; c++) {
+        direct[c] = mu_s > 0 ? p->solar_irradiance[c] * t[c] * mu_s : 0.0;
+        sky[c] = 0;
+    }
+    double sin_s = sqrt(fmax(1 - mu_s * mu_s, 0.0));
+    for (int k = 0; k < q.directions_mu; k++) {
+        double mu, w_mu;
+        gl_node(k, q.directions_mu, 0.0, 1.0, &mu, &w_mu);
+        double sin_v = sqrt(fmax(1 - mu * mu, 0.0));
+        for (int ip = 0; ip < q.directions_phi; ip++) {
+            double phi = (ip + 0.5) * REF_PI / q.directions_phi;
+            double nu = fmax(-1.0, fmin(1.0, sin_v * sin_s * cos(phi) + mu * mu_s));
+            struct ray_sums rs;
+            integrate_ray(p, r, mu, mu_s, nu, false, ms_lut, &q, &rs);
+            double w = w_mu * 2 * REF_PI / q.directions_phi * mu;
+            for (int c = 0; c < 3; c++)
+                sky[c] += w * (p->solar_irradiance[c] * (rs.sun_rayleigh[c] * phase_rayleigh(nu) +
+                                                         rs.sun_mie[c] * phase_mie(p->mie_g, nu)) +
+                               rs.ms_rayleigh[c] + rs.ms_mie[c]);
+        }
+    }
+}
+
+void sb_ref_irradiance_sky(const struct sb_atmosphere_params *p, double h, double mu_s, const struct sb_image *ms_lut,
+                           const struct sb_image *ig_lut, const struct sb_ref_quality *quality, double out[9])
+{
+    pthread_once(&gl_once, gl_init);
+    struct sb_ref_quality q = resolve(quality);
+    double R = p->ground_radius_km, r = R + h;
+    double mu_h = -sqrt(fmax(1.0 - (R / r) * (R / r), 0.0));
+    double sin_s = sqrt(fmax(1 - mu_s * mu_s, 0.0));
+    memset(out, 0, 9 * sizeof(double));
+    for (int part = 0; part < 2; part++) {
+        bool ground = part == 1;
+        double a = ground ? -1.0 : mu_h, b = ground ? mu_h : 1.0;
+        for (int k = 0; k < q.directions_mu; k++) {
+            double mu, w_mu;
+            gl_node(k, q.directions_mu, a, b, &mu, &w_mu);
+            double sin_v = sqrt(fmax(1 - mu * mu, 0.0));
+            for (int ip = 0; ip < q.directions_phi; ip++) {
+                double phi = (ip + 0.5) * REF_PI / q.directions_phi;
+                double w = w_mu * 2 * REF_PI / q.directions_phi / (4 * REF_PI);
+                double nu = fmax(-1.0, fmin(1.0, sin_v * sin_s * cos(phi) + mu * mu_s));
+                struct ray_sums rs;
+                integrate_ray(p, r, mu, mu_s, nu, ground, ms_lut, &q, &rs);
+                double eg[6] = {0};
+                if (ground) {
+                    double mu_sp = fmax(-1.0, fmin(1.0, (r * mu_s + rs.t_end * nu) / R));
+                    sb_ref_lut_subtexel(ig_lut, mu_sp * 0.5 + 0.5, 0.0, eg);
+                }
+                for (int c = 0; c < 3; c++) {
+                    out[c] += w * (p->solar_irradiance[c] * rs.sun_rayleigh[c] * phase_rayleigh(nu) + rs.ms_rayleigh[c]);
+                    out[3 + c] += w * (p->solar_irradiance[c] * rs.sun_mie[c] * phase_mie(p->mie_g, nu) + rs.ms_mie[c]);
+                    if (ground)
+                        out[6 + c] += w * rs.transmittance[c] * p->ground_albedo[c] / REF_PI * (eg[c] + eg[3 + c]);
+                }
+            }
+        }
+    }
+}

@@ -1,0 +1,53 @@
+/*
+ * fp64 CPU reference of the atmosphere products, written independently of
+ * the shaders: geometry in plain double precision, transmittance by composite
+ * 16-point Gauss-Legendre, scattering along rays with segments cut at
+ * denser altitude levels, at the tangent point and where the planet's shadow
+ * begins, and with exact (not tabulated) transmittance toward the sun.
+ * Where a product's definition reads another product (the multiple-
+ * scattering LUT for irradiance), the reference reads the same baked LUT with
+ * its own bilinear interpolation in fp64. All functions are thread safe.
+ */
+#ifndef SB_BAKER_ATMOSPHERE_REF_H
+#define SB_BAKER_ATMOSPHERE_REF_H
+
+#include <stdint.h>
+
+#include "image.h"
+#include "scene.h"
+
+struct sb_ref_quality {
+    int directions_mu;  /* Gauss-Legendre nodes in cos(zenith) per interval; 0: 24 */
+    int directions_phi; /* midpoint nodes in azimuth over [0, pi]; 0: 24 */
+    int level_steps;    /* altitude levels per factor 2 of altitude; 0: 2 */
+    int transmittance_subdivisions; /* GL-16 sub-pieces per piece of a sun ray; 0: 2 */
+};
+
+/* Transmittance from radius r (km) with cosine mu to the top; the ray must not
+ * hit the ground. subdivisions: GL-16 sub-pieces per piece (8 is converged to
+ * fp64 rounding). */
+void sb_ref_transmittance(const struct sb_atmosphere_params *p, double r, double mu, int subdivisions, double out[3]);
+
+/* (r, mu) of transmittance texel (x, y) of a width x height LUT (Hillaire 2020). */
+void sb_ref_transmittance_texel_geometry(const struct sb_atmosphere_params *p, uint32_t x, uint32_t y,
+                                         uint32_t width, uint32_t height, double *r, double *mu);
+
+/* Hillaire's psi_ms at altitude h (km) with sun cosine mu_s (see multiscattering.comp). */
+void sb_ref_multiscattering(const struct sb_atmosphere_params *p, double h, double mu_s,
+                            const struct sb_ref_quality *q, double out[3]);
+
+/* Ground irradiance (see irradiance_ground.comp); `multiscattering` is the
+ * baked LUT the product reads. */
+void sb_ref_irradiance_ground(const struct sb_atmosphere_params *p, double h, double mu_s,
+                              const struct sb_image *multiscattering, const struct sb_ref_quality *q, double direct[3],
+                              double sky[3]);
+
+/* Sky irradiance split rayleigh.rgb, mie.rgb, ground.rgb (see irradiance_sky.comp). */
+void sb_ref_irradiance_sky(const struct sb_atmosphere_params *p, double h, double mu_s,
+                           const struct sb_image *multiscattering, const struct sb_image *irradiance_ground,
+                           const struct sb_ref_quality *q, double out[9]);
+
+/* Bilinear lookup of a LUT whose texel i of n sits at x = i / (n - 1). */
+void sb_ref_lut_subtexel(const struct sb_image *lut, double x_u, double x_v, double *out);
+
+#endif

@@ -1,0 +1,163 @@
+/*
+ * skybake: bake the lighting data a scene needs into a versioned pack.
+ *
+ * Exit codes: 0 success; 1 the bake or the pack failed; 2 bad command line or
+ * bad scene; 3 no Vulkan device; 4 validation layers reported messages.
+ */
+#include <cJSON.h>
+#include <stdbool.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "bake.h"
+#include "context.h"
+#include "log.h"
+#include "scene.h"
+#include "skybake_version.h"
+
+enum {
+    EXIT_BAKE_FAILED = 1,
+    EXIT_USAGE = 2,
+    EXIT_NO_DEVICE = 3,
+    EXIT_VALIDATION = 4,
+};
+
+static void usage(FILE *f)
+{
+    fprintf(f,
+            "usage: skybake bake SCENE -o OUT_DIR [options]\n"
+            "       skybake --version | --help\n"
+            "\n"
+            "Bakes what SCENE (JSON, see docs/scene.md) needs into the pack OUT_DIR:\n"
+            "manifest.json plus one EXR per product. The pack is replaced atomically;\n"
+            "a failed bake leaves the previous pack as it was.\n"
+            "\n"
+            "options:\n"
+            "  -o, --output DIR    the pack to write (required)\n"
+            "  --device NAME|INDEX Vulkan device by index or name substring\n"
+            "                      (default: first discrete GPU, else the first device)\n"
+            "  --validate          enable Vulkan validation; any message fails the bake\n"
+            "                      (also SKYBAKE_VALIDATE=1)\n"
+            "  --json              print a machine-readable summary on stdout\n"
+            "  -q, --quiet         no per-product lines on stderr\n"
+            "  -v, --verbose       debug messages\n"
+            "\n"
+            "exit codes: 0 ok, 1 bake failed, 2 usage or scene error, 3 no Vulkan device,\n"
+            "            4 validation messages\n");
+}
+
+static void print_json(const char *out_dir, const struct sb_vk *vk, const struct sb_bake_report *report)
+{
+    cJSON *root = cJSON_CreateObject();
+    cJSON_AddStringToObject(root, "pack", out_dir);
+    cJSON_AddStringToObject(root, "device", vk->properties.deviceName);
+    cJSON *arr = cJSON_AddArrayToObject(root, "artifacts");
+    for (int i = 0; i < report->artifact_count; i++) {
+        const struct sb_artifact *a = &report->artifacts[i];
+        cJSON *o = cJSON_CreateObject();
+        cJSON_AddStringToObject(o, "name", sb_product_name(a->product));
+        cJSON_AddStringToObject(o, "file", a->file);
+        cJSON_AddNumberToObject(o, "width", report->shapes[i][0]);
+        cJSON_AddNumberToObject(o, "height", report->shapes[i][1]);
+        cJSON_AddNumberToObject(o, "channels", report->shapes[i][2]);
+        cJSON_AddNumberToObject(o, "gpu_ms", a->gpu_ms);
+        cJSON_AddNumberToObject(o, "bake_ms", a->bake_ms);
+        cJSON_AddStringToObject(o, "content_hash", a->content_hash);
+        cJSON_AddItemToArray(arr, o);
+    }
+    char *text = cJSON_Print(root);
+    if (text)
+        printf("%s\n", text);
+    free(text);
+    cJSON_Delete(root);
+}
+
+static int cmd_bake(int argc, char **argv)
+{
+    const char *scene_path = NULL, *out_dir = NULL, *device = NULL;
+    bool validate = false, json = false;
+    const char *env = getenv("SKYBAKE_VALIDATE");
+    if (env && *env && strcmp(env, "0") != 0)
+        validate = true;
+    for (int i = 0; i < argc; i++) {
+        const char *a = argv[i];
+        if ((!strcmp(a, "-o") || !strcmp(a, "--output")) && i + 1 < argc)
+            out_dir = argv[++i];
+        else if (!strcmp(a, "--device") && i + 1 < argc)
+            device = argv[++i];
+        else if (!strcmp(a, "--validate"))
+            validate = true;
+        else if (!strcmp(a, "--json"))
+            json = true;
+        else if (!strcmp(a, "-q") || !strcmp(a, "--quiet"))
+            sb_log_set_level(SB_LOG_WARN);
+        else if (!strcmp(a, "-v") || !strcmp(a, "--verbose"))
+            sb_log_set_level(SB_LOG_DEBUG);
+        else if (a[0] == '-' && a[1]) {
+            fprintf(stderr, "skybake: unknown or incomplete option '%s'\n", a);
+            usage(stderr);
+            return EXIT_USAGE;
+        } else if (!scene_path)
+            scene_path = a;
+        else {
+            fprintf(stderr, "skybake: unexpected argument '%s'\n", a);
+            return EXIT_USAGE;
+        }
+    }
+    if (!scene_path || !out_dir) {
+        fprintf(stderr, "skybake: bake needs a SCENE and -o OUT_DIR\n");
+        usage(stderr);
+        return EXIT_USAGE;
+    }
+
+    struct sb_scene scene;
+    if (sb_scene_load(scene_path, &scene))
+        return EXIT_USAGE;
+
+    struct sb_vk *vk = NULL;
+    struct sb_vk_params params = {.device = device, .validate = validate};
+    enum sb_result res = sb_vk_create(&params, &vk);
+    if (res)
+        return res == SB_ERR_NO_DEVICE ? EXIT_NO_DEVICE : EXIT_BAKE_FAILED;
+    sb_info("skybake %s: baking %s on %s (%s)", SKYBAKE_VERSION, scene_path, vk->properties.deviceName,
+            vk->driver_name);
+
+    struct sb_bake_report report;
+    res = sb_bake_scene(vk, &scene, out_dir, &report);
+    unsigned messages = sb_vk_validation_messages(vk);
+    if (!res && json)
+        print_json(out_dir, vk, &report);
+    sb_vk_destroy(&vk);
+    if (res) {
+        sb_error("bake failed (%s); %s was left as it was", sb_result_name(res), out_dir);
+        return EXIT_BAKE_FAILED;
+    }
+    if (messages) {
+        sb_error("%u validation message(s) during the bake", messages);
+        return EXIT_VALIDATION;
+    }
+    sb_info("wrote %s (%d artifacts)", out_dir, report.artifact_count);
+    return 0;
+}
+
+int main(int argc, char **argv)
+{
+    if (argc < 2) {
+        usage(stderr);
+        return EXIT_USAGE;
+    }
+    if (!strcmp(argv[1], "--help") || !strcmp(argv[1], "-h") || !strcmp(argv[1], "help")) {
+        usage(stdout);
+        return 0;
+    }
+    if (!strcmp(argv[1], "--version")) {
+        printf("skybake %s (pack format %d)\n", SKYBAKE_VERSION, SB_PACK_FORMAT_VERSION);
+        return 0;
+    }
+    if (!strcmp(argv[1], "bake"))
+        return cmd_bake(argc - 2, argv + 2);
+    fprintf(stderr, "skybake: unknown command '%s'\n", argv[1]);
+    usage(stderr);
+    return EXIT_USAGE;
+}

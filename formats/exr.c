@@ -1,0 +1,264 @@
+#include "exr.h"
+
+#include <openexr.h>
+#include <stdbool.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "log.h"
+
+#define EXR_DEFAULT_MAX_PIXELS (64ull << 20)
+
+static void silent_errors(exr_const_context_t ctxt, exr_result_t code, const char *msg)
+{
+    (void)ctxt;
+    sb_debug("openexr: %s (%d)", msg, (int)code);
+}
+
+static enum sb_result exr_fail(const char *path, const char *what, exr_result_t rv)
+{
+    sb_error("%s: %s: %s", path, what, exr_get_default_error_message(rv));
+    return rv == EXR_ERR_FILE_ACCESS ? SB_ERR_IO : SB_ERR_EXR;
+}
+
+enum sb_result sb_exr_write(const char *path, const struct sb_image *image, const struct sb_exr_attribute *attributes,
+                            int attribute_count)
+{
+    exr_context_initializer_t init = EXR_DEFAULT_CONTEXT_INITIALIZER;
+    init.error_handler_fn = silent_errors;
+    exr_context_t ctxt = NULL;
+    exr_encode_pipeline_t encoder;
+    bool encoder_live = false;
+    enum sb_result res = SB_OK;
+    exr_result_t rv;
+    int part = 0;
+
+    rv = exr_start_write(&ctxt, path, EXR_WRITE_FILE_DIRECTLY, &init);
+    if (rv != EXR_ERR_SUCCESS) {
+        sb_error("%s: cannot create EXR file: %s", path, exr_get_default_error_message(rv));
+        return SB_ERR_IO;
+    }
+#define EXR_TRY(call, what)                                                                                            \
+    do {                                                                                                               \
+        rv = (call);                                                                                                   \
+        if (rv != EXR_ERR_SUCCESS) {                                                                                   \
+            res = exr_fail(path, what, rv);                                                                            \
+            goto cleanup;                                                                                              \
+        }                                                                                                              \
+    } while (0)
+
+    EXR_TRY(exr_add_part(ctxt, "main", EXR_STORAGE_SCANLINE, &part), "adding the part");
+    EXR_TRY(exr_initialize_required_attr_simple(ctxt, part, (int32_t)image->width, (int32_t)image->height,
+                                                EXR_COMPRESSION_ZIP),
+            "setting the header");
+    for (uint32_t c = 0; c < image->channel_count; c++)
+        EXR_TRY(exr_add_channel(ctxt, part, image->channel_names[c], EXR_PIXEL_FLOAT, EXR_PERCEPTUALLY_LINEAR, 1, 1),
+                "adding a channel");
+    for (int a = 0; a < attribute_count; a++)
+        EXR_TRY(exr_attr_set_string(ctxt, part, attributes[a].name, attributes[a].value), "setting an attribute");
+    EXR_TRY(exr_write_header(ctxt), "writing the header");
+
+    int32_t lines_per_chunk = 1, chunks = 0;
+    EXR_TRY(exr_get_scanlines_per_chunk(ctxt, part, &lines_per_chunk), "querying chunks");
+    EXR_TRY(exr_get_chunk_count(ctxt, part, &chunks), "querying chunks");
+    size_t pixel_stride = (size_t)image->channel_count * sizeof(float);
+    for (int32_t chunk = 0; chunk < chunks; chunk++) {
+        int32_t y = chunk * lines_per_chunk;
+        exr_chunk_info_t cinfo;
+        EXR_TRY(exr_write_scanline_chunk_info(ctxt, part, y, &cinfo), "preparing a chunk");
+        if (!encoder_live) {
+            EXR_TRY(exr_encoding_initialize(ctxt, part, &cinfo, &encoder), "starting the encoder");
+            encoder_live = true;
+        } else {
+            EXR_TRY(exr_encoding_update(ctxt, part, &cinfo, &encoder), "updating the encoder");
+        }
+        for (int16_t ch = 0; ch < encoder.channel_count; ch++) {
+            exr_coding_channel_info_t *info = &encoder.channels[ch];
+            uint32_t src = 0;
+            while (src < image->channel_count && strcmp(image->channel_names[src], info->channel_name) != 0)
+                src++;
+            if (src == image->channel_count) {
+                sb_error("%s: channel %s vanished while writing", path, info->channel_name);
+                res = SB_ERR_EXR;
+                goto cleanup;
+            }
+            info->encode_from_ptr = (const uint8_t *)(image->data + ((size_t)y * image->width) * image->channel_count + src);
+            info->user_pixel_stride = (int32_t)pixel_stride;
+            info->user_line_stride = (int32_t)(pixel_stride * image->width);
+            info->user_bytes_per_element = 4;
+            info->user_data_type = EXR_PIXEL_FLOAT;
+        }
+        if (chunk == 0)
+            EXR_TRY(exr_encoding_choose_default_routines(ctxt, part, &encoder), "choosing the encoder");
+        EXR_TRY(exr_encoding_run(ctxt, part, &encoder), "encoding");
+    }
+
+cleanup:
+    if (encoder_live)
+        exr_encoding_destroy(ctxt, &encoder);
+    rv = exr_finish(&ctxt);
+    if (rv != EXR_ERR_SUCCESS && res == SB_OK) {
+        sb_error("%s: finishing the EXR file: %s", path, exr_get_default_error_message(rv));
+        res = SB_ERR_IO;
+    }
+    return res;
+}
+
+enum sb_result sb_exr_read(const char *path, const char *channel_order, uint64_t max_pixels, struct sb_image *image,
+                           struct sb_exr_attribute *attributes, int *attribute_count)
+{
+    exr_context_initializer_t init = EXR_DEFAULT_CONTEXT_INITIALIZER;
+    init.error_handler_fn = silent_errors;
+    exr_context_t ctxt = NULL;
+    exr_decode_pipeline_t decoder;
+    bool decoder_live = false;
+    enum sb_result res = SB_OK;
+    exr_result_t rv;
+    int map[SB_IMAGE_MAX_CHANNELS]; /* file channel -> image channel */
+
+    memset(image, 0, sizeof(*image));
+    if (attribute_count)
+        *attribute_count = 0;
+    if (!max_pixels)
+        max_pixels = EXR_DEFAULT_MAX_PIXELS;
+
+    rv = exr_start_read(&ctxt, path, &init);
+    if (rv != EXR_ERR_SUCCESS) {
+        sb_error("%s: not a readable EXR file: %s", path, exr_get_default_error_message(rv));
+        return rv == EXR_ERR_FILE_ACCESS ? SB_ERR_IO : SB_ERR_EXR;
+    }
+    int parts = 0;
+    EXR_TRY(exr_get_count(ctxt, &parts), "counting parts");
+    exr_storage_t storage;
+    EXR_TRY(exr_get_storage(ctxt, 0, &storage), "reading the storage type");
+    if (parts != 1 || storage != EXR_STORAGE_SCANLINE) {
+        sb_error("%s: expected one scanline part, found %d part(s)", path, parts);
+        res = SB_ERR_BAD_IMAGE;
+        goto cleanup;
+    }
+    exr_attr_box2i_t window;
+    EXR_TRY(exr_get_data_window(ctxt, 0, &window), "reading the data window");
+    int64_t width = (int64_t)window.max.x - window.min.x + 1, height = (int64_t)window.max.y - window.min.y + 1;
+    if (width <= 0 || height <= 0 || (uint64_t)(width * height) > max_pixels) {
+        sb_error("%s: data window %lldx%lld is empty or larger than %llu pixels", path, (long long)width,
+                 (long long)height, (unsigned long long)max_pixels);
+        res = SB_ERR_BAD_IMAGE;
+        goto cleanup;
+    }
+    const exr_attr_chlist_t *chlist = NULL;
+    EXR_TRY(exr_get_channels(ctxt, 0, &chlist), "reading the channel list");
+    int file_channels = chlist->num_channels;
+    if (file_channels <= 0 || file_channels > SB_IMAGE_MAX_CHANNELS) {
+        sb_error("%s: %d channels; skybake images have 1 to %d", path, file_channels, SB_IMAGE_MAX_CHANNELS);
+        res = SB_ERR_BAD_IMAGE;
+        goto cleanup;
+    }
+    for (int c = 0; c < file_channels; c++) {
+        const exr_attr_chlist_entry_t *e = &chlist->entries[c];
+        if (e->x_sampling != 1 || e->y_sampling != 1 || e->pixel_type == EXR_PIXEL_UINT) {
+            sb_error("%s: channel %s is subsampled or not a float channel", path, e->name.str);
+            res = SB_ERR_BAD_IMAGE;
+            goto cleanup;
+        }
+    }
+
+    /* Decide the image's channel order. */
+    struct sb_image tmp = {0};
+    uint32_t count = (uint32_t)file_channels;
+    if (channel_order) {
+        sb_image_set_channel_names(&tmp, channel_order);
+        count = 0;
+        while (count < SB_IMAGE_MAX_CHANNELS && tmp.channel_names[count][0])
+            count++;
+        if (count != (uint32_t)file_channels) {
+            sb_error("%s: %d channels, expected %u (%s)", path, file_channels, count, channel_order);
+            res = SB_ERR_BAD_IMAGE;
+            goto cleanup;
+        }
+    }
+    for (int c = 0; c < file_channels; c++) {
+        const char *name = chlist->entries[c].name.str;
+        map[c] = c;
+        if (channel_order) {
+            map[c] = -1;
+            for (uint32_t k = 0; k < count; k++)
+                if (strcmp(tmp.channel_names[k], name) == 0)
+                    map[c] = (int)k;
+            if (map[c] < 0) {
+                sb_error("%s: unexpected channel %s (expected %s)", path, name, channel_order);
+                res = SB_ERR_BAD_IMAGE;
+                goto cleanup;
+            }
+        }
+    }
+    res = sb_image_init(image, (uint32_t)width, (uint32_t)height, count);
+    if (res)
+        goto cleanup;
+    for (int c = 0; c < file_channels; c++)
+        snprintf(image->channel_names[map[c]], SB_CHANNEL_NAME_MAX, "%s", chlist->entries[c].name.str);
+
+    int32_t lines_per_chunk = 1, chunks = 0;
+    EXR_TRY(exr_get_scanlines_per_chunk(ctxt, 0, &lines_per_chunk), "querying chunks");
+    EXR_TRY(exr_get_chunk_count(ctxt, 0, &chunks), "querying chunks");
+    size_t pixel_stride = (size_t)count * sizeof(float);
+    for (int32_t chunk = 0; chunk < chunks; chunk++) {
+        int32_t y = window.min.y + chunk * lines_per_chunk;
+        exr_chunk_info_t cinfo;
+        EXR_TRY(exr_read_scanline_chunk_info(ctxt, 0, y, &cinfo), "reading a chunk");
+        if (!decoder_live) {
+            EXR_TRY(exr_decoding_initialize(ctxt, 0, &cinfo, &decoder), "starting the decoder");
+            decoder_live = true;
+        } else {
+            EXR_TRY(exr_decoding_update(ctxt, 0, &cinfo, &decoder), "updating the decoder");
+        }
+        int64_t row = (int64_t)cinfo.start_y - window.min.y;
+        if (row < 0 || row + cinfo.height > height || cinfo.width != width) {
+            sb_error("%s: chunk %d lies outside the data window", path, chunk);
+            res = SB_ERR_EXR;
+            goto cleanup;
+        }
+        for (int16_t ch = 0; ch < decoder.channel_count; ch++) {
+            exr_coding_channel_info_t *info = &decoder.channels[ch];
+            int dst = -1;
+            for (int c = 0; c < file_channels; c++)
+                if (strcmp(chlist->entries[c].name.str, info->channel_name) == 0)
+                    dst = map[c];
+            if (dst < 0) {
+                res = SB_ERR_EXR;
+                goto cleanup;
+            }
+            info->decode_to_ptr = (uint8_t *)(image->data + (size_t)row * width * count + dst);
+            info->user_pixel_stride = (int32_t)pixel_stride;
+            info->user_line_stride = (int32_t)(pixel_stride * width);
+            info->user_bytes_per_element = 4;
+            info->user_data_type = EXR_PIXEL_FLOAT;
+        }
+        if (chunk == 0)
+            EXR_TRY(exr_decoding_choose_default_routines(ctxt, 0, &decoder), "choosing the decoder");
+        EXR_TRY(exr_decoding_run(ctxt, 0, &decoder), "decoding");
+    }
+
+    if (attributes && attribute_count) {
+        int32_t n = 0;
+        EXR_TRY(exr_get_attribute_count(ctxt, 0, &n), "counting attributes");
+        for (int32_t i = 0; i < n && *attribute_count < SB_EXR_MAX_ATTRIBUTES; i++) {
+            const exr_attribute_t *attr = NULL;
+            if (exr_get_attribute_by_index(ctxt, 0, EXR_ATTR_LIST_FILE_ORDER, i, &attr) != EXR_ERR_SUCCESS)
+                continue;
+            if (attr->type != EXR_ATTR_STRING || strncmp(attr->name, "skybake.", 8) != 0)
+                continue;
+            struct sb_exr_attribute *out = &attributes[(*attribute_count)++];
+            snprintf(out->name, sizeof(out->name), "%s", attr->name);
+            snprintf(out->value, sizeof(out->value), "%.*s", attr->string->length, attr->string->str);
+        }
+    }
+
+cleanup:
+    if (decoder_live)
+        exr_decoding_destroy(ctxt, &decoder);
+    exr_finish(&ctxt);
+    if (res)
+        sb_image_finish(image);
+    return res;
+}

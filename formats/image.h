@@ -1,0 +1,55 @@
+/*
+ * A 2D image of fp32 channels, interleaved, rows from y = 0 upward in memory
+ * (pixel (x, y) at data[(y * width + x) * channel_count]). The shape every
+ * product of format version 1 has, and what EXR files and content hashes
+ * are made of.
+ */
+#ifndef SB_IMAGE_H
+#define SB_IMAGE_H
+
+#include <stddef.h>
+#include <stdint.h>
+
+#include "result.h"
+
+#define SB_IMAGE_MAX_CHANNELS 16
+#define SB_CHANNEL_NAME_MAX 32
+
+struct sb_image {
+    uint32_t width;
+    uint32_t height;
+    uint32_t channel_count;
+    char channel_names[SB_IMAGE_MAX_CHANNELS][SB_CHANNEL_NAME_MAX];
+    float *data; /* owned: width * height * channel_count floats */
+};
+
+/* Allocate zeroed data for the given shape; names are set by the caller. */
+enum sb_result sb_image_init(struct sb_image *image, uint32_t width, uint32_t height, uint32_t channel_count);
+/* Free the data; accepts a zeroed or already finished image. */
+void sb_image_finish(struct sb_image *image);
+
+/* Number of floats in the image. */
+static inline uint64_t sb_image_float_count(const struct sb_image *image)
+{
+    return (uint64_t)image->width * image->height * image->channel_count;
+}
+
+/* Set channel names from one comma-separated list ("r,g,b"). */
+void sb_image_set_channel_names(struct sb_image *image, const char *names);
+
+/*
+ * Content hash: XXH3-128 over the canonical content (a tag, the element type,
+ * width, height, depth 1, channel count, the NUL-terminated channel names,
+ * then the values as little-endian IEEE binary32), written as 32 lowercase
+ * hex digits plus NUL. It does not depend on the file that holds the image.
+ */
+#define SB_HASH_HEX_SIZE 33
+void sb_image_content_hash(const struct sb_image *image, char out[SB_HASH_HEX_SIZE]);
+
+/* 128-bit XXH3 of bytes as hex (for scenes and other canonical text). */
+void sb_hash_bytes(const void *data, size_t size, char out[SB_HASH_HEX_SIZE]);
+
+/* First NaN or infinite value, as a float index, or -1 when all are finite. */
+int64_t sb_image_find_nonfinite(const struct sb_image *image);
+
+#endif

@@ -1,0 +1,33 @@
+/*
+ * One logger for every tier. Messages go to stderr as "skybake: LEVEL: text"
+ * unless a sink is installed (tests capture messages this way). Not thread
+ * safe: configure it before starting threads.
+ */
+#ifndef SB_LOG_H
+#define SB_LOG_H
+
+enum sb_log_level {
+    SB_LOG_ERROR,
+    SB_LOG_WARN,
+    SB_LOG_INFO,
+    SB_LOG_DEBUG,
+};
+
+typedef void (*sb_log_sink)(void *user, enum sb_log_level level, const char *message);
+
+/* Messages above `level` are dropped. Default: SB_LOG_INFO. */
+void sb_log_set_level(enum sb_log_level level);
+/* Replace the stderr sink; NULL restores it. */
+void sb_log_set_sink(sb_log_sink sink, void *user);
+
+#if defined(__GNUC__)
+__attribute__((format(printf, 2, 3)))
+#endif
+void sb_log(enum sb_log_level level, const char *fmt, ...);
+
+#define sb_error(...) sb_log(SB_LOG_ERROR, __VA_ARGS__)
+#define sb_warn(...) sb_log(SB_LOG_WARN, __VA_ARGS__)
+#define sb_info(...) sb_log(SB_LOG_INFO, __VA_ARGS__)
+#define sb_debug(...) sb_log(SB_LOG_DEBUG, __VA_ARGS__)
+
+#endif

@@ -1,0 +1,309 @@
+#include "pack.h"
+
+#include <cJSON.h>
+#include <dirent.h>
+#include <errno.h>
+#include <fcntl.h>
+#include <libgen.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <sys/stat.h>
+#include <unistd.h>
+
+#include "log.h"
+#include "skybake_version.h"
+
+#define PACK_MAX_ARTIFACTS 32
+
+static const char *const product_names[SB_PRODUCT_COUNT] = {
+    [SB_PRODUCT_TRANSMITTANCE] = "transmittance",
+    [SB_PRODUCT_MULTISCATTERING] = "multiscattering",
+    [SB_PRODUCT_IRRADIANCE_GROUND] = "irradiance_ground",
+    [SB_PRODUCT_IRRADIANCE_SKY] = "irradiance_sky",
+};
+
+const char *sb_product_name(enum sb_product_id id)
+{
+    return (unsigned)id < SB_PRODUCT_COUNT ? product_names[id] : "unknown";
+}
+
+bool sb_product_from_name(const char *name, enum sb_product_id *id)
+{
+    for (int p = 0; p < SB_PRODUCT_COUNT; p++)
+        if (strcmp(name, product_names[p]) == 0) {
+            *id = (enum sb_product_id)p;
+            return true;
+        }
+    return false;
+}
+
+struct sb_pack_writer {
+    char out_dir[4000];
+    char tmp_dir[4096];
+    int artifact_count;
+    struct sb_artifact artifacts[PACK_MAX_ARTIFACTS];
+    struct {
+        uint32_t width, height, channel_count;
+        char channels[SB_IMAGE_MAX_CHANNELS][SB_CHANNEL_NAME_MAX];
+    } shapes[PACK_MAX_ARTIFACTS];
+};
+
+/* Remove the regular files of a flat directory, then the directory. */
+static int remove_flat_dir(const char *dir)
+{
+    DIR *d = opendir(dir);
+    if (!d)
+        return -1;
+    struct dirent *e;
+    char path[8192];
+    int failed = 0;
+    while ((e = readdir(d))) {
+        if (!strcmp(e->d_name, ".") || !strcmp(e->d_name, ".."))
+            continue;
+        snprintf(path, sizeof(path), "%s/%s", dir, e->d_name);
+        if (unlink(path) != 0)
+            failed = -1;
+    }
+    closedir(d);
+    return rmdir(dir) == 0 ? failed : -1;
+}
+
+static bool is_pack_or_empty(const char *dir)
+{
+    DIR *d = opendir(dir);
+    if (!d)
+        return false;
+    bool empty = true, manifest = false;
+    struct dirent *e;
+    while ((e = readdir(d))) {
+        if (!strcmp(e->d_name, ".") || !strcmp(e->d_name, ".."))
+            continue;
+        empty = false;
+        if (!strcmp(e->d_name, SB_PACK_MANIFEST))
+            manifest = true;
+    }
+    closedir(d);
+    return empty || manifest;
+}
+
+static int fsync_path(const char *path, bool directory)
+{
+    int fd = open(path, (directory ? O_RDONLY | O_DIRECTORY : O_RDONLY) | O_CLOEXEC);
+    if (fd < 0)
+        return -1;
+    int rv = fsync(fd);
+    close(fd);
+    return rv;
+}
+
+static void parent_of(const char *path, char *out, size_t size)
+{
+    char tmp[4096];
+    snprintf(tmp, sizeof(tmp), "%s", path);
+    snprintf(out, size, "%s", dirname(tmp));
+}
+
+enum sb_result sb_pack_writer_create(const char *out_dir, struct sb_pack_writer **out)
+{
+    *out = NULL;
+    size_t len = strlen(out_dir);
+    while (len > 1 && out_dir[len - 1] == '/')
+        len--;
+    if (len == 0 || len >= 4000) {
+        sb_error("output directory: empty or too long a path");
+        return SB_ERR_USAGE;
+    }
+    struct sb_pack_writer *w = calloc(1, sizeof(*w));
+    if (!w)
+        return SB_ERR_NOMEM;
+    memcpy(w->out_dir, out_dir, len);
+
+    struct stat st;
+    if (lstat(w->out_dir, &st) == 0) {
+        if (!S_ISDIR(st.st_mode)) {
+            sb_error("%s: exists and is not a directory; refusing to replace it", w->out_dir);
+            free(w);
+            return SB_ERR_IO;
+        }
+        if (!is_pack_or_empty(w->out_dir)) {
+            sb_error("%s: exists and is neither empty nor a skybake pack (no %s); refusing to replace it",
+                     w->out_dir, SB_PACK_MANIFEST);
+            free(w);
+            return SB_ERR_IO;
+        }
+    } else if (errno != ENOENT) {
+        sb_error("%s: %s", w->out_dir, strerror(errno));
+        free(w);
+        return SB_ERR_IO;
+    }
+
+    snprintf(w->tmp_dir, sizeof(w->tmp_dir), "%s.tmp-XXXXXX", w->out_dir);
+    if (!mkdtemp(w->tmp_dir)) {
+        char parent[4096];
+        parent_of(w->out_dir, parent, sizeof(parent));
+        sb_error("%s: cannot create a temporary directory beside the pack: %s", parent, strerror(errno));
+        free(w);
+        return SB_ERR_IO;
+    }
+    /* mkdtemp makes 0700; a pack gets the permissions the umask gives. */
+    mode_t mask = umask(0);
+    umask(mask);
+    chmod(w->tmp_dir, 0777 & ~mask);
+    *out = w;
+    return SB_OK;
+}
+
+enum sb_result sb_pack_writer_add_image(struct sb_pack_writer *w, struct sb_artifact *artifact,
+                                        const struct sb_image *image)
+{
+    if (w->artifact_count >= PACK_MAX_ARTIFACTS)
+        return SB_ERR_OUT_OF_RANGE;
+    if (strchr(artifact->file, '/') || !artifact->file[0] || artifact->file[0] == '.') {
+        sb_error("pack: artifact file name \"%s\" must be a plain file name", artifact->file);
+        return SB_ERR_OUT_OF_RANGE;
+    }
+    int64_t bad = sb_image_find_nonfinite(image);
+    if (bad >= 0) {
+        uint64_t texel = (uint64_t)bad / image->channel_count;
+        sb_error("%s: value at texel (%llu, %llu) channel %s is %g; refusing to write a non-finite product",
+                 sb_product_name(artifact->product), (unsigned long long)(texel % image->width),
+                 (unsigned long long)(texel / image->width), image->channel_names[bad % image->channel_count],
+                 image->data[bad]);
+        return SB_ERR_NUMERIC;
+    }
+    sb_image_content_hash(image, artifact->content_hash);
+
+    struct sb_exr_attribute attrs[4];
+    int n = 0;
+    snprintf(attrs[n].name, sizeof(attrs[n].name), "skybake.product");
+    snprintf(attrs[n++].value, sizeof(attrs[0].value), "%s", sb_product_name(artifact->product));
+    snprintf(attrs[n].name, sizeof(attrs[n].name), "skybake.format_version");
+    snprintf(attrs[n++].value, sizeof(attrs[0].value), "%d", SB_PACK_FORMAT_VERSION);
+    snprintf(attrs[n].name, sizeof(attrs[n].name), "skybake.content_hash");
+    snprintf(attrs[n++].value, sizeof(attrs[0].value), "%s", artifact->content_hash);
+    snprintf(attrs[n].name, sizeof(attrs[n].name), "skybake.parameterization");
+    snprintf(attrs[n++].value, sizeof(attrs[0].value), "%s", artifact->parameterization);
+
+    char path[8192];
+    snprintf(path, sizeof(path), "%s/%s", w->tmp_dir, artifact->file);
+    enum sb_result res = sb_exr_write(path, image, attrs, n);
+    if (res)
+        return res;
+    int i = w->artifact_count++;
+    w->artifacts[i] = *artifact;
+    w->shapes[i].width = image->width;
+    w->shapes[i].height = image->height;
+    w->shapes[i].channel_count = image->channel_count;
+    memcpy(w->shapes[i].channels, image->channel_names, sizeof(w->shapes[i].channels));
+    return SB_OK;
+}
+
+static char *manifest_json(const struct sb_pack_writer *w, const char *scene_json,
+                           const struct sb_device_info *device)
+{
+    cJSON *root = cJSON_CreateObject();
+    if (!root)
+        return NULL;
+    char scene_hash[SB_HASH_HEX_SIZE];
+    sb_hash_bytes(scene_json, strlen(scene_json), scene_hash);
+    cJSON_AddStringToObject(root, "format", "skybake-pack");
+    cJSON_AddNumberToObject(root, "format_version", SB_PACK_FORMAT_VERSION);
+    cJSON_AddStringToObject(root, "skybake_version", SKYBAKE_VERSION);
+    cJSON *scene = cJSON_Parse(scene_json);
+    cJSON_AddItemToObject(root, "scene", scene ? scene : cJSON_CreateNull());
+    cJSON_AddStringToObject(root, "scene_hash", scene_hash);
+    cJSON *dev = cJSON_AddObjectToObject(root, "device");
+    cJSON_AddStringToObject(dev, "name", device->name);
+    cJSON_AddStringToObject(dev, "driver", device->driver);
+    cJSON_AddStringToObject(dev, "api_version", device->api_version);
+    cJSON_AddNumberToObject(dev, "vendor_id", device->vendor_id);
+    cJSON_AddNumberToObject(dev, "device_id", device->device_id);
+    cJSON *arr = cJSON_AddArrayToObject(root, "artifacts");
+    for (int i = 0; i < w->artifact_count; i++) {
+        const struct sb_artifact *a = &w->artifacts[i];
+        cJSON *o = cJSON_CreateObject();
+        cJSON_AddStringToObject(o, "name", sb_product_name(a->product));
+        cJSON_AddStringToObject(o, "file", a->file);
+        cJSON_AddNumberToObject(o, "width", w->shapes[i].width);
+        cJSON_AddNumberToObject(o, "height", w->shapes[i].height);
+        cJSON_AddNumberToObject(o, "depth", 1);
+        cJSON *ch = cJSON_AddArrayToObject(o, "channels");
+        for (uint32_t c = 0; c < w->shapes[i].channel_count; c++)
+            cJSON_AddItemToArray(ch, cJSON_CreateString(w->shapes[i].channels[c]));
+        cJSON_AddStringToObject(o, "pixel_type", "float32");
+        cJSON_AddStringToObject(o, "parameterization", a->parameterization);
+        cJSON *settings = cJSON_Parse(a->settings_json[0] ? a->settings_json : "{}");
+        cJSON_AddItemToObject(o, "settings", settings ? settings : cJSON_CreateObject());
+        cJSON_AddNumberToObject(o, "bake_ms", a->bake_ms);
+        cJSON_AddNumberToObject(o, "gpu_ms", a->gpu_ms);
+        cJSON_AddStringToObject(o, "content_hash", a->content_hash);
+        cJSON_AddItemToArray(arr, o);
+    }
+    char *text = cJSON_Print(root);
+    cJSON_Delete(root);
+    return text;
+}
+
+enum sb_result sb_pack_writer_commit(struct sb_pack_writer **writer, const char *scene_json,
+                                     const struct sb_device_info *device)
+{
+    struct sb_pack_writer *w = *writer;
+    char path[8192];
+    char *text = manifest_json(w, scene_json, device);
+    if (!text)
+        return SB_ERR_NOMEM;
+    snprintf(path, sizeof(path), "%s/%s", w->tmp_dir, SB_PACK_MANIFEST);
+    FILE *f = fopen(path, "wb");
+    bool ok = f && fputs(text, f) >= 0 && fputc('\n', f) != EOF;
+    ok = f && fclose(f) == 0 && ok;
+    free(text);
+    if (!ok) {
+        sb_error("%s: cannot write the manifest: %s", path, strerror(errno));
+        return SB_ERR_IO;
+    }
+    /* Everything reaches the disk before the pack becomes visible. */
+    for (int i = 0; i < w->artifact_count; i++) {
+        snprintf(path, sizeof(path), "%s/%s", w->tmp_dir, w->artifacts[i].file);
+        if (fsync_path(path, false) != 0) {
+            sb_error("%s: fsync failed: %s", path, strerror(errno));
+            return SB_ERR_IO;
+        }
+    }
+    snprintf(path, sizeof(path), "%s/%s", w->tmp_dir, SB_PACK_MANIFEST);
+    if (fsync_path(path, false) != 0 || fsync_path(w->tmp_dir, true) != 0) {
+        sb_error("%s: fsync failed: %s", w->tmp_dir, strerror(errno));
+        return SB_ERR_IO;
+    }
+
+    struct stat st;
+    if (lstat(w->out_dir, &st) == 0) {
+        /* Swap atomically; the old pack ends up at the temporary name. */
+        if (renameat2(AT_FDCWD, w->tmp_dir, AT_FDCWD, w->out_dir, RENAME_EXCHANGE) != 0) {
+            sb_error("%s: cannot replace the pack: %s", w->out_dir, strerror(errno));
+            return SB_ERR_IO;
+        }
+        if (remove_flat_dir(w->tmp_dir) != 0)
+            sb_warn("%s: the previous pack was replaced but its old copy could not be removed", w->tmp_dir);
+    } else if (rename(w->tmp_dir, w->out_dir) != 0) {
+        sb_error("%s: cannot publish the pack: %s", w->out_dir, strerror(errno));
+        return SB_ERR_IO;
+    }
+    char parent[4096];
+    parent_of(w->out_dir, parent, sizeof(parent));
+    fsync_path(parent, true);
+    free(w);
+    *writer = NULL;
+    return SB_OK;
+}
+
+void sb_pack_writer_destroy(struct sb_pack_writer **writer)
+{
+    struct sb_pack_writer *w = *writer;
+    if (!w)
+        return;
+    if (remove_flat_dir(w->tmp_dir) != 0 && errno != ENOENT)
+        sb_warn("%s: could not remove the temporary directory", w->tmp_dir);
+    free(w);
+    *writer = NULL;
+}

@@ -1,0 +1,77 @@
+/*
+ * Packs: a directory holding manifest.json and one file per artifact.
+ * This header names the products of format version 1 and writes packs
+ * atomically: everything goes into a temporary directory beside the
+ * destination, which is renamed into place only when complete, so a failed
+ * bake leaves the previous pack as it was. docs/pack.md describes the format.
+ */
+#ifndef SB_PACK_H
+#define SB_PACK_H
+
+#include <stdbool.h>
+#include <stdint.h>
+
+#include "exr.h"
+#include "image.h"
+#include "result.h"
+
+#define SB_PACK_FORMAT_VERSION 1
+#define SB_PACK_MANIFEST "manifest.json"
+
+enum sb_product_id {
+    SB_PRODUCT_TRANSMITTANCE,
+    SB_PRODUCT_MULTISCATTERING,
+    SB_PRODUCT_IRRADIANCE_GROUND,
+    SB_PRODUCT_IRRADIANCE_SKY,
+    SB_PRODUCT_COUNT,
+};
+
+/* "transmittance", "multiscattering", "irradiance_ground", "irradiance_sky". */
+const char *sb_product_name(enum sb_product_id id);
+bool sb_product_from_name(const char *name, enum sb_product_id *id);
+
+/* One artifact of a manifest. Strings are copied when the artifact is added. */
+struct sb_artifact {
+    enum sb_product_id product;
+    char file[64];             /* relative to the pack, no directories */
+    char parameterization[64]; /* mapping id, see docs/pack.md */
+    char settings_json[512];   /* compact JSON object of the bake settings */
+    double bake_ms;            /* wall time of the product's bake, host side */
+    double gpu_ms;             /* GPU time between the product's timestamps */
+    char content_hash[SB_HASH_HEX_SIZE];
+};
+
+struct sb_device_info {
+    char name[256];
+    char driver[2 * 256 + 2];
+    char api_version[32];
+    uint32_t vendor_id;
+    uint32_t device_id;
+};
+
+struct sb_pack_writer;
+
+/*
+ * Begin a pack that will replace `out_dir`. Refuses (SB_ERR_IO) when out_dir
+ * exists and is neither an empty directory nor a pack, or when its parent
+ * cannot be written. The returned writer owns a temporary directory.
+ */
+enum sb_result sb_pack_writer_create(const char *out_dir, struct sb_pack_writer **writer);
+
+/* Write one artifact's EXR into the pack and record it; fills
+ * artifact->content_hash from the image. */
+enum sb_result sb_pack_writer_add_image(struct sb_pack_writer *writer, struct sb_artifact *artifact,
+                                        const struct sb_image *image);
+
+/*
+ * Write the manifest, flush everything to disk and rename the pack into
+ * place. scene_json is the normalised scene (sb_scene_normalized_json).
+ * On success the writer is destroyed and *writer set to NULL.
+ */
+enum sb_result sb_pack_writer_commit(struct sb_pack_writer **writer, const char *scene_json,
+                                     const struct sb_device_info *device);
+
+/* Abandon the pack: remove the temporary directory. Accepts NULL. */
+void sb_pack_writer_destroy(struct sb_pack_writer **writer);
+
+#endif

@@ -1,0 +1,34 @@
+/*
+ * The closed set of outcomes of every reader, writer and check in skybake.
+ * Tests compare codes, never message strings; messages for people are logged
+ * where the error is found and name the file, the field and the reason.
+ */
+#ifndef SB_RESULT_H
+#define SB_RESULT_H
+
+enum sb_result {
+    SB_OK = 0,
+    SB_ERR_IO,              /* a file could not be opened, read, written or renamed */
+    SB_ERR_NOMEM,           /* an allocation failed */
+    SB_ERR_JSON_SYNTAX,     /* not well-formed JSON */
+    SB_ERR_UNKNOWN_KEY,     /* a key the schema does not define */
+    SB_ERR_DUPLICATE_KEY,   /* a key given twice in one object */
+    SB_ERR_WRONG_TYPE,      /* a value of the wrong JSON type */
+    SB_ERR_OUT_OF_RANGE,    /* a value outside its documented domain */
+    SB_ERR_MISSING_FIELD,   /* a required key is absent */
+    SB_ERR_UNKNOWN_PRESET,  /* a preset name skybake does not know */
+    SB_ERR_UNKNOWN_PRODUCT, /* a product name skybake does not know */
+    SB_ERR_EXR,             /* OpenEXR refused the file or the data */
+    SB_ERR_BAD_IMAGE,       /* an image whose shape or channels are not the expected ones */
+    SB_ERR_NO_DEVICE,       /* no Vulkan device (or none matching --device) */
+    SB_ERR_VULKAN,          /* a Vulkan call failed */
+    SB_ERR_VALIDATION,      /* the validation layers reported a message */
+    SB_ERR_NUMERIC,         /* a product holds NaN, Inf or a value outside its range */
+    SB_ERR_USAGE,           /* bad command line */
+    SB_RESULT_COUNT,
+};
+
+/* Short stable name of a code, e.g. "out-of-range". Never NULL. */
+const char *sb_result_name(enum sb_result result);
+
+#endif

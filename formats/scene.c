@@ -1,0 +1,392 @@
+#include "scene.h"
+
+#include <cJSON.h>
+#include <errno.h>
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "log.h"
+
+#define SCENE_MAX_BYTES (1u << 20)
+
+void sb_atmosphere_preset_earth(struct sb_atmosphere_params *p)
+{
+    *p = (struct sb_atmosphere_params){
+        .ground_radius_km = 6360.0,
+        .top_radius_km = 6460.0,
+        .rayleigh_scattering_per_km = {5.802e-3, 13.558e-3, 33.1e-3},
+        .rayleigh_scale_height_km = 8.0,
+        .mie_scattering_per_km = {3.996e-3, 3.996e-3, 3.996e-3},
+        .mie_absorption_per_km = {0.444e-3, 0.444e-3, 0.444e-3},
+        .mie_scale_height_km = 1.2,
+        .mie_g = 0.8,
+        .ozone_absorption_per_km = {0.650e-3, 1.881e-3, 0.085e-3},
+        .ozone_center_km = 25.0,
+        .ozone_half_width_km = 15.0,
+        .ground_albedo = {0.3, 0.3, 0.3},
+        .solar_irradiance = {1.0, 1.0, 1.0},
+    };
+}
+
+/* ---- Field table: one row per atmosphere key ------------------------------------- */
+
+enum field_kind { FIELD_SCALAR, FIELD_RGB };
+
+struct field {
+    const char *key;
+    enum field_kind kind;
+    size_t offset;
+    double min, max;   /* allowed range */
+    bool min_exclusive; /* value must be > min */
+    const char *unit;
+};
+
+#define F(key, kind, lo, hi, excl, unit) {#key, kind, offsetof(struct sb_atmosphere_params, key), lo, hi, excl, unit}
+static const struct field atmosphere_fields[] = {
+    F(ground_radius_km, FIELD_SCALAR, 0.0, 1e6, true, "km"),
+    F(top_radius_km, FIELD_SCALAR, 0.0, 2e6, true, "km"),
+    F(rayleigh_scattering_per_km, FIELD_RGB, 0.0, 1e3, false, "1/km"),
+    F(rayleigh_scale_height_km, FIELD_SCALAR, 1e-3, 1e5, false, "km"),
+    F(mie_scattering_per_km, FIELD_RGB, 0.0, 1e3, false, "1/km"),
+    F(mie_absorption_per_km, FIELD_RGB, 0.0, 1e3, false, "1/km"),
+    F(mie_scale_height_km, FIELD_SCALAR, 1e-3, 1e5, false, "km"),
+    F(mie_g, FIELD_SCALAR, -0.999, 0.999, false, ""),
+    F(ozone_absorption_per_km, FIELD_RGB, 0.0, 1e3, false, "1/km"),
+    F(ozone_center_km, FIELD_SCALAR, 0.0, 1e6, false, "km"),
+    F(ozone_half_width_km, FIELD_SCALAR, 0.0, 1e6, true, "km"),
+    F(ground_albedo, FIELD_RGB, 0.0, 1.0, false, ""),
+    F(solar_irradiance, FIELD_RGB, 0.0, 1e6, false, ""),
+};
+#undef F
+#define FIELD_COUNT (sizeof(atmosphere_fields) / sizeof(atmosphere_fields[0]))
+
+static double *field_ptr(struct sb_atmosphere_params *p, const struct field *f)
+{
+    return (double *)((char *)p + f->offset);
+}
+
+static const double *field_cptr(const struct sb_atmosphere_params *p, const struct field *f)
+{
+    return (const double *)((const char *)p + f->offset);
+}
+
+static enum sb_result check_range(const struct field *f, double v, const char *source, const char *path)
+{
+    if (!isfinite(v)) {
+        sb_error("%s: %s: must be a finite number", source, path);
+        return SB_ERR_OUT_OF_RANGE;
+    }
+    bool low = f->min_exclusive ? v <= f->min : v < f->min;
+    if (low || v > f->max) {
+        sb_error("%s: %s: %.17g is out of range, expected %s%g%s and <= %g%s%s", source, path, v,
+                 f->min_exclusive ? "> " : ">= ", f->min, "", f->max, *f->unit ? " " : "", f->unit);
+        return SB_ERR_OUT_OF_RANGE;
+    }
+    return SB_OK;
+}
+
+enum sb_result sb_atmosphere_validate(const struct sb_atmosphere_params *p, const char *source)
+{
+    char path[96];
+    for (size_t i = 0; i < FIELD_COUNT; i++) {
+        const struct field *f = &atmosphere_fields[i];
+        const double *v = field_cptr(p, f);
+        int n = f->kind == FIELD_RGB ? 3 : 1;
+        for (int c = 0; c < n; c++) {
+            if (n == 3)
+                snprintf(path, sizeof(path), "atmosphere.%s[%d]", f->key, c);
+            else
+                snprintf(path, sizeof(path), "atmosphere.%s", f->key);
+            enum sb_result res = check_range(f, v[c], source, path);
+            if (res)
+                return res;
+        }
+    }
+    if (!(p->top_radius_km > p->ground_radius_km)) {
+        sb_error("%s: atmosphere.top_radius_km: %.17g must exceed ground_radius_km (%.17g)", source,
+                 p->top_radius_km, p->ground_radius_km);
+        return SB_ERR_OUT_OF_RANGE;
+    }
+    if (p->top_radius_km - p->ground_radius_km < 1e-3 * p->ground_radius_km * 1e-3) {
+        sb_error("%s: atmosphere.top_radius_km: the atmosphere is thinner than fp32 can resolve on this planet",
+                 source);
+        return SB_ERR_OUT_OF_RANGE;
+    }
+    return SB_OK;
+}
+
+/* ---- JSON walking -------------------------------------------------------------- */
+
+static enum sb_result check_duplicates(const cJSON *object, const char *source, const char *where)
+{
+    for (const cJSON *a = object->child; a; a = a->next)
+        for (const cJSON *b = a->next; b; b = b->next)
+            if (strcmp(a->string, b->string) == 0) {
+                sb_error("%s: %s%s%s: key given twice", source, where, *where ? "." : "", a->string);
+                return SB_ERR_DUPLICATE_KEY;
+            }
+    return SB_OK;
+}
+
+static enum sb_result read_number(const cJSON *item, double *out, const char *source, const char *path)
+{
+    if (!cJSON_IsNumber(item)) {
+        sb_error("%s: %s: expected a number", source, path);
+        return SB_ERR_WRONG_TYPE;
+    }
+    *out = item->valuedouble;
+    return SB_OK;
+}
+
+static enum sb_result parse_field(const struct field *f, const cJSON *item, struct sb_atmosphere_params *p,
+                                  const char *source)
+{
+    char path[96];
+    snprintf(path, sizeof(path), "atmosphere.%s", f->key);
+    double *dst = field_ptr(p, f);
+    if (f->kind == FIELD_SCALAR)
+        return read_number(item, dst, source, path);
+    if (cJSON_IsNumber(item)) {
+        dst[0] = dst[1] = dst[2] = item->valuedouble;
+        return SB_OK;
+    }
+    if (!cJSON_IsArray(item) || cJSON_GetArraySize(item) != 3) {
+        sb_error("%s: %s: expected a number or an array of 3 numbers (r, g, b)", source, path);
+        return SB_ERR_WRONG_TYPE;
+    }
+    for (int c = 0; c < 3; c++) {
+        char elem[112];
+        snprintf(elem, sizeof(elem), "%s[%d]", path, c);
+        enum sb_result res = read_number(cJSON_GetArrayItem(item, c), &dst[c], source, elem);
+        if (res)
+            return res;
+    }
+    return SB_OK;
+}
+
+static enum sb_result parse_atmosphere(const cJSON *obj, struct sb_scene *scene, const char *source)
+{
+    if (!cJSON_IsObject(obj)) {
+        sb_error("%s: atmosphere: expected an object", source);
+        return SB_ERR_WRONG_TYPE;
+    }
+    enum sb_result res = check_duplicates(obj, source, "atmosphere");
+    if (res)
+        return res;
+    const cJSON *preset = cJSON_GetObjectItemCaseSensitive(obj, "preset");
+    if (!preset) {
+        sb_error("%s: atmosphere.preset: missing (known presets: \"earth\")", source);
+        return SB_ERR_MISSING_FIELD;
+    }
+    if (!cJSON_IsString(preset)) {
+        sb_error("%s: atmosphere.preset: expected a string", source);
+        return SB_ERR_WRONG_TYPE;
+    }
+    if (strcmp(preset->valuestring, "earth") != 0) {
+        sb_error("%s: atmosphere.preset: unknown preset \"%s\" (known presets: \"earth\")", source,
+                 preset->valuestring);
+        return SB_ERR_UNKNOWN_PRESET;
+    }
+    snprintf(scene->preset, sizeof(scene->preset), "%s", preset->valuestring);
+    sb_atmosphere_preset_earth(&scene->atmosphere);
+
+    for (const cJSON *item = obj->child; item; item = item->next) {
+        if (strcmp(item->string, "preset") == 0)
+            continue;
+        const struct field *f = NULL;
+        for (size_t i = 0; i < FIELD_COUNT; i++)
+            if (strcmp(item->string, atmosphere_fields[i].key) == 0)
+                f = &atmosphere_fields[i];
+        if (!f) {
+            sb_error("%s: atmosphere.%s: unknown key (see docs/scene.md for the schema)", source, item->string);
+            return SB_ERR_UNKNOWN_KEY;
+        }
+        res = parse_field(f, item, &scene->atmosphere, source);
+        if (res)
+            return res;
+    }
+    return sb_atmosphere_validate(&scene->atmosphere, source);
+}
+
+static enum sb_result parse_products(const cJSON *arr, struct sb_scene *scene, const char *source)
+{
+    if (!cJSON_IsArray(arr)) {
+        sb_error("%s: products: expected an array of product names", source);
+        return SB_ERR_WRONG_TYPE;
+    }
+    int i = 0;
+    for (const cJSON *item = arr->child; item; item = item->next, i++) {
+        if (!cJSON_IsString(item)) {
+            sb_error("%s: products[%d]: expected a product name string", source, i);
+            return SB_ERR_WRONG_TYPE;
+        }
+        enum sb_product_id id;
+        if (!sb_product_from_name(item->valuestring, &id)) {
+            sb_error("%s: products[%d]: unknown product \"%s\"", source, i, item->valuestring);
+            return SB_ERR_UNKNOWN_PRODUCT;
+        }
+        if (scene->wants[id]) {
+            sb_error("%s: products[%d]: \"%s\" is listed twice", source, i, item->valuestring);
+            return SB_ERR_DUPLICATE_KEY;
+        }
+        scene->wants[id] = true;
+    }
+    if (i == 0) {
+        sb_error("%s: products: empty; leave the key out to bake every product", source);
+        return SB_ERR_OUT_OF_RANGE;
+    }
+    return SB_OK;
+}
+
+static enum sb_result parse_root(const cJSON *root, struct sb_scene *scene, const char *source)
+{
+    if (!cJSON_IsObject(root)) {
+        sb_error("%s: the scene must be a JSON object", source);
+        return SB_ERR_WRONG_TYPE;
+    }
+    enum sb_result res = check_duplicates(root, source, "");
+    if (res)
+        return res;
+    bool have_atmosphere = false, have_products = false;
+    for (const cJSON *item = root->child; item; item = item->next) {
+        if (strcmp(item->string, "version") == 0) {
+            if (!cJSON_IsNumber(item)) {
+                sb_error("%s: version: expected a number", source);
+                return SB_ERR_WRONG_TYPE;
+            }
+            if (item->valuedouble != 1.0) {
+                sb_error("%s: version: %g is not a scene version this skybake reads (1)", source, item->valuedouble);
+                return SB_ERR_OUT_OF_RANGE;
+            }
+        } else if (strcmp(item->string, "name") == 0) {
+            if (!cJSON_IsString(item)) {
+                sb_error("%s: name: expected a string", source);
+                return SB_ERR_WRONG_TYPE;
+            }
+            if (strlen(item->valuestring) >= sizeof(scene->name)) {
+                sb_error("%s: name: longer than %zu bytes", source, sizeof(scene->name) - 1);
+                return SB_ERR_OUT_OF_RANGE;
+            }
+            snprintf(scene->name, sizeof(scene->name), "%s", item->valuestring);
+        } else if (strcmp(item->string, "atmosphere") == 0) {
+            if ((res = parse_atmosphere(item, scene, source)))
+                return res;
+            have_atmosphere = true;
+        } else if (strcmp(item->string, "products") == 0) {
+            if ((res = parse_products(item, scene, source)))
+                return res;
+            have_products = true;
+        } else {
+            sb_error("%s: %s: unknown key (see docs/scene.md for the schema)", source, item->string);
+            return SB_ERR_UNKNOWN_KEY;
+        }
+    }
+    if (!have_atmosphere) {
+        sb_error("%s: atmosphere: missing", source);
+        return SB_ERR_MISSING_FIELD;
+    }
+    if (!have_products)
+        for (int p = 0; p < SB_PRODUCT_COUNT; p++)
+            scene->wants[p] = true;
+    return SB_OK;
+}
+
+enum sb_result sb_scene_parse(const char *json, size_t size, const char *source, struct sb_scene *scene)
+{
+    memset(scene, 0, sizeof(*scene));
+    if (size == 0) {
+        sb_error("%s: empty file, expected a JSON object", source);
+        return SB_ERR_JSON_SYNTAX;
+    }
+    if (memchr(json, '\0', size)) {
+        sb_error("%s: contains a NUL byte: not a JSON text", source);
+        return SB_ERR_JSON_SYNTAX;
+    }
+    const char *end = NULL;
+    cJSON *root = cJSON_ParseWithLengthOpts(json, size, &end, false);
+    if (!root) {
+        size_t offset = end ? (size_t)(end - json) : 0;
+        size_t line = 1;
+        for (size_t i = 0; i < offset && i < size; i++)
+            line += json[i] == '\n';
+        sb_error("%s: line %zu: malformed JSON near byte %zu", source, line, offset);
+        return SB_ERR_JSON_SYNTAX;
+    }
+    /* Anything but whitespace after the value is an error. */
+    for (const char *c = end; c && c < json + size; c++)
+        if (*c != ' ' && *c != '\t' && *c != '\n' && *c != '\r') {
+            sb_error("%s: trailing data after the JSON value at byte %zu", source, (size_t)(c - json));
+            cJSON_Delete(root);
+            return SB_ERR_JSON_SYNTAX;
+        }
+    enum sb_result res = parse_root(root, scene, source);
+    cJSON_Delete(root);
+    if (res)
+        memset(scene, 0, sizeof(*scene));
+    return res;
+}
+
+enum sb_result sb_scene_load(const char *path, struct sb_scene *scene)
+{
+    memset(scene, 0, sizeof(*scene));
+    FILE *f = fopen(path, "rb");
+    if (!f) {
+        sb_error("%s: cannot open scene: %s", path, strerror(errno));
+        return SB_ERR_IO;
+    }
+    char *buf = malloc(SCENE_MAX_BYTES + 1);
+    if (!buf) {
+        fclose(f);
+        return SB_ERR_NOMEM;
+    }
+    size_t n = fread(buf, 1, SCENE_MAX_BYTES + 1, f);
+    bool failed = ferror(f);
+    fclose(f);
+    enum sb_result res;
+    if (failed) {
+        sb_error("%s: cannot read scene: %s", path, strerror(errno));
+        res = SB_ERR_IO;
+    } else if (n > SCENE_MAX_BYTES) {
+        sb_error("%s: larger than %u bytes: not a scene file", path, SCENE_MAX_BYTES);
+        res = SB_ERR_OUT_OF_RANGE;
+    } else {
+        res = sb_scene_parse(buf, n, path, scene);
+    }
+    free(buf);
+    return res;
+}
+
+char *sb_scene_normalized_json(const struct sb_scene *scene)
+{
+    cJSON *root = cJSON_CreateObject();
+    cJSON *atm = cJSON_CreateObject();
+    cJSON *products = cJSON_CreateArray();
+    char *out = NULL;
+    if (!root || !atm || !products) {
+        cJSON_Delete(atm);
+        cJSON_Delete(products);
+        goto done;
+    }
+    cJSON_AddNumberToObject(root, "version", 1);
+    cJSON_AddStringToObject(root, "name", scene->name);
+    cJSON_AddItemToObject(root, "atmosphere", atm);
+    cJSON_AddStringToObject(atm, "preset", scene->preset);
+    for (size_t i = 0; i < FIELD_COUNT; i++) {
+        const struct field *f = &atmosphere_fields[i];
+        const double *v = field_cptr(&scene->atmosphere, f);
+        if (f->kind == FIELD_RGB)
+            cJSON_AddItemToObject(atm, f->key, cJSON_CreateDoubleArray(v, 3));
+        else
+            cJSON_AddNumberToObject(atm, f->key, v[0]);
+    }
+    cJSON_AddItemToObject(root, "products", products);
+    for (int p = 0; p < SB_PRODUCT_COUNT; p++)
+        if (scene->wants[p])
+            cJSON_AddItemToArray(products, cJSON_CreateString(sb_product_name((enum sb_product_id)p)));
+    out = cJSON_PrintUnformatted(root);
+done:
+    cJSON_Delete(root);
+    return out;
+}

@@ -1,0 +1,61 @@
+/*
+ * Scene description (JSON; schema in docs/scene.md). Parsing resolves the
+ * preset, applies overrides, and refuses unknown keys, duplicate keys, wrong
+ * types and out-of-range values before any GPU work, logging the file, the
+ * JSON path and the reason.
+ */
+#ifndef SB_SCENE_H
+#define SB_SCENE_H
+
+#include <stdbool.h>
+#include <stddef.h>
+
+#include "pack.h"
+#include "result.h"
+
+/* All lengths in km, all coefficients in 1/km, RGB triples in linear Rec.709
+ * primaries as the literature gives them. */
+struct sb_atmosphere_params {
+    double ground_radius_km;
+    double top_radius_km;
+    double rayleigh_scattering_per_km[3];
+    double rayleigh_scale_height_km;
+    double mie_scattering_per_km[3];
+    double mie_absorption_per_km[3];
+    double mie_scale_height_km;
+    double mie_g; /* Cornette-Shanks asymmetry, |g| < 1 */
+    double ozone_absorption_per_km[3];
+    double ozone_center_km;     /* the tent's peak altitude */
+    double ozone_half_width_km; /* density falls linearly to 0 this far above and below */
+    double ground_albedo[3];    /* Lambertian, [0, 1] */
+    double solar_irradiance[3]; /* 1 makes every product a transfer function */
+};
+
+struct sb_scene {
+    char name[64];
+    char preset[32];
+    struct sb_atmosphere_params atmosphere;
+    /* Products the scene asks for, before dependencies are pulled in. */
+    bool wants[SB_PRODUCT_COUNT];
+};
+
+/* Hillaire 2020's Earth. */
+void sb_atmosphere_preset_earth(struct sb_atmosphere_params *params);
+
+/* Read and validate a scene file. On failure the scene is left zeroed. */
+enum sb_result sb_scene_load(const char *path, struct sb_scene *scene);
+
+/* Same from memory; source names the origin in messages. */
+enum sb_result sb_scene_parse(const char *json, size_t size, const char *source, struct sb_scene *scene);
+
+/* Validate parameters, logging "source: path: reason" for the first problem. */
+enum sb_result sb_atmosphere_validate(const struct sb_atmosphere_params *params, const char *source);
+
+/*
+ * The normalised scene as compact JSON with every parameter resolved, keys in
+ * a fixed order and numbers written to round-trip. Its hash identifies the
+ * scene. Returns a malloc'd string (caller frees) or NULL on allocation failure.
+ */
+char *sb_scene_normalized_json(const struct sb_scene *scene);
+
+#endif

@@ -1,0 +1,449 @@
+/*
+ * The atmosphere model shared by every bake shader and, later, the runtime:
+ * medium densities, phase functions, LUT parameterisations, and the ray
+ * integrals built from them. Include after config.h.
+ *
+ * Units: lengths in km, coefficients in 1/km, angles as cosines. Altitudes
+ * are carried instead of radii wherever they are subtracted, because r is
+ * about 6360 km and fp32 keeps only ~0.5 m of it (the cancellation-free forms
+ * below are what make transmittance good to 1e-5).
+ *
+ * The fp64 CPU reference in baker/atmosphere_ref.c implements the same model
+ * independently; docs/products.md states the definitions both follow.
+ */
+#ifndef SB_ATMOSPHERE_GLSL
+#define SB_ATMOSPHERE_GLSL
+
+#extension GL_GOOGLE_include_directive : require
+
+const float PI = 3.14159265358979;
+
+layout(std430, set = 0, binding = SB_BINDING_ATMOSPHERE) readonly buffer AtmosphereBuffer {
+    sb_atmosphere_gpu atm;
+};
+layout(std430, set = 0, binding = SB_BINDING_TRANSMITTANCE) readonly buffer TransmittanceBuffer {
+    float transmittance_lut[];
+};
+layout(std430, set = 0, binding = SB_BINDING_MULTISCATTERING) readonly buffer MultiscatteringBuffer {
+    float multiscattering_lut[];
+};
+layout(std430, set = 0, binding = SB_BINDING_IRRADIANCE_GROUND) readonly buffer IrradianceGroundBuffer {
+    float irradiance_ground_lut[];
+};
+
+float ground_radius() { return atm.radii.x; }
+float top_radius() { return atm.radii.y; }
+/* Distance from the ground to the horizon seen from the top. */
+float horizon_top() { return atm.radii.z; }
+float atmosphere_thickness() { return atm.radii.w; }
+
+/* ---- Medium ---------------------------------------------------------------- */
+
+struct Medium {
+    vec3 scattering_rayleigh;
+    vec3 scattering_mie;
+    vec3 extinction;
+};
+
+float ozone_density(float h)
+{
+    return max(0.0, 1.0 - abs(h - atm.ozone_absorption.w) / atm.ground_albedo.w);
+}
+
+Medium medium_at(float h)
+{
+    float rayleigh = exp(-h / atm.rayleigh_scattering.w);
+    float mie = exp(-h / atm.mie_scattering.w);
+    Medium m;
+    m.scattering_rayleigh = atm.rayleigh_scattering.rgb * rayleigh;
+    m.scattering_mie = atm.mie_scattering.rgb * mie;
+    m.extinction = m.scattering_rayleigh + atm.mie_extinction.rgb * mie
+                 + atm.ozone_absorption.rgb * ozone_density(h);
+    return m;
+}
+
+vec3 extinction_at(float h)
+{
+    return atm.rayleigh_scattering.rgb * exp(-h / atm.rayleigh_scattering.w)
+         + atm.mie_extinction.rgb * exp(-h / atm.mie_scattering.w)
+         + atm.ozone_absorption.rgb * ozone_density(h);
+}
+
+/* Phase functions, normalised over the sphere (1/sr); nu = cos(scattering angle). */
+float phase_rayleigh(float nu)
+{
+    return 3.0 / (16.0 * PI) * (1.0 + nu * nu);
+}
+
+/* Cornette-Shanks, as in Bruneton 2017. */
+float phase_mie(float nu)
+{
+    float g = atm.mie_extinction.w;
+    float k = 3.0 / (8.0 * PI) * (1.0 - g * g) / (2.0 + g * g);
+    return k * (1.0 + nu * nu) / pow(max(1.0 + g * g - 2.0 * g * nu, 1e-12), 1.5);
+}
+
+/* ---- Geometry ---------------------------------------------------------------- */
+
+/* rho: distance from the point at altitude h to the ground horizon. */
+float horizon_distance(float h)
+{
+    return sqrt(max(h * (2.0 * ground_radius() + h), 0.0));
+}
+
+bool ray_hits_ground(float h, float mu)
+{
+    float r = ground_radius() + h;
+    return mu < 0.0 && r * r * mu * mu >= h * (2.0 * ground_radius() + h);
+}
+
+float distance_to_top(float h, float mu)
+{
+    float r = ground_radius() + h;
+    float above = max(atmosphere_thickness() - h, 0.0) * (top_radius() + r); /* top^2 - r^2 */
+    float disc = sqrt(above + r * r * mu * mu);
+    return mu >= 0.0 ? above / (r * mu + disc) : disc - r * mu;
+}
+
+float distance_to_ground(float h, float mu)
+{
+    float r = ground_radius() + h;
+    float below = h * (2.0 * ground_radius() + h); /* r^2 - ground^2 */
+    float disc = sqrt(max(r * r * mu * mu - below, 0.0));
+    return below / max(disc - r * mu, 1e-30);
+}
+
+/* Altitude at distance t along a ray from altitude h0 with cosine mu. */
+float altitude_along(float h0, float mu, float t)
+{
+    float r0 = ground_radius() + h0;
+    float q = t * (t + 2.0 * r0 * mu); /* r(t)^2 - r0^2 */
+    float rt = sqrt(max(r0 * r0 + q, 0.0));
+    return max(h0 + q / (rt + r0), 0.0);
+}
+
+/* ---- Transmittance LUT (Hillaire 2020 / Bruneton 2017) ------------------------ */
+/*
+ * Texel (x, y): x_mu = (x + 0.5) / W, x_r = (y + 0.5) / H_tex; rho = H x_r,
+ * d = d_min + x_mu (d_max - d_min), d_min = top - r, d_max = rho + H.
+ * The integral is parameterised by e = d_max - d, which is exact near the
+ * horizon where d itself would cancel.
+ */
+
+/* Gauss-Legendre 8 on [-1, 1], positive half (nodes come in +- pairs). */
+const float GL8_X[4] = float[4](0.1834346424956498, 0.5255324099163290, 0.7966664774136267, 0.9602898564975363);
+const float GL8_W[4] = float[4](0.3626837833783620, 0.3137066458778873, 0.2223810344533745, 0.1012285362903763);
+
+/* Altitude along an ascending path from a base point (altitude hb, radius rb)
+ * whose ray has tangential offset sb >= 0: r(t)^2 = rb^2 + t^2 + 2 sb t. */
+float path_altitude(float hb, float rb, float sb, float t)
+{
+    float q = t * (t + 2.0 * sb);
+    return hb + q / (sqrt(rb * rb + q) + rb);
+}
+
+/* Distance along that path to altitude level (> hb). */
+float path_distance_to_level(float hb, float sb, float level)
+{
+    float c = (level - hb) * (2.0 * ground_radius() + level + hb);
+    return c / (sb + sqrt(sb * sb + c));
+}
+
+vec3 path_segment_depth(float hb, float rb, float sb, float t0, float t1)
+{
+    float half_len = 0.5 * (t1 - t0), mid = 0.5 * (t0 + t1);
+    vec3 sum = vec3(0.0);
+    for (int i = 0; i < 4; i++) {
+        float dt = half_len * GL8_X[i];
+        sum += GL8_W[i] * (extinction_at(path_altitude(hb, rb, sb, mid - dt))
+                           + extinction_at(path_altitude(hb, rb, sb, mid + dt)));
+    }
+    return sum * half_len;
+}
+
+/*
+ * Optical depth from a point to the top of the atmosphere along a ray that
+ * does not hit the ground, given rho (horizon distance of the point) and
+ * e = d_max - d. A downward ray is folded at its tangent point: the part
+ * below the start altitude is traversed twice. The ascending path is cut at
+ * the ozone tent's corners (the only kinks of the integrand) and at the fold,
+ * at most five pieces, each integrated by 8-point Gauss-Legendre: at most
+ * 40 density samples.
+ */
+vec3 optical_depth_to_top(float rho, float e)
+{
+    float R = ground_radius(), H = horizon_top();
+    float r = sqrt(rho * rho + R * R);
+    float d = rho + H - e;
+    float s0 = ((2.0 * (H + rho)) * (e - rho) - e * e) / (2.0 * d); /* r mu */
+    float hb, rb, sb, fold = 0.0, t_end;
+    if (s0 < 0.0) {
+        float del = e * (2.0 * H - e) / (2.0 * d); /* rho + s0, exactly */
+        float q = max((2.0 * rho - del) * del, 0.0); /* r_min^2 - R^2 */
+        rb = sqrt(R * R + q);
+        hb = q / (rb + R);
+        sb = 0.0;
+        fold = -s0;
+        t_end = d + s0;
+    } else {
+        hb = rho * rho / (r + R);
+        rb = r;
+        sb = s0;
+        t_end = d;
+    }
+
+    float ts[6];
+    int n = 0;
+    ts[n++] = 0.0;
+    float corners[3] = float[3](atm.ozone_absorption.w - atm.ground_albedo.w, atm.ozone_absorption.w,
+                                atm.ozone_absorption.w + atm.ground_albedo.w);
+    for (int k = 0; k < 3; k++) {
+        if (corners[k] > hb && corners[k] < atmosphere_thickness()) {
+            float tk = path_distance_to_level(hb, sb, corners[k]);
+            if (tk < t_end)
+                ts[n++] = tk;
+        }
+    }
+    if (fold > 0.0 && fold < t_end)
+        ts[n++] = fold;
+    ts[n++] = t_end;
+    for (int i = 1; i < n; i++) { /* insertion sort, n <= 6 */
+        float v = ts[i];
+        int j = i - 1;
+        while (j >= 0 && ts[j] > v) {
+            ts[j + 1] = ts[j];
+            j--;
+        }
+        ts[j + 1] = v;
+    }
+
+    vec3 tau = vec3(0.0);
+    for (int i = 0; i + 1 < n; i++) {
+        if (ts[i + 1] <= ts[i])
+            continue;
+        vec3 piece = path_segment_depth(hb, rb, sb, ts[i], ts[i + 1]);
+        tau += ts[i + 1] <= fold ? 2.0 * piece : piece;
+    }
+    return tau;
+}
+
+/* The transmittance LUT's coordinates in unit range for a point and direction
+ * whose ray does not hit the ground. */
+vec2 transmittance_unit_coords(float h, float mu)
+{
+    float rho = horizon_distance(h);
+    float r = ground_radius() + h;
+    float d = distance_to_top(h, mu);
+    float d_min = atmosphere_thickness() - h;
+    float d_max = rho + horizon_top();
+    float x_mu = (d - d_min) / max(d_max - d_min, 1e-30);
+    return vec2(x_mu, rho / horizon_top());
+}
+
+/* Exact transmittance to the top by the quadrature above. */
+vec3 transmittance_to_top(float h, float mu)
+{
+    float rho = horizon_distance(h);
+    float e = rho + horizon_top() - distance_to_top(h, mu);
+    return exp(-optical_depth_to_top(rho, max(e, 0.0)));
+}
+
+/* Bilinear lookup of an interleaved fp32 LUT with texel centres at (i + 0.5) / size. */
+#define SB_LUT_BILINEAR(lut, channels, width, height, fx, fy, out_value) {                       \
+    float sx_ = clamp(fx, 0.0, float(width - 1)), sy_ = clamp(fy, 0.0, float(height - 1));          \
+    int x0_ = min(int(sx_), width - 2), y0_ = min(int(sy_), height - 2);                            \
+    float ax_ = sx_ - float(x0_), ay_ = sy_ - float(y0_);                                           \
+    for (int c_ = 0; c_ < channels; c_++) {                                                          \
+        float v00_ = lut[((y0_) * width + x0_) * channels + c_];                                     \
+        float v10_ = lut[((y0_) * width + x0_ + 1) * channels + c_];                                 \
+        float v01_ = lut[((y0_ + 1) * width + x0_) * channels + c_];                                 \
+        float v11_ = lut[((y0_ + 1) * width + x0_ + 1) * channels + c_];                             \
+        out_value[c_] = mix(mix(v00_, v10_, ax_), mix(v01_, v11_, ax_), ay_);                        \
+    } }
+
+vec3 transmittance_lut_sample(float h, float mu)
+{
+    vec2 x = transmittance_unit_coords(h, mu);
+    vec3 v;
+    SB_LUT_BILINEAR(transmittance_lut, 3, SB_TRANSMITTANCE_WIDTH, SB_TRANSMITTANCE_HEIGHT,
+                    x.x * SB_TRANSMITTANCE_WIDTH - 0.5, x.y * SB_TRANSMITTANCE_HEIGHT - 0.5, v);
+    return v;
+}
+
+/* Transmittance toward the sun from altitude h; zero when the planet hides it. */
+vec3 sun_transmittance(float h, float mu_s)
+{
+    if (ray_hits_ground(h, mu_s))
+        return vec3(0.0);
+    return transmittance_lut_sample(h, mu_s);
+}
+
+/* ---- Multiple-scattering LUT and irradiance LUTs -------------------------------- */
+/*
+ * Both use Bruneton's sub-texel mapping: texel i of n sits at x = i / (n - 1),
+ * so the first and last texels hold the domain's edges exactly.
+ * Multiple scattering: mu_s = 2 x_u - 1, h = x_v (top - ground).
+ * Irradiance (ground and sky): mu_s = 2 x_u - 1, h = x_v (top - ground).
+ */
+float texel_unit(uint i, uint n)
+{
+    return float(i) / float(n - 1u);
+}
+
+vec3 multiscattering_lut_sample(float h, float mu_s)
+{
+    float fx = (mu_s * 0.5 + 0.5) * float(SB_MULTISCATTERING_SIZE - 1);
+    float fy = h / atmosphere_thickness() * float(SB_MULTISCATTERING_SIZE - 1);
+    vec3 v;
+    SB_LUT_BILINEAR(multiscattering_lut, 3, SB_MULTISCATTERING_SIZE, SB_MULTISCATTERING_SIZE, fx, fy, v);
+    return v;
+}
+
+/* Total (direct + sky) irradiance on the ground, from irradiance_ground. */
+vec3 ground_irradiance_sample(float mu_s)
+{
+    float fx = (mu_s * 0.5 + 0.5) * float(SB_IRRADIANCE_WIDTH - 1);
+    float v[6];
+    SB_LUT_BILINEAR(irradiance_ground_lut, 6, SB_IRRADIANCE_WIDTH, SB_IRRADIANCE_HEIGHT, fx, 0.0, v);
+    return vec3(v[0] + v[3], v[1] + v[4], v[2] + v[5]);
+}
+
+/* ---- Ray integrals for scattering ---------------------------------------------- */
+/*
+ * A ray from altitude h0 with cosine mu is cut where it crosses the altitude
+ * levels of the atmosphere (geometric in the smallest scale height, see
+ * sb_atmosphere_gpu_pack), so each segment spans at most a factor ~2 of
+ * density. Each segment is integrated by Gauss-Legendre 4; the transmittance
+ * from the ray's origin to each node comes from the same node values through
+ * the Gauss-Legendre collocation (integration) matrix, exact for cubic
+ * extinction within the segment.
+ */
+const float GL4_X[4] = float[4](-0.8611363115940526, -0.3399810435848563, 0.3399810435848563, 0.8611363115940526);
+const float GL4_W[4] = float[4](0.3478548451374538, 0.6521451548625461, 0.6521451548625461, 0.3478548451374538);
+/* GL4_S[i][j] = integral from -1 to x_i of the j-th Lagrange basis polynomial. */
+const float GL4_S[16] = float[16](
+    0.1739274225687270, -0.0532083601699975, 0.0252549253788094, -0.0071102993715914,
+    0.3762362349997362, 0.3260725774312730, -0.0557608572049417, 0.0134710011890763,
+    0.3343838439483776, 0.7079060120674879, 0.3260725774312732, -0.0283813898622823,
+    0.3549651445090452, 0.6268902294837367, 0.7053535150325437, 0.1739274225687269);
+
+float level_at(int i)
+{
+    return i < 4 ? atm.levels_a[i] : (i < 8 ? atm.levels_b[i - 4] : (i < 12 ? atm.levels_c[i - 8] : atm.levels_d[i - 12]));
+}
+
+/* Sorted distances in [0, t_end] where the ray crosses the altitude levels. */
+int ray_breakpoints(float h0, float mu, float t_end, out float ts[2 * SB_MAX_LEVELS + 2])
+{
+    float R = ground_radius();
+    float s0 = (R + h0) * mu;
+    int n = 0;
+    ts[n++] = 0.0;
+    for (int i = 0; i < int(atm.level_count.x); i++) {
+        float level = level_at(i);
+        float c = (level - h0) * (2.0 * R + level + h0);
+        float disc = s0 * s0 + c;
+        if (c > 0.0) {
+            float t = s0 >= 0.0 ? c / (s0 + sqrt(disc)) : sqrt(disc) - s0;
+            if (t < t_end)
+                ts[n++] = t;
+        } else if (c < 0.0 && s0 < 0.0 && disc > 0.0) {
+            float root = sqrt(disc);
+            float t1 = -c / (root - s0), t2 = root - s0;
+            if (t1 < t_end)
+                ts[n++] = t1;
+            if (t2 < t_end)
+                ts[n++] = t2;
+        }
+    }
+    ts[n++] = t_end;
+    for (int i = 1; i < n; i++) {
+        float v = ts[i];
+        int j = i - 1;
+        while (j >= 0 && ts[j] > v) {
+            ts[j + 1] = ts[j];
+            j--;
+        }
+        ts[j + 1] = v;
+    }
+    return n;
+}
+
+struct RayIntegrals {
+    vec3 sun_rayleigh; /* integral of T(x,y) sigma_s,R(y) T_sun(y) dt */
+    vec3 sun_mie;      /* integral of T(x,y) sigma_s,M(y) T_sun(y) dt */
+    vec3 ms_rayleigh;  /* integral of T(x,y) sigma_s,R(y) psi_ms(y) dt (when asked) */
+    vec3 ms_mie;       /* integral of T(x,y) sigma_s,M(y) psi_ms(y) dt (when asked) */
+    vec3 scattering;   /* integral of T(x,y) sigma_s(y) dt */
+    vec3 transmittance; /* T(x, end of ray) */
+    float t_end;
+};
+
+/* nu: cosine between the ray and the sun; toward_ground: the ray ends on the ground. */
+RayIntegrals integrate_ray(float h0, float mu, float mu_s, float nu, bool toward_ground, bool want_ms)
+{
+    RayIntegrals o;
+    o.sun_rayleigh = o.sun_mie = o.ms_rayleigh = o.ms_mie = o.scattering = vec3(0.0);
+    float r0 = ground_radius() + h0;
+    float t_end = toward_ground ? distance_to_ground(h0, mu) : distance_to_top(h0, mu);
+    o.t_end = t_end;
+
+    float ts[2 * SB_MAX_LEVELS + 2];
+    int n = ray_breakpoints(h0, mu, t_end, ts);
+    vec3 tau = vec3(0.0);
+    for (int s = 0; s + 1 < n; s++) {
+        float half_len = 0.5 * (ts[s + 1] - ts[s]), mid = 0.5 * (ts[s + 1] + ts[s]);
+        if (half_len <= 0.0)
+            continue;
+        Medium m[4];
+        float hs[4], mus[4];
+        for (int j = 0; j < 4; j++) {
+            float t = mid + half_len * GL4_X[j];
+            hs[j] = altitude_along(h0, mu, t);
+            float rt = ground_radius() + hs[j];
+            mus[j] = clamp((r0 * mu_s + t * nu) / rt, -1.0, 1.0);
+            m[j] = medium_at(hs[j]);
+        }
+        for (int i = 0; i < 4; i++) {
+            vec3 depth = tau;
+            for (int j = 0; j < 4; j++)
+                depth += half_len * GL4_S[i * 4 + j] * m[j].extinction;
+            vec3 tw = exp(-depth) * (half_len * GL4_W[i]);
+            vec3 sun = sun_transmittance(hs[i], mus[i]);
+            o.sun_rayleigh += tw * m[i].scattering_rayleigh * sun;
+            o.sun_mie += tw * m[i].scattering_mie * sun;
+            o.scattering += tw * (m[i].scattering_rayleigh + m[i].scattering_mie);
+            if (want_ms) {
+                vec3 psi = multiscattering_lut_sample(hs[i], mus[i]);
+                o.ms_rayleigh += tw * m[i].scattering_rayleigh * psi;
+                o.ms_mie += tw * m[i].scattering_mie * psi;
+            }
+        }
+        for (int j = 0; j < 4; j++)
+            tau += half_len * GL4_W[j] * m[j].extinction;
+    }
+    o.transmittance = exp(-tau);
+    return o;
+}
+
+/* Gauss-Legendre node k of n on [a, b] (Golub-Welsch is overkill for n <= 64:
+ * Newton on the Legendre recurrence in fp32 converges to a few ulp). */
+void gauss_legendre(int k, int n, float a, float b, out float x, out float w)
+{
+    float z = cos(PI * (float(k) + 0.75) / (float(n) + 0.5));
+    float dp = 1.0;
+    for (int it = 0; it < 8; it++) {
+        float p0 = 1.0, p1 = 0.0;
+        for (int j = 1; j <= n; j++) {
+            float p2 = p1;
+            p1 = p0;
+            p0 = ((2.0 * float(j) - 1.0) * z * p1 - (float(j) - 1.0) * p2) / float(j);
+        }
+        dp = float(n) * (z * p0 - p1) / (z * z - 1.0);
+        z -= p0 / dp;
+    }
+    x = 0.5 * (a + b) - 0.5 * (b - a) * z; /* ascending in k */
+    w = (b - a) / ((1.0 - z * z) * dp * dp);
+}
+
+#endif

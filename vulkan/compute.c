@@ -1,0 +1,250 @@
+#include "compute.h"
+
+#include <string.h>
+
+#include "log.h"
+
+static int find_memory_type(const struct sb_vk *vk, uint32_t type_bits, VkMemoryPropertyFlags want)
+{
+    for (uint32_t i = 0; i < vk->memory_properties.memoryTypeCount; i++)
+        if ((type_bits & (1u << i)) && (vk->memory_properties.memoryTypes[i].propertyFlags & want) == want)
+            return (int)i;
+    return -1;
+}
+
+enum sb_result sb_buffer_create(struct sb_vk *vk, VkDeviceSize size, const char *name, struct sb_buffer *b)
+{
+    enum sb_result res = SB_OK;
+    memset(b, 0, sizeof(*b));
+    VkBufferCreateInfo info = {
+        .sType = VK_STRUCTURE_TYPE_BUFFER_CREATE_INFO,
+        .size = size,
+        .usage = VK_BUFFER_USAGE_STORAGE_BUFFER_BIT | VK_BUFFER_USAGE_TRANSFER_SRC_BIT | VK_BUFFER_USAGE_TRANSFER_DST_BIT,
+        .sharingMode = VK_SHARING_MODE_EXCLUSIVE,
+    };
+    VK(vkCreateBuffer(vk->device, &info, NULL, &b->buffer));
+    sb_vk_name(vk, VK_OBJECT_TYPE_BUFFER, (uint64_t)b->buffer, name);
+    VkMemoryRequirements req;
+    vkGetBufferMemoryRequirements(vk->device, b->buffer, &req);
+    const VkMemoryPropertyFlags host = VK_MEMORY_PROPERTY_HOST_VISIBLE_BIT | VK_MEMORY_PROPERTY_HOST_COHERENT_BIT;
+    int type = find_memory_type(vk, req.memoryTypeBits, host | VK_MEMORY_PROPERTY_DEVICE_LOCAL_BIT);
+    if (type < 0)
+        type = find_memory_type(vk, req.memoryTypeBits, host);
+    if (type < 0) {
+        sb_error("%s: no host-visible coherent memory type for a storage buffer", name);
+        res = SB_ERR_VULKAN;
+        goto cleanup;
+    }
+    VkMemoryAllocateInfo alloc = {
+        .sType = VK_STRUCTURE_TYPE_MEMORY_ALLOCATE_INFO,
+        .allocationSize = req.size,
+        .memoryTypeIndex = (uint32_t)type,
+    };
+    VK(vkAllocateMemory(vk->device, &alloc, NULL, &b->memory));
+    VK(vkBindBufferMemory(vk->device, b->buffer, b->memory, 0));
+    VK(vkMapMemory(vk->device, b->memory, 0, VK_WHOLE_SIZE, 0, &b->mapped));
+    memset(b->mapped, 0, size);
+    b->size = size;
+    return SB_OK;
+
+cleanup:
+    sb_buffer_destroy(vk, b);
+    return res;
+}
+
+void sb_buffer_destroy(struct sb_vk *vk, struct sb_buffer *b)
+{
+    if (b->buffer)
+        vkDestroyBuffer(vk->device, b->buffer, NULL);
+    if (b->memory)
+        vkFreeMemory(vk->device, b->memory, NULL); /* unmaps */
+    memset(b, 0, sizeof(*b));
+}
+
+enum sb_result sb_pipeline_create(struct sb_vk *vk, const struct sb_pipeline_params *params, struct sb_pipeline *p)
+{
+    enum sb_result res = SB_OK;
+    VkShaderModule module = VK_NULL_HANDLE;
+    memset(p, 0, sizeof(*p));
+    p->binding_count = params->binding_count;
+    p->push_size = params->push_size;
+
+    VkDescriptorSetLayoutBinding bindings[16];
+    if (params->binding_count > 16) {
+        res = SB_ERR_OUT_OF_RANGE;
+        goto cleanup;
+    }
+    for (uint32_t i = 0; i < params->binding_count; i++)
+        bindings[i] = (VkDescriptorSetLayoutBinding){
+            .binding = i,
+            .descriptorType = VK_DESCRIPTOR_TYPE_STORAGE_BUFFER,
+            .descriptorCount = 1,
+            .stageFlags = VK_SHADER_STAGE_COMPUTE_BIT,
+        };
+    VkDescriptorSetLayoutCreateInfo set_info = {
+        .sType = VK_STRUCTURE_TYPE_DESCRIPTOR_SET_LAYOUT_CREATE_INFO,
+        .bindingCount = params->binding_count,
+        .pBindings = bindings,
+    };
+    VK(vkCreateDescriptorSetLayout(vk->device, &set_info, NULL, &p->set_layout));
+    VkPushConstantRange range = {.stageFlags = VK_SHADER_STAGE_COMPUTE_BIT, .size = params->push_size};
+    VkPipelineLayoutCreateInfo layout_info = {
+        .sType = VK_STRUCTURE_TYPE_PIPELINE_LAYOUT_CREATE_INFO,
+        .setLayoutCount = 1,
+        .pSetLayouts = &p->set_layout,
+        .pushConstantRangeCount = params->push_size ? 1 : 0,
+        .pPushConstantRanges = &range,
+    };
+    VK(vkCreatePipelineLayout(vk->device, &layout_info, NULL, &p->layout));
+    VkShaderModuleCreateInfo module_info = {
+        .sType = VK_STRUCTURE_TYPE_SHADER_MODULE_CREATE_INFO,
+        .codeSize = params->spirv_size,
+        .pCode = params->spirv,
+    };
+    VK(vkCreateShaderModule(vk->device, &module_info, NULL, &module));
+    VkComputePipelineCreateInfo pipe_info = {
+        .sType = VK_STRUCTURE_TYPE_COMPUTE_PIPELINE_CREATE_INFO,
+        .stage = {
+            .sType = VK_STRUCTURE_TYPE_PIPELINE_SHADER_STAGE_CREATE_INFO,
+            .stage = VK_SHADER_STAGE_COMPUTE_BIT,
+            .module = module,
+            .pName = "main",
+        },
+        .layout = p->layout,
+    };
+    VK(vkCreateComputePipelines(vk->device, VK_NULL_HANDLE, 1, &pipe_info, NULL, &p->pipeline));
+    sb_vk_name(vk, VK_OBJECT_TYPE_PIPELINE, (uint64_t)p->pipeline, params->name);
+
+    VkDescriptorPoolSize pool_size = {
+        .type = VK_DESCRIPTOR_TYPE_STORAGE_BUFFER,
+        .descriptorCount = params->binding_count ? params->binding_count : 1,
+    };
+    VkDescriptorPoolCreateInfo pool_info = {
+        .sType = VK_STRUCTURE_TYPE_DESCRIPTOR_POOL_CREATE_INFO,
+        .maxSets = 1,
+        .poolSizeCount = 1,
+        .pPoolSizes = &pool_size,
+    };
+    VK(vkCreateDescriptorPool(vk->device, &pool_info, NULL, &p->descriptor_pool));
+    VkDescriptorSetAllocateInfo set_alloc = {
+        .sType = VK_STRUCTURE_TYPE_DESCRIPTOR_SET_ALLOCATE_INFO,
+        .descriptorPool = p->descriptor_pool,
+        .descriptorSetCount = 1,
+        .pSetLayouts = &p->set_layout,
+    };
+    VK(vkAllocateDescriptorSets(vk->device, &set_alloc, &p->set));
+    vkDestroyShaderModule(vk->device, module, NULL);
+    return SB_OK;
+
+cleanup:
+    if (module)
+        vkDestroyShaderModule(vk->device, module, NULL);
+    sb_pipeline_destroy(vk, p);
+    return res;
+}
+
+void sb_pipeline_destroy(struct sb_vk *vk, struct sb_pipeline *p)
+{
+    if (p->descriptor_pool)
+        vkDestroyDescriptorPool(vk->device, p->descriptor_pool, NULL);
+    if (p->pipeline)
+        vkDestroyPipeline(vk->device, p->pipeline, NULL);
+    if (p->layout)
+        vkDestroyPipelineLayout(vk->device, p->layout, NULL);
+    if (p->set_layout)
+        vkDestroyDescriptorSetLayout(vk->device, p->set_layout, NULL);
+    memset(p, 0, sizeof(*p));
+}
+
+void sb_pipeline_bind(struct sb_vk *vk, struct sb_pipeline *p, const struct sb_buffer *const *buffers)
+{
+    VkDescriptorBufferInfo infos[16];
+    VkWriteDescriptorSet writes[16];
+    for (uint32_t i = 0; i < p->binding_count; i++) {
+        infos[i] = (VkDescriptorBufferInfo){.buffer = buffers[i]->buffer, .range = VK_WHOLE_SIZE};
+        writes[i] = (VkWriteDescriptorSet){
+            .sType = VK_STRUCTURE_TYPE_WRITE_DESCRIPTOR_SET,
+            .dstSet = p->set,
+            .dstBinding = i,
+            .descriptorCount = 1,
+            .descriptorType = VK_DESCRIPTOR_TYPE_STORAGE_BUFFER,
+            .pBufferInfo = &infos[i],
+        };
+    }
+    vkUpdateDescriptorSets(vk->device, p->binding_count, writes, 0, NULL);
+}
+
+enum sb_result sb_dispatch(struct sb_vk *vk, struct sb_pipeline *p, const void *push, uint32_t gx, uint32_t gy,
+                           uint32_t gz, double *gpu_ms)
+{
+    enum sb_result res = SB_OK;
+    VkCommandBuffer cmd = VK_NULL_HANDLE;
+    VkQueryPool queries = VK_NULL_HANDLE;
+    VkFence fence = VK_NULL_HANDLE;
+    *gpu_ms = 0.0;
+
+    if (vk->has_timestamps) {
+        VkQueryPoolCreateInfo qinfo = {
+            .sType = VK_STRUCTURE_TYPE_QUERY_POOL_CREATE_INFO,
+            .queryType = VK_QUERY_TYPE_TIMESTAMP,
+            .queryCount = 2,
+        };
+        VK(vkCreateQueryPool(vk->device, &qinfo, NULL, &queries));
+        vkResetQueryPool(vk->device, queries, 0, 2);
+    }
+    VkCommandBufferAllocateInfo alloc = {
+        .sType = VK_STRUCTURE_TYPE_COMMAND_BUFFER_ALLOCATE_INFO,
+        .commandPool = vk->command_pool,
+        .level = VK_COMMAND_BUFFER_LEVEL_PRIMARY,
+        .commandBufferCount = 1,
+    };
+    VK(vkAllocateCommandBuffers(vk->device, &alloc, &cmd));
+    VkCommandBufferBeginInfo begin = {
+        .sType = VK_STRUCTURE_TYPE_COMMAND_BUFFER_BEGIN_INFO,
+        .flags = VK_COMMAND_BUFFER_USAGE_ONE_TIME_SUBMIT_BIT,
+    };
+    VK(vkBeginCommandBuffer(cmd, &begin));
+    /* Host writes to the inputs are visible through the submission itself. */
+    if (queries)
+        vkCmdWriteTimestamp(cmd, VK_PIPELINE_STAGE_TOP_OF_PIPE_BIT, queries, 0);
+    vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, p->pipeline);
+    vkCmdBindDescriptorSets(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, p->layout, 0, 1, &p->set, 0, NULL);
+    if (push && p->push_size)
+        vkCmdPushConstants(cmd, p->layout, VK_SHADER_STAGE_COMPUTE_BIT, 0, p->push_size, push);
+    vkCmdDispatch(cmd, gx, gy, gz);
+    if (queries)
+        vkCmdWriteTimestamp(cmd, VK_PIPELINE_STAGE_BOTTOM_OF_PIPE_BIT, queries, 1);
+    /* Make the shader's writes visible to the host once the fence signals. */
+    VkMemoryBarrier barrier = {
+        .sType = VK_STRUCTURE_TYPE_MEMORY_BARRIER,
+        .srcAccessMask = VK_ACCESS_SHADER_WRITE_BIT,
+        .dstAccessMask = VK_ACCESS_HOST_READ_BIT,
+    };
+    vkCmdPipelineBarrier(cmd, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, VK_PIPELINE_STAGE_HOST_BIT, 0, 1, &barrier, 0, NULL,
+                         0, NULL);
+    VK(vkEndCommandBuffer(cmd));
+    VkFenceCreateInfo finfo = {.sType = VK_STRUCTURE_TYPE_FENCE_CREATE_INFO};
+    VK(vkCreateFence(vk->device, &finfo, NULL, &fence));
+    VkSubmitInfo submit = {
+        .sType = VK_STRUCTURE_TYPE_SUBMIT_INFO,
+        .commandBufferCount = 1,
+        .pCommandBuffers = &cmd,
+    };
+    VK(vkQueueSubmit(vk->queue, 1, &submit, fence));
+    VK(vkWaitForFences(vk->device, 1, &fence, VK_TRUE, UINT64_MAX));
+    if (queries) {
+        uint64_t ts[2];
+        VK(vkGetQueryPoolResults(vk->device, queries, 0, 2, sizeof(ts), ts, sizeof(uint64_t),
+                                 VK_QUERY_RESULT_64_BIT | VK_QUERY_RESULT_WAIT_BIT));
+        *gpu_ms = (double)(ts[1] - ts[0]) * vk->timestamp_period_ns * 1e-6;
+    }
+
+cleanup:
+    if (fence)
+        vkDestroyFence(vk->device, fence, NULL);
+    if (cmd)
+        vkFreeCommandBuffers(vk->device, vk->command_pool, 1, &cmd);
+    if (queries)
+        vkDestroyQueryPool(vk->device, queries, NULL);
+    return res;
+}

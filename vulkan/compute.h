@@ -1,0 +1,60 @@
+/*
+ * Storage buffers and compute pipelines on an sb_vk context, and timed,
+ * synchronous dispatches. Buffers live in memory the host can map (device
+ * local where the device offers such a type), which is right for the small
+ * LUTs skybake bakes; all functions are for one thread at a time.
+ */
+#ifndef SB_VK_COMPUTE_H
+#define SB_VK_COMPUTE_H
+
+#include <stddef.h>
+#include <stdint.h>
+
+#include "context.h"
+
+struct sb_buffer {
+    VkBuffer buffer;
+    VkDeviceMemory memory;
+    VkDeviceSize size;
+    void *mapped; /* persistently mapped, coherent */
+};
+
+/* A zero-filled storage buffer of `size` bytes (> 0). */
+enum sb_result sb_buffer_create(struct sb_vk *vk, VkDeviceSize size, const char *name, struct sb_buffer *buffer);
+/* Free a buffer; accepts a zeroed one. */
+void sb_buffer_destroy(struct sb_vk *vk, struct sb_buffer *buffer);
+
+struct sb_pipeline {
+    VkDescriptorSetLayout set_layout;
+    VkPipelineLayout layout;
+    VkPipeline pipeline;
+    VkDescriptorPool descriptor_pool;
+    VkDescriptorSet set;
+    uint32_t binding_count;
+    uint32_t push_size;
+};
+
+struct sb_pipeline_params {
+    const uint32_t *spirv; /* SPIR-V words, entry point "main" */
+    size_t spirv_size;     /* in bytes */
+    uint32_t binding_count; /* storage buffers at bindings 0..count-1 of set 0 */
+    uint32_t push_size;     /* bytes of push constants, 0 for none */
+    const char *name;       /* debug name */
+};
+
+enum sb_result sb_pipeline_create(struct sb_vk *vk, const struct sb_pipeline_params *params,
+                                  struct sb_pipeline *pipeline);
+void sb_pipeline_destroy(struct sb_vk *vk, struct sb_pipeline *pipeline);
+
+/* Point binding i at buffers[i] for every binding of the pipeline. */
+void sb_pipeline_bind(struct sb_vk *vk, struct sb_pipeline *pipeline, const struct sb_buffer *const *buffers);
+
+/*
+ * Record, submit and wait for one dispatch of groups_x * groups_y * groups_z
+ * workgroups. *gpu_ms receives the time between timestamps written before
+ * and after it (0 when the queue has no timestamps). `push` may be NULL.
+ */
+enum sb_result sb_dispatch(struct sb_vk *vk, struct sb_pipeline *pipeline, const void *push, uint32_t groups_x,
+                           uint32_t groups_y, uint32_t groups_z, double *gpu_ms);
+
+#endif

@@ -1,0 +1,312 @@
+#include "context.h"
+
+#include <ctype.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "log.h"
+
+#define VALIDATION_LAYER "VK_LAYER_KHRONOS_validation"
+
+const char *sb_vk_result_name(VkResult r)
+{
+    switch (r) {
+#define CASE(x) case x: return #x
+        CASE(VK_SUCCESS);
+        CASE(VK_NOT_READY);
+        CASE(VK_TIMEOUT);
+        CASE(VK_INCOMPLETE);
+        CASE(VK_ERROR_OUT_OF_HOST_MEMORY);
+        CASE(VK_ERROR_OUT_OF_DEVICE_MEMORY);
+        CASE(VK_ERROR_INITIALIZATION_FAILED);
+        CASE(VK_ERROR_DEVICE_LOST);
+        CASE(VK_ERROR_MEMORY_MAP_FAILED);
+        CASE(VK_ERROR_LAYER_NOT_PRESENT);
+        CASE(VK_ERROR_EXTENSION_NOT_PRESENT);
+        CASE(VK_ERROR_FEATURE_NOT_PRESENT);
+        CASE(VK_ERROR_INCOMPATIBLE_DRIVER);
+        CASE(VK_ERROR_TOO_MANY_OBJECTS);
+        CASE(VK_ERROR_FORMAT_NOT_SUPPORTED);
+        CASE(VK_ERROR_FRAGMENTED_POOL);
+        CASE(VK_ERROR_OUT_OF_POOL_MEMORY);
+#undef CASE
+    default:
+        return "VK_ERROR_(unknown)";
+    }
+}
+
+static VKAPI_ATTR VkBool32 VKAPI_CALL on_validation(VkDebugUtilsMessageSeverityFlagBitsEXT severity,
+                                                    VkDebugUtilsMessageTypeFlagsEXT types,
+                                                    const VkDebugUtilsMessengerCallbackDataEXT *data, void *user)
+{
+    (void)types;
+    struct sb_vk *vk = user;
+    if (severity & (VK_DEBUG_UTILS_MESSAGE_SEVERITY_WARNING_BIT_EXT | VK_DEBUG_UTILS_MESSAGE_SEVERITY_ERROR_BIT_EXT)) {
+        vk->validation_messages++;
+        sb_error("validation: %s", data->pMessage);
+    }
+    return VK_FALSE;
+}
+
+static bool has_layer(const char *name)
+{
+    uint32_t n = 0;
+    vkEnumerateInstanceLayerProperties(&n, NULL);
+    VkLayerProperties *layers = calloc(n ? n : 1, sizeof(*layers));
+    bool found = false;
+    if (layers && vkEnumerateInstanceLayerProperties(&n, layers) == VK_SUCCESS)
+        for (uint32_t i = 0; i < n; i++)
+            found |= strcmp(layers[i].layerName, name) == 0;
+    free(layers);
+    return found;
+}
+
+static bool has_instance_extension(const char *name)
+{
+    uint32_t n = 0;
+    vkEnumerateInstanceExtensionProperties(NULL, &n, NULL);
+    VkExtensionProperties *ext = calloc(n ? n : 1, sizeof(*ext));
+    bool found = false;
+    if (ext && vkEnumerateInstanceExtensionProperties(NULL, &n, ext) == VK_SUCCESS)
+        for (uint32_t i = 0; i < n; i++)
+            found |= strcmp(ext[i].extensionName, name) == 0;
+    free(ext);
+    return found;
+}
+
+static bool contains_ci(const char *haystack, const char *needle)
+{
+    size_t n = strlen(needle);
+    for (; *haystack; haystack++) {
+        size_t i = 0;
+        while (i < n && haystack[i] && tolower((unsigned char)haystack[i]) == tolower((unsigned char)needle[i]))
+            i++;
+        if (i == n)
+            return true;
+    }
+    return n == 0;
+}
+
+static enum sb_result pick_device(struct sb_vk *vk, const char *want)
+{
+    uint32_t n = 0;
+    VkResult r = vkEnumeratePhysicalDevices(vk->instance, &n, NULL);
+    if (r != VK_SUCCESS || n == 0) {
+        sb_error("no Vulkan device found (install mesa-vulkan-drivers for the CPU device, lavapipe)");
+        return SB_ERR_NO_DEVICE;
+    }
+    VkPhysicalDevice *devs = calloc(n, sizeof(*devs));
+    if (!devs)
+        return SB_ERR_NOMEM;
+    vkEnumeratePhysicalDevices(vk->instance, &n, devs);
+    int chosen = -1;
+    bool is_index = want && *want && strspn(want, "0123456789") == strlen(want);
+    for (uint32_t i = 0; i < n && chosen < 0; i++) {
+        VkPhysicalDeviceProperties p;
+        vkGetPhysicalDeviceProperties(devs[i], &p);
+        if (!want)
+            chosen = p.deviceType == VK_PHYSICAL_DEVICE_TYPE_DISCRETE_GPU ? (int)i : -1;
+        else if (is_index)
+            chosen = (uint32_t)atoi(want) == i ? (int)i : -1;
+        else
+            chosen = contains_ci(p.deviceName, want) ? (int)i : -1;
+    }
+    if (!want && chosen < 0)
+        chosen = 0;
+    if (chosen < 0) {
+        sb_error("no Vulkan device matches --device \"%s\"; devices:", want);
+        for (uint32_t i = 0; i < n; i++) {
+            VkPhysicalDeviceProperties p;
+            vkGetPhysicalDeviceProperties(devs[i], &p);
+            sb_error("  %u: %s", i, p.deviceName);
+        }
+        free(devs);
+        return SB_ERR_NO_DEVICE;
+    }
+    vk->physical_device = devs[chosen];
+    free(devs);
+    return SB_OK;
+}
+
+enum sb_result sb_vk_create(const struct sb_vk_params *params, struct sb_vk **out)
+{
+    enum sb_result res = SB_OK;
+    *out = NULL;
+    struct sb_vk *vk = calloc(1, sizeof(*vk));
+    if (!vk)
+        return SB_ERR_NOMEM;
+
+    if (params->validate && !has_layer(VALIDATION_LAYER)) {
+        sb_error("validation requested but %s is not installed (Debian: vulkan-validationlayers)", VALIDATION_LAYER);
+        res = SB_ERR_VULKAN;
+        goto cleanup;
+    }
+    bool debug_utils = has_instance_extension(VK_EXT_DEBUG_UTILS_EXTENSION_NAME);
+    const char *layers[] = {VALIDATION_LAYER};
+    const char *extensions[] = {VK_EXT_DEBUG_UTILS_EXTENSION_NAME};
+    VkApplicationInfo app = {
+        .sType = VK_STRUCTURE_TYPE_APPLICATION_INFO,
+        .pApplicationName = "skybake",
+        .pEngineName = "skybake",
+        .apiVersion = VK_API_VERSION_1_2,
+    };
+    VkDebugUtilsMessengerCreateInfoEXT messenger_info = {
+        .sType = VK_STRUCTURE_TYPE_DEBUG_UTILS_MESSENGER_CREATE_INFO_EXT,
+        .messageSeverity = VK_DEBUG_UTILS_MESSAGE_SEVERITY_WARNING_BIT_EXT | VK_DEBUG_UTILS_MESSAGE_SEVERITY_ERROR_BIT_EXT,
+        .messageType = VK_DEBUG_UTILS_MESSAGE_TYPE_GENERAL_BIT_EXT | VK_DEBUG_UTILS_MESSAGE_TYPE_VALIDATION_BIT_EXT |
+                       VK_DEBUG_UTILS_MESSAGE_TYPE_PERFORMANCE_BIT_EXT,
+        .pfnUserCallback = on_validation,
+        .pUserData = vk,
+    };
+    VkInstanceCreateInfo instance_info = {
+        .sType = VK_STRUCTURE_TYPE_INSTANCE_CREATE_INFO,
+        .pNext = params->validate && debug_utils ? &messenger_info : NULL,
+        .pApplicationInfo = &app,
+        .enabledLayerCount = params->validate ? 1 : 0,
+        .ppEnabledLayerNames = layers,
+        .enabledExtensionCount = debug_utils ? 1 : 0,
+        .ppEnabledExtensionNames = extensions,
+    };
+    VkResult r = vkCreateInstance(&instance_info, NULL, &vk->instance);
+    if (r == VK_ERROR_INCOMPATIBLE_DRIVER) {
+        sb_error("no Vulkan device found: no driver accepts Vulkan 1.2 (install mesa-vulkan-drivers for lavapipe)");
+        res = SB_ERR_NO_DEVICE;
+        goto cleanup;
+    }
+    VK(r);
+    if (params->validate && debug_utils) {
+        PFN_vkCreateDebugUtilsMessengerEXT create_messenger =
+            (PFN_vkCreateDebugUtilsMessengerEXT)vkGetInstanceProcAddr(vk->instance, "vkCreateDebugUtilsMessengerEXT");
+        if (create_messenger)
+            VK(create_messenger(vk->instance, &messenger_info, NULL, &vk->messenger));
+    }
+    if (debug_utils)
+        vk->set_object_name =
+            (PFN_vkSetDebugUtilsObjectNameEXT)vkGetInstanceProcAddr(vk->instance, "vkSetDebugUtilsObjectNameEXT");
+
+    if ((res = pick_device(vk, params->device)))
+        goto cleanup;
+    vkGetPhysicalDeviceProperties(vk->physical_device, &vk->properties);
+    vkGetPhysicalDeviceMemoryProperties(vk->physical_device, &vk->memory_properties);
+    if (vk->properties.apiVersion < VK_API_VERSION_1_2) {
+        sb_error("%s supports Vulkan %u.%u; skybake needs 1.2", vk->properties.deviceName,
+                 VK_API_VERSION_MAJOR(vk->properties.apiVersion), VK_API_VERSION_MINOR(vk->properties.apiVersion));
+        res = SB_ERR_NO_DEVICE;
+        goto cleanup;
+    }
+    VkPhysicalDeviceDriverProperties driver = {.sType = VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_DRIVER_PROPERTIES};
+    VkPhysicalDeviceProperties2 props2 = {.sType = VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_PROPERTIES_2, .pNext = &driver};
+    vkGetPhysicalDeviceProperties2(vk->physical_device, &props2);
+    snprintf(vk->driver_name, sizeof(vk->driver_name), "%s", driver.driverName);
+    snprintf(vk->driver_info, sizeof(vk->driver_info), "%s", driver.driverInfo);
+
+    uint32_t nq = 0;
+    vkGetPhysicalDeviceQueueFamilyProperties(vk->physical_device, &nq, NULL);
+    VkQueueFamilyProperties qf[16];
+    if (nq > 16)
+        nq = 16;
+    vkGetPhysicalDeviceQueueFamilyProperties(vk->physical_device, &nq, qf);
+    int family = -1;
+    for (uint32_t i = 0; i < nq && family < 0; i++) /* prefer a queue that does both */
+        if ((qf[i].queueFlags & (VK_QUEUE_COMPUTE_BIT | VK_QUEUE_GRAPHICS_BIT)) ==
+            (VK_QUEUE_COMPUTE_BIT | VK_QUEUE_GRAPHICS_BIT))
+            family = (int)i;
+    for (uint32_t i = 0; i < nq && family < 0; i++)
+        if (qf[i].queueFlags & VK_QUEUE_COMPUTE_BIT)
+            family = (int)i;
+    if (family < 0) {
+        sb_error("%s has no compute queue", vk->properties.deviceName);
+        res = SB_ERR_NO_DEVICE;
+        goto cleanup;
+    }
+    vk->queue_family = (uint32_t)family;
+    vk->has_timestamps = qf[family].timestampValidBits > 0 && vk->properties.limits.timestampPeriod > 0;
+    vk->timestamp_period_ns = vk->properties.limits.timestampPeriod;
+
+    float priority = 1.0f;
+    VkDeviceQueueCreateInfo queue_info = {
+        .sType = VK_STRUCTURE_TYPE_DEVICE_QUEUE_CREATE_INFO,
+        .queueFamilyIndex = vk->queue_family,
+        .queueCount = 1,
+        .pQueuePriorities = &priority,
+    };
+    VkPhysicalDeviceVulkan12Features features12 = {
+        .sType = VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_VULKAN_1_2_FEATURES,
+        .hostQueryReset = VK_TRUE,
+    };
+    VkDeviceCreateInfo device_info = {
+        .sType = VK_STRUCTURE_TYPE_DEVICE_CREATE_INFO,
+        .pNext = &features12,
+        .queueCreateInfoCount = 1,
+        .pQueueCreateInfos = &queue_info,
+    };
+    VK(vkCreateDevice(vk->physical_device, &device_info, NULL, &vk->device));
+    vkGetDeviceQueue(vk->device, vk->queue_family, 0, &vk->queue);
+    VkCommandPoolCreateInfo pool_info = {
+        .sType = VK_STRUCTURE_TYPE_COMMAND_POOL_CREATE_INFO,
+        .flags = VK_COMMAND_POOL_CREATE_RESET_COMMAND_BUFFER_BIT,
+        .queueFamilyIndex = vk->queue_family,
+    };
+    VK(vkCreateCommandPool(vk->device, &pool_info, NULL, &vk->command_pool));
+    sb_debug("device: %s (%s %s)", vk->properties.deviceName, vk->driver_name, vk->driver_info);
+    *out = vk;
+    return SB_OK;
+
+cleanup:
+    sb_vk_destroy(&vk);
+    return res;
+}
+
+void sb_vk_destroy(struct sb_vk **pvk)
+{
+    struct sb_vk *vk = *pvk;
+    if (!vk)
+        return;
+    if (vk->device) {
+        vkDeviceWaitIdle(vk->device);
+        if (vk->command_pool)
+            vkDestroyCommandPool(vk->device, vk->command_pool, NULL);
+        vkDestroyDevice(vk->device, NULL);
+    }
+    if (vk->messenger) {
+        PFN_vkDestroyDebugUtilsMessengerEXT destroy_messenger =
+            (PFN_vkDestroyDebugUtilsMessengerEXT)vkGetInstanceProcAddr(vk->instance, "vkDestroyDebugUtilsMessengerEXT");
+        if (destroy_messenger)
+            destroy_messenger(vk->instance, vk->messenger, NULL);
+    }
+    if (vk->instance)
+        vkDestroyInstance(vk->instance, NULL);
+    free(vk);
+    *pvk = NULL;
+}
+
+unsigned sb_vk_validation_messages(const struct sb_vk *vk)
+{
+    return vk->validation_messages;
+}
+
+void sb_vk_device_info(const struct sb_vk *vk, struct sb_device_info *info)
+{
+    memset(info, 0, sizeof(*info));
+    snprintf(info->name, sizeof(info->name), "%s", vk->properties.deviceName);
+    snprintf(info->driver, sizeof(info->driver), "%s %s", vk->driver_name, vk->driver_info);
+    uint32_t v = vk->properties.apiVersion;
+    snprintf(info->api_version, sizeof(info->api_version), "%u.%u.%u", VK_API_VERSION_MAJOR(v),
+             VK_API_VERSION_MINOR(v), VK_API_VERSION_PATCH(v));
+    info->vendor_id = vk->properties.vendorID;
+    info->device_id = vk->properties.deviceID;
+}
+
+void sb_vk_name(struct sb_vk *vk, VkObjectType type, uint64_t handle, const char *name)
+{
+    if (!vk->set_object_name || !name)
+        return;
+    VkDebugUtilsObjectNameInfoEXT info = {
+        .sType = VK_STRUCTURE_TYPE_DEBUG_UTILS_OBJECT_NAME_INFO_EXT,
+        .objectType = type,
+        .objectHandle = handle,
+        .pObjectName = name,
+    };
+    vk->set_object_name(vk->device, &info);
+}
