@@ -14,45 +14,52 @@
 #define BIT(p) (1u << (p))
 
 static const struct sb_atmosphere_product products[SB_PRODUCT_COUNT] = {
-    [SB_PRODUCT_TRANSMITTANCE] = {
-        .id = SB_PRODUCT_TRANSMITTANCE,
-        .width = SB_TRANSMITTANCE_WIDTH,
-        .height = SB_TRANSMITTANCE_HEIGHT,
-        .channel_count = SB_TRANSMITTANCE_CHANNELS,
-        .channel_names = "r,g,b",
-        .parameterization = "transmittance-hillaire2020-v1",
-    },
-    [SB_PRODUCT_MULTISCATTERING] = {
-        .id = SB_PRODUCT_MULTISCATTERING,
-        .width = SB_MULTISCATTERING_SIZE,
-        .height = SB_MULTISCATTERING_SIZE,
-        .channel_count = SB_MULTISCATTERING_CHANNELS,
-        .channel_names = "r,g,b",
-        .parameterization = "multiscattering-hillaire2020-subtexel-v1",
-        .depends_on = BIT(SB_PRODUCT_TRANSMITTANCE),
-        .defaults = {.directions_mu = 16, .directions_phi = 16},
-    },
-    [SB_PRODUCT_IRRADIANCE_GROUND] = {
-        .id = SB_PRODUCT_IRRADIANCE_GROUND,
-        .width = SB_IRRADIANCE_WIDTH,
-        .height = SB_IRRADIANCE_HEIGHT,
-        .channel_count = SB_IRRADIANCE_GROUND_CHANNELS,
-        .channel_names = "direct.r,direct.g,direct.b,sky.r,sky.g,sky.b",
-        .parameterization = "irradiance-bruneton2017-subtexel-v1",
-        .depends_on = BIT(SB_PRODUCT_TRANSMITTANCE) | BIT(SB_PRODUCT_MULTISCATTERING),
-        .defaults = {.directions_mu = 16, .directions_phi = 16},
-    },
-    [SB_PRODUCT_IRRADIANCE_SKY] = {
-        .id = SB_PRODUCT_IRRADIANCE_SKY,
-        .width = SB_IRRADIANCE_WIDTH,
-        .height = SB_IRRADIANCE_HEIGHT,
-        .channel_count = SB_IRRADIANCE_SKY_CHANNELS,
-        .channel_names = "rayleigh.r,rayleigh.g,rayleigh.b,mie.r,mie.g,mie.b,ground.r,ground.g,ground.b",
-        .parameterization = "irradiance-bruneton2017-subtexel-v1",
-        .depends_on = BIT(SB_PRODUCT_TRANSMITTANCE) | BIT(SB_PRODUCT_MULTISCATTERING) |
-                      BIT(SB_PRODUCT_IRRADIANCE_GROUND),
-        .defaults = {.directions_mu = 16, .directions_phi = 16},
-    },
+    [SB_PRODUCT_TRANSMITTANCE] =
+        {
+            .id = SB_PRODUCT_TRANSMITTANCE,
+            .width = SB_TRANSMITTANCE_WIDTH,
+            .height = SB_TRANSMITTANCE_HEIGHT,
+            .channel_count = SB_TRANSMITTANCE_CHANNELS,
+            .channel_names = "r,g,b",
+            .parameterization = "transmittance-hillaire2020-v1",
+        },
+    [SB_PRODUCT_MULTISCATTERING] =
+        {
+            .id = SB_PRODUCT_MULTISCATTERING,
+            .width = SB_MULTISCATTERING_SIZE,
+            .height = SB_MULTISCATTERING_SIZE,
+            .channel_count = SB_MULTISCATTERING_CHANNELS,
+            .channel_names = "r,g,b",
+            .parameterization = "multiscattering-hillaire2020-subtexel-v1",
+            .depends_on = BIT(SB_PRODUCT_TRANSMITTANCE),
+            .defaults = {.directions_mu = 16, .directions_phi = 16},
+            .workgroup_per_texel = true,
+        },
+    [SB_PRODUCT_IRRADIANCE_GROUND] =
+        {
+            .id = SB_PRODUCT_IRRADIANCE_GROUND,
+            .width = SB_IRRADIANCE_WIDTH,
+            .height = SB_IRRADIANCE_HEIGHT,
+            .channel_count = SB_IRRADIANCE_GROUND_CHANNELS,
+            .channel_names = "direct.r,direct.g,direct.b,sky.r,sky.g,sky.b",
+            .parameterization = "irradiance-bruneton2017-subtexel-v1",
+            .depends_on = BIT(SB_PRODUCT_TRANSMITTANCE) | BIT(SB_PRODUCT_MULTISCATTERING),
+            .defaults = {.directions_mu = 12, .directions_phi = 12},
+            .workgroup_per_texel = true,
+        },
+    [SB_PRODUCT_IRRADIANCE_SKY] =
+        {
+            .id = SB_PRODUCT_IRRADIANCE_SKY,
+            .width = SB_IRRADIANCE_WIDTH,
+            .height = SB_IRRADIANCE_HEIGHT,
+            .channel_count = SB_IRRADIANCE_SKY_CHANNELS,
+            .channel_names = "rayleigh.r,rayleigh.g,rayleigh.b,mie.r,mie.g,mie.b,ground.r,ground.g,ground.b",
+            .parameterization = "irradiance-bruneton2017-subtexel-v1",
+            .depends_on =
+                BIT(SB_PRODUCT_TRANSMITTANCE) | BIT(SB_PRODUCT_MULTISCATTERING) | BIT(SB_PRODUCT_IRRADIANCE_GROUND),
+            .defaults = {.directions_mu = 16, .directions_phi = 16},
+            .workgroup_per_texel = true,
+        },
 };
 
 static const struct {
@@ -158,12 +165,62 @@ void sb_atmosphere_baker_destroy(struct sb_atmosphere_baker **pb)
     *pb = NULL;
 }
 
+/*
+ * One dispatch of a kernel with the parameters and every product baked so
+ * far bound (a product is never bound as its own input), writing `output`.
+ * The kernel runs one workgroup per texel of width x height, or
+ * SB_WORKGROUP_X x SB_WORKGROUP_Y texels a workgroup.
+ */
+static enum sb_result run(struct sb_atmosphere_baker *b, const uint32_t *spirv, size_t spirv_size, const char *name,
+                          struct sb_buffer *output, uint32_t width, uint32_t height, bool workgroup_per_texel,
+                          uint32_t directions_mu, uint32_t directions_phi, double *gpu_ms)
+{
+    struct sb_pipeline pipeline = {0};
+    struct sb_pipeline_params pp = {
+        .spirv = spirv,
+        .spirv_size = spirv_size,
+        .binding_count = SB_BINDING_COUNT,
+        .push_size = sizeof(struct sb_bake_push),
+        .name = name,
+    };
+    enum sb_result res = sb_pipeline_create(b->vk, &pp, &pipeline);
+    if (res)
+        return res;
+    const struct sb_buffer *bindings[SB_BINDING_COUNT] = {
+        [SB_BINDING_ATMOSPHERE] = &b->params,
+        [SB_BINDING_OUTPUT] = output,
+    };
+    static const int inputs[][2] = {
+        {SB_BINDING_TRANSMITTANCE, SB_PRODUCT_TRANSMITTANCE},
+        {SB_BINDING_MULTISCATTERING, SB_PRODUCT_MULTISCATTERING},
+        {SB_BINDING_IRRADIANCE_GROUND, SB_PRODUCT_IRRADIANCE_GROUND},
+    };
+    for (size_t i = 0; i < sizeof(inputs) / sizeof(inputs[0]); i++) {
+        const struct sb_buffer *in = &b->outputs[inputs[i][1]];
+        bindings[inputs[i][0]] = in->buffer && in != output ? in : &b->dummy;
+    }
+    sb_pipeline_bind(b->vk, &pipeline, bindings);
+    struct sb_bake_push push = {
+        .width = width,
+        .height = height,
+        .directions_mu = directions_mu,
+        .directions_phi = directions_phi,
+    };
+    double ms = 0;
+    uint32_t groups_x = workgroup_per_texel ? width : (width + SB_WORKGROUP_X - 1) / SB_WORKGROUP_X;
+    uint32_t groups_y = workgroup_per_texel ? height : (height + SB_WORKGROUP_Y - 1) / SB_WORKGROUP_Y;
+    res = sb_dispatch(b->vk, &pipeline, &push, groups_x, groups_y, 1, &ms);
+    if (gpu_ms)
+        *gpu_ms = ms;
+    sb_pipeline_destroy(b->vk, &pipeline);
+    return res;
+}
+
 enum sb_result sb_atmosphere_bake(struct sb_atmosphere_baker *b, enum sb_product_id id,
                                   const struct sb_atmosphere_settings *settings, struct sb_image *image,
                                   struct sb_atmosphere_settings *used, double *gpu_ms)
 {
     const struct sb_atmosphere_product *prod = &products[id];
-    struct sb_pipeline pipeline = {0};
     struct sb_atmosphere_settings s = prod->defaults;
     if (settings && settings->directions_mu)
         s.directions_mu = settings->directions_mu;
@@ -171,6 +228,12 @@ enum sb_result sb_atmosphere_bake(struct sb_atmosphere_baker *b, enum sb_product
         s.directions_phi = settings->directions_phi;
     if (used)
         *used = s;
+    if (prod->workgroup_per_texel &&
+        (s.directions_mu < 1 || s.directions_mu > SB_MAX_DIRECTIONS_MU || s.directions_phi < 1)) {
+        sb_error("%s: directions_mu must be 1 to %d and directions_phi at least 1 (got %u, %u)", sb_product_name(id),
+                 SB_MAX_DIRECTIONS_MU, s.directions_mu, s.directions_phi);
+        return SB_ERR_USAGE;
+    }
     for (int dep = 0; dep < SB_PRODUCT_COUNT; dep++)
         if ((prod->depends_on & BIT(dep)) && !b->outputs[dep].buffer) {
             sb_error("%s: needs %s, which has not been baked", sb_product_name(id),
@@ -187,51 +250,39 @@ enum sb_result sb_atmosphere_bake(struct sb_atmosphere_baker *b, enum sb_product
     if ((res = sb_buffer_create(b->vk, bytes, sb_product_name(id), &b->outputs[id])))
         goto cleanup;
 
-    struct sb_pipeline_params pp = {
-        .spirv = shaders[id].words,
-        .spirv_size = shaders[id].size,
-        .binding_count = SB_BINDING_COUNT,
-        .push_size = sizeof(struct sb_bake_push),
-        .name = sb_product_name(id),
-    };
-    if ((res = sb_pipeline_create(b->vk, &pp, &pipeline)))
-        goto cleanup;
-    const struct sb_buffer *bindings[SB_BINDING_COUNT] = {
-        [SB_BINDING_ATMOSPHERE] = &b->params,
-        [SB_BINDING_TRANSMITTANCE] = &b->dummy,
-        [SB_BINDING_MULTISCATTERING] = &b->dummy,
-        [SB_BINDING_IRRADIANCE_GROUND] = &b->dummy,
-        [SB_BINDING_OUTPUT] = &b->outputs[id],
-    };
-    if (b->outputs[SB_PRODUCT_TRANSMITTANCE].buffer && id != SB_PRODUCT_TRANSMITTANCE)
-        bindings[SB_BINDING_TRANSMITTANCE] = &b->outputs[SB_PRODUCT_TRANSMITTANCE];
-    if (b->outputs[SB_PRODUCT_MULTISCATTERING].buffer && id != SB_PRODUCT_MULTISCATTERING)
-        bindings[SB_BINDING_MULTISCATTERING] = &b->outputs[SB_PRODUCT_MULTISCATTERING];
-    if (b->outputs[SB_PRODUCT_IRRADIANCE_GROUND].buffer && id != SB_PRODUCT_IRRADIANCE_GROUND)
-        bindings[SB_BINDING_IRRADIANCE_GROUND] = &b->outputs[SB_PRODUCT_IRRADIANCE_GROUND];
-    sb_pipeline_bind(b->vk, &pipeline, bindings);
-
-    struct sb_bake_push push = {
-        .width = prod->width,
-        .height = prod->height,
-        .directions_mu = s.directions_mu,
-        .directions_phi = s.directions_phi,
-    };
-    res = sb_dispatch(b->vk, &pipeline, &push, (prod->width + SB_WORKGROUP_X - 1) / SB_WORKGROUP_X,
-                      (prod->height + SB_WORKGROUP_Y - 1) / SB_WORKGROUP_Y, 1, gpu_ms);
-    if (res)
+    if ((res = run(b, shaders[id].words, shaders[id].size, sb_product_name(id), &b->outputs[id], prod->width,
+                   prod->height, prod->workgroup_per_texel, s.directions_mu, s.directions_phi, gpu_ms)))
         goto cleanup;
     memcpy(image->data, b->outputs[id].mapped, bytes);
 
 cleanup:
-    sb_pipeline_destroy(b->vk, &pipeline);
     if (res)
         sb_image_finish(image);
     return res;
 }
 
-void sb_atmosphere_settings_json(enum sb_product_id id, const struct sb_atmosphere_settings *s, char *out,
-                                 size_t size)
+enum sb_result sb_atmosphere_run_kernel(struct sb_atmosphere_baker *b, const uint32_t *spirv, size_t spirv_size,
+                                        float *records, uint32_t record_count, uint32_t record_floats)
+{
+    if (!record_count || !record_floats)
+        return SB_ERR_USAGE;
+    struct sb_buffer io = {0};
+    size_t bytes = (size_t)record_count * record_floats * sizeof(float);
+    enum sb_result res = sb_buffer_create(b->vk, bytes, "kernel records", &io);
+    if (res)
+        return res;
+    memcpy(io.mapped, records, bytes);
+    uint32_t per_row = SB_WORKGROUP_X * 32;
+    uint32_t width = record_count < per_row ? record_count : per_row;
+    uint32_t height = (record_count + per_row - 1) / per_row;
+    res = run(b, spirv, spirv_size, "kernel", &io, width, height, false, record_count, record_floats, NULL);
+    if (!res)
+        memcpy(records, io.mapped, bytes);
+    sb_buffer_destroy(b->vk, &io);
+    return res;
+}
+
+void sb_atmosphere_settings_json(enum sb_product_id id, const struct sb_atmosphere_settings *s, char *out, size_t size)
 {
     if (id == SB_PRODUCT_TRANSMITTANCE) {
         snprintf(out, size,
@@ -240,10 +291,12 @@ void sb_atmosphere_settings_json(enum sb_product_id id, const struct sb_atmosphe
         return;
     }
     snprintf(out, size,
-             "{\"directions_mu\":%u,\"directions_phi\":%u,\"directions\":%u,"
-             "\"ray_segments\":\"altitude levels, geometric from half the smallest scale height\","
-             "\"segment_quadrature\":\"gauss-legendre-%d\"}",
-             s->directions_mu, s->directions_phi,
-             s->directions_mu * s->directions_phi * (id == SB_PRODUCT_IRRADIANCE_GROUND ? 1u : 2u),
-             SB_RAY_GL_ORDER);
+             "{\"directions_mu\":%u,\"directions_phi\":%u,"
+             "\"zenith\":\"gauss-legendre per piece, cut at the horizon, the ozone corners%s\","
+             "\"azimuth\":\"midpoint over [0, pi]%s\","
+             "\"ray_segments\":\"altitude levels, geometric from half the smallest scale height, and the shadow "
+             "boundary\",\"segment_quadrature\":\"gauss-legendre-%d\","
+             "\"sun_transmittance\":\"integrated, at most 40 samples\"}",
+             s->directions_mu, s->directions_phi, id == SB_PRODUCT_MULTISCATTERING ? "" : " and the sun",
+             id == SB_PRODUCT_MULTISCATTERING ? "" : ", crowded toward the sun", SB_RAY_GL_ORDER);
 }

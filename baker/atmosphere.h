@@ -7,6 +7,7 @@
 #ifndef SB_BAKER_ATMOSPHERE_H
 #define SB_BAKER_ATMOSPHERE_H
 
+#include <stdbool.h>
 #include <stdint.h>
 
 #include "compute.h"
@@ -27,6 +28,7 @@ struct sb_atmosphere_product {
     const char *channel_names;    /* comma-separated */
     const char *parameterization; /* id recorded in the manifest */
     uint32_t depends_on;          /* bit mask of sb_product_id */
+    bool workgroup_per_texel;     /* sphere.glsl's layout, else 8x8 texels a workgroup */
     struct sb_atmosphere_settings defaults;
 };
 
@@ -56,6 +58,18 @@ void sb_atmosphere_baker_destroy(struct sb_atmosphere_baker **baker);
 enum sb_result sb_atmosphere_bake(struct sb_atmosphere_baker *baker, enum sb_product_id id,
                                   const struct sb_atmosphere_settings *settings, struct sb_image *image,
                                   struct sb_atmosphere_settings *used, double *gpu_ms);
+
+/*
+ * Evaluate the shared GLSL model directly, for tests and tools: run a
+ * kernel with the baker's parameters and products bound as in a bake, over
+ * `record_count` records of `record_floats` floats each, read and written in
+ * place at SB_BINDING_OUTPUT. The kernel gets an sb_bake_push whose
+ * directions_mu is the record count and directions_phi the record size, and
+ * runs over a (width, height) grid of 8x8 workgroups with
+ * record index = y * width + x, width = pc.width.
+ */
+enum sb_result sb_atmosphere_run_kernel(struct sb_atmosphere_baker *baker, const uint32_t *spirv, size_t spirv_size,
+                                        float *records, uint32_t record_count, uint32_t record_floats);
 
 /* The manifest's settings object for a product baked with `settings`. */
 void sb_atmosphere_settings_json(enum sb_product_id id, const struct sb_atmosphere_settings *settings, char *out,

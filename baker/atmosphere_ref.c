@@ -188,12 +188,11 @@ void sb_ref_transmittance(const struct sb_atmosphere_params *p, double r, double
         out[c] = exp(-tau[c]);
 }
 
-void sb_ref_transmittance_texel_geometry(const struct sb_atmosphere_params *p, uint32_t x, uint32_t y,
-                                         uint32_t width, uint32_t height, double *r_out, double *mu_out)
+void sb_ref_transmittance_geometry(const struct sb_atmosphere_params *p, double x_mu, double x_r, double *r_out,
+                                   double *mu_out)
 {
     double R = p->ground_radius_km, top = p->top_radius_km;
     double H = sqrt(top * top - R * R);
-    double x_mu = (x + 0.5) / width, x_r = (y + 0.5) / height;
     double rho = H * x_r;
     double r = sqrt(rho * rho + R * R);
     double d_min = top - r, d_max = rho + H;
@@ -201,6 +200,16 @@ void sb_ref_transmittance_texel_geometry(const struct sb_atmosphere_params *p, u
     double mu = d == 0.0 ? 1.0 : (H * H - rho * rho - d * d) / (2.0 * r * d);
     *r_out = r;
     *mu_out = fmax(-1.0, fmin(1.0, mu));
+}
+
+void sb_ref_transmittance_coords(const struct sb_atmosphere_params *p, double r, double mu, double *x_mu, double *x_r)
+{
+    double R = p->ground_radius_km, top = p->top_radius_km;
+    double H = sqrt(top * top - R * R);
+    double rho = sqrt(fmax(r * r - R * R, 0.0));
+    double d = dist_top(p, r, mu), d_min = top - r, d_max = rho + H;
+    *x_mu = d_max > d_min ? (d - d_min) / (d_max - d_min) : 0.0;
+    *x_r = rho / H;
 }
 
 /* ---- LUT lookups ------------------------------------------------------------- */
@@ -321,9 +330,9 @@ static struct sb_ref_quality resolve(const struct sb_ref_quality *q)
 {
     struct sb_ref_quality r = q ? *q : (struct sb_ref_quality){0};
     if (!r.directions_mu)
-        r.directions_mu = 24;
+        r.directions_mu = 32;
     if (!r.directions_phi)
-        r.directions_phi = 24;
+        r.directions_phi = 16;
     if (!r.level_steps)
         r.level_steps = 2;
     if (!r.transmittance_subdivisions)
@@ -352,26 +361,113 @@ static void gl_node(int k, int n, double a, double b, double *x, double *w)
     *w = (b - a) / ((1 - z * z) * dp * dp);
 }
 
+/*
+ * Quadrature in cos(zenith). The sphere is cut into pieces where the
+ * integrand is not smooth: the horizon (the ray meets the ground below it)
+ * and, above it, the directions whose tangent point sits at a kink of the
+ * density (the ozone tent's corners), and at `peak` (the sun, for
+ * products with a forward-peaked phase function; > 1 for none). Next to the horizon a ray integral
+ * behaves like sqrt(|mu - mu_h|) (the path through the dense air near the
+ * tangent point), so those pieces take Gauss-Legendre nodes in s with
+ * mu = mu_h +- (range) s^2, in which the integrand is smooth; pieces next
+ * to the peak crowd their nodes toward it the same way.
+ */
+struct zenith_piece {
+    double lo, hi;
+    bool ground;             /* below the horizon */
+    bool crowd_lo, crowd_hi; /* nodes crowded toward that end (horizon or peak) */
+};
+
+static int zenith_pieces(const struct sb_atmosphere_params *p, double h, bool whole_sphere, double peak,
+                         struct zenith_piece *out)
+{
+    double R = p->ground_radius_km, r = R + h;
+    double mu_h = whole_sphere ? -sqrt(fmax(1.0 - (R / r) * (R / r), 0.0)) : 0.0;
+    int n = 0;
+    if (whole_sphere)
+        out[n++] = (struct zenith_piece){-1.0, mu_h, true, false, true};
+    double corners[3] = {p->ozone_center_km - p->ozone_half_width_km, p->ozone_center_km,
+                         p->ozone_center_km + p->ozone_half_width_km};
+    double from = mu_h;
+    int first_sky = n;
+    for (int i = 0; i < 3 && whole_sphere; i++) {
+        if (corners[i] <= 0 || corners[i] >= h)
+            continue;
+        double rc = R + corners[i];
+        double mu_c = -sqrt(1.0 - (rc / r) * (rc / r));
+        if (mu_c > from) {
+            out[n] = (struct zenith_piece){from, mu_c, false, n == first_sky, false};
+            n++;
+            from = mu_c;
+        }
+    }
+    out[n] = (struct zenith_piece){from, 1.0, false, n == first_sky, false};
+    n++;
+    /* A forward-peaked phase function peaks at the sun: cut there. */
+    for (int i = first_sky; i < n; i++) {
+        if (!(peak > out[i].lo && peak < out[i].hi))
+            continue;
+        memmove(out + i + 2, out + i + 1, (size_t)(n - i - 1) * sizeof(*out));
+        out[i + 1] = (struct zenith_piece){peak, out[i].hi, false, true, out[i].crowd_hi};
+        out[i].hi = peak;
+        out[i].crowd_hi = true;
+        n++;
+        break;
+    }
+    return n;
+}
+
+static void zenith_node(const struct zenith_piece *piece, int k, int n, double *mu, double *w)
+{
+    double s, ws;
+    gl_node(k, n, 0.0, 1.0, &s, &ws);
+    double x = s, dx = 1.0;
+    if (piece->crowd_lo && piece->crowd_hi) {
+        x = s * s * (3 - 2 * s);
+        dx = 6 * s * (1 - s);
+    } else if (piece->crowd_lo) {
+        x = s * s;
+        dx = 2 * s;
+    } else if (piece->crowd_hi) {
+        x = 1 - (1 - s) * (1 - s);
+        dx = 2 * (1 - s);
+    }
+    *mu = piece->lo + (piece->hi - piece->lo) * x;
+    *w = (piece->hi - piece->lo) * dx * ws;
+}
+
+/* Azimuth node ip of n over [0, pi]: the midpoint rule in v, with
+ * phi = pi (v - sin(2 pi v) / (2 pi)) if `crowd`, crowding toward the sun's
+ * side where the Mie peak is. *w includes the factor 2 for the other half. */
+static void azimuth_node(int ip, int n, bool crowd, double *cos_phi, double *w)
+{
+    double v = (ip + 0.5) / n;
+    double phi = crowd ? REF_PI * (v - sin(2 * REF_PI * v) / (2 * REF_PI)) : REF_PI * v;
+    *cos_phi = cos(phi);
+    *w = 2 * REF_PI * (crowd ? 1 - cos(2 * REF_PI * v) : 1.0) / n;
+}
+
 void sb_ref_multiscattering(const struct sb_atmosphere_params *p, double h, double mu_s,
                             const struct sb_ref_quality *quality, double out[3])
 {
     pthread_once(&gl_once, gl_init);
     struct sb_ref_quality q = resolve(quality);
     double R = p->ground_radius_km, r = R + h;
-    double mu_h = -sqrt(fmax(1.0 - (R / r) * (R / r), 0.0));
     double sin_s = sqrt(fmax(1 - mu_s * mu_s, 0.0));
     double l2[3] = {0, 0, 0}, f[3] = {0, 0, 0};
-    for (int part = 0; part < 2; part++) {
-        bool ground = part == 1;
-        double a = ground ? -1.0 : mu_h, b = ground ? mu_h : 1.0;
+    struct zenith_piece pieces[6];
+    int piece_count = zenith_pieces(p, h, true, 2.0, pieces);
+    for (int pc = 0; pc < piece_count; pc++) {
+        bool ground = pieces[pc].ground;
         for (int k = 0; k < q.directions_mu; k++) {
             double mu, w_mu;
-            gl_node(k, q.directions_mu, a, b, &mu, &w_mu);
+            zenith_node(&pieces[pc], k, q.directions_mu, &mu, &w_mu);
             double sin_v = sqrt(fmax(1 - mu * mu, 0.0));
             for (int ip = 0; ip < q.directions_phi; ip++) {
-                double phi = (ip + 0.5) * REF_PI / q.directions_phi;
-                double w = w_mu * 2 * REF_PI / q.directions_phi;
-                double nu = fmax(-1.0, fmin(1.0, sin_v * sin_s * cos(phi) + mu * mu_s));
+                double cos_phi, w_phi;
+                azimuth_node(ip, q.directions_phi, false, &cos_phi, &w_phi);
+                double w = w_mu * w_phi;
+                double nu = fmax(-1.0, fmin(1.0, sin_v * sin_s * cos_phi + mu * mu_s));
                 struct ray_sums rs;
                 integrate_ray(p, r, mu, mu_s, nu, ground, NULL, &q, &rs);
                 double ground_term[3] = {0, 0, 0};
@@ -412,22 +508,26 @@ void sb_ref_irradiance_ground(const struct sb_atmosphere_params *p, double h, do
         sky[c] = 0;
     }
     double sin_s = sqrt(fmax(1 - mu_s * mu_s, 0.0));
-    for (int k = 0; k < q.directions_mu; k++) {
-        double mu, w_mu;
-        gl_node(k, q.directions_mu, 0.0, 1.0, &mu, &w_mu);
-        double sin_v = sqrt(fmax(1 - mu * mu, 0.0));
-        for (int ip = 0; ip < q.directions_phi; ip++) {
-            double phi = (ip + 0.5) * REF_PI / q.directions_phi;
-            double nu = fmax(-1.0, fmin(1.0, sin_v * sin_s * cos(phi) + mu * mu_s));
-            struct ray_sums rs;
-            integrate_ray(p, r, mu, mu_s, nu, false, ms_lut, &q, &rs);
-            double w = w_mu * 2 * REF_PI / q.directions_phi * mu;
-            for (int c = 0; c < 3; c++)
-                sky[c] += w * (p->solar_irradiance[c] * (rs.sun_rayleigh[c] * phase_rayleigh(nu) +
-                                                         rs.sun_mie[c] * phase_mie(p->mie_g, nu)) +
-                               rs.ms_rayleigh[c] + rs.ms_mie[c]);
+    struct zenith_piece hemisphere[2];
+    int piece_count = zenith_pieces(p, h, false, mu_s, hemisphere);
+    for (int pc = 0; pc < piece_count; pc++)
+        for (int k = 0; k < q.directions_mu; k++) {
+            double mu, w_mu;
+            zenith_node(&hemisphere[pc], k, q.directions_mu, &mu, &w_mu);
+            double sin_v = sqrt(fmax(1 - mu * mu, 0.0));
+            for (int ip = 0; ip < q.directions_phi; ip++) {
+                double cos_phi, w_phi;
+                azimuth_node(ip, q.directions_phi, true, &cos_phi, &w_phi);
+                double nu = fmax(-1.0, fmin(1.0, sin_v * sin_s * cos_phi + mu * mu_s));
+                struct ray_sums rs;
+                integrate_ray(p, r, mu, mu_s, nu, false, ms_lut, &q, &rs);
+                double w = w_mu * w_phi * mu;
+                for (int c = 0; c < 3; c++)
+                    sky[c] += w * (p->solar_irradiance[c] * (rs.sun_rayleigh[c] * phase_rayleigh(nu) +
+                                                             rs.sun_mie[c] * phase_mie(p->mie_g, nu)) +
+                                   rs.ms_rayleigh[c] + rs.ms_mie[c]);
+            }
         }
-    }
 }
 
 void sb_ref_irradiance_sky(const struct sb_atmosphere_params *p, double h, double mu_s, const struct sb_image *ms_lut,
@@ -436,20 +536,21 @@ void sb_ref_irradiance_sky(const struct sb_atmosphere_params *p, double h, doubl
     pthread_once(&gl_once, gl_init);
     struct sb_ref_quality q = resolve(quality);
     double R = p->ground_radius_km, r = R + h;
-    double mu_h = -sqrt(fmax(1.0 - (R / r) * (R / r), 0.0));
     double sin_s = sqrt(fmax(1 - mu_s * mu_s, 0.0));
     memset(out, 0, 9 * sizeof(double));
-    for (int part = 0; part < 2; part++) {
-        bool ground = part == 1;
-        double a = ground ? -1.0 : mu_h, b = ground ? mu_h : 1.0;
+    struct zenith_piece pieces[6];
+    int piece_count = zenith_pieces(p, h, true, mu_s, pieces);
+    for (int pc = 0; pc < piece_count; pc++) {
+        bool ground = pieces[pc].ground;
         for (int k = 0; k < q.directions_mu; k++) {
             double mu, w_mu;
-            gl_node(k, q.directions_mu, a, b, &mu, &w_mu);
+            zenith_node(&pieces[pc], k, q.directions_mu, &mu, &w_mu);
             double sin_v = sqrt(fmax(1 - mu * mu, 0.0));
             for (int ip = 0; ip < q.directions_phi; ip++) {
-                double phi = (ip + 0.5) * REF_PI / q.directions_phi;
-                double w = w_mu * 2 * REF_PI / q.directions_phi / (4 * REF_PI);
-                double nu = fmax(-1.0, fmin(1.0, sin_v * sin_s * cos(phi) + mu * mu_s));
+                double cos_phi, w_phi;
+                azimuth_node(ip, q.directions_phi, true, &cos_phi, &w_phi);
+                double w = w_mu * w_phi / (4 * REF_PI);
+                double nu = fmax(-1.0, fmin(1.0, sin_v * sin_s * cos_phi + mu * mu_s));
                 struct ray_sums rs;
                 integrate_ray(p, r, mu, mu_s, nu, ground, ms_lut, &q, &rs);
                 double eg[6] = {0};
@@ -458,7 +559,8 @@ void sb_ref_irradiance_sky(const struct sb_atmosphere_params *p, double h, doubl
                     sb_ref_lut_subtexel(ig_lut, mu_sp * 0.5 + 0.5, 0.0, eg);
                 }
                 for (int c = 0; c < 3; c++) {
-                    out[c] += w * (p->solar_irradiance[c] * rs.sun_rayleigh[c] * phase_rayleigh(nu) + rs.ms_rayleigh[c]);
+                    out[c] +=
+                        w * (p->solar_irradiance[c] * rs.sun_rayleigh[c] * phase_rayleigh(nu) + rs.ms_rayleigh[c]);
                     out[3 + c] += w * (p->solar_irradiance[c] * rs.sun_mie[c] * phase_mie(p->mie_g, nu) + rs.ms_mie[c]);
                     if (ground)
                         out[6 + c] += w * rs.transmittance[c] * p->ground_albedo[c] / REF_PI * (eg[c] + eg[3 + c]);

@@ -17,9 +17,9 @@
 #include "scene.h"
 
 struct sb_ref_quality {
-    int directions_mu;  /* Gauss-Legendre nodes in cos(zenith) per interval; 0: 24 */
-    int directions_phi; /* midpoint nodes in azimuth over [0, pi]; 0: 24 */
-    int level_steps;    /* altitude levels per factor 2 of altitude; 0: 2 */
+    int directions_mu;              /* Gauss-Legendre nodes in cos(zenith) per piece; 0: 32 */
+    int directions_phi;             /* midpoint nodes in azimuth over [0, pi]; 0: 16 */
+    int level_steps;                /* altitude levels per factor 2 of altitude; 0: 2 */
     int transmittance_subdivisions; /* GL-16 sub-pieces per piece of a sun ray; 0: 2 */
 };
 
@@ -28,13 +28,17 @@ struct sb_ref_quality {
  * fp64 rounding). */
 void sb_ref_transmittance(const struct sb_atmosphere_params *p, double r, double mu, int subdivisions, double out[3]);
 
-/* (r, mu) of transmittance texel (x, y) of a width x height LUT (Hillaire 2020). */
-void sb_ref_transmittance_texel_geometry(const struct sb_atmosphere_params *p, uint32_t x, uint32_t y,
-                                         uint32_t width, uint32_t height, double *r, double *mu);
+/* (r, mu) at unit coordinates (x_mu, x_r) of the transmittance LUT
+ * (Hillaire 2020; texel (x, y) of W x H is at ((x + 0.5) / W, (y + 0.5) / H)). */
+void sb_ref_transmittance_geometry(const struct sb_atmosphere_params *p, double x_mu, double x_r, double *r,
+                                   double *mu);
+
+/* The inverse: unit coordinates of (r, mu), for a ray that does not hit the ground. */
+void sb_ref_transmittance_coords(const struct sb_atmosphere_params *p, double r, double mu, double *x_mu, double *x_r);
 
 /* Hillaire's psi_ms at altitude h (km) with sun cosine mu_s (see multiscattering.comp). */
-void sb_ref_multiscattering(const struct sb_atmosphere_params *p, double h, double mu_s,
-                            const struct sb_ref_quality *q, double out[3]);
+void sb_ref_multiscattering(const struct sb_atmosphere_params *p, double h, double mu_s, const struct sb_ref_quality *q,
+                            double out[3]);
 
 /* Ground irradiance (see irradiance_ground.comp); `multiscattering` is the
  * baked LUT the product reads. */

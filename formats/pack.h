@@ -35,7 +35,7 @@ struct sb_artifact {
     enum sb_product_id product;
     char file[64];             /* relative to the pack, no directories */
     char parameterization[64]; /* mapping id, see docs/pack.md */
-    char settings_json[512];   /* compact JSON object of the bake settings */
+    char settings_json[1024];  /* compact JSON object of the bake settings */
     double bake_ms;            /* wall time of the product's bake, host side */
     double gpu_ms;             /* GPU time between the product's timestamps */
     char content_hash[SB_HASH_HEX_SIZE];

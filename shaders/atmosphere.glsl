@@ -9,7 +9,7 @@
  * below are what make transmittance good to 1e-5).
  *
  * The fp64 CPU reference in baker/atmosphere_ref.c implements the same model
- * independently; docs/products.md states the definitions both follow.
+ * independently; docs/pack.md states the definitions both follow.
  */
 #ifndef SB_ATMOSPHERE_GLSL
 #define SB_ATMOSPHERE_GLSL
@@ -102,7 +102,7 @@ float distance_to_top(float h, float mu)
     float r = ground_radius() + h;
     float above = max(atmosphere_thickness() - h, 0.0) * (top_radius() + r); /* top^2 - r^2 */
     float disc = sqrt(above + r * r * mu * mu);
-    return mu >= 0.0 ? above / (r * mu + disc) : disc - r * mu;
+    return mu >= 0.0 ? above / max(r * mu + disc, 1e-30) : disc - r * mu;
 }
 
 float distance_to_ground(float h, float mu)
@@ -175,6 +175,8 @@ vec3 optical_depth_to_top(float rho, float e)
     float R = ground_radius(), H = horizon_top();
     float r = sqrt(rho * rho + R * R);
     float d = rho + H - e;
+    if (d <= 0.0) /* at the top, looking along it or up */
+        return vec3(0.0);
     float s0 = ((2.0 * (H + rho)) * (e - rho) - e * e) / (2.0 * d); /* r mu */
     float hb, rb, sb, fold = 0.0, t_end;
     if (s0 < 0.0) {
@@ -192,37 +194,29 @@ vec3 optical_depth_to_top(float rho, float e)
         t_end = d;
     }
 
-    float ts[6];
-    int n = 0;
-    ts[n++] = 0.0;
-    float corners[3] = float[3](atm.ozone_absorption.w - atm.ground_albedo.w, atm.ozone_absorption.w,
-                                atm.ozone_absorption.w + atm.ground_albedo.w);
-    for (int k = 0; k < 3; k++) {
-        if (corners[k] > hb && corners[k] < atmosphere_thickness()) {
-            float tk = path_distance_to_level(hb, sb, corners[k]);
-            if (tk < t_end)
-                ts[n++] = tk;
-        }
-    }
-    if (fold > 0.0 && fold < t_end)
-        ts[n++] = fold;
-    ts[n++] = t_end;
-    for (int i = 1; i < n; i++) { /* insertion sort, n <= 6 */
-        float v = ts[i];
-        int j = i - 1;
-        while (j >= 0 && ts[j] > v) {
-            ts[j + 1] = ts[j];
-            j--;
-        }
-        ts[j + 1] = v;
-    }
-
+    /* Walk up the path from boundary to boundary: the ozone corners above
+     * the base (ascending, so their distances are too) and, for a folded
+     * ray, the fold itself, taken by distance since it may lie a fraction
+     * of a metre above the base. No sorting and no local arrays. */
+    float centre = atm.ozone_absorption.w, half_width = atm.ground_albedo.w;
+    int corner = 0;
+    while (corner < 3 && centre + float(corner - 1) * half_width <= hb)
+        corner++;
     vec3 tau = vec3(0.0);
-    for (int i = 0; i + 1 < n; i++) {
-        if (ts[i + 1] <= ts[i])
-            continue;
-        vec3 piece = path_segment_depth(hb, rb, sb, ts[i], ts[i + 1]);
-        tau += ts[i + 1] <= fold ? 2.0 * piece : piece;
+    float t0 = 0.0;
+    for (int piece = 0; piece < 5 && t0 < t_end; piece++) {
+        float level = centre + float(corner - 1) * half_width;
+        float t1 = corner < 3 && level < atmosphere_thickness() ? min(path_distance_to_level(hb, sb, level), t_end)
+                                                                  : t_end;
+        if (fold > t0 && fold < t1)
+            t1 = fold;
+        else
+            corner++;
+        if (t1 > t0) {
+            vec3 depth = path_segment_depth(hb, rb, sb, t0, t1);
+            tau += t1 <= fold ? 2.0 * depth : depth;
+        }
+        t0 = t1;
     }
     return tau;
 }
@@ -232,12 +226,35 @@ vec3 optical_depth_to_top(float rho, float e)
 vec2 transmittance_unit_coords(float h, float mu)
 {
     float rho = horizon_distance(h);
-    float r = ground_radius() + h;
     float d = distance_to_top(h, mu);
     float d_min = atmosphere_thickness() - h;
     float d_max = rho + horizon_top();
     float x_mu = (d - d_min) / max(d_max - d_min, 1e-30);
     return vec2(x_mu, rho / horizon_top());
+}
+
+/* The ray of the transmittance LUT at unit coordinates x, as the quadrature
+ * takes it: rho and e = d_max - d. */
+void transmittance_unit_ray(vec2 x, out float rho, out float e)
+{
+    float R = ground_radius(), H = horizon_top();
+    rho = H * x.y;
+    float r = sqrt(rho * rho + R * R);
+    float h = rho * rho / (r + R);
+    /* d_max - d_min = rho + H - (top - r), with top - r = thickness - h */
+    e = (1.0 - x.x) * (rho + H - (atmosphere_thickness() - h));
+}
+
+/* The same ray as altitude and view cosine (the inverse of transmittance_unit_coords). */
+void transmittance_unit_geometry(vec2 x, out float h, out float mu)
+{
+    float rho, e;
+    transmittance_unit_ray(x, rho, e);
+    float R = ground_radius(), H = horizon_top();
+    float r = sqrt(rho * rho + R * R);
+    float d = rho + H - e;
+    h = rho * rho / (r + R);
+    mu = d > 0.0 ? clamp(((2.0 * (H + rho)) * (e - rho) - e * e) / (2.0 * d * r), -1.0, 1.0) : 1.0;
 }
 
 /* Exact transmittance to the top by the quadrature above. */
@@ -270,12 +287,14 @@ vec3 transmittance_lut_sample(float h, float mu)
     return v;
 }
 
-/* Transmittance toward the sun from altitude h; zero when the planet hides it. */
+/* Transmittance toward the sun from altitude h; zero when the planet hides it.
+ * Integrated, not read from the LUT: bilinear lookups of the 256x64 LUT are
+ * off by up to ~1e-2 (more near the horizon), which the bakes cannot afford. */
 vec3 sun_transmittance(float h, float mu_s)
 {
     if (ray_hits_ground(h, mu_s))
         return vec3(0.0);
-    return transmittance_lut_sample(h, mu_s);
+    return transmittance_to_top(h, mu_s);
 }
 
 /* ---- Multiple-scattering LUT and irradiance LUTs -------------------------------- */
@@ -290,21 +309,32 @@ float texel_unit(uint i, uint n)
     return float(i) / float(n - 1u);
 }
 
+/* (h, mu_s) of texel `texel` of a size.x by size.y sub-texel LUT. */
+vec2 subtexel_geometry(uvec2 texel, uvec2 size)
+{
+    return vec2(atmosphere_thickness() * texel_unit(texel.y, size.y), 2.0 * texel_unit(texel.x, size.x) - 1.0);
+}
+
+/* Continuous texel coordinates of (h, mu_s) in such a LUT (texel i at i). */
+vec2 subtexel_coords(float h, float mu_s, uvec2 size)
+{
+    return vec2((mu_s * 0.5 + 0.5) * float(size.x - 1u), h / atmosphere_thickness() * float(size.y - 1u));
+}
+
 vec3 multiscattering_lut_sample(float h, float mu_s)
 {
-    float fx = (mu_s * 0.5 + 0.5) * float(SB_MULTISCATTERING_SIZE - 1);
-    float fy = h / atmosphere_thickness() * float(SB_MULTISCATTERING_SIZE - 1);
+    vec2 f = subtexel_coords(h, mu_s, uvec2(SB_MULTISCATTERING_SIZE));
     vec3 v;
-    SB_LUT_BILINEAR(multiscattering_lut, 3, SB_MULTISCATTERING_SIZE, SB_MULTISCATTERING_SIZE, fx, fy, v);
+    SB_LUT_BILINEAR(multiscattering_lut, 3, SB_MULTISCATTERING_SIZE, SB_MULTISCATTERING_SIZE, f.x, f.y, v);
     return v;
 }
 
 /* Total (direct + sky) irradiance on the ground, from irradiance_ground. */
 vec3 ground_irradiance_sample(float mu_s)
 {
-    float fx = (mu_s * 0.5 + 0.5) * float(SB_IRRADIANCE_WIDTH - 1);
+    vec2 f = subtexel_coords(0.0, mu_s, uvec2(SB_IRRADIANCE_WIDTH, SB_IRRADIANCE_HEIGHT));
     float v[6];
-    SB_LUT_BILINEAR(irradiance_ground_lut, 6, SB_IRRADIANCE_WIDTH, SB_IRRADIANCE_HEIGHT, fx, 0.0, v);
+    SB_LUT_BILINEAR(irradiance_ground_lut, 6, SB_IRRADIANCE_WIDTH, SB_IRRADIANCE_HEIGHT, f.x, f.y, v);
     return vec3(v[0] + v[3], v[1] + v[4], v[2] + v[5]);
 }
 
@@ -332,8 +362,12 @@ float level_at(int i)
     return i < 4 ? atm.levels_a[i] : (i < 8 ? atm.levels_b[i - 4] : (i < 12 ? atm.levels_c[i - 8] : atm.levels_d[i - 12]));
 }
 
-/* Sorted distances in [0, t_end] where the ray crosses the altitude levels. */
-int ray_breakpoints(float h0, float mu, float t_end, out float ts[2 * SB_MAX_LEVELS + 2])
+#define SB_RAY_MAX_BREAKS (2 * SB_MAX_LEVELS + 4)
+
+/* Sorted distances in [0, t_end] where the ray crosses the altitude levels
+ * and where the planet's shadow starts or ends along it (the sun's
+ * transmittance jumps there). */
+int ray_breakpoints(float h0, float mu, float mu_s, float nu, float t_end, out float ts[SB_RAY_MAX_BREAKS])
 {
     float R = ground_radius();
     float s0 = (R + h0) * mu;
@@ -356,6 +390,26 @@ int ray_breakpoints(float h0, float mu, float t_end, out float ts[2 * SB_MAX_LEV
                 ts[n++] = t2;
         }
     }
+    /* Shadow: the sun line through the point at t passes the planet's centre
+     * at distance R, on the sun's side: |y|^2 - (y.s)^2 = R^2 with
+     * y.s = r0 mu_s + t nu < 0, a quadratic in t. */
+    float r0 = R + h0, a = r0 * mu_s;
+    float qa = 1.0 - nu * nu, qb = 2.0 * (r0 * mu - a * nu);
+    float qc = h0 * (2.0 * R + h0) - a * a; /* r0^2 - R^2 - a^2 */
+    float roots[2] = float[2](-1.0, -1.0);
+    if (qa > 1e-6) {
+        float disc = qb * qb - 4.0 * qa * qc;
+        if (disc >= 0.0) {
+            float q = -0.5 * (qb + (qb >= 0.0 ? sqrt(disc) : -sqrt(disc)));
+            roots[0] = q / qa;
+            roots[1] = q != 0.0 ? qc / q : -1.0;
+        }
+    } else if (abs(qb) > 1e-6) {
+        roots[0] = -qc / qb;
+    }
+    for (int i = 0; i < 2; i++)
+        if (roots[i] > 0.0 && roots[i] < t_end && a + nu * roots[i] < 0.0)
+            ts[n++] = roots[i];
     ts[n++] = t_end;
     for (int i = 1; i < n; i++) {
         float v = ts[i];
@@ -388,8 +442,8 @@ RayIntegrals integrate_ray(float h0, float mu, float mu_s, float nu, bool toward
     float t_end = toward_ground ? distance_to_ground(h0, mu) : distance_to_top(h0, mu);
     o.t_end = t_end;
 
-    float ts[2 * SB_MAX_LEVELS + 2];
-    int n = ray_breakpoints(h0, mu, t_end, ts);
+    float ts[SB_RAY_MAX_BREAKS];
+    int n = ray_breakpoints(h0, mu, mu_s, nu, t_end, ts);
     vec3 tau = vec3(0.0);
     for (int s = 0; s + 1 < n; s++) {
         float half_len = 0.5 * (ts[s + 1] - ts[s]), mid = 0.5 * (ts[s + 1] + ts[s]);

@@ -24,6 +24,15 @@
 #define SB_WORKGROUP_X 8
 #define SB_WORKGROUP_Y 8
 
+/* Scattering bakes (sphere.glsl) run one workgroup of SB_SPHERE_THREADS per
+ * texel; each invocation sums at most SB_SPHERE_MAX_SUMS values. */
+#define SB_SPHERE_THREADS 64
+#define SB_SPHERE_MAX_SUMS 9
+/* Gauss-Legendre nodes in cos(zenith) per piece, at most, and the pieces:
+ * the ground, and the sky cut at the three ozone corners and the sun. */
+#define SB_MAX_DIRECTIONS_MU 64
+#define SB_SPHERE_MAX_PIECES 6
+
 /* Every atmosphere bake pipeline has the same descriptor set layout: five
  * storage buffers. Inputs a product does not read are bound to a dummy. */
 #define SB_BINDING_ATMOSPHERE 0

@@ -6,55 +6,48 @@
  *         + [ray hits ground] T(x,p) albedo/pi max(mu_s(p), 0) T_sun(p),
  *   f   = 1/(4 pi) * integral over the sphere of integral of T(x,y) sigma_s(y) dt dw,
  *   psi = E_sun L2 / (1 - f).
- * Directions: Gauss-Legendre in mu on [-1, mu_horizon] and [mu_horizon, 1]
- * (the integrand jumps at the horizon), midpoint in azimuth (the integrand is
- * even in azimuth about the sun's plane: [0, pi] twice). */
+ * One workgroup per texel (sphere.glsl). */
 #extension GL_GOOGLE_include_directive : require
 #include "config.h"
 #include "atmosphere.glsl"
+#include "sphere.glsl"
 
-layout(local_size_x = SB_WORKGROUP_X, local_size_y = SB_WORKGROUP_Y) in;
 layout(std430, set = 0, binding = SB_BINDING_OUTPUT) writeonly buffer Output { float result[]; };
 layout(push_constant) uniform Push { sb_bake_push pc; };
 
 void main()
 {
-    uvec2 texel = gl_GlobalInvocationID.xy;
-    if (texel.x >= pc.width || texel.y >= pc.height)
-        return;
-    float mu_s = 2.0 * texel_unit(texel.x, pc.width) - 1.0;
-    float h = atmosphere_thickness() * texel_unit(texel.y, pc.height);
+    uvec2 texel = gl_WorkGroupID.xy;
+    vec2 geometry = subtexel_geometry(texel, uvec2(pc.width, pc.height));
+    float h = geometry.x, mu_s = geometry.y;
     float r = ground_radius() + h;
-    float mu_horizon = -horizon_distance(h) / r;
     float sin_s = sqrt(max(1.0 - mu_s * mu_s, 0.0));
-    int n_mu = int(pc.directions_mu), n_phi = int(pc.directions_phi);
+    sphere_init(pc.directions_mu);
+    SpherePieces pieces = sphere_pieces(h, true, 2.0);
 
     vec3 l2 = vec3(0.0), f = vec3(0.0);
-    for (int part = 0; part < 2; part++) {
-        bool toward_ground = part == 1;
-        float a = toward_ground ? -1.0 : mu_horizon, b = toward_ground ? mu_horizon : 1.0;
-        for (int k = 0; k < n_mu; k++) {
-            float mu, w_mu;
-            gauss_legendre(k, n_mu, a, b, mu, w_mu);
-            float sin_v = sqrt(max(1.0 - mu * mu, 0.0));
-            for (int p = 0; p < n_phi; p++) {
-                float phi = (float(p) + 0.5) * PI / float(n_phi);
-                float w = w_mu * 2.0 * PI / float(n_phi);
-                float nu = clamp(sin_v * sin_s * cos(phi) + mu * mu_s, -1.0, 1.0);
-                RayIntegrals ri = integrate_ray(h, mu, mu_s, nu, toward_ground, false);
-                vec3 lp = (ri.sun_rayleigh + ri.sun_mie) / (4.0 * PI);
-                if (toward_ground) {
-                    float mu_sp = clamp((r * mu_s + ri.t_end * nu) / ground_radius(), -1.0, 1.0);
-                    if (mu_sp > 0.0)
-                        lp += ri.transmittance * atm.ground_albedo.rgb / PI * mu_sp * sun_transmittance(0.0, mu_sp);
-                }
-                l2 += w * lp;
-                f += w * ri.scattering;
-            }
+    uint count = sphere_direction_count(pieces, pc.directions_mu, pc.directions_phi);
+    for (uint d = gl_LocalInvocationIndex; d < count; d += SB_SPHERE_THREADS) {
+        SphereDirection s = sphere_direction(pieces, d, pc.directions_mu, pc.directions_phi);
+        float sin_v = sqrt(max(1.0 - s.mu * s.mu, 0.0));
+        float nu = clamp(sin_v * sin_s * s.cos_phi + s.mu * mu_s, -1.0, 1.0);
+        RayIntegrals ri = integrate_ray(h, s.mu, mu_s, nu, s.toward_ground, false);
+        vec3 lp = (ri.sun_rayleigh + ri.sun_mie) / (4.0 * PI);
+        if (s.toward_ground) {
+            float mu_sp = clamp((r * mu_s + ri.t_end * nu) / ground_radius(), -1.0, 1.0);
+            if (mu_sp > 0.0)
+                lp += ri.transmittance * atm.ground_albedo.rgb / PI * mu_sp * sun_transmittance(0.0, mu_sp);
         }
+        l2 += s.weight * lp;
+        f += s.weight * ri.scattering;
     }
-    l2 /= 4.0 * PI;
-    f /= 4.0 * PI;
+    sphere_store3(0u, l2);
+    sphere_store3(3u, f);
+    sphere_reduce(6u);
+    if (gl_LocalInvocationIndex != 0u)
+        return;
+    l2 = sphere_sum3(0u) / (4.0 * PI);
+    f = sphere_sum3(3u) / (4.0 * PI);
     vec3 psi = atm.solar_irradiance.rgb * l2 / (1.0 - f);
     uint i = (texel.y * pc.width + texel.x) * 3u;
     result[i + 0u] = psi.r;

@@ -14,15 +14,8 @@ void main()
     uvec2 texel = gl_GlobalInvocationID.xy;
     if (texel.x >= pc.width || texel.y >= pc.height)
         return;
-    float x_mu = (float(texel.x) + 0.5) / float(pc.width);
-    float x_r = (float(texel.y) + 0.5) / float(pc.height);
-    float R = ground_radius(), H = horizon_top();
-    float rho = H * x_r;
-    float r = sqrt(rho * rho + R * R);
-    float h = rho * rho / (r + R);
-    /* d_max - d_min = rho + H - (top - r), with top - r = thickness - h */
-    float span = rho + H - (atmosphere_thickness() - h);
-    float e = (1.0 - x_mu) * span;
+    float rho, e;
+    transmittance_unit_ray((vec2(texel) + 0.5) / vec2(pc.width, pc.height), rho, e);
     vec3 t = exp(-optical_depth_to_top(rho, e));
     uint i = (texel.y * pc.width + texel.x) * 3u;
     result[i + 0u] = t.r;
