@@ -3,6 +3,7 @@
 #include <math.h>
 #include <pthread.h>
 #include <stdbool.h>
+#include <stdlib.h>
 #include <string.h>
 
 #define REF_PI 3.14159265358979323846
@@ -447,49 +448,73 @@ static void azimuth_node(int ip, int n, bool crowd, double *cos_phi, double *w)
     *w = 2 * REF_PI * (crowd ? 1 - cos(2 * REF_PI * v) : 1.0) / n;
 }
 
+/* A direction of a sphere (or hemisphere) quadrature around a point. */
+struct direction {
+    double mu, nu, weight; /* cos(zenith), cos(angle to the sun), solid angle */
+    bool ground;           /* the ray ends on the ground */
+};
+
+/* Every direction of the quadrature at altitude h with the sun at mu_s; the
+ * caller frees *out. Returns the count, or 0 when out of memory. */
+static int directions(const struct sb_atmosphere_params *p, const struct sb_ref_quality *q, double h, double mu_s,
+                      bool whole_sphere, bool peaked, struct direction **out)
+{
+    struct zenith_piece pieces[6];
+    int piece_count = zenith_pieces(p, h, whole_sphere, peaked ? mu_s : 2.0, pieces);
+    int n = 0;
+    *out = malloc((size_t)piece_count * q->directions_mu * q->directions_phi * sizeof(**out));
+    if (!*out)
+        return 0;
+    double sin_s = sqrt(fmax(1 - mu_s * mu_s, 0.0));
+    for (int pc = 0; pc < piece_count; pc++)
+        for (int k = 0; k < q->directions_mu; k++) {
+            double mu, w_mu;
+            zenith_node(&pieces[pc], k, q->directions_mu, &mu, &w_mu);
+            double sin_v = sqrt(fmax(1 - mu * mu, 0.0));
+            for (int ip = 0; ip < q->directions_phi; ip++) {
+                double cos_phi, w_phi;
+                azimuth_node(ip, q->directions_phi, peaked, &cos_phi, &w_phi);
+                (*out)[n++] = (struct direction){
+                    .mu = mu,
+                    .nu = fmax(-1.0, fmin(1.0, sin_v * sin_s * cos_phi + mu * mu_s)),
+                    .weight = w_mu * w_phi,
+                    .ground = pieces[pc].ground,
+                };
+            }
+        }
+    return n;
+}
+
 void sb_ref_multiscattering(const struct sb_atmosphere_params *p, double h, double mu_s,
                             const struct sb_ref_quality *quality, double out[3])
 {
     pthread_once(&gl_once, gl_init);
     struct sb_ref_quality q = resolve(quality);
     double R = p->ground_radius_km, r = R + h;
-    double sin_s = sqrt(fmax(1 - mu_s * mu_s, 0.0));
     double l2[3] = {0, 0, 0}, f[3] = {0, 0, 0};
-    struct zenith_piece pieces[6];
-    int piece_count = zenith_pieces(p, h, true, 2.0, pieces);
-    for (int pc = 0; pc < piece_count; pc++) {
-        bool ground = pieces[pc].ground;
-        for (int k = 0; k < q.directions_mu; k++) {
-            double mu, w_mu;
-            zenith_node(&pieces[pc], k, q.directions_mu, &mu, &w_mu);
-            double sin_v = sqrt(fmax(1 - mu * mu, 0.0));
-            for (int ip = 0; ip < q.directions_phi; ip++) {
-                double cos_phi, w_phi;
-                azimuth_node(ip, q.directions_phi, false, &cos_phi, &w_phi);
-                double w = w_mu * w_phi;
-                double nu = fmax(-1.0, fmin(1.0, sin_v * sin_s * cos_phi + mu * mu_s));
-                struct ray_sums rs;
-                integrate_ray(p, r, mu, mu_s, nu, ground, NULL, &q, &rs);
-                double ground_term[3] = {0, 0, 0};
-                if (ground) {
-                    double mu_sp = fmax(-1.0, fmin(1.0, (r * mu_s + rs.t_end * nu) / R));
-                    if (mu_sp > 0) {
-                        double ts[3];
-                        sb_ref_transmittance(p, R, mu_sp, q.transmittance_subdivisions, ts);
-                        for (int c = 0; c < 3; c++)
-                            ground_term[c] = rs.transmittance[c] * p->ground_albedo[c] / REF_PI * mu_sp * ts[c];
-                    }
-                }
-                for (int c = 0; c < 3; c++) {
-                    l2[c] += w * ((rs.sun_rayleigh[c] + rs.sun_mie[c]) / (4 * REF_PI) + ground_term[c]);
-                    f[c] += w * rs.scattering[c];
-                }
-            }
+    struct direction *dirs;
+    int n = directions(p, &q, h, mu_s, true, false, &dirs);
+    for (int i = 0; i < n; i++) {
+        const struct direction *d = &dirs[i];
+        struct ray_sums rs;
+        integrate_ray(p, r, d->mu, mu_s, d->nu, d->ground, NULL, &q, &rs);
+        double ground_term[3] = {0, 0, 0};
+        double mu_sp = fmax(-1.0, fmin(1.0, (r * mu_s + rs.t_end * d->nu) / R));
+        if (d->ground && mu_sp > 0) {
+            double ts[3];
+            sb_ref_transmittance(p, R, mu_sp, q.transmittance_subdivisions, ts);
+            for (int c = 0; c < 3; c++)
+                ground_term[c] = rs.transmittance[c] * p->ground_albedo[c] / REF_PI * mu_sp * ts[c];
+        }
+        for (int c = 0; c < 3; c++) {
+            l2[c] += d->weight * ((rs.sun_rayleigh[c] + rs.sun_mie[c]) / (4 * REF_PI) + ground_term[c]);
+            f[c] += d->weight * rs.scattering[c];
         }
     }
+    free(dirs);
     for (int c = 0; c < 3; c++) {
         double L2 = l2[c] / (4 * REF_PI), fms = f[c] / (4 * REF_PI);
-        out[c] = p->solar_irradiance[c] * L2 / (1 - fms);
+        out[c] = n ? p->solar_irradiance[c] * L2 / (1 - fms) : NAN;
     }
 }
 
@@ -503,31 +528,23 @@ void sb_ref_irradiance_ground(const struct sb_atmosphere_params *p, double h, do
     double t[3] = {0, 0, 0};
     if (mu_s > 0)
         sb_ref_transmittance(p, r, mu_s, 8, t);
+    struct direction *dirs;
+    int n = directions(p, &q, h, mu_s, false, true, &dirs);
     for (int c = 0; c < 3; c++) {
         direct[c] = mu_s > 0 ? p->solar_irradiance[c] * t[c] * mu_s : 0.0;
-        sky[c] = 0;
+        sky[c] = n ? 0.0 : NAN;
     }
-    double sin_s = sqrt(fmax(1 - mu_s * mu_s, 0.0));
-    struct zenith_piece hemisphere[2];
-    int piece_count = zenith_pieces(p, h, false, mu_s, hemisphere);
-    for (int pc = 0; pc < piece_count; pc++)
-        for (int k = 0; k < q.directions_mu; k++) {
-            double mu, w_mu;
-            zenith_node(&hemisphere[pc], k, q.directions_mu, &mu, &w_mu);
-            double sin_v = sqrt(fmax(1 - mu * mu, 0.0));
-            for (int ip = 0; ip < q.directions_phi; ip++) {
-                double cos_phi, w_phi;
-                azimuth_node(ip, q.directions_phi, true, &cos_phi, &w_phi);
-                double nu = fmax(-1.0, fmin(1.0, sin_v * sin_s * cos_phi + mu * mu_s));
-                struct ray_sums rs;
-                integrate_ray(p, r, mu, mu_s, nu, false, ms_lut, &q, &rs);
-                double w = w_mu * w_phi * mu;
-                for (int c = 0; c < 3; c++)
-                    sky[c] += w * (p->solar_irradiance[c] * (rs.sun_rayleigh[c] * phase_rayleigh(nu) +
-                                                             rs.sun_mie[c] * phase_mie(p->mie_g, nu)) +
-                                   rs.ms_rayleigh[c] + rs.ms_mie[c]);
-            }
-        }
+    for (int i = 0; i < n; i++) {
+        const struct direction *d = &dirs[i];
+        struct ray_sums rs;
+        integrate_ray(p, r, d->mu, mu_s, d->nu, false, ms_lut, &q, &rs);
+        double w = d->weight * d->mu;
+        for (int c = 0; c < 3; c++)
+            sky[c] += w * (p->solar_irradiance[c] * (rs.sun_rayleigh[c] * phase_rayleigh(d->nu) +
+                                                     rs.sun_mie[c] * phase_mie(p->mie_g, d->nu)) +
+                           rs.ms_rayleigh[c] + rs.ms_mie[c]);
+    }
+    free(dirs);
 }
 
 void sb_ref_irradiance_sky(const struct sb_atmosphere_params *p, double h, double mu_s, const struct sb_image *ms_lut,
@@ -536,36 +553,26 @@ void sb_ref_irradiance_sky(const struct sb_atmosphere_params *p, double h, doubl
     pthread_once(&gl_once, gl_init);
     struct sb_ref_quality q = resolve(quality);
     double R = p->ground_radius_km, r = R + h;
-    double sin_s = sqrt(fmax(1 - mu_s * mu_s, 0.0));
-    memset(out, 0, 9 * sizeof(double));
-    struct zenith_piece pieces[6];
-    int piece_count = zenith_pieces(p, h, true, mu_s, pieces);
-    for (int pc = 0; pc < piece_count; pc++) {
-        bool ground = pieces[pc].ground;
-        for (int k = 0; k < q.directions_mu; k++) {
-            double mu, w_mu;
-            zenith_node(&pieces[pc], k, q.directions_mu, &mu, &w_mu);
-            double sin_v = sqrt(fmax(1 - mu * mu, 0.0));
-            for (int ip = 0; ip < q.directions_phi; ip++) {
-                double cos_phi, w_phi;
-                azimuth_node(ip, q.directions_phi, true, &cos_phi, &w_phi);
-                double w = w_mu * w_phi / (4 * REF_PI);
-                double nu = fmax(-1.0, fmin(1.0, sin_v * sin_s * cos_phi + mu * mu_s));
-                struct ray_sums rs;
-                integrate_ray(p, r, mu, mu_s, nu, ground, ms_lut, &q, &rs);
-                double eg[6] = {0};
-                if (ground) {
-                    double mu_sp = fmax(-1.0, fmin(1.0, (r * mu_s + rs.t_end * nu) / R));
-                    sb_ref_lut_subtexel(ig_lut, mu_sp * 0.5 + 0.5, 0.0, eg);
-                }
-                for (int c = 0; c < 3; c++) {
-                    out[c] +=
-                        w * (p->solar_irradiance[c] * rs.sun_rayleigh[c] * phase_rayleigh(nu) + rs.ms_rayleigh[c]);
-                    out[3 + c] += w * (p->solar_irradiance[c] * rs.sun_mie[c] * phase_mie(p->mie_g, nu) + rs.ms_mie[c]);
-                    if (ground)
-                        out[6 + c] += w * rs.transmittance[c] * p->ground_albedo[c] / REF_PI * (eg[c] + eg[3 + c]);
-                }
-            }
+    struct direction *dirs;
+    int n = directions(p, &q, h, mu_s, true, true, &dirs);
+    for (int c = 0; c < 9; c++)
+        out[c] = n ? 0.0 : NAN;
+    for (int i = 0; i < n; i++) {
+        const struct direction *d = &dirs[i];
+        double w = d->weight / (4 * REF_PI), nu = d->nu;
+        struct ray_sums rs;
+        integrate_ray(p, r, d->mu, mu_s, nu, d->ground, ms_lut, &q, &rs);
+        double eg[6] = {0};
+        if (d->ground) {
+            double mu_sp = fmax(-1.0, fmin(1.0, (r * mu_s + rs.t_end * nu) / R));
+            sb_ref_lut_subtexel(ig_lut, mu_sp * 0.5 + 0.5, 0.0, eg);
+        }
+        for (int c = 0; c < 3; c++) {
+            out[c] += w * (p->solar_irradiance[c] * rs.sun_rayleigh[c] * phase_rayleigh(nu) + rs.ms_rayleigh[c]);
+            out[3 + c] += w * (p->solar_irradiance[c] * rs.sun_mie[c] * phase_mie(p->mie_g, nu) + rs.ms_mie[c]);
+            if (d->ground)
+                out[6 + c] += w * rs.transmittance[c] * p->ground_albedo[c] / REF_PI * (eg[c] + eg[3 + c]);
         }
     }
+    free(dirs);
 }

@@ -263,6 +263,8 @@ static double compare_samples(struct sample_job *job, double floor_fraction, con
             double ref = job->ref[k][c];
             double scale = fmax(fabs(ref), floor_fraction * chan_max[c]);
             double rel = scale > 0 ? fabs(gpu - ref) / scale : fabs(gpu);
+            if (!isfinite(rel)) /* a NaN (e.g. a reference out of memory) must fail, not compare false */
+                rel = INFINITY;
             if (rel > worst) {
                 worst = rel;
                 wk = k;
