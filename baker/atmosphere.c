@@ -128,6 +128,7 @@ struct sb_atmosphere_baker {
     struct sb_buffer params;
     struct sb_buffer dummy;
     struct sb_buffer outputs[SB_PRODUCT_COUNT];
+    struct sb_buffer lookups[SB_PRODUCT_COUNT]; /* the form later bakes read (config.h) */
 };
 
 enum sb_result sb_atmosphere_baker_create(struct sb_vk *vk, const struct sb_atmosphere_params *params,
@@ -157,8 +158,10 @@ void sb_atmosphere_baker_destroy(struct sb_atmosphere_baker **pb)
     struct sb_atmosphere_baker *b = *pb;
     if (!b)
         return;
-    for (int p = 0; p < SB_PRODUCT_COUNT; p++)
+    for (int p = 0; p < SB_PRODUCT_COUNT; p++) {
         sb_buffer_destroy(b->vk, &b->outputs[p]);
+        sb_buffer_destroy(b->vk, &b->lookups[p]);
+    }
     sb_buffer_destroy(b->vk, &b->params);
     sb_buffer_destroy(b->vk, &b->dummy);
     free(b);
@@ -196,7 +199,9 @@ static enum sb_result run(struct sb_atmosphere_baker *b, const uint32_t *spirv, 
         {SB_BINDING_IRRADIANCE_GROUND, SB_PRODUCT_IRRADIANCE_GROUND},
     };
     for (size_t i = 0; i < sizeof(inputs) / sizeof(inputs[0]); i++) {
-        const struct sb_buffer *in = &b->outputs[inputs[i][1]];
+        const struct sb_buffer *in = &b->lookups[inputs[i][1]];
+        if (!in->buffer)
+            in = &b->outputs[inputs[i][1]];
         bindings[inputs[i][0]] = in->buffer && in != output ? in : &b->dummy;
     }
     sb_pipeline_bind(b->vk, &pipeline, bindings);
@@ -214,6 +219,30 @@ static enum sb_result run(struct sb_atmosphere_baker *b, const uint32_t *spirv, 
         *gpu_ms = ms;
     sb_pipeline_destroy(b->vk, &pipeline);
     return res;
+}
+
+/*
+ * The form in which later bakes read a product (config.h): the logarithm,
+ * floored at 1e-30, of psi_ms, and of the total ground irradiance on the
+ * ground row. Transmittance is read as baked.
+ */
+static enum sb_result make_lookup(struct sb_atmosphere_baker *b, enum sb_product_id id, const struct sb_image *image)
+{
+    if (id != SB_PRODUCT_MULTISCATTERING && id != SB_PRODUCT_IRRADIANCE_GROUND)
+        return SB_OK;
+    bool ground = id == SB_PRODUCT_IRRADIANCE_GROUND;
+    size_t texels = ground ? image->width : (size_t)image->width * image->height;
+    enum sb_result res = sb_buffer_create(b->vk, texels * 3 * sizeof(float), "lookup", &b->lookups[id]);
+    if (res)
+        return res;
+    float *dst = b->lookups[id].mapped;
+    for (size_t t = 0; t < texels; t++)
+        for (int c = 0; c < 3; c++) {
+            const float *texel = image->data + t * image->channel_count;
+            double v = ground ? (double)texel[c] + texel[3 + c] : texel[c];
+            dst[t * 3 + c] = (float)log(fmax(v, 1e-30));
+        }
+    return SB_OK;
 }
 
 enum sb_result sb_atmosphere_bake(struct sb_atmosphere_baker *b, enum sb_product_id id,
@@ -246,6 +275,7 @@ enum sb_result sb_atmosphere_bake(struct sb_atmosphere_baker *b, enum sb_product
         return res;
     sb_image_set_channel_names(image, prod->channel_names);
     sb_buffer_destroy(b->vk, &b->outputs[id]);
+    sb_buffer_destroy(b->vk, &b->lookups[id]);
     size_t bytes = sb_image_float_count(image) * sizeof(float);
     if ((res = sb_buffer_create(b->vk, bytes, sb_product_name(id), &b->outputs[id])))
         goto cleanup;
@@ -254,6 +284,7 @@ enum sb_result sb_atmosphere_bake(struct sb_atmosphere_baker *b, enum sb_product
                    prod->height, prod->workgroup_per_texel, s.directions_mu, s.directions_phi, gpu_ms)))
         goto cleanup;
     memcpy(image->data, b->outputs[id].mapped, bytes);
+    res = make_lookup(b, id, image);
 
 cleanup:
     if (res)
@@ -290,13 +321,19 @@ void sb_atmosphere_settings_json(enum sb_product_id id, const struct sb_atmosphe
                  "\"max_samples\":40}");
         return;
     }
+    const char *zenith_cuts = id == SB_PRODUCT_IRRADIANCE_GROUND ? "the sun's mirror and the sun (upper hemisphere)"
+                              : id == SB_PRODUCT_MULTISCATTERING
+                                  ? "the horizon, two ground depths, the ozone corners and the sun's mirror"
+                                  : "the horizon, two ground depths, the ozone corners, the sun's mirror and "
+                                    "the sun";
     snprintf(out, size,
              "{\"directions_mu\":%u,\"directions_phi\":%u,"
-             "\"zenith\":\"gauss-legendre per piece, cut at the horizon, the ozone corners%s\","
+             "\"zenith\":\"gauss-legendre per piece, cut at %s\","
              "\"azimuth\":\"midpoint over [0, pi]%s\","
-             "\"ray_segments\":\"altitude levels, geometric from half the smallest scale height, and the shadow "
-             "boundary\",\"segment_quadrature\":\"gauss-legendre-%d\","
-             "\"sun_transmittance\":\"integrated, at most 40 samples\"}",
-             s->directions_mu, s->directions_phi, id == SB_PRODUCT_MULTISCATTERING ? "" : " and the sun",
-             id == SB_PRODUCT_MULTISCATTERING ? "" : ", crowded toward the sun", SB_RAY_GL_ORDER);
+             "\"ray_segments\":\"altitude levels, geometric from half the smallest scale height, the shadow "
+             "boundary and the sun grazing the ozone corners\",\"segment_quadrature\":\"gauss-legendre-%d\","
+             "\"sun_transmittance\":\"integrated, at most 40 samples\"%s}",
+             s->directions_mu, s->directions_phi, zenith_cuts,
+             id == SB_PRODUCT_MULTISCATTERING ? "" : ", crowded toward the sun", SB_RAY_GL_ORDER,
+             id == SB_PRODUCT_MULTISCATTERING ? "" : ",\"lut_lookup\":\"catmull-rom of the logarithm\"");
 }

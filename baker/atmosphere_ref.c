@@ -214,27 +214,57 @@ void sb_ref_transmittance_coords(const struct sb_atmosphere_params *p, double r,
 }
 
 /* ---- LUT lookups ------------------------------------------------------------- */
+/*
+ * The LUTs a product reads (psi_ms along rays, ground irradiance for the
+ * ground seen from the air) are read as the shaders read them: Catmull-Rom
+ * of the logarithm (floored at 1e-30) in each axis, the edge texels
+ * repeated, on LUTs whose texel i of n sits at x = i / (n - 1). C1, since the
+ * kinks of a bilinear lookup slow the sphere quadratures down; in log space,
+ * since at twilight these LUTs fall by a factor 5 to 7 per texel and a
+ * linear lookup overestimates them by up to 2x.
+ */
 
-void sb_ref_lut_subtexel(const struct sb_image *lut, double x_u, double x_v, double *out)
+static void catmull_rom(double t, double w[4])
 {
-    double fx = fmin(fmax(x_u, 0.0), 1.0) * (lut->width - 1);
-    double fy = fmin(fmax(x_v, 0.0), 1.0) * (lut->height - 1);
-    uint32_t x0 = (uint32_t)fx, y0 = (uint32_t)fy;
-    if (x0 > lut->width - 2)
-        x0 = lut->width - 2;
-    if (lut->height < 2)
-        y0 = 0;
-    else if (y0 > lut->height - 2)
-        y0 = lut->height - 2;
-    double ax = fx - x0, ay = lut->height < 2 ? 0 : fy - y0;
-    uint32_t y1 = lut->height < 2 ? y0 : y0 + 1;
-    uint32_t n = lut->channel_count;
-    for (uint32_t c = 0; c < n; c++) {
-        double v00 = lut->data[(y0 * lut->width + x0) * n + c];
-        double v10 = lut->data[(y0 * lut->width + x0 + 1) * n + c];
-        double v01 = lut->data[(y1 * lut->width + x0) * n + c];
-        double v11 = lut->data[(y1 * lut->width + x0 + 1) * n + c];
-        out[c] = (v00 * (1 - ax) + v10 * ax) * (1 - ay) + (v01 * (1 - ax) + v11 * ax) * ay;
+    double t2 = t * t, t3 = t2 * t;
+    w[0] = 0.5 * (-t3 + 2 * t2 - t);
+    w[1] = 0.5 * (3 * t3 - 5 * t2 + 2);
+    w[2] = 0.5 * (-3 * t3 + 4 * t2 + t);
+    w[3] = 0.5 * (t3 - t2);
+}
+
+/* First of the four texels around x in [0, 1] on n texels, and their weights. */
+static int cubic_taps(double x, int n, double w[4])
+{
+    double f = fmin(fmax(x, 0.0), 1.0) * (n - 1);
+    int i = n < 2 ? 0 : (int)f;
+    if (i > n - 2)
+        i = n - 2 < 0 ? 0 : n - 2;
+    catmull_rom(f - i, w);
+    return i - 1;
+}
+
+static int clamp_index(int i, int n)
+{
+    return i < 0 ? 0 : (i > n - 1 ? n - 1 : i);
+}
+
+/* The sum of channels c and c + stride (stride 0: channel c alone) of a
+ * LUT at unit coordinates (x_u, x_v), channels c = 0..2. */
+static void lut_log_cubic(const struct sb_image *lut, double x_u, double x_v, uint32_t stride, double out[3])
+{
+    int w = (int)lut->width, h = (int)lut->height, nc = (int)lut->channel_count;
+    double wx[4], wy[4];
+    int x0 = cubic_taps(x_u, w, wx), y0 = cubic_taps(x_v, h, wy);
+    for (int c = 0; c < 3; c++) {
+        double sum = 0;
+        for (int j = 0; j < 4; j++)
+            for (int i = 0; i < 4; i++) {
+                const float *texel = lut->data + ((size_t)clamp_index(y0 + j, h) * w + clamp_index(x0 + i, w)) * nc;
+                double v = (double)texel[c] + (stride ? (double)texel[c + stride] : 0.0);
+                sum += wx[i] * wy[j] * log(fmax(v, 1e-30));
+            }
+        out[c] = exp(sum);
     }
 }
 
@@ -303,7 +333,7 @@ static void integrate_ray(const struct sb_atmosphere_params *p, double r0, doubl
                 sb_ref_transmittance(p, fmax(rt, R), mus, q->transmittance_subdivisions, sun[j]);
             }
             if (ms_lut)
-                sb_ref_lut_subtexel(ms_lut, mus * 0.5 + 0.5, h / thickness, psi[j]);
+                lut_log_cubic(ms_lut, mus * 0.5 + 0.5, h / thickness, 0, psi[j]);
         }
         for (int i = 0; i < 8; i++)
             for (int c = 0; c < 3; c++) {
@@ -364,10 +394,12 @@ static void gl_node(int k, int n, double a, double b, double *x, double *w)
 
 /*
  * Quadrature in cos(zenith). The sphere is cut into pieces where the
- * integrand is not smooth: the horizon (the ray meets the ground below it)
- * and, above it, the directions whose tangent point sits at a kink of the
- * density (the ozone tent's corners), and at `peak` (the sun, for
- * products with a forward-peaked phase function; > 1 for none). Next to the horizon a ray integral
+ * integrand is not smooth or changes scale: the horizon (the ray meets the
+ * ground below it); below it, where the ray's virtual tangent point is 2.5
+ * and 25 scale heights under the ground; above it, the directions whose
+ * tangent point sits at a kink of the density (the ozone tent's corners);
+ * the sun's mirror image mu = -mu_s; and the sun, for products with a
+ * forward-peaked phase function. Next to the horizon a ray integral
  * behaves like sqrt(|mu - mu_h|) (the path through the dense air near the
  * tangent point), so those pieces take Gauss-Legendre nodes in s with
  * mu = mu_h +- (range) s^2, in which the integrand is smooth; pieces next
@@ -379,14 +411,47 @@ struct zenith_piece {
     bool crowd_lo, crowd_hi; /* nodes crowded toward that end (horizon or peak) */
 };
 
-static int zenith_pieces(const struct sb_atmosphere_params *p, double h, bool whole_sphere, double peak,
+/* Cut the piece strictly containing mu there; `crowd`: toward the cut. */
+static int split_piece(struct zenith_piece *out, int n, double mu, bool crowd)
+{
+    for (int i = 0; i < n; i++) {
+        if (!(mu > out[i].lo && mu < out[i].hi))
+            continue;
+        memmove(out + i + 2, out + i + 1, (size_t)(n - i - 1) * sizeof(*out));
+        out[i + 1] = out[i];
+        out[i + 1].lo = mu;
+        out[i + 1].crowd_lo = crowd;
+        out[i].hi = mu;
+        out[i].crowd_hi = crowd;
+        return n + 1;
+    }
+    return n;
+}
+
+static int zenith_pieces(const struct sb_atmosphere_params *p, double h, bool whole_sphere, double mu_s, bool peaked,
                          struct zenith_piece *out)
 {
     double R = p->ground_radius_km, r = R + h;
     double mu_h = whole_sphere ? -sqrt(fmax(1.0 - (R / r) * (R / r), 0.0)) : 0.0;
     int n = 0;
-    if (whole_sphere)
-        out[n++] = (struct zenith_piece){-1.0, mu_h, true, false, true};
+    if (whole_sphere) {
+        /* Below the horizon, cut where the ray's (virtual) tangent point is
+         * 25 and 2.5 smallest scale heights below the ground: the ray
+         * integral goes from a grazing path to a slant one over a few. */
+        double scale = fmin(p->rayleigh_scale_height_km, p->mie_scale_height_km), lo = -1.0;
+        const double depths[2] = {25 * scale, 2.5 * scale};
+        for (int i = 0; i < 2; i++) {
+            double rt = R - depths[i];
+            if (rt <= 0)
+                continue;
+            double mu = -sqrt(1.0 - (rt / r) * (rt / r));
+            if (mu > lo && mu < mu_h) {
+                out[n++] = (struct zenith_piece){lo, mu, true, false, false};
+                lo = mu;
+            }
+        }
+        out[n++] = (struct zenith_piece){lo, mu_h, true, false, true};
+    }
     double corners[3] = {p->ozone_center_km - p->ozone_half_width_km, p->ozone_center_km,
                          p->ozone_center_km + p->ozone_half_width_km};
     double from = mu_h;
@@ -404,17 +469,13 @@ static int zenith_pieces(const struct sb_atmosphere_params *p, double h, bool wh
     }
     out[n] = (struct zenith_piece){from, 1.0, false, n == first_sky, false};
     n++;
-    /* A forward-peaked phase function peaks at the sun: cut there. */
-    for (int i = first_sky; i < n; i++) {
-        if (!(peak > out[i].lo && peak < out[i].hi))
-            continue;
-        memmove(out + i + 2, out + i + 1, (size_t)(n - i - 1) * sizeof(*out));
-        out[i + 1] = (struct zenith_piece){peak, out[i].hi, false, true, out[i].crowd_hi};
-        out[i].hi = peak;
-        out[i].crowd_hi = true;
-        n++;
-        break;
-    }
+    /* The sun's mirror image in the horizontal plane: the azimuthal
+     * integral kinks there (rays leaving parallel to the shadow's edge,
+     * mu = mu_s nu, reach azimuth pi). A forward-peaked phase function
+     * peaks at the sun: cut there too, crowding toward it. */
+    n = split_piece(out, n, -mu_s, false);
+    if (peaked)
+        n = split_piece(out, n, mu_s, true);
     return n;
 }
 
@@ -459,8 +520,8 @@ struct direction {
 static int directions(const struct sb_atmosphere_params *p, const struct sb_ref_quality *q, double h, double mu_s,
                       bool whole_sphere, bool peaked, struct direction **out)
 {
-    struct zenith_piece pieces[6];
-    int piece_count = zenith_pieces(p, h, whole_sphere, peaked ? mu_s : 2.0, pieces);
+    struct zenith_piece pieces[9];
+    int piece_count = zenith_pieces(p, h, whole_sphere, mu_s, peaked, pieces);
     int n = 0;
     *out = malloc((size_t)piece_count * q->directions_mu * q->directions_phi * sizeof(**out));
     if (!*out)
@@ -562,16 +623,16 @@ void sb_ref_irradiance_sky(const struct sb_atmosphere_params *p, double h, doubl
         double w = d->weight / (4 * REF_PI), nu = d->nu;
         struct ray_sums rs;
         integrate_ray(p, r, d->mu, mu_s, nu, d->ground, ms_lut, &q, &rs);
-        double eg[6] = {0};
+        double eg[3] = {0};
         if (d->ground) {
             double mu_sp = fmax(-1.0, fmin(1.0, (r * mu_s + rs.t_end * nu) / R));
-            sb_ref_lut_subtexel(ig_lut, mu_sp * 0.5 + 0.5, 0.0, eg);
+            lut_log_cubic(ig_lut, mu_sp * 0.5 + 0.5, 0.0, 3, eg); /* direct + sky */
         }
         for (int c = 0; c < 3; c++) {
             out[c] += w * (p->solar_irradiance[c] * rs.sun_rayleigh[c] * phase_rayleigh(nu) + rs.ms_rayleigh[c]);
             out[3 + c] += w * (p->solar_irradiance[c] * rs.sun_mie[c] * phase_mie(p->mie_g, nu) + rs.ms_mie[c]);
             if (d->ground)
-                out[6 + c] += w * rs.transmittance[c] * p->ground_albedo[c] / REF_PI * (eg[c] + eg[3 + c]);
+                out[6 + c] += w * rs.transmittance[c] * p->ground_albedo[c] / REF_PI * eg[c];
         }
     }
     free(dirs);

@@ -6,7 +6,7 @@
  * begins, and with exact (not tabulated) transmittance toward the sun.
  * Where a product's definition reads another product (the multiple-
  * scattering LUT for irradiance), the reference reads the same baked LUT with
- * its own bilinear interpolation in fp64. All functions are thread safe.
+ * its own fp64 interpolation (the shaders' lookup, see lut_log_cubic). All functions are thread safe.
  */
 #ifndef SB_BAKER_ATMOSPHERE_REF_H
 #define SB_BAKER_ATMOSPHERE_REF_H
@@ -50,8 +50,5 @@ void sb_ref_irradiance_ground(const struct sb_atmosphere_params *p, double h, do
 void sb_ref_irradiance_sky(const struct sb_atmosphere_params *p, double h, double mu_s,
                            const struct sb_image *multiscattering, const struct sb_image *irradiance_ground,
                            const struct sb_ref_quality *q, double out[9]);
-
-/* Bilinear lookup of a LUT whose texel i of n sits at x = i / (n - 1). */
-void sb_ref_lut_subtexel(const struct sb_image *lut, double x_u, double x_v, double *out);
 
 #endif

@@ -24,11 +24,12 @@ layout(std430, set = 0, binding = SB_BINDING_ATMOSPHERE) readonly buffer Atmosph
 layout(std430, set = 0, binding = SB_BINDING_TRANSMITTANCE) readonly buffer TransmittanceBuffer {
     float transmittance_lut[];
 };
+/* The lookup forms of multiscattering and irradiance_ground (config.h). */
 layout(std430, set = 0, binding = SB_BINDING_MULTISCATTERING) readonly buffer MultiscatteringBuffer {
-    float multiscattering_lut[];
+    float multiscattering_log[];
 };
 layout(std430, set = 0, binding = SB_BINDING_IRRADIANCE_GROUND) readonly buffer IrradianceGroundBuffer {
-    float irradiance_ground_lut[];
+    float ground_irradiance_log[];
 };
 
 float ground_radius() { return atm.radii.x; }
@@ -321,21 +322,62 @@ vec2 subtexel_coords(float h, float mu_s, uvec2 size)
     return vec2((mu_s * 0.5 + 0.5) * float(size.x - 1u), h / atmosphere_thickness() * float(size.y - 1u));
 }
 
-vec3 multiscattering_lut_sample(float h, float mu_s)
+/*
+ * The LUTs a bake reads (psi_ms along rays, ground irradiance for the ground
+ * seen from the air) are read by Catmull-Rom of their logarithm (floored at
+ * 1e-30) in each axis, the edge texels repeated; the logarithms come
+ * precomputed (config.h). C1, because the kinks of a bilinear lookup slow
+ * the sphere quadratures down; in log space, because at twilight these LUTs
+ * fall by a factor 5 to 7 per texel, where a linear lookup overestimates
+ * them by up to 2x.
+ */
+void catmull_rom(float t, out float w[4])
 {
-    vec2 f = subtexel_coords(h, mu_s, uvec2(SB_MULTISCATTERING_SIZE));
-    vec3 v;
-    SB_LUT_BILINEAR(multiscattering_lut, 3, SB_MULTISCATTERING_SIZE, SB_MULTISCATTERING_SIZE, f.x, f.y, v);
-    return v;
+    float t2 = t * t, t3 = t2 * t;
+    w[0] = 0.5 * (-t3 + 2.0 * t2 - t);
+    w[1] = 0.5 * (3.0 * t3 - 5.0 * t2 + 2.0);
+    w[2] = 0.5 * (-3.0 * t3 + 4.0 * t2 + t);
+    w[3] = 0.5 * (t3 - t2);
 }
 
-/* Total (direct + sky) irradiance on the ground, from irradiance_ground. */
+/* First of the four texels around continuous texel coordinate f on n texels. */
+int cubic_taps(float f, int n, out float w[4])
+{
+    f = clamp(f, 0.0, float(n - 1));
+    int i = min(int(f), n - 2);
+    catmull_rom(f - float(i), w);
+    return i - 1;
+}
+
+vec3 multiscattering_lut_sample(float h, float mu_s)
+{
+    const int n = SB_MULTISCATTERING_SIZE;
+    vec2 f = subtexel_coords(h, mu_s, uvec2(n));
+    float wx[4], wy[4];
+    int x0 = cubic_taps(f.x, n, wx), y0 = cubic_taps(f.y, n, wy);
+    vec3 sum = vec3(0.0);
+    for (int j = 0; j < 4; j++) {
+        int row = clamp(y0 + j, 0, n - 1) * n;
+        for (int i = 0; i < 4; i++) {
+            int k = (row + clamp(x0 + i, 0, n - 1)) * 3;
+            sum += (wx[i] * wy[j]) * vec3(multiscattering_log[k], multiscattering_log[k + 1], multiscattering_log[k + 2]);
+        }
+    }
+    return exp(sum);
+}
+
+/* Total (direct + sky) irradiance on the ground at sun cosine mu_s. */
 vec3 ground_irradiance_sample(float mu_s)
 {
-    vec2 f = subtexel_coords(0.0, mu_s, uvec2(SB_IRRADIANCE_WIDTH, SB_IRRADIANCE_HEIGHT));
-    float v[6];
-    SB_LUT_BILINEAR(irradiance_ground_lut, 6, SB_IRRADIANCE_WIDTH, SB_IRRADIANCE_HEIGHT, f.x, f.y, v);
-    return vec3(v[0] + v[3], v[1] + v[4], v[2] + v[5]);
+    const int n = SB_IRRADIANCE_WIDTH;
+    float w[4];
+    int x0 = cubic_taps(subtexel_coords(0.0, mu_s, uvec2(n, SB_IRRADIANCE_HEIGHT)).x, n, w);
+    vec3 sum = vec3(0.0);
+    for (int i = 0; i < 4; i++) {
+        int k = clamp(x0 + i, 0, n - 1) * 3;
+        sum += w[i] * vec3(ground_irradiance_log[k], ground_irradiance_log[k + 1], ground_irradiance_log[k + 2]);
+    }
+    return exp(sum);
 }
 
 /* ---- Ray integrals for scattering ---------------------------------------------- */
@@ -362,11 +404,15 @@ float level_at(int i)
     return i < 4 ? atm.levels_a[i] : (i < 8 ? atm.levels_b[i - 4] : (i < 12 ? atm.levels_c[i - 8] : atm.levels_d[i - 12]));
 }
 
-#define SB_RAY_MAX_BREAKS (2 * SB_MAX_LEVELS + 4)
+/* Two crossings per level, two per shadow cylinder (the ground and the
+ * three ozone corners), and both ends. */
+#define SB_RAY_MAX_BREAKS (2 * SB_MAX_LEVELS + 2 * 4 + 2)
 
-/* Sorted distances in [0, t_end] where the ray crosses the altitude levels
- * and where the planet's shadow starts or ends along it (the sun's
- * transmittance jumps there). */
+/* Sorted distances in [0, t_end] where the ray crosses the altitude levels,
+ * where the planet's shadow starts or ends along it (the sun's
+ * transmittance jumps there), and where the sun's ray grazes an ozone
+ * corner at its tangent point (the sun's transmittance kinks there, and at
+ * twilight these cuts follow its steep rise out of the shadow). */
 int ray_breakpoints(float h0, float mu, float mu_s, float nu, float t_end, out float ts[SB_RAY_MAX_BREAKS])
 {
     float R = ground_radius();
@@ -390,26 +436,32 @@ int ray_breakpoints(float h0, float mu, float mu_s, float nu, float t_end, out f
                 ts[n++] = t2;
         }
     }
-    /* Shadow: the sun line through the point at t passes the planet's centre
-     * at distance R, on the sun's side: |y|^2 - (y.s)^2 = R^2 with
-     * y.s = r0 mu_s + t nu < 0, a quadratic in t. */
+    /* The sun's ray from the point at t has its tangent point at altitude
+     * hc where |y|^2 - (y.s)^2 = (R + hc)^2 with y.s = r0 mu_s + t nu < 0
+     * (the ray goes down first): a quadratic in t per cylinder. hc = 0 is
+     * the shadow's edge. */
     float r0 = R + h0, a = r0 * mu_s;
     float qa = 1.0 - nu * nu, qb = 2.0 * (r0 * mu - a * nu);
-    float qc = h0 * (2.0 * R + h0) - a * a; /* r0^2 - R^2 - a^2 */
-    float roots[2] = float[2](-1.0, -1.0);
-    if (qa > 1e-6) {
-        float disc = qb * qb - 4.0 * qa * qc;
-        if (disc >= 0.0) {
-            float q = -0.5 * (qb + (qb >= 0.0 ? sqrt(disc) : -sqrt(disc)));
-            roots[0] = q / qa;
-            roots[1] = q != 0.0 ? qc / q : -1.0;
+    for (int k = -1; k < 3; k++) {
+        float hc = k < 0 ? 0.0 : atm.ozone_absorption.w + float(k - 1) * atm.ground_albedo.w;
+        if (k >= 0 && (hc <= 0.0 || hc >= atmosphere_thickness()))
+            continue;
+        float qc = (h0 - hc) * (2.0 * R + h0 + hc) - a * a; /* r0^2 - (R + hc)^2 - a^2 */
+        float roots[2] = float[2](-1.0, -1.0);
+        if (qa > 1e-6) {
+            float disc = qb * qb - 4.0 * qa * qc;
+            if (disc >= 0.0) {
+                float q = -0.5 * (qb + (qb >= 0.0 ? sqrt(disc) : -sqrt(disc)));
+                roots[0] = q / qa;
+                roots[1] = q != 0.0 ? qc / q : -1.0;
+            }
+        } else if (abs(qb) > 1e-6) {
+            roots[0] = -qc / qb;
         }
-    } else if (abs(qb) > 1e-6) {
-        roots[0] = -qc / qb;
+        for (int i = 0; i < 2; i++)
+            if (roots[i] > 0.0 && roots[i] < t_end && a + nu * roots[i] < 0.0)
+                ts[n++] = roots[i];
     }
-    for (int i = 0; i < 2; i++)
-        if (roots[i] > 0.0 && roots[i] < t_end && a + nu * roots[i] < 0.0)
-            ts[n++] = roots[i];
     ts[n++] = t_end;
     for (int i = 1; i < n; i++) {
         float v = ts[i];

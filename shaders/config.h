@@ -28,13 +28,17 @@
  * texel; each invocation sums at most SB_SPHERE_MAX_SUMS values. */
 #define SB_SPHERE_THREADS 64
 #define SB_SPHERE_MAX_SUMS 9
-/* Gauss-Legendre nodes in cos(zenith) per piece, at most, and the pieces:
- * the ground, and the sky cut at the three ozone corners and the sun. */
+/* Gauss-Legendre nodes in cos(zenith) per piece, at most, and the pieces
+ * (sphere.glsl): three of the ground, four of the sky, cut again at the
+ * sun and at its mirror image. */
 #define SB_MAX_DIRECTIONS_MU 64
-#define SB_SPHERE_MAX_PIECES 6
+#define SB_SPHERE_MAX_PIECES 9
 
 /* Every atmosphere bake pipeline has the same descriptor set layout: five
- * storage buffers. Inputs a product does not read are bound to a dummy. */
+ * storage buffers. Inputs a product does not read are bound to a dummy.
+ * Transmittance is bound as baked; multiscattering and irradiance_ground
+ * in their lookup form (see atmosphere.glsl): ln(max(psi, 1e-30)) per texel
+ * and channel, and ln(max(direct + sky, 1e-30)) of the ground row. */
 #define SB_BINDING_ATMOSPHERE 0
 #define SB_BINDING_TRANSMITTANCE 1
 #define SB_BINDING_MULTISCATTERING 2

@@ -23,7 +23,7 @@ void main()
     vec3 sun = atm.solar_irradiance.rgb;
     float sin_s = sqrt(max(1.0 - mu_s * mu_s, 0.0));
     sphere_init(pc.directions_mu);
-    SpherePieces pieces = sphere_pieces(h, false, mu_s);
+    SpherePieces pieces = sphere_pieces(h, false, mu_s, true);
 
     vec3 sky = vec3(0.0);
     uint count = sphere_direction_count(pieces, pc.directions_mu, pc.directions_phi);

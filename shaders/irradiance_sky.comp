@@ -27,7 +27,7 @@ void main()
     vec3 sun = atm.solar_irradiance.rgb;
     float sin_s = sqrt(max(1.0 - mu_s * mu_s, 0.0));
     sphere_init(pc.directions_mu);
-    SpherePieces pieces = sphere_pieces(h, true, mu_s);
+    SpherePieces pieces = sphere_pieces(h, true, mu_s, true);
 
     vec3 rayleigh = vec3(0.0), mie = vec3(0.0), ground = vec3(0.0);
     uint count = sphere_direction_count(pieces, pc.directions_mu, pc.directions_phi);

@@ -23,7 +23,7 @@ void main()
     float r = ground_radius() + h;
     float sin_s = sqrt(max(1.0 - mu_s * mu_s, 0.0));
     sphere_init(pc.directions_mu);
-    SpherePieces pieces = sphere_pieces(h, true, 2.0);
+    SpherePieces pieces = sphere_pieces(h, true, mu_s, false);
 
     vec3 l2 = vec3(0.0), f = vec3(0.0);
     uint count = sphere_direction_count(pieces, pc.directions_mu, pc.directions_phi);

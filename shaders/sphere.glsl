@@ -30,32 +30,76 @@ shared float sphere_weight[SB_MAX_DIRECTIONS_MU];
 shared float sphere_partial[SB_SPHERE_THREADS * SB_SPHERE_MAX_SUMS];
 
 /*
- * The pieces of [-1, 1] in mu that get n_mu nodes each, as their lower and
- * upper ends: the ground part [-1, mu_horizon] (whole sphere only), then
- * the sky from the horizon up, cut where the ray's tangent point sits at an
- * ozone corner (the density's kinks, which make the ray integral kink as a
- * function of mu), and at `peak` (> 1 for none). Every invocation of the
- * workgroup computes the same list.
+ * The pieces of [-1, 1] in mu (of [0, 1] for the upper hemisphere) that get
+ * n_mu nodes each, as their lower and upper ends, cut where the integrand
+ * is not smooth or changes scale:
+ * - the horizon (whole sphere): below it rays end on the ground;
+ * - below the horizon, two depths of the ray's virtual tangent point (see
+ *   sphere_pieces);
+ * - above it, where the ray's tangent point sits at an ozone corner (the
+ *   density's kinks make the ray integral kink as a function of mu);
+ * - at the sun's mirror image in the horizontal plane, mu = -mu_s: there
+ *   the azimuthal integral kinks, since the rays that start out parallel to
+ *   the planet's shadow boundary (mu = mu_s nu) reach azimuth pi there;
+ * - for a peaked phase function, at the sun, where the nodes crowd.
+ * Every invocation of the workgroup computes the same list.
  */
 struct SpherePieces {
     float lo[SB_SPHERE_MAX_PIECES];
     float hi[SB_SPHERE_MAX_PIECES];
     int count;
     int first_sky; /* index of the piece starting at the horizon */
-    float peak;    /* where the pieces were cut for the phase function's peak */
+    float peak;    /* mu_s for a peaked phase function, else 2 */
 };
 
-SpherePieces sphere_pieces(float h, bool whole_sphere, float peak)
+/* Cut the piece that strictly contains `mu` there. */
+void sphere_split(inout SpherePieces sp, float mu)
+{
+    for (int i = 0; i < sp.count; i++)
+        if (mu > sp.lo[i] && mu < sp.hi[i]) {
+            for (int j = sp.count; j > i + 1; j--) {
+                sp.lo[j] = sp.lo[j - 1];
+                sp.hi[j] = sp.hi[j - 1];
+            }
+            sp.lo[i + 1] = mu;
+            sp.hi[i + 1] = sp.hi[i];
+            sp.hi[i] = mu;
+            sp.count++;
+            if (i < sp.first_sky)
+                sp.first_sky++;
+            return;
+        }
+}
+
+SpherePieces sphere_pieces(float h, bool whole_sphere, float mu_s, bool peaked)
 {
     SpherePieces sp;
-    sp.peak = peak;
+    sp.peak = peaked ? mu_s : 2.0;
     float r = ground_radius() + h;
     float mu_horizon = whole_sphere ? -horizon_distance(h) / r : 0.0;
     sp.count = 0;
     if (whole_sphere) {
-        sp.lo[0] = -1.0;
-        sp.hi[0] = mu_horizon;
-        sp.count = 1;
+        /* Ground rays change character over a few scale heights of
+         * virtual depth (R - r sqrt(1 - mu^2), how far below the ground
+         * the ray's tangent point lies): from a grazing path through the
+         * densest air to a slant one. Cut at a decade either side of the
+         * smallest scale height. */
+        float depth_scale = min(atm.rayleigh_scattering.w, atm.mie_scattering.w);
+        float lower = -1.0;
+        for (int k = 1; k >= 0; k--) {
+            float depth = (k == 1 ? 25.0 : 2.5) * depth_scale;
+            float rc = ground_radius() - depth; /* the tangent point's radius */
+            float mu = -sqrt(max((r - rc) * (r + rc), 0.0)) / r;
+            if (rc > 0.0 && mu > lower && mu < mu_horizon) {
+                sp.lo[sp.count] = lower;
+                sp.hi[sp.count] = mu;
+                sp.count++;
+                lower = mu;
+            }
+        }
+        sp.lo[sp.count] = lower;
+        sp.hi[sp.count] = mu_horizon;
+        sp.count++;
     }
     sp.first_sky = sp.count;
     float from = mu_horizon;
@@ -76,20 +120,9 @@ SpherePieces sphere_pieces(float h, bool whole_sphere, float peak)
     sp.lo[sp.count] = from;
     sp.hi[sp.count] = 1.0;
     sp.count++;
-    /* Cut the sky piece holding `peak` there (the sun's direction, where a
-     * forward-scattering phase function peaks), so nodes crowd toward it. */
-    for (int i = sp.first_sky; i < sp.count; i++)
-        if (peak > sp.lo[i] && peak < sp.hi[i]) {
-            for (int j = sp.count; j > i + 1; j--) {
-                sp.lo[j] = sp.lo[j - 1];
-                sp.hi[j] = sp.hi[j - 1];
-            }
-            sp.lo[i + 1] = peak;
-            sp.hi[i + 1] = sp.hi[i];
-            sp.hi[i] = peak;
-            sp.count++;
-            break;
-        }
+    sphere_split(sp, -mu_s);
+    if (peaked)
+        sphere_split(sp, mu_s);
     return sp;
 }
 
@@ -126,9 +159,12 @@ SphereDirection sphere_direction(SpherePieces sp, uint d, uint n_mu, uint n_phi)
     s.toward_ground = int(piece) < sp.first_sky;
     float u = 0.5 + 0.5 * sphere_node[k], w_u = 0.5 * sphere_weight[k];
     float lo = sp.lo[piece], hi = sp.hi[piece];
-    /* Crowd the nodes toward an end at the horizon or at the peak. */
-    bool at_lo = int(piece) == sp.first_sky || lo == sp.peak;
-    bool at_hi = s.toward_ground || hi == sp.peak;
+    /* Crowd the nodes toward the horizon and toward the peak: a sky piece
+     * toward its end on the peak's side, since the peak (Mie's, about 1 - g
+     * wide) reaches well beyond the pieces that touch it. */
+    bool peaked = sp.peak <= 1.0;
+    bool at_lo = int(piece) == sp.first_sky || (peaked && !s.toward_ground && lo >= sp.peak);
+    bool at_hi = int(piece) + 1 == sp.first_sky || (peaked && !s.toward_ground && hi <= sp.peak);
     float x = u, dx = 1.0;
     if (at_lo && at_hi) {
         x = u * u * (3.0 - 2.0 * u);
@@ -146,7 +182,7 @@ SphereDirection sphere_direction(SpherePieces sp, uint d, uint n_mu, uint n_phi)
      * the Mie peak is) and keeps the rule's accuracy on the even, periodic
      * integrand. */
     float v = (float(p) + 0.5) / float(n_phi);
-    bool crowd = sp.peak <= 1.0;
+    bool crowd = peaked;
     float phi = crowd ? PI * (v - sin(2.0 * PI * v) / (2.0 * PI)) : PI * v;
     float dphi = crowd ? PI * (1.0 - cos(2.0 * PI * v)) : PI;
     s.cos_phi = cos(phi);
