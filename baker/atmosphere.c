@@ -32,7 +32,7 @@ static const struct sb_atmosphere_product products[SB_PRODUCT_COUNT] = {
             .channel_names = "r,g,b",
             .parameterization = "multiscattering-hillaire2020-subtexel-v1",
             .depends_on = BIT(SB_PRODUCT_TRANSMITTANCE),
-            .defaults = {.directions_mu = 16, .directions_phi = 16},
+            .defaults = {.directions_mu = 16, .directions_phi = 12},
             .workgroup_per_texel = true,
         },
     [SB_PRODUCT_IRRADIANCE_GROUND] =
@@ -127,6 +127,7 @@ struct sb_atmosphere_baker {
     struct sb_vk *vk;
     struct sb_buffer params;
     struct sb_buffer dummy;
+    struct sb_buffer scratch; /* sphere.glsl's sums between passes */
     struct sb_buffer outputs[SB_PRODUCT_COUNT];
     struct sb_buffer lookups[SB_PRODUCT_COUNT]; /* the form later bakes read (config.h) */
 };
@@ -164,20 +165,44 @@ void sb_atmosphere_baker_destroy(struct sb_atmosphere_baker **pb)
     }
     sb_buffer_destroy(b->vk, &b->params);
     sb_buffer_destroy(b->vk, &b->dummy);
+    sb_buffer_destroy(b->vk, &b->scratch);
     free(b);
     *pb = NULL;
 }
 
 /*
- * One dispatch of a kernel with the parameters and every product baked so
- * far bound (a product is never bound as its own input), writing `output`.
- * The kernel runs one workgroup per texel of width x height, or
- * SB_WORKGROUP_X x SB_WORKGROUP_Y texels a workgroup.
+ * Run a kernel with the parameters and every product baked so far bound (a
+ * product is never bound as its own input), writing `output`. The kernel
+ * runs SB_WORKGROUP_X x SB_WORKGROUP_Y texels a workgroup in one dispatch,
+ * or, for sphere.glsl's integrals, one workgroup per texel in passes of
+ * SB_SPHERE_STEPS_PER_PASS directions per invocation, the partial sums kept
+ * in the scratch buffer; *gpu_ms sums the passes.
  */
 static enum sb_result run(struct sb_atmosphere_baker *b, const uint32_t *spirv, size_t spirv_size, const char *name,
                           struct sb_buffer *output, uint32_t width, uint32_t height, bool workgroup_per_texel,
                           uint32_t directions_mu, uint32_t directions_phi, double *gpu_ms)
 {
+    struct sb_bake_push push = {
+        .width = width,
+        .height = height,
+        .directions_mu = directions_mu,
+        .directions_phi = directions_phi,
+        .step_count = 1,
+    };
+    enum sb_result res = SB_OK;
+    if (workgroup_per_texel) {
+        uint64_t directions = (uint64_t)SB_SPHERE_MAX_PIECES * directions_mu * directions_phi;
+        push.step_count = (uint32_t)((directions + SB_SPHERE_THREADS - 1) / SB_SPHERE_THREADS);
+        size_t bytes = 16 + (size_t)width * height * SB_SPHERE_THREADS * SB_SPHERE_MAX_SUMS * sizeof(float);
+        if (b->scratch.size < bytes) {
+            sb_buffer_destroy(b->vk, &b->scratch);
+            if ((res = sb_buffer_create(b->vk, bytes, "sphere scratch", &b->scratch)))
+                return res;
+        }
+        const uint32_t header[4] = {0, 1, 1, 0}; /* truncated flag, sentinel */
+        memcpy(b->scratch.mapped, header, sizeof(header));
+    }
+
     struct sb_pipeline pipeline = {0};
     struct sb_pipeline_params pp = {
         .spirv = spirv,
@@ -186,12 +211,12 @@ static enum sb_result run(struct sb_atmosphere_baker *b, const uint32_t *spirv, 
         .push_size = sizeof(struct sb_bake_push),
         .name = name,
     };
-    enum sb_result res = sb_pipeline_create(b->vk, &pp, &pipeline);
-    if (res)
+    if ((res = sb_pipeline_create(b->vk, &pp, &pipeline)))
         return res;
     const struct sb_buffer *bindings[SB_BINDING_COUNT] = {
         [SB_BINDING_ATMOSPHERE] = &b->params,
         [SB_BINDING_OUTPUT] = output,
+        [SB_BINDING_SCRATCH] = workgroup_per_texel ? &b->scratch : &b->dummy,
     };
     static const int inputs[][2] = {
         {SB_BINDING_TRANSMITTANCE, SB_PRODUCT_TRANSMITTANCE},
@@ -205,18 +230,26 @@ static enum sb_result run(struct sb_atmosphere_baker *b, const uint32_t *spirv, 
         bindings[inputs[i][0]] = in->buffer && in != output ? in : &b->dummy;
     }
     sb_pipeline_bind(b->vk, &pipeline, bindings);
-    struct sb_bake_push push = {
-        .width = width,
-        .height = height,
-        .directions_mu = directions_mu,
-        .directions_phi = directions_phi,
-    };
-    double ms = 0;
     uint32_t groups_x = workgroup_per_texel ? width : (width + SB_WORKGROUP_X - 1) / SB_WORKGROUP_X;
     uint32_t groups_y = workgroup_per_texel ? height : (height + SB_WORKGROUP_Y - 1) / SB_WORKGROUP_Y;
-    res = sb_dispatch(b->vk, &pipeline, &push, groups_x, groups_y, 1, &ms);
+    double total_ms = 0;
+    for (uint32_t step = 0; step < push.step_count && !res; step += SB_SPHERE_STEPS_PER_PASS) {
+        push.step_begin = step;
+        push.step_end = workgroup_per_texel && push.step_count - step > SB_SPHERE_STEPS_PER_PASS
+                            ? step + SB_SPHERE_STEPS_PER_PASS
+                            : push.step_count;
+        double ms = 0;
+        res = sb_dispatch(b->vk, &pipeline, &push, groups_x, groups_y, 1, &ms);
+        total_ms += ms;
+    }
+    if (!res && workgroup_per_texel && *(const uint32_t *)b->scratch.mapped) {
+        sb_error("%s: the device ended the shader's loops early (llvmpipe allows 65535 loop iterations per "
+                 "invocation); the sums would be short, so nothing was baked",
+                 name);
+        res = SB_ERR_DEVICE_LIMIT;
+    }
     if (gpu_ms)
-        *gpu_ms = ms;
+        *gpu_ms = total_ms;
     sb_pipeline_destroy(b->vk, &pipeline);
     return res;
 }

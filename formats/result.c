@@ -19,6 +19,7 @@ static const char *const result_names[SB_RESULT_COUNT] = {
     [SB_ERR_VALIDATION] = "validation",
     [SB_ERR_NUMERIC] = "numeric",
     [SB_ERR_USAGE] = "usage",
+    [SB_ERR_DEVICE_LIMIT] = "device-limit",
 };
 
 const char *sb_result_name(enum sb_result result)

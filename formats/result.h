@@ -25,6 +25,7 @@ enum sb_result {
     SB_ERR_VALIDATION,      /* the validation layers reported a message */
     SB_ERR_NUMERIC,         /* a product holds NaN, Inf or a value outside its range */
     SB_ERR_USAGE,           /* bad command line */
+    SB_ERR_DEVICE_LIMIT,    /* the device ended a kernel early (llvmpipe's loop limit) */
     SB_RESULT_COUNT,
 };
 

@@ -28,13 +28,16 @@
  * texel; each invocation sums at most SB_SPHERE_MAX_SUMS values. */
 #define SB_SPHERE_THREADS 64
 #define SB_SPHERE_MAX_SUMS 9
+/* Directions per invocation in one dispatch (sphere.glsl): the passes keep
+ * every invocation far below llvmpipe's 65535 loop iterations. */
+#define SB_SPHERE_STEPS_PER_PASS 8
 /* Gauss-Legendre nodes in cos(zenith) per piece, at most, and the pieces
  * (sphere.glsl): three of the ground, four of the sky, cut again at the
  * sun and at its mirror image. */
 #define SB_MAX_DIRECTIONS_MU 64
 #define SB_SPHERE_MAX_PIECES 9
 
-/* Every atmosphere bake pipeline has the same descriptor set layout: five
+/* Every atmosphere bake pipeline has the same descriptor set layout: six
  * storage buffers. Inputs a product does not read are bound to a dummy.
  * Transmittance is bound as baked; multiscattering and irradiance_ground
  * in their lookup form (see atmosphere.glsl): ln(max(psi, 1e-30)) per texel
@@ -44,7 +47,8 @@
 #define SB_BINDING_MULTISCATTERING 2
 #define SB_BINDING_IRRADIANCE_GROUND 3
 #define SB_BINDING_OUTPUT 4
-#define SB_BINDING_COUNT 5
+#define SB_BINDING_SCRATCH 5 /* sphere.glsl's partial sums between passes */
+#define SB_BINDING_COUNT 6
 
 /* Product sizes and channel counts of format version 1. */
 #define SB_TRANSMITTANCE_WIDTH 256
@@ -87,6 +91,10 @@ struct sb_bake_push {
     SB_UINT height;
     SB_UINT directions_mu;  /* Gauss-Legendre nodes in cos(zenith), per interval */
     SB_UINT directions_phi; /* midpoint nodes in azimuth over [0, pi] */
+    SB_UINT step_begin;     /* sphere.glsl: this pass's steps, [begin, end) of */
+    SB_UINT step_end;       /* SB_SPHERE_THREADS directions each */
+    SB_UINT step_count;     /* steps of the whole integral */
+    SB_UINT pad;
 };
 
 #endif

@@ -13,7 +13,6 @@
 #include "sphere.glsl"
 
 layout(std430, set = 0, binding = SB_BINDING_OUTPUT) writeonly buffer Output { float result[]; };
-layout(push_constant) uniform Push { sb_bake_push pc; };
 
 void main()
 {
@@ -25,21 +24,19 @@ void main()
     sphere_init(pc.directions_mu);
     SpherePieces pieces = sphere_pieces(h, false, mu_s, true);
 
-    vec3 sky = vec3(0.0);
+    sphere_begin();
     uint count = sphere_direction_count(pieces, pc.directions_mu, pc.directions_phi);
-    for (uint d = gl_LocalInvocationIndex; d < count; d += SB_SPHERE_THREADS) {
+    for (uint d = sphere_first_direction(); d < sphere_end_direction(count); d += SB_SPHERE_THREADS) {
         SphereDirection s = sphere_direction(pieces, d, pc.directions_mu, pc.directions_phi);
         float sin_v = sqrt(max(1.0 - s.mu * s.mu, 0.0));
         float nu = clamp(sin_v * sin_s * s.cos_phi + s.mu * mu_s, -1.0, 1.0);
         RayIntegrals ri = integrate_ray(h, s.mu, mu_s, nu, false, true);
         vec3 l = sun * (ri.sun_rayleigh * phase_rayleigh(nu) + ri.sun_mie * phase_mie(nu)) + ri.ms_rayleigh + ri.ms_mie;
-        sky += s.weight * s.mu * l;
+        sphere_add3(0u, s.weight * s.mu * l);
     }
-    sphere_store3(0u, sky);
-    sphere_reduce(3u);
-    if (gl_LocalInvocationIndex != 0u)
+    if (!sphere_finish(3u) || gl_LocalInvocationIndex != 0u)
         return;
-    sky = sphere_sum3(0u);
+    vec3 sky = sphere_sum3(0u);
     vec3 direct = mu_s > 0.0 ? sun * transmittance_to_top(h, mu_s) * mu_s : vec3(0.0);
     uint i = (texel.y * pc.width + texel.x) * 6u;
     result[i + 0u] = direct.r;

@@ -16,7 +16,6 @@
 #include "sphere.glsl"
 
 layout(std430, set = 0, binding = SB_BINDING_OUTPUT) writeonly buffer Output { float result[]; };
-layout(push_constant) uniform Push { sb_bake_push pc; };
 
 void main()
 {
@@ -29,25 +28,21 @@ void main()
     sphere_init(pc.directions_mu);
     SpherePieces pieces = sphere_pieces(h, true, mu_s, true);
 
-    vec3 rayleigh = vec3(0.0), mie = vec3(0.0), ground = vec3(0.0);
+    sphere_begin();
     uint count = sphere_direction_count(pieces, pc.directions_mu, pc.directions_phi);
-    for (uint d = gl_LocalInvocationIndex; d < count; d += SB_SPHERE_THREADS) {
+    for (uint d = sphere_first_direction(); d < sphere_end_direction(count); d += SB_SPHERE_THREADS) {
         SphereDirection s = sphere_direction(pieces, d, pc.directions_mu, pc.directions_phi);
         float sin_v = sqrt(max(1.0 - s.mu * s.mu, 0.0));
         float nu = clamp(sin_v * sin_s * s.cos_phi + s.mu * mu_s, -1.0, 1.0);
         RayIntegrals ri = integrate_ray(h, s.mu, mu_s, nu, s.toward_ground, true);
-        rayleigh += s.weight * (sun * ri.sun_rayleigh * phase_rayleigh(nu) + ri.ms_rayleigh);
-        mie += s.weight * (sun * ri.sun_mie * phase_mie(nu) + ri.ms_mie);
+        sphere_add3(0u, s.weight * (sun * ri.sun_rayleigh * phase_rayleigh(nu) + ri.ms_rayleigh));
+        sphere_add3(3u, s.weight * (sun * ri.sun_mie * phase_mie(nu) + ri.ms_mie));
         if (s.toward_ground) {
             float mu_sp = clamp((r * mu_s + ri.t_end * nu) / ground_radius(), -1.0, 1.0);
-            ground += s.weight * ri.transmittance * atm.ground_albedo.rgb / PI * ground_irradiance_sample(mu_sp);
+            sphere_add3(6u, s.weight * ri.transmittance * atm.ground_albedo.rgb / PI * ground_irradiance_sample(mu_sp));
         }
     }
-    sphere_store3(0u, rayleigh);
-    sphere_store3(3u, mie);
-    sphere_store3(6u, ground);
-    sphere_reduce(9u);
-    if (gl_LocalInvocationIndex != 0u)
+    if (!sphere_finish(9u) || gl_LocalInvocationIndex != 0u)
         return;
     float norm = 1.0 / (4.0 * PI);
     uint i = (texel.y * pc.width + texel.x) * 9u;

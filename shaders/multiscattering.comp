@@ -13,7 +13,6 @@
 #include "sphere.glsl"
 
 layout(std430, set = 0, binding = SB_BINDING_OUTPUT) writeonly buffer Output { float result[]; };
-layout(push_constant) uniform Push { sb_bake_push pc; };
 
 void main()
 {
@@ -25,9 +24,9 @@ void main()
     sphere_init(pc.directions_mu);
     SpherePieces pieces = sphere_pieces(h, true, mu_s, false);
 
-    vec3 l2 = vec3(0.0), f = vec3(0.0);
+    sphere_begin();
     uint count = sphere_direction_count(pieces, pc.directions_mu, pc.directions_phi);
-    for (uint d = gl_LocalInvocationIndex; d < count; d += SB_SPHERE_THREADS) {
+    for (uint d = sphere_first_direction(); d < sphere_end_direction(count); d += SB_SPHERE_THREADS) {
         SphereDirection s = sphere_direction(pieces, d, pc.directions_mu, pc.directions_phi);
         float sin_v = sqrt(max(1.0 - s.mu * s.mu, 0.0));
         float nu = clamp(sin_v * sin_s * s.cos_phi + s.mu * mu_s, -1.0, 1.0);
@@ -38,16 +37,13 @@ void main()
             if (mu_sp > 0.0)
                 lp += ri.transmittance * atm.ground_albedo.rgb / PI * mu_sp * sun_transmittance(0.0, mu_sp);
         }
-        l2 += s.weight * lp;
-        f += s.weight * ri.scattering;
+        sphere_add3(0u, s.weight * lp);
+        sphere_add3(3u, s.weight * ri.scattering);
     }
-    sphere_store3(0u, l2);
-    sphere_store3(3u, f);
-    sphere_reduce(6u);
-    if (gl_LocalInvocationIndex != 0u)
+    if (!sphere_finish(6u) || gl_LocalInvocationIndex != 0u)
         return;
-    l2 = sphere_sum3(0u) / (4.0 * PI);
-    f = sphere_sum3(3u) / (4.0 * PI);
+    vec3 l2 = sphere_sum3(0u) / (4.0 * PI);
+    vec3 f = sphere_sum3(3u) / (4.0 * PI);
     vec3 psi = atm.solar_irradiance.rgb * l2 / (1.0 - f);
     uint i = (texel.y * pc.width + texel.x) * 3u;
     result[i + 0u] = psi.r;

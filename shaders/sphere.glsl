@@ -7,8 +7,20 @@
  * Why not one invocation per texel: a GPU would get 1024 threads for a
  * 32x32 LUT, and llvmpipe (lavapipe) silently ends every loop of an
  * invocation once it has run 65535 loop iterations in all
- * (LP_MAX_TGSI_LOOP_ITERATIONS), which one invocation integrating hundreds
- * of rays exceeds. Spread over 64 invocations, each stays far below it.
+ * (LP_MAX_TGSI_LOOP_ITERATIONS, one budget per shader invocation, spent by
+ * every loop that is not unrolled), which one invocation integrating
+ * hundreds of rays exceeds. Spread over 64 invocations, and over passes of
+ * SB_SPHERE_STEPS_PER_PASS directions per invocation (the partial sums wait
+ * in the scratch buffer between passes, accumulated in the same order as in
+ * one pass, so the result does not depend on the split), each stays far
+ * below it, whatever the direction counts. Should a pass still run out, a
+ * sentinel loop at its end notices (sphere_finish) and the baker fails
+ * instead of returning short sums.
+ *
+ * A product's kernel: sphere_begin(), then for each of its directions
+ * d = sphere_first_direction(), ... < sphere_end_direction(count), step
+ * SB_SPHERE_THREADS, sphere_add3() its values, then sphere_finish(), which
+ * returns true on the last pass with the sums in sphere_sum3().
  *
  * Directions: Gauss-Legendre with n_mu nodes in mu = cos(zenith) on each
  * piece of sphere_pieces() (the integrand jumps at the horizon, kinks where
@@ -24,10 +36,19 @@
 #define SB_SPHERE_GLSL
 
 layout(local_size_x = SB_SPHERE_THREADS) in;
+layout(push_constant) uniform Push { sb_bake_push pc; };
 
 shared float sphere_node[SB_MAX_DIRECTIONS_MU];
 shared float sphere_weight[SB_MAX_DIRECTIONS_MU];
 shared float sphere_partial[SB_SPHERE_THREADS * SB_SPHERE_MAX_SUMS];
+
+layout(std430, set = 0, binding = SB_BINDING_SCRATCH) buffer SphereScratch {
+    uint sphere_truncated;    /* set when a pass ran out of loop iterations */
+    uint sphere_sentinel[3];  /* 1, 1, 0, written by the host */
+    float sphere_partials[];  /* per texel, invocation and sum, between passes */
+};
+
+float sphere_acc[SB_SPHERE_MAX_SUMS]; /* this invocation's sums */
 
 /*
  * The pieces of [-1, 1] in mu (of [0, 1] for the upper hemisphere) that get
@@ -204,16 +225,61 @@ void sphere_reduce(uint count)
     barrier();
 }
 
-void sphere_store(uint c, float value)
+uint sphere_slot()
 {
-    sphere_partial[gl_LocalInvocationIndex * SB_SPHERE_MAX_SUMS + c] = value;
+    uint texel = gl_WorkGroupID.y * gl_NumWorkGroups.x + gl_WorkGroupID.x;
+    return (texel * SB_SPHERE_THREADS + gl_LocalInvocationIndex) * SB_SPHERE_MAX_SUMS;
 }
 
-void sphere_store3(uint c, vec3 value)
+/* Start this pass from the previous passes' sums. */
+void sphere_begin()
 {
-    sphere_store(c, value.r);
-    sphere_store(c + 1u, value.g);
-    sphere_store(c + 2u, value.b);
+    uint slot = sphere_slot();
+    for (uint c = 0u; c < SB_SPHERE_MAX_SUMS; c++)
+        sphere_acc[c] = pc.step_begin > 0u ? sphere_partials[slot + c] : 0.0;
+}
+
+uint sphere_first_direction()
+{
+    return gl_LocalInvocationIndex + pc.step_begin * SB_SPHERE_THREADS;
+}
+
+uint sphere_end_direction(uint count)
+{
+    return min(count, pc.step_end * SB_SPHERE_THREADS);
+}
+
+void sphere_add3(uint c, vec3 value)
+{
+    sphere_acc[c] += value.r;
+    sphere_acc[c + 1u] += value.g;
+    sphere_acc[c + 2u] += value.b;
+}
+
+/*
+ * End of this pass: flag the scratch buffer if llvmpipe's loop limiter ran
+ * out (then this two-iteration loop over a buffer the compiler cannot see
+ * through stops after one), then keep the sums for the next pass and return
+ * false, or, after the last pass, reduce the first `count` sums over the
+ * workgroup and return true. Every invocation must call it.
+ */
+bool sphere_finish(uint count)
+{
+    uint k = 0u;
+    while (sphere_sentinel[k] != 0u)
+        k++;
+    if (k != 2u)
+        sphere_truncated = 1u;
+    if (pc.step_end < pc.step_count) {
+        uint slot = sphere_slot();
+        for (uint c = 0u; c < count; c++)
+            sphere_partials[slot + c] = sphere_acc[c];
+        return false;
+    }
+    for (uint c = 0u; c < count; c++)
+        sphere_partial[gl_LocalInvocationIndex * SB_SPHERE_MAX_SUMS + c] = sphere_acc[c];
+    sphere_reduce(count);
+    return true;
 }
 
 vec3 sphere_sum3(uint c)
