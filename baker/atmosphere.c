@@ -17,20 +17,10 @@ static const struct sb_atmosphere_product products[SB_PRODUCT_COUNT] = {
     [SB_PRODUCT_TRANSMITTANCE] =
         {
             .id = SB_PRODUCT_TRANSMITTANCE,
-            .width = SB_TRANSMITTANCE_WIDTH,
-            .height = SB_TRANSMITTANCE_HEIGHT,
-            .channel_count = SB_TRANSMITTANCE_CHANNELS,
-            .channel_names = "r,g,b",
-            .parameterization = "transmittance-hillaire2020-v1",
         },
     [SB_PRODUCT_MULTISCATTERING] =
         {
             .id = SB_PRODUCT_MULTISCATTERING,
-            .width = SB_MULTISCATTERING_SIZE,
-            .height = SB_MULTISCATTERING_SIZE,
-            .channel_count = SB_MULTISCATTERING_CHANNELS,
-            .channel_names = "r,g,b",
-            .parameterization = "multiscattering-hillaire2020-subtexel-v1",
             .depends_on = BIT(SB_PRODUCT_TRANSMITTANCE),
             .defaults = {.directions_mu = 16, .directions_phi = 12},
             .workgroup_per_texel = true,
@@ -38,11 +28,6 @@ static const struct sb_atmosphere_product products[SB_PRODUCT_COUNT] = {
     [SB_PRODUCT_IRRADIANCE_GROUND] =
         {
             .id = SB_PRODUCT_IRRADIANCE_GROUND,
-            .width = SB_IRRADIANCE_WIDTH,
-            .height = SB_IRRADIANCE_HEIGHT,
-            .channel_count = SB_IRRADIANCE_GROUND_CHANNELS,
-            .channel_names = "direct.r,direct.g,direct.b,sky.r,sky.g,sky.b",
-            .parameterization = "irradiance-bruneton2017-subtexel-v1",
             .depends_on = BIT(SB_PRODUCT_TRANSMITTANCE) | BIT(SB_PRODUCT_MULTISCATTERING),
             .defaults = {.directions_mu = 12, .directions_phi = 12},
             .workgroup_per_texel = true,
@@ -50,11 +35,6 @@ static const struct sb_atmosphere_product products[SB_PRODUCT_COUNT] = {
     [SB_PRODUCT_IRRADIANCE_SKY] =
         {
             .id = SB_PRODUCT_IRRADIANCE_SKY,
-            .width = SB_IRRADIANCE_WIDTH,
-            .height = SB_IRRADIANCE_HEIGHT,
-            .channel_count = SB_IRRADIANCE_SKY_CHANNELS,
-            .channel_names = "rayleigh.r,rayleigh.g,rayleigh.b,mie.r,mie.g,mie.b,ground.r,ground.g,ground.b",
-            .parameterization = "irradiance-bruneton2017-subtexel-v1",
             .depends_on =
                 BIT(SB_PRODUCT_TRANSMITTANCE) | BIT(SB_PRODUCT_MULTISCATTERING) | BIT(SB_PRODUCT_IRRADIANCE_GROUND),
             .defaults = {.directions_mu = 16, .directions_phi = 16},
@@ -303,18 +283,19 @@ enum sb_result sb_atmosphere_bake(struct sb_atmosphere_baker *b, enum sb_product
             return SB_ERR_USAGE;
         }
 
-    enum sb_result res = sb_image_init(image, prod->width, prod->height, prod->channel_count);
+    const struct sb_product_format *format = sb_product_format(id);
+    enum sb_result res = sb_image_init(image, format->width, format->height, format->channel_count);
     if (res)
         return res;
-    sb_image_set_channel_names(image, prod->channel_names);
+    sb_image_set_channel_names(image, format->channel_names);
     sb_buffer_destroy(b->vk, &b->outputs[id]);
     sb_buffer_destroy(b->vk, &b->lookups[id]);
     size_t bytes = sb_image_float_count(image) * sizeof(float);
     if ((res = sb_buffer_create(b->vk, bytes, sb_product_name(id), &b->outputs[id])))
         goto cleanup;
 
-    if ((res = run(b, shaders[id].words, shaders[id].size, sb_product_name(id), &b->outputs[id], prod->width,
-                   prod->height, prod->workgroup_per_texel, s.directions_mu, s.directions_phi, gpu_ms)))
+    if ((res = run(b, shaders[id].words, shaders[id].size, sb_product_name(id), &b->outputs[id], format->width,
+                   format->height, prod->workgroup_per_texel, s.directions_mu, s.directions_phi, gpu_ms)))
         goto cleanup;
     memcpy(image->data, b->outputs[id].mapped, bytes);
     res = make_lookup(b, id, image);

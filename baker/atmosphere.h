@@ -24,11 +24,8 @@ struct sb_atmosphere_settings {
 
 struct sb_atmosphere_product {
     enum sb_product_id id;
-    uint32_t width, height, channel_count;
-    const char *channel_names;    /* comma-separated */
-    const char *parameterization; /* id recorded in the manifest */
-    uint32_t depends_on;          /* bit mask of sb_product_id */
-    bool workgroup_per_texel;     /* sphere.glsl's layout, else 8x8 texels a workgroup */
+    uint32_t depends_on;      /* bit mask of sb_product_id */
+    bool workgroup_per_texel; /* sphere.glsl's layout, else 8x8 texels a workgroup */
     struct sb_atmosphere_settings defaults;
 };
 

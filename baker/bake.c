@@ -53,7 +53,7 @@ enum sb_result sb_bake_scene(struct sb_vk *vk, const struct sb_scene *scene, con
         memset(a, 0, sizeof(*a));
         a->product = id;
         snprintf(a->file, sizeof(a->file), "%s.exr", sb_product_name(id));
-        snprintf(a->parameterization, sizeof(a->parameterization), "%s", sb_atmosphere_product(id)->parameterization);
+        snprintf(a->parameterization, sizeof(a->parameterization), "%s", sb_product_format(id)->parameterization);
 
         double t0 = now_ms();
         if ((res = sb_atmosphere_bake(baker, id, NULL, &image, &used, &a->gpu_ms)))

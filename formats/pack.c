@@ -11,27 +11,41 @@
 #include <sys/stat.h>
 #include <unistd.h>
 
+#include "config.h"
+#include "json.h"
 #include "log.h"
 #include "skybake_version.h"
 
 #define PACK_MAX_ARTIFACTS 32
 
-static const char *const product_names[SB_PRODUCT_COUNT] = {
-    [SB_PRODUCT_TRANSMITTANCE] = "transmittance",
-    [SB_PRODUCT_MULTISCATTERING] = "multiscattering",
-    [SB_PRODUCT_IRRADIANCE_GROUND] = "irradiance_ground",
-    [SB_PRODUCT_IRRADIANCE_SKY] = "irradiance_sky",
+static const struct sb_product_format product_formats[SB_PRODUCT_COUNT] = {
+    [SB_PRODUCT_TRANSMITTANCE] = {"transmittance", SB_TRANSMITTANCE_WIDTH, SB_TRANSMITTANCE_HEIGHT,
+                                  SB_TRANSMITTANCE_CHANNELS, "r,g,b", "transmittance-hillaire2020-v1"},
+    [SB_PRODUCT_MULTISCATTERING] = {"multiscattering", SB_MULTISCATTERING_SIZE, SB_MULTISCATTERING_SIZE,
+                                    SB_MULTISCATTERING_CHANNELS, "r,g,b", "multiscattering-hillaire2020-subtexel-v1"},
+    [SB_PRODUCT_IRRADIANCE_GROUND] = {"irradiance_ground", SB_IRRADIANCE_WIDTH, SB_IRRADIANCE_HEIGHT,
+                                      SB_IRRADIANCE_GROUND_CHANNELS, "direct.r,direct.g,direct.b,sky.r,sky.g,sky.b",
+                                      "irradiance-bruneton2017-subtexel-v1"},
+    [SB_PRODUCT_IRRADIANCE_SKY] = {"irradiance_sky", SB_IRRADIANCE_WIDTH, SB_IRRADIANCE_HEIGHT,
+                                   SB_IRRADIANCE_SKY_CHANNELS,
+                                   "rayleigh.r,rayleigh.g,rayleigh.b,mie.r,mie.g,mie.b,ground.r,ground.g,ground.b",
+                                   "irradiance-bruneton2017-subtexel-v1"},
 };
+
+const struct sb_product_format *sb_product_format(enum sb_product_id id)
+{
+    return &product_formats[id];
+}
 
 const char *sb_product_name(enum sb_product_id id)
 {
-    return (unsigned)id < SB_PRODUCT_COUNT ? product_names[id] : "unknown";
+    return (unsigned)id < SB_PRODUCT_COUNT ? product_formats[id].name : "unknown";
 }
 
 bool sb_product_from_name(const char *name, enum sb_product_id *id)
 {
     for (int p = 0; p < SB_PRODUCT_COUNT; p++)
-        if (strcmp(name, product_names[p]) == 0) {
+        if (strcmp(name, product_formats[p].name) == 0) {
             *id = (enum sb_product_id)p;
             return true;
         }
@@ -127,8 +141,8 @@ enum sb_result sb_pack_writer_create(const char *out_dir, struct sb_pack_writer 
             return SB_ERR_IO;
         }
         if (!is_pack_or_empty(w->out_dir)) {
-            sb_error("%s: exists and is neither empty nor a skybake pack (no %s); refusing to replace it",
-                     w->out_dir, SB_PACK_MANIFEST);
+            sb_error("%s: exists and is neither empty nor a skybake pack (no %s); refusing to replace it", w->out_dir,
+                     SB_PACK_MANIFEST);
             free(w);
             return SB_ERR_IO;
         }
@@ -199,8 +213,7 @@ enum sb_result sb_pack_writer_add_image(struct sb_pack_writer *w, struct sb_arti
     return SB_OK;
 }
 
-static char *manifest_json(const struct sb_pack_writer *w, const char *scene_json,
-                           const struct sb_device_info *device)
+static char *manifest_json(const struct sb_pack_writer *w, const char *scene_json, const struct sb_device_info *device)
 {
     cJSON *root = cJSON_CreateObject();
     if (!root)
@@ -306,4 +319,265 @@ void sb_pack_writer_destroy(struct sb_pack_writer **writer)
         sb_warn("%s: could not remove the temporary directory", w->tmp_dir);
     free(w);
     *writer = NULL;
+}
+
+/* ---- Reading ------------------------------------------------------------------ */
+
+#define PACK_MANIFEST_MAX_BYTES (1u << 20)
+
+/* A string member of `object`, copied into out[size]; absent, another type
+ * or too long is an error naming where. */
+static enum sb_result manifest_string(const cJSON *object, const char *key, char *out, size_t size, const char *source,
+                                      const char *where)
+{
+    const cJSON *item = cJSON_GetObjectItemCaseSensitive(object, key);
+    if (!item) {
+        sb_error("%s: %s%s: missing", source, where, key);
+        return SB_ERR_MISSING_FIELD;
+    }
+    if (!cJSON_IsString(item)) {
+        sb_error("%s: %s%s: expected a string", source, where, key);
+        return SB_ERR_WRONG_TYPE;
+    }
+    if (strlen(item->valuestring) >= size) {
+        sb_error("%s: %s%s: longer than %zu characters", source, where, key, size - 1);
+        return SB_ERR_OUT_OF_RANGE;
+    }
+    snprintf(out, size, "%s", item->valuestring);
+    return SB_OK;
+}
+
+/* An integer member that must equal `expect`. */
+static enum sb_result manifest_expect_int(const cJSON *object, const char *key, uint32_t expect, const char *source,
+                                          const char *where, const char *product)
+{
+    const cJSON *item = cJSON_GetObjectItemCaseSensitive(object, key);
+    if (!item) {
+        sb_error("%s: %s%s: missing", source, where, key);
+        return SB_ERR_MISSING_FIELD;
+    }
+    if (!cJSON_IsNumber(item)) {
+        sb_error("%s: %s%s: expected a number", source, where, key);
+        return SB_ERR_WRONG_TYPE;
+    }
+    if (item->valuedouble != (double)expect) {
+        sb_error("%s: %s%s: %s of format version %d has %u, the manifest says %g", source, where, key, product,
+                 SB_PACK_FORMAT_VERSION, expect, item->valuedouble);
+        return SB_ERR_BAD_IMAGE;
+    }
+    return SB_OK;
+}
+
+/* The manifest's description of one artifact, checked against its product's format. */
+static enum sb_result read_artifact_entry(const cJSON *entry, int index, struct sb_pack *pack, const char *source,
+                                          enum sb_product_id *out_id)
+{
+    char where[64];
+    snprintf(where, sizeof(where), "artifacts[%d].", index);
+    if (!cJSON_IsObject(entry)) {
+        sb_error("%s: artifacts[%d]: expected an object", source, index);
+        return SB_ERR_WRONG_TYPE;
+    }
+    enum sb_result res = sb_json_check_duplicates(entry, source, where);
+    char name[64];
+    if (res || (res = manifest_string(entry, "name", name, sizeof(name), source, where)))
+        return res;
+    enum sb_product_id id;
+    if (!sb_product_from_name(name, &id)) {
+        sb_error("%s: %sname: \"%s\" is not a product of format version %d", source, where, name,
+                 SB_PACK_FORMAT_VERSION);
+        return SB_ERR_UNKNOWN_PRODUCT;
+    }
+    if (pack->present[id]) {
+        sb_error("%s: %sname: %s is listed twice", source, where, name);
+        return SB_ERR_DUPLICATE_KEY;
+    }
+    const struct sb_product_format *format = sb_product_format(id);
+    struct sb_artifact *a = &pack->artifacts[id];
+    a->product = id;
+    if ((res = manifest_string(entry, "file", a->file, sizeof(a->file), source, where)) ||
+        (res = manifest_string(entry, "content_hash", a->content_hash, sizeof(a->content_hash), source, where)) ||
+        (res = manifest_string(entry, "parameterization", a->parameterization, sizeof(a->parameterization), source,
+                               where)))
+        return res;
+    if (!a->file[0] || strchr(a->file, '/') || a->file[0] == '.') {
+        sb_error("%s: %sfile: \"%s\" is not a plain file name inside the pack; refused", source, where, a->file);
+        return SB_ERR_UNSAFE_PATH;
+    }
+    if (strcmp(a->parameterization, format->parameterization) != 0) {
+        sb_error("%s: %sparameterization: \"%s\", but %s of format version %d is \"%s\"", source, where,
+                 a->parameterization, name, SB_PACK_FORMAT_VERSION, format->parameterization);
+        return SB_ERR_BAD_IMAGE;
+    }
+    if ((res = manifest_expect_int(entry, "width", format->width, source, where, name)) ||
+        (res = manifest_expect_int(entry, "height", format->height, source, where, name)) ||
+        (res = manifest_expect_int(entry, "depth", 1, source, where, name)))
+        return res;
+    char pixel_type[16];
+    if ((res = manifest_string(entry, "pixel_type", pixel_type, sizeof(pixel_type), source, where)))
+        return res;
+    if (strcmp(pixel_type, "float32") != 0) {
+        sb_error("%s: %spixel_type: \"%s\", expected \"float32\"", source, where, pixel_type);
+        return SB_ERR_BAD_IMAGE;
+    }
+    /* Channels: the product's, in its order. */
+    const cJSON *channels = cJSON_GetObjectItemCaseSensitive(entry, "channels");
+    if (!cJSON_IsArray(channels)) {
+        sb_error("%s: %schannels: expected an array of names", source, where);
+        return channels ? SB_ERR_WRONG_TYPE : SB_ERR_MISSING_FIELD;
+    }
+    char expect[256], got[256] = "";
+    snprintf(expect, sizeof(expect), "%s", format->channel_names);
+    const cJSON *c;
+    cJSON_ArrayForEach(c, channels)
+    {
+        if (!cJSON_IsString(c) || strlen(got) + strlen(c->valuestring) + 2 > sizeof(got)) {
+            sb_error("%s: %schannels: expected names", source, where);
+            return SB_ERR_WRONG_TYPE;
+        }
+        if (got[0])
+            strcat(got, ",");
+        strcat(got, c->valuestring);
+    }
+    if (strcmp(got, expect) != 0) {
+        sb_error("%s: %schannels: \"%s\", but %s of format version %d has \"%s\"", source, where, got, name,
+                 SB_PACK_FORMAT_VERSION, expect);
+        return SB_ERR_BAD_IMAGE;
+    }
+    const cJSON *settings = cJSON_GetObjectItemCaseSensitive(entry, "settings");
+    if (cJSON_IsObject(settings) &&
+        !cJSON_PrintPreallocated((cJSON *)settings, a->settings_json, (int)sizeof(a->settings_json) - 5, false))
+        a->settings_json[0] = '\0';
+    const cJSON *ms = cJSON_GetObjectItemCaseSensitive(entry, "bake_ms");
+    a->bake_ms = cJSON_IsNumber(ms) ? ms->valuedouble : 0.0;
+    ms = cJSON_GetObjectItemCaseSensitive(entry, "gpu_ms");
+    a->gpu_ms = cJSON_IsNumber(ms) ? ms->valuedouble : 0.0;
+    *out_id = id;
+    return SB_OK;
+}
+
+/* Read one artifact's EXR (a regular file, not a link) and verify its content. */
+static enum sb_result read_artifact_image(const char *dir, int dir_fd, struct sb_pack *pack, enum sb_product_id id)
+{
+    struct sb_artifact *a = &pack->artifacts[id];
+    const struct sb_product_format *format = sb_product_format(id);
+    char path[8192];
+    snprintf(path, sizeof(path), "%s/%s", dir, a->file);
+    struct stat st;
+    if (fstatat(dir_fd, a->file, &st, AT_SYMLINK_NOFOLLOW) != 0) {
+        sb_error("%s: %s: cannot read %s: %s", path, sb_product_name(id), a->file, strerror(errno));
+        return SB_ERR_IO;
+    }
+    if (S_ISLNK(st.st_mode)) {
+        sb_error("%s: %s: is a symbolic link; refused", path, sb_product_name(id));
+        return SB_ERR_UNSAFE_PATH;
+    }
+    if (!S_ISREG(st.st_mode)) {
+        sb_error("%s: %s: not a regular file", path, sb_product_name(id));
+        return SB_ERR_IO;
+    }
+    struct sb_image *image = &pack->images[id];
+    struct sb_exr_attribute attrs[SB_EXR_MAX_ATTRIBUTES];
+    int attr_count = 0;
+    enum sb_result res =
+        sb_exr_read(path, format->channel_names, (uint64_t)format->width * format->height, image, attrs, &attr_count);
+    if (res)
+        return res;
+    if (image->width != format->width || image->height != format->height) {
+        sb_error("%s: %s: the file is %ux%u, the product %ux%u", path, sb_product_name(id), image->width, image->height,
+                 format->width, format->height);
+        return SB_ERR_BAD_IMAGE;
+    }
+    if (sb_image_find_nonfinite(image) >= 0) {
+        sb_error("%s: %s: holds NaN or Inf", path, sb_product_name(id));
+        return SB_ERR_NUMERIC;
+    }
+    char hash[SB_HASH_HEX_SIZE];
+    sb_image_content_hash(image, hash);
+    if (strcmp(hash, a->content_hash) != 0) {
+        sb_error("%s: %s: content hash %s, the manifest records %s: the file was changed or corrupted", path,
+                 sb_product_name(id), hash, a->content_hash);
+        return SB_ERR_HASH_MISMATCH;
+    }
+    return SB_OK;
+}
+
+enum sb_result sb_pack_open(const char *dir, struct sb_pack *pack)
+{
+    memset(pack, 0, sizeof(*pack));
+    char source[4200];
+    snprintf(source, sizeof(source), "%s/%s", dir, SB_PACK_MANIFEST);
+    int dir_fd = open(dir, O_RDONLY | O_DIRECTORY | O_CLOEXEC);
+    if (dir_fd < 0) {
+        sb_error("%s: cannot open the pack: %s", dir, strerror(errno));
+        return SB_ERR_IO;
+    }
+    cJSON *root = NULL;
+    enum sb_result res = sb_json_load(dir_fd, SB_PACK_MANIFEST, source, PACK_MANIFEST_MAX_BYTES, false, &root);
+    if (!res && !cJSON_IsObject(root)) {
+        sb_error("%s: expected a JSON object", source);
+        res = SB_ERR_WRONG_TYPE;
+    }
+    if (!res)
+        res = sb_json_check_duplicates(root, source, "");
+    char format[32];
+    if (!res && !(res = manifest_string(root, "format", format, sizeof(format), source, "")) &&
+        strcmp(format, "skybake-pack") != 0) {
+        sb_error("%s: format: \"%s\" is not a skybake pack", source, format);
+        res = SB_ERR_VERSION;
+    }
+    if (!res) {
+        const cJSON *version = cJSON_GetObjectItemCaseSensitive(root, "format_version");
+        if (!cJSON_IsNumber(version)) {
+            sb_error("%s: format_version: %s", source, version ? "expected a number" : "missing");
+            res = version ? SB_ERR_WRONG_TYPE : SB_ERR_MISSING_FIELD;
+        } else if (version->valuedouble != SB_PACK_FORMAT_VERSION) {
+            sb_error("%s: format_version %g; this build reads version %d only: rebake needed", source,
+                     version->valuedouble, SB_PACK_FORMAT_VERSION);
+            res = SB_ERR_VERSION;
+        } else {
+            pack->format_version = SB_PACK_FORMAT_VERSION;
+        }
+    }
+    if (!res)
+        res =
+            manifest_string(root, "skybake_version", pack->skybake_version, sizeof(pack->skybake_version), source, "");
+    if (!res)
+        res = manifest_string(root, "scene_hash", pack->scene_hash, sizeof(pack->scene_hash), source, "");
+    const cJSON *device = res ? NULL : cJSON_GetObjectItemCaseSensitive(root, "device");
+    if (cJSON_IsObject(device)) {
+        manifest_string(device, "name", pack->device.name, sizeof(pack->device.name), source, "device.");
+        manifest_string(device, "driver", pack->device.driver, sizeof(pack->device.driver), source, "device.");
+    }
+    const cJSON *artifacts = res ? NULL : cJSON_GetObjectItemCaseSensitive(root, "artifacts");
+    if (!res && !cJSON_IsArray(artifacts)) {
+        sb_error("%s: artifacts: %s", source, artifacts ? "expected an array" : "missing");
+        res = artifacts ? SB_ERR_WRONG_TYPE : SB_ERR_MISSING_FIELD;
+    }
+    /* Every entry is checked before any pixel is read. */
+    int index = 0;
+    const cJSON *entry;
+    if (!res)
+        cJSON_ArrayForEach(entry, artifacts)
+        {
+            enum sb_product_id id;
+            if ((res = read_artifact_entry(entry, index++, pack, source, &id)))
+                break;
+            pack->present[id] = true;
+        }
+    for (int p = 0; p < SB_PRODUCT_COUNT && !res; p++)
+        if (pack->present[p])
+            res = read_artifact_image(dir, dir_fd, pack, (enum sb_product_id)p);
+    cJSON_Delete(root);
+    close(dir_fd);
+    if (res)
+        sb_pack_close(pack);
+    return res;
+}
+
+void sb_pack_close(struct sb_pack *pack)
+{
+    for (int p = 0; p < SB_PRODUCT_COUNT; p++)
+        sb_image_finish(&pack->images[p]);
+    memset(pack, 0, sizeof(*pack));
 }

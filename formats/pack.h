@@ -26,7 +26,15 @@ enum sb_product_id {
     SB_PRODUCT_COUNT,
 };
 
-/* "transmittance", "multiscattering", "irradiance_ground", "irradiance_sky". */
+/* What a product's file holds in this format version. */
+struct sb_product_format {
+    const char *name; /* "transmittance", "multiscattering", "irradiance_ground", "irradiance_sky" */
+    uint32_t width, height, channel_count;
+    const char *channel_names;    /* comma-separated, in storage order */
+    const char *parameterization; /* mapping id, see docs/pack.md */
+};
+
+const struct sb_product_format *sb_product_format(enum sb_product_id id);
 const char *sb_product_name(enum sb_product_id id);
 bool sb_product_from_name(const char *name, enum sb_product_id *id);
 
@@ -73,5 +81,35 @@ enum sb_result sb_pack_writer_commit(struct sb_pack_writer **writer, const char 
 
 /* Abandon the pack: remove the temporary directory. Accepts NULL. */
 void sb_pack_writer_destroy(struct sb_pack_writer **writer);
+
+/*
+ * A pack as read back: the manifest's fields and every artifact's image,
+ * each verified. Products the pack does not hold have present[id] false.
+ */
+struct sb_pack {
+    int format_version;
+    char skybake_version[32];
+    char scene_hash[SB_HASH_HEX_SIZE];
+    struct sb_device_info device;
+    bool present[SB_PRODUCT_COUNT];
+    struct sb_artifact artifacts[SB_PRODUCT_COUNT];
+    struct sb_image images[SB_PRODUCT_COUNT];
+};
+
+/*
+ * Read the pack in `dir` and verify all of it before returning: the
+ * manifest (at most 1 MiB, strict JSON, no key twice), its format version
+ * (SB_ERR_VERSION for one this build does not read: "rebake needed", never
+ * a guess), every artifact's name (a product of this version, at most once),
+ * file (a plain name inside the pack, not a symbolic link), dimensions,
+ * channels and pixel type against the product's format (checked before any
+ * pixel is read), the EXR itself, that it holds only finite values, and its
+ * content hash against the manifest's. Any failure is logged naming the
+ * pack, the artifact and the reason; *pack is then empty.
+ */
+enum sb_result sb_pack_open(const char *dir, struct sb_pack *pack);
+
+/* Free the images; accepts an empty or closed pack. */
+void sb_pack_close(struct sb_pack *pack);
 
 #endif

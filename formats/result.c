@@ -20,6 +20,9 @@ static const char *const result_names[SB_RESULT_COUNT] = {
     [SB_ERR_NUMERIC] = "numeric",
     [SB_ERR_USAGE] = "usage",
     [SB_ERR_DEVICE_LIMIT] = "device-limit",
+    [SB_ERR_VERSION] = "version",
+    [SB_ERR_HASH_MISMATCH] = "hash-mismatch",
+    [SB_ERR_UNSAFE_PATH] = "unsafe-path",
 };
 
 const char *sb_result_name(enum sb_result result)

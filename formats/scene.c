@@ -2,11 +2,13 @@
 
 #include <cJSON.h>
 #include <errno.h>
+#include <fcntl.h>
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 
+#include "json.h"
 #include "log.h"
 
 #define SCENE_MAX_BYTES (1u << 20)
@@ -38,12 +40,15 @@ struct field {
     const char *key;
     enum field_kind kind;
     size_t offset;
-    double min, max;   /* allowed range */
+    double min, max;    /* allowed range */
     bool min_exclusive; /* value must be > min */
     const char *unit;
 };
 
-#define F(key, kind, lo, hi, excl, unit) {#key, kind, offsetof(struct sb_atmosphere_params, key), lo, hi, excl, unit}
+#define F(key, kind, lo, hi, excl, unit)                                                                               \
+    {                                                                                                                  \
+#key, kind, offsetof(struct sb_atmosphere_params, key), lo, hi, excl, unit                                     \
+    }
 static const struct field atmosphere_fields[] = {
     F(ground_radius_km, FIELD_SCALAR, 0.0, 1e6, true, "km"),
     F(top_radius_km, FIELD_SCALAR, 0.0, 2e6, true, "km"),
@@ -105,8 +110,8 @@ enum sb_result sb_atmosphere_validate(const struct sb_atmosphere_params *p, cons
         }
     }
     if (!(p->top_radius_km > p->ground_radius_km)) {
-        sb_error("%s: atmosphere.top_radius_km: %.17g must exceed ground_radius_km (%.17g)", source,
-                 p->top_radius_km, p->ground_radius_km);
+        sb_error("%s: atmosphere.top_radius_km: %.17g must exceed ground_radius_km (%.17g)", source, p->top_radius_km,
+                 p->ground_radius_km);
         return SB_ERR_OUT_OF_RANGE;
     }
     if (p->top_radius_km - p->ground_radius_km < 1e-3 * p->ground_radius_km * 1e-3) {
@@ -118,17 +123,6 @@ enum sb_result sb_atmosphere_validate(const struct sb_atmosphere_params *p, cons
 }
 
 /* ---- JSON walking -------------------------------------------------------------- */
-
-static enum sb_result check_duplicates(const cJSON *object, const char *source, const char *where)
-{
-    for (const cJSON *a = object->child; a; a = a->next)
-        for (const cJSON *b = a->next; b; b = b->next)
-            if (strcmp(a->string, b->string) == 0) {
-                sb_error("%s: %s%s%s: key given twice", source, where, *where ? "." : "", a->string);
-                return SB_ERR_DUPLICATE_KEY;
-            }
-    return SB_OK;
-}
 
 static enum sb_result read_number(const cJSON *item, double *out, const char *source, const char *path)
 {
@@ -172,7 +166,7 @@ static enum sb_result parse_atmosphere(const cJSON *obj, struct sb_scene *scene,
         sb_error("%s: atmosphere: expected an object", source);
         return SB_ERR_WRONG_TYPE;
     }
-    enum sb_result res = check_duplicates(obj, source, "atmosphere");
+    enum sb_result res = sb_json_check_duplicates(obj, source, "atmosphere");
     if (res)
         return res;
     const cJSON *preset = cJSON_GetObjectItemCaseSensitive(obj, "preset");
@@ -246,7 +240,7 @@ static enum sb_result parse_root(const cJSON *root, struct sb_scene *scene, cons
         sb_error("%s: the scene must be a JSON object", source);
         return SB_ERR_WRONG_TYPE;
     }
-    enum sb_result res = check_duplicates(root, source, "");
+    enum sb_result res = sb_json_check_duplicates(root, source, "");
     if (res)
         return res;
     bool have_atmosphere = false, have_products = false;
@@ -296,32 +290,11 @@ static enum sb_result parse_root(const cJSON *root, struct sb_scene *scene, cons
 enum sb_result sb_scene_parse(const char *json, size_t size, const char *source, struct sb_scene *scene)
 {
     memset(scene, 0, sizeof(*scene));
-    if (size == 0) {
-        sb_error("%s: empty file, expected a JSON object", source);
-        return SB_ERR_JSON_SYNTAX;
-    }
-    if (memchr(json, '\0', size)) {
-        sb_error("%s: contains a NUL byte: not a JSON text", source);
-        return SB_ERR_JSON_SYNTAX;
-    }
-    const char *end = NULL;
-    cJSON *root = cJSON_ParseWithLengthOpts(json, size, &end, false);
-    if (!root) {
-        size_t offset = end ? (size_t)(end - json) : 0;
-        size_t line = 1;
-        for (size_t i = 0; i < offset && i < size; i++)
-            line += json[i] == '\n';
-        sb_error("%s: line %zu: malformed JSON near byte %zu", source, line, offset);
-        return SB_ERR_JSON_SYNTAX;
-    }
-    /* Anything but whitespace after the value is an error. */
-    for (const char *c = end; c && c < json + size; c++)
-        if (*c != ' ' && *c != '\t' && *c != '\n' && *c != '\r') {
-            sb_error("%s: trailing data after the JSON value at byte %zu", source, (size_t)(c - json));
-            cJSON_Delete(root);
-            return SB_ERR_JSON_SYNTAX;
-        }
-    enum sb_result res = parse_root(root, scene, source);
+    cJSON *root;
+    enum sb_result res = sb_json_parse(json, size, source, &root);
+    if (res)
+        return res;
+    res = parse_root(root, scene, source);
     cJSON_Delete(root);
     if (res)
         memset(scene, 0, sizeof(*scene));
@@ -331,30 +304,14 @@ enum sb_result sb_scene_parse(const char *json, size_t size, const char *source,
 enum sb_result sb_scene_load(const char *path, struct sb_scene *scene)
 {
     memset(scene, 0, sizeof(*scene));
-    FILE *f = fopen(path, "rb");
-    if (!f) {
-        sb_error("%s: cannot open scene: %s", path, strerror(errno));
-        return SB_ERR_IO;
-    }
-    char *buf = malloc(SCENE_MAX_BYTES + 1);
-    if (!buf) {
-        fclose(f);
-        return SB_ERR_NOMEM;
-    }
-    size_t n = fread(buf, 1, SCENE_MAX_BYTES + 1, f);
-    bool failed = ferror(f);
-    fclose(f);
-    enum sb_result res;
-    if (failed) {
-        sb_error("%s: cannot read scene: %s", path, strerror(errno));
-        res = SB_ERR_IO;
-    } else if (n > SCENE_MAX_BYTES) {
-        sb_error("%s: larger than %u bytes: not a scene file", path, SCENE_MAX_BYTES);
-        res = SB_ERR_OUT_OF_RANGE;
-    } else {
-        res = sb_scene_parse(buf, n, path, scene);
-    }
-    free(buf);
+    cJSON *root;
+    enum sb_result res = sb_json_load(AT_FDCWD, path, path, SCENE_MAX_BYTES, true, &root);
+    if (res)
+        return res;
+    res = parse_root(root, scene, path);
+    cJSON_Delete(root);
+    if (res)
+        memset(scene, 0, sizeof(*scene));
     return res;
 }
 

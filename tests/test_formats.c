@@ -1,13 +1,17 @@
-/* formats/: EXR round trips, content hashes, scene parsing and validation. */
+/* formats/: EXR round trips, content hashes, scene parsing and validation,
+ * packs written and read back, and packs that must be refused. */
+#include <cJSON.h>
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
+#include <sys/stat.h>
 #include <unistd.h>
 
 #include "exr.h"
 #include "harness.h"
 #include "image.h"
 #include "log.h"
+#include "pack.h"
 #include "scene.h"
 
 static void quiet(void *user, enum sb_log_level level, const char *msg)
@@ -32,8 +36,8 @@ static void test_exr_round_trip(void)
     struct sb_exr_attribute got[SB_EXR_MAX_ATTRIBUTES];
     int ngot = 0;
     CHECK(sb_exr_read(path, "r,g,b", 0, &back, got, &ngot) == SB_OK, "read");
-    CHECK(back.width == 37 && back.height == 11 && back.channel_count == 3, "shape %ux%ux%u", back.width,
-          back.height, back.channel_count);
+    CHECK(back.width == 37 && back.height == 11 && back.channel_count == 3, "shape %ux%ux%u", back.width, back.height,
+          back.channel_count);
     CHECK(back.data && memcmp(back.data, img.data, sb_image_float_count(&img) * 4) == 0, "data differs");
     CHECK(ngot == 2 && !strcmp(got[0].value, "transmittance"), "attributes: %d", ngot);
     char h1[SB_HASH_HEX_SIZE], h2[SB_HASH_HEX_SIZE];
@@ -131,10 +135,221 @@ static void test_scenes(void)
     CHECK(sb_scene_load("/nonexistent/scene.json", &a) == SB_ERR_IO, "missing file");
 }
 
+/* ---- packs ---------------------------------------------------------------------- */
+
+static char pack_root[] = "/tmp/skybake-pack-test-XXXXXX";
+
+static void run(const char *command)
+{
+    CHECK(system(command) == 0, "%s", command);
+}
+
+/* A pack of every product with synthetic, finite content. */
+static void write_test_pack(const char *dir, struct sb_image images[SB_PRODUCT_COUNT])
+{
+    struct sb_pack_writer *w = NULL;
+    CHECK(sb_pack_writer_create(dir, &w) == SB_OK, "writer");
+    for (int p = 0; p < SB_PRODUCT_COUNT && w; p++) {
+        const struct sb_product_format *f = sb_product_format((enum sb_product_id)p);
+        sb_image_init(&images[p], f->width, f->height, f->channel_count);
+        sb_image_set_channel_names(&images[p], f->channel_names);
+        for (uint64_t i = 0; i < sb_image_float_count(&images[p]); i++)
+            images[p].data[i] = (float)((double)(i * 2654435761u % 1000003u) * 1e-6 + p);
+        struct sb_artifact a = {.product = (enum sb_product_id)p};
+        snprintf(a.file, sizeof(a.file), "%s.exr", f->name);
+        snprintf(a.parameterization, sizeof(a.parameterization), "%s", f->parameterization);
+        CHECK(sb_pack_writer_add_image(w, &a, &images[p]) == SB_OK, "add %s", f->name);
+    }
+    struct sb_device_info device = {.name = "test device", .driver = "none"};
+    CHECK(w && sb_pack_writer_commit(&w, "{}", &device) == SB_OK, "commit");
+    sb_pack_writer_destroy(&w);
+}
+
+/* Copy the good pack to `bad`, let `edit` change its manifest (may be NULL), and return the code opening it gives. */
+static enum sb_result open_edited(const char *good, const char *bad, void (*edit)(cJSON *root), const char *shell)
+{
+    char cmd[1024];
+    snprintf(cmd, sizeof(cmd), "rm -rf '%s' && cp -r '%s' '%s'", bad, good, bad);
+    run(cmd);
+    if (edit) {
+        char path[512];
+        snprintf(path, sizeof(path), "%s/manifest.json", bad);
+        FILE *f = fopen(path, "rb");
+        char *text = calloc(1, 1 << 20);
+        size_t n = f ? fread(text, 1, (1 << 20) - 1, f) : 0;
+        if (f)
+            fclose(f);
+        cJSON *root = cJSON_ParseWithLength(text, n);
+        free(text);
+        CHECK(root != NULL, "manifest parses");
+        if (!root)
+            return SB_OK;
+        edit(root);
+        char *out = cJSON_Print(root);
+        cJSON_Delete(root);
+        f = fopen(path, "wb");
+        fputs(out, f);
+        fclose(f);
+        free(out);
+    }
+    if (shell) {
+        snprintf(cmd, sizeof(cmd), "cd '%s' && %s", bad, shell);
+        run(cmd);
+    }
+    struct sb_pack *pack = calloc(1, sizeof(*pack));
+    enum sb_result res = sb_pack_open(bad, pack);
+    sb_pack_close(pack);
+    free(pack);
+    return res;
+}
+
+static cJSON *artifact(cJSON *root, int i)
+{
+    return cJSON_GetArrayItem(cJSON_GetObjectItem(root, "artifacts"), i);
+}
+
+static void set_string(cJSON *object, const char *key, const char *value)
+{
+    cJSON_ReplaceItemInObject(object, key, cJSON_CreateString(value));
+}
+
+static void edit_version(cJSON *r)
+{
+    cJSON_ReplaceItemInObject(r, "format_version", cJSON_CreateNumber(2));
+}
+static void edit_no_version(cJSON *r)
+{
+    cJSON_DeleteItemFromObject(r, "format_version");
+}
+static void edit_parent_path(cJSON *r)
+{
+    set_string(artifact(r, 0), "file", "../transmittance.exr");
+}
+static void edit_absolute_path(cJSON *r)
+{
+    set_string(artifact(r, 0), "file", "/etc/passwd");
+}
+static void edit_hidden_path(cJSON *r)
+{
+    set_string(artifact(r, 0), "file", ".hidden.exr");
+}
+static void edit_hash(cJSON *r)
+{
+    set_string(artifact(r, 1), "content_hash", "00000000000000000000000000000000");
+}
+static void edit_width(cJSON *r)
+{
+    cJSON_ReplaceItemInObject(artifact(r, 0), "width", cJSON_CreateNumber(255));
+}
+static void edit_huge(cJSON *r)
+{
+    cJSON_ReplaceItemInObject(artifact(r, 0), "height", cJSON_CreateNumber(1e12));
+}
+static void edit_channels(cJSON *r)
+{
+    cJSON_ReplaceItemInObject(artifact(r, 0), "channels", cJSON_CreateString("r,g,b"));
+}
+static void edit_unknown(cJSON *r)
+{
+    set_string(artifact(r, 2), "name", "clouds");
+}
+static void edit_duplicate(cJSON *r)
+{
+    cJSON_AddItemToArray(cJSON_GetObjectItem(r, "artifacts"), cJSON_Duplicate(artifact(r, 0), true));
+}
+static void edit_pixel_type(cJSON *r)
+{
+    set_string(artifact(r, 0), "pixel_type", "float16");
+}
+
+static void test_pack_reader(void)
+{
+    CHECK(mkdtemp(pack_root) != NULL, "temporary directory");
+    char good[256], bad[256];
+    snprintf(good, sizeof(good), "%s/good", pack_root);
+    snprintf(bad, sizeof(bad), "%s/bad", pack_root);
+    struct sb_image images[SB_PRODUCT_COUNT] = {0};
+    write_test_pack(good, images);
+
+    struct sb_pack *pack = calloc(1, sizeof(*pack));
+    CHECK(sb_pack_open(good, pack) == SB_OK, "a pack just written opens");
+    for (int p = 0; p < SB_PRODUCT_COUNT; p++) {
+        CHECK(pack->present[p], "%s present", sb_product_name((enum sb_product_id)p));
+        CHECK(pack->images[p].data &&
+                  !memcmp(pack->images[p].data, images[p].data, sb_image_float_count(&images[p]) * sizeof(float)),
+              "%s reads back bit for bit", sb_product_name((enum sb_product_id)p));
+        sb_image_finish(&images[p]);
+    }
+    CHECK(pack->format_version == SB_PACK_FORMAT_VERSION && !strcmp(pack->device.name, "test device"), "header");
+    sb_pack_close(pack);
+    free(pack);
+
+    static const struct {
+        const char *what;
+        void (*edit)(cJSON *root);
+        const char *shell;
+        enum sb_result expect;
+    } cases[] = {
+        {"unchanged copy", NULL, NULL, SB_OK},
+        {"unknown format version", edit_version, NULL, SB_ERR_VERSION},
+        {"no format version", edit_no_version, NULL, SB_ERR_MISSING_FIELD},
+        {"file in the parent directory", edit_parent_path, NULL, SB_ERR_UNSAFE_PATH},
+        {"absolute file", edit_absolute_path, NULL, SB_ERR_UNSAFE_PATH},
+        {"hidden file", edit_hidden_path, NULL, SB_ERR_UNSAFE_PATH},
+        {"artifact that is a symbolic link", NULL, "mv transmittance.exr t.exr && ln -s t.exr transmittance.exr",
+         SB_ERR_UNSAFE_PATH},
+        {"manifest that is a symbolic link", NULL, "mv manifest.json m && ln -s m manifest.json", SB_ERR_UNSAFE_PATH},
+        {"missing artifact", NULL, "rm multiscattering.exr", SB_ERR_IO},
+        {"recorded hash differs", edit_hash, NULL, SB_ERR_HASH_MISMATCH},
+        {"artifact replaced by another product's file", NULL, "cp irradiance_sky.exr irradiance_ground.exr",
+         SB_ERR_BAD_IMAGE},
+        {"truncated artifact", NULL, "head -c 3000 transmittance.exr > t && mv t transmittance.exr", SB_ERR_EXR},
+        {"one flipped byte in the compressed pixels", NULL,
+         "printf '\\x55' | dd of=multiscattering.exr bs=1 seek=$(( $(stat -c %s multiscattering.exr) - 40 )) "
+         "conv=notrunc 2>/dev/null",
+         SB_ERR_EXR},
+        {"width differs from the product's", edit_width, NULL, SB_ERR_BAD_IMAGE},
+        {"absurd height", edit_huge, NULL, SB_ERR_BAD_IMAGE},
+        {"channels of the wrong type", edit_channels, NULL, SB_ERR_WRONG_TYPE},
+        {"pixel type", edit_pixel_type, NULL, SB_ERR_BAD_IMAGE},
+        {"unknown product", edit_unknown, NULL, SB_ERR_UNKNOWN_PRODUCT},
+        {"product listed twice", edit_duplicate, NULL, SB_ERR_DUPLICATE_KEY},
+        {"manifest is garbage", NULL, "head -c 100 /dev/urandom > manifest.json", SB_ERR_JSON_SYNTAX},
+        {"manifest is empty", NULL, ": > manifest.json", SB_ERR_JSON_SYNTAX},
+        {"manifest over 1 MiB", NULL, "head -c 1100000 /dev/zero | tr '\\\\0' ' ' >> manifest.json",
+         SB_ERR_OUT_OF_RANGE},
+        {"no manifest", NULL, "rm manifest.json", SB_ERR_IO},
+    };
+    for (size_t i = 0; i < sizeof(cases) / sizeof(cases[0]); i++) {
+        enum sb_result got = open_edited(good, bad, cases[i].edit, cases[i].shell);
+        CHECK(got == cases[i].expect, "pack with %s: got %s, expected %s", cases[i].what, sb_result_name(got),
+              sb_result_name(cases[i].expect));
+    }
+    /* A well-formed EXR whose pixels differ from what the manifest recorded. */
+    open_edited(good, bad, NULL, NULL);
+    char path[512];
+    snprintf(path, sizeof(path), "%s/transmittance.exr", bad);
+    struct sb_image t;
+    CHECK(sb_exr_read(path, "r,g,b", 0, &t, NULL, NULL) == SB_OK, "read");
+    t.data[7] = nextafterf(t.data[7], 2.0f);
+    CHECK(sb_exr_write(path, &t, NULL, 0) == SB_OK, "rewrite");
+    sb_image_finish(&t);
+    pack = calloc(1, sizeof(*pack));
+    enum sb_result got = sb_pack_open(bad, pack);
+    CHECK(got == SB_ERR_HASH_MISMATCH, "one ulp changed in a pixel: got %s", sb_result_name(got));
+    CHECK(!pack->present[0] && !pack->images[0].data, "a refused pack is left empty");
+    free(pack);
+
+    char cmd[512];
+    snprintf(cmd, sizeof(cmd), "rm -rf '%s'", pack_root);
+    run(cmd);
+}
+
 int main(void)
 {
     sb_log_set_sink(quiet, NULL);
     test_exr_round_trip();
     test_scenes();
+    test_pack_reader();
     return test_finish("formats");
 }

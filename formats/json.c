@@ -1,0 +1,109 @@
+#include "json.h"
+
+#include <errno.h>
+#include <fcntl.h>
+#include <stdint.h>
+#include <stdlib.h>
+#include <string.h>
+#include <sys/stat.h>
+#include <unistd.h>
+
+#include "log.h"
+
+enum sb_result sb_json_parse(const char *text, size_t size, const char *source, cJSON **root)
+{
+    *root = NULL;
+    if (size == 0) {
+        sb_error("%s: empty file, expected a JSON object", source);
+        return SB_ERR_JSON_SYNTAX;
+    }
+    if (memchr(text, '\0', size)) {
+        sb_error("%s: contains a NUL byte: not a JSON text", source);
+        return SB_ERR_JSON_SYNTAX;
+    }
+    const char *end = NULL;
+    cJSON *value = cJSON_ParseWithLengthOpts(text, size, &end, false);
+    if (!value) {
+        size_t offset = end ? (size_t)(end - text) : 0;
+        size_t line = 1;
+        for (size_t i = 0; i < offset && i < size; i++)
+            line += text[i] == '\n';
+        sb_error("%s: line %zu: malformed JSON near byte %zu", source, line, offset);
+        return SB_ERR_JSON_SYNTAX;
+    }
+    /* Anything but whitespace after the value is an error. */
+    for (const char *c = end; c && c < text + size; c++)
+        if (*c != ' ' && *c != '\t' && *c != '\n' && *c != '\r') {
+            sb_error("%s: trailing data after the JSON value at byte %zu", source, (size_t)(c - text));
+            cJSON_Delete(value);
+            return SB_ERR_JSON_SYNTAX;
+        }
+    *root = value;
+    return SB_OK;
+}
+
+enum sb_result sb_json_load(int dir, const char *path, const char *source, size_t max_bytes, bool follow_symlinks,
+                            cJSON **root)
+{
+    *root = NULL;
+    int fd = openat(dir, path, O_RDONLY | O_CLOEXEC | (follow_symlinks ? 0 : O_NOFOLLOW));
+    if (fd < 0) {
+        if (errno == ELOOP) {
+            sb_error("%s: is a symbolic link; refused", source);
+            return SB_ERR_UNSAFE_PATH;
+        }
+        sb_error("%s: cannot open: %s", source, strerror(errno));
+        return SB_ERR_IO;
+    }
+    struct stat st;
+    if (fstat(fd, &st) != 0 || !S_ISREG(st.st_mode)) {
+        sb_error("%s: not a regular file", source);
+        close(fd);
+        return SB_ERR_IO;
+    }
+    if ((uint64_t)st.st_size > max_bytes) {
+        sb_error("%s: larger than %zu bytes; refused", source, max_bytes);
+        close(fd);
+        return SB_ERR_OUT_OF_RANGE;
+    }
+    char *buf = malloc(max_bytes + 1);
+    if (!buf) {
+        close(fd);
+        return SB_ERR_NOMEM;
+    }
+    size_t n = 0;
+    for (;;) {
+        ssize_t got = read(fd, buf + n, max_bytes + 1 - n);
+        if (got < 0 && errno == EINTR)
+            continue;
+        if (got < 0) {
+            sb_error("%s: cannot read: %s", source, strerror(errno));
+            free(buf);
+            close(fd);
+            return SB_ERR_IO;
+        }
+        if (got == 0 || (n += (size_t)got) > max_bytes)
+            break;
+    }
+    close(fd);
+    enum sb_result res;
+    if (n > max_bytes) {
+        sb_error("%s: larger than %zu bytes; refused", source, max_bytes);
+        res = SB_ERR_OUT_OF_RANGE;
+    } else {
+        res = sb_json_parse(buf, n, source, root);
+    }
+    free(buf);
+    return res;
+}
+
+enum sb_result sb_json_check_duplicates(const cJSON *object, const char *source, const char *where)
+{
+    for (const cJSON *a = object->child; a; a = a->next)
+        for (const cJSON *b = a->next; b; b = b->next)
+            if (a->string && b->string && strcmp(a->string, b->string) == 0) {
+                sb_error("%s: %s%s%s: key given twice", source, where, *where ? "." : "", a->string);
+                return SB_ERR_DUPLICATE_KEY;
+            }
+    return SB_OK;
+}

@@ -1,0 +1,29 @@
+/*
+ * Strict JSON reading shared by the scene and manifest parsers: one value,
+ * nothing after it but whitespace, no NUL bytes, no key given twice, and a
+ * size cap checked before parsing. Errors name the source and the line.
+ */
+#ifndef SB_JSON_H
+#define SB_JSON_H
+
+#include <cJSON.h>
+#include <stdbool.h>
+#include <stddef.h>
+
+#include "result.h"
+
+/* Parse `size` bytes of `text`; on success the caller owns *root (cJSON_Delete). */
+enum sb_result sb_json_parse(const char *text, size_t size, const char *source, cJSON **root);
+
+/*
+ * Read and parse the file `path` (relative to the directory fd `dir`, or
+ * AT_FDCWD) of at most max_bytes. With follow_symlinks false a symbolic
+ * link is refused (SB_ERR_UNSAFE_PATH). `source` names the file in messages.
+ */
+enum sb_result sb_json_load(int dir, const char *path, const char *source, size_t max_bytes, bool follow_symlinks,
+                            cJSON **root);
+
+/* SB_ERR_DUPLICATE_KEY, logged as source: where.key, if `object` has a key twice. */
+enum sb_result sb_json_check_duplicates(const cJSON *object, const char *source, const char *where);
+
+#endif
