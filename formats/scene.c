@@ -287,18 +287,22 @@ static enum sb_result parse_root(const cJSON *root, struct sb_scene *scene, cons
     return SB_OK;
 }
 
+/* The scene from a parsed root (deleted here); *scene is left empty on error. */
+static enum sb_result scene_from_root(cJSON *root, const char *source, struct sb_scene *scene)
+{
+    enum sb_result res = parse_root(root, scene, source);
+    cJSON_Delete(root);
+    if (res)
+        memset(scene, 0, sizeof(*scene));
+    return res;
+}
+
 enum sb_result sb_scene_parse(const char *json, size_t size, const char *source, struct sb_scene *scene)
 {
     memset(scene, 0, sizeof(*scene));
     cJSON *root;
     enum sb_result res = sb_json_parse(json, size, source, &root);
-    if (res)
-        return res;
-    res = parse_root(root, scene, source);
-    cJSON_Delete(root);
-    if (res)
-        memset(scene, 0, sizeof(*scene));
-    return res;
+    return res ? res : scene_from_root(root, source, scene);
 }
 
 enum sb_result sb_scene_load(const char *path, struct sb_scene *scene)
@@ -306,13 +310,7 @@ enum sb_result sb_scene_load(const char *path, struct sb_scene *scene)
     memset(scene, 0, sizeof(*scene));
     cJSON *root;
     enum sb_result res = sb_json_load(AT_FDCWD, path, path, SCENE_MAX_BYTES, true, &root);
-    if (res)
-        return res;
-    res = parse_root(root, scene, path);
-    cJSON_Delete(root);
-    if (res)
-        memset(scene, 0, sizeof(*scene));
-    return res;
+    return res ? res : scene_from_root(root, path, scene);
 }
 
 char *sb_scene_normalized_json(const struct sb_scene *scene)
