@@ -545,10 +545,14 @@ enum sb_result sb_pack_open(const char *dir, struct sb_pack *pack)
     if (!res)
         res = manifest_string(root, "scene_hash", pack->scene_hash, sizeof(pack->scene_hash), source, "");
     const cJSON *device = res ? NULL : cJSON_GetObjectItemCaseSensitive(root, "device");
-    if (cJSON_IsObject(device)) {
-        manifest_string(device, "name", pack->device.name, sizeof(pack->device.name), source, "device.");
-        manifest_string(device, "driver", pack->device.driver, sizeof(pack->device.driver), source, "device.");
+    if (!res && !cJSON_IsObject(device)) {
+        sb_error("%s: device: %s", source, device ? "expected an object" : "missing");
+        res = device ? SB_ERR_WRONG_TYPE : SB_ERR_MISSING_FIELD;
     }
+    if (!res)
+        res = manifest_string(device, "name", pack->device.name, sizeof(pack->device.name), source, "device.");
+    if (!res)
+        res = manifest_string(device, "driver", pack->device.driver, sizeof(pack->device.driver), source, "device.");
     const cJSON *artifacts = res ? NULL : cJSON_GetObjectItemCaseSensitive(root, "artifacts");
     if (!res && !cJSON_IsArray(artifacts)) {
         sb_error("%s: artifacts: %s", source, artifacts ? "expected an array" : "missing");

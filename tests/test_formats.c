@@ -137,7 +137,7 @@ static void test_scenes(void)
 
 /* ---- packs ---------------------------------------------------------------------- */
 
-static char pack_root[] = "/tmp/skybake-pack-test-XXXXXX";
+static char pack_root[200];
 
 static void run(const char *command)
 {
@@ -261,9 +261,15 @@ static void edit_pixel_type(cJSON *r)
 {
     set_string(artifact(r, 0), "pixel_type", "float16");
 }
+static void edit_device(cJSON *r)
+{
+    cJSON_DeleteItemFromObject(cJSON_GetObjectItem(r, "device"), "name");
+}
 
 static void test_pack_reader(void)
 {
+    const char *tmp = getenv("TMPDIR");
+    snprintf(pack_root, sizeof(pack_root), "%s/skybake-pack-test-%s", tmp && *tmp ? tmp : "/tmp", "XXXXXX");
     CHECK(mkdtemp(pack_root) != NULL, "temporary directory");
     char good[256], bad[256];
     snprintf(good, sizeof(good), "%s/good", pack_root);
@@ -312,9 +318,13 @@ static void test_pack_reader(void)
         {"absurd height", edit_huge, NULL, SB_ERR_BAD_IMAGE},
         {"channels of the wrong type", edit_channels, NULL, SB_ERR_WRONG_TYPE},
         {"pixel type", edit_pixel_type, NULL, SB_ERR_BAD_IMAGE},
+        {"device without a name", edit_device, NULL, SB_ERR_MISSING_FIELD},
         {"unknown product", edit_unknown, NULL, SB_ERR_UNKNOWN_PRODUCT},
         {"product listed twice", edit_duplicate, NULL, SB_ERR_DUPLICATE_KEY},
-        {"manifest is garbage", NULL, "head -c 100 /dev/urandom > manifest.json", SB_ERR_JSON_SYNTAX},
+        {"manifest is binary garbage", NULL, "printf '\\211PNG\\r\\n\\032\\n\\000\\377{[' > manifest.json",
+         SB_ERR_JSON_SYNTAX},
+        {"manifest is a truncated object", NULL, "head -c 200 manifest.json > m && mv m manifest.json",
+         SB_ERR_JSON_SYNTAX},
         {"manifest is empty", NULL, ": > manifest.json", SB_ERR_JSON_SYNTAX},
         {"manifest over 1 MiB", NULL, "head -c 1100000 /dev/zero | tr '\\\\0' ' ' >> manifest.json",
          SB_ERR_OUT_OF_RANGE},
