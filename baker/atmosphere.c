@@ -9,6 +9,7 @@
 #include "irradiance_sky.spv.h"
 #include "log.h"
 #include "multiscattering.spv.h"
+#include "physics.h"
 #include "transmittance.spv.h"
 
 #define BIT(p) (1u << (p))
@@ -55,52 +56,6 @@ static const struct {
 const struct sb_atmosphere_product *sb_atmosphere_product(enum sb_product_id id)
 {
     return &products[id];
-}
-
-int sb_atmosphere_levels(const struct sb_atmosphere_params *p, double levels[SB_MAX_LEVELS])
-{
-    double thickness = p->top_radius_km - p->ground_radius_km;
-    double level = 0.5 * fmin(p->rayleigh_scale_height_km, p->mie_scale_height_km);
-    int n = 0;
-    while (n < SB_MAX_LEVELS && level < thickness) {
-        levels[n++] = level;
-        level *= M_SQRT2;
-    }
-    return n;
-}
-
-static void put3(float dst[4], const double src[3], double w)
-{
-    dst[0] = (float)src[0];
-    dst[1] = (float)src[1];
-    dst[2] = (float)src[2];
-    dst[3] = (float)w;
-}
-
-void sb_atmosphere_gpu_pack(const struct sb_atmosphere_params *p, struct sb_atmosphere_gpu *g)
-{
-    memset(g, 0, sizeof(*g));
-    double mie_ext[3];
-    for (int c = 0; c < 3; c++)
-        mie_ext[c] = p->mie_scattering_per_km[c] + p->mie_absorption_per_km[c];
-    put3(g->rayleigh_scattering, p->rayleigh_scattering_per_km, p->rayleigh_scale_height_km);
-    put3(g->mie_scattering, p->mie_scattering_per_km, p->mie_scale_height_km);
-    put3(g->mie_extinction, mie_ext, p->mie_g);
-    put3(g->ozone_absorption, p->ozone_absorption_per_km, p->ozone_center_km);
-    put3(g->ground_albedo, p->ground_albedo, p->ozone_half_width_km);
-    put3(g->solar_irradiance, p->solar_irradiance, 0.0);
-    double R = p->ground_radius_km, top = p->top_radius_km;
-    double thickness = top - R;
-    g->radii[0] = (float)R;
-    g->radii[1] = (float)top;
-    g->radii[2] = (float)sqrt(thickness * (top + R)); /* sqrt(top^2 - R^2) without cancellation */
-    g->radii[3] = (float)thickness;
-    double levels[SB_MAX_LEVELS];
-    int n = sb_atmosphere_levels(p, levels);
-    float *dst[4] = {g->levels_a, g->levels_b, g->levels_c, g->levels_d};
-    for (int i = 0; i < SB_MAX_LEVELS; i++)
-        dst[i / 4][i % 4] = i < n ? (float)levels[i] : (float)(2.0 * thickness);
-    g->level_count[0] = (uint32_t)n;
 }
 
 struct sb_atmosphere_baker {
@@ -234,28 +189,16 @@ static enum sb_result run(struct sb_atmosphere_baker *b, const uint32_t *spirv, 
     return res;
 }
 
-/*
- * The form in which later bakes read a product (config.h): the logarithm,
- * floored at 1e-30, of psi_ms, and of the total ground irradiance on the
- * ground row. Transmittance is read as baked.
- */
+/* The form in which later bakes read a product (physics.h). */
 static enum sb_result make_lookup(struct sb_atmosphere_baker *b, enum sb_product_id id, const struct sb_image *image)
 {
-    if (id != SB_PRODUCT_MULTISCATTERING && id != SB_PRODUCT_IRRADIANCE_GROUND)
+    size_t n = sb_lookup_float_count(id);
+    if (!n)
         return SB_OK;
-    bool ground = id == SB_PRODUCT_IRRADIANCE_GROUND;
-    size_t texels = ground ? image->width : (size_t)image->width * image->height;
-    enum sb_result res = sb_buffer_create(b->vk, texels * 3 * sizeof(float), "lookup", &b->lookups[id]);
-    if (res)
-        return res;
-    float *dst = b->lookups[id].mapped;
-    for (size_t t = 0; t < texels; t++)
-        for (int c = 0; c < 3; c++) {
-            const float *texel = image->data + t * image->channel_count;
-            double v = ground ? (double)texel[c] + texel[3 + c] : texel[c];
-            dst[t * 3 + c] = (float)log(fmax(v, 1e-30));
-        }
-    return SB_OK;
+    enum sb_result res = sb_buffer_create(b->vk, n * sizeof(float), "lookup", &b->lookups[id]);
+    if (!res)
+        sb_lookup_fill(id, image, b->lookups[id].mapped);
+    return res;
 }
 
 enum sb_result sb_atmosphere_bake(struct sb_atmosphere_baker *b, enum sb_product_id id,

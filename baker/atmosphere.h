@@ -14,6 +14,7 @@
 #include "config.h"
 #include "image.h"
 #include "pack.h"
+#include "physics.h"
 #include "scene.h"
 
 /* Settings of one product's bake. Zero fields take the product's defaults. */
@@ -31,13 +32,6 @@ struct sb_atmosphere_product {
 
 /* The descriptor of a product. */
 const struct sb_atmosphere_product *sb_atmosphere_product(enum sb_product_id id);
-
-/* Pack parameters for the shaders (fp64 -> fp32, derived radii, levels). */
-void sb_atmosphere_gpu_pack(const struct sb_atmosphere_params *params, struct sb_atmosphere_gpu *gpu);
-
-/* Altitude levels that cut rays into segments: geometric from half the
- * smallest scale height up to the top, at most SB_MAX_LEVELS. Returns the count. */
-int sb_atmosphere_levels(const struct sb_atmosphere_params *params, double levels[SB_MAX_LEVELS]);
 
 /* Baking state: the device, the parameters and every product baked so far. */
 struct sb_atmosphere_baker;

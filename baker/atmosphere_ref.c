@@ -637,3 +637,27 @@ void sb_ref_irradiance_sky(const struct sb_atmosphere_params *p, double h, doubl
     }
     free(dirs);
 }
+
+void sb_ref_sky_radiance(const struct sb_atmosphere_params *p, double h, double mu, double mu_s, double nu,
+                         const struct sb_image *ms_lut, const struct sb_image *ig_lut,
+                         const struct sb_ref_quality *quality, double out[3])
+{
+    pthread_once(&gl_once, gl_init);
+    struct sb_ref_quality q = resolve(quality);
+    double R = p->ground_radius_km, r = R + h;
+    bool ground = hits_ground(p, r, mu);
+    struct ray_sums rs;
+    integrate_ray(p, r, mu, mu_s, nu, ground, ms_lut, &q, &rs);
+    double eg[3] = {0};
+    if (ground) {
+        double mu_sp = fmax(-1.0, fmin(1.0, (r * mu_s + rs.t_end * nu) / R));
+        lut_log_cubic(ig_lut, mu_sp * 0.5 + 0.5, 0.0, 3, eg);
+    }
+    for (int c = 0; c < 3; c++) {
+        out[c] = p->solar_irradiance[c] *
+                     (rs.sun_rayleigh[c] * phase_rayleigh(nu) + rs.sun_mie[c] * phase_mie(p->mie_g, nu)) +
+                 rs.ms_rayleigh[c] + rs.ms_mie[c];
+        if (ground)
+            out[c] += rs.transmittance[c] * p->ground_albedo[c] / REF_PI * eg[c];
+    }
+}

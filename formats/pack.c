@@ -14,6 +14,7 @@
 #include "config.h"
 #include "json.h"
 #include "log.h"
+#include "scene.h"
 #include "skybake_version.h"
 
 #define PACK_MAX_ARTIFACTS 32
@@ -502,6 +503,42 @@ static enum sb_result read_artifact_image(const char *dir, int dir_fd, struct sb
     return SB_OK;
 }
 
+/* The scene must parse as a scene file would, and its normalised form must
+ * be what the scene hash names: an edited scene is as bad as an edited LUT. */
+static enum sb_result read_scene(const cJSON *root, struct sb_pack *pack, const char *source)
+{
+    const cJSON *obj = cJSON_GetObjectItemCaseSensitive(root, "scene");
+    if (!cJSON_IsObject(obj)) {
+        sb_error("%s: scene: %s", source, obj ? "expected an object" : "missing");
+        return obj ? SB_ERR_WRONG_TYPE : SB_ERR_MISSING_FIELD;
+    }
+    char scene_source[4300];
+    snprintf(scene_source, sizeof(scene_source), "%s: scene", source);
+    char *text = cJSON_PrintUnformatted(obj);
+    pack->scene = calloc(1, sizeof(*pack->scene));
+    if (!text || !pack->scene) {
+        free(text);
+        return SB_ERR_NOMEM;
+    }
+    enum sb_result res = sb_scene_parse(text, strlen(text), scene_source, pack->scene);
+    free(text);
+    if (res)
+        return res;
+    char *normal = sb_scene_normalized_json(pack->scene);
+    if (!normal)
+        return SB_ERR_NOMEM;
+    char hash[SB_HASH_HEX_SIZE];
+    sb_hash_bytes(normal, strlen(normal), hash);
+    free(normal);
+    if (strcmp(hash, pack->scene_hash) != 0) {
+        sb_error("%s: scene: its normalised form hashes to %s, the manifest records scene_hash %s: the manifest was "
+                 "edited or corrupted",
+                 source, hash, pack->scene_hash);
+        return SB_ERR_HASH_MISMATCH;
+    }
+    return SB_OK;
+}
+
 enum sb_result sb_pack_open(const char *dir, struct sb_pack *pack)
 {
     memset(pack, 0, sizeof(*pack));
@@ -544,6 +581,8 @@ enum sb_result sb_pack_open(const char *dir, struct sb_pack *pack)
             manifest_string(root, "skybake_version", pack->skybake_version, sizeof(pack->skybake_version), source, "");
     if (!res)
         res = manifest_string(root, "scene_hash", pack->scene_hash, sizeof(pack->scene_hash), source, "");
+    if (!res)
+        res = read_scene(root, pack, source);
     const cJSON *device = res ? NULL : cJSON_GetObjectItemCaseSensitive(root, "device");
     if (!res && !cJSON_IsObject(device)) {
         sb_error("%s: device: %s", source, device ? "expected an object" : "missing");
@@ -583,5 +622,6 @@ void sb_pack_close(struct sb_pack *pack)
 {
     for (int p = 0; p < SB_PRODUCT_COUNT; p++)
         sb_image_finish(&pack->images[p]);
+    free(pack->scene);
     memset(pack, 0, sizeof(*pack));
 }

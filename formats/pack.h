@@ -86,10 +86,13 @@ void sb_pack_writer_destroy(struct sb_pack_writer **writer);
  * A pack as read back: the manifest's fields and every artifact's image,
  * each verified. Products the pack does not hold have present[id] false.
  */
+struct sb_scene;
+
 struct sb_pack {
     int format_version;
     char skybake_version[32];
     char scene_hash[SB_HASH_HEX_SIZE];
+    struct sb_scene *scene; /* owned: the scene it was baked from (scene.h) */
     struct sb_device_info device;
     bool present[SB_PRODUCT_COUNT];
     struct sb_artifact artifacts[SB_PRODUCT_COUNT];
@@ -104,7 +107,8 @@ struct sb_pack {
  * file (a plain name inside the pack, not a symbolic link), dimensions,
  * channels and pixel type against the product's format (checked before any
  * pixel is read), the EXR itself, that it holds only finite values, and its
- * content hash against the manifest's. Any failure is logged naming the
+ * content hash against the manifest's; and the scene the manifest records
+ * (a valid scene, whose normalised form hashes to scene_hash). Any failure is logged naming the
  * pack, the artifact and the reason; *pack is then empty.
  */
 enum sb_result sb_pack_open(const char *dir, struct sb_pack *pack);

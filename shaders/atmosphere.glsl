@@ -289,13 +289,19 @@ vec3 transmittance_lut_sample(float h, float mu)
 }
 
 /* Transmittance toward the sun from altitude h; zero when the planet hides it.
- * Integrated, not read from the LUT: bilinear lookups of the 256x64 LUT are
- * off by up to ~1e-2 (more near the horizon), which the bakes cannot afford. */
+ * The bakes integrate it: bilinear lookups of the 256x64 LUT are off by up to
+ * ~1e-2 (more near the horizon), which they cannot afford. The runtime
+ * defines SB_SUN_TRANSMITTANCE_LUT and reads the baked LUT, which is what a
+ * pack is for. */
 vec3 sun_transmittance(float h, float mu_s)
 {
     if (ray_hits_ground(h, mu_s))
         return vec3(0.0);
+#ifdef SB_SUN_TRANSMITTANCE_LUT
+    return transmittance_lut_sample(h, mu_s);
+#else
     return transmittance_to_top(h, mu_s);
+#endif
 }
 
 /* ---- Multiple-scattering LUT and irradiance LUTs -------------------------------- */
@@ -366,18 +372,30 @@ vec3 multiscattering_lut_sample(float h, float mu_s)
     return exp(sum);
 }
 
-/* Total (direct + sky) irradiance on the ground at sun cosine mu_s. */
-vec3 ground_irradiance_sample(float mu_s)
+/* Row `row` of the ground irradiance lookup (physics.h) at sun cosine mu_s. */
+vec3 ground_irradiance_row(int row, float mu_s)
 {
     const int n = SB_IRRADIANCE_WIDTH;
     float w[4];
     int x0 = cubic_taps(subtexel_coords(0.0, mu_s, uvec2(n, SB_IRRADIANCE_HEIGHT)).x, n, w);
     vec3 sum = vec3(0.0);
     for (int i = 0; i < 4; i++) {
-        int k = clamp(x0 + i, 0, n - 1) * 3;
+        int k = (row * n + clamp(x0 + i, 0, n - 1)) * 3;
         sum += w[i] * vec3(ground_irradiance_log[k], ground_irradiance_log[k + 1], ground_irradiance_log[k + 2]);
     }
     return exp(sum);
+}
+
+/* Total (direct + sky) irradiance on the ground at sun cosine mu_s. */
+vec3 ground_irradiance_sample(float mu_s)
+{
+    return ground_irradiance_row(0, mu_s);
+}
+
+/* Irradiance from the sky alone (no direct sun) on the ground. */
+vec3 ground_sky_irradiance_sample(float mu_s)
+{
+    return ground_irradiance_row(1, mu_s);
 }
 
 /* ---- Ray integrals for scattering ---------------------------------------------- */
@@ -483,52 +501,68 @@ struct RayIntegrals {
     vec3 scattering;   /* integral of T(x,y) sigma_s(y) dt */
     vec3 transmittance; /* T(x, end of ray) */
     float t_end;
+    vec3 tau;          /* optical depth from x to the end of what was integrated */
 };
+
+RayIntegrals ray_integrals_begin()
+{
+    RayIntegrals o;
+    o.sun_rayleigh = o.sun_mie = o.ms_rayleigh = o.ms_mie = o.scattering = o.tau = vec3(0.0);
+    o.transmittance = vec3(1.0);
+    o.t_end = 0.0;
+    return o;
+}
+
+/* Add the segment [t0, t1] of the ray from altitude h0 with cosine mu (sun
+ * cosine mu_s, cosine nu between the ray and the sun) by Gauss-Legendre 4;
+ * the segments must come in order along the ray. Altitudes under the ground
+ * (a straight ray through the runtime's flat world) read the ground's medium. */
+void integrate_segment(inout RayIntegrals o, float h0, float mu, float mu_s, float nu, float t0, float t1, bool want_ms)
+{
+    float half_len = 0.5 * (t1 - t0), mid = 0.5 * (t1 + t0);
+    if (half_len <= 0.0)
+        return;
+    float r0 = ground_radius() + h0;
+    Medium m[4];
+    float hs[4], mus[4];
+    for (int j = 0; j < 4; j++) {
+        float t = mid + half_len * GL4_X[j];
+        hs[j] = max(altitude_along(h0, mu, t), 0.0);
+        float rt = ground_radius() + hs[j];
+        mus[j] = clamp((r0 * mu_s + t * nu) / rt, -1.0, 1.0);
+        m[j] = medium_at(hs[j]);
+    }
+    for (int i = 0; i < 4; i++) {
+        vec3 depth = o.tau;
+        for (int j = 0; j < 4; j++)
+            depth += half_len * GL4_S[i * 4 + j] * m[j].extinction;
+        vec3 tw = exp(-depth) * (half_len * GL4_W[i]);
+        vec3 sun = sun_transmittance(hs[i], mus[i]);
+        o.sun_rayleigh += tw * m[i].scattering_rayleigh * sun;
+        o.sun_mie += tw * m[i].scattering_mie * sun;
+        o.scattering += tw * (m[i].scattering_rayleigh + m[i].scattering_mie);
+        if (want_ms) {
+            vec3 psi = multiscattering_lut_sample(hs[i], mus[i]);
+            o.ms_rayleigh += tw * m[i].scattering_rayleigh * psi;
+            o.ms_mie += tw * m[i].scattering_mie * psi;
+        }
+    }
+    for (int j = 0; j < 4; j++)
+        o.tau += half_len * GL4_W[j] * m[j].extinction;
+    o.transmittance = exp(-o.tau);
+    o.t_end = t1;
+}
 
 /* nu: cosine between the ray and the sun; toward_ground: the ray ends on the ground. */
 RayIntegrals integrate_ray(float h0, float mu, float mu_s, float nu, bool toward_ground, bool want_ms)
 {
-    RayIntegrals o;
-    o.sun_rayleigh = o.sun_mie = o.ms_rayleigh = o.ms_mie = o.scattering = vec3(0.0);
-    float r0 = ground_radius() + h0;
+    RayIntegrals o = ray_integrals_begin();
     float t_end = toward_ground ? distance_to_ground(h0, mu) : distance_to_top(h0, mu);
-    o.t_end = t_end;
-
     float ts[SB_RAY_MAX_BREAKS];
     int n = ray_breakpoints(h0, mu, mu_s, nu, t_end, ts);
-    vec3 tau = vec3(0.0);
-    for (int s = 0; s + 1 < n; s++) {
-        float half_len = 0.5 * (ts[s + 1] - ts[s]), mid = 0.5 * (ts[s + 1] + ts[s]);
-        if (half_len <= 0.0)
-            continue;
-        Medium m[4];
-        float hs[4], mus[4];
-        for (int j = 0; j < 4; j++) {
-            float t = mid + half_len * GL4_X[j];
-            hs[j] = altitude_along(h0, mu, t);
-            float rt = ground_radius() + hs[j];
-            mus[j] = clamp((r0 * mu_s + t * nu) / rt, -1.0, 1.0);
-            m[j] = medium_at(hs[j]);
-        }
-        for (int i = 0; i < 4; i++) {
-            vec3 depth = tau;
-            for (int j = 0; j < 4; j++)
-                depth += half_len * GL4_S[i * 4 + j] * m[j].extinction;
-            vec3 tw = exp(-depth) * (half_len * GL4_W[i]);
-            vec3 sun = sun_transmittance(hs[i], mus[i]);
-            o.sun_rayleigh += tw * m[i].scattering_rayleigh * sun;
-            o.sun_mie += tw * m[i].scattering_mie * sun;
-            o.scattering += tw * (m[i].scattering_rayleigh + m[i].scattering_mie);
-            if (want_ms) {
-                vec3 psi = multiscattering_lut_sample(hs[i], mus[i]);
-                o.ms_rayleigh += tw * m[i].scattering_rayleigh * psi;
-                o.ms_mie += tw * m[i].scattering_mie * psi;
-            }
-        }
-        for (int j = 0; j < 4; j++)
-            tau += half_len * GL4_W[j] * m[j].extinction;
-    }
-    o.transmittance = exp(-tau);
+    for (int s = 0; s + 1 < n; s++)
+        integrate_segment(o, h0, mu, mu_s, nu, ts[s], ts[s + 1], want_ms);
+    o.t_end = t_end;
     return o;
 }
 

@@ -12,11 +12,13 @@
 #ifdef GL_core_profile
 #define SB_VEC4(name) vec4 name
 #define SB_UVEC4(name) uvec4 name
+#define SB_MAT4(name) mat4 name
 #define SB_UINT uint
 #else
 #include <stdint.h>
 #define SB_VEC4(name) float name[4]
 #define SB_UVEC4(name) uint32_t name[4]
+#define SB_MAT4(name) float name[16] /* column-major, as GLSL's mat4 */
 #define SB_UINT uint32_t
 #endif
 
@@ -40,8 +42,9 @@
 /* Every atmosphere bake pipeline has the same descriptor set layout: six
  * storage buffers. Inputs a product does not read are bound to a dummy.
  * Transmittance is bound as baked; multiscattering and irradiance_ground
- * in their lookup form (see atmosphere.glsl): ln(max(psi, 1e-30)) per texel
- * and channel, and ln(max(direct + sky, 1e-30)) of the ground row. */
+ * in their lookup form (physics.h): ln(max(psi, 1e-30)) per texel and
+ * channel, and of the ground row ln(max(direct + sky, 1e-30)), then
+ * ln(max(sky, 1e-30)). */
 #define SB_BINDING_ATMOSPHERE 0
 #define SB_BINDING_TRANSMITTANCE 1
 #define SB_BINDING_MULTISCATTERING 2
@@ -94,6 +97,87 @@ struct sb_bake_push {
     SB_UINT step_begin;     /* sphere.glsl: this pass's steps, [begin, end) of */
     SB_UINT step_end;       /* SB_SPHERE_THREADS directions each */
     SB_UINT step_count;     /* steps of the whole integral */
+    SB_UINT pad;
+};
+
+/* ---- skyview ------------------------------------------------------------------ */
+/*
+ * Every skyview pass uses one descriptor set layout: bindings 0 to 3 are the
+ * atmosphere's (above, in their lookup forms), then these. The world frame
+ * is y up, in metres, with the origin on the ground; the planet's centre is
+ * at (0, -ground radius, 0). Shaders work relative to the camera.
+ */
+#define SB_VIEW_BINDING_FRAME 4          /* struct sb_frame_gpu */
+#define SB_VIEW_BINDING_VERTICES 5       /* struct sb_vertex_gpu[] */
+#define SB_VIEW_BINDING_EXPOSURE 6       /* histogram bins, then struct sb_exposure_gpu */
+#define SB_VIEW_BINDING_SKY_VIEW 7       /* sampler2D: the sky-view LUT */
+#define SB_VIEW_BINDING_SKY_VIEW_OUT 8   /* image2D rgba16f: the same, written */
+#define SB_VIEW_BINDING_AERIAL 9         /* sampler3D: in-scattered radiance (rgb) */
+#define SB_VIEW_BINDING_AERIAL_T 10      /* sampler3D: transmittance (rgb) */
+#define SB_VIEW_BINDING_AERIAL_OUT 11    /* image3D rgba16f */
+#define SB_VIEW_BINDING_AERIAL_T_OUT 12  /* image3D rgba16f */
+#define SB_VIEW_BINDING_SHADOW 13        /* sampler2DArrayShadow: the cascades */
+#define SB_VIEW_BINDING_HDR 14           /* image2D rgba16f: the lit frame */
+#define SB_VIEW_BINDING_DEPTH 15         /* sampler2D: the scene's depth (reverse Z, 0 = sky) */
+#define SB_VIEW_BINDING_BLOOM_SRC 16     /* sampler2D: a bloom step's source (per descriptor set) */
+#define SB_VIEW_BINDING_BLOOM_DST 17     /* image2D rgba16f: a bloom step's target (per set) */
+#define SB_VIEW_BINDING_BLOOM 18         /* sampler2D: the finished bloom, mip 0 */
+#define SB_VIEW_BINDING_LDR 19           /* image2D rgba8: the display-referred frame */
+#define SB_VIEW_BINDING_COUNT 20
+
+#define SB_SKY_VIEW_WIDTH 192 /* azimuth from the sun, 0 to pi */
+#define SB_SKY_VIEW_HEIGHT 108 /* zenith angle, the horizon between rows 53 and 54 */
+#define SB_AERIAL_SIZE 32      /* x, y: screen; z: distance slices */
+#define SB_CASCADES 4
+#define SB_HISTOGRAM_BINS 256
+#define SB_BLOOM_MAX_LEVELS 6
+
+/* Tone mappers, sb_frame_gpu.post.w. */
+#define SB_TONEMAP_AGX 0
+#define SB_TONEMAP_ACES 1
+#define SB_TONEMAP_GT 2
+
+/* One vertex of the world: a triangle list, each vertex carrying its material. */
+struct sb_vertex_gpu {
+    SB_VEC4(position); /* xyz: m, world; w: metallic */
+    SB_VEC4(normal);   /* xyz: unit normal; w: perceptual roughness */
+    SB_VEC4(albedo);   /* rgb: base colour, linear; w: unused */
+};
+
+/* Per-frame constants (std430). */
+struct sb_frame_gpu {
+    SB_MAT4(view_proj);        /* camera-relative world (m) to clip, reverse Z, infinite far */
+    SB_MAT4(inv_view_proj);
+    SB_MAT4(shadow_view_proj[SB_CASCADES]); /* camera-relative world (m) to each cascade's clip */
+    SB_VEC4(camera_m);         /* the camera in the world (m); w: unused */
+    SB_VEC4(camera_km);        /* planet-centred camera (km); w: its altitude (km) */
+    SB_VEC4(camera_forward);   /* unit view direction, world; w: cos of the sun's angular radius */
+    SB_VEC4(sun_direction);    /* unit vector toward the sun, world; w: sun's angular radius (rad) */
+    SB_VEC4(cascade_ends);     /* view depth (m) where each cascade ends */
+    SB_VEC4(cascade_texel);    /* a shadow texel's width (m) in each cascade */
+    SB_VEC4(shadow);           /* x: blend band (fraction of a cascade), y: normal offset (texels),
+                                  z: shadow map size (texels), w: 1 to use shadows */
+    SB_VEC4(aerial);           /* x: the volume's far distance (km); y: radiance scale (what the frame's
+                                  radiance is multiplied by before storage); zw: unused */
+    SB_VEC4(exposure);         /* x: log2 luminance at bin 1, y: log2 range of bins 1..255,
+                                  z, w: low and high percentile of the metering window */
+    SB_VEC4(adaptation);       /* x: speed to brighter (1/s), y: to darker (1/s), z: dt (s), w: 1 to snap */
+    SB_VEC4(post);             /* x: bloom threshold (exposed), y: bloom strength, z: exposure
+                                  compensation (EV), w: tone mapper (SB_TONEMAP_*) */
+    SB_UVEC4(size);            /* xy: frame size; z: bloom levels; w: unused */
+};
+
+/* What exposure.comp keeps between frames, after the histogram's bins. */
+struct sb_exposure_gpu {
+    SB_VEC4(state); /* x: adapted log2 luminance; y: exposure (multiplier); z: metered log2 luminance
+                       of this frame; w: pixels in the metering window */
+};
+
+/* Push constants of skyview's passes. */
+struct sb_view_push {
+    SB_UINT cascade;     /* shadow.vert: the cascade drawn */
+    SB_UINT level;       /* bloom: the mip level written */
+    SB_UINT first_level; /* bloom_down: 1 when reading the frame (threshold and Karis average) */
     SB_UINT pad;
 };
 

@@ -161,7 +161,13 @@ static void write_test_pack(const char *dir, struct sb_image images[SB_PRODUCT_C
         CHECK(sb_pack_writer_add_image(w, &a, &images[p]) == SB_OK, "add %s", f->name);
     }
     struct sb_device_info device = {.name = "test device", .driver = "none"};
-    CHECK(w && sb_pack_writer_commit(&w, "{}", &device) == SB_OK, "commit");
+    struct sb_scene scene = {.name = "test", .preset = "earth"};
+    sb_atmosphere_preset_earth(&scene.atmosphere);
+    for (int p = 0; p < SB_PRODUCT_COUNT; p++)
+        scene.wants[p] = true;
+    char *scene_json = sb_scene_normalized_json(&scene);
+    CHECK(w && scene_json && sb_pack_writer_commit(&w, scene_json, &device) == SB_OK, "commit");
+    free(scene_json);
     sb_pack_writer_destroy(&w);
 }
 
@@ -266,6 +272,21 @@ static void edit_device(cJSON *r)
     cJSON_DeleteItemFromObject(cJSON_GetObjectItem(r, "device"), "name");
 }
 
+static void edit_scene_value(cJSON *r)
+{
+    cJSON *atm = cJSON_GetObjectItem(cJSON_GetObjectItem(r, "scene"), "atmosphere");
+    cJSON_ReplaceItemInObject(atm, "mie_g", cJSON_CreateNumber(0.7));
+}
+static void edit_scene_invalid(cJSON *r)
+{
+    cJSON *atm = cJSON_GetObjectItem(cJSON_GetObjectItem(r, "scene"), "atmosphere");
+    cJSON_ReplaceItemInObject(atm, "mie_g", cJSON_CreateNumber(1.5));
+}
+static void edit_no_scene(cJSON *r)
+{
+    cJSON_DeleteItemFromObject(r, "scene");
+}
+
 static void test_pack_reader(void)
 {
     const char *tmp = getenv("TMPDIR");
@@ -287,6 +308,8 @@ static void test_pack_reader(void)
         sb_image_finish(&images[p]);
     }
     CHECK(pack->format_version == SB_PACK_FORMAT_VERSION && !strcmp(pack->device.name, "test device"), "header");
+    CHECK(pack->scene && !strcmp(pack->scene->name, "test") && pack->scene->atmosphere.mie_g == 0.8,
+          "the scene reads back");
     sb_pack_close(pack);
     free(pack);
 
@@ -319,6 +342,9 @@ static void test_pack_reader(void)
         {"channels of the wrong type", edit_channels, NULL, SB_ERR_WRONG_TYPE},
         {"pixel type", edit_pixel_type, NULL, SB_ERR_BAD_IMAGE},
         {"device without a name", edit_device, NULL, SB_ERR_MISSING_FIELD},
+        {"scene edited", edit_scene_value, NULL, SB_ERR_HASH_MISMATCH},
+        {"scene out of range", edit_scene_invalid, NULL, SB_ERR_OUT_OF_RANGE},
+        {"no scene", edit_no_scene, NULL, SB_ERR_MISSING_FIELD},
         {"unknown product", edit_unknown, NULL, SB_ERR_UNKNOWN_PRODUCT},
         {"product listed twice", edit_duplicate, NULL, SB_ERR_DUPLICATE_KEY},
         {"manifest is binary garbage", NULL, "printf '\\211PNG\\r\\n\\032\\n\\000\\377{[' > manifest.json",
@@ -357,7 +383,8 @@ static void test_pack_reader(void)
 
 int main(void)
 {
-    sb_log_set_sink(quiet, NULL);
+    if (!getenv("SKYBAKE_TEST_VERBOSE"))
+        sb_log_set_sink(quiet, NULL);
     test_exr_round_trip();
     test_scenes();
     test_pack_reader();

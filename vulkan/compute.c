@@ -3,6 +3,7 @@
 #include <string.h>
 
 #include "log.h"
+#include "pipeline.h"
 
 static int find_memory_type(const struct sb_vk *vk, uint32_t type_bits, VkMemoryPropertyFlags want)
 {
@@ -19,7 +20,8 @@ enum sb_result sb_buffer_create(struct sb_vk *vk, VkDeviceSize size, const char 
     VkBufferCreateInfo info = {
         .sType = VK_STRUCTURE_TYPE_BUFFER_CREATE_INFO,
         .size = size,
-        .usage = VK_BUFFER_USAGE_STORAGE_BUFFER_BIT | VK_BUFFER_USAGE_TRANSFER_SRC_BIT | VK_BUFFER_USAGE_TRANSFER_DST_BIT,
+        .usage =
+            VK_BUFFER_USAGE_STORAGE_BUFFER_BIT | VK_BUFFER_USAGE_TRANSFER_SRC_BIT | VK_BUFFER_USAGE_TRANSFER_DST_BIT,
         .sharingMode = VK_SHARING_MODE_EXCLUSIVE,
     };
     VK(vkCreateBuffer(vk->device, &info, NULL, &b->buffer));
@@ -64,7 +66,6 @@ void sb_buffer_destroy(struct sb_vk *vk, struct sb_buffer *b)
 enum sb_result sb_pipeline_create(struct sb_vk *vk, const struct sb_pipeline_params *params, struct sb_pipeline *p)
 {
     enum sb_result res = SB_OK;
-    VkShaderModule module = VK_NULL_HANDLE;
     memset(p, 0, sizeof(*p));
     p->binding_count = params->binding_count;
     p->push_size = params->push_size;
@@ -96,24 +97,9 @@ enum sb_result sb_pipeline_create(struct sb_vk *vk, const struct sb_pipeline_par
         .pPushConstantRanges = &range,
     };
     VK(vkCreatePipelineLayout(vk->device, &layout_info, NULL, &p->layout));
-    VkShaderModuleCreateInfo module_info = {
-        .sType = VK_STRUCTURE_TYPE_SHADER_MODULE_CREATE_INFO,
-        .codeSize = params->spirv_size,
-        .pCode = params->spirv,
-    };
-    VK(vkCreateShaderModule(vk->device, &module_info, NULL, &module));
-    VkComputePipelineCreateInfo pipe_info = {
-        .sType = VK_STRUCTURE_TYPE_COMPUTE_PIPELINE_CREATE_INFO,
-        .stage = {
-            .sType = VK_STRUCTURE_TYPE_PIPELINE_SHADER_STAGE_CREATE_INFO,
-            .stage = VK_SHADER_STAGE_COMPUTE_BIT,
-            .module = module,
-            .pName = "main",
-        },
-        .layout = p->layout,
-    };
-    VK(vkCreateComputePipelines(vk->device, VK_NULL_HANDLE, 1, &pipe_info, NULL, &p->pipeline));
-    sb_vk_name(vk, VK_OBJECT_TYPE_PIPELINE, (uint64_t)p->pipeline, params->name);
+    if ((res =
+             sb_compute_pipeline_create(vk, p->layout, params->spirv, params->spirv_size, params->name, &p->pipeline)))
+        goto cleanup;
 
     VkDescriptorPoolSize pool_size = {
         .type = VK_DESCRIPTOR_TYPE_STORAGE_BUFFER,
@@ -133,12 +119,9 @@ enum sb_result sb_pipeline_create(struct sb_vk *vk, const struct sb_pipeline_par
         .pSetLayouts = &p->set_layout,
     };
     VK(vkAllocateDescriptorSets(vk->device, &set_alloc, &p->set));
-    vkDestroyShaderModule(vk->device, module, NULL);
     return SB_OK;
 
 cleanup:
-    if (module)
-        vkDestroyShaderModule(vk->device, module, NULL);
     sb_pipeline_destroy(vk, p);
     return res;
 }
@@ -180,7 +163,6 @@ enum sb_result sb_dispatch(struct sb_vk *vk, struct sb_pipeline *p, const void *
     enum sb_result res = SB_OK;
     VkCommandBuffer cmd = VK_NULL_HANDLE;
     VkQueryPool queries = VK_NULL_HANDLE;
-    VkFence fence = VK_NULL_HANDLE;
     *gpu_ms = 0.0;
 
     if (vk->has_timestamps) {
@@ -192,18 +174,8 @@ enum sb_result sb_dispatch(struct sb_vk *vk, struct sb_pipeline *p, const void *
         VK(vkCreateQueryPool(vk->device, &qinfo, NULL, &queries));
         vkResetQueryPool(vk->device, queries, 0, 2);
     }
-    VkCommandBufferAllocateInfo alloc = {
-        .sType = VK_STRUCTURE_TYPE_COMMAND_BUFFER_ALLOCATE_INFO,
-        .commandPool = vk->command_pool,
-        .level = VK_COMMAND_BUFFER_LEVEL_PRIMARY,
-        .commandBufferCount = 1,
-    };
-    VK(vkAllocateCommandBuffers(vk->device, &alloc, &cmd));
-    VkCommandBufferBeginInfo begin = {
-        .sType = VK_STRUCTURE_TYPE_COMMAND_BUFFER_BEGIN_INFO,
-        .flags = VK_COMMAND_BUFFER_USAGE_ONE_TIME_SUBMIT_BIT,
-    };
-    VK(vkBeginCommandBuffer(cmd, &begin));
+    if ((res = sb_vk_begin_once(vk, &cmd)))
+        goto cleanup;
     /* Host writes to the inputs are visible through the submission itself. */
     if (queries)
         vkCmdWriteTimestamp(cmd, VK_PIPELINE_STAGE_TOP_OF_PIPE_BIT, queries, 0);
@@ -222,16 +194,8 @@ enum sb_result sb_dispatch(struct sb_vk *vk, struct sb_pipeline *p, const void *
     };
     vkCmdPipelineBarrier(cmd, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, VK_PIPELINE_STAGE_HOST_BIT, 0, 1, &barrier, 0, NULL,
                          0, NULL);
-    VK(vkEndCommandBuffer(cmd));
-    VkFenceCreateInfo finfo = {.sType = VK_STRUCTURE_TYPE_FENCE_CREATE_INFO};
-    VK(vkCreateFence(vk->device, &finfo, NULL, &fence));
-    VkSubmitInfo submit = {
-        .sType = VK_STRUCTURE_TYPE_SUBMIT_INFO,
-        .commandBufferCount = 1,
-        .pCommandBuffers = &cmd,
-    };
-    VK(vkQueueSubmit(vk->queue, 1, &submit, fence));
-    VK(vkWaitForFences(vk->device, 1, &fence, VK_TRUE, UINT64_MAX));
+    if ((res = sb_vk_end_once(vk, cmd)))
+        goto cleanup;
     if (queries) {
         uint64_t ts[2];
         VK(vkGetQueryPoolResults(vk->device, queries, 0, 2, sizeof(ts), ts, sizeof(uint64_t),
@@ -240,10 +204,6 @@ enum sb_result sb_dispatch(struct sb_vk *vk, struct sb_pipeline *p, const void *
     }
 
 cleanup:
-    if (fence)
-        vkDestroyFence(vk->device, fence, NULL);
-    if (cmd)
-        vkFreeCommandBuffers(vk->device, vk->command_pool, 1, &cmd);
     if (queries)
         vkDestroyQueryPool(vk->device, queries, NULL);
     return res;

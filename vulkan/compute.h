@@ -35,8 +35,8 @@ struct sb_pipeline {
 };
 
 struct sb_pipeline_params {
-    const uint32_t *spirv; /* SPIR-V words, entry point "main" */
-    size_t spirv_size;     /* in bytes */
+    const uint32_t *spirv;  /* SPIR-V words, entry point "main" */
+    size_t spirv_size;      /* in bytes */
     uint32_t binding_count; /* storage buffers at bindings 0..count-1 of set 0 */
     uint32_t push_size;     /* bytes of push constants, 0 for none */
     const char *name;       /* debug name */

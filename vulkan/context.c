@@ -12,7 +12,9 @@
 const char *sb_vk_result_name(VkResult r)
 {
     switch (r) {
-#define CASE(x) case x: return #x
+#define CASE(x)                                                                                                        \
+    case x:                                                                                                            \
+        return #x
         CASE(VK_SUCCESS);
         CASE(VK_NOT_READY);
         CASE(VK_TIMEOUT);
@@ -149,11 +151,12 @@ enum sb_result sb_vk_create(const struct sb_vk_params *params, struct sb_vk **ou
         .sType = VK_STRUCTURE_TYPE_APPLICATION_INFO,
         .pApplicationName = "skybake",
         .pEngineName = "skybake",
-        .apiVersion = VK_API_VERSION_1_2,
+        .apiVersion = params->graphics ? VK_API_VERSION_1_3 : VK_API_VERSION_1_2,
     };
     VkDebugUtilsMessengerCreateInfoEXT messenger_info = {
         .sType = VK_STRUCTURE_TYPE_DEBUG_UTILS_MESSENGER_CREATE_INFO_EXT,
-        .messageSeverity = VK_DEBUG_UTILS_MESSAGE_SEVERITY_WARNING_BIT_EXT | VK_DEBUG_UTILS_MESSAGE_SEVERITY_ERROR_BIT_EXT,
+        .messageSeverity =
+            VK_DEBUG_UTILS_MESSAGE_SEVERITY_WARNING_BIT_EXT | VK_DEBUG_UTILS_MESSAGE_SEVERITY_ERROR_BIT_EXT,
         .messageType = VK_DEBUG_UTILS_MESSAGE_TYPE_GENERAL_BIT_EXT | VK_DEBUG_UTILS_MESSAGE_TYPE_VALIDATION_BIT_EXT |
                        VK_DEBUG_UTILS_MESSAGE_TYPE_PERFORMANCE_BIT_EXT,
         .pfnUserCallback = on_validation,
@@ -189,9 +192,11 @@ enum sb_result sb_vk_create(const struct sb_vk_params *params, struct sb_vk **ou
         goto cleanup;
     vkGetPhysicalDeviceProperties(vk->physical_device, &vk->properties);
     vkGetPhysicalDeviceMemoryProperties(vk->physical_device, &vk->memory_properties);
-    if (vk->properties.apiVersion < VK_API_VERSION_1_2) {
-        sb_error("%s supports Vulkan %u.%u; skybake needs 1.2", vk->properties.deviceName,
-                 VK_API_VERSION_MAJOR(vk->properties.apiVersion), VK_API_VERSION_MINOR(vk->properties.apiVersion));
+    uint32_t need = params->graphics ? VK_API_VERSION_1_3 : VK_API_VERSION_1_2;
+    if (vk->properties.apiVersion < need) {
+        sb_error("%s supports Vulkan %u.%u; %s needs %u.%u", vk->properties.deviceName,
+                 VK_API_VERSION_MAJOR(vk->properties.apiVersion), VK_API_VERSION_MINOR(vk->properties.apiVersion),
+                 params->graphics ? "rendering" : "baking", VK_API_VERSION_MAJOR(need), VK_API_VERSION_MINOR(need));
         res = SB_ERR_NO_DEVICE;
         goto cleanup;
     }
@@ -212,11 +217,12 @@ enum sb_result sb_vk_create(const struct sb_vk_params *params, struct sb_vk **ou
         if ((qf[i].queueFlags & (VK_QUEUE_COMPUTE_BIT | VK_QUEUE_GRAPHICS_BIT)) ==
             (VK_QUEUE_COMPUTE_BIT | VK_QUEUE_GRAPHICS_BIT))
             family = (int)i;
-    for (uint32_t i = 0; i < nq && family < 0; i++)
+    for (uint32_t i = 0; i < nq && family < 0 && !params->graphics; i++)
         if (qf[i].queueFlags & VK_QUEUE_COMPUTE_BIT)
             family = (int)i;
     if (family < 0) {
-        sb_error("%s has no compute queue", vk->properties.deviceName);
+        sb_error("%s has no %s queue", vk->properties.deviceName,
+                 params->graphics ? "graphics and compute" : "compute");
         res = SB_ERR_NO_DEVICE;
         goto cleanup;
     }
@@ -231,13 +237,33 @@ enum sb_result sb_vk_create(const struct sb_vk_params *params, struct sb_vk **ou
         .queueCount = 1,
         .pQueuePriorities = &priority,
     };
+    VkPhysicalDeviceVulkan13Features features13 = {
+        .sType = VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_VULKAN_1_3_FEATURES,
+        .dynamicRendering = VK_TRUE,
+    };
     VkPhysicalDeviceVulkan12Features features12 = {
         .sType = VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_VULKAN_1_2_FEATURES,
+        .pNext = params->graphics ? &features13 : NULL,
         .hostQueryReset = VK_TRUE,
     };
+    VkPhysicalDeviceFeatures features = {0};
+    if (params->graphics) {
+        VkPhysicalDeviceVulkan13Features have13 = {.sType = VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_VULKAN_1_3_FEATURES};
+        VkPhysicalDeviceFeatures2 have = {.sType = VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_FEATURES_2, .pNext = &have13};
+        vkGetPhysicalDeviceFeatures2(vk->physical_device, &have);
+        if (!have13.dynamicRendering) {
+            sb_error("%s does not offer dynamic rendering, which rendering needs", vk->properties.deviceName);
+            res = SB_ERR_NO_DEVICE;
+            goto cleanup;
+        }
+        features.depthClamp = have.features.depthClamp;
+        vk->depth_clamp = have.features.depthClamp;
+        vk->graphics = true;
+    }
     VkDeviceCreateInfo device_info = {
         .sType = VK_STRUCTURE_TYPE_DEVICE_CREATE_INFO,
         .pNext = &features12,
+        .pEnabledFeatures = &features,
         .queueCreateInfoCount = 1,
         .pQueueCreateInfos = &queue_info,
     };
@@ -281,6 +307,53 @@ void sb_vk_destroy(struct sb_vk **pvk)
     *pvk = NULL;
 }
 
+enum sb_result sb_vk_begin_once(struct sb_vk *vk, VkCommandBuffer *cmd)
+{
+    enum sb_result res = SB_OK;
+    *cmd = VK_NULL_HANDLE;
+    VkCommandBufferAllocateInfo alloc = {
+        .sType = VK_STRUCTURE_TYPE_COMMAND_BUFFER_ALLOCATE_INFO,
+        .commandPool = vk->command_pool,
+        .level = VK_COMMAND_BUFFER_LEVEL_PRIMARY,
+        .commandBufferCount = 1,
+    };
+    VK(vkAllocateCommandBuffers(vk->device, &alloc, cmd));
+    VkCommandBufferBeginInfo begin = {
+        .sType = VK_STRUCTURE_TYPE_COMMAND_BUFFER_BEGIN_INFO,
+        .flags = VK_COMMAND_BUFFER_USAGE_ONE_TIME_SUBMIT_BIT,
+    };
+    VK(vkBeginCommandBuffer(*cmd, &begin));
+    return SB_OK;
+
+cleanup:
+    if (*cmd)
+        vkFreeCommandBuffers(vk->device, vk->command_pool, 1, cmd);
+    *cmd = VK_NULL_HANDLE;
+    return res;
+}
+
+enum sb_result sb_vk_end_once(struct sb_vk *vk, VkCommandBuffer cmd)
+{
+    enum sb_result res = SB_OK;
+    VkFence fence = VK_NULL_HANDLE;
+    VK(vkEndCommandBuffer(cmd));
+    VkFenceCreateInfo finfo = {.sType = VK_STRUCTURE_TYPE_FENCE_CREATE_INFO};
+    VK(vkCreateFence(vk->device, &finfo, NULL, &fence));
+    VkSubmitInfo submit = {
+        .sType = VK_STRUCTURE_TYPE_SUBMIT_INFO,
+        .commandBufferCount = 1,
+        .pCommandBuffers = &cmd,
+    };
+    VK(vkQueueSubmit(vk->queue, 1, &submit, fence));
+    VK(vkWaitForFences(vk->device, 1, &fence, VK_TRUE, UINT64_MAX));
+
+cleanup:
+    if (fence)
+        vkDestroyFence(vk->device, fence, NULL);
+    vkFreeCommandBuffers(vk->device, vk->command_pool, 1, &cmd);
+    return res;
+}
+
 unsigned sb_vk_validation_messages(const struct sb_vk *vk)
 {
     return vk->validation_messages;
@@ -292,8 +365,8 @@ void sb_vk_device_info(const struct sb_vk *vk, struct sb_device_info *info)
     snprintf(info->name, sizeof(info->name), "%s", vk->properties.deviceName);
     snprintf(info->driver, sizeof(info->driver), "%s %s", vk->driver_name, vk->driver_info);
     uint32_t v = vk->properties.apiVersion;
-    snprintf(info->api_version, sizeof(info->api_version), "%u.%u.%u", VK_API_VERSION_MAJOR(v),
-             VK_API_VERSION_MINOR(v), VK_API_VERSION_PATCH(v));
+    snprintf(info->api_version, sizeof(info->api_version), "%u.%u.%u", VK_API_VERSION_MAJOR(v), VK_API_VERSION_MINOR(v),
+             VK_API_VERSION_PATCH(v));
     info->vendor_id = vk->properties.vendorID;
     info->device_id = vk->properties.deviceID;
 }

@@ -21,6 +21,9 @@ struct sb_vk_params {
     /* Enable VK_LAYER_KHRONOS_validation; every warning or error it reports
      * is logged and counted (see sb_vk_validation_messages). */
     bool validate;
+    /* Also rasterise: the queue must do graphics, and the device must offer
+     * Vulkan 1.3 or dynamic rendering (skyview); else SB_ERR_NO_DEVICE. */
+    bool graphics;
 };
 
 struct sb_vk {
@@ -35,6 +38,8 @@ struct sb_vk {
     VkPhysicalDeviceMemoryProperties memory_properties;
     char driver_name[VK_MAX_DRIVER_NAME_SIZE];
     char driver_info[VK_MAX_DRIVER_INFO_SIZE];
+    bool graphics;    /* created with sb_vk_params.graphics */
+    bool depth_clamp; /* the depthClamp feature is enabled */
     bool has_timestamps;
     double timestamp_period_ns;
     unsigned validation_messages;
@@ -53,6 +58,13 @@ void sb_vk_destroy(struct sb_vk **vk);
 
 /* Validation messages counted so far (0 when validation is off). */
 unsigned sb_vk_validation_messages(const struct sb_vk *vk);
+
+/*
+ * One-time command buffers: begin one, record, then end it, which submits it
+ * and waits for the queue. sb_vk_end_once frees the buffer on every path.
+ */
+enum sb_result sb_vk_begin_once(struct sb_vk *vk, VkCommandBuffer *cmd);
+enum sb_result sb_vk_end_once(struct sb_vk *vk, VkCommandBuffer cmd);
 
 /* Name, driver and ids of the device, for manifests. */
 void sb_vk_device_info(const struct sb_vk *vk, struct sb_device_info *info);

@@ -1,0 +1,393 @@
+/*
+ * skyview: render a pack headless and write the frames.
+ *
+ * Exit codes: 0 success; 1 rendering or writing failed; 2 bad command line,
+ * pack or world; 3 no Vulkan device; 4 validation layers reported messages.
+ */
+#include <cJSON.h>
+#include <errno.h>
+#include <math.h>
+#include <stdbool.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <sys/stat.h>
+
+#include "context.h"
+#include "exr.h"
+#include "log.h"
+#include "pack.h"
+#include "pngfile.h"
+#include "renderer.h"
+#include "skybake_version.h"
+#include "world.h"
+
+enum {
+    EXIT_RENDER_FAILED = 1,
+    EXIT_USAGE = 2,
+    EXIT_NO_DEVICE = 3,
+    EXIT_VALIDATION = 4,
+};
+
+#define DEG (M_PI / 180.0)
+
+static void usage(FILE *f)
+{
+    fprintf(f, "usage: skyview PACK -o OUT_DIR [options]\n"
+               "       skyview --version | --help\n"
+               "\n"
+               "Renders the world lit by the atmosphere of PACK (a skybake pack), offscreen,\n"
+               "and writes OUT_DIR/frame_0000.png, ... (8-bit sRGB).\n"
+               "\n"
+               "options:\n"
+               "  -o, --output DIR        where the frames go (created if missing)\n"
+               "  --size WxH              frame size (default 1280x720)\n"
+               "  --frames N              frames to render (default 1; with --bench 30)\n"
+               "  --sun-elevation DEG     the sun above the horizon (default 30)\n"
+               "  --sun-azimuth DEG       clockwise from north, -z (default 150)\n"
+               "  --camera X,Y,Z[,YAW,PITCH[,FOV]]\n"
+               "                          metres (y up, origin on the ground) and degrees: yaw\n"
+               "                          clockwise from north, pitch above the horizontal,\n"
+               "                          vertical field of view (default 0,2,0,0,3,50)\n"
+               "  --world FILE            the world (default data/worlds/test.json)\n"
+               "  --tonemap agx|aces|gt   tone mapper (default agx)\n"
+               "  --exposure EV           exposure compensation (default 0)\n"
+               "  --no-bloom              no bloom\n"
+               "  --shadow-size N         texels per side of each of the 4 cascades (default 2048)\n"
+               "  --hdr                   also write the linear HDR frames, frame_0000.exr, ...\n"
+               "  --bench                 time the passes: warm-up frames, then --frames frames;\n"
+               "                          prints a table and writes OUT_DIR/bench.json\n"
+               "  --warmup N              warm-up frames for --bench (default 5)\n"
+               "  --device NAME|INDEX     Vulkan device by index or name substring\n"
+               "  --validate              enable Vulkan validation; any message fails the run\n"
+               "                          (also SKYBAKE_VALIDATE=1)\n"
+               "  -q, --quiet             warnings and errors only\n"
+               "  -v, --verbose           debug messages\n"
+               "\n"
+               "exit codes: 0 ok, 1 rendering failed, 2 usage, pack or world error,\n"
+               "            3 no Vulkan device, 4 validation messages\n");
+}
+
+static bool parse_doubles(const char *s, double *out, int min, int max, int *count)
+{
+    int n = 0;
+    while (*s && n < max) {
+        char *end;
+        errno = 0;
+        double v = strtod(s, &end);
+        if (end == s || errno || !isfinite(v))
+            return false;
+        out[n++] = v;
+        s = end;
+        if (*s == ',')
+            s++;
+        else if (*s)
+            return false;
+    }
+    *count = n;
+    return !*s && n >= min;
+}
+
+static bool parse_number(const char *s, double lo, double hi, double *out)
+{
+    int n;
+    return parse_doubles(s, out, 1, 1, &n) && *out >= lo && *out <= hi;
+}
+
+struct options {
+    const char *pack, *out_dir, *device, *world;
+    struct sb_renderer_params params;
+    struct sb_view view;
+    int frames, warmup;
+    bool validate, hdr, bench;
+};
+
+static int parse_options(int argc, char **argv, struct options *o)
+{
+    memset(o, 0, sizeof(*o));
+    o->world = SKYVIEW_DEFAULT_WORLD;
+    o->frames = -1;
+    o->warmup = 5;
+    o->view = (struct sb_view){
+        .camera_m = {0.0, 2.0, 0.0},
+        .pitch = 3.0 * DEG,
+        .fov_y = 50.0 * DEG,
+        .sun_azimuth = 150.0 * DEG,
+        .sun_elevation = 30.0 * DEG,
+    };
+    const char *env = getenv("SKYBAKE_VALIDATE");
+    o->validate = env && *env && strcmp(env, "0") != 0;
+    for (int i = 0; i < argc; i++) {
+        const char *a = argv[i];
+        const char *next = i + 1 < argc ? argv[i + 1] : NULL;
+        double v, c[6];
+        int n;
+        bool ok = true;
+        if ((!strcmp(a, "-o") || !strcmp(a, "--output")) && next)
+            o->out_dir = argv[++i];
+        else if (!strcmp(a, "--size") && next) {
+            unsigned w, h;
+            char extra;
+            ok = sscanf(argv[++i], "%ux%u%c", &w, &h, &extra) == 2 && w >= 8 && h >= 8 && w <= 8192 && h <= 8192;
+            o->params.width = w;
+            o->params.height = h;
+        } else if (!strcmp(a, "--frames") && next) {
+            ok = parse_number(argv[++i], 1, 100000, &v) && v == floor(v);
+            o->frames = (int)v;
+        } else if (!strcmp(a, "--warmup") && next) {
+            ok = parse_number(argv[++i], 0, 10000, &v) && v == floor(v);
+            o->warmup = (int)v;
+        } else if (!strcmp(a, "--sun-elevation") && next) {
+            ok = parse_number(argv[++i], -90, 90, &v);
+            o->view.sun_elevation = v * DEG;
+        } else if (!strcmp(a, "--sun-azimuth") && next) {
+            ok = parse_number(argv[++i], -360, 360, &v);
+            o->view.sun_azimuth = v * DEG;
+        } else if (!strcmp(a, "--camera") && next) {
+            ok = parse_doubles(argv[++i], c, 3, 6, &n) && fabs(c[0]) <= 1e7 && fabs(c[2]) <= 1e7 && c[1] > 0.0 &&
+                 c[1] <= 1e8;
+            if (ok) {
+                memcpy(o->view.camera_m, c, sizeof(o->view.camera_m));
+                if (n >= 5) {
+                    o->view.yaw = c[3] * DEG;
+                    o->view.pitch = c[4] * DEG;
+                    ok = fabs(c[4]) <= 90.0;
+                }
+                if (n >= 6) {
+                    o->view.fov_y = c[5] * DEG;
+                    ok = ok && c[5] > 1.0 && c[5] < 170.0;
+                }
+            }
+        } else if (!strcmp(a, "--world") && next)
+            o->world = argv[++i];
+        else if (!strcmp(a, "--tonemap") && next) {
+            const char *t = argv[++i];
+            o->params.tonemap = !strcmp(t, "agx")    ? SB_TONEMAP_AGX
+                                : !strcmp(t, "aces") ? SB_TONEMAP_ACES
+                                : !strcmp(t, "gt")   ? SB_TONEMAP_GT
+                                                     : -1;
+            ok = o->params.tonemap >= 0;
+        } else if (!strcmp(a, "--exposure") && next) {
+            ok = parse_number(argv[++i], -20, 20, &v);
+            o->params.exposure_compensation_ev = v;
+        } else if (!strcmp(a, "--no-bloom"))
+            o->params.bloom_strength = -1.0;
+        else if (!strcmp(a, "--shadow-size") && next) {
+            ok = parse_number(argv[++i], 64, 8192, &v) && v == floor(v);
+            o->params.shadow_size = (uint32_t)v;
+        } else if (!strcmp(a, "--hdr"))
+            o->hdr = true;
+        else if (!strcmp(a, "--bench"))
+            o->bench = true;
+        else if (!strcmp(a, "--device") && next)
+            o->device = argv[++i];
+        else if (!strcmp(a, "--validate"))
+            o->validate = true;
+        else if (!strcmp(a, "-q") || !strcmp(a, "--quiet"))
+            sb_log_set_level(SB_LOG_WARN);
+        else if (!strcmp(a, "-v") || !strcmp(a, "--verbose"))
+            sb_log_set_level(SB_LOG_DEBUG);
+        else if (a[0] == '-' && a[1]) {
+            fprintf(stderr, "skyview: unknown or incomplete option '%s'\n", a);
+            usage(stderr);
+            return EXIT_USAGE;
+        } else if (!o->pack)
+            o->pack = a;
+        else {
+            fprintf(stderr, "skyview: unexpected argument '%s'\n", a);
+            return EXIT_USAGE;
+        }
+        if (!ok) {
+            fprintf(stderr, "skyview: %s: bad value '%s'\n", a, argv[i]);
+            usage(stderr);
+            return EXIT_USAGE;
+        }
+    }
+    if (!o->pack || !o->out_dir) {
+        fprintf(stderr, "skyview: needs a PACK and -o OUT_DIR\n");
+        usage(stderr);
+        return EXIT_USAGE;
+    }
+    if (o->frames < 0)
+        o->frames = o->bench ? 30 : 1;
+    return 0;
+}
+
+static int compare_doubles(const void *a, const void *b)
+{
+    double x = *(const double *)a, y = *(const double *)b;
+    return (x > y) - (x < y);
+}
+
+static double median(double *v, int n)
+{
+    qsort(v, (size_t)n, sizeof(double), compare_doubles);
+    return n % 2 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
+}
+
+/* The bench table on stdout and the same numbers as JSON in OUT_DIR/bench.json. */
+static enum sb_result report_bench(const struct options *o, const struct sb_vk *vk, uint32_t w, uint32_t h,
+                                   const struct sb_frame_timings *t, int n)
+{
+    double *v = malloc((size_t)n * sizeof(double));
+    if (!v)
+        return SB_ERR_NOMEM;
+    cJSON *root = cJSON_CreateObject();
+    cJSON_AddStringToObject(root, "skyview", SKYBAKE_VERSION);
+    cJSON_AddStringToObject(root, "device", vk->properties.deviceName);
+    cJSON_AddStringToObject(root, "driver", vk->driver_name);
+    cJSON_AddNumberToObject(root, "width", w);
+    cJSON_AddNumberToObject(root, "height", h);
+    cJSON_AddNumberToObject(root, "warmup_frames", o->warmup);
+    cJSON_AddNumberToObject(root, "frames", n);
+    cJSON_AddStringToObject(root, "statistic", "median over the frames");
+    cJSON *passes = cJSON_AddArrayToObject(root, "passes");
+    printf("skyview bench: %ux%u on %s, median of %d frames after %d warm-up\n", w, h, vk->properties.deviceName, n,
+           o->warmup);
+    printf("%-20s %12s %12s %12s\n", "pass", "median ms", "min ms", "max ms");
+    for (int p = 0; p <= SB_PASS_COUNT; p++) {
+        for (int i = 0; i < n; i++)
+            v[i] = p < SB_PASS_COUNT ? t[i].ms[p] : t[i].total_ms;
+        double med = median(v, n);
+        const char *name = p < SB_PASS_COUNT ? sb_pass_name((enum sb_pass)p) : "total";
+        printf("%-20s %12.3f %12.3f %12.3f\n", name, med, v[0], v[n - 1]);
+        cJSON *item = cJSON_CreateObject();
+        cJSON_AddStringToObject(item, "pass", name);
+        cJSON_AddNumberToObject(item, "median_ms", med);
+        cJSON_AddNumberToObject(item, "min_ms", v[0]);
+        cJSON_AddNumberToObject(item, "max_ms", v[n - 1]);
+        cJSON_AddItemToArray(passes, item);
+    }
+    free(v);
+    char path[4200];
+    snprintf(path, sizeof(path), "%s/bench.json", o->out_dir);
+    char *text = cJSON_Print(root);
+    cJSON_Delete(root);
+    FILE *f = text ? fopen(path, "w") : NULL;
+    enum sb_result res = SB_OK;
+    if (!f || fputs(text, f) < 0 || fputc('\n', f) < 0) {
+        sb_error("%s: cannot write: %s", path, strerror(errno));
+        res = SB_ERR_IO;
+    }
+    if (f && fclose(f) != 0 && !res) {
+        sb_error("%s: cannot write: %s", path, strerror(errno));
+        res = SB_ERR_IO;
+    }
+    free(text);
+    return res;
+}
+
+static enum sb_result write_frame(const struct options *o, struct sb_renderer *r, int index)
+{
+    uint32_t w, h;
+    sb_renderer_size(r, &w, &h);
+    char path[4200];
+    snprintf(path, sizeof(path), "%s/frame_%04d.png", o->out_dir, index);
+    enum sb_result res = sb_png_write(path, w, h, sb_renderer_ldr(r));
+    if (res || !o->hdr)
+        return res;
+    struct sb_image image = {0};
+    if ((res = sb_image_init(&image, w, h, 3)))
+        return res;
+    sb_image_set_channel_names(&image, "R,G,B");
+    sb_renderer_hdr(r, image.data);
+    snprintf(path, sizeof(path), "%s/frame_%04d.exr", o->out_dir, index);
+    res = sb_exr_write(path, &image, NULL, 0);
+    sb_image_finish(&image);
+    return res;
+}
+
+static int run(const struct options *o)
+{
+    struct sb_pack pack;
+    if (sb_pack_open(o->pack, &pack)) {
+        sb_error("%s: refused; nothing was rendered", o->pack);
+        return EXIT_USAGE;
+    }
+    struct sb_world world;
+    if (sb_world_load(o->world, &world)) {
+        sb_pack_close(&pack);
+        return EXIT_USAGE;
+    }
+    if (mkdir(o->out_dir, 0777) != 0 && errno != EEXIST) {
+        sb_error("%s: cannot create the output directory: %s", o->out_dir, strerror(errno));
+        sb_world_finish(&world);
+        sb_pack_close(&pack);
+        return EXIT_RENDER_FAILED;
+    }
+
+    int code = 0;
+    struct sb_vk *vk = NULL;
+    struct sb_renderer *r = NULL;
+    struct sb_frame_timings *timings = NULL;
+    struct sb_vk_params vp = {.device = o->device, .validate = o->validate, .graphics = true};
+    enum sb_result res = sb_vk_create(&vp, &vk);
+    if (res) {
+        code = res == SB_ERR_NO_DEVICE ? EXIT_NO_DEVICE : EXIT_RENDER_FAILED;
+        goto done;
+    }
+    sb_info("skyview %s: %s on %s (%s)", SKYBAKE_VERSION, o->pack, vk->properties.deviceName, vk->driver_name);
+    res = sb_renderer_create(vk, &pack, &world, &o->params, &r);
+    if (res) {
+        code = res == SB_ERR_USAGE ? EXIT_USAGE : EXIT_RENDER_FAILED;
+        goto done;
+    }
+    int total = o->frames + (o->bench ? o->warmup : 0);
+    timings = calloc((size_t)o->frames, sizeof(*timings));
+    if (!timings) {
+        code = EXIT_RENDER_FAILED;
+        goto done;
+    }
+    for (int i = 0; i < total && !res; i++) {
+        struct sb_view view = o->view;
+        view.snap_exposure = i == 0;
+        int measured = o->bench ? i - o->warmup : i;
+        bool write = !o->bench || i == total - 1;
+        res = sb_renderer_render(r, &view, write, measured >= 0 ? &timings[measured] : NULL);
+        if (!res && write)
+            res = write_frame(o, r, o->bench ? 0 : i);
+    }
+    if (!res && o->bench) {
+        uint32_t w, h;
+        sb_renderer_size(r, &w, &h);
+        if (!timings[0].valid)
+            sb_warn("%s has no timestamps on its queue: the bench measures nothing", vk->properties.deviceName);
+        res = report_bench(o, vk, w, h, timings, o->frames);
+    }
+    if (res)
+        code = EXIT_RENDER_FAILED;
+    else
+        sb_info("wrote %d frame(s) to %s", o->bench ? 1 : o->frames, o->out_dir);
+
+done:
+    sb_renderer_destroy(&r);
+    unsigned messages = vk ? sb_vk_validation_messages(vk) : 0;
+    sb_vk_destroy(&vk);
+    free(timings);
+    sb_world_finish(&world);
+    sb_pack_close(&pack);
+    if (!code && messages) {
+        sb_error("%u validation message(s)", messages);
+        code = EXIT_VALIDATION;
+    }
+    return code;
+}
+
+int main(int argc, char **argv)
+{
+    if (argc < 2) {
+        usage(stderr);
+        return EXIT_USAGE;
+    }
+    if (!strcmp(argv[1], "--help") || !strcmp(argv[1], "-h")) {
+        usage(stdout);
+        return 0;
+    }
+    if (!strcmp(argv[1], "--version")) {
+        printf("skyview %s (pack format %d)\n", SKYBAKE_VERSION, SB_PACK_FORMAT_VERSION);
+        return 0;
+    }
+    struct options o;
+    int code = parse_options(argc - 1, argv + 1, &o);
+    return code ? code : run(&o);
+}

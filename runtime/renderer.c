@@ -1,0 +1,910 @@
+#include "renderer.h"
+
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "aerial_perspective.spv.h"
+#include "bloom_down.spv.h"
+#include "bloom_up.spv.h"
+#include "compute.h"
+#include "exposure.spv.h"
+#include "histogram.spv.h"
+#include "log.h"
+#include "physics.h"
+#include "pipeline.h"
+#include "scene.h"
+#include "scene_frag.spv.h"
+#include "scene_vert.spv.h"
+#include "shadow_vert.spv.h"
+#include "shadows.h"
+#include "sky.spv.h"
+#include "sky_view.spv.h"
+#include "texture.h"
+#include "tonemap.spv.h"
+#include "transform.h"
+
+#define NEAR_M 0.1
+#define AERIAL_FAR_KM 32.0
+#define HDR_FORMAT VK_FORMAT_R16G16B16A16_SFLOAT
+#define DEPTH_FORMAT VK_FORMAT_D32_SFLOAT
+#define BLOOM_SETS (2 * SB_BLOOM_MAX_LEVELS)
+
+static const char *const pass_names[SB_PASS_COUNT] = {
+    [SB_PASS_SKY_VIEW] = "sky-view", [SB_PASS_AERIAL_PERSPECTIVE] = "aerial perspective",
+    [SB_PASS_SHADOWS] = "shadows",   [SB_PASS_SCENE] = "scene",
+    [SB_PASS_SKY] = "sky",           [SB_PASS_EXPOSURE] = "exposure",
+    [SB_PASS_BLOOM] = "bloom",       [SB_PASS_TONEMAP] = "tonemap",
+};
+
+const char *sb_pass_name(enum sb_pass pass)
+{
+    return pass < SB_PASS_COUNT ? pass_names[pass] : "?";
+}
+
+enum compute_kernel {
+    KERNEL_SKY_VIEW,
+    KERNEL_AERIAL,
+    KERNEL_SKY,
+    KERNEL_HISTOGRAM,
+    KERNEL_EXPOSURE,
+    KERNEL_BLOOM_DOWN,
+    KERNEL_BLOOM_UP,
+    KERNEL_TONEMAP,
+    KERNEL_COUNT,
+};
+
+struct sb_renderer {
+    struct sb_vk *vk;
+    struct sb_renderer_params params;
+    uint32_t width, height, bloom_levels;
+    uint32_t vertex_count;
+    double radiance_scale; /* what stored radiance is multiplied by (fp16 headroom) */
+    double ground_radius_km;
+
+    struct sb_buffer atmosphere, transmittance, multiscattering, irradiance_ground;
+    struct sb_buffer frame, vertices, exposure;
+    struct sb_buffer read_ldr, read_hdr, read_sky_view;
+
+    struct sb_texture sky_view, aerial, aerial_t, shadow, hdr, depth, bloom, ldr;
+    VkSampler linear, nearest, shadow_compare;
+
+    VkDescriptorSetLayout set_layout;
+    VkPipelineLayout layout;
+    VkDescriptorPool pool;
+    VkDescriptorSet set;                    /* everything, bloom bindings at level 0 */
+    VkDescriptorSet bloom_sets[BLOOM_SETS]; /* down steps 0..L-1, then up steps */
+    VkPipeline kernels[KERNEL_COUNT];
+    VkPipeline shadow_pipeline, scene_pipeline;
+
+    VkQueryPool queries;
+    VkCommandBuffer cmd;
+    VkFence fence;
+    struct sb_mat4 view_proj; /* of the last frame, camera-relative */
+    double camera_m[3];
+};
+
+static const struct {
+    const uint32_t *words;
+    size_t size;
+    const char *name;
+} kernel_spirv[KERNEL_COUNT] = {
+    [KERNEL_SKY_VIEW] = {sb_spv_sky_view, sizeof(sb_spv_sky_view), "sky-view"},
+    [KERNEL_AERIAL] = {sb_spv_aerial_perspective, sizeof(sb_spv_aerial_perspective), "aerial perspective"},
+    [KERNEL_SKY] = {sb_spv_sky, sizeof(sb_spv_sky), "sky"},
+    [KERNEL_HISTOGRAM] = {sb_spv_histogram, sizeof(sb_spv_histogram), "histogram"},
+    [KERNEL_EXPOSURE] = {sb_spv_exposure, sizeof(sb_spv_exposure), "exposure"},
+    [KERNEL_BLOOM_DOWN] = {sb_spv_bloom_down, sizeof(sb_spv_bloom_down), "bloom down"},
+    [KERNEL_BLOOM_UP] = {sb_spv_bloom_up, sizeof(sb_spv_bloom_up), "bloom up"},
+    [KERNEL_TONEMAP] = {sb_spv_tonemap, sizeof(sb_spv_tonemap), "tonemap"},
+};
+
+/* ---- Descriptors --------------------------------------------------------------- */
+
+static const VkDescriptorType binding_types[SB_VIEW_BINDING_COUNT] = {
+    [SB_BINDING_ATMOSPHERE] = VK_DESCRIPTOR_TYPE_STORAGE_BUFFER,
+    [SB_BINDING_TRANSMITTANCE] = VK_DESCRIPTOR_TYPE_STORAGE_BUFFER,
+    [SB_BINDING_MULTISCATTERING] = VK_DESCRIPTOR_TYPE_STORAGE_BUFFER,
+    [SB_BINDING_IRRADIANCE_GROUND] = VK_DESCRIPTOR_TYPE_STORAGE_BUFFER,
+    [SB_VIEW_BINDING_FRAME] = VK_DESCRIPTOR_TYPE_STORAGE_BUFFER,
+    [SB_VIEW_BINDING_VERTICES] = VK_DESCRIPTOR_TYPE_STORAGE_BUFFER,
+    [SB_VIEW_BINDING_EXPOSURE] = VK_DESCRIPTOR_TYPE_STORAGE_BUFFER,
+    [SB_VIEW_BINDING_SKY_VIEW] = VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER,
+    [SB_VIEW_BINDING_SKY_VIEW_OUT] = VK_DESCRIPTOR_TYPE_STORAGE_IMAGE,
+    [SB_VIEW_BINDING_AERIAL] = VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER,
+    [SB_VIEW_BINDING_AERIAL_T] = VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER,
+    [SB_VIEW_BINDING_AERIAL_OUT] = VK_DESCRIPTOR_TYPE_STORAGE_IMAGE,
+    [SB_VIEW_BINDING_AERIAL_T_OUT] = VK_DESCRIPTOR_TYPE_STORAGE_IMAGE,
+    [SB_VIEW_BINDING_SHADOW] = VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER,
+    [SB_VIEW_BINDING_HDR] = VK_DESCRIPTOR_TYPE_STORAGE_IMAGE,
+    [SB_VIEW_BINDING_DEPTH] = VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER,
+    [SB_VIEW_BINDING_BLOOM_SRC] = VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER,
+    [SB_VIEW_BINDING_BLOOM_DST] = VK_DESCRIPTOR_TYPE_STORAGE_IMAGE,
+    [SB_VIEW_BINDING_BLOOM] = VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER,
+    [SB_VIEW_BINDING_LDR] = VK_DESCRIPTOR_TYPE_STORAGE_IMAGE,
+};
+
+/* Write every binding of `set`; the bloom step's source and target vary per set. */
+static void write_set(struct sb_renderer *r, VkDescriptorSet set, VkImageView bloom_src, VkImageView bloom_dst)
+{
+    VkDescriptorBufferInfo buffers[SB_VIEW_BINDING_COUNT] = {0};
+    VkDescriptorImageInfo images[SB_VIEW_BINDING_COUNT] = {0};
+    VkWriteDescriptorSet writes[SB_VIEW_BINDING_COUNT];
+    const struct sb_buffer *buffer_of[SB_VIEW_BINDING_COUNT] = {
+        [SB_BINDING_ATMOSPHERE] = &r->atmosphere,
+        [SB_BINDING_TRANSMITTANCE] = &r->transmittance,
+        [SB_BINDING_MULTISCATTERING] = &r->multiscattering,
+        [SB_BINDING_IRRADIANCE_GROUND] = &r->irradiance_ground,
+        [SB_VIEW_BINDING_FRAME] = &r->frame,
+        [SB_VIEW_BINDING_VERTICES] = &r->vertices,
+        [SB_VIEW_BINDING_EXPOSURE] = &r->exposure,
+    };
+    const VkImageView view_of[SB_VIEW_BINDING_COUNT] = {
+        [SB_VIEW_BINDING_SKY_VIEW] = r->sky_view.view,
+        [SB_VIEW_BINDING_SKY_VIEW_OUT] = r->sky_view.view,
+        [SB_VIEW_BINDING_AERIAL] = r->aerial.view,
+        [SB_VIEW_BINDING_AERIAL_T] = r->aerial_t.view,
+        [SB_VIEW_BINDING_AERIAL_OUT] = r->aerial.view,
+        [SB_VIEW_BINDING_AERIAL_T_OUT] = r->aerial_t.view,
+        [SB_VIEW_BINDING_SHADOW] = r->shadow.view,
+        [SB_VIEW_BINDING_HDR] = r->hdr.view,
+        [SB_VIEW_BINDING_DEPTH] = r->depth.view,
+        [SB_VIEW_BINDING_BLOOM_SRC] = bloom_src,
+        [SB_VIEW_BINDING_BLOOM_DST] = bloom_dst,
+        [SB_VIEW_BINDING_BLOOM] = r->bloom.subview_count ? r->bloom.subviews[0] : r->bloom.view,
+        [SB_VIEW_BINDING_LDR] = r->ldr.view,
+    };
+    for (uint32_t b = 0; b < SB_VIEW_BINDING_COUNT; b++) {
+        writes[b] = (VkWriteDescriptorSet){
+            .sType = VK_STRUCTURE_TYPE_WRITE_DESCRIPTOR_SET,
+            .dstSet = set,
+            .dstBinding = b,
+            .descriptorCount = 1,
+            .descriptorType = binding_types[b],
+        };
+        if (binding_types[b] == VK_DESCRIPTOR_TYPE_STORAGE_BUFFER) {
+            buffers[b] = (VkDescriptorBufferInfo){.buffer = buffer_of[b]->buffer, .range = VK_WHOLE_SIZE};
+            writes[b].pBufferInfo = &buffers[b];
+        } else {
+            images[b] = (VkDescriptorImageInfo){
+                .sampler = b == SB_VIEW_BINDING_SHADOW  ? r->shadow_compare
+                           : b == SB_VIEW_BINDING_DEPTH ? r->nearest /* depth formats need not filter */
+                                                        : r->linear,
+                .imageView = view_of[b],
+                .imageLayout = VK_IMAGE_LAYOUT_GENERAL,
+            };
+            writes[b].pImageInfo = &images[b];
+        }
+    }
+    vkUpdateDescriptorSets(r->vk->device, SB_VIEW_BINDING_COUNT, writes, 0, NULL);
+}
+
+static enum sb_result create_descriptors(struct sb_renderer *r)
+{
+    enum sb_result res = SB_OK;
+    struct sb_vk *vk = r->vk;
+    VkDescriptorSetLayoutBinding bindings[SB_VIEW_BINDING_COUNT];
+    uint32_t counts[16] = {0};
+    for (uint32_t b = 0; b < SB_VIEW_BINDING_COUNT; b++) {
+        bindings[b] = (VkDescriptorSetLayoutBinding){
+            .binding = b,
+            .descriptorType = binding_types[b],
+            .descriptorCount = 1,
+            .stageFlags = VK_SHADER_STAGE_ALL,
+        };
+        counts[binding_types[b]]++;
+    }
+    VkDescriptorSetLayoutCreateInfo set_info = {
+        .sType = VK_STRUCTURE_TYPE_DESCRIPTOR_SET_LAYOUT_CREATE_INFO,
+        .bindingCount = SB_VIEW_BINDING_COUNT,
+        .pBindings = bindings,
+    };
+    VK(vkCreateDescriptorSetLayout(vk->device, &set_info, NULL, &r->set_layout));
+    VkPushConstantRange range = {.stageFlags = VK_SHADER_STAGE_ALL, .size = sizeof(struct sb_view_push)};
+    VkPipelineLayoutCreateInfo layout_info = {
+        .sType = VK_STRUCTURE_TYPE_PIPELINE_LAYOUT_CREATE_INFO,
+        .setLayoutCount = 1,
+        .pSetLayouts = &r->set_layout,
+        .pushConstantRangeCount = 1,
+        .pPushConstantRanges = &range,
+    };
+    VK(vkCreatePipelineLayout(vk->device, &layout_info, NULL, &r->layout));
+
+    const uint32_t set_count = 1 + BLOOM_SETS;
+    VkDescriptorPoolSize sizes[4];
+    uint32_t n = 0;
+    const VkDescriptorType types[] = {VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER,
+                                      VK_DESCRIPTOR_TYPE_STORAGE_IMAGE};
+    for (size_t i = 0; i < sizeof(types) / sizeof(types[0]); i++)
+        sizes[n++] = (VkDescriptorPoolSize){.type = types[i], .descriptorCount = counts[types[i]] * set_count};
+    VkDescriptorPoolCreateInfo pool_info = {
+        .sType = VK_STRUCTURE_TYPE_DESCRIPTOR_POOL_CREATE_INFO,
+        .maxSets = set_count,
+        .poolSizeCount = n,
+        .pPoolSizes = sizes,
+    };
+    VK(vkCreateDescriptorPool(vk->device, &pool_info, NULL, &r->pool));
+    VkDescriptorSetLayout layouts[1 + BLOOM_SETS];
+    for (uint32_t i = 0; i < set_count; i++)
+        layouts[i] = r->set_layout;
+    VkDescriptorSet sets[1 + BLOOM_SETS];
+    VkDescriptorSetAllocateInfo alloc = {
+        .sType = VK_STRUCTURE_TYPE_DESCRIPTOR_SET_ALLOCATE_INFO,
+        .descriptorPool = r->pool,
+        .descriptorSetCount = set_count,
+        .pSetLayouts = layouts,
+    };
+    VK(vkAllocateDescriptorSets(vk->device, &alloc, sets));
+    r->set = sets[0];
+    memcpy(r->bloom_sets, sets + 1, sizeof(r->bloom_sets));
+
+    VkImageView mip[SB_BLOOM_MAX_LEVELS];
+    for (uint32_t i = 0; i < SB_BLOOM_MAX_LEVELS; i++)
+        mip[i] = r->bloom.subview_count ? r->bloom.subviews[i < r->bloom_levels ? i : 0] : r->bloom.view;
+    write_set(r, r->set, r->hdr.view, mip[0]);
+    /* Down step i reads level i - 1 (the frame for i = 0) and writes level i;
+     * up step i reads level i + 1 and adds into level i. */
+    for (uint32_t i = 0; i < SB_BLOOM_MAX_LEVELS; i++) {
+        write_set(r, r->bloom_sets[i], i == 0 ? r->hdr.view : mip[i - 1], mip[i]);
+        write_set(r, r->bloom_sets[SB_BLOOM_MAX_LEVELS + i], mip[i + 1 < SB_BLOOM_MAX_LEVELS ? i + 1 : i], mip[i]);
+    }
+cleanup:
+    return res;
+}
+
+/* ---- Creation ------------------------------------------------------------------ */
+
+static enum sb_result upload(struct sb_vk *vk, const void *data, size_t bytes, const char *name, struct sb_buffer *b)
+{
+    enum sb_result res = sb_buffer_create(vk, bytes, name, b);
+    if (!res && data)
+        memcpy(b->mapped, data, bytes);
+    return res;
+}
+
+static enum sb_result upload_atmosphere(struct sb_renderer *r, const struct sb_pack *pack)
+{
+    static const enum sb_product_id needed[] = {SB_PRODUCT_TRANSMITTANCE, SB_PRODUCT_MULTISCATTERING,
+                                                SB_PRODUCT_IRRADIANCE_GROUND};
+    for (size_t i = 0; i < sizeof(needed) / sizeof(needed[0]); i++)
+        if (!pack->present[needed[i]]) {
+            sb_error("the pack has no %s, which skyview needs: bake a scene that asks for it",
+                     sb_product_name(needed[i]));
+            return SB_ERR_USAGE;
+        }
+    const struct sb_atmosphere_params *atm = &pack->scene->atmosphere;
+    struct sb_atmosphere_gpu gpu;
+    sb_atmosphere_gpu_pack(atm, &gpu);
+    double sun_max = fmax(atm->solar_irradiance[0], fmax(atm->solar_irradiance[1], atm->solar_irradiance[2]));
+    r->radiance_scale = sun_max > 0.0 ? 1.0 / sun_max : 1.0;
+    r->ground_radius_km = atm->ground_radius_km;
+
+    const struct sb_image *t = &pack->images[SB_PRODUCT_TRANSMITTANCE];
+    enum sb_result res = upload(r->vk, &gpu, sizeof(gpu), "atmosphere parameters", &r->atmosphere);
+    if (!res)
+        res = upload(r->vk, t->data, sb_image_float_count(t) * sizeof(float), "transmittance", &r->transmittance);
+    const enum sb_product_id lookups[2] = {SB_PRODUCT_MULTISCATTERING, SB_PRODUCT_IRRADIANCE_GROUND};
+    struct sb_buffer *dst[2] = {&r->multiscattering, &r->irradiance_ground};
+    for (int i = 0; i < 2 && !res; i++) {
+        res =
+            upload(r->vk, NULL, sb_lookup_float_count(lookups[i]) * sizeof(float), sb_product_name(lookups[i]), dst[i]);
+        if (!res)
+            sb_lookup_fill(lookups[i], &pack->images[lookups[i]], dst[i]->mapped);
+    }
+    return res;
+}
+
+static enum sb_result create_texture(struct sb_renderer *r, struct sb_texture *t, uint32_t w, uint32_t h,
+                                     uint32_t depth, uint32_t layers, uint32_t mips, VkFormat format,
+                                     VkImageUsageFlags usage, const char *name)
+{
+    struct sb_texture_params p = {
+        .width = w,
+        .height = h,
+        .depth = depth,
+        .layers = layers,
+        .mips = mips,
+        .format = format,
+        .usage = usage,
+        .name = name,
+    };
+    return sb_texture_create(r->vk, &p, t);
+}
+
+static enum sb_result create_images(struct sb_renderer *r)
+{
+    const VkImageUsageFlags storage_sampled = VK_IMAGE_USAGE_STORAGE_BIT | VK_IMAGE_USAGE_SAMPLED_BIT;
+    const VkImageUsageFlags copy = VK_IMAGE_USAGE_TRANSFER_SRC_BIT;
+    uint32_t s = r->params.shadow_size;
+    uint32_t bw = r->width / 2 ? r->width / 2 : 1, bh = r->height / 2 ? r->height / 2 : 1;
+    enum sb_result res = create_texture(r, &r->sky_view, SB_SKY_VIEW_WIDTH, SB_SKY_VIEW_HEIGHT, 1, 1, 1, HDR_FORMAT,
+                                        storage_sampled | copy, "sky-view LUT");
+    if (!res)
+        res = create_texture(r, &r->aerial, SB_AERIAL_SIZE, SB_AERIAL_SIZE, SB_AERIAL_SIZE, 1, 1, HDR_FORMAT,
+                             storage_sampled, "aerial perspective in-scattering");
+    if (!res)
+        res = create_texture(r, &r->aerial_t, SB_AERIAL_SIZE, SB_AERIAL_SIZE, SB_AERIAL_SIZE, 1, 1, HDR_FORMAT,
+                             storage_sampled, "aerial perspective transmittance");
+    if (!res)
+        res =
+            create_texture(r, &r->shadow, s, s, 1, SB_CASCADES, 1, DEPTH_FORMAT,
+                           VK_IMAGE_USAGE_DEPTH_STENCIL_ATTACHMENT_BIT | VK_IMAGE_USAGE_SAMPLED_BIT, "shadow cascades");
+    if (!res)
+        res = create_texture(r, &r->hdr, r->width, r->height, 1, 1, 1, HDR_FORMAT,
+                             storage_sampled | copy | VK_IMAGE_USAGE_COLOR_ATTACHMENT_BIT, "HDR frame");
+    if (!res)
+        res = create_texture(r, &r->depth, r->width, r->height, 1, 1, 1, DEPTH_FORMAT,
+                             VK_IMAGE_USAGE_DEPTH_STENCIL_ATTACHMENT_BIT | VK_IMAGE_USAGE_SAMPLED_BIT, "scene depth");
+    if (!res)
+        res = create_texture(r, &r->bloom, bw, bh, 1, 1, r->bloom_levels > 1 ? r->bloom_levels : 2, HDR_FORMAT,
+                             storage_sampled, "bloom chain");
+    if (!res)
+        res = create_texture(r, &r->ldr, r->width, r->height, 1, 1, 1, VK_FORMAT_R8G8B8A8_UNORM,
+                             VK_IMAGE_USAGE_STORAGE_BIT | copy, "LDR frame");
+    if (res)
+        return res;
+
+    struct sb_vk *vk = r->vk;
+    VkSamplerCreateInfo info = {
+        .sType = VK_STRUCTURE_TYPE_SAMPLER_CREATE_INFO,
+        .magFilter = VK_FILTER_LINEAR,
+        .minFilter = VK_FILTER_LINEAR,
+        .mipmapMode = VK_SAMPLER_MIPMAP_MODE_NEAREST,
+        .addressModeU = VK_SAMPLER_ADDRESS_MODE_CLAMP_TO_EDGE,
+        .addressModeV = VK_SAMPLER_ADDRESS_MODE_CLAMP_TO_EDGE,
+        .addressModeW = VK_SAMPLER_ADDRESS_MODE_CLAMP_TO_EDGE,
+        .maxLod = VK_LOD_CLAMP_NONE,
+    };
+    VK(vkCreateSampler(vk->device, &info, NULL, &r->linear));
+    info.magFilter = info.minFilter = VK_FILTER_NEAREST;
+    VK(vkCreateSampler(vk->device, &info, NULL, &r->nearest));
+    info.magFilter = info.minFilter = VK_FILTER_LINEAR;
+    info.compareEnable = VK_TRUE;
+    info.compareOp = VK_COMPARE_OP_LESS_OR_EQUAL;
+    VK(vkCreateSampler(vk->device, &info, NULL, &r->shadow_compare));
+cleanup:
+    return res;
+}
+
+static enum sb_result create_pipelines(struct sb_renderer *r)
+{
+    enum sb_result res = SB_OK;
+    for (int k = 0; k < KERNEL_COUNT && !res; k++)
+        res = sb_compute_pipeline_create(r->vk, r->layout, kernel_spirv[k].words, kernel_spirv[k].size,
+                                         kernel_spirv[k].name, &r->kernels[k]);
+    if (res)
+        return res;
+    struct sb_graphics_pipeline_params shadow = {
+        .layout = r->layout,
+        .vertex_spirv = sb_spv_shadow_vert,
+        .vertex_size = sizeof(sb_spv_shadow_vert),
+        .depth_format = DEPTH_FORMAT,
+        .depth_compare = VK_COMPARE_OP_LESS,
+        .depth_clamp = true, /* casters behind the near plane still cast ("pancaking") */
+        .depth_bias_constant = 1.0f,
+        .depth_bias_slope = 1.5f,
+        .name = "shadow cascades",
+    };
+    res = sb_graphics_pipeline_create(r->vk, &shadow, &r->shadow_pipeline);
+    struct sb_graphics_pipeline_params scene = {
+        .layout = r->layout,
+        .vertex_spirv = sb_spv_scene_vert,
+        .vertex_size = sizeof(sb_spv_scene_vert),
+        .fragment_spirv = sb_spv_scene_frag,
+        .fragment_size = sizeof(sb_spv_scene_frag),
+        .color_format = HDR_FORMAT,
+        .depth_format = DEPTH_FORMAT,
+        .depth_compare = VK_COMPARE_OP_GREATER, /* reverse Z */
+        .name = "scene",
+    };
+    if (!res)
+        res = sb_graphics_pipeline_create(r->vk, &scene, &r->scene_pipeline);
+    return res;
+}
+
+enum sb_result sb_renderer_create(struct sb_vk *vk, const struct sb_pack *pack, const struct sb_world *world,
+                                  const struct sb_renderer_params *params, struct sb_renderer **out)
+{
+    enum sb_result res = SB_OK;
+    *out = NULL;
+    if (!vk->graphics) {
+        sb_error("skyview needs a Vulkan context created for graphics");
+        return SB_ERR_USAGE;
+    }
+    if (!pack->scene) {
+        sb_error("the pack has no scene");
+        return SB_ERR_USAGE;
+    }
+    struct sb_renderer *r = calloc(1, sizeof(*r));
+    if (!r)
+        return SB_ERR_NOMEM;
+    r->vk = vk;
+    r->params = *params;
+    r->width = params->width ? params->width : 1280;
+    r->height = params->height ? params->height : 720;
+    if (!r->params.shadow_size)
+        r->params.shadow_size = 2048;
+    if (r->params.shadow_distance_m <= 0.0)
+        r->params.shadow_distance_m = 250.0;
+    if (r->params.bloom_strength == 0.0)
+        r->params.bloom_strength = 0.15;
+    uint32_t shorter = r->width < r->height ? r->width : r->height;
+    r->bloom_levels = 0;
+    if (r->params.bloom_strength > 0.0)
+        while (r->bloom_levels < SB_BLOOM_MAX_LEVELS && (shorter >> (r->bloom_levels + 1)) >= 4)
+            r->bloom_levels++;
+    r->vertex_count = world->vertex_count;
+
+    if ((res = upload_atmosphere(r, pack)))
+        goto cleanup;
+    res = upload(vk, world->vertices, world->vertex_count * sizeof(struct sb_vertex_gpu), "world", &r->vertices);
+    if (!res)
+        res = upload(vk, NULL, sizeof(struct sb_frame_gpu), "frame constants", &r->frame);
+    if (!res)
+        res = upload(vk, NULL, SB_HISTOGRAM_BINS * sizeof(uint32_t) + sizeof(struct sb_exposure_gpu), "exposure",
+                     &r->exposure);
+    if (!res)
+        res = upload(vk, NULL, (size_t)r->width * r->height * 4, "LDR readback", &r->read_ldr);
+    if (!res)
+        res = upload(vk, NULL, (size_t)r->width * r->height * 8, "HDR readback", &r->read_hdr);
+    if (!res)
+        res = upload(vk, NULL, (size_t)SB_SKY_VIEW_WIDTH * SB_SKY_VIEW_HEIGHT * 8, "sky-view readback",
+                     &r->read_sky_view);
+    if (!res)
+        res = create_images(r);
+    if (!res)
+        res = create_descriptors(r);
+    if (!res)
+        res = create_pipelines(r);
+    if (res)
+        goto cleanup;
+
+    if (vk->has_timestamps) {
+        VkQueryPoolCreateInfo qinfo = {
+            .sType = VK_STRUCTURE_TYPE_QUERY_POOL_CREATE_INFO,
+            .queryType = VK_QUERY_TYPE_TIMESTAMP,
+            .queryCount = 2 * SB_PASS_COUNT,
+        };
+        VK(vkCreateQueryPool(vk->device, &qinfo, NULL, &r->queries));
+    }
+    VkCommandBufferAllocateInfo alloc = {
+        .sType = VK_STRUCTURE_TYPE_COMMAND_BUFFER_ALLOCATE_INFO,
+        .commandPool = vk->command_pool,
+        .level = VK_COMMAND_BUFFER_LEVEL_PRIMARY,
+        .commandBufferCount = 1,
+    };
+    VK(vkAllocateCommandBuffers(vk->device, &alloc, &r->cmd));
+    VkFenceCreateInfo finfo = {.sType = VK_STRUCTURE_TYPE_FENCE_CREATE_INFO};
+    VK(vkCreateFence(vk->device, &finfo, NULL, &r->fence));
+    *out = r;
+    return SB_OK;
+
+cleanup:
+    sb_renderer_destroy(&r);
+    return res;
+}
+
+void sb_renderer_destroy(struct sb_renderer **pr)
+{
+    struct sb_renderer *r = *pr;
+    if (!r)
+        return;
+    struct sb_vk *vk = r->vk;
+    VkDevice d = vk->device;
+    vkDeviceWaitIdle(d);
+    if (r->fence)
+        vkDestroyFence(d, r->fence, NULL);
+    if (r->cmd)
+        vkFreeCommandBuffers(d, vk->command_pool, 1, &r->cmd);
+    if (r->queries)
+        vkDestroyQueryPool(d, r->queries, NULL);
+    for (int k = 0; k < KERNEL_COUNT; k++)
+        if (r->kernels[k])
+            vkDestroyPipeline(d, r->kernels[k], NULL);
+    if (r->shadow_pipeline)
+        vkDestroyPipeline(d, r->shadow_pipeline, NULL);
+    if (r->scene_pipeline)
+        vkDestroyPipeline(d, r->scene_pipeline, NULL);
+    if (r->pool)
+        vkDestroyDescriptorPool(d, r->pool, NULL);
+    if (r->layout)
+        vkDestroyPipelineLayout(d, r->layout, NULL);
+    if (r->set_layout)
+        vkDestroyDescriptorSetLayout(d, r->set_layout, NULL);
+    if (r->linear)
+        vkDestroySampler(d, r->linear, NULL);
+    if (r->nearest)
+        vkDestroySampler(d, r->nearest, NULL);
+    if (r->shadow_compare)
+        vkDestroySampler(d, r->shadow_compare, NULL);
+    struct sb_texture *textures[] = {&r->sky_view, &r->aerial, &r->aerial_t, &r->shadow,
+                                     &r->hdr,      &r->depth,  &r->bloom,    &r->ldr};
+    for (size_t i = 0; i < sizeof(textures) / sizeof(textures[0]); i++)
+        sb_texture_destroy(vk, textures[i]);
+    struct sb_buffer *buffers[] = {&r->atmosphere, &r->transmittance, &r->multiscattering, &r->irradiance_ground,
+                                   &r->frame,      &r->vertices,      &r->exposure,        &r->read_ldr,
+                                   &r->read_hdr,   &r->read_sky_view};
+    for (size_t i = 0; i < sizeof(buffers) / sizeof(buffers[0]); i++)
+        sb_buffer_destroy(vk, buffers[i]);
+    free(r);
+    *pr = NULL;
+}
+
+/* ---- A frame ------------------------------------------------------------------- */
+
+static void store4(float dst[4], double x, double y, double z, double w)
+{
+    dst[0] = (float)x;
+    dst[1] = (float)y;
+    dst[2] = (float)z;
+    dst[3] = (float)w;
+}
+
+static void fill_frame(struct sb_renderer *r, const struct sb_view *v, struct sb_frame_gpu *f)
+{
+    memset(f, 0, sizeof(*f));
+    double fov = v->fov_y > 0.0 ? v->fov_y : 50.0 * M_PI / 180.0;
+    double aspect = (double)r->width / r->height;
+    double forward[3], sun[3];
+    sb_direction(v->yaw, v->pitch, forward);
+    sb_direction(v->sun_azimuth, v->sun_elevation, sun);
+    double up[3] = {0.0, 1.0, 0.0};
+    if (fabs(forward[1]) > 0.999) { /* looking straight up or down: yaw decides what is up */
+        sb_direction(v->yaw, 0.0, up);
+        if (forward[1] > 0.0)
+            for (int i = 0; i < 3; i++)
+                up[i] = -up[i];
+    }
+    struct sb_mat4 view = sb_mat4_look(forward, up);
+    struct sb_mat4 proj = sb_mat4_perspective(fov, aspect, NEAR_M);
+    r->view_proj = sb_mat4_mul(&proj, &view);
+    memcpy(r->camera_m, v->camera_m, sizeof(r->camera_m));
+    struct sb_mat4 inv = sb_mat4_inverse(&r->view_proj);
+    sb_mat4_store(&r->view_proj, f->view_proj);
+    sb_mat4_store(&inv, f->inv_view_proj);
+
+    struct sb_cascade_params cp = {
+        .near_m = NEAR_M,
+        .distance_m = r->params.shadow_distance_m,
+        .lambda = 0.75,
+        .fov_y = fov,
+        .aspect = aspect,
+        .map_size = r->params.shadow_size,
+        .caster_margin_m = 200.0,
+    };
+    struct sb_cascades cascades;
+    sb_cascades_compute(&cp, v->camera_m, forward, sun, &cascades);
+    for (int c = 0; c < SB_CASCADES; c++) {
+        sb_mat4_store(&cascades.view_proj[c], f->shadow_view_proj[c]);
+        f->cascade_ends[c] = (float)cascades.ends_m[c];
+        f->cascade_texel[c] = (float)cascades.texel_m[c];
+    }
+
+    const double R = r->ground_radius_km;
+    double km[3] = {v->camera_m[0] * 1e-3, R + v->camera_m[1] * 1e-3, v->camera_m[2] * 1e-3};
+    double altitude = sqrt(km[0] * km[0] + km[1] * km[1] + km[2] * km[2]) - R;
+    const double sun_radius = 0.2666 * M_PI / 180.0; /* the sun's mean angular radius */
+    store4(f->camera_m, v->camera_m[0], v->camera_m[1], v->camera_m[2], 0.0);
+    store4(f->camera_km, km[0], km[1], km[2], altitude);
+    store4(f->camera_forward, forward[0], forward[1], forward[2], cos(sun_radius));
+    store4(f->sun_direction, sun[0], sun[1], sun[2], sun_radius);
+    store4(f->shadow, 0.1, 1.5, r->params.shadow_size, 1.0);
+    store4(f->aerial, AERIAL_FAR_KM, r->radiance_scale, 0.0, 0.0);
+    /* Bins 1 to 255 span 2^-20 to 2^12 of the solar irradiance's units:
+     * from starlight-dark to beyond the sun-lit snow. */
+    double log_sun = log2(1.0 / r->radiance_scale);
+    store4(f->exposure, log_sun - 20.0, 32.0, 0.10, 0.90);
+    store4(f->adaptation, 3.0, 1.0, v->dt_s > 0.0 ? v->dt_s : 1.0 / 60.0, v->snap_exposure ? 1.0 : 0.0);
+    store4(f->post, 1.0, r->params.bloom_strength > 0.0 ? r->params.bloom_strength : 0.0,
+           r->params.exposure_compensation_ev, r->params.tonemap);
+    f->size[0] = r->width;
+    f->size[1] = r->height;
+    f->size[2] = r->bloom_levels;
+}
+
+static void barrier(VkCommandBuffer cmd)
+{
+    VkMemoryBarrier b = {
+        .sType = VK_STRUCTURE_TYPE_MEMORY_BARRIER,
+        .srcAccessMask = VK_ACCESS_MEMORY_WRITE_BIT,
+        .dstAccessMask = VK_ACCESS_MEMORY_READ_BIT | VK_ACCESS_MEMORY_WRITE_BIT,
+    };
+    vkCmdPipelineBarrier(cmd, VK_PIPELINE_STAGE_ALL_COMMANDS_BIT, VK_PIPELINE_STAGE_ALL_COMMANDS_BIT, 0, 1, &b, 0, NULL,
+                         0, NULL);
+}
+
+static void pass_begin(struct sb_renderer *r, enum sb_pass pass)
+{
+    if (r->queries)
+        vkCmdWriteTimestamp(r->cmd, VK_PIPELINE_STAGE_TOP_OF_PIPE_BIT, r->queries, 2 * pass);
+}
+
+static void pass_end(struct sb_renderer *r, enum sb_pass pass)
+{
+    if (r->queries)
+        vkCmdWriteTimestamp(r->cmd, VK_PIPELINE_STAGE_BOTTOM_OF_PIPE_BIT, r->queries, 2 * pass + 1);
+    barrier(r->cmd);
+}
+
+static void dispatch(struct sb_renderer *r, enum compute_kernel k, VkDescriptorSet set, const struct sb_view_push *push,
+                     uint32_t width, uint32_t height, uint32_t group_x, uint32_t group_y)
+{
+    struct sb_view_push none = {0};
+    vkCmdBindPipeline(r->cmd, VK_PIPELINE_BIND_POINT_COMPUTE, r->kernels[k]);
+    vkCmdBindDescriptorSets(r->cmd, VK_PIPELINE_BIND_POINT_COMPUTE, r->layout, 0, 1, &set, 0, NULL);
+    vkCmdPushConstants(r->cmd, r->layout, VK_SHADER_STAGE_ALL, 0, sizeof(none), push ? push : &none);
+    vkCmdDispatch(r->cmd, (width + group_x - 1) / group_x, (height + group_y - 1) / group_y, 1);
+}
+
+static void set_viewport(VkCommandBuffer cmd, uint32_t w, uint32_t h)
+{
+    VkViewport viewport = {0.0f, 0.0f, (float)w, (float)h, 0.0f, 1.0f};
+    VkRect2D scissor = {{0, 0}, {w, h}};
+    vkCmdSetViewport(cmd, 0, 1, &viewport);
+    vkCmdSetScissor(cmd, 0, 1, &scissor);
+}
+
+static void record_shadows(struct sb_renderer *r)
+{
+    uint32_t s = r->params.shadow_size;
+    vkCmdBindPipeline(r->cmd, VK_PIPELINE_BIND_POINT_GRAPHICS, r->shadow_pipeline);
+    vkCmdBindDescriptorSets(r->cmd, VK_PIPELINE_BIND_POINT_GRAPHICS, r->layout, 0, 1, &r->set, 0, NULL);
+    for (uint32_t c = 0; c < SB_CASCADES; c++) {
+        VkRenderingAttachmentInfo depth = {
+            .sType = VK_STRUCTURE_TYPE_RENDERING_ATTACHMENT_INFO,
+            .imageView = r->shadow.subviews[c],
+            .imageLayout = VK_IMAGE_LAYOUT_GENERAL,
+            .loadOp = VK_ATTACHMENT_LOAD_OP_CLEAR,
+            .storeOp = VK_ATTACHMENT_STORE_OP_STORE,
+            .clearValue = {.depthStencil = {1.0f, 0}},
+        };
+        VkRenderingInfo info = {
+            .sType = VK_STRUCTURE_TYPE_RENDERING_INFO,
+            .renderArea = {{0, 0}, {s, s}},
+            .layerCount = 1,
+            .pDepthAttachment = &depth,
+        };
+        vkCmdBeginRendering(r->cmd, &info);
+        set_viewport(r->cmd, s, s);
+        struct sb_view_push push = {.cascade = c};
+        vkCmdPushConstants(r->cmd, r->layout, VK_SHADER_STAGE_ALL, 0, sizeof(push), &push);
+        vkCmdDraw(r->cmd, r->vertex_count, 1, 0, 0);
+        vkCmdEndRendering(r->cmd);
+    }
+}
+
+static void record_scene(struct sb_renderer *r)
+{
+    VkRenderingAttachmentInfo color = {
+        .sType = VK_STRUCTURE_TYPE_RENDERING_ATTACHMENT_INFO,
+        .imageView = r->hdr.view,
+        .imageLayout = VK_IMAGE_LAYOUT_GENERAL,
+        .loadOp = VK_ATTACHMENT_LOAD_OP_CLEAR,
+        .storeOp = VK_ATTACHMENT_STORE_OP_STORE,
+    };
+    VkRenderingAttachmentInfo depth = {
+        .sType = VK_STRUCTURE_TYPE_RENDERING_ATTACHMENT_INFO,
+        .imageView = r->depth.view,
+        .imageLayout = VK_IMAGE_LAYOUT_GENERAL,
+        .loadOp = VK_ATTACHMENT_LOAD_OP_CLEAR,
+        .storeOp = VK_ATTACHMENT_STORE_OP_STORE,
+        .clearValue = {.depthStencil = {0.0f, 0}}, /* reverse Z: 0 is infinitely far */
+    };
+    VkRenderingInfo info = {
+        .sType = VK_STRUCTURE_TYPE_RENDERING_INFO,
+        .renderArea = {{0, 0}, {r->width, r->height}},
+        .layerCount = 1,
+        .colorAttachmentCount = 1,
+        .pColorAttachments = &color,
+        .pDepthAttachment = &depth,
+    };
+    vkCmdBeginRendering(r->cmd, &info);
+    set_viewport(r->cmd, r->width, r->height);
+    vkCmdBindPipeline(r->cmd, VK_PIPELINE_BIND_POINT_GRAPHICS, r->scene_pipeline);
+    vkCmdBindDescriptorSets(r->cmd, VK_PIPELINE_BIND_POINT_GRAPHICS, r->layout, 0, 1, &r->set, 0, NULL);
+    struct sb_view_push push = {0};
+    vkCmdPushConstants(r->cmd, r->layout, VK_SHADER_STAGE_ALL, 0, sizeof(push), &push);
+    vkCmdDraw(r->cmd, r->vertex_count, 1, 0, 0);
+    vkCmdEndRendering(r->cmd);
+}
+
+static void record_bloom(struct sb_renderer *r)
+{
+    if (!r->bloom_levels)
+        return;
+    uint32_t w = r->bloom.width, h = r->bloom.height;
+    for (uint32_t i = 0; i < r->bloom_levels; i++) {
+        struct sb_view_push push = {.level = i, .first_level = i == 0};
+        dispatch(r, KERNEL_BLOOM_DOWN, r->bloom_sets[i], &push, w >> i ? w >> i : 1, h >> i ? h >> i : 1,
+                 SB_WORKGROUP_X, SB_WORKGROUP_Y);
+        barrier(r->cmd);
+    }
+    for (uint32_t i = r->bloom_levels - 1; i-- > 0;) {
+        struct sb_view_push push = {.level = i};
+        dispatch(r, KERNEL_BLOOM_UP, r->bloom_sets[SB_BLOOM_MAX_LEVELS + i], &push, w >> i ? w >> i : 1,
+                 h >> i ? h >> i : 1, SB_WORKGROUP_X, SB_WORKGROUP_Y);
+        barrier(r->cmd);
+    }
+}
+
+static void transition(VkCommandBuffer cmd, const struct sb_texture *t, VkImageLayout from, VkImageLayout to)
+{
+    VkImageMemoryBarrier b = {
+        .sType = VK_STRUCTURE_TYPE_IMAGE_MEMORY_BARRIER,
+        .srcAccessMask = VK_ACCESS_MEMORY_WRITE_BIT,
+        .dstAccessMask = VK_ACCESS_MEMORY_READ_BIT | VK_ACCESS_MEMORY_WRITE_BIT,
+        .oldLayout = from,
+        .newLayout = to,
+        .srcQueueFamilyIndex = VK_QUEUE_FAMILY_IGNORED,
+        .dstQueueFamilyIndex = VK_QUEUE_FAMILY_IGNORED,
+        .image = t->image,
+        .subresourceRange = {t->aspect, 0, t->mips, 0, t->layers},
+    };
+    vkCmdPipelineBarrier(cmd, VK_PIPELINE_STAGE_ALL_COMMANDS_BIT, VK_PIPELINE_STAGE_ALL_COMMANDS_BIT, 0, 0, NULL, 0,
+                         NULL, 1, &b);
+}
+
+/* Copies are the one place a texture leaves the general layout. */
+static void copy_image(struct sb_renderer *r, const struct sb_texture *t, const struct sb_buffer *b)
+{
+    VkBufferImageCopy region = {
+        .imageSubresource = {VK_IMAGE_ASPECT_COLOR_BIT, 0, 0, 1},
+        .imageExtent = {t->width, t->height, 1},
+    };
+    transition(r->cmd, t, VK_IMAGE_LAYOUT_GENERAL, VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL);
+    vkCmdCopyImageToBuffer(r->cmd, t->image, VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL, b->buffer, 1, &region);
+    transition(r->cmd, t, VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL, VK_IMAGE_LAYOUT_GENERAL);
+}
+
+enum sb_result sb_renderer_render(struct sb_renderer *r, const struct sb_view *view, bool readback,
+                                  struct sb_frame_timings *timings)
+{
+    enum sb_result res = SB_OK;
+    struct sb_vk *vk = r->vk;
+    fill_frame(r, view, r->frame.mapped);
+
+    VK(vkResetCommandBuffer(r->cmd, 0));
+    VkCommandBufferBeginInfo begin = {
+        .sType = VK_STRUCTURE_TYPE_COMMAND_BUFFER_BEGIN_INFO,
+        .flags = VK_COMMAND_BUFFER_USAGE_ONE_TIME_SUBMIT_BIT,
+    };
+    VK(vkBeginCommandBuffer(r->cmd, &begin));
+    if (r->queries)
+        vkCmdResetQueryPool(r->cmd, r->queries, 0, 2 * SB_PASS_COUNT);
+
+    pass_begin(r, SB_PASS_SKY_VIEW);
+    dispatch(r, KERNEL_SKY_VIEW, r->set, NULL, SB_SKY_VIEW_WIDTH, SB_SKY_VIEW_HEIGHT, SB_WORKGROUP_X, SB_WORKGROUP_Y);
+    pass_end(r, SB_PASS_SKY_VIEW);
+
+    pass_begin(r, SB_PASS_AERIAL_PERSPECTIVE);
+    dispatch(r, KERNEL_AERIAL, r->set, NULL, SB_AERIAL_SIZE, SB_AERIAL_SIZE, SB_WORKGROUP_X, SB_WORKGROUP_Y);
+    pass_end(r, SB_PASS_AERIAL_PERSPECTIVE);
+
+    pass_begin(r, SB_PASS_SHADOWS);
+    record_shadows(r);
+    pass_end(r, SB_PASS_SHADOWS);
+
+    pass_begin(r, SB_PASS_SCENE);
+    record_scene(r);
+    pass_end(r, SB_PASS_SCENE);
+
+    pass_begin(r, SB_PASS_SKY);
+    dispatch(r, KERNEL_SKY, r->set, NULL, r->width, r->height, SB_WORKGROUP_X, SB_WORKGROUP_Y);
+    pass_end(r, SB_PASS_SKY);
+
+    pass_begin(r, SB_PASS_EXPOSURE);
+    dispatch(r, KERNEL_HISTOGRAM, r->set, NULL, r->width, r->height, 16, 16);
+    barrier(r->cmd);
+    dispatch(r, KERNEL_EXPOSURE, r->set, NULL, 1, 1, 1, 1);
+    pass_end(r, SB_PASS_EXPOSURE);
+
+    pass_begin(r, SB_PASS_BLOOM);
+    record_bloom(r);
+    pass_end(r, SB_PASS_BLOOM);
+
+    pass_begin(r, SB_PASS_TONEMAP);
+    dispatch(r, KERNEL_TONEMAP, r->set, NULL, r->width, r->height, SB_WORKGROUP_X, SB_WORKGROUP_Y);
+    pass_end(r, SB_PASS_TONEMAP);
+
+    if (readback) {
+        copy_image(r, &r->ldr, &r->read_ldr);
+        copy_image(r, &r->hdr, &r->read_hdr);
+        copy_image(r, &r->sky_view, &r->read_sky_view);
+    }
+    VkMemoryBarrier to_host = {
+        .sType = VK_STRUCTURE_TYPE_MEMORY_BARRIER,
+        .srcAccessMask = VK_ACCESS_MEMORY_WRITE_BIT,
+        .dstAccessMask = VK_ACCESS_HOST_READ_BIT,
+    };
+    vkCmdPipelineBarrier(r->cmd, VK_PIPELINE_STAGE_ALL_COMMANDS_BIT, VK_PIPELINE_STAGE_HOST_BIT, 0, 1, &to_host, 0,
+                         NULL, 0, NULL);
+    VK(vkEndCommandBuffer(r->cmd));
+    VK(vkResetFences(vk->device, 1, &r->fence));
+    VkSubmitInfo submit = {
+        .sType = VK_STRUCTURE_TYPE_SUBMIT_INFO,
+        .commandBufferCount = 1,
+        .pCommandBuffers = &r->cmd,
+    };
+    VK(vkQueueSubmit(vk->queue, 1, &submit, r->fence));
+    VK(vkWaitForFences(vk->device, 1, &r->fence, VK_TRUE, UINT64_MAX));
+
+    if (timings) {
+        memset(timings, 0, sizeof(*timings));
+        if (r->queries) {
+            uint64_t ts[2 * SB_PASS_COUNT];
+            VK(vkGetQueryPoolResults(vk->device, r->queries, 0, 2 * SB_PASS_COUNT, sizeof(ts), ts, sizeof(uint64_t),
+                                     VK_QUERY_RESULT_64_BIT | VK_QUERY_RESULT_WAIT_BIT));
+            double to_ms = vk->timestamp_period_ns * 1e-6;
+            for (int p = 0; p < SB_PASS_COUNT; p++)
+                timings->ms[p] = (double)(ts[2 * p + 1] - ts[2 * p]) * to_ms;
+            timings->total_ms = (double)(ts[2 * SB_PASS_COUNT - 1] - ts[0]) * to_ms;
+            timings->valid = true;
+        }
+    }
+cleanup:
+    return res;
+}
+
+/* ---- Reading back ---------------------------------------------------------------- */
+
+void sb_renderer_size(const struct sb_renderer *r, uint32_t *width, uint32_t *height)
+{
+    *width = r->width;
+    *height = r->height;
+}
+
+const uint8_t *sb_renderer_ldr(const struct sb_renderer *r)
+{
+    return r->read_ldr.mapped;
+}
+
+static float half_to_float(uint16_t h)
+{
+    uint32_t sign = (uint32_t)(h >> 15) << 31, exp = (h >> 10) & 31, mant = h & 1023;
+    float v;
+    if (exp == 0)
+        v = ldexpf((float)mant, -24);
+    else if (exp == 31)
+        v = mant ? NAN : INFINITY;
+    else
+        v = ldexpf((float)(mant | 1024), (int)exp - 25);
+    return sign ? -v : v;
+}
+
+static void halves_to_rgb(const uint16_t *src, size_t pixels, double scale, float *rgb)
+{
+    for (size_t i = 0; i < pixels; i++)
+        for (int c = 0; c < 3; c++)
+            rgb[i * 3 + c] = (float)(half_to_float(src[i * 4 + c]) / scale);
+}
+
+void sb_renderer_hdr(const struct sb_renderer *r, float *rgb)
+{
+    halves_to_rgb(r->read_hdr.mapped, (size_t)r->width * r->height, r->radiance_scale, rgb);
+}
+
+void sb_renderer_sky_view(const struct sb_renderer *r, float *rgb)
+{
+    halves_to_rgb(r->read_sky_view.mapped, (size_t)SB_SKY_VIEW_WIDTH * SB_SKY_VIEW_HEIGHT, r->radiance_scale, rgb);
+}
+
+void sb_renderer_exposure(const struct sb_renderer *r, float state[4])
+{
+    const struct sb_exposure_gpu *e =
+        (const struct sb_exposure_gpu *)((const uint32_t *)r->exposure.mapped + SB_HISTOGRAM_BINS);
+    memcpy(state, e->state, 4 * sizeof(float));
+}
+
+bool sb_renderer_project(const struct sb_renderer *r, const double world_m[3], double pixel[2])
+{
+    double rel[3] = {world_m[0] - r->camera_m[0], world_m[1] - r->camera_m[1], world_m[2] - r->camera_m[2]};
+    const double *m = r->view_proj.m;
+    double w = m[3] * rel[0] + m[7] * rel[1] + m[11] * rel[2] + m[15];
+    if (w <= 0.0)
+        return false;
+    double ndc[3];
+    sb_mat4_project(&r->view_proj, rel, ndc);
+    pixel[0] = (ndc[0] * 0.5 + 0.5) * r->width;
+    pixel[1] = (ndc[1] * 0.5 + 0.5) * r->height;
+    return true;
+}

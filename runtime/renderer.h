@@ -1,0 +1,97 @@
+/*
+ * skyview's renderer: one frame is a chain of GPU passes on one queue,
+ *   sky-view LUT -> aerial perspective -> shadow cascades -> scene -> sky ->
+ *   exposure -> bloom -> tone mapping,
+ * each bracketed by timestamps. The atmosphere comes from a pack (its
+ * transmittance, multiple-scattering and ground-irradiance LUTs), read
+ * through formats/ and uploaded once; the world from sb_world. Frames are
+ * offscreen; their pixels are read back on request. One thread at a time.
+ */
+#ifndef SB_RUNTIME_RENDERER_H
+#define SB_RUNTIME_RENDERER_H
+
+#include <stdbool.h>
+#include <stdint.h>
+
+#include "context.h"
+#include "pack.h"
+#include "world.h"
+
+struct sb_renderer_params {
+    uint32_t width, height;          /* 0: 1280 x 720 */
+    uint32_t shadow_size;            /* texels per side of each cascade; 0: 2048 */
+    double shadow_distance_m;        /* where the last cascade ends; 0: 250 */
+    int tonemap;                     /* SB_TONEMAP_AGX (0, the default), _ACES or _GT */
+    double exposure_compensation_ev; /* added to the metered exposure; 0: none */
+    double bloom_strength;           /* 0: 0.15; negative: no bloom */
+};
+
+/* What one frame looks at. Angles in radians; lengths in metres. */
+struct sb_view {
+    double camera_m[3];   /* in the world: y up, the origin on the ground */
+    double yaw, pitch;    /* view direction: azimuth clockwise from -z (north) toward +x, elevation */
+    double fov_y;         /* vertical field of view; 0: 50 degrees */
+    double sun_azimuth;   /* same convention as yaw */
+    double sun_elevation; /* above the horizon; negative below */
+    double dt_s;          /* time since the previous frame, for exposure adaptation; 0: 1/60 s */
+    bool snap_exposure;   /* take the metered exposure at once (a first frame, a cut) */
+};
+
+enum sb_pass {
+    SB_PASS_SKY_VIEW,
+    SB_PASS_AERIAL_PERSPECTIVE,
+    SB_PASS_SHADOWS,
+    SB_PASS_SCENE,
+    SB_PASS_SKY,
+    SB_PASS_EXPOSURE,
+    SB_PASS_BLOOM,
+    SB_PASS_TONEMAP,
+    SB_PASS_COUNT,
+};
+
+/* "sky-view", "aerial perspective", "shadows", "scene", "sky", "exposure", "bloom", "tonemap". */
+const char *sb_pass_name(enum sb_pass pass);
+
+struct sb_frame_timings {
+    bool valid;               /* false when the queue has no timestamps */
+    double ms[SB_PASS_COUNT]; /* GPU time of each pass */
+    double total_ms;          /* from the first pass's start to the last one's end */
+};
+
+struct sb_renderer;
+
+/*
+ * Create a renderer for `pack` (which must hold transmittance,
+ * multiscattering and irradiance_ground; SB_ERR_USAGE naming the missing
+ * product otherwise) and `world` (copied; both may be freed afterwards).
+ * `vk` must have been created with graphics.
+ */
+enum sb_result sb_renderer_create(struct sb_vk *vk, const struct sb_pack *pack, const struct sb_world *world,
+                                  const struct sb_renderer_params *params, struct sb_renderer **renderer);
+void sb_renderer_destroy(struct sb_renderer **renderer);
+
+/* Render one frame and wait for it. With readback, the frame's pixels can
+ * be read afterwards. `timings` may be NULL. */
+enum sb_result sb_renderer_render(struct sb_renderer *renderer, const struct sb_view *view, bool readback,
+                                  struct sb_frame_timings *timings);
+
+/* The last frame rendered with readback, top row first:
+ * - ldr: width * height * 4 bytes, sRGB-encoded RGBA;
+ * - hdr: width * height * 3 floats, linear radiance in the pack's units
+ *   (those of its solar irradiance), before exposure;
+ * - sky_view: SB_SKY_VIEW_WIDTH * SB_SKY_VIEW_HEIGHT * 3 floats, likewise. */
+void sb_renderer_size(const struct sb_renderer *renderer, uint32_t *width, uint32_t *height);
+const uint8_t *sb_renderer_ldr(const struct sb_renderer *renderer);
+void sb_renderer_hdr(const struct sb_renderer *renderer, float *rgb);
+void sb_renderer_sky_view(const struct sb_renderer *renderer, float *rgb);
+
+/* The exposure state after the last frame: adapted log2 luminance, the
+ * exposure multiplier, this frame's metered log2 luminance, and the pixels
+ * in the metering window. */
+void sb_renderer_exposure(const struct sb_renderer *renderer, float state[4]);
+
+/* Where a world point lands in the last frame's image (pixels, x right, y
+ * down); false when it is behind the camera. */
+bool sb_renderer_project(const struct sb_renderer *renderer, const double world_m[3], double pixel[2]);
+
+#endif

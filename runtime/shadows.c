@@ -1,0 +1,61 @@
+#include "shadows.h"
+
+#include <math.h>
+
+void sb_cascades_compute(const struct sb_cascade_params *p, const double camera_m[3], const double forward[3],
+                         const double sun[3], struct sb_cascades *out)
+{
+    double n = p->near_m, f = p->distance_m;
+    double tan_y = tan(0.5 * p->fov_y), tan_x = tan_y * p->aspect;
+    double diag2 = tan_x * tan_x + tan_y * tan_y; /* squared slope of the frustum's corner rays */
+    /* The sun's frame: any up that is not parallel to it. */
+    double ref_up[3] = {0.0, 1.0, 0.0};
+    if (fabs(sun[1]) > 0.99) {
+        ref_up[1] = 0.0;
+        ref_up[2] = 1.0;
+    }
+    double toward_ground[3] = {-sun[0], -sun[1], -sun[2]};
+    struct sb_mat4 light = sb_mat4_look(toward_ground, ref_up);
+
+    double begin = n;
+    for (int i = 0; i < SB_CASCADES; i++) {
+        double t = (double)(i + 1) / SB_CASCADES;
+        double end = p->lambda * n * pow(f / n, t) + (1.0 - p->lambda) * (n + (f - n) * t);
+        out->ends_m[i] = end;
+        /* Smallest sphere around the slice [begin, end] of the frustum: its
+         * centre on the axis at depth z minimises the larger of the distances
+         * to the near and far corner rings; it depends only on the
+         * projection, so the cascade keeps its size as the camera turns. */
+        double z = 0.5 * (begin + end) * (1.0 + diag2);
+        if (z > end)
+            z = end;
+        double dn = sqrt((z - begin) * (z - begin) + begin * begin * diag2);
+        double df = sqrt((end - z) * (end - z) + end * end * diag2);
+        double radius = fmax(dn, df);
+        radius = ceil(radius * 16.0) / 16.0; /* whole sixteenths: no jitter from rounding */
+        double texel = 2.0 * radius / p->map_size;
+        out->radius_m[i] = radius;
+        out->texel_m[i] = texel;
+
+        /* The centre in the world, snapped to the texel grid of the sun's frame. */
+        double centre[3], centre_light[3], snapped[3];
+        for (int k = 0; k < 3; k++)
+            centre[k] = camera_m[k] + forward[k] * z;
+        sb_mat4_project(&light, centre, centre_light);
+        snapped[0] = floor(centre_light[0] / texel) * texel;
+        snapped[1] = floor(centre_light[1] / texel) * texel;
+        snapped[2] = centre_light[2];
+        /* The light frame's view matrix is a rotation, so its inverse is the transpose. */
+        double world[3];
+        for (int k = 0; k < 3; k++)
+            world[k] =
+                light.m[k * 4 + 0] * snapped[0] + light.m[k * 4 + 1] * snapped[1] + light.m[k * 4 + 2] * snapped[2];
+        /* camera-relative -> centred on the snapped centre -> sun's frame -> clip */
+        double shift[3] = {camera_m[0] - world[0], camera_m[1] - world[1], camera_m[2] - world[2]};
+        struct sb_mat4 to_centre = sb_mat4_translate(shift);
+        struct sb_mat4 ortho = sb_mat4_ortho(radius, -(radius + p->caster_margin_m), radius);
+        struct sb_mat4 view = sb_mat4_mul(&light, &to_centre);
+        out->view_proj[i] = sb_mat4_mul(&ortho, &view);
+        begin = end;
+    }
+}

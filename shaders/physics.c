@@ -1,0 +1,85 @@
+#include "physics.h"
+
+#include <math.h>
+#include <string.h>
+
+int sb_atmosphere_levels(const struct sb_atmosphere_params *p, double levels[SB_MAX_LEVELS])
+{
+    double thickness = p->top_radius_km - p->ground_radius_km;
+    double level = 0.5 * fmin(p->rayleigh_scale_height_km, p->mie_scale_height_km);
+    int n = 0;
+    while (n < SB_MAX_LEVELS && level < thickness) {
+        levels[n++] = level;
+        level *= M_SQRT2;
+    }
+    return n;
+}
+
+static void put3(float dst[4], const double src[3], double w)
+{
+    dst[0] = (float)src[0];
+    dst[1] = (float)src[1];
+    dst[2] = (float)src[2];
+    dst[3] = (float)w;
+}
+
+void sb_atmosphere_gpu_pack(const struct sb_atmosphere_params *p, struct sb_atmosphere_gpu *g)
+{
+    memset(g, 0, sizeof(*g));
+    double mie_ext[3];
+    for (int c = 0; c < 3; c++)
+        mie_ext[c] = p->mie_scattering_per_km[c] + p->mie_absorption_per_km[c];
+    put3(g->rayleigh_scattering, p->rayleigh_scattering_per_km, p->rayleigh_scale_height_km);
+    put3(g->mie_scattering, p->mie_scattering_per_km, p->mie_scale_height_km);
+    put3(g->mie_extinction, mie_ext, p->mie_g);
+    put3(g->ozone_absorption, p->ozone_absorption_per_km, p->ozone_center_km);
+    put3(g->ground_albedo, p->ground_albedo, p->ozone_half_width_km);
+    put3(g->solar_irradiance, p->solar_irradiance, 0.0);
+    double R = p->ground_radius_km, top = p->top_radius_km;
+    double thickness = top - R;
+    g->radii[0] = (float)R;
+    g->radii[1] = (float)top;
+    g->radii[2] = (float)sqrt(thickness * (top + R)); /* sqrt(top^2 - R^2) without cancellation */
+    g->radii[3] = (float)thickness;
+    double levels[SB_MAX_LEVELS];
+    int n = sb_atmosphere_levels(p, levels);
+    float *dst[4] = {g->levels_a, g->levels_b, g->levels_c, g->levels_d};
+    for (int i = 0; i < SB_MAX_LEVELS; i++)
+        dst[i / 4][i % 4] = i < n ? (float)levels[i] : (float)(2.0 * thickness);
+    g->level_count[0] = (uint32_t)n;
+}
+
+size_t sb_lookup_float_count(enum sb_product_id id)
+{
+    switch (id) {
+    case SB_PRODUCT_MULTISCATTERING:
+        return (size_t)SB_MULTISCATTERING_SIZE * SB_MULTISCATTERING_SIZE * 3;
+    case SB_PRODUCT_IRRADIANCE_GROUND:
+        return (size_t)2 * SB_IRRADIANCE_WIDTH * 3;
+    default:
+        return 0;
+    }
+}
+
+static float log_floor(double v)
+{
+    return (float)log(fmax(v, 1e-30));
+}
+
+void sb_lookup_fill(enum sb_product_id id, const struct sb_image *image, float *dst)
+{
+    if (id == SB_PRODUCT_MULTISCATTERING) {
+        size_t n = (size_t)image->width * image->height * 3;
+        for (size_t i = 0; i < n; i++)
+            dst[i] = log_floor(image->data[i]);
+    } else if (id == SB_PRODUCT_IRRADIANCE_GROUND) {
+        /* Row 0 of the image is the ground, h = 0. */
+        for (uint32_t x = 0; x < image->width; x++) {
+            const float *texel = image->data + (size_t)x * image->channel_count;
+            for (int c = 0; c < 3; c++) {
+                dst[x * 3 + c] = log_floor((double)texel[c] + texel[3 + c]);
+                dst[(image->width + x) * 3 + c] = log_floor(texel[3 + c]);
+            }
+        }
+    }
+}

@@ -1,0 +1,38 @@
+/*
+ * The C half of the shared physics (atmosphere.glsl): the GPU image of the
+ * atmosphere parameters and the lookup forms in which shaders read baked
+ * LUTs. Used by the baker, whose later products read earlier ones, and by
+ * the runtime, which reads a pack. No Vulkan here; all functions are pure
+ * and thread safe.
+ */
+#ifndef SB_SHADERS_PHYSICS_H
+#define SB_SHADERS_PHYSICS_H
+
+#include <stddef.h>
+
+#include "config.h"
+#include "image.h"
+#include "pack.h"
+#include "scene.h"
+
+/* Fill the std430 image of the parameters (config.h) from validated ones. */
+void sb_atmosphere_gpu_pack(const struct sb_atmosphere_params *params, struct sb_atmosphere_gpu *gpu);
+
+/* The altitude levels (km, ascending) that cut rays into segments: geometric
+ * by sqrt(2) from half the smallest scale height, below the top. Returns
+ * their number, at most SB_MAX_LEVELS. */
+int sb_atmosphere_levels(const struct sb_atmosphere_params *params, double levels[SB_MAX_LEVELS]);
+
+/*
+ * The lookup form of a baked product (config.h), which shaders read:
+ * - multiscattering: ln(max(psi, 1e-30)) per texel and channel;
+ * - irradiance_ground: two rows of SB_IRRADIANCE_WIDTH x 3 floats taken from
+ *   the ground row (h = 0), ln(max(direct + sky, 1e-30)) then
+ *   ln(max(sky, 1e-30));
+ * other products are read as baked and have no lookup form (0 floats).
+ * `image` must have the product's format (sb_product_format).
+ */
+size_t sb_lookup_float_count(enum sb_product_id id);
+void sb_lookup_fill(enum sb_product_id id, const struct sb_image *image, float *dst);
+
+#endif

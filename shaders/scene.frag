@@ -1,0 +1,154 @@
+#version 450
+/* The world lit by the sun and the sky, seen through the air:
+ * - the sun: E_sun times the baked transmittance toward it, through the
+ *   cascaded shadow maps (normal offset, 3x3 comparison PCF, a blend band
+ *   between cascades);
+ * - the BRDF: GGX distribution, height-correlated Smith visibility, Schlick
+ *   Fresnel, Lambert diffuse (Karis 2013; Filament);
+ * - the sky: irradiance_ground's sky irradiance on an upward surface, and the
+ *   ground's bounce for downward ones, blended by (1 +- n.up) / 2, with
+ *   Karis's analytic environment BRDF for the specular part;
+ * - aerial perspective: the volume inside its range, else the same
+ *   integral per fragment (cameras above the atmosphere, far geometry). */
+#extension GL_GOOGLE_include_directive : require
+#include "config.h"
+#include "view.glsl"
+
+layout(set = 0, binding = SB_VIEW_BINDING_SHADOW) uniform sampler2DArrayShadow shadow_map;
+layout(set = 0, binding = SB_VIEW_BINDING_AERIAL) uniform sampler3D aerial_inscatter;
+layout(set = 0, binding = SB_VIEW_BINDING_AERIAL_T) uniform sampler3D aerial_transmittance;
+
+layout(location = 0) in vec3 in_offset;
+layout(location = 1) in vec3 in_normal;
+layout(location = 2) in vec3 in_albedo;
+layout(location = 3) in vec2 in_metallic_roughness;
+layout(location = 0) out vec4 out_color;
+
+float cascade_visibility(int c, vec3 offset, vec3 n)
+{
+    vec3 p = offset + n * (frame.cascade_texel[c] * frame.shadow.y);
+    vec4 clip = frame.shadow_view_proj[c] * vec4(p, 1.0);
+    vec3 s = clip.xyz / clip.w;
+    vec2 uv = s.xy * 0.5 + 0.5;
+    if (any(lessThan(uv, vec2(0.0))) || any(greaterThan(uv, vec2(1.0))) || s.z > 1.0)
+        return 1.0;
+    float texel = 1.0 / frame.shadow.z;
+    float sum = 0.0;
+    for (int j = -1; j <= 1; j++)
+        for (int i = -1; i <= 1; i++)
+            sum += texture(shadow_map, vec4(uv + vec2(i, j) * texel, float(c), s.z));
+    return sum / 9.0;
+}
+
+float sun_visibility(vec3 offset, vec3 n)
+{
+    if (frame.shadow.w == 0.0)
+        return 1.0;
+    float depth = dot(offset, frame.camera_forward.xyz);
+    int c = 0;
+    while (c < SB_CASCADES && depth > frame.cascade_ends[c])
+        c++;
+    if (c == SB_CASCADES)
+        return 1.0;
+    float visibility = cascade_visibility(c, offset, n);
+    float begin = c == 0 ? 0.0 : frame.cascade_ends[c - 1];
+    float band = frame.shadow.x * (frame.cascade_ends[c] - begin);
+    float f = band > 0.0 ? (depth - (frame.cascade_ends[c] - band)) / band : 0.0;
+    if (f > 0.0) /* toward the next cascade, or out of the shadows past the last */
+        visibility = mix(visibility, c + 1 < SB_CASCADES ? cascade_visibility(c + 1, offset, n) : 1.0, f);
+    return visibility;
+}
+
+/* In-scattered radiance (rgb, scaled like the frame) and transmittance from
+ * the camera to a point `offset` metres away. */
+void aerial_perspective(vec3 offset, out vec3 inscatter, out vec3 transmittance)
+{
+    float d_km = length(offset) * 1e-3;
+    float far_km = frame.aerial.x;
+    bool inside = frame.camera_km.w < atmosphere_thickness();
+    if (inside && d_km <= far_km) {
+        vec2 uv = gl_FragCoord.xy / vec2(frame.size.xy);
+        float w = sqrt(d_km / far_km);
+        const float w0 = 0.5 / float(SB_AERIAL_SIZE);
+        vec3 uvw = vec3(uv, max(w, w0));
+        inscatter = textureLod(aerial_inscatter, uvw, 0.0).rgb;
+        transmittance = textureLod(aerial_transmittance, uvw, 0.0).rgb;
+        if (w < w0) { /* before the first slice, linear in distance */
+            float f = (w / w0) * (w / w0);
+            inscatter *= f;
+            transmittance = mix(vec3(1.0), transmittance, f);
+        }
+        return;
+    }
+    vec3 d = normalize(offset);
+    vec3 p = frame.camera_km.xyz;
+    float entry = atmosphere_entry(p, d);
+    inscatter = vec3(0.0);
+    transmittance = vec3(1.0);
+    if (entry < 0.0 || entry >= d_km)
+        return;
+    vec3 p0 = p + d * entry;
+    float r0 = length(p0);
+    float h0 = max(r0 - ground_radius(), 0.0);
+    float mu = dot(p0, d) / r0, mu_s = dot(p0, frame.sun_direction.xyz) / r0;
+    float nu = dot(d, frame.sun_direction.xyz);
+    float ts[SB_RAY_MAX_BREAKS];
+    int n = ray_breakpoints(h0, mu, mu_s, nu, d_km - entry, ts);
+    RayIntegrals ri = ray_integrals_begin();
+    for (int s = 0; s + 1 < n; s++)
+        integrate_segment(ri, h0, mu, mu_s, nu, ts[s], ts[s + 1], true);
+    vec3 L = atm.solar_irradiance.rgb * (ri.sun_rayleigh * phase_rayleigh(nu) + ri.sun_mie * phase_mie(nu)) +
+             ri.ms_rayleigh + ri.ms_mie;
+    inscatter = L * frame.aerial.y;
+    transmittance = ri.transmittance;
+}
+
+void main()
+{
+    vec3 n = normalize(in_normal);
+    vec3 v = -normalize(in_offset);
+    vec3 l = frame.sun_direction.xyz;
+    vec3 p = planet_position(in_offset);
+    float r = length(p);
+    vec3 up = p / r;
+    float h = max(r - ground_radius(), 0.0);
+    float mu_s = dot(up, l);
+
+    float metallic = clamp(in_metallic_roughness.x, 0.0, 1.0);
+    float roughness = clamp(in_metallic_roughness.y, 0.045, 1.0);
+    float a = roughness * roughness, a2 = a * a;
+    vec3 f0 = mix(vec3(0.04), in_albedo, metallic);
+    vec3 diffuse_color = in_albedo * (1.0 - metallic);
+
+    float n_dot_v = max(dot(n, v), 1e-4);
+    float n_dot_l = max(dot(n, l), 0.0);
+    vec3 hv = normalize(l + v);
+    float n_dot_h = max(dot(n, hv), 0.0), l_dot_h = max(dot(l, hv), 0.0);
+    float dd = n_dot_h * n_dot_h * (a2 - 1.0) + 1.0;
+    float D = a2 / (PI * dd * dd);
+    float V = 0.5 / (n_dot_l * sqrt(n_dot_v * n_dot_v * (1.0 - a2) + a2) +
+                     n_dot_v * sqrt(n_dot_l * n_dot_l * (1.0 - a2) + a2));
+    vec3 F = f0 + (1.0 - f0) * pow(1.0 - l_dot_h, 5.0);
+    vec3 brdf = diffuse_color / PI + D * V * F;
+
+    vec3 e_sun = atm.solar_irradiance.rgb * sun_transmittance(h, mu_s);
+    vec3 color = brdf * e_sun * (n_dot_l * sun_visibility(in_offset, n));
+
+    /* The world is low enough to read the ground row of irradiance_ground. */
+    vec3 e_sky = ground_sky_irradiance_sample(mu_s);
+    vec3 e_bounce = atm.ground_albedo.rgb * ground_irradiance_sample(mu_s);
+    float n_up = dot(n, up);
+    vec3 e_n = e_sky * (0.5 + 0.5 * n_up) + e_bounce * (0.5 - 0.5 * n_up);
+    vec3 refl = reflect(-v, n);
+    float r_up = dot(refl, up);
+    vec3 l_env = (e_sky * (0.5 + 0.5 * r_up) + e_bounce * (0.5 - 0.5 * r_up)) / PI;
+    const vec4 c0 = vec4(-1.0, -0.0275, -0.572, 0.022), c1 = vec4(1.0, 0.0425, 1.04, -0.04);
+    vec4 rr = roughness * c0 + c1;
+    float a004 = min(rr.x * rr.x, exp2(-9.28 * n_dot_v)) * rr.x + rr.y;
+    vec2 env_ab = vec2(-1.04, 1.04) * a004 + rr.zw;
+    color += diffuse_color / PI * e_n + (f0 * env_ab.x + env_ab.y) * l_env;
+
+    vec3 inscatter, transmittance;
+    aerial_perspective(in_offset, inscatter, transmittance);
+    out_color = vec4(fp16_safe(color * frame.aerial.y * transmittance + inscatter), 1.0);
+}

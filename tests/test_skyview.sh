@@ -1,0 +1,78 @@
+#!/bin/sh
+# skyview as a user runs it: frames and files written, --bench's table and
+# JSON, and packs or worlds that must be refused with a message naming what
+# is wrong. Usage: test_skyview.sh SKYVIEW SKYBAKE SOURCE_ROOT
+set -u
+skyview=$1
+skybake=$2
+root=$3
+tmp=$(mktemp -d)
+trap 'rm -rf "$tmp"' EXIT
+fails=0
+checks=0
+check() { # description, then a command that must succeed
+    desc=$1; shift
+    checks=$((checks + 1))
+    if ! "$@"; then echo "FAILED: $desc"; fails=$((fails + 1)); fi
+}
+expect_exit() { # code, command...
+    want=$1; shift
+    "$@" >"$tmp/out" 2>"$tmp/err"
+    got=$?
+    [ "$got" = "$want" ] || { echo "exit $got, expected $want: $*"; cat "$tmp/err"; return 1; }
+}
+export SKYBAKE_VALIDATE=1
+small="--size 64x36 --shadow-size 256"
+
+# A pack of what skyview reads, and one without multiple scattering.
+printf '{"version":1,"name":"view","atmosphere":{"preset":"earth"},"products":["irradiance_ground"]}' >"$tmp/view.json"
+printf '{"version":1,"name":"thin","atmosphere":{"preset":"earth"},"products":["transmittance"]}' >"$tmp/thin.json"
+check "bake the pack" expect_exit 0 "$skybake" bake "$tmp/view.json" -o "$tmp/pack" -q
+check "bake a transmittance-only pack" expect_exit 0 "$skybake" bake "$tmp/thin.json" -o "$tmp/thin" -q
+
+check "help exits 0" expect_exit 0 "$skyview" --help
+check "no arguments is a usage error" expect_exit 2 "$skyview"
+check "no -o is a usage error" expect_exit 2 "$skyview" "$tmp/pack"
+check "bad --size is a usage error" expect_exit 2 "$skyview" "$tmp/pack" -o "$tmp/f" --size 64by36
+check "bad --tonemap is a usage error" expect_exit 2 "$skyview" "$tmp/pack" -o "$tmp/f" --tonemap reinhard
+
+check "one frame" expect_exit 0 "$skyview" "$tmp/pack" -o "$tmp/f" $small --hdr
+check "frame_0000.png is a PNG" test "$(head -c 8 "$tmp/f/frame_0000.png" | od -An -tx1 | tr -d ' ')" = 89504e470d0a1a0a
+check "frame_0000.exr is an EXR" test "$(head -c 4 "$tmp/f/frame_0000.exr" | od -An -tx1 | tr -d ' ')" = 762f3101
+check "three frames, each tone mapper" expect_exit 0 "$skyview" "$tmp/pack" -o "$tmp/g" $small --frames 3 --tonemap gt
+check "frame_0002.png" test -s "$tmp/g/frame_0002.png"
+check "aces" expect_exit 0 "$skyview" "$tmp/pack" -o "$tmp/g" $small --tonemap aces --no-bloom
+check "camera above the atmosphere" expect_exit 0 "$skyview" "$tmp/pack" -o "$tmp/g" $small --camera 0,1000000,0,0,-60,60
+
+check "bench" expect_exit 0 "$skyview" "$tmp/pack" -o "$tmp/b" $small --bench --frames 3 --warmup 1
+for pass in sky-view "aerial perspective" shadows scene sky exposure bloom tonemap total; do
+    check "bench table has $pass" grep -q "^$pass " "$tmp/out"
+    check "bench.json has $pass" grep -q "\"pass\":[[:space:]]*\"$pass\"" "$tmp/b/bench.json"
+done
+
+# Packs that must be refused, with what is wrong named.
+cp -r "$tmp/pack" "$tmp/edited"
+sed -i '0,/"content_hash":[[:space:]]*"[0-9a-f]*"/s//"content_hash": "00000000000000000000000000000000"/' \
+    "$tmp/edited/manifest.json"
+check "a recorded hash that differs is refused" expect_exit 2 "$skyview" "$tmp/edited" -o "$tmp/x"
+check "the message says hash" grep -q "hash" "$tmp/err"
+check "nothing was written" test ! -e "$tmp/x"
+cp -r "$tmp/pack" "$tmp/missing"
+rm "$tmp/missing/irradiance_ground.exr"
+check "a missing artifact is refused" expect_exit 2 "$skyview" "$tmp/missing" -o "$tmp/x"
+check "the message names the file" grep -q "irradiance_ground.exr" "$tmp/err"
+cp -r "$tmp/pack" "$tmp/future"
+sed -i 's/"format_version":[[:space:]]*1/"format_version": 7/' "$tmp/future/manifest.json"
+check "an unknown format version is refused" expect_exit 2 "$skyview" "$tmp/future" -o "$tmp/x"
+check "the message says rebake" grep -q "rebake needed" "$tmp/err"
+check "a pack without multiscattering is refused" expect_exit 2 "$skyview" "$tmp/thin" -o "$tmp/x"
+check "the message names multiscattering" grep -q "multiscattering" "$tmp/err"
+check "a directory that is not a pack is refused" expect_exit 2 "$skyview" "$tmp" -o "$tmp/x"
+
+printf '{"version":1,"boxes":[{"center_m":[0,1,0],"size_m":[1,1,1],"colour":[1,0,0]}]}' >"$tmp/world.json"
+check "a world with an unknown key is refused" expect_exit 2 "$skyview" "$tmp/pack" -o "$tmp/x" --world "$tmp/world.json"
+check "the message names the key" grep -q "boxes\[0\].colour" "$tmp/err"
+check "output into a missing parent fails" expect_exit 1 "$skyview" "$tmp/pack" -o "$tmp/missing/parent/f" $small
+
+echo "skyview cli: $checks checks, $fails failed"
+[ "$fails" = 0 ]

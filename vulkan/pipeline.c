@@ -1,0 +1,146 @@
+#include "pipeline.h"
+
+#include "log.h"
+
+static enum sb_result shader_module(struct sb_vk *vk, const uint32_t *spirv, size_t size, VkShaderModule *module)
+{
+    enum sb_result res = SB_OK;
+    VkShaderModuleCreateInfo info = {
+        .sType = VK_STRUCTURE_TYPE_SHADER_MODULE_CREATE_INFO,
+        .codeSize = size,
+        .pCode = spirv,
+    };
+    VK(vkCreateShaderModule(vk->device, &info, NULL, module));
+cleanup:
+    return res;
+}
+
+enum sb_result sb_compute_pipeline_create(struct sb_vk *vk, VkPipelineLayout layout, const uint32_t *spirv,
+                                          size_t spirv_size, const char *name, VkPipeline *pipeline)
+{
+    VkShaderModule module = VK_NULL_HANDLE;
+    *pipeline = VK_NULL_HANDLE;
+    enum sb_result res = shader_module(vk, spirv, spirv_size, &module);
+    if (res)
+        return res;
+    VkComputePipelineCreateInfo info = {
+        .sType = VK_STRUCTURE_TYPE_COMPUTE_PIPELINE_CREATE_INFO,
+        .stage =
+            {
+                .sType = VK_STRUCTURE_TYPE_PIPELINE_SHADER_STAGE_CREATE_INFO,
+                .stage = VK_SHADER_STAGE_COMPUTE_BIT,
+                .module = module,
+                .pName = "main",
+            },
+        .layout = layout,
+    };
+    VK(vkCreateComputePipelines(vk->device, VK_NULL_HANDLE, 1, &info, NULL, pipeline));
+    sb_vk_name(vk, VK_OBJECT_TYPE_PIPELINE, (uint64_t)*pipeline, name);
+cleanup:
+    vkDestroyShaderModule(vk->device, module, NULL);
+    return res;
+}
+
+enum sb_result sb_graphics_pipeline_create(struct sb_vk *vk, const struct sb_graphics_pipeline_params *p,
+                                           VkPipeline *pipeline)
+{
+    VkShaderModule modules[2] = {VK_NULL_HANDLE, VK_NULL_HANDLE};
+    *pipeline = VK_NULL_HANDLE;
+    enum sb_result res = shader_module(vk, p->vertex_spirv, p->vertex_size, &modules[0]);
+    if (!res && p->fragment_spirv)
+        res = shader_module(vk, p->fragment_spirv, p->fragment_size, &modules[1]);
+    if (res)
+        goto cleanup;
+    VkPipelineShaderStageCreateInfo stages[2] = {
+        {
+            .sType = VK_STRUCTURE_TYPE_PIPELINE_SHADER_STAGE_CREATE_INFO,
+            .stage = VK_SHADER_STAGE_VERTEX_BIT,
+            .module = modules[0],
+            .pName = "main",
+        },
+        {
+            .sType = VK_STRUCTURE_TYPE_PIPELINE_SHADER_STAGE_CREATE_INFO,
+            .stage = VK_SHADER_STAGE_FRAGMENT_BIT,
+            .module = modules[1],
+            .pName = "main",
+        },
+    };
+    VkPipelineVertexInputStateCreateInfo vertex_input = {
+        .sType = VK_STRUCTURE_TYPE_PIPELINE_VERTEX_INPUT_STATE_CREATE_INFO,
+    };
+    VkPipelineInputAssemblyStateCreateInfo assembly = {
+        .sType = VK_STRUCTURE_TYPE_PIPELINE_INPUT_ASSEMBLY_STATE_CREATE_INFO,
+        .topology = VK_PRIMITIVE_TOPOLOGY_TRIANGLE_LIST,
+    };
+    VkPipelineViewportStateCreateInfo viewport = {
+        .sType = VK_STRUCTURE_TYPE_PIPELINE_VIEWPORT_STATE_CREATE_INFO,
+        .viewportCount = 1,
+        .scissorCount = 1,
+    };
+    bool bias = p->depth_bias_constant != 0.0f || p->depth_bias_slope != 0.0f;
+    VkPipelineRasterizationStateCreateInfo raster = {
+        .sType = VK_STRUCTURE_TYPE_PIPELINE_RASTERIZATION_STATE_CREATE_INFO,
+        .depthClampEnable = p->depth_clamp && vk->depth_clamp,
+        .polygonMode = VK_POLYGON_MODE_FILL,
+        .cullMode = p->cull_mode,
+        .frontFace = VK_FRONT_FACE_COUNTER_CLOCKWISE,
+        .depthBiasEnable = bias,
+        .depthBiasConstantFactor = p->depth_bias_constant,
+        .depthBiasSlopeFactor = p->depth_bias_slope,
+        .lineWidth = 1.0f,
+    };
+    VkPipelineMultisampleStateCreateInfo multisample = {
+        .sType = VK_STRUCTURE_TYPE_PIPELINE_MULTISAMPLE_STATE_CREATE_INFO,
+        .rasterizationSamples = VK_SAMPLE_COUNT_1_BIT,
+    };
+    VkPipelineDepthStencilStateCreateInfo depth = {
+        .sType = VK_STRUCTURE_TYPE_PIPELINE_DEPTH_STENCIL_STATE_CREATE_INFO,
+        .depthTestEnable = VK_TRUE,
+        .depthWriteEnable = VK_TRUE,
+        .depthCompareOp = p->depth_compare,
+    };
+    VkPipelineColorBlendAttachmentState blend_attachment = {
+        .colorWriteMask =
+            VK_COLOR_COMPONENT_R_BIT | VK_COLOR_COMPONENT_G_BIT | VK_COLOR_COMPONENT_B_BIT | VK_COLOR_COMPONENT_A_BIT,
+    };
+    bool color = p->color_format != VK_FORMAT_UNDEFINED;
+    VkPipelineColorBlendStateCreateInfo blend = {
+        .sType = VK_STRUCTURE_TYPE_PIPELINE_COLOR_BLEND_STATE_CREATE_INFO,
+        .attachmentCount = color ? 1 : 0,
+        .pAttachments = &blend_attachment,
+    };
+    const VkDynamicState dynamic_states[] = {VK_DYNAMIC_STATE_VIEWPORT, VK_DYNAMIC_STATE_SCISSOR};
+    VkPipelineDynamicStateCreateInfo dynamic = {
+        .sType = VK_STRUCTURE_TYPE_PIPELINE_DYNAMIC_STATE_CREATE_INFO,
+        .dynamicStateCount = 2,
+        .pDynamicStates = dynamic_states,
+    };
+    VkPipelineRenderingCreateInfo rendering = {
+        .sType = VK_STRUCTURE_TYPE_PIPELINE_RENDERING_CREATE_INFO,
+        .colorAttachmentCount = color ? 1 : 0,
+        .pColorAttachmentFormats = &p->color_format,
+        .depthAttachmentFormat = p->depth_format,
+    };
+    VkGraphicsPipelineCreateInfo info = {
+        .sType = VK_STRUCTURE_TYPE_GRAPHICS_PIPELINE_CREATE_INFO,
+        .pNext = &rendering,
+        .stageCount = p->fragment_spirv ? 2 : 1,
+        .pStages = stages,
+        .pVertexInputState = &vertex_input,
+        .pInputAssemblyState = &assembly,
+        .pViewportState = &viewport,
+        .pRasterizationState = &raster,
+        .pMultisampleState = &multisample,
+        .pDepthStencilState = &depth,
+        .pColorBlendState = &blend,
+        .pDynamicState = &dynamic,
+        .layout = p->layout,
+    };
+    VK(vkCreateGraphicsPipelines(vk->device, VK_NULL_HANDLE, 1, &info, NULL, pipeline));
+    sb_vk_name(vk, VK_OBJECT_TYPE_PIPELINE, (uint64_t)*pipeline, p->name);
+cleanup:
+    for (int i = 0; i < 2; i++)
+        if (modules[i])
+            vkDestroyShaderModule(vk->device, modules[i], NULL);
+    return res;
+}

@@ -1,0 +1,126 @@
+#include "texture.h"
+
+#include <string.h>
+
+#include "log.h"
+
+static int device_memory_type(const struct sb_vk *vk, uint32_t type_bits)
+{
+    for (uint32_t i = 0; i < vk->memory_properties.memoryTypeCount; i++)
+        if ((type_bits & (1u << i)) &&
+            (vk->memory_properties.memoryTypes[i].propertyFlags & VK_MEMORY_PROPERTY_DEVICE_LOCAL_BIT))
+            return (int)i;
+    for (uint32_t i = 0; i < vk->memory_properties.memoryTypeCount; i++)
+        if (type_bits & (1u << i))
+            return (int)i;
+    return -1;
+}
+
+static bool is_depth(VkFormat f)
+{
+    return f == VK_FORMAT_D32_SFLOAT || f == VK_FORMAT_D16_UNORM || f == VK_FORMAT_X8_D24_UNORM_PACK32;
+}
+
+enum sb_result sb_texture_create(struct sb_vk *vk, const struct sb_texture_params *params, struct sb_texture *t)
+{
+    enum sb_result res = SB_OK;
+    memset(t, 0, sizeof(*t));
+    t->width = params->width;
+    t->height = params->height;
+    t->depth = params->depth ? params->depth : 1;
+    t->layers = params->layers ? params->layers : 1;
+    t->mips = params->mips ? params->mips : 1;
+    t->format = params->format;
+    t->aspect = is_depth(params->format) ? VK_IMAGE_ASPECT_DEPTH_BIT : VK_IMAGE_ASPECT_COLOR_BIT;
+    if (t->layers > SB_TEXTURE_MAX_SUBVIEWS || t->mips > SB_TEXTURE_MAX_SUBVIEWS) {
+        sb_error("%s: %u layers and %u mips; at most %d", params->name, t->layers, t->mips, SB_TEXTURE_MAX_SUBVIEWS);
+        return SB_ERR_OUT_OF_RANGE;
+    }
+    VkImageCreateInfo info = {
+        .sType = VK_STRUCTURE_TYPE_IMAGE_CREATE_INFO,
+        .imageType = t->depth > 1 ? VK_IMAGE_TYPE_3D : VK_IMAGE_TYPE_2D,
+        .format = params->format,
+        .extent = {t->width, t->height, t->depth},
+        .mipLevels = t->mips,
+        .arrayLayers = t->layers,
+        .samples = VK_SAMPLE_COUNT_1_BIT,
+        .tiling = VK_IMAGE_TILING_OPTIMAL,
+        .usage = params->usage,
+        .sharingMode = VK_SHARING_MODE_EXCLUSIVE,
+        .initialLayout = VK_IMAGE_LAYOUT_UNDEFINED,
+    };
+    VK(vkCreateImage(vk->device, &info, NULL, &t->image));
+    sb_vk_name(vk, VK_OBJECT_TYPE_IMAGE, (uint64_t)t->image, params->name);
+    VkMemoryRequirements req;
+    vkGetImageMemoryRequirements(vk->device, t->image, &req);
+    int type = device_memory_type(vk, req.memoryTypeBits);
+    if (type < 0) {
+        sb_error("%s: no memory type for the image", params->name);
+        res = SB_ERR_VULKAN;
+        goto cleanup;
+    }
+    VkMemoryAllocateInfo alloc = {
+        .sType = VK_STRUCTURE_TYPE_MEMORY_ALLOCATE_INFO,
+        .allocationSize = req.size,
+        .memoryTypeIndex = (uint32_t)type,
+    };
+    VK(vkAllocateMemory(vk->device, &alloc, NULL, &t->memory));
+    VK(vkBindImageMemory(vk->device, t->image, t->memory, 0));
+
+    VkImageViewType whole_type = t->depth > 1    ? VK_IMAGE_VIEW_TYPE_3D
+                                 : t->layers > 1 ? VK_IMAGE_VIEW_TYPE_2D_ARRAY
+                                                 : VK_IMAGE_VIEW_TYPE_2D;
+    VkImageViewCreateInfo view = {
+        .sType = VK_STRUCTURE_TYPE_IMAGE_VIEW_CREATE_INFO,
+        .image = t->image,
+        .viewType = whole_type,
+        .format = params->format,
+        .subresourceRange = {t->aspect, 0, t->mips, 0, t->layers},
+    };
+    VK(vkCreateImageView(vk->device, &view, NULL, &t->view));
+    /* Per layer of an array, or per mip level of anything else. */
+    t->subview_count = t->layers > 1 ? t->layers : (t->mips > 1 ? t->mips : 0);
+    for (uint32_t i = 0; i < t->subview_count; i++) {
+        view.viewType = t->depth > 1 ? VK_IMAGE_VIEW_TYPE_3D : VK_IMAGE_VIEW_TYPE_2D;
+        view.subresourceRange = t->layers > 1 ? (VkImageSubresourceRange){t->aspect, 0, t->mips, i, 1}
+                                              : (VkImageSubresourceRange){t->aspect, i, 1, 0, 1};
+        VK(vkCreateImageView(vk->device, &view, NULL, &t->subviews[i]));
+    }
+
+    VkCommandBuffer cmd;
+    if ((res = sb_vk_begin_once(vk, &cmd)))
+        goto cleanup;
+    VkImageMemoryBarrier barrier = {
+        .sType = VK_STRUCTURE_TYPE_IMAGE_MEMORY_BARRIER,
+        .dstAccessMask = VK_ACCESS_MEMORY_READ_BIT | VK_ACCESS_MEMORY_WRITE_BIT,
+        .oldLayout = VK_IMAGE_LAYOUT_UNDEFINED,
+        .newLayout = VK_IMAGE_LAYOUT_GENERAL,
+        .srcQueueFamilyIndex = VK_QUEUE_FAMILY_IGNORED,
+        .dstQueueFamilyIndex = VK_QUEUE_FAMILY_IGNORED,
+        .image = t->image,
+        .subresourceRange = {t->aspect, 0, t->mips, 0, t->layers},
+    };
+    vkCmdPipelineBarrier(cmd, VK_PIPELINE_STAGE_TOP_OF_PIPE_BIT, VK_PIPELINE_STAGE_ALL_COMMANDS_BIT, 0, 0, NULL, 0,
+                         NULL, 1, &barrier);
+    if ((res = sb_vk_end_once(vk, cmd)))
+        goto cleanup;
+    return SB_OK;
+
+cleanup:
+    sb_texture_destroy(vk, t);
+    return res;
+}
+
+void sb_texture_destroy(struct sb_vk *vk, struct sb_texture *t)
+{
+    for (uint32_t i = 0; i < t->subview_count; i++)
+        if (t->subviews[i])
+            vkDestroyImageView(vk->device, t->subviews[i], NULL);
+    if (t->view)
+        vkDestroyImageView(vk->device, t->view, NULL);
+    if (t->image)
+        vkDestroyImage(vk->device, t->image, NULL);
+    if (t->memory)
+        vkFreeMemory(vk->device, t->memory, NULL);
+    memset(t, 0, sizeof(*t));
+}

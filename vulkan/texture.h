@@ -1,0 +1,46 @@
+/*
+ * Images on the device ("textures", to keep them apart from formats/'s CPU
+ * images): 2D, 2D arrays, 3D, with mip levels, each with a view of the whole
+ * and one view per layer or per mip level. A texture lives in
+ * VK_IMAGE_LAYOUT_GENERAL from creation to destruction, so passes need only
+ * memory barriers between them: the frames skyview renders are small enough
+ * that the layouts' compression would not pay for the transitions.
+ */
+#ifndef SB_VK_TEXTURE_H
+#define SB_VK_TEXTURE_H
+
+#include <stdint.h>
+
+#include "context.h"
+
+#define SB_TEXTURE_MAX_SUBVIEWS 16
+
+struct sb_texture_params {
+    uint32_t width, height;
+    uint32_t depth;  /* 0 or 1: 2D; more: 3D */
+    uint32_t layers; /* 0 or 1: one layer; more: a 2D array */
+    uint32_t mips;   /* 0: 1 */
+    VkFormat format;
+    VkImageUsageFlags usage;
+    const char *name;
+};
+
+struct sb_texture {
+    VkImage image;
+    VkDeviceMemory memory;
+    VkImageView view;                              /* everything */
+    VkImageView subviews[SB_TEXTURE_MAX_SUBVIEWS]; /* per layer (arrays) or per mip level */
+    uint32_t subview_count;
+    VkFormat format;
+    VkImageAspectFlags aspect;
+    uint32_t width, height, depth, layers, mips;
+};
+
+/* Create a texture in device-local memory, in the general layout, its
+ * contents undefined. Returns SB_ERR_OUT_OF_RANGE for more than
+ * SB_TEXTURE_MAX_SUBVIEWS layers or mips, SB_ERR_VULKAN on other failures. */
+enum sb_result sb_texture_create(struct sb_vk *vk, const struct sb_texture_params *params, struct sb_texture *texture);
+/* Free a texture; accepts a zeroed one. */
+void sb_texture_destroy(struct sb_vk *vk, struct sb_texture *texture);
+
+#endif
