@@ -280,6 +280,7 @@ static enum sb_result build(struct sb_world *w)
     const double up[3] = {0, 1, 0};
     double g[4][3] = {{-h, 0, h}, {h, 0, h}, {h, 0, -h}, {-h, 0, -h}};
     quad(&b, g[0], g[1], g[2], g[3], up, &w->ground);
+    w->caster_first_vertex = b.count;
     for (int i = 0; i < w->box_count; i++)
         box(&b, &w->boxes[i]);
     for (int i = 0; i < w->pillar_count; i++)

@@ -42,6 +42,7 @@ struct sb_world {
     struct sb_world_pillar pillars[SB_WORLD_MAX_OBJECTS];
     struct sb_vertex_gpu *vertices; /* owned: vertex_count, a triangle list */
     uint32_t vertex_count;
+    uint32_t caster_first_vertex; /* the ground comes first: it receives shadows but casts none */
 };
 
 /* Read and check a world file, then build its triangles. On failure the

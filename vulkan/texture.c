@@ -90,18 +90,7 @@ enum sb_result sb_texture_create(struct sb_vk *vk, const struct sb_texture_param
     VkCommandBuffer cmd;
     if ((res = sb_vk_begin_once(vk, &cmd)))
         goto cleanup;
-    VkImageMemoryBarrier barrier = {
-        .sType = VK_STRUCTURE_TYPE_IMAGE_MEMORY_BARRIER,
-        .dstAccessMask = VK_ACCESS_MEMORY_READ_BIT | VK_ACCESS_MEMORY_WRITE_BIT,
-        .oldLayout = VK_IMAGE_LAYOUT_UNDEFINED,
-        .newLayout = VK_IMAGE_LAYOUT_GENERAL,
-        .srcQueueFamilyIndex = VK_QUEUE_FAMILY_IGNORED,
-        .dstQueueFamilyIndex = VK_QUEUE_FAMILY_IGNORED,
-        .image = t->image,
-        .subresourceRange = {t->aspect, 0, t->mips, 0, t->layers},
-    };
-    vkCmdPipelineBarrier(cmd, VK_PIPELINE_STAGE_TOP_OF_PIPE_BIT, VK_PIPELINE_STAGE_ALL_COMMANDS_BIT, 0, 0, NULL, 0,
-                         NULL, 1, &barrier);
+    sb_texture_barrier(cmd, t, VK_IMAGE_LAYOUT_UNDEFINED, VK_IMAGE_LAYOUT_GENERAL);
     if ((res = sb_vk_end_once(vk, cmd)))
         goto cleanup;
     return SB_OK;
@@ -109,6 +98,23 @@ enum sb_result sb_texture_create(struct sb_vk *vk, const struct sb_texture_param
 cleanup:
     sb_texture_destroy(vk, t);
     return res;
+}
+
+void sb_texture_barrier(VkCommandBuffer cmd, const struct sb_texture *t, VkImageLayout from, VkImageLayout to)
+{
+    VkImageMemoryBarrier b = {
+        .sType = VK_STRUCTURE_TYPE_IMAGE_MEMORY_BARRIER,
+        .srcAccessMask = VK_ACCESS_MEMORY_WRITE_BIT,
+        .dstAccessMask = VK_ACCESS_MEMORY_READ_BIT | VK_ACCESS_MEMORY_WRITE_BIT,
+        .oldLayout = from,
+        .newLayout = to,
+        .srcQueueFamilyIndex = VK_QUEUE_FAMILY_IGNORED,
+        .dstQueueFamilyIndex = VK_QUEUE_FAMILY_IGNORED,
+        .image = t->image,
+        .subresourceRange = {t->aspect, 0, t->mips, 0, t->layers},
+    };
+    vkCmdPipelineBarrier(cmd, VK_PIPELINE_STAGE_ALL_COMMANDS_BIT, VK_PIPELINE_STAGE_ALL_COMMANDS_BIT, 0, 0, NULL, 0,
+                         NULL, 1, &b);
 }
 
 void sb_texture_destroy(struct sb_vk *vk, struct sb_texture *t)

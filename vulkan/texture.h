@@ -1,10 +1,10 @@
 /*
  * Images on the device ("textures", to keep them apart from formats/'s CPU
  * images): 2D, 2D arrays, 3D, with mip levels, each with a view of the whole
- * and one view per layer or per mip level. A texture lives in
- * VK_IMAGE_LAYOUT_GENERAL from creation to destruction, so passes need only
- * memory barriers between them: the frames skyview renders are small enough
- * that the layouts' compression would not pay for the transitions.
+ * and one view per layer or per mip level. A texture starts in
+ * VK_IMAGE_LAYOUT_GENERAL, where storage and sampled use need only memory
+ * barriers between passes; users move attachments to the optimal layouts
+ * around rendering (depth compression is worth it) and back.
  */
 #ifndef SB_VK_TEXTURE_H
 #define SB_VK_TEXTURE_H
@@ -40,6 +40,10 @@ struct sb_texture {
  * contents undefined. Returns SB_ERR_OUT_OF_RANGE for more than
  * SB_TEXTURE_MAX_SUBVIEWS layers or mips, SB_ERR_VULKAN on other failures. */
 enum sb_result sb_texture_create(struct sb_vk *vk, const struct sb_texture_params *params, struct sb_texture *texture);
+/* Record a move of the whole texture from one layout to another, after every
+ * earlier command's writes and before every later command (a full barrier:
+ * skyview's passes depend on each other in sequence anyway). */
+void sb_texture_barrier(VkCommandBuffer cmd, const struct sb_texture *t, VkImageLayout from, VkImageLayout to);
 /* Free a texture; accepts a zeroed one. */
 void sb_texture_destroy(struct sb_vk *vk, struct sb_texture *texture);
 
