@@ -164,6 +164,12 @@ static void test_shadows(struct sb_renderer *r)
     free(rgb);
 }
 
+static int compare_doubles(const void *a, const void *b)
+{
+    double x = *(const double *)a, y = *(const double *)b;
+    return (x > y) - (x < y);
+}
+
 /* The geometric mean of the exposed luminance over the middle 80% of the
  * pixels, which is what the meter aims at mid grey. */
 static double exposed_middle(struct sb_renderer *r)
@@ -175,16 +181,7 @@ static double exposed_middle(struct sb_renderer *r)
     for (int i = 0; i < W * H; i++)
         lum[i] = luminance(rgb + 3 * i) * state[1];
     int n = W * H;
-    /* insertion-free: sort */
-    for (int i = 1; i < n; i++) {
-        double x = lum[i];
-        int j = i - 1;
-        while (j >= 0 && lum[j] > x) {
-            lum[j + 1] = lum[j];
-            j--;
-        }
-        lum[j + 1] = x;
-    }
+    qsort(lum, (size_t)n, sizeof(double), compare_doubles);
     double sum = 0.0;
     int count = 0;
     for (int i = n / 10; i < n - n / 10; i++, count++)

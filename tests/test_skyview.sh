@@ -6,21 +6,7 @@ set -u
 skyview=$1
 skybake=$2
 root=$3
-tmp=$(mktemp -d)
-trap 'rm -rf "$tmp"' EXIT
-fails=0
-checks=0
-check() { # description, then a command that must succeed
-    desc=$1; shift
-    checks=$((checks + 1))
-    if ! "$@"; then echo "FAILED: $desc"; fails=$((fails + 1)); fi
-}
-expect_exit() { # code, command...
-    want=$1; shift
-    "$@" >"$tmp/out" 2>"$tmp/err"
-    got=$?
-    [ "$got" = "$want" ] || { echo "exit $got, expected $want: $*"; cat "$tmp/err"; return 1; }
-}
+. "$root/tests/cli_lib.sh"
 export SKYBAKE_VALIDATE=1
 small="--size 64x36 --shadow-size 256"
 

@@ -5,14 +5,6 @@
 #include "log.h"
 #include "pipeline.h"
 
-static int find_memory_type(const struct sb_vk *vk, uint32_t type_bits, VkMemoryPropertyFlags want)
-{
-    for (uint32_t i = 0; i < vk->memory_properties.memoryTypeCount; i++)
-        if ((type_bits & (1u << i)) && (vk->memory_properties.memoryTypes[i].propertyFlags & want) == want)
-            return (int)i;
-    return -1;
-}
-
 enum sb_result sb_buffer_create(struct sb_vk *vk, VkDeviceSize size, const char *name, struct sb_buffer *b)
 {
     enum sb_result res = SB_OK;
@@ -29,9 +21,9 @@ enum sb_result sb_buffer_create(struct sb_vk *vk, VkDeviceSize size, const char 
     VkMemoryRequirements req;
     vkGetBufferMemoryRequirements(vk->device, b->buffer, &req);
     const VkMemoryPropertyFlags host = VK_MEMORY_PROPERTY_HOST_VISIBLE_BIT | VK_MEMORY_PROPERTY_HOST_COHERENT_BIT;
-    int type = find_memory_type(vk, req.memoryTypeBits, host | VK_MEMORY_PROPERTY_DEVICE_LOCAL_BIT);
+    int type = sb_vk_memory_type(vk, req.memoryTypeBits, host | VK_MEMORY_PROPERTY_DEVICE_LOCAL_BIT);
     if (type < 0)
-        type = find_memory_type(vk, req.memoryTypeBits, host);
+        type = sb_vk_memory_type(vk, req.memoryTypeBits, host);
     if (type < 0) {
         sb_error("%s: no host-visible coherent memory type for a storage buffer", name);
         res = SB_ERR_VULKAN;

@@ -307,6 +307,14 @@ void sb_vk_destroy(struct sb_vk **pvk)
     *pvk = NULL;
 }
 
+int sb_vk_memory_type(const struct sb_vk *vk, uint32_t type_bits, VkMemoryPropertyFlags want)
+{
+    for (uint32_t i = 0; i < vk->memory_properties.memoryTypeCount; i++)
+        if ((type_bits & (1u << i)) && (vk->memory_properties.memoryTypes[i].propertyFlags & want) == want)
+            return (int)i;
+    return -1;
+}
+
 enum sb_result sb_vk_begin_once(struct sb_vk *vk, VkCommandBuffer *cmd)
 {
     enum sb_result res = SB_OK;

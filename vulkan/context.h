@@ -66,6 +66,10 @@ unsigned sb_vk_validation_messages(const struct sb_vk *vk);
 enum sb_result sb_vk_begin_once(struct sb_vk *vk, VkCommandBuffer *cmd);
 enum sb_result sb_vk_end_once(struct sb_vk *vk, VkCommandBuffer cmd);
 
+/* The first memory type allowed by type_bits that has every flag of `want`;
+ * -1 when none has. */
+int sb_vk_memory_type(const struct sb_vk *vk, uint32_t type_bits, VkMemoryPropertyFlags want);
+
 /* Name, driver and ids of the device, for manifests. */
 void sb_vk_device_info(const struct sb_vk *vk, struct sb_device_info *info);
 

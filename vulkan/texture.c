@@ -4,18 +4,6 @@
 
 #include "log.h"
 
-static int device_memory_type(const struct sb_vk *vk, uint32_t type_bits)
-{
-    for (uint32_t i = 0; i < vk->memory_properties.memoryTypeCount; i++)
-        if ((type_bits & (1u << i)) &&
-            (vk->memory_properties.memoryTypes[i].propertyFlags & VK_MEMORY_PROPERTY_DEVICE_LOCAL_BIT))
-            return (int)i;
-    for (uint32_t i = 0; i < vk->memory_properties.memoryTypeCount; i++)
-        if (type_bits & (1u << i))
-            return (int)i;
-    return -1;
-}
-
 static bool is_depth(VkFormat f)
 {
     return f == VK_FORMAT_D32_SFLOAT || f == VK_FORMAT_D16_UNORM || f == VK_FORMAT_X8_D24_UNORM_PACK32;
@@ -53,7 +41,9 @@ enum sb_result sb_texture_create(struct sb_vk *vk, const struct sb_texture_param
     sb_vk_name(vk, VK_OBJECT_TYPE_IMAGE, (uint64_t)t->image, params->name);
     VkMemoryRequirements req;
     vkGetImageMemoryRequirements(vk->device, t->image, &req);
-    int type = device_memory_type(vk, req.memoryTypeBits);
+    int type = sb_vk_memory_type(vk, req.memoryTypeBits, VK_MEMORY_PROPERTY_DEVICE_LOCAL_BIT);
+    if (type < 0)
+        type = sb_vk_memory_type(vk, req.memoryTypeBits, 0);
     if (type < 0) {
         sb_error("%s: no memory type for the image", params->name);
         res = SB_ERR_VULKAN;
