@@ -275,9 +275,30 @@ struct ray_sums {
     double t_end;
 };
 
+/* The sun's transmittance read from a baked LUT as the runtime reads it:
+ * bilinear between texel centres, clamped at the edges. */
+static void lut_bilinear_transmittance(const struct sb_atmosphere_params *p, const struct sb_image *lut, double r,
+                                       double mu, double out[3])
+{
+    double x_mu, x_r;
+    sb_ref_transmittance_coords(p, r, mu, &x_mu, &x_r);
+    int w = (int)lut->width, h = (int)lut->height;
+    double fx = fmin(fmax(x_mu * w - 0.5, 0.0), w - 1.0), fy = fmin(fmax(x_r * h - 0.5, 0.0), h - 1.0);
+    int x0 = (int)fx < w - 2 ? (int)fx : w - 2, y0 = (int)fy < h - 2 ? (int)fy : h - 2;
+    double ax = fx - x0, ay = fy - y0;
+    for (int c = 0; c < 3; c++) {
+        const float *d = lut->data;
+        size_t nc = lut->channel_count;
+        double v00 = d[((size_t)y0 * w + x0) * nc + c], v10 = d[((size_t)y0 * w + x0 + 1) * nc + c];
+        double v01 = d[((size_t)(y0 + 1) * w + x0) * nc + c], v11 = d[((size_t)(y0 + 1) * w + x0 + 1) * nc + c];
+        out[c] = (v00 * (1 - ax) + v10 * ax) * (1 - ay) + (v01 * (1 - ax) + v11 * ax) * ay;
+    }
+}
+
+/* t_lut: NULL to integrate the sun's transmittance exactly, else read it from this LUT. */
 static void integrate_ray(const struct sb_atmosphere_params *p, double r0, double mu, double mu_s, double nu,
-                          bool toward_ground, const struct sb_image *ms_lut, const struct sb_ref_quality *q,
-                          struct ray_sums *o)
+                          bool toward_ground, const struct sb_image *ms_lut, const struct sb_image *t_lut,
+                          const struct sb_ref_quality *q, struct ray_sums *o)
 {
     memset(o, 0, sizeof(*o));
     double R = p->ground_radius_km, thickness = p->top_radius_km - R;
@@ -329,6 +350,8 @@ static void integrate_ray(const struct sb_atmosphere_params *p, double r0, doubl
             medium(p, h, &m[j]);
             if (hits_ground(p, rt, mus)) {
                 sun[j][0] = sun[j][1] = sun[j][2] = 0;
+            } else if (t_lut) {
+                lut_bilinear_transmittance(p, t_lut, fmax(rt, R), mus, sun[j]);
             } else {
                 sb_ref_transmittance(p, fmax(rt, R), mus, q->transmittance_subdivisions, sun[j]);
             }
@@ -558,7 +581,7 @@ void sb_ref_multiscattering(const struct sb_atmosphere_params *p, double h, doub
     for (int i = 0; i < n; i++) {
         const struct direction *d = &dirs[i];
         struct ray_sums rs;
-        integrate_ray(p, r, d->mu, mu_s, d->nu, d->ground, NULL, &q, &rs);
+        integrate_ray(p, r, d->mu, mu_s, d->nu, d->ground, NULL, NULL, &q, &rs);
         double ground_term[3] = {0, 0, 0};
         double mu_sp = fmax(-1.0, fmin(1.0, (r * mu_s + rs.t_end * d->nu) / R));
         if (d->ground && mu_sp > 0) {
@@ -598,7 +621,7 @@ void sb_ref_irradiance_ground(const struct sb_atmosphere_params *p, double h, do
     for (int i = 0; i < n; i++) {
         const struct direction *d = &dirs[i];
         struct ray_sums rs;
-        integrate_ray(p, r, d->mu, mu_s, d->nu, false, ms_lut, &q, &rs);
+        integrate_ray(p, r, d->mu, mu_s, d->nu, false, ms_lut, NULL, &q, &rs);
         double w = d->weight * d->mu;
         for (int c = 0; c < 3; c++)
             sky[c] += w * (p->solar_irradiance[c] * (rs.sun_rayleigh[c] * phase_rayleigh(d->nu) +
@@ -622,7 +645,7 @@ void sb_ref_irradiance_sky(const struct sb_atmosphere_params *p, double h, doubl
         const struct direction *d = &dirs[i];
         double w = d->weight / (4 * REF_PI), nu = d->nu;
         struct ray_sums rs;
-        integrate_ray(p, r, d->mu, mu_s, nu, d->ground, ms_lut, &q, &rs);
+        integrate_ray(p, r, d->mu, mu_s, nu, d->ground, ms_lut, NULL, &q, &rs);
         double eg[3] = {0};
         if (d->ground) {
             double mu_sp = fmax(-1.0, fmin(1.0, (r * mu_s + rs.t_end * nu) / R));
@@ -639,7 +662,7 @@ void sb_ref_irradiance_sky(const struct sb_atmosphere_params *p, double h, doubl
 }
 
 void sb_ref_sky_radiance(const struct sb_atmosphere_params *p, double h, double mu, double mu_s, double nu,
-                         const struct sb_image *ms_lut, const struct sb_image *ig_lut,
+                         const struct sb_image *t_lut, const struct sb_image *ms_lut, const struct sb_image *ig_lut,
                          const struct sb_ref_quality *quality, double out[3])
 {
     pthread_once(&gl_once, gl_init);
@@ -647,7 +670,7 @@ void sb_ref_sky_radiance(const struct sb_atmosphere_params *p, double h, double 
     double R = p->ground_radius_km, r = R + h;
     bool ground = hits_ground(p, r, mu);
     struct ray_sums rs;
-    integrate_ray(p, r, mu, mu_s, nu, ground, ms_lut, &q, &rs);
+    integrate_ray(p, r, mu, mu_s, nu, ground, ms_lut, t_lut, &q, &rs);
     double eg[3] = {0};
     if (ground) {
         double mu_sp = fmax(-1.0, fmin(1.0, (r * mu_s + rs.t_end * nu) / R));

@@ -52,12 +52,13 @@ void sb_ref_irradiance_sky(const struct sb_atmosphere_params *p, double h, doubl
                            const struct sb_ref_quality *q, double out[9]);
 
 /* Sky radiance seen from altitude h (km) along view cosine mu, with sun cosine
- * mu_s and view-sun cosine nu: single scattering with exact transmittance
- * toward the sun, multiple scattering from the baked psi_ms, and the lit
- * ground (baked irradiance_ground) where the ray ends on it; no sun disk.
- * What skyview's sky-view LUT holds. */
+ * mu_s and view-sun cosine nu: single scattering, multiple scattering from
+ * the baked psi_ms, and the lit ground (baked irradiance_ground) where the
+ * ray ends on it; no sun disk. What skyview's sky-view LUT holds. The sun's
+ * transmittance is integrated exactly when `transmittance` is NULL, else
+ * read from that baked LUT bilinearly, as the runtime reads it. */
 void sb_ref_sky_radiance(const struct sb_atmosphere_params *p, double h, double mu, double mu_s, double nu,
-                         const struct sb_image *multiscattering, const struct sb_image *irradiance_ground,
-                         const struct sb_ref_quality *q, double out[3]);
+                         const struct sb_image *transmittance, const struct sb_image *multiscattering,
+                         const struct sb_image *irradiance_ground, const struct sb_ref_quality *q, double out[3]);
 
 #endif

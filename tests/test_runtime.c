@@ -237,14 +237,18 @@ static void test_exposure(struct sb_renderer *r)
 struct sky_case {
     double h, mu, mu_s, nu;
     float gpu[3];
-    double ref[3];
+    double ref[3];   /* the sun's transmittance read bilinearly from the baked LUT, as the runtime does */
+    double exact[3]; /* the sun's transmittance integrated */
 };
 
 static void sky_reference(void *user, int i)
 {
     struct sky_case *c = (struct sky_case *)user + i;
-    sb_ref_sky_radiance(&pack.scene->atmosphere, c->h, c->mu, c->mu_s, c->nu, &pack.images[SB_PRODUCT_MULTISCATTERING],
-                        &pack.images[SB_PRODUCT_IRRADIANCE_GROUND], NULL, c->ref);
+    const struct sb_image *lut = pack.images;
+    sb_ref_sky_radiance(&pack.scene->atmosphere, c->h, c->mu, c->mu_s, c->nu, &lut[SB_PRODUCT_TRANSMITTANCE],
+                        &lut[SB_PRODUCT_MULTISCATTERING], &lut[SB_PRODUCT_IRRADIANCE_GROUND], NULL, c->ref);
+    sb_ref_sky_radiance(&pack.scene->atmosphere, c->h, c->mu, c->mu_s, c->nu, NULL, &lut[SB_PRODUCT_MULTISCATTERING],
+                        &lut[SB_PRODUCT_IRRADIANCE_GROUND], NULL, c->exact);
 }
 
 static void test_sky_view(struct sb_renderer *r, double sun_elevation_deg, double tolerance)
@@ -280,10 +284,11 @@ static void test_sky_view(struct sb_renderer *r, double sun_elevation_deg, doubl
             memcpy(c->gpu, lut + ((size_t)y * SB_SKY_VIEW_WIDTH + x) * 3, sizeof(c->gpu));
         }
     parallel_for(nrows * ncols, sky_reference, cases);
-    double worst = 0.0;
+    double worst = 0.0, lut_effect = 0.0;
     int worst_i = 0, worst_c = 0;
     for (int i = 0; i < nrows * ncols; i++)
         for (int c = 0; c < 3; c++) {
+            lut_effect = fmax(lut_effect, fabs(cases[i].ref[c] - cases[i].exact[c]) / fmax(cases[i].exact[c], 1e-30));
             double e = fabs(cases[i].gpu[c] - cases[i].ref[c]) / fmax(cases[i].ref[c], 1e-30);
             if (e > worst) {
                 worst = e;
@@ -295,6 +300,9 @@ static void test_sky_view(struct sb_renderer *r, double sun_elevation_deg, doubl
            "ref %.6g)\n",
            sun_elevation_deg, worst, nrows * ncols, worst_i % ncols, rows[worst_i / ncols], worst_c,
            cases[worst_i].gpu[worst_c], cases[worst_i].ref[worst_c]);
+    printf("  (reading the sun's transmittance from the LUT instead of integrating it moves the fp64 sky by up to "
+           "%.3g)\n",
+           lut_effect);
     CHECK(worst <= tolerance, "sky-view LUT with the sun at %g deg within %g of fp64 (max %.3g)", sun_elevation_deg,
           tolerance, worst);
     free(cases);
@@ -355,11 +363,15 @@ int main(int argc, char **argv)
         test_sky_colours(r);
         test_shadows(r);
         test_exposure(r);
-        /* The runtime reads the sun's transmittance from the baked 256x64 LUT
-         * bilinearly, which is off by up to ~1e-2 of it near the horizon (test_atmosphere
-         * reports it); the LUT stores fp16 (4.9e-4). */
-        test_sky_view(r, 45.0, 2e-2);
-        test_sky_view(r, 3.0, 2e-2);
+        /* Against a reference that reads the sun's transmittance from the
+         * baked LUT as the runtime does, so the LUT's own error (reported)
+         * is not in the bound. High sun: the LUT stores fp16 (4.9e-4) and
+         * the rays use Gauss-Legendre 4 where the reference uses 8 (~1e-4):
+         * 2e-3. Low sun: the horizon rows add fp32 geometry of rays that stay
+         * within metres of the ground for kilometres (radii of 6360 km carry
+         * 0.5 m ulps), 5e-3 measured on lavapipe and the H200: 1e-2. */
+        test_sky_view(r, 45.0, 2e-3);
+        test_sky_view(r, 3.0, 1e-2);
         test_above_atmosphere(r);
     }
     sb_renderer_destroy(&r);

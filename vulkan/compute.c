@@ -21,20 +21,8 @@ enum sb_result sb_buffer_create(struct sb_vk *vk, VkDeviceSize size, const char 
     VkMemoryRequirements req;
     vkGetBufferMemoryRequirements(vk->device, b->buffer, &req);
     const VkMemoryPropertyFlags host = VK_MEMORY_PROPERTY_HOST_VISIBLE_BIT | VK_MEMORY_PROPERTY_HOST_COHERENT_BIT;
-    int type = sb_vk_memory_type(vk, req.memoryTypeBits, host | VK_MEMORY_PROPERTY_DEVICE_LOCAL_BIT);
-    if (type < 0)
-        type = sb_vk_memory_type(vk, req.memoryTypeBits, host);
-    if (type < 0) {
-        sb_error("%s: no host-visible coherent memory type for a storage buffer", name);
-        res = SB_ERR_VULKAN;
+    if ((res = sb_vk_allocate(vk, &req, host, VK_MEMORY_PROPERTY_DEVICE_LOCAL_BIT, name, &b->memory)))
         goto cleanup;
-    }
-    VkMemoryAllocateInfo alloc = {
-        .sType = VK_STRUCTURE_TYPE_MEMORY_ALLOCATE_INFO,
-        .allocationSize = req.size,
-        .memoryTypeIndex = (uint32_t)type,
-    };
-    VK(vkAllocateMemory(vk->device, &alloc, NULL, &b->memory));
     VK(vkBindBufferMemory(vk->device, b->buffer, b->memory, 0));
     VK(vkMapMemory(vk->device, b->memory, 0, VK_WHOLE_SIZE, 0, &b->mapped));
     memset(b->mapped, 0, size);

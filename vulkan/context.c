@@ -307,12 +307,34 @@ void sb_vk_destroy(struct sb_vk **pvk)
     *pvk = NULL;
 }
 
-int sb_vk_memory_type(const struct sb_vk *vk, uint32_t type_bits, VkMemoryPropertyFlags want)
+static int memory_type(const struct sb_vk *vk, uint32_t type_bits, VkMemoryPropertyFlags want)
 {
     for (uint32_t i = 0; i < vk->memory_properties.memoryTypeCount; i++)
         if ((type_bits & (1u << i)) && (vk->memory_properties.memoryTypes[i].propertyFlags & want) == want)
             return (int)i;
     return -1;
+}
+
+enum sb_result sb_vk_allocate(struct sb_vk *vk, const VkMemoryRequirements *req, VkMemoryPropertyFlags required,
+                              VkMemoryPropertyFlags preferred, const char *name, VkDeviceMemory *memory)
+{
+    enum sb_result res = SB_OK;
+    *memory = VK_NULL_HANDLE;
+    int type = memory_type(vk, req->memoryTypeBits, required | preferred);
+    if (type < 0)
+        type = memory_type(vk, req->memoryTypeBits, required);
+    if (type < 0) {
+        sb_error("%s: no memory type with the properties 0x%x", name, (unsigned)required);
+        return SB_ERR_VULKAN;
+    }
+    VkMemoryAllocateInfo alloc = {
+        .sType = VK_STRUCTURE_TYPE_MEMORY_ALLOCATE_INFO,
+        .allocationSize = req->size,
+        .memoryTypeIndex = (uint32_t)type,
+    };
+    VK(vkAllocateMemory(vk->device, &alloc, NULL, memory));
+cleanup:
+    return res;
 }
 
 enum sb_result sb_vk_begin_once(struct sb_vk *vk, VkCommandBuffer *cmd)

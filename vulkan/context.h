@@ -66,9 +66,13 @@ unsigned sb_vk_validation_messages(const struct sb_vk *vk);
 enum sb_result sb_vk_begin_once(struct sb_vk *vk, VkCommandBuffer *cmd);
 enum sb_result sb_vk_end_once(struct sb_vk *vk, VkCommandBuffer cmd);
 
-/* The first memory type allowed by type_bits that has every flag of `want`;
- * -1 when none has. */
-int sb_vk_memory_type(const struct sb_vk *vk, uint32_t type_bits, VkMemoryPropertyFlags want);
+/*
+ * Allocate memory for `req`: of a type with every flag of `required` and,
+ * where one exists, of `preferred` too. SB_ERR_VULKAN, naming `name`, when
+ * no type qualifies or the allocation fails.
+ */
+enum sb_result sb_vk_allocate(struct sb_vk *vk, const VkMemoryRequirements *req, VkMemoryPropertyFlags required,
+                              VkMemoryPropertyFlags preferred, const char *name, VkDeviceMemory *memory);
 
 /* Name, driver and ids of the device, for manifests. */
 void sb_vk_device_info(const struct sb_vk *vk, struct sb_device_info *info);

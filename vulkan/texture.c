@@ -41,20 +41,8 @@ enum sb_result sb_texture_create(struct sb_vk *vk, const struct sb_texture_param
     sb_vk_name(vk, VK_OBJECT_TYPE_IMAGE, (uint64_t)t->image, params->name);
     VkMemoryRequirements req;
     vkGetImageMemoryRequirements(vk->device, t->image, &req);
-    int type = sb_vk_memory_type(vk, req.memoryTypeBits, VK_MEMORY_PROPERTY_DEVICE_LOCAL_BIT);
-    if (type < 0)
-        type = sb_vk_memory_type(vk, req.memoryTypeBits, 0);
-    if (type < 0) {
-        sb_error("%s: no memory type for the image", params->name);
-        res = SB_ERR_VULKAN;
+    if ((res = sb_vk_allocate(vk, &req, 0, VK_MEMORY_PROPERTY_DEVICE_LOCAL_BIT, params->name, &t->memory)))
         goto cleanup;
-    }
-    VkMemoryAllocateInfo alloc = {
-        .sType = VK_STRUCTURE_TYPE_MEMORY_ALLOCATE_INFO,
-        .allocationSize = req.size,
-        .memoryTypeIndex = (uint32_t)type,
-    };
-    VK(vkAllocateMemory(vk->device, &alloc, NULL, &t->memory));
     VK(vkBindImageMemory(vk->device, t->image, t->memory, 0));
 
     VkImageViewType whole_type = t->depth > 1    ? VK_IMAGE_VIEW_TYPE_3D
