@@ -10,7 +10,15 @@
 #include "log.h"
 #include "multiscattering.spv.h"
 #include "physics.h"
-#include "transmittance.spv.h"
+#include "transmittance_gl0.spv.h"
+#include "transmittance_gl1.spv.h"
+#include "transmittance_gl2.spv.h"
+#include "transmittance_gl3.spv.h"
+#include "transmittance_gl4.spv.h"
+#include "transmittance_gl5.spv.h"
+#include "transmittance_gl6.spv.h"
+#include "transmittance_gl7.spv.h"
+#include "transmittance_gl8.spv.h"
 
 #define BIT(p) (1u << (p))
 
@@ -18,6 +26,7 @@ static const struct sb_atmosphere_product products[SB_PRODUCT_COUNT] = {
     [SB_PRODUCT_TRANSMITTANCE] =
         {
             .id = SB_PRODUCT_TRANSMITTANCE,
+            .defaults = {.quadrature = SB_QUADRATURE_GAUSS_LEGENDRE, .samples = 8, .subdivisions = 1},
         },
     [SB_PRODUCT_MULTISCATTERING] =
         {
@@ -46,16 +55,116 @@ static const struct sb_atmosphere_product products[SB_PRODUCT_COUNT] = {
 static const struct {
     const uint32_t *words;
     size_t size;
-} shaders[SB_PRODUCT_COUNT] = {
-    [SB_PRODUCT_TRANSMITTANCE] = {sb_spv_transmittance, sizeof(sb_spv_transmittance)},
-    [SB_PRODUCT_MULTISCATTERING] = {sb_spv_multiscattering, sizeof(sb_spv_multiscattering)},
-    [SB_PRODUCT_IRRADIANCE_GROUND] = {sb_spv_irradiance_ground, sizeof(sb_spv_irradiance_ground)},
-    [SB_PRODUCT_IRRADIANCE_SKY] = {sb_spv_irradiance_sky, sizeof(sb_spv_irradiance_sky)},
+} transmittance_shaders[SB_GL_MAX_ORDER + 1] =
+    {
+#define T(n)                                                                                                           \
+    {                                                                                                                  \
+        sb_spv_transmittance_gl##n, sizeof(sb_spv_transmittance_gl##n)                                                 \
+    }
+        T(0), T(1), T(2), T(3), T(4), T(5), T(6), T(7), T(8),
+#undef T
+},
+                                          shaders[SB_PRODUCT_COUNT] = {
+                                              [SB_PRODUCT_TRANSMITTANCE] = {sb_spv_transmittance_gl8,
+                                                                            sizeof(sb_spv_transmittance_gl8)},
+                                              [SB_PRODUCT_MULTISCATTERING] = {sb_spv_multiscattering,
+                                                                              sizeof(sb_spv_multiscattering)},
+                                              [SB_PRODUCT_IRRADIANCE_GROUND] = {sb_spv_irradiance_ground,
+                                                                                sizeof(sb_spv_irradiance_ground)},
+                                              [SB_PRODUCT_IRRADIANCE_SKY] = {sb_spv_irradiance_sky,
+                                                                             sizeof(sb_spv_irradiance_sky)},
 };
 
 const struct sb_atmosphere_product *sb_atmosphere_product(enum sb_product_id id)
 {
     return &products[id];
+}
+
+/* `settings` over the product's defaults, with the fields it does not use zeroed. */
+static struct sb_atmosphere_settings resolve_settings(enum sb_product_id id,
+                                                      const struct sb_atmosphere_settings *settings)
+{
+    struct sb_atmosphere_settings s = products[id].defaults,
+                                  in = settings ? *settings : (struct sb_atmosphere_settings){0};
+    if (id == SB_PRODUCT_TRANSMITTANCE) {
+        if (in.quadrature || in.samples) {
+            s.quadrature = in.quadrature;
+            s.samples = in.samples;
+            s.subdivisions = in.quadrature == SB_QUADRATURE_GAUSS_LEGENDRE ? 1 : 0;
+        }
+        if (in.subdivisions && s.quadrature == SB_QUADRATURE_GAUSS_LEGENDRE)
+            s.subdivisions = in.subdivisions;
+        s.width = in.width;
+        s.height = in.height;
+        return s;
+    }
+    if (in.directions_mu)
+        s.directions_mu = in.directions_mu;
+    if (in.directions_phi)
+        s.directions_phi = in.directions_phi;
+    return s;
+}
+
+static enum sb_result check_settings(enum sb_product_id id, const struct sb_atmosphere_settings *s)
+{
+    const char *name = sb_product_name(id);
+    if (id != SB_PRODUCT_TRANSMITTANCE) {
+        if (s->directions_mu < 1 || s->directions_mu > SB_MAX_DIRECTIONS_MU || s->directions_phi < 1 ||
+            s->directions_phi > SB_MAX_DIRECTIONS_PHI) {
+            sb_error("%s: directions_mu must be 1 to %d and directions_phi 1 to %d (got %u, %u)", name,
+                     SB_MAX_DIRECTIONS_MU, SB_MAX_DIRECTIONS_PHI, s->directions_mu, s->directions_phi);
+            return SB_ERR_USAGE;
+        }
+        return SB_OK;
+    }
+    if (s->quadrature >= SB_QUADRATURE_COUNT) {
+        sb_error("%s: unknown quadrature %u", name, s->quadrature);
+        return SB_ERR_USAGE;
+    }
+    if (s->quadrature == SB_QUADRATURE_GAUSS_LEGENDRE &&
+        (s->samples < 1 || s->samples > SB_GL_MAX_ORDER || s->subdivisions < 1 ||
+         s->subdivisions > SB_GL_MAX_SUBDIVISIONS)) {
+        sb_error("%s: Gauss-Legendre order must be 1 to %d and subdivisions 1 to %d (got %u, %u)", name,
+                 SB_GL_MAX_ORDER, SB_GL_MAX_SUBDIVISIONS, s->samples, s->subdivisions);
+        return SB_ERR_USAGE;
+    }
+    if (s->quadrature != SB_QUADRATURE_GAUSS_LEGENDRE && (s->samples < 1 || s->samples > SB_UNIFORM_MAX_STEPS)) {
+        sb_error("%s: a uniform rule takes 1 to %d steps (got %u)", name, SB_UNIFORM_MAX_STEPS, s->samples);
+        return SB_ERR_USAGE;
+    }
+    if ((s->width || s->height) && (s->width < 2 || s->height < 2 || s->width > 4096 || s->height > 4096)) {
+        sb_error("%s: resolution %ux%u is outside 2 to 4096 a side", name, s->width, s->height);
+        return SB_ERR_USAGE;
+    }
+    return SB_OK;
+}
+
+uint64_t sb_atmosphere_settings_cost(enum sb_product_id id, const struct sb_atmosphere_settings *settings)
+{
+    struct sb_atmosphere_settings s = resolve_settings(id, settings);
+    if (id != SB_PRODUCT_TRANSMITTANCE)
+        return (uint64_t)SB_SPHERE_MAX_PIECES * s.directions_mu * s.directions_phi;
+    if (s.quadrature == SB_QUADRATURE_GAUSS_LEGENDRE)
+        return 5ull * s.samples * s.subdivisions; /* five pieces, as on the earth */
+    return s.quadrature == SB_QUADRATURE_TRAPEZOID ? s.samples + 1ull : s.samples;
+}
+
+void sb_atmosphere_settings_label(enum sb_product_id id, const struct sb_atmosphere_settings *settings, char *out,
+                                  size_t size)
+{
+    struct sb_atmosphere_settings s = resolve_settings(id, settings);
+    if (id != SB_PRODUCT_TRANSMITTANCE) {
+        snprintf(out, size, "%ux%u", s.directions_mu, s.directions_phi);
+        return;
+    }
+    static const char *rules[SB_QUADRATURE_COUNT] = {"gl", "uniform0.3-", "midpoint-", "trapezoid-"};
+    int n;
+    if (s.quadrature == SB_QUADRATURE_GAUSS_LEGENDRE)
+        n = snprintf(out, size, "gl%ux%u", s.samples, s.subdivisions);
+    else
+        n = snprintf(out, size, "%s%u", s.quadrature < SB_QUADRATURE_COUNT ? rules[s.quadrature] : "?", s.samples);
+    if (s.width && n > 0 && (size_t)n < size)
+        snprintf(out + n, size - (size_t)n, "@%ux%u", s.width, s.height);
 }
 
 struct sb_atmosphere_baker {
@@ -115,14 +224,18 @@ void sb_atmosphere_baker_destroy(struct sb_atmosphere_baker **pb)
  */
 static enum sb_result run(struct sb_atmosphere_baker *b, const uint32_t *spirv, size_t spirv_size, const char *name,
                           struct sb_buffer *output, uint32_t width, uint32_t height, bool workgroup_per_texel,
-                          uint32_t directions_mu, uint32_t directions_phi, double *gpu_ms)
+                          const struct sb_atmosphere_settings *s, double *gpu_ms)
 {
+    uint32_t directions_mu = s->directions_mu, directions_phi = s->directions_phi;
     struct sb_bake_push push = {
         .width = width,
         .height = height,
         .directions_mu = directions_mu,
         .directions_phi = directions_phi,
         .step_count = 1,
+        .quadrature = s->quadrature,
+        .samples = s->samples,
+        .subdivisions = s->subdivisions,
     };
     enum sb_result res = SB_OK;
     if (workgroup_per_texel) {
@@ -206,19 +319,12 @@ enum sb_result sb_atmosphere_bake(struct sb_atmosphere_baker *b, enum sb_product
                                   struct sb_atmosphere_settings *used, double *gpu_ms)
 {
     const struct sb_atmosphere_product *prod = &products[id];
-    struct sb_atmosphere_settings s = prod->defaults;
-    if (settings && settings->directions_mu)
-        s.directions_mu = settings->directions_mu;
-    if (settings && settings->directions_phi)
-        s.directions_phi = settings->directions_phi;
+    struct sb_atmosphere_settings s = resolve_settings(id, settings);
     if (used)
         *used = s;
-    if (prod->workgroup_per_texel &&
-        (s.directions_mu < 1 || s.directions_mu > SB_MAX_DIRECTIONS_MU || s.directions_phi < 1)) {
-        sb_error("%s: directions_mu must be 1 to %d and directions_phi at least 1 (got %u, %u)", sb_product_name(id),
-                 SB_MAX_DIRECTIONS_MU, s.directions_mu, s.directions_phi);
-        return SB_ERR_USAGE;
-    }
+    enum sb_result res = check_settings(id, &s);
+    if (res)
+        return res;
     for (int dep = 0; dep < SB_PRODUCT_COUNT; dep++)
         if ((prod->depends_on & BIT(dep)) && !b->outputs[dep].buffer) {
             sb_error("%s: needs %s, which has not been baked", sb_product_name(id),
@@ -227,8 +333,8 @@ enum sb_result sb_atmosphere_bake(struct sb_atmosphere_baker *b, enum sb_product
         }
 
     const struct sb_product_format *format = sb_product_format(id);
-    enum sb_result res = sb_image_init(image, format->width, format->height, format->channel_count);
-    if (res)
+    uint32_t width = s.width ? s.width : format->width, height = s.height ? s.height : format->height;
+    if ((res = sb_image_init(image, width, height, format->channel_count)))
         return res;
     sb_image_set_channel_names(image, format->channel_names);
     sb_buffer_destroy(b->vk, &b->outputs[id]);
@@ -237,11 +343,23 @@ enum sb_result sb_atmosphere_bake(struct sb_atmosphere_baker *b, enum sb_product
     if ((res = sb_buffer_create(b->vk, bytes, sb_product_name(id), &b->outputs[id])))
         goto cleanup;
 
-    if ((res = run(b, shaders[id].words, shaders[id].size, sb_product_name(id), &b->outputs[id], format->width,
-                   format->height, prod->workgroup_per_texel, s.directions_mu, s.directions_phi, gpu_ms)))
+    const uint32_t *words = shaders[id].words;
+    size_t words_size = shaders[id].size;
+    if (id == SB_PRODUCT_TRANSMITTANCE) {
+        uint32_t variant = s.quadrature == SB_QUADRATURE_GAUSS_LEGENDRE ? s.samples : 0;
+        words = transmittance_shaders[variant].words;
+        words_size = transmittance_shaders[variant].size;
+    }
+    if ((res = run(b, words, words_size, sb_product_name(id), &b->outputs[id], width, height, prod->workgroup_per_texel,
+                   &s, gpu_ms)))
         goto cleanup;
     memcpy(image->data, b->outputs[id].mapped, bytes);
-    res = make_lookup(b, id, image);
+    /* A resolution other than the format's is a measurement: later bakes
+     * must not read it. */
+    if (width != format->width || height != format->height)
+        sb_buffer_destroy(b->vk, &b->outputs[id]);
+    else
+        res = make_lookup(b, id, image);
 
 cleanup:
     if (res)
@@ -263,7 +381,8 @@ enum sb_result sb_atmosphere_run_kernel(struct sb_atmosphere_baker *b, const uin
     uint32_t per_row = SB_WORKGROUP_X * 32;
     uint32_t width = record_count < per_row ? record_count : per_row;
     uint32_t height = (record_count + per_row - 1) / per_row;
-    res = run(b, spirv, spirv_size, "kernel", &io, width, height, false, record_count, record_floats, NULL);
+    struct sb_atmosphere_settings s = {.directions_mu = record_count, .directions_phi = record_floats};
+    res = run(b, spirv, spirv_size, "kernel", &io, width, height, false, &s, NULL);
     if (!res)
         memcpy(records, io.mapped, bytes);
     sb_buffer_destroy(b->vk, &io);
@@ -273,9 +392,18 @@ enum sb_result sb_atmosphere_run_kernel(struct sb_atmosphere_baker *b, const uin
 void sb_atmosphere_settings_json(enum sb_product_id id, const struct sb_atmosphere_settings *s, char *out, size_t size)
 {
     if (id == SB_PRODUCT_TRANSMITTANCE) {
-        snprintf(out, size,
-                 "{\"quadrature\":\"gauss-legendre-8, pieces cut at the ozone corners and the tangent fold\","
-                 "\"max_samples\":40}");
+        struct sb_atmosphere_settings t = resolve_settings(id, s);
+        if (t.quadrature == SB_QUADRATURE_GAUSS_LEGENDRE)
+            snprintf(out, size,
+                     "{\"quadrature\":\"gauss-legendre\",\"order\":%u,\"subdivisions\":%u,"
+                     "\"pieces\":\"cut at the ozone corners and the tangent fold\",\"max_samples\":%llu}",
+                     t.samples, t.subdivisions, (unsigned long long)sb_atmosphere_settings_cost(id, &t));
+        else
+            snprintf(out, size, "{\"quadrature\":\"%s\",\"steps\":%u,\"max_samples\":%llu}",
+                     t.quadrature == SB_QUADRATURE_TRAPEZOID  ? "trapezoid"
+                     : t.quadrature == SB_QUADRATURE_MIDPOINT ? "midpoint"
+                                                              : "uniform, offset 0.3",
+                     t.samples, (unsigned long long)sb_atmosphere_settings_cost(id, &t));
         return;
     }
     const char *zenith_cuts = id == SB_PRODUCT_IRRADIANCE_GROUND ? "the sun's mirror and the sun (upper hemisphere)"

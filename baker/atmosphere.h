@@ -17,11 +17,26 @@
 #include "physics.h"
 #include "scene.h"
 
-/* Settings of one product's bake. Zero fields take the product's defaults. */
+/* Settings of one product's bake. Zero fields take the product's defaults;
+ * fields a product does not use stay zero. */
 struct sb_atmosphere_settings {
-    uint32_t directions_mu;  /* Gauss-Legendre nodes in cos(zenith) per interval */
-    uint32_t directions_phi; /* azimuth nodes over [0, pi] */
+    uint32_t directions_mu;  /* scattering products: Gauss-Legendre nodes in cos(zenith) per piece */
+    uint32_t directions_phi; /* scattering products: azimuth nodes over [0, pi] */
+    uint32_t quadrature;     /* transmittance: SB_QUADRATURE_* (config.h) */
+    uint32_t samples;        /* transmittance: Gauss-Legendre order, or steps of a uniform rule */
+    uint32_t subdivisions;   /* transmittance, Gauss-Legendre: sub-pieces per piece */
+    uint32_t width, height;  /* transmittance: a resolution other than the format's, for
+                                measurements only (a pack holds the format's) */
 };
+
+/* Density samples a texel of the transmittance LUT takes at most, or the
+ * directions a texel of a scattering product integrates: the work a setting
+ * costs, independent of the device. */
+uint64_t sb_atmosphere_settings_cost(enum sb_product_id id, const struct sb_atmosphere_settings *settings);
+
+/* A short label of a setting, e.g. "gl8x1", "uniform0.3-40", "16x12". */
+void sb_atmosphere_settings_label(enum sb_product_id id, const struct sb_atmosphere_settings *settings, char *out,
+                                  size_t size);
 
 struct sb_atmosphere_product {
     enum sb_product_id id;

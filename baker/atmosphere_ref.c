@@ -159,7 +159,7 @@ void sb_ref_transmittance(const struct sb_atmosphere_params *p, double r, double
 {
     pthread_once(&gl_once, gl_init);
     double t_end = dist_top(p, r, mu);
-    double br[16];
+    double br[80];
     int n = 0;
     br[n++] = 0;
     double corners[3] = {p->ozone_center_km - p->ozone_half_width_km, p->ozone_center_km,
@@ -167,6 +167,13 @@ void sb_ref_transmittance(const struct sb_atmosphere_params *p, double r, double
     for (int k = 0; k < 3; k++)
         if (corners[k] > 0)
             n += level_crossings(p, r, mu, t_end, corners[k], br + n);
+    /* Deep in the exponential tails of a thick atmosphere, cut at 16 H x 2^k
+     * (the largest scale height H) too, so that the composite rule's
+     * pieces follow the density down. */
+    double thickness = p->top_radius_km - p->ground_radius_km;
+    double tail = 16.0 * fmax(p->rayleigh_scale_height_km, p->mie_scale_height_km);
+    for (int k = 0; k < 30 && tail < thickness; k++, tail *= 2.0)
+        n += level_crossings(p, r, mu, t_end, tail, br + n);
     if (-r * mu > 0 && -r * mu < t_end)
         br[n++] = -r * mu;
     br[n++] = t_end;
@@ -275,10 +282,8 @@ struct ray_sums {
     double t_end;
 };
 
-/* The sun's transmittance read from a baked LUT as the runtime reads it:
- * bilinear between texel centres, clamped at the edges. */
-static void lut_bilinear_transmittance(const struct sb_atmosphere_params *p, const struct sb_image *lut, double r,
-                                       double mu, double out[3])
+void sb_ref_transmittance_lookup(const struct sb_atmosphere_params *p, const struct sb_image *lut, double r, double mu,
+                                 double out[3])
 {
     double x_mu, x_r;
     sb_ref_transmittance_coords(p, r, mu, &x_mu, &x_r);
@@ -351,7 +356,7 @@ static void integrate_ray(const struct sb_atmosphere_params *p, double r0, doubl
             if (hits_ground(p, rt, mus)) {
                 sun[j][0] = sun[j][1] = sun[j][2] = 0;
             } else if (t_lut) {
-                lut_bilinear_transmittance(p, t_lut, fmax(rt, R), mus, sun[j]);
+                sb_ref_transmittance_lookup(p, t_lut, fmax(rt, R), mus, sun[j]);
             } else {
                 sb_ref_transmittance(p, fmax(rt, R), mus, q->transmittance_subdivisions, sun[j]);
             }
@@ -667,7 +672,20 @@ void sb_ref_sky_radiance(const struct sb_atmosphere_params *p, double h, double 
 {
     pthread_once(&gl_once, gl_init);
     struct sb_ref_quality q = resolve(quality);
-    double R = p->ground_radius_km, r = R + h;
+    double R = p->ground_radius_km, r = R + h, top = p->top_radius_km;
+    out[0] = out[1] = out[2] = 0.0;
+    if (r > top) {
+        /* From outside: start where the ray enters the atmosphere, or see
+         * black space where it misses it. */
+        double b = r * mu, disc = b * b - (r - top) * (r + top);
+        if (mu >= 0.0 || disc < 0.0)
+            return;
+        double t = (r - top) * (r + top) / (-b + sqrt(disc)); /* the nearer root, without cancellation */
+        double r_entry = top;
+        mu = fmin(1.0, (r * mu + t) / r_entry);
+        mu_s = fmax(-1.0, fmin(1.0, (r * mu_s + t * nu) / r_entry));
+        r = r_entry;
+    }
     bool ground = hits_ground(p, r, mu);
     struct ray_sums rs;
     integrate_ray(p, r, mu, mu_s, nu, ground, ms_lut, t_lut, &q, &rs);

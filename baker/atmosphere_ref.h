@@ -36,6 +36,11 @@ void sb_ref_transmittance_geometry(const struct sb_atmosphere_params *p, double 
 /* The inverse: unit coordinates of (r, mu), for a ray that does not hit the ground. */
 void sb_ref_transmittance_coords(const struct sb_atmosphere_params *p, double r, double mu, double *x_mu, double *x_r);
 
+/* A baked transmittance LUT (any size) read at (r, mu) as the runtime reads
+ * it: bilinear between texel centres, clamped at the edges; in fp64. */
+void sb_ref_transmittance_lookup(const struct sb_atmosphere_params *p, const struct sb_image *lut, double r, double mu,
+                                 double out[3]);
+
 /* Hillaire's psi_ms at altitude h (km) with sun cosine mu_s (see multiscattering.comp). */
 void sb_ref_multiscattering(const struct sb_atmosphere_params *p, double h, double mu_s, const struct sb_ref_quality *q,
                             double out[3]);
@@ -56,7 +61,8 @@ void sb_ref_irradiance_sky(const struct sb_atmosphere_params *p, double h, doubl
  * the baked psi_ms, and the lit ground (baked irradiance_ground) where the
  * ray ends on it; no sun disk. What skyview's sky-view LUT holds. The sun's
  * transmittance is integrated exactly when `transmittance` is NULL, else
- * read from that baked LUT bilinearly, as the runtime reads it. */
+ * read from that baked LUT bilinearly, as the runtime reads it. From above
+ * the atmosphere the ray starts where it enters it (0 where it misses). */
 void sb_ref_sky_radiance(const struct sb_atmosphere_params *p, double h, double mu, double mu_s, double nu,
                          const struct sb_image *transmittance, const struct sb_image *multiscattering,
                          const struct sb_image *irradiance_ground, const struct sb_ref_quality *q, double out[3]);

@@ -11,6 +11,7 @@
 #include <string.h>
 
 #include "bake.h"
+#include "bench.h"
 #include "context.h"
 #include "log.h"
 #include "scene.h"
@@ -25,26 +26,33 @@ enum {
 
 static void usage(FILE *f)
 {
-    fprintf(f,
-            "usage: skybake bake SCENE -o OUT_DIR [options]\n"
-            "       skybake --version | --help\n"
-            "\n"
-            "Bakes what SCENE (JSON, see docs/scene.md) needs into the pack OUT_DIR:\n"
-            "manifest.json plus one EXR per product. The pack is replaced atomically;\n"
-            "a failed bake leaves the previous pack as it was.\n"
-            "\n"
-            "options:\n"
-            "  -o, --output DIR    the pack to write (required)\n"
-            "  --device NAME|INDEX Vulkan device by index or name substring\n"
-            "                      (default: first discrete GPU, else the first device)\n"
-            "  --validate          enable Vulkan validation; any message fails the bake\n"
-            "                      (also SKYBAKE_VALIDATE=1)\n"
-            "  --json              print a machine-readable summary on stdout\n"
-            "  -q, --quiet         no per-product lines on stderr\n"
-            "  -v, --verbose       debug messages\n"
-            "\n"
-            "exit codes: 0 ok, 1 bake failed, 2 usage or scene error, 3 no Vulkan device,\n"
-            "            4 validation messages\n");
+    fprintf(f, "usage: skybake bake SCENE -o OUT_DIR [options]\n"
+               "       skybake bench [SCENE] [--product NAME]... [--json] [-o DIR] [--repeat N] [--quick]\n"
+               "       skybake --version | --help\n"
+               "\n"
+               "Bakes what SCENE (JSON, see docs/scene.md) needs into the pack OUT_DIR:\n"
+               "manifest.json plus one EXR per product. The pack is replaced atomically;\n"
+               "a failed bake leaves the previous pack as it was.\n"
+               "\n"
+               "options:\n"
+               "  -o, --output DIR    the pack to write (required)\n"
+               "  --device NAME|INDEX Vulkan device by index or name substring\n"
+               "                      (default: first discrete GPU, else the first device)\n"
+               "  --validate          enable Vulkan validation; any message fails the bake\n"
+               "                      (also SKYBAKE_VALIDATE=1)\n"
+               "  --json              print a machine-readable summary on stdout\n"
+               "  -q, --quiet         no per-product lines on stderr\n"
+               "  -v, --verbose       debug messages\n"
+               "\n"
+               "bench: speed against error for each product's settings, on the device,\n"
+               "against the fp64 reference (docs/accuracy.md). Products: transmittance,\n"
+               "transmittance_resolution, multiscattering, irradiance_ground, irradiance_sky\n"
+               "(default: all). -o DIR writes bench.csv, bench.json and bench.svg (gnuplot).\n"
+               "--repeat N bakes each setting N times (default 3) and reports the median;\n"
+               "--quick runs a short sweep (the meson benchmark).\n"
+               "\n"
+               "exit codes: 0 ok, 1 bake failed, 2 usage or scene error, 3 no Vulkan device,\n"
+               "            4 validation messages\n");
 }
 
 static void print_json(const char *out_dir, const struct sb_vk *vk, const struct sb_bake_report *report)
@@ -73,27 +81,42 @@ static void print_json(const char *out_dir, const struct sb_vk *vk, const struct
     cJSON_Delete(root);
 }
 
+/* The options bake and bench share; returns false for an unknown one. */
+static bool common_option(int argc, char **argv, int *i, struct sb_vk_params *vk_params, bool *json)
+{
+    const char *a = argv[*i];
+    if (!strcmp(a, "--device") && *i + 1 < argc)
+        vk_params->device = argv[++*i];
+    else if (!strcmp(a, "--validate"))
+        vk_params->validate = true;
+    else if (!strcmp(a, "--json"))
+        *json = true;
+    else if (!strcmp(a, "-q") || !strcmp(a, "--quiet"))
+        sb_log_set_level(SB_LOG_WARN);
+    else if (!strcmp(a, "-v") || !strcmp(a, "--verbose"))
+        sb_log_set_level(SB_LOG_DEBUG);
+    else
+        return false;
+    return true;
+}
+
+static bool validate_from_env(void)
+{
+    const char *env = getenv("SKYBAKE_VALIDATE");
+    return env && *env && strcmp(env, "0") != 0;
+}
+
 static int cmd_bake(int argc, char **argv)
 {
-    const char *scene_path = NULL, *out_dir = NULL, *device = NULL;
-    bool validate = false, json = false;
-    const char *env = getenv("SKYBAKE_VALIDATE");
-    if (env && *env && strcmp(env, "0") != 0)
-        validate = true;
+    const char *scene_path = NULL, *out_dir = NULL;
+    struct sb_vk_params params = {.validate = validate_from_env()};
+    bool json = false;
     for (int i = 0; i < argc; i++) {
         const char *a = argv[i];
+        if (common_option(argc, argv, &i, &params, &json))
+            continue;
         if ((!strcmp(a, "-o") || !strcmp(a, "--output")) && i + 1 < argc)
             out_dir = argv[++i];
-        else if (!strcmp(a, "--device") && i + 1 < argc)
-            device = argv[++i];
-        else if (!strcmp(a, "--validate"))
-            validate = true;
-        else if (!strcmp(a, "--json"))
-            json = true;
-        else if (!strcmp(a, "-q") || !strcmp(a, "--quiet"))
-            sb_log_set_level(SB_LOG_WARN);
-        else if (!strcmp(a, "-v") || !strcmp(a, "--verbose"))
-            sb_log_set_level(SB_LOG_DEBUG);
         else if (a[0] == '-' && a[1]) {
             fprintf(stderr, "skybake: unknown or incomplete option '%s'\n", a);
             usage(stderr);
@@ -116,7 +139,6 @@ static int cmd_bake(int argc, char **argv)
         return EXIT_USAGE;
 
     struct sb_vk *vk = NULL;
-    struct sb_vk_params params = {.device = device, .validate = validate};
     enum sb_result res = sb_vk_create(&params, &vk);
     if (res)
         return res == SB_ERR_NO_DEVICE ? EXIT_NO_DEVICE : EXIT_BAKE_FAILED;
@@ -131,13 +153,87 @@ static int cmd_bake(int argc, char **argv)
     sb_vk_destroy(&vk);
     if (res) {
         sb_error("bake failed (%s); %s was left as it was", sb_result_name(res), out_dir);
-        return EXIT_BAKE_FAILED;
+        return res == SB_ERR_TOLERANCE ? EXIT_USAGE : EXIT_BAKE_FAILED;
     }
     if (messages) {
         sb_error("%u validation message(s) during the bake", messages);
         return EXIT_VALIDATION;
     }
     sb_info("wrote %s (%d artifacts)", out_dir, report.artifact_count);
+    return 0;
+}
+
+static int cmd_bench(int argc, char **argv)
+{
+    const char *scene_path = NULL, *out_dir = NULL;
+    struct sb_vk_params vk_params = {.validate = validate_from_env()};
+    struct sb_bench_params params = {.repeat = 3};
+    bool json = false, any = false;
+    for (int i = 0; i < argc; i++) {
+        const char *a = argv[i];
+        enum sb_bench_sweep sweep;
+        if (common_option(argc, argv, &i, &vk_params, &json))
+            continue;
+        if ((!strcmp(a, "-o") || !strcmp(a, "--output")) && i + 1 < argc) {
+            out_dir = argv[++i];
+        } else if (!strcmp(a, "--product") && i + 1 < argc) {
+            if (!sb_bench_sweep_from_name(argv[++i], &sweep)) {
+                fprintf(stderr, "skybake: bench: unknown product '%s'\n", argv[i]);
+                return EXIT_USAGE;
+            }
+            params.sweeps[sweep] = any = true;
+        } else if (!strcmp(a, "--repeat") && i + 1 < argc) {
+            char *end;
+            long n = strtol(argv[++i], &end, 10);
+            if (*end || n < 1 || n > 1000) {
+                fprintf(stderr, "skybake: bench: --repeat takes 1 to 1000\n");
+                return EXIT_USAGE;
+            }
+            params.repeat = (int)n;
+        } else if (!strcmp(a, "--quick")) {
+            params.quick = true;
+        } else if (a[0] == '-' && a[1]) {
+            fprintf(stderr, "skybake: unknown or incomplete option '%s'\n", a);
+            usage(stderr);
+            return EXIT_USAGE;
+        } else if (!scene_path) {
+            scene_path = a;
+        } else {
+            fprintf(stderr, "skybake: unexpected argument '%s'\n", a);
+            return EXIT_USAGE;
+        }
+    }
+    if (!any)
+        for (int w = 0; w < SB_BENCH_SWEEP_COUNT; w++)
+            params.sweeps[w] = true;
+    struct sb_scene scene = {0};
+    if (scene_path && sb_scene_load(scene_path, &scene))
+        return EXIT_USAGE;
+    if (!scene_path)
+        sb_atmosphere_preset_earth(&scene.atmosphere);
+
+    struct sb_vk *vk = NULL;
+    enum sb_result res = sb_vk_create(&vk_params, &vk);
+    if (res)
+        return res == SB_ERR_NO_DEVICE ? EXIT_NO_DEVICE : EXIT_BAKE_FAILED;
+    sb_info("skybake %s: bench of %s on %s (%s)", SKYBAKE_VERSION, scene_path ? scene_path : "the earth preset",
+            vk->properties.deviceName, vk->driver_name);
+    struct sb_bench_report report;
+    res = sb_bench_run(vk, &scene.atmosphere, &params, &report);
+    if (!res) {
+        sb_bench_print(&report, vk, json);
+        if (out_dir)
+            res = sb_bench_write(&report, vk, out_dir);
+    }
+    unsigned messages = sb_vk_validation_messages(vk);
+    sb_bench_report_finish(&report);
+    sb_vk_destroy(&vk);
+    if (res)
+        return EXIT_BAKE_FAILED;
+    if (messages) {
+        sb_error("%u validation message(s) during the bench", messages);
+        return EXIT_VALIDATION;
+    }
     return 0;
 }
 
@@ -157,6 +253,8 @@ int main(int argc, char **argv)
     }
     if (!strcmp(argv[1], "bake"))
         return cmd_bake(argc - 2, argv + 2);
+    if (!strcmp(argv[1], "bench"))
+        return cmd_bench(argc - 2, argv + 2);
     fprintf(stderr, "skybake: unknown command '%s'\n", argv[1]);
     usage(stderr);
     return EXIT_USAGE;

@@ -23,6 +23,7 @@ static const char *const result_names[SB_RESULT_COUNT] = {
     [SB_ERR_VERSION] = "version",
     [SB_ERR_HASH_MISMATCH] = "hash-mismatch",
     [SB_ERR_UNSAFE_PATH] = "unsafe-path",
+    [SB_ERR_TOLERANCE] = "tolerance",
 };
 
 const char *sb_result_name(enum sb_result result)

@@ -29,6 +29,7 @@ enum sb_result {
     SB_ERR_VERSION,         /* a pack of a format version this build does not read: rebake needed */
     SB_ERR_HASH_MISMATCH,   /* an artifact's content differs from the hash its manifest records */
     SB_ERR_UNSAFE_PATH,     /* a path that leaves the pack or goes through a symbolic link */
+    SB_ERR_TOLERANCE,       /* no setting of a product reaches the scene's tolerance */
     SB_RESULT_COUNT,
 };
 

@@ -32,6 +32,38 @@ void sb_atmosphere_preset_earth(struct sb_atmosphere_params *p)
     };
 }
 
+void sb_atmosphere_preset_mars(struct sb_atmosphere_params *p)
+{
+    /* Illustrative, not a validated model of Mars: CO2 at ~0.8% of Earth's
+     * surface number density with 2.5x air's cross-section; dust of visible
+     * optical depth 0.5 over an 11 km scale height, single-scattering albedo
+     * 0.97 / 0.93 / 0.76 and asymmetry 0.65 (Wolff et al.'s order of
+     * magnitude); no ozone; a reddish ground. */
+    *p = (struct sb_atmosphere_params){
+        .ground_radius_km = 3389.5,
+        .top_radius_km = 3389.5 + 80.0,
+        .rayleigh_scattering_per_km = {1.16e-4, 2.71e-4, 6.62e-4},
+        .rayleigh_scale_height_km = 11.1,
+        .mie_scattering_per_km = {0.0437, 0.0419, 0.0342},
+        .mie_absorption_per_km = {0.0013, 0.0032, 0.0108},
+        .mie_scale_height_km = 11.0,
+        .mie_g = 0.65,
+        .ozone_absorption_per_km = {0.0, 0.0, 0.0},
+        .ozone_center_km = 25.0,
+        .ozone_half_width_km = 15.0,
+        .ground_albedo = {0.35, 0.22, 0.13},
+        .solar_irradiance = {1.0, 1.0, 1.0},
+    };
+}
+
+static const struct {
+    const char *name;
+    void (*fill)(struct sb_atmosphere_params *p);
+} presets[] = {
+    {"earth", sb_atmosphere_preset_earth},
+    {"mars", sb_atmosphere_preset_mars},
+};
+
 /* ---- Field table: one row per atmosphere key ------------------------------------- */
 
 enum field_kind { FIELD_SCALAR, FIELD_RGB };
@@ -171,20 +203,23 @@ static enum sb_result parse_atmosphere(const cJSON *obj, struct sb_scene *scene,
         return res;
     const cJSON *preset = cJSON_GetObjectItemCaseSensitive(obj, "preset");
     if (!preset) {
-        sb_error("%s: atmosphere.preset: missing (known presets: \"earth\")", source);
+        sb_error("%s: atmosphere.preset: missing (known presets: \"earth\", \"mars\")", source);
         return SB_ERR_MISSING_FIELD;
     }
     if (!cJSON_IsString(preset)) {
         sb_error("%s: atmosphere.preset: expected a string", source);
         return SB_ERR_WRONG_TYPE;
     }
-    if (strcmp(preset->valuestring, "earth") != 0) {
-        sb_error("%s: atmosphere.preset: unknown preset \"%s\" (known presets: \"earth\")", source,
+    size_t known = 0;
+    while (known < sizeof(presets) / sizeof(presets[0]) && strcmp(preset->valuestring, presets[known].name))
+        known++;
+    if (known == sizeof(presets) / sizeof(presets[0])) {
+        sb_error("%s: atmosphere.preset: unknown preset \"%s\" (known presets: \"earth\", \"mars\")", source,
                  preset->valuestring);
         return SB_ERR_UNKNOWN_PRESET;
     }
     snprintf(scene->preset, sizeof(scene->preset), "%s", preset->valuestring);
-    sb_atmosphere_preset_earth(&scene->atmosphere);
+    presets[known].fill(&scene->atmosphere);
 
     for (const cJSON *item = obj->child; item; item = item->next) {
         if (strcmp(item->string, "preset") == 0)
@@ -234,6 +269,96 @@ static enum sb_result parse_products(const cJSON *arr, struct sb_scene *scene, c
     return SB_OK;
 }
 
+static enum sb_result tolerance_value(const cJSON *item, const char *source, const char *path, double *out)
+{
+    if (!cJSON_IsNumber(item)) {
+        sb_error("%s: %s: expected a number (a relative error)", source, path);
+        return SB_ERR_WRONG_TYPE;
+    }
+    double v = item->valuedouble;
+    if (!isfinite(v) || v < SB_TOLERANCE_MIN || v > SB_TOLERANCE_MAX) {
+        sb_error("%s: %s: %.17g is out of range, expected a relative error in [%g, %g] (fp32 cannot do better "
+                 "than the first)",
+                 source, path, v, SB_TOLERANCE_MIN, SB_TOLERANCE_MAX);
+        return SB_ERR_OUT_OF_RANGE;
+    }
+    *out = v;
+    return SB_OK;
+}
+
+/* "tolerance": a number for every product, or an object of product names. */
+static enum sb_result parse_tolerance(const cJSON *item, struct sb_scene *scene, const char *source)
+{
+    if (cJSON_IsNumber(item)) {
+        double v;
+        enum sb_result res = tolerance_value(item, source, "tolerance", &v);
+        for (int p = 0; p < SB_PRODUCT_COUNT && !res; p++)
+            scene->tolerance[p] = v;
+        return res;
+    }
+    if (!cJSON_IsObject(item)) {
+        sb_error("%s: tolerance: expected a number or an object of product names", source);
+        return SB_ERR_WRONG_TYPE;
+    }
+    enum sb_result res = sb_json_check_duplicates(item, source, "tolerance");
+    if (res)
+        return res;
+    for (const cJSON *t = item->child; t; t = t->next) {
+        enum sb_product_id id;
+        char path[96];
+        snprintf(path, sizeof(path), "tolerance.%s", t->string);
+        if (!sb_product_from_name(t->string, &id)) {
+            sb_error("%s: %s: unknown product", source, path);
+            return SB_ERR_UNKNOWN_PRODUCT;
+        }
+        if ((res = tolerance_value(t, source, path, &scene->tolerance[id])))
+            return res;
+    }
+    if (!item->child) {
+        sb_error("%s: tolerance: empty; leave the key out for the default settings", source);
+        return SB_ERR_OUT_OF_RANGE;
+    }
+    return SB_OK;
+}
+
+static enum sb_result view_number(const cJSON *obj, const char *key, double lo, double hi, const char *source,
+                                  double *out)
+{
+    const cJSON *item = cJSON_GetObjectItemCaseSensitive(obj, key);
+    if (!item)
+        return SB_OK;
+    if (!cJSON_IsNumber(item)) {
+        sb_error("%s: view.%s: expected a number", source, key);
+        return SB_ERR_WRONG_TYPE;
+    }
+    if (!isfinite(item->valuedouble) || item->valuedouble < lo || item->valuedouble > hi) {
+        sb_error("%s: view.%s: %.17g is out of range, expected %g to %g", source, key, item->valuedouble, lo, hi);
+        return SB_ERR_OUT_OF_RANGE;
+    }
+    *out = item->valuedouble;
+    return SB_OK;
+}
+
+static enum sb_result parse_view(const cJSON *obj, struct sb_scene *scene, const char *source)
+{
+    if (!cJSON_IsObject(obj)) {
+        sb_error("%s: view: expected an object", source);
+        return SB_ERR_WRONG_TYPE;
+    }
+    enum sb_result res = sb_json_check_duplicates(obj, source, "view");
+    for (const cJSON *item = obj->child; item && !res; item = item->next)
+        if (strcmp(item->string, "altitude_km") && strcmp(item->string, "sun_elevation_deg")) {
+            sb_error("%s: view.%s: unknown key (altitude_km, sun_elevation_deg)", source, item->string);
+            res = SB_ERR_UNKNOWN_KEY;
+        }
+    if (!res)
+        res = view_number(obj, "altitude_km", 0.0, 1e6, source, &scene->view.altitude_km);
+    if (!res)
+        res = view_number(obj, "sun_elevation_deg", -90.0, 90.0, source, &scene->view.sun_elevation_deg);
+    scene->has_view = true;
+    return res;
+}
+
 static enum sb_result parse_root(const cJSON *root, struct sb_scene *scene, const char *source)
 {
     if (!cJSON_IsObject(root)) {
@@ -244,6 +369,7 @@ static enum sb_result parse_root(const cJSON *root, struct sb_scene *scene, cons
     if (res)
         return res;
     bool have_atmosphere = false, have_products = false;
+    scene->view = (struct sb_scene_view){.altitude_km = 0.002, .sun_elevation_deg = 30.0};
     for (const cJSON *item = root->child; item; item = item->next) {
         if (strcmp(item->string, "version") == 0) {
             if (!cJSON_IsNumber(item)) {
@@ -272,6 +398,12 @@ static enum sb_result parse_root(const cJSON *root, struct sb_scene *scene, cons
             if ((res = parse_products(item, scene, source)))
                 return res;
             have_products = true;
+        } else if (strcmp(item->string, "view") == 0) {
+            if ((res = parse_view(item, scene, source)))
+                return res;
+        } else if (strcmp(item->string, "tolerance") == 0) {
+            if ((res = parse_tolerance(item, scene, source)))
+                return res;
         } else {
             sb_error("%s: %s: unknown key (see docs/scene.md for the schema)", source, item->string);
             return SB_ERR_UNKNOWN_KEY;
@@ -340,6 +472,20 @@ char *sb_scene_normalized_json(const struct sb_scene *scene)
     for (int p = 0; p < SB_PRODUCT_COUNT; p++)
         if (scene->wants[p])
             cJSON_AddItemToArray(products, cJSON_CreateString(sb_product_name((enum sb_product_id)p)));
+    /* Only when given, so that scenes without them keep their hashes. */
+    if (scene->has_view) {
+        cJSON *view = cJSON_AddObjectToObject(root, "view");
+        cJSON_AddNumberToObject(view, "altitude_km", scene->view.altitude_km);
+        cJSON_AddNumberToObject(view, "sun_elevation_deg", scene->view.sun_elevation_deg);
+    }
+    cJSON *tolerance = NULL;
+    for (int p = 0; p < SB_PRODUCT_COUNT; p++) {
+        if (scene->tolerance[p] <= 0)
+            continue;
+        if (!tolerance)
+            tolerance = cJSON_AddObjectToObject(root, "tolerance");
+        cJSON_AddNumberToObject(tolerance, sb_product_name((enum sb_product_id)p), scene->tolerance[p]);
+    }
     out = cJSON_PrintUnformatted(root);
 done:
     cJSON_Delete(root);

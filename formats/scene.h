@@ -31,16 +31,34 @@ struct sb_atmosphere_params {
     double solar_irradiance[3]; /* 1 makes every product a transfer function */
 };
 
+/* Where the scene's sky is looked at from, by default: skyview's camera and
+ * the sky checks of the tests. Not used by the bakes. */
+struct sb_scene_view {
+    double altitude_km;       /* the camera above the ground, [0, 1e6] */
+    double sun_elevation_deg; /* the sun above the horizon, [-90, 90] */
+};
+
 struct sb_scene {
     char name[64];
     char preset[32];
     struct sb_atmosphere_params atmosphere;
     /* Products the scene asks for, before dependencies are pulled in. */
     bool wants[SB_PRODUCT_COUNT];
+    /* Largest relative error against the fp64 reference each product may
+     * have (0: none asked; the product's default settings). */
+    double tolerance[SB_PRODUCT_COUNT];
+    bool has_view;
+    struct sb_scene_view view; /* 2 m up, the sun at 30 degrees unless the scene says */
 };
+
+/* Tolerances a scene may ask for: [SB_TOLERANCE_MIN, SB_TOLERANCE_MAX]. */
+#define SB_TOLERANCE_MIN 1e-7
+#define SB_TOLERANCE_MAX 0.5
 
 /* Hillaire 2020's Earth. */
 void sb_atmosphere_preset_earth(struct sb_atmosphere_params *params);
+/* A thin, dusty Mars-like atmosphere (illustrative values, see scene.c). */
+void sb_atmosphere_preset_mars(struct sb_atmosphere_params *params);
 
 /* Read and validate a scene file. On failure the scene is left zeroed. */
 enum sb_result sb_scene_load(const char *path, struct sb_scene *scene);

@@ -76,12 +76,16 @@ float phase_rayleigh(float nu)
     return 3.0 / (16.0 * PI) * (1.0 + nu * nu);
 }
 
-/* Cornette-Shanks, as in Bruneton 2017. */
+/* Cornette-Shanks, as in Bruneton 2017. Its denominator 1 + g^2 - 2 g nu
+ * is written as (1 - |g|)^2 + 2 |g| (1 -+ nu): at its peak (nu = +-1 with
+ * |g| = 0.999 it is 1e-6) the plain form cancels to fp32 rounding of 2 and
+ * lost 30% of the peak, differently with and without FMA contraction. */
 float phase_mie(float nu)
 {
-    float g = atm.mie_extinction.w;
+    float g = atm.mie_extinction.w, ag = abs(g);
     float k = 3.0 / (8.0 * PI) * (1.0 - g * g) / (2.0 + g * g);
-    return k * (1.0 + nu * nu) / pow(max(1.0 + g * g - 2.0 * g * nu, 1e-12), 1.5);
+    float denom = (1.0 - ag) * (1.0 - ag) + 2.0 * ag * (g >= 0.0 ? 1.0 - nu : 1.0 + nu);
+    return k * (1.0 + nu * nu) / pow(max(denom, 1e-12), 1.5);
 }
 
 /* ---- Geometry ---------------------------------------------------------------- */
@@ -131,9 +135,43 @@ float altitude_along(float h0, float mu, float t)
  * horizon where d itself would cancel.
  */
 
-/* Gauss-Legendre 8 on [-1, 1], positive half (nodes come in +- pairs). */
-const float GL8_X[4] = float[4](0.1834346424956498, 0.5255324099163290, 0.7966664774136267, 0.9602898564975363);
-const float GL8_W[4] = float[4](0.3626837833783620, 0.3137066458778873, 0.2223810344533745, 0.1012285362903763);
+/*
+ * Gauss-Legendre of order SB_TRANSMITTANCE_GL_ORDER (1 to 8, default 8) for
+ * the transmittance integral: the non-negative nodes on [-1, 1] ascending and
+ * their weights (an odd order's first node is 0). The order is fixed when a
+ * shader is compiled, so the loops over these small tables unroll.
+ */
+#ifndef SB_TRANSMITTANCE_GL_ORDER
+#define SB_TRANSMITTANCE_GL_ORDER 8
+#endif
+#define SB_GL_HALF ((SB_TRANSMITTANCE_GL_ORDER + 1) / 2)
+#if SB_TRANSMITTANCE_GL_ORDER == 1
+const float GL_X[1] = float[1](0.0);
+const float GL_W[1] = float[1](2.0);
+#elif SB_TRANSMITTANCE_GL_ORDER == 2
+const float GL_X[1] = float[1](0.5773502691896258);
+const float GL_W[1] = float[1](1.0);
+#elif SB_TRANSMITTANCE_GL_ORDER == 3
+const float GL_X[2] = float[2](0.0, 0.7745966692414834);
+const float GL_W[2] = float[2](0.888888888888889, 0.5555555555555556);
+#elif SB_TRANSMITTANCE_GL_ORDER == 4
+const float GL_X[2] = float[2](0.3399810435848563, 0.8611363115940526);
+const float GL_W[2] = float[2](0.6521451548625461, 0.3478548451374539);
+#elif SB_TRANSMITTANCE_GL_ORDER == 5
+const float GL_X[3] = float[3](0.0, 0.5384693101056831, 0.906179845938664);
+const float GL_W[3] = float[3](0.5688888888888889, 0.4786286704993665, 0.2369268850561891);
+#elif SB_TRANSMITTANCE_GL_ORDER == 6
+const float GL_X[3] = float[3](0.2386191860831969, 0.6612093864662645, 0.932469514203152);
+const float GL_W[3] = float[3](0.467913934572691, 0.3607615730481386, 0.1713244923791703);
+#elif SB_TRANSMITTANCE_GL_ORDER == 7
+const float GL_X[4] = float[4](0.0, 0.4058451513773972, 0.7415311855993943, 0.9491079123427585);
+const float GL_W[4] = float[4](0.4179591836734694, 0.3818300505051189, 0.2797053914892767, 0.1294849661688697);
+#elif SB_TRANSMITTANCE_GL_ORDER == 8
+const float GL_X[4] = float[4](0.1834346424956498, 0.525532409916329, 0.7966664774136267, 0.9602898564975362);
+const float GL_W[4] = float[4](0.362683783378362, 0.3137066458778873, 0.2223810344533745, 0.1012285362903763);
+#else
+#error SB_TRANSMITTANCE_GL_ORDER must be 1 to 8
+#endif
 
 /* Altitude along an ascending path from a base point (altitude hb, radius rb)
  * whose ray has tangential offset sb >= 0: r(t)^2 = rb^2 + t^2 + 2 sb t. */
@@ -150,76 +188,147 @@ float path_distance_to_level(float hb, float sb, float level)
     return c / (sb + sqrt(sb * sb + c));
 }
 
-vec3 path_segment_depth(float hb, float rb, float sb, float t0, float t1)
+/* Optical depth of the path between t0 and t1 by Gauss-Legendre on each of
+ * `subdivisions` equal pieces; nodes in +- pairs around each piece's middle. */
+vec3 path_segment_depth(float hb, float rb, float sb, float t0, float t1, int subdivisions)
 {
-    float half_len = 0.5 * (t1 - t0), mid = 0.5 * (t0 + t1);
+    const bool odd = (SB_TRANSMITTANCE_GL_ORDER & 1) != 0;
+    float step = (t1 - t0) / float(subdivisions);
     vec3 sum = vec3(0.0);
-    for (int i = 0; i < 4; i++) {
-        float dt = half_len * GL8_X[i];
-        sum += GL8_W[i] * (extinction_at(path_altitude(hb, rb, sb, mid - dt))
-                           + extinction_at(path_altitude(hb, rb, sb, mid + dt)));
+    for (int k = 0; k < subdivisions; k++) {
+        float half_len = 0.5 * step, mid = t0 + (float(k) + 0.5) * step;
+        vec3 piece = odd ? GL_W[0] * extinction_at(path_altitude(hb, rb, sb, mid)) : vec3(0.0);
+        for (int i = odd ? 1 : 0; i < SB_GL_HALF; i++) {
+            float dt = half_len * GL_X[i];
+            piece += GL_W[i] * (extinction_at(path_altitude(hb, rb, sb, mid - dt))
+                                + extinction_at(path_altitude(hb, rb, sb, mid + dt)));
+        }
+        sum += piece * half_len;
     }
-    return sum * half_len;
+    return sum;
 }
 
 /*
- * Optical depth from a point to the top of the atmosphere along a ray that
- * does not hit the ground, given rho (horizon distance of the point) and
- * e = d_max - d. A downward ray is folded at its tangent point: the part
- * below the start altitude is traversed twice. The ascending path is cut at
- * the ozone tent's corners (the only kinks of the integrand) and at the fold,
- * at most five pieces, each integrated by 8-point Gauss-Legendre: at most
- * 40 density samples.
+ * The ray of the transmittance LUT given rho (horizon distance of its
+ * origin) and e = d_max - d, as an ascending path: a downward ray is folded
+ * at its tangent point, whose altitude hb, radius rb it starts from (sb = 0)
+ * after running `fold` down to it; an upward ray starts at its origin (fold
+ * 0, sb = r mu). Returns the path's length above the base, t_end; the ray's
+ * length is fold + t_end. Returns -1 for an empty ray (at the top, looking
+ * along it or up).
  */
-vec3 optical_depth_to_top(float rho, float e)
+float transmittance_path(float rho, float e, out float hb, out float rb, out float sb, out float fold)
 {
     float R = ground_radius(), H = horizon_top();
     float r = sqrt(rho * rho + R * R);
     float d = rho + H - e;
-    if (d <= 0.0) /* at the top, looking along it or up */
-        return vec3(0.0);
+    hb = rb = sb = fold = 0.0;
+    if (d <= 0.0)
+        return -1.0;
     float s0 = ((2.0 * (H + rho)) * (e - rho) - e * e) / (2.0 * d); /* r mu */
-    float hb, rb, sb, fold = 0.0, t_end;
     if (s0 < 0.0) {
         float del = e * (2.0 * H - e) / (2.0 * d); /* rho + s0, exactly */
         float q = max((2.0 * rho - del) * del, 0.0); /* r_min^2 - R^2 */
         rb = sqrt(R * R + q);
         hb = q / (rb + R);
-        sb = 0.0;
         fold = -s0;
-        t_end = d + s0;
-    } else {
-        hb = rho * rho / (r + R);
-        rb = r;
-        sb = s0;
-        t_end = d;
+        return d + s0;
     }
+    hb = rho * rho / (r + R);
+    rb = r;
+    sb = s0;
+    return d;
+}
 
-    /* Walk up the path from boundary to boundary: the ozone corners above
-     * the base (ascending, so their distances are too) and, for a folded
-     * ray, the fold itself, taken by distance since it may lie a fraction
-     * of a metre above the base. No sorting and no local arrays. */
+/*
+ * The next altitude above a (km) where the transmittance integral is cut:
+ * the ozone tent's corners (the only kinks of the integrand), and in a
+ * thick atmosphere altitudes 16 H, 32 H, 64 H ... of the largest scale
+ * height H, so that no piece spans more than half its altitude of an
+ * exponential tail (an atmosphere as thick as its planet needs them: 1% of
+ * error without; the earth's, 100 km thick with H = 8 km, has none).
+ */
+float next_boundary(float a)
+{
     float centre = atm.ozone_absorption.w, half_width = atm.ground_albedo.w;
-    int corner = 0;
-    while (corner < 3 && centre + float(corner - 1) * half_width <= hb)
-        corner++;
+    float best = 3.0e38;
+    for (int k = -1; k <= 1; k++) {
+        float level = centre + float(k) * half_width;
+        if (level > a)
+            best = min(best, level);
+    }
+    float level = 16.0 * max(atm.rayleigh_scattering.w, atm.mie_scattering.w);
+    for (int k = 0; k < 32 && level <= a; k++)
+        level *= 2.0;
+    return level > a ? min(best, level) : best;
+}
+
+/*
+ * Optical depth to the top along a ray that does not hit the ground, by
+ * Gauss-Legendre: the ascending path is cut at next_boundary's altitudes
+ * and at the fold (the part below the start altitude is traversed twice),
+ * each piece integrated by Gauss-Legendre of SB_TRANSMITTANCE_GL_ORDER on
+ * `subdivisions` sub-pieces. On the earth the defaults (8, 1) take at most
+ * 40 density samples (five pieces).
+ */
+vec3 optical_depth_to_top_gl(float rho, float e, int subdivisions)
+{
+    float hb, rb, sb, fold;
+    float t_end = transmittance_path(rho, e, hb, rb, sb, fold);
+    if (t_end < 0.0)
+        return vec3(0.0);
+
+    /* Walk up the path from boundary to boundary (next_boundary) and, for a
+     * folded ray, the fold itself, taken by distance since it may lie a
+     * fraction of a metre above the base. No sorting and no local arrays. */
     vec3 tau = vec3(0.0);
-    float t0 = 0.0;
-    for (int piece = 0; piece < 5 && t0 < t_end; piece++) {
-        float level = centre + float(corner - 1) * half_width;
-        float t1 = corner < 3 && level < atmosphere_thickness() ? min(path_distance_to_level(hb, sb, level), t_end)
-                                                                  : t_end;
-        if (fold > t0 && fold < t1)
+    float t0 = 0.0, a0 = hb;
+    for (int piece = 0; piece < SB_TRANSMITTANCE_MAX_PIECES && t0 < t_end; piece++) {
+        float level = next_boundary(a0);
+        float t1 = level < atmosphere_thickness() ? min(path_distance_to_level(hb, sb, level), t_end) : t_end;
+        if (fold > t0 && fold < t1) {
             t1 = fold;
-        else
-            corner++;
+            a0 = path_altitude(hb, rb, sb, fold);
+        } else {
+            a0 = level;
+        }
         if (t1 > t0) {
-            vec3 depth = path_segment_depth(hb, rb, sb, t0, t1);
+            vec3 depth = path_segment_depth(hb, rb, sb, t0, t1, subdivisions);
             tau += t1 <= fold ? 2.0 * depth : depth;
         }
         t0 = t1;
     }
     return tau;
+}
+
+vec3 optical_depth_to_top(float rho, float e)
+{
+    return optical_depth_to_top_gl(rho, e, 1);
+}
+
+/*
+ * The same by a rule of `steps` equally spaced samples over the whole ray
+ * (length fold + t_end), as the published bakes integrate it: sampled at
+ * `offset` of each step (Hillaire 2020: 0.3, 40 steps; the midpoint rule:
+ * 0.5), or by the trapezoidal rule when `trapezoid` (Bruneton 2017: 500
+ * steps). Positions come from the same folded path, so only the quadrature
+ * differs from optical_depth_to_top_gl.
+ */
+vec3 optical_depth_to_top_uniform(float rho, float e, int steps, float offset, bool trapezoid)
+{
+    float hb, rb, sb, fold;
+    float t_end = transmittance_path(rho, e, hb, rb, sb, fold);
+    if (t_end < 0.0)
+        return vec3(0.0);
+    float length_ = fold + t_end, dt = length_ / float(steps);
+    vec3 sum = vec3(0.0);
+    int count = trapezoid ? steps + 1 : steps;
+    for (int i = 0; i < count; i++) {
+        float t = trapezoid ? float(i) * dt : (float(i) + offset) * dt;
+        float weight = trapezoid && (i == 0 || i == steps) ? 0.5 : 1.0;
+        sum += weight * extinction_at(path_altitude(hb, rb, sb, abs(t - fold)));
+    }
+    return sum * dt;
 }
 
 /* The transmittance LUT's coordinates in unit range for a point and direction

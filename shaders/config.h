@@ -37,6 +37,7 @@
  * (sphere.glsl): three of the ground, four of the sky, cut again at the
  * sun and at its mirror image. */
 #define SB_MAX_DIRECTIONS_MU 64
+#define SB_MAX_DIRECTIONS_PHI 256
 #define SB_SPHERE_MAX_PIECES 9
 
 /* Every atmosphere bake pipeline has the same descriptor set layout: six
@@ -97,8 +98,32 @@ struct sb_bake_push {
     SB_UINT step_begin;     /* sphere.glsl: this pass's steps, [begin, end) of */
     SB_UINT step_end;       /* SB_SPHERE_THREADS directions each */
     SB_UINT step_count;     /* steps of the whole integral */
-    SB_UINT pad;
+    SB_UINT quadrature;     /* transmittance: SB_QUADRATURE_* */
+    SB_UINT samples;        /* transmittance: steps of a uniform rule (a Gauss-Legendre order is compiled in) */
+    SB_UINT subdivisions;   /* transmittance, Gauss-Legendre: equal sub-pieces per piece */
 };
+
+/* Quadratures of the transmittance bake (sb_bake_push.quadrature):
+ * Gauss-Legendre of order `samples` (1 to SB_GL_MAX_ORDER) on the pieces
+ * between the integrand's kinks, each cut into `subdivisions`; or a uniform
+ * rule of `samples` steps over the whole ray, sampled at offset 0.3 of each
+ * step (Hillaire 2020's code) or at its middle, or the trapezoidal rule
+ * (Bruneton 2017's code). The uniform rules exist to measure the published
+ * settings against ours (skybake bench). Each Gauss-Legendre order is its
+ * own shader (transmittance_glN), so that its loops unroll with their node
+ * tables: indexing them by a value known only at run time costs llvmpipe
+ * 50x, and specialisation constants do not fold early enough there. */
+#define SB_QUADRATURE_GAUSS_LEGENDRE 0
+#define SB_QUADRATURE_UNIFORM_0_3 1
+#define SB_QUADRATURE_MIDPOINT 2
+#define SB_QUADRATURE_TRAPEZOID 3
+#define SB_QUADRATURE_COUNT 4
+#define SB_GL_MAX_ORDER 8
+/* Pieces of a transmittance ray at most: three ozone corners, the fold, the
+ * end, and up to 16 tail levels of a thick atmosphere (atmosphere.glsl). */
+#define SB_TRANSMITTANCE_MAX_PIECES 21
+#define SB_GL_MAX_SUBDIVISIONS 16
+#define SB_UNIFORM_MAX_STEPS 4096
 
 /* ---- skyview ------------------------------------------------------------------ */
 /*

@@ -1,8 +1,14 @@
 #version 450
-/* Transmittance to the top of the atmosphere, 256x64 RGB fp32 (Hillaire 2020
- * parameterisation, see atmosphere.glsl). At most 40 density samples a texel. */
+/* Transmittance to the top of the atmosphere, RGB fp32 (Hillaire 2020
+ * parameterisation, see atmosphere.glsl). Built once per Gauss-Legendre
+ * order SB_GL_ORDER (transmittance_glN; the bake's default is order 8 on
+ * the pieces between kinks, at most 40 density samples a texel), and once
+ * with SB_GL_ORDER 0 for the uniform rules of the push constants (config.h). */
 #extension GL_GOOGLE_include_directive : require
 #include "config.h"
+#if SB_GL_ORDER > 0
+#define SB_TRANSMITTANCE_GL_ORDER SB_GL_ORDER
+#endif
 #include "atmosphere.glsl"
 
 layout(local_size_x = SB_WORKGROUP_X, local_size_y = SB_WORKGROUP_Y) in;
@@ -16,7 +22,14 @@ void main()
         return;
     float rho, e;
     transmittance_unit_ray((vec2(texel) + 0.5) / vec2(pc.width, pc.height), rho, e);
-    vec3 t = exp(-optical_depth_to_top(rho, e));
+#if SB_GL_ORDER > 0
+    vec3 tau = optical_depth_to_top_gl(rho, e, int(pc.subdivisions));
+#else
+    vec3 tau = optical_depth_to_top_uniform(rho, e, int(pc.samples),
+                                            pc.quadrature == SB_QUADRATURE_UNIFORM_0_3 ? 0.3 : 0.5,
+                                            pc.quadrature == SB_QUADRATURE_TRAPEZOID);
+#endif
+    vec3 t = exp(-tau);
     uint i = (texel.y * pc.width + texel.x) * 3u;
     result[i + 0u] = t.r;
     result[i + 1u] = t.g;

@@ -12,6 +12,7 @@
 #include "context.h"
 #include "harness.h"
 #include "log.h"
+#include "parallel.h"
 
 static struct sb_atmosphere_params earth;
 static struct sb_image luts[SB_PRODUCT_COUNT];
@@ -54,7 +55,7 @@ static void transmittance_row(void *user, int y)
 static void test_transmittance(void)
 {
     struct t_job job = {0};
-    parallel_for(SB_TRANSMITTANCE_HEIGHT, transmittance_row, &job);
+    sb_parallel_for(SB_TRANSMITTANCE_HEIGHT, transmittance_row, &job);
     double max_rel = 0, acc = 0;
     int n = 0, wx = 0, wy = 0;
     for (int y = 0; y < SB_TRANSMITTANCE_HEIGHT; y++) {
@@ -289,7 +290,7 @@ static void test_sampled(enum sb_product_id id, const int *xs, int nx, const int
     memcpy(job->ys, ys, ny * sizeof(int));
     job->nx = nx;
     job->ny = ny;
-    parallel_for(nx * ny, sample_texel, job);
+    sb_parallel_for(nx * ny, sample_texel, job);
     double worst = compare_samples(job, floor_fraction, sb_product_name(id));
     CHECK(worst <= tolerance, "%s: max relative error %.3g > %.3g", sb_product_name(id), worst, tolerance);
     free(job);

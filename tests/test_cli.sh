@@ -49,6 +49,52 @@ check "foreign directory untouched" test "$(cat "$tmp/notapack/file.txt")" = kee
 check "no temporary directories left" test -z "$(ls -d "$tmp"/*.tmp-* 2>/dev/null)"
 check "output into a missing parent fails" expect_exit 1 "$skybake" bake "$scene" -o "$tmp/missing/parent/p"
 
+# Refused parameter values (docs/scene.md), each naming its key.
+for bad in 'top_radius_km:6360' 'top_radius_km:6000' 'top_radius_km:6360.000001' 'ground_radius_km:0' \
+    'ground_radius_km:-1' 'mie_g:1' 'mie_g:-1' 'mie_g:0.9995' 'rayleigh_scattering_per_km:-1e-3' \
+    'mie_absorption_per_km:[0,-1,0]' 'ground_albedo:1.01' 'solar_irradiance:-1' 'mie_scale_height_km:0' \
+    'ozone_half_width_km:0'; do
+    key=${bad%%:*}
+    printf '{"atmosphere":{"preset":"earth","%s":%s}}' "$key" "${bad#*:}" >"$tmp/refused.json"
+    check "refuses $bad" expect_exit 2 "$skybake" bake "$tmp/refused.json" -o "$tmp/p"
+    check "names atmosphere.$key" grep -q "atmosphere.$key" "$tmp/err"
+done
+check "no pack after refused values" test ! -e "$tmp/p"
+
+# Tolerance-driven settings: the cheapest setting within the tolerance,
+# recorded with its measured error; an unreachable one is refused.
+json_number() { # file key: the first number after "key":
+    sed -n "s/.*\"$2\":[[:space:]]*\([-0-9.eE+]*\).*/\1/p" "$1" | head -n 1
+}
+printf '{"atmosphere":{"preset":"earth"},"products":["transmittance"],"tolerance":{"transmittance":1e-3}}' >"$tmp/tol.json"
+check "bake to a tolerance" expect_exit 0 "$skybake" bake "$tmp/tol.json" -o "$tmp/tol" -q
+check "manifest records the tolerance" grep -Eq '"tolerance":[[:space:]]*0.001' "$tmp/tol/manifest.json"
+err=$(json_number "$tmp/tol/manifest.json" max_rel)
+samples=$(json_number "$tmp/tol/manifest.json" max_samples)
+check "recorded error ($err) is within the tolerance" awk -v e="$err" 'BEGIN { exit !(e != "" && e <= 1e-3) }'
+check "a loose tolerance picks a cheaper setting than the default's 40 samples ($samples)" test "${samples:-40}" -lt 40
+check "the default bake records no tolerance" test -z "$(grep -o tolerance "$tmp/a/manifest.json")"
+printf '{"atmosphere":{"preset":"earth"},"products":["transmittance"],"tolerance":1e-7}' >"$tmp/tight.json"
+check "unreachable tolerance is exit 2" expect_exit 2 "$skybake" bake "$tmp/tight.json" -o "$tmp/tight"
+check "unreachable tolerance names the best reachable" grep -q "best reachable is" "$tmp/err"
+check "no pack after an unreachable tolerance" test ! -e "$tmp/tight"
+for bad in '"tolerance":0' '"tolerance":"1e-3"' '"tolerance":{"sky":1e-3}' '"tolerance":{}' '"tolerance":{"transmittance":2}'; do
+    printf '{"atmosphere":{"preset":"earth"},%s}' "$bad" >"$tmp/badtol.json"
+    check "refuses $bad" expect_exit 2 "$skybake" bake "$tmp/badtol.json" -o "$tmp/p"
+    check "names the field for $bad" grep -q "tolerance" "$tmp/err"
+done
+
+# bench: table, CSV, JSON and plot, with the published settings as rows.
+check "bench of transmittance" expect_exit 0 "$skybake" bench --product transmittance --repeat 1 -q -o "$tmp/bench"
+for f in bench.csv bench.json bench.svg bench_transmittance.csv; do
+    check "bench wrote $f" test -s "$tmp/bench/$f"
+done
+check "bench has Hillaire's row" grep -q "uniform0.3-40,.*Hillaire" "$tmp/bench/bench.csv"
+check "bench has Bruneton's row" grep -q "trapezoid-500,.*Bruneton" "$tmp/bench/bench.csv"
+check "bench marks a Pareto front" grep -Eq '"pareto":[[:space:]]*true' "$tmp/bench/bench.json"
+check "bench table names the default" grep -q '^.\*gl8x1' "$tmp/out"
+check "bench refuses an unknown product" expect_exit 2 "$skybake" bench --product sky
+
 echo "cli: $checks checks, $fails failed"
 echo "$((checks - fails)) passed, $fails failed"
 [ "$fails" = 0 ]

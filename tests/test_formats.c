@@ -98,7 +98,7 @@ static void test_scenes(void)
         {"[]", SB_ERR_WRONG_TYPE},
         {"{}", SB_ERR_MISSING_FIELD},
         {"{\"atmosphere\":{}}", SB_ERR_MISSING_FIELD},
-        {"{\"atmosphere\":{\"preset\":\"mars\"}}", SB_ERR_UNKNOWN_PRESET},
+        {"{\"atmosphere\":{\"preset\":\"venus\"}}", SB_ERR_UNKNOWN_PRESET},
         {"{\"atmosphere\":{\"preset\":\"earth\",\"mie_gg\":0.5}}", SB_ERR_UNKNOWN_KEY},
         {"{\"atmosphere\":{\"preset\":\"earth\"},\"extra\":1}", SB_ERR_UNKNOWN_KEY},
         {"{\"atmosphere\":{\"preset\":\"earth\",\"mie_g\":1.0}}", SB_ERR_OUT_OF_RANGE},

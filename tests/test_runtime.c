@@ -13,6 +13,7 @@
 #include "harness.h"
 #include "log.h"
 #include "pack.h"
+#include "parallel.h"
 #include "renderer.h"
 #include "scene.h"
 #include "world.h"
@@ -283,7 +284,7 @@ static void test_sky_view(struct sb_renderer *r, double sun_elevation_deg, doubl
             c->nu = c->mu * mu_s + sin(theta) * sqrt(1.0 - mu_s * mu_s) * cos(phi);
             memcpy(c->gpu, lut + ((size_t)y * SB_SKY_VIEW_WIDTH + x) * 3, sizeof(c->gpu));
         }
-    parallel_for(nrows * ncols, sky_reference, cases);
+    sb_parallel_for(nrows * ncols, sky_reference, cases);
     double worst = 0.0, lut_effect = 0.0;
     int worst_i = 0, worst_c = 0;
     for (int i = 0; i < nrows * ncols; i++)

@@ -1,0 +1,536 @@
+#include "bench.h"
+
+#include <cJSON.h>
+#include <errno.h>
+#include <math.h>
+#include <stdarg.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <sys/stat.h>
+#include <sys/wait.h>
+#include <time.h>
+#include <unistd.h>
+
+#include "log.h"
+
+#define HILLAIRE "Hillaire 2020 (40-step march, offset 0.3)"
+#define BRUNETON "Bruneton 2017 (500-step trapezoid)"
+
+struct sweep_entry {
+    struct sb_atmosphere_settings settings;
+    const char *anchor;
+    bool quick; /* part of --quick */
+};
+
+#define GL(n, s)                                                                                                       \
+    {                                                                                                                  \
+        .quadrature = SB_QUADRATURE_GAUSS_LEGENDRE, .samples = n, .subdivisions = s                                    \
+    }
+#define UNI(rule, n)                                                                                                   \
+    {                                                                                                                  \
+        .quadrature = rule, .samples = n                                                                               \
+    }
+static const struct sweep_entry transmittance_sweep[] = {
+    {GL(1, 1), NULL, true},
+    {GL(2, 1), NULL, true},
+    {GL(3, 1), NULL, true},
+    {GL(4, 1), NULL, true},
+    {GL(5, 1), NULL, false},
+    {GL(6, 1), NULL, true},
+    {GL(8, 1), NULL, true},
+    {GL(4, 2), NULL, false},
+    {GL(8, 2), NULL, true},
+    {GL(8, 4), NULL, false},
+    {GL(8, 16), NULL, false},
+    {UNI(SB_QUADRATURE_UNIFORM_0_3, 10), NULL, false},
+    {UNI(SB_QUADRATURE_UNIFORM_0_3, 20), NULL, false},
+    {UNI(SB_QUADRATURE_UNIFORM_0_3, 40), HILLAIRE, true},
+    {UNI(SB_QUADRATURE_UNIFORM_0_3, 80), NULL, false},
+    {UNI(SB_QUADRATURE_UNIFORM_0_3, 160), NULL, false},
+    {UNI(SB_QUADRATURE_UNIFORM_0_3, 320), NULL, false},
+    {UNI(SB_QUADRATURE_MIDPOINT, 40), NULL, false},
+    {UNI(SB_QUADRATURE_MIDPOINT, 160), NULL, false},
+    {UNI(SB_QUADRATURE_TRAPEZOID, 100), NULL, false},
+    {UNI(SB_QUADRATURE_TRAPEZOID, 500), BRUNETON, true},
+    {UNI(SB_QUADRATURE_TRAPEZOID, 2000), NULL, false},
+};
+#define RES(w, h)                                                                                                      \
+    {                                                                                                                  \
+        .quadrature = SB_QUADRATURE_GAUSS_LEGENDRE, .samples = 8, .subdivisions = 1, .width = w, .height = h           \
+    }
+static const struct sweep_entry resolution_sweep[] = {
+    {RES(64, 16), NULL, true},   {RES(128, 32), NULL, true},    {RES(256, 64), NULL, true},
+    {RES(512, 128), NULL, true}, {RES(1024, 256), NULL, false},
+};
+#define DIRS(m, p)                                                                                                     \
+    {                                                                                                                  \
+        .directions_mu = m, .directions_phi = p                                                                        \
+    }
+static const struct sweep_entry multiscattering_sweep[] = {
+    {DIRS(2, 2), NULL, true},    {DIRS(4, 4), NULL, true},    {DIRS(6, 6), NULL, false},   {DIRS(8, 8), NULL, true},
+    {DIRS(12, 12), NULL, false}, {DIRS(16, 12), NULL, false}, {DIRS(24, 16), NULL, false}, {DIRS(32, 24), NULL, false},
+};
+static const struct sweep_entry irradiance_ground_sweep[] = {
+    {DIRS(4, 4), NULL, true},    {DIRS(6, 6), NULL, true},    {DIRS(8, 8), NULL, true},
+    {DIRS(12, 12), NULL, false}, {DIRS(16, 16), NULL, false}, {DIRS(24, 24), NULL, false},
+};
+static const struct sweep_entry irradiance_sky_sweep[] = {
+    {DIRS(4, 4), NULL, true},    {DIRS(8, 8), NULL, true},    {DIRS(12, 12), NULL, false},
+    {DIRS(16, 16), NULL, false}, {DIRS(24, 24), NULL, false},
+};
+#undef GL
+#undef UNI
+#undef RES
+#undef DIRS
+
+static const struct {
+    const char *name;
+    enum sb_product_id product;
+    bool lookup;
+    const struct sweep_entry *entries;
+    int count;
+    const char *error_name;
+} sweeps[SB_BENCH_SWEEP_COUNT] = {
+#define S(list) list, (int)(sizeof(list) / sizeof(list[0]))
+    [SB_BENCH_TRANSMITTANCE] = {"transmittance", SB_PRODUCT_TRANSMITTANCE, false, S(transmittance_sweep),
+                                "texel error"},
+    [SB_BENCH_TRANSMITTANCE_RESOLUTION] = {"transmittance_resolution", SB_PRODUCT_TRANSMITTANCE, true,
+                                           S(resolution_sweep), "bilinear lookup error"},
+    [SB_BENCH_MULTISCATTERING] = {"multiscattering", SB_PRODUCT_MULTISCATTERING, false, S(multiscattering_sweep),
+                                  "texel error"},
+    [SB_BENCH_IRRADIANCE_GROUND] = {"irradiance_ground", SB_PRODUCT_IRRADIANCE_GROUND, false,
+                                    S(irradiance_ground_sweep), "texel error"},
+    [SB_BENCH_IRRADIANCE_SKY] = {"irradiance_sky", SB_PRODUCT_IRRADIANCE_SKY, false, S(irradiance_sky_sweep),
+                                 "texel error"},
+#undef S
+};
+
+const char *sb_bench_sweep_name(enum sb_bench_sweep sweep)
+{
+    return sweeps[sweep].name;
+}
+
+bool sb_bench_sweep_from_name(const char *name, enum sb_bench_sweep *sweep)
+{
+    for (int i = 0; i < SB_BENCH_SWEEP_COUNT; i++)
+        if (!strcmp(name, sweeps[i].name)) {
+            *sweep = (enum sb_bench_sweep)i;
+            return true;
+        }
+    return false;
+}
+
+static bool same_settings(enum sb_product_id id, const struct sb_atmosphere_settings *a,
+                          const struct sb_atmosphere_settings *b)
+{
+    char la[48], lb[48];
+    sb_atmosphere_settings_label(id, a, la, sizeof(la));
+    sb_atmosphere_settings_label(id, b, lb, sizeof(lb));
+    return !strcmp(la, lb);
+}
+
+const struct sb_atmosphere_settings *sb_bench_candidates(enum sb_product_id id, int *count)
+{
+    /* Built once per product, sorted by cost (stable: ties keep the sweep's
+     * order, so the choice is the same on every run). Not thread safe on
+     * first use, like the logger. */
+    static struct sb_atmosphere_settings lists[SB_PRODUCT_COUNT][32];
+    static int counts[SB_PRODUCT_COUNT] = {-1, -1, -1, -1};
+    if (counts[id] < 0) {
+        int n = 0;
+        for (int w = 0; w < SB_BENCH_SWEEP_COUNT; w++) {
+            if (sweeps[w].product != id || sweeps[w].lookup)
+                continue;
+            for (int i = 0; i < sweeps[w].count && n < 32; i++)
+                lists[id][n++] = sweeps[w].entries[i].settings;
+        }
+        /* insertion sort: stable and small */
+        for (int i = 1; i < n; i++) {
+            struct sb_atmosphere_settings v = lists[id][i];
+            int j = i - 1;
+            while (j >= 0 && sb_atmosphere_settings_cost(id, &lists[id][j]) > sb_atmosphere_settings_cost(id, &v)) {
+                lists[id][j + 1] = lists[id][j];
+                j--;
+            }
+            lists[id][j + 1] = v;
+        }
+        counts[id] = n;
+    }
+    *count = counts[id];
+    return lists[id];
+}
+
+static double now_s(void)
+{
+    struct timespec ts;
+    clock_gettime(CLOCK_MONOTONIC, &ts);
+    return ts.tv_sec + ts.tv_nsec * 1e-9;
+}
+
+static int compare_doubles(const void *a, const void *b)
+{
+    double x = *(const double *)a, y = *(const double *)b;
+    return x < y ? -1 : x > y;
+}
+
+/* Rows on the Pareto front of their sweep: no other row is as fast or faster
+ * and strictly more accurate, or strictly faster and as accurate. */
+static void mark_pareto(struct sb_bench_row *rows, int count)
+{
+    for (int i = 0; i < count; i++) {
+        rows[i].pareto = isfinite(rows[i].error.max_rel);
+        for (int j = 0; j < count && rows[i].pareto; j++) {
+            if (j == i || rows[j].sweep != rows[i].sweep)
+                continue;
+            bool faster_eq = rows[j].gpu_ms <= rows[i].gpu_ms,
+                 better_eq = rows[j].error.max_rel <= rows[i].error.max_rel;
+            if (faster_eq && better_eq &&
+                (rows[j].gpu_ms < rows[i].gpu_ms || rows[j].error.max_rel < rows[i].error.max_rel))
+                rows[i].pareto = false;
+        }
+    }
+}
+
+enum sb_result sb_bench_run(struct sb_vk *vk, const struct sb_atmosphere_params *atmosphere,
+                            const struct sb_bench_params *params, struct sb_bench_report *report)
+{
+    memset(report, 0, sizeof(*report));
+    struct sb_atmosphere_baker *baker = NULL;
+    struct sb_image inputs[SB_PRODUCT_COUNT] = {0}, image = {0};
+    struct sb_accuracy_ref *ref = NULL;
+    int repeat = params->repeat > 0 ? params->repeat : 1;
+    double *times = calloc((size_t)repeat, sizeof(double));
+    int total = 0;
+    for (int w = 0; w < SB_BENCH_SWEEP_COUNT; w++)
+        total += params->sweeps[w] ? sweeps[w].count : 0;
+    report->rows = calloc((size_t)total + 1, sizeof(*report->rows));
+    enum sb_result res = times && report->rows ? SB_OK : SB_ERR_NOMEM;
+    if (!res)
+        res = sb_atmosphere_baker_create(vk, atmosphere, &baker);
+
+    /* Every product a sweep reads, and the product itself, baked at its
+     * defaults first: the sweeps of later products read these. */
+    uint32_t need = 0;
+    for (int w = 0; w < SB_BENCH_SWEEP_COUNT; w++)
+        if (params->sweeps[w])
+            need |= sb_atmosphere_product(sweeps[w].product)->depends_on | 1u << sweeps[w].product;
+    for (int p = 0; p < SB_PRODUCT_COUNT && !res; p++)
+        if (need & 1u << p)
+            res = sb_atmosphere_bake(baker, (enum sb_product_id)p, NULL, &inputs[p], NULL, NULL);
+
+    for (int w = 0; w < SB_BENCH_SWEEP_COUNT && !res; w++) {
+        if (!params->sweeps[w])
+            continue;
+        enum sb_product_id id = sweeps[w].product;
+        const struct sb_atmosphere_product *product = sb_atmosphere_product(id);
+        double t0 = now_s();
+        if ((res =
+                 sb_accuracy_ref_create(atmosphere, id, sweeps[w].lookup ? SB_ACCURACY_LOOKUP : 0, 0, 0, inputs, &ref)))
+            break;
+        report->reference_s[w] = now_s() - t0;
+        snprintf(report->probe[w], sizeof(report->probe[w]), "%s", sb_accuracy_ref_probe(ref));
+        sb_info("%s: fp64 reference at %s in %.1f s", sweeps[w].name, report->probe[w], report->reference_s[w]);
+
+        for (int e = 0; e < sweeps[w].count && !res; e++) {
+            const struct sweep_entry *entry = &sweeps[w].entries[e];
+            if (params->quick && !entry->quick)
+                continue;
+            struct sb_bench_row *row = &report->rows[report->row_count];
+            row->sweep = (enum sb_bench_sweep)w;
+            row->anchor = entry->anchor;
+            row->cost = sb_atmosphere_settings_cost(id, &entry->settings);
+            sb_atmosphere_settings_label(id, &entry->settings, row->label, sizeof(row->label));
+            /* one untimed bake first when timing repeats: pipeline caches and GPU clocks settle */
+            for (int k = repeat >= 3 ? -1 : 0; k < repeat && !res; k++) {
+                double ms;
+                sb_image_finish(&image);
+                res = sb_atmosphere_bake(baker, id, &entry->settings, &image, &row->settings, k >= 0 ? &times[k] : &ms);
+            }
+            if (res)
+                break;
+            const struct sb_product_format *format = sb_product_format(id);
+            struct sb_atmosphere_settings at_format = row->settings;
+            if (at_format.width == format->width && at_format.height == format->height)
+                at_format.width = at_format.height = 0;
+            row->is_default = same_settings(id, &at_format, &product->defaults);
+            qsort(times, (size_t)repeat, sizeof(double), compare_doubles);
+            row->gpu_ms = times[repeat / 2];
+            row->gpu_ms_min = times[0];
+            sb_accuracy_measure(ref, &image, false, &row->error);
+            sb_accuracy_measure(ref, &image, true, &row->error_half);
+            report->row_count++;
+            sb_info("%-24s %-22s %10.3f ms  max %.3g  rms %.3g", sweeps[w].name, row->label, row->gpu_ms,
+                    row->error.max_rel, row->error.rms_rel);
+        }
+        sb_accuracy_ref_destroy(&ref);
+        /* Later sweeps read this product at its defaults again. */
+        if (!res)
+            res = sb_atmosphere_bake(baker, id, NULL, &image, NULL, NULL);
+    }
+    if (!res)
+        mark_pareto(report->rows, report->row_count);
+    sb_image_finish(&image);
+    for (int p = 0; p < SB_PRODUCT_COUNT; p++)
+        sb_image_finish(&inputs[p]);
+    sb_accuracy_ref_destroy(&ref);
+    sb_atmosphere_baker_destroy(&baker);
+    free(times);
+    if (res)
+        sb_bench_report_finish(report);
+    return res;
+}
+
+void sb_bench_report_finish(struct sb_bench_report *report)
+{
+    free(report->rows);
+    memset(report, 0, sizeof(*report));
+}
+
+/* ---- Output ---------------------------------------------------------------------- */
+
+static cJSON *report_json(const struct sb_bench_report *report, const struct sb_vk *vk)
+{
+    cJSON *root = cJSON_CreateObject();
+    cJSON_AddStringToObject(root, "device", vk->properties.deviceName);
+    cJSON_AddStringToObject(root, "driver", vk->driver_name);
+    cJSON *sw = cJSON_AddObjectToObject(root, "sweeps");
+    for (int w = 0; w < SB_BENCH_SWEEP_COUNT; w++) {
+        if (!report->probe[w][0])
+            continue;
+        cJSON *o = cJSON_AddObjectToObject(sw, sweeps[w].name);
+        cJSON_AddStringToObject(o, "product", sb_product_name(sweeps[w].product));
+        cJSON_AddStringToObject(o, "error", sweeps[w].error_name);
+        cJSON_AddStringToObject(o, "probe", report->probe[w]);
+        cJSON_AddNumberToObject(o, "reference_s", report->reference_s[w]);
+    }
+    cJSON *rows = cJSON_AddArrayToObject(root, "rows");
+    for (int i = 0; i < report->row_count; i++) {
+        const struct sb_bench_row *r = &report->rows[i];
+        cJSON *o = cJSON_CreateObject();
+        cJSON_AddStringToObject(o, "sweep", sweeps[r->sweep].name);
+        cJSON_AddStringToObject(o, "setting", r->label);
+        if (r->anchor)
+            cJSON_AddStringToObject(o, "anchor", r->anchor);
+        cJSON_AddBoolToObject(o, "default", r->is_default);
+        cJSON_AddNumberToObject(o, "cost", (double)r->cost);
+        cJSON_AddNumberToObject(o, "gpu_ms", r->gpu_ms);
+        cJSON_AddNumberToObject(o, "gpu_ms_min", r->gpu_ms_min);
+        cJSON_AddNumberToObject(o, "max_rel", isfinite(r->error.max_rel) ? r->error.max_rel : -1);
+        cJSON_AddNumberToObject(o, "rms_rel", isfinite(r->error.rms_rel) ? r->error.rms_rel : -1);
+        cJSON_AddNumberToObject(o, "max_rel_fp16", isfinite(r->error_half.max_rel) ? r->error_half.max_rel : -1);
+        cJSON_AddNumberToObject(o, "rms_rel_fp16", isfinite(r->error_half.rms_rel) ? r->error_half.rms_rel : -1);
+        cJSON_AddNumberToObject(o, "values", r->error.count);
+        cJSON *worst = cJSON_AddArrayToObject(o, "worst_texel");
+        cJSON_AddItemToArray(worst, cJSON_CreateNumber(r->error.worst_x));
+        cJSON_AddItemToArray(worst, cJSON_CreateNumber(r->error.worst_y));
+        cJSON_AddItemToArray(worst, cJSON_CreateNumber(r->error.worst_channel));
+        cJSON_AddBoolToObject(o, "pareto", r->pareto);
+        cJSON_AddItemToArray(rows, o);
+    }
+    return root;
+}
+
+void sb_bench_print(const struct sb_bench_report *report, const struct sb_vk *vk, bool json)
+{
+    if (json) {
+        cJSON *root = report_json(report, vk);
+        char *text = cJSON_Print(root);
+        if (text)
+            printf("%s\n", text);
+        free(text);
+        cJSON_Delete(root);
+        return;
+    }
+    printf("skybake bench on %s (%s); GPU time is the median of the repeats\n", vk->properties.deviceName,
+           vk->driver_name);
+    printf("P: on the Pareto front; *: skybake's default\n");
+    for (int w = 0; w < SB_BENCH_SWEEP_COUNT; w++) {
+        if (!report->probe[w][0])
+            continue;
+        printf("\n%s (%s over %s; reference %.1f s)\n", sweeps[w].name, sweeps[w].error_name, report->probe[w],
+               report->reference_s[w]);
+        printf("  %-22s %7s %11s %10s %10s %10s  %s\n", "setting", "cost", "gpu ms", "max rel", "rms rel", "fp16 max",
+               "");
+        for (int i = 0; i < report->row_count; i++) {
+            const struct sb_bench_row *r = &report->rows[i];
+            if (r->sweep != (enum sb_bench_sweep)w)
+                continue;
+            printf("%c%c%-22s %7llu %11.4f %10.3g %10.3g %10.3g  %s\n", r->pareto ? 'P' : ' ',
+                   r->is_default ? '*' : ' ', r->label, (unsigned long long)r->cost, r->gpu_ms, r->error.max_rel,
+                   r->error.rms_rel, r->error_half.max_rel, r->anchor ? r->anchor : "");
+        }
+    }
+}
+
+static enum sb_result write_text(const char *dir, const char *name, const char *text)
+{
+    char path[4096], tmp[4200];
+    snprintf(path, sizeof(path), "%s/%s", dir, name);
+    snprintf(tmp, sizeof(tmp), "%s.tmp", path);
+    FILE *f = fopen(tmp, "w");
+    if (!f) {
+        sb_error("%s: cannot write: %s", tmp, strerror(errno));
+        return SB_ERR_IO;
+    }
+    bool ok = fputs(text, f) >= 0;
+    ok = fclose(f) == 0 && ok;
+    if (!ok || rename(tmp, path) != 0) {
+        sb_error("%s: cannot write: %s", path, strerror(errno));
+        unlink(tmp);
+        return SB_ERR_IO;
+    }
+    return SB_OK;
+}
+
+/* A growing string for the CSV and the plot's script. */
+struct text {
+    char *data;
+    size_t size, cap;
+    bool failed;
+};
+
+#if defined(__GNUC__)
+__attribute__((format(printf, 2, 3)))
+#endif
+static void
+text_add(struct text *t, const char *fmt, ...)
+{
+    va_list ap;
+    va_start(ap, fmt);
+    int n = vsnprintf(NULL, 0, fmt, ap);
+    va_end(ap);
+    if (n < 0 || t->failed)
+        return;
+    if (t->size + (size_t)n + 1 > t->cap) {
+        size_t cap = (t->cap + (size_t)n + 1) * 2;
+        char *p = realloc(t->data, cap);
+        if (!p) {
+            t->failed = true;
+            return;
+        }
+        t->data = p;
+        t->cap = cap;
+    }
+    va_start(ap, fmt);
+    vsnprintf(t->data + t->size, t->cap - t->size, fmt, ap);
+    va_end(ap);
+    t->size += (size_t)n;
+}
+
+static enum sb_result write_plot(const struct sb_bench_report *report, const struct sb_vk *vk, const char *dir)
+{
+    int panels = 0;
+    for (int w = 0; w < SB_BENCH_SWEEP_COUNT; w++)
+        panels += report->probe[w][0] != 0;
+    struct text gp = {0};
+    text_add(&gp, "# skybake bench: max relative error against GPU time; run with gnuplot in this directory\n");
+    text_add(&gp, "set terminal svg size 1500,%d dynamic font 'sans,11'\nset output 'bench.svg'\n",
+             panels > 3 ? 1000 : 520);
+    text_add(&gp, "set datafile separator ','\nset termoption noenhanced\nset logscale xy\nset grid\n");
+    text_add(&gp, "set key top right font ',9'\nset xlabel 'GPU ms (median)'\nset ylabel 'max rel error vs fp64'\n");
+    text_add(&gp, "set multiplot layout %d,3 title 'skybake bench on %s'\n", panels > 3 ? 2 : 1,
+             vk->properties.deviceName);
+    for (int w = 0; w < SB_BENCH_SWEEP_COUNT; w++) {
+        if (!report->probe[w][0])
+            continue;
+        /* columns of bench.csv: 1 sweep, 2 setting, 5 gpu_ms, 7 max_rel, 12 pareto, 13 anchor, 4 default */
+        text_add(&gp, "set title '%s (%s)'\n", sweeps[w].name, sweeps[w].error_name);
+        text_add(
+            &gp,
+            "plot 'bench_%s.csv' using 5:7 with points pt 7 ps 0.6 lc rgb '#7f7f7f' title 'settings', \\\n"
+            "     '' using 5:($12 > 0 ? $7 : 1/0) smooth unique with linespoints pt 7 lw 2 lc rgb '#1f77b4' "
+            "title 'Pareto front', \\\n"
+            "     '' using 5:($13 > 0 ? $7 : 1/0) with points pt 9 ps 1.6 lc rgb '#d62728' title 'published', \\\n"
+            "     '' using 5:($4 > 0 ? $7 : 1/0) with points pt 5 ps 1.2 lc rgb '#2ca02c' title 'skybake default', "
+            "\\\n"
+            "     '' using 5:7:2 with labels offset 0.6,0.5 left font ',8' notitle\n",
+            sweeps[w].name);
+    }
+    text_add(&gp, "unset multiplot\n");
+    enum sb_result res = gp.failed ? SB_ERR_NOMEM : write_text(dir, "bench.gp", gp.data);
+    free(gp.data);
+    if (res)
+        return res;
+
+    pid_t pid = fork();
+    if (pid < 0) {
+        sb_error("cannot start gnuplot: %s", strerror(errno));
+        return SB_ERR_IO;
+    }
+    if (pid == 0) {
+        if (chdir(dir) == 0)
+            execlp("gnuplot", "gnuplot", "bench.gp", (char *)NULL);
+        _exit(127);
+    }
+    int status = 0;
+    while (waitpid(pid, &status, 0) < 0 && errno == EINTR)
+        ;
+    if (!WIFEXITED(status) || WEXITSTATUS(status) != 0) {
+        sb_error("%s/bench.gp: gnuplot failed (exit %d)%s; the CSV and JSON are written", dir,
+                 WIFEXITED(status) ? WEXITSTATUS(status) : -1,
+                 WIFEXITED(status) && WEXITSTATUS(status) == 127 ? " or is not installed (apt-get install gnuplot-nox)"
+                                                                 : "");
+        return SB_ERR_IO;
+    }
+    return SB_OK;
+}
+
+static void csv_row(struct text *t, const struct sb_bench_row *r)
+{
+    text_add(t, "%s,%s,%llu,%d,%.6g,%.6g,%.6g,%.6g,%.6g,%.6g,%u,%d,%d,\"%s\"\n", sweeps[r->sweep].name, r->label,
+             (unsigned long long)r->cost, r->is_default, r->gpu_ms, r->gpu_ms_min, r->error.max_rel, r->error.rms_rel,
+             r->error_half.max_rel, r->error_half.rms_rel, r->error.count, r->pareto, r->anchor != NULL,
+             r->anchor ? r->anchor : "");
+}
+
+enum sb_result sb_bench_write(const struct sb_bench_report *report, const struct sb_vk *vk, const char *dir)
+{
+    if (mkdir(dir, 0777) != 0 && errno != EEXIST) {
+        sb_error("%s: cannot create: %s", dir, strerror(errno));
+        return SB_ERR_IO;
+    }
+    static const char header[] = "sweep,setting,cost,default,gpu_ms,gpu_ms_min,max_rel,rms_rel,max_rel_fp16,"
+                                 "rms_rel_fp16,values,pareto,anchor,anchor_name\n";
+    struct text all = {0};
+    text_add(&all, "%s", header);
+    enum sb_result res = SB_OK;
+    for (int w = 0; w < SB_BENCH_SWEEP_COUNT && !res; w++) {
+        if (!report->probe[w][0])
+            continue;
+        struct text one = {0};
+        text_add(&one, "%s", header);
+        /* by time, so that the front's line runs left to right */
+        int order[64], n = 0;
+        for (int i = 0; i < report->row_count && n < 64; i++)
+            if (report->rows[i].sweep == (enum sb_bench_sweep)w)
+                order[n++] = i;
+        for (int i = 1; i < n; i++)
+            for (int j = i; j > 0 && report->rows[order[j]].gpu_ms < report->rows[order[j - 1]].gpu_ms; j--) {
+                int tmp = order[j];
+                order[j] = order[j - 1];
+                order[j - 1] = tmp;
+            }
+        for (int i = 0; i < n; i++) {
+            csv_row(&one, &report->rows[order[i]]);
+            csv_row(&all, &report->rows[order[i]]);
+        }
+        char name[96];
+        snprintf(name, sizeof(name), "bench_%s.csv", sweeps[w].name);
+        res = one.failed ? SB_ERR_NOMEM : write_text(dir, name, one.data);
+        free(one.data);
+    }
+    if (!res)
+        res = all.failed ? SB_ERR_NOMEM : write_text(dir, "bench.csv", all.data);
+    free(all.data);
+    if (!res) {
+        cJSON *root = report_json(report, vk);
+        char *text = cJSON_Print(root);
+        res = text ? write_text(dir, "bench.json", text) : SB_ERR_NOMEM;
+        free(text);
+        cJSON_Delete(root);
+    }
+    if (!res)
+        res = write_plot(report, vk, dir);
+    return res;
+}

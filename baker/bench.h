@@ -1,0 +1,78 @@
+/*
+ * skybake bench: speed against error. For each atmosphere product, bake it
+ * with each setting of a sweep (quadratures, sample and direction counts,
+ * resolution where it matters), time it on the device (GPU timestamps, the
+ * median of repeated bakes) and measure its max and RMS error against the
+ * fp64 reference (accuracy.h). The published settings are rows of their
+ * own: Hillaire 2020's 40-step march and Bruneton 2017's 500-step
+ * trapezoid for transmittance. The Pareto front (no other setting both
+ * faster and more accurate) is marked, and the default setting's error in
+ * half precision is reported (what fp16 storage would cost).
+ */
+#ifndef SB_BAKER_BENCH_H
+#define SB_BAKER_BENCH_H
+
+#include <stdbool.h>
+
+#include "accuracy.h"
+#include "atmosphere.h"
+#include "context.h"
+#include "scene.h"
+
+/* The sweeps: one per product, and one of transmittance's resolution
+ * measured by its lookup error. */
+enum sb_bench_sweep {
+    SB_BENCH_TRANSMITTANCE,
+    SB_BENCH_TRANSMITTANCE_RESOLUTION,
+    SB_BENCH_MULTISCATTERING,
+    SB_BENCH_IRRADIANCE_GROUND,
+    SB_BENCH_IRRADIANCE_SKY,
+    SB_BENCH_SWEEP_COUNT,
+};
+
+struct sb_bench_row {
+    enum sb_bench_sweep sweep;
+    struct sb_atmosphere_settings settings;
+    char label[48];
+    const char *anchor; /* the published setting this row reproduces, or NULL */
+    bool is_default;    /* what skybake bakes without a tolerance */
+    uint64_t cost;      /* sb_atmosphere_settings_cost */
+    double gpu_ms;      /* median over the repeats */
+    double gpu_ms_min;
+    struct sb_error error;
+    struct sb_error error_half; /* the same bake stored in half precision */
+    bool pareto;
+};
+
+struct sb_bench_params {
+    bool sweeps[SB_BENCH_SWEEP_COUNT]; /* which to run */
+    int repeat;                        /* bakes per setting; the median is reported */
+    bool quick;                        /* only the settings marked quick (meson's benchmark) */
+};
+
+struct sb_bench_report {
+    int row_count;
+    struct sb_bench_row *rows;
+    double reference_s[SB_BENCH_SWEEP_COUNT]; /* wall time of each fp64 reference */
+    char probe[SB_BENCH_SWEEP_COUNT][96];
+};
+
+const char *sb_bench_sweep_name(enum sb_bench_sweep sweep);
+bool sb_bench_sweep_from_name(const char *name, enum sb_bench_sweep *sweep);
+
+/* Candidate settings of `id` at the format's resolution, cheapest first (for
+ * a tolerance): *count of them. */
+const struct sb_atmosphere_settings *sb_bench_candidates(enum sb_product_id id, int *count);
+
+enum sb_result sb_bench_run(struct sb_vk *vk, const struct sb_atmosphere_params *atmosphere,
+                            const struct sb_bench_params *params, struct sb_bench_report *report);
+void sb_bench_report_finish(struct sb_bench_report *report);
+
+/* Print the tables (text) or the report as JSON on stdout. */
+void sb_bench_print(const struct sb_bench_report *report, const struct sb_vk *vk, bool json);
+
+/* Write bench.csv, bench.json, bench.gp and bench.svg (drawn by gnuplot)
+ * into dir, created if missing. */
+enum sb_result sb_bench_write(const struct sb_bench_report *report, const struct sb_vk *vk, const char *dir);
+
+#endif
