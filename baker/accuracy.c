@@ -183,15 +183,14 @@ void sb_accuracy_measure(const struct sb_accuracy_ref *ref, const struct sb_imag
     }
     struct sb_image half = {0};
     const struct sb_image *read = image;
-    if (as_half || ref->lookup) {
-        /* the lookup reads a copy so that half rounding applies to it too */
+    if (as_half) {
         if (sb_image_init(&half, image->width, image->height, image->channel_count)) {
             err->max_rel = err->rms_rel = INFINITY;
             return;
         }
         size_t n = sb_image_float_count(image);
         for (size_t i = 0; i < n; i++)
-            half.data[i] = as_half ? (float)round_to_half(image->data[i]) : image->data[i];
+            half.data[i] = (float)round_to_half(image->data[i]);
         read = &half;
     }
     double acc = 0;

@@ -52,28 +52,27 @@ static const struct sb_atmosphere_product products[SB_PRODUCT_COUNT] = {
         },
 };
 
-static const struct {
+struct spirv {
     const uint32_t *words;
     size_t size;
-} transmittance_shaders[SB_GL_MAX_ORDER + 1] =
-    {
-#define T(n)                                                                                                           \
-    {                                                                                                                  \
-        sb_spv_transmittance_gl##n, sizeof(sb_spv_transmittance_gl##n)                                                 \
-    }
-        T(0), T(1), T(2), T(3), T(4), T(5), T(6), T(7), T(8),
-#undef T
-},
-                                          shaders[SB_PRODUCT_COUNT] = {
-                                              [SB_PRODUCT_TRANSMITTANCE] = {sb_spv_transmittance_gl8,
-                                                                            sizeof(sb_spv_transmittance_gl8)},
-                                              [SB_PRODUCT_MULTISCATTERING] = {sb_spv_multiscattering,
-                                                                              sizeof(sb_spv_multiscattering)},
-                                              [SB_PRODUCT_IRRADIANCE_GROUND] = {sb_spv_irradiance_ground,
-                                                                                sizeof(sb_spv_irradiance_ground)},
-                                              [SB_PRODUCT_IRRADIANCE_SKY] = {sb_spv_irradiance_sky,
-                                                                             sizeof(sb_spv_irradiance_sky)},
 };
+
+#define SPIRV(name)                                                                                                    \
+    {                                                                                                                  \
+        sb_spv_##name, sizeof(sb_spv_##name)                                                                           \
+    }
+/* Transmittance: one shader per Gauss-Legendre order, 0 for the uniform rules (config.h). */
+static const struct spirv transmittance_shaders[SB_GL_MAX_ORDER + 1] = {
+    SPIRV(transmittance_gl0), SPIRV(transmittance_gl1), SPIRV(transmittance_gl2),
+    SPIRV(transmittance_gl3), SPIRV(transmittance_gl4), SPIRV(transmittance_gl5),
+    SPIRV(transmittance_gl6), SPIRV(transmittance_gl7), SPIRV(transmittance_gl8),
+};
+static const struct spirv scattering_shaders[SB_PRODUCT_COUNT] = {
+    [SB_PRODUCT_MULTISCATTERING] = SPIRV(multiscattering),
+    [SB_PRODUCT_IRRADIANCE_GROUND] = SPIRV(irradiance_ground),
+    [SB_PRODUCT_IRRADIANCE_SKY] = SPIRV(irradiance_sky),
+};
+#undef SPIRV
 
 const struct sb_atmosphere_product *sb_atmosphere_product(enum sb_product_id id)
 {
@@ -343,15 +342,12 @@ enum sb_result sb_atmosphere_bake(struct sb_atmosphere_baker *b, enum sb_product
     if ((res = sb_buffer_create(b->vk, bytes, sb_product_name(id), &b->outputs[id])))
         goto cleanup;
 
-    const uint32_t *words = shaders[id].words;
-    size_t words_size = shaders[id].size;
-    if (id == SB_PRODUCT_TRANSMITTANCE) {
-        uint32_t variant = s.quadrature == SB_QUADRATURE_GAUSS_LEGENDRE ? s.samples : 0;
-        words = transmittance_shaders[variant].words;
-        words_size = transmittance_shaders[variant].size;
-    }
-    if ((res = run(b, words, words_size, sb_product_name(id), &b->outputs[id], width, height, prod->workgroup_per_texel,
-                   &s, gpu_ms)))
+    const struct spirv *shader =
+        id == SB_PRODUCT_TRANSMITTANCE
+            ? &transmittance_shaders[s.quadrature == SB_QUADRATURE_GAUSS_LEGENDRE ? s.samples : 0]
+            : &scattering_shaders[id];
+    if ((res = run(b, shader->words, shader->size, sb_product_name(id), &b->outputs[id], width, height,
+                   prod->workgroup_per_texel, &s, gpu_ms)))
         goto cleanup;
     memcpy(image->data, b->outputs[id].mapped, bytes);
     /* A resolution other than the format's is a measurement: later bakes

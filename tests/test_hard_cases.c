@@ -87,20 +87,22 @@ static void check_transmittance_rays(const char *name, const struct sb_atmospher
             if (mu < 0 && r0 * r0 * (1 - mu * mu) <= R * R * (1 + 1e-9))
                 continue; /* hits the ground */
             double d = -r0 * mu + sqrt(top * top - r0 * r0 * (1 - mu * mu));
-            double prev = -1, prev_exact = -1;
+            double prev[3] = {-1, -1, -1}, prev_exact[3] = {-1, -1, -1};
             rays++;
             for (int k = 0; k <= 32; k++) {
                 double s = d * k / 33.0;
                 double r = sqrt(r0 * r0 + s * s + 2 * r0 * mu * s), m = (r0 * mu + s) / r, v[3], exact[3];
                 sb_ref_transmittance_lookup(p, t, r, m, v);
                 sb_ref_transmittance(p, r, m, 4, exact);
-                if (prev >= 0) {
-                    /* a drop beyond what the two lookups' errors explain */
-                    double err = fabs(v[0] - exact[0]) + fabs(prev - prev_exact) + 1e-5 * (v[0] + prev);
-                    worst = fmax(worst, (prev - v[0]) - err);
+                for (int c = 0; c < 3; c++) {
+                    if (prev[c] >= 0) {
+                        /* a drop beyond what the two lookups' errors explain */
+                        double err = fabs(v[c] - exact[c]) + fabs(prev[c] - prev_exact[c]) + 1e-5 * (v[c] + prev[c]);
+                        worst = fmax(worst, (prev[c] - v[c]) - err);
+                    }
+                    prev[c] = v[c];
+                    prev_exact[c] = exact[c];
                 }
-                prev = v[0];
-                prev_exact = exact[0];
             }
         }
     }
