@@ -155,43 +155,54 @@ static int level_crossings(const struct sb_atmosphere_params *p, double r0, doub
 
 /* ---- Transmittance ----------------------------------------------------------- */
 
-void sb_ref_transmittance(const struct sb_atmosphere_params *p, double r, double mu, int subdivisions, double out[3])
+void sb_ref_optical_depth(const struct sb_atmosphere_params *p, double r, double mu, double t_from, double t_to,
+                          int subdivisions, double out[3])
 {
     pthread_once(&gl_once, gl_init);
-    double t_end = dist_top(p, r, mu);
     double br[80];
     int n = 0;
-    br[n++] = 0;
+    br[n++] = t_from;
+    double cuts[80];
+    int m = 0;
     double corners[3] = {p->ozone_center_km - p->ozone_half_width_km, p->ozone_center_km,
                          p->ozone_center_km + p->ozone_half_width_km};
     for (int k = 0; k < 3; k++)
         if (corners[k] > 0)
-            n += level_crossings(p, r, mu, t_end, corners[k], br + n);
+            m += level_crossings(p, r, mu, t_to, corners[k], cuts + m);
     /* Deep in the exponential tails of a thick atmosphere, cut at 16 H x 2^k
      * (the largest scale height H) too, so that the composite rule's
      * pieces follow the density down. */
     double thickness = p->top_radius_km - p->ground_radius_km;
     double tail = 16.0 * fmax(p->rayleigh_scale_height_km, p->mie_scale_height_km);
     for (int k = 0; k < 30 && tail < thickness; k++, tail *= 2.0)
-        n += level_crossings(p, r, mu, t_end, tail, br + n);
-    if (-r * mu > 0 && -r * mu < t_end)
-        br[n++] = -r * mu;
-    br[n++] = t_end;
+        m += level_crossings(p, r, mu, t_to, tail, cuts + m);
+    if (-r * mu > 0 && -r * mu < t_to)
+        cuts[m++] = -r * mu;
+    for (int k = 0; k < m; k++)
+        if (cuts[k] > t_from)
+            br[n++] = cuts[k];
+    br[n++] = t_to;
     sort_doubles(br, n);
-    double tau[3] = {0, 0, 0};
+    out[0] = out[1] = out[2] = 0;
     for (int i = 0; i + 1 < n; i++) {
         double step = (br[i + 1] - br[i]) / subdivisions;
         for (int s = 0; s < subdivisions; s++) {
             double a = br[i] + s * step, half = 0.5 * step;
             for (int k = 0; k < 16; k++) {
                 double t = a + half * (1.0 + gl16.x[k]);
-                struct medium m;
-                medium(p, radius_at(r, mu, t) - p->ground_radius_km, &m);
+                struct medium md;
+                medium(p, radius_at(r, mu, t) - p->ground_radius_km, &md);
                 for (int c = 0; c < 3; c++)
-                    tau[c] += half * gl16.w[k] * m.extinction[c];
+                    out[c] += half * gl16.w[k] * md.extinction[c];
             }
         }
     }
+}
+
+void sb_ref_transmittance(const struct sb_atmosphere_params *p, double r, double mu, int subdivisions, double out[3])
+{
+    double tau[3];
+    sb_ref_optical_depth(p, r, mu, 0.0, dist_top(p, r, mu), subdivisions, tau);
     for (int c = 0; c < 3; c++)
         out[c] = exp(-tau[c]);
 }
@@ -690,7 +701,7 @@ void sb_ref_sky_radiance(const struct sb_atmosphere_params *p, double h, double 
     struct ray_sums rs;
     integrate_ray(p, r, mu, mu_s, nu, ground, ms_lut, t_lut, &q, &rs);
     double eg[3] = {0};
-    if (ground) {
+    if (ground && ig_lut) {
         double mu_sp = fmax(-1.0, fmin(1.0, (r * mu_s + rs.t_end * nu) / R));
         lut_log_cubic(ig_lut, mu_sp * 0.5 + 0.5, 0.0, 3, eg);
     }
@@ -698,7 +709,7 @@ void sb_ref_sky_radiance(const struct sb_atmosphere_params *p, double h, double 
         out[c] = p->solar_irradiance[c] *
                      (rs.sun_rayleigh[c] * phase_rayleigh(nu) + rs.sun_mie[c] * phase_mie(p->mie_g, nu)) +
                  rs.ms_rayleigh[c] + rs.ms_mie[c];
-        if (ground)
+        if (ground && ig_lut)
             out[c] += rs.transmittance[c] * p->ground_albedo[c] / REF_PI * eg[c];
     }
 }

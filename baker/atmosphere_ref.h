@@ -28,6 +28,12 @@ struct sb_ref_quality {
  * fp64 rounding). */
 void sb_ref_transmittance(const struct sb_atmosphere_params *p, double r, double mu, int subdivisions, double out[3]);
 
+/* Optical depth along the ray from radius r (km) with cosine mu, between
+ * the distances t_from <= t_to (km) on it, at the same precision; the
+ * segment must stay in the atmosphere. */
+void sb_ref_optical_depth(const struct sb_atmosphere_params *p, double r, double mu, double t_from, double t_to,
+                          int subdivisions, double out[3]);
+
 /* (r, mu) at unit coordinates (x_mu, x_r) of the transmittance LUT
  * (Hillaire 2020; texel (x, y) of W x H is at ((x + 0.5) / W, (y + 0.5) / H)). */
 void sb_ref_transmittance_geometry(const struct sb_atmosphere_params *p, double x_mu, double x_r, double *r,
@@ -62,7 +68,9 @@ void sb_ref_irradiance_sky(const struct sb_atmosphere_params *p, double h, doubl
  * ray ends on it; no sun disk. What skyview's sky-view LUT holds. The sun's
  * transmittance is integrated exactly when `transmittance` is NULL, else
  * read from that baked LUT bilinearly, as the runtime reads it. From above
- * the atmosphere the ray starts where it enters it (0 where it misses). */
+ * the atmosphere the ray starts where it enters it (0 where it misses).
+ * With multiscattering NULL, only single scattering; with irradiance_ground
+ * NULL, no light from the ground. */
 void sb_ref_sky_radiance(const struct sb_atmosphere_params *p, double h, double mu, double mu_s, double nu,
                          const struct sb_image *transmittance, const struct sb_image *multiscattering,
                          const struct sb_image *irradiance_ground, const struct sb_ref_quality *q, double out[3]);

@@ -5,6 +5,7 @@
  * bad scene; 3 no Vulkan device; 4 validation layers reported messages.
  */
 #include <cJSON.h>
+#include <math.h>
 #include <stdbool.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -16,6 +17,7 @@
 #include "log.h"
 #include "scene.h"
 #include "skybake_version.h"
+#include "sky_error.h"
 
 enum {
     EXIT_BAKE_FAILED = 1,
@@ -28,6 +30,7 @@ static void usage(FILE *f)
 {
     fprintf(f, "usage: skybake bake SCENE -o OUT_DIR [options]\n"
                "       skybake bench [SCENE] [--product NAME]... [--json] [-o DIR] [--repeat N] [--quick]\n"
+               "       skybake sky-error [SCENE]... [--paths N] [--seed N] [--sun DEG]... [--json]\n"
                "       skybake --version | --help\n"
                "\n"
                "Bakes what SCENE (JSON, see docs/scene.md) needs into the pack OUT_DIR:\n"
@@ -50,6 +53,12 @@ static void usage(FILE *f)
                "(default: all). -o DIR writes bench.csv, bench.json and bench.svg (gnuplot).\n"
                "--repeat N bakes each setting N times (default 3) and reports the median;\n"
                "--quick runs a short sweep (the meson benchmark).\n"
+               "\n"
+               "sky-error: the sky as the runtime computes it from a default bake, against\n"
+               "an fp64 path tracer with every scattering order, per sun elevation (default\n"
+               "90 30 10 2 -4, or each --sun DEG) over 16 view directions from the scene's\n"
+               "camera altitude (docs/accuracy.md). --paths N per direction and channel\n"
+               "(default 16384); --seed N (default 1).\n"
                "\n"
                "exit codes: 0 ok, 1 bake failed, 2 usage or scene error, 3 no Vulkan device,\n"
                "            4 validation messages\n");
@@ -237,6 +246,98 @@ static int cmd_bench(int argc, char **argv)
     return 0;
 }
 
+static bool parse_number(const char *text, double lo, double hi, double *out)
+{
+    char *end;
+    double v = strtod(text, &end);
+    if (end == text || *end || !(v >= lo && v <= hi))
+        return false;
+    *out = v;
+    return true;
+}
+
+static int cmd_sky_error(int argc, char **argv)
+{
+    const char *scenes[16];
+    int scene_count = 0;
+    struct sb_vk_params vk_params = {.validate = validate_from_env()};
+    struct sb_sky_error_params params = {.seed = 1};
+    bool json = false;
+    for (int i = 0; i < argc; i++) {
+        const char *a = argv[i];
+        double v;
+        if (common_option(argc, argv, &i, &vk_params, &json))
+            continue;
+        if (!strcmp(a, "--paths") && i + 1 < argc) {
+            if (!parse_number(argv[++i], 32, 1e8, &v)) {
+                fprintf(stderr, "skybake: sky-error: --paths takes 32 to 1e8\n");
+                return EXIT_USAGE;
+            }
+            params.paths = (int)v;
+        } else if (!strcmp(a, "--seed") && i + 1 < argc) {
+            if (!parse_number(argv[++i], 0, 9007199254740992.0, &v) || v != floor(v)) {
+                fprintf(stderr, "skybake: sky-error: --seed takes an integer from 0 to 2^53\n");
+                return EXIT_USAGE;
+            }
+            params.seed = (uint64_t)v;
+        } else if (!strcmp(a, "--sun") && i + 1 < argc) {
+            if (!parse_number(argv[++i], -90, 90, &v) || params.sun_count == SB_SKY_ERROR_MAX_SUNS) {
+                fprintf(stderr, "skybake: sky-error: --sun takes an elevation in [-90, 90] degrees, at most %d times\n",
+                        SB_SKY_ERROR_MAX_SUNS);
+                return EXIT_USAGE;
+            }
+            params.sun_elevation_deg[params.sun_count++] = v;
+        } else if (a[0] == '-' && a[1]) {
+            fprintf(stderr, "skybake: unknown or incomplete option '%s'\n", a);
+            usage(stderr);
+            return EXIT_USAGE;
+        } else if (scene_count < 16) {
+            scenes[scene_count++] = a;
+        } else {
+            fprintf(stderr, "skybake: sky-error takes at most 16 scenes\n");
+            return EXIT_USAGE;
+        }
+    }
+    struct sb_scene *loaded = calloc((size_t)(scene_count ? scene_count : 1), sizeof(*loaded));
+    struct sb_sky_error_report *reports = calloc((size_t)(scene_count ? scene_count : 1), sizeof(*reports));
+    int rc = EXIT_USAGE;
+    if (!loaded || !reports)
+        goto done;
+    for (int i = 0; i < scene_count; i++)
+        if (sb_scene_load(scenes[i], &loaded[i]))
+            goto done;
+    if (!scene_count) {
+        sb_atmosphere_preset_earth(&loaded[0].atmosphere);
+        loaded[0].view = (struct sb_scene_view){0.002, 30};
+        scenes[scene_count++] = "the earth preset";
+    }
+
+    struct sb_vk *vk = NULL;
+    enum sb_result res = sb_vk_create(&vk_params, &vk);
+    if (res) {
+        rc = res == SB_ERR_NO_DEVICE ? EXIT_NO_DEVICE : EXIT_BAKE_FAILED;
+        goto done;
+    }
+    for (int i = 0; i < scene_count && !res; i++)
+        res = sb_sky_error_run(vk, scenes[i], &loaded[i], &params, &reports[i]);
+    unsigned messages = sb_vk_validation_messages(vk);
+    sb_vk_destroy(&vk);
+    if (res) {
+        rc = EXIT_BAKE_FAILED;
+        goto done;
+    }
+    sb_sky_error_print(reports, scene_count, json);
+    rc = 0;
+    if (messages) {
+        sb_error("%u validation message(s) during sky-error", messages);
+        rc = EXIT_VALIDATION;
+    }
+done:
+    free(loaded);
+    free(reports);
+    return rc;
+}
+
 int main(int argc, char **argv)
 {
     if (argc < 2) {
@@ -255,6 +356,8 @@ int main(int argc, char **argv)
         return cmd_bake(argc - 2, argv + 2);
     if (!strcmp(argv[1], "bench"))
         return cmd_bench(argc - 2, argv + 2);
+    if (!strcmp(argv[1], "sky-error"))
+        return cmd_sky_error(argc - 2, argv + 2);
     fprintf(stderr, "skybake: unknown command '%s'\n", argv[1]);
     usage(stderr);
     return EXIT_USAGE;

@@ -95,6 +95,16 @@ check "bench marks a Pareto front" grep -Eq '"pareto":[[:space:]]*true' "$tmp/be
 check "bench table names the default" grep -q '^.\*gl8x1' "$tmp/out"
 check "bench refuses an unknown product" expect_exit 2 "$skybake" bench --product sky
 
+# sky-error: the runtime's sky against the path tracer.
+check "sky-error runs" expect_exit 0 "$skybake" sky-error "$scene" --paths 64 --sun 30 --sun -4 --json -q
+check "sky-error reports both suns" test "$(grep -c '"elevation_deg"' "$tmp/out")" = 2
+check "sky-error reports 16 directions per sun" test "$(grep -c '"zenith_deg"' "$tmp/out")" = 32
+check "sky-error values are finite" test -z "$(grep -Ei 'nan|inf' "$tmp/out")"
+for bad in '--paths 8' '--paths x' '--sun 91' '--sun' '--seed -1'; do
+    # shellcheck disable=SC2086 # split on purpose
+    check "sky-error refuses $bad" expect_exit 2 "$skybake" sky-error "$scene" $bad
+done
+
 echo "cli: $checks checks, $fails failed"
 echo "$((checks - fails)) passed, $fails failed"
 [ "$fails" = 0 ]

@@ -1,0 +1,69 @@
+/*
+ * skybake sky-error: how good the sky is, not only the LUTs. The scene's
+ * atmosphere is baked with the default settings on the device; its sky
+ * radiance is then evaluated as the runtime computes it from those LUTs
+ * (single scattering, Hillaire's multiple scattering from the
+ * multiscattering LUT, the lit ground from irradiance_ground; in fp64 by
+ * sb_ref_sky_radiance, which skyview's sky-view LUT matches to 1e-3) and
+ * compared with the fp64 path tracer (pathtrace.h), every order counted,
+ * over a fixed set of view directions from the scene's camera altitude, for
+ * each of a list of sun elevations. What it measures is the multiple-
+ * scattering approximation itself: the LUTs' own errors against fp64 are
+ * bench's business and 1e-3 or less.
+ */
+#ifndef SB_BAKER_SKY_ERROR_H
+#define SB_BAKER_SKY_ERROR_H
+
+#include <stdbool.h>
+#include <stdint.h>
+
+#include "context.h"
+#include "scene.h"
+
+#define SB_SKY_ERROR_MAX_SUNS 16
+#define SB_SKY_ERROR_DIRECTIONS 16
+
+struct sb_sky_error_params {
+    int paths;     /* per direction and channel; 0: 16384 */
+    uint64_t seed; /* the path tracer's */
+    int sun_count; /* 0: 90, 30, 10, 2 and -4 degrees */
+    double sun_elevation_deg[SB_SKY_ERROR_MAX_SUNS];
+};
+
+/* One view direction: zenith angle and azimuth from the sun, in degrees. */
+struct sb_sky_error_direction {
+    double zenith_deg, azimuth_deg;
+    double skybake[3];     /* the runtime's model on the baked LUTs */
+    double single[3];      /* its single scattering alone (no ground light) */
+    double path_traced[3]; /* the reference */
+    double std_error[3];   /* the reference's standard error */
+};
+
+struct sb_sky_error_sun {
+    double elevation_deg;
+    struct sb_sky_error_direction directions[SB_SKY_ERROR_DIRECTIONS];
+    /* Over directions and channels, relative to the path tracer (floored at
+     * 1e-3 of the sun's brightest value in that channel): */
+    double max_rel, rms_rel, mean_rel; /* mean_rel is signed: skybake above the reference > 0 */
+    int worst_direction, worst_channel;
+    double noise;          /* the largest 2 standard errors, relative */
+    double multiple_share; /* mean of 1 - single / path traced: how much light the higher orders bring */
+};
+
+struct sb_sky_error_report {
+    char scene[256];
+    double altitude_km;
+    int paths;
+    int sun_count;
+    struct sb_sky_error_sun suns[SB_SKY_ERROR_MAX_SUNS];
+    double path_trace_s; /* wall time of the path tracer */
+};
+
+/* Bake and compare; the report is the caller's (no resources to free). */
+enum sb_result sb_sky_error_run(struct sb_vk *vk, const char *scene_name, const struct sb_scene *scene,
+                                const struct sb_sky_error_params *params, struct sb_sky_error_report *report);
+
+/* A table per report, or all reports as one JSON array, on stdout. */
+void sb_sky_error_print(const struct sb_sky_error_report *reports, int count, bool json);
+
+#endif
