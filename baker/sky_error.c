@@ -17,10 +17,35 @@
 
 /* Zenith angles from straight up to below the horizon (the ground, for a
  * camera in the air), each at the sun's azimuth, across and opposite; the
- * zenith once. */
+ * zenith once. A camera above the atmosphere looks down instead: the
+ * nadir, three rings on the ground (0.5, 0.9 and 0.99 of the angle to its
+ * edge) and two through the limb (grazing 5 and 30 km up). */
 static const double zenith_deg[] = {30, 60, 80, 87, 120};
 static const double azimuth_deg[] = {0, 90, 180};
 static const double default_suns[] = {90, 30, 10, 2, -4};
+
+static void direction_angles(const struct sb_atmosphere_params *p, double altitude_km, int i, double *zenith,
+                             double *azimuth)
+{
+    double R = p->ground_radius_km, r = R + altitude_km;
+    bool space = r > p->top_radius_km;
+    if (i == 0) {
+        *zenith = space ? 180 : 0;
+        *azimuth = 0;
+        return;
+    }
+    int ring = (i - 1) / 3;
+    *azimuth = azimuth_deg[(i - 1) % 3];
+    if (!space) {
+        *zenith = zenith_deg[ring];
+        return;
+    }
+    /* angles from the nadir */
+    double edge = asin(R / r) * 180 / SKY_PI;
+    const double ground[3] = {0.5, 0.9, 0.99}, limb_km[2] = {5, 30};
+    double from_nadir = ring < 3 ? ground[ring] * edge : asin((R + limb_km[ring - 3]) / r) * 180 / SKY_PI;
+    *zenith = 180 - from_nadir;
+}
 
 struct job {
     const struct sb_atmosphere_params *params;
@@ -28,16 +53,6 @@ struct job {
     const struct sb_sky_error_params *settings;
     struct sb_sky_error_report *report;
 };
-
-static void direction_angles(int i, double *zenith, double *azimuth)
-{
-    if (i == 0) {
-        *zenith = *azimuth = 0;
-        return;
-    }
-    *zenith = zenith_deg[(i - 1) / 3];
-    *azimuth = azimuth_deg[(i - 1) % 3];
-}
 
 /* One (sun, direction, channel). */
 static void run_one(void *user, int index)
@@ -50,8 +65,9 @@ static void run_one(void *user, int index)
     double elevation = sun->elevation_deg * SKY_PI / 180;
     double mu = cos(zenith), mu_s = sin(elevation);
     double nu = fmax(-1.0, fmin(1.0, sin(zenith) * cos(elevation) * cos(azimuth) + mu * mu_s));
-    double h = job->report->altitude_km;
+    double h = job->report->altitude_km, R = job->params->ground_radius_km, r = R + h;
     if (channel == 0) {
+        dir->ground = mu < 0 && r * r * (mu * mu - 1) + R * R >= 0;
         sb_ref_sky_radiance(job->params, h, mu, mu_s, nu, &job->luts[SB_PRODUCT_TRANSMITTANCE],
                             &job->luts[SB_PRODUCT_MULTISCATTERING], &job->luts[SB_PRODUCT_IRRADIANCE_GROUND], NULL,
                             dir->skybake);
@@ -60,9 +76,9 @@ static void run_one(void *user, int index)
     }
     struct sb_pathtrace_view view = {h, mu, mu_s, nu};
     struct sb_pathtrace_params params = {.seed = job->settings->seed, .paths = job->report->paths};
-    struct sb_pathtrace_result r = sb_pathtrace_radiance(job->params, &view, channel, &params);
-    dir->path_traced[channel] = r.radiance;
-    dir->std_error[channel] = r.std_error;
+    struct sb_pathtrace_result traced = sb_pathtrace_radiance(job->params, &view, channel, &params);
+    dir->path_traced[channel] = traced.radiance;
+    dir->std_error[channel] = traced.std_error;
 }
 
 static void summarise(struct sb_sky_error_sun *sun)
@@ -90,7 +106,7 @@ static void summarise(struct sb_sky_error_sun *sun)
             sum2 += rel * rel;
             sun->noise = fmax(sun->noise, 2 * dir->std_error[c] / ref);
             n++;
-            if (dir->zenith_deg < 90 && dir->path_traced[c] > 0) {
+            if (!dir->ground && dir->path_traced[c] > 0) {
                 share += 1 - dir->single[c] / dir->path_traced[c];
                 lit++;
             }
@@ -121,7 +137,8 @@ enum sb_result sb_sky_error_run(struct sb_vk *vk, const char *scene_name, const 
         struct sb_sky_error_sun *sun = &report->suns[s];
         sun->elevation_deg = params->sun_count > 0 ? params->sun_elevation_deg[s] : default_suns[s];
         for (int d = 0; d < SB_SKY_ERROR_DIRECTIONS; d++)
-            direction_angles(d, &sun->directions[d].zenith_deg, &sun->directions[d].azimuth_deg);
+            direction_angles(&scene->atmosphere, report->altitude_km, d, &sun->directions[d].zenith_deg,
+                             &sun->directions[d].azimuth_deg);
     }
 
     /* The products the sky reads, baked as a default bake bakes them. */

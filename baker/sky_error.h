@@ -33,6 +33,7 @@ struct sb_sky_error_params {
 /* One view direction: zenith angle and azimuth from the sun, in degrees. */
 struct sb_sky_error_direction {
     double zenith_deg, azimuth_deg;
+    bool ground;           /* the view ends on the ground */
     double skybake[3];     /* the runtime's model on the baked LUTs */
     double single[3];      /* its single scattering alone (no ground light) */
     double path_traced[3]; /* the reference */
@@ -47,7 +48,8 @@ struct sb_sky_error_sun {
     double max_rel, rms_rel, mean_rel; /* mean_rel is signed: skybake above the reference > 0 */
     int worst_direction, worst_channel;
     double noise;          /* the largest 2 standard errors, relative */
-    double multiple_share; /* mean of 1 - single / path traced: how much light the higher orders bring */
+    double multiple_share; /* mean of 1 - single / path traced over the views of the sky (not
+                              the ground): how much light the higher orders bring */
 };
 
 struct sb_sky_error_report {

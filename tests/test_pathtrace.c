@@ -8,6 +8,12 @@
  *   space) against the deterministic fp64 integrator of atmosphere_ref.h;
  * - double scattering against a nested quadrature of that integrator's
  *   single scattering over the sphere at points of the view ray;
+ * - every order at once by energy: with nothing absorbing (no ozone, no
+ *   Mie absorption, a white ground) all the sunlight the atmosphere
+ *   intercepts leaves through its top again, so the radiance leaving it,
+ *   integrated over the top sphere and its directions, equals the
+ *   incoming flux less what crosses the atmosphere's rim unscattered
+ *   (the sun itself, which the sky leaves out) -- a "white furnace";
  * - reproducibility: the same numbers on every call and any thread.
  * Each comparison allows 5 standard errors of the path tracer (estimated
  * from 16 independent batches) plus the deterministic side's own error, and
@@ -277,6 +283,78 @@ static void check_double_scattering(void)
     free(job);
 }
 
+/*
+ * The furnace: Phi_out = int_top int_inward L cos dw dA against
+ * Phi_in = pi top^2 E (1 - direct), direct being the fraction that crosses
+ * unscattered: (2 / top^2) int_R^top T(b) b db over impact parameters b,
+ * T(b) the whole chord's. With points uniform on the top sphere (the sun's
+ * cosine there uniform in [-1, 1]), inward directions cosine-weighted and
+ * the azimuth to the sun uniform, each sample estimates the ratio as
+ * 4 pi L / E. Stratified, in independent replicas whose spread gives the
+ * error.
+ */
+#define FURNACE_REPLICAS 8
+#define FURNACE_STRATA 12 /* per dimension of (sun cosine, view cosine^2, azimuth): 1728 views a replica */
+
+struct furnace_job {
+    struct sb_atmosphere_params p;
+    int channel;
+    double ratio[FURNACE_REPLICAS];
+};
+
+static void furnace_replica(void *user, int k)
+{
+    struct furnace_job *job = user;
+    const int n = FURNACE_STRATA;
+    double sum = 0;
+    uint64_t state = 0x9e3779b97f4a7c15ull * (uint64_t)(k + 1);
+    for (int i = 0; i < n * n * n; i++) {
+        double u[3];
+        for (int d = 0; d < 3; d++) { /* jitter in the stratum (a 64-bit LCG is plenty here) */
+            state = state * 6364136223846793005ull + 1442695040888963407ull;
+            u[d] = ((i / (d == 0 ? 1 : d == 1 ? n : n * n)) % n + (double)(state >> 11) * 0x1.0p-53) / n;
+        }
+        double mu_s = 2 * u[0] - 1, mu = -sqrt(u[1]), phi = 2 * M_PI * u[2];
+        double nu = mu * mu_s + sqrt(1 - mu * mu) * sqrt(1 - mu_s * mu_s) * cos(phi);
+        struct sb_pathtrace_view view = {job->p.top_radius_km - job->p.ground_radius_km, mu, mu_s, nu};
+        struct sb_pathtrace_params params = {.seed = (uint64_t)k, .paths = 16};
+        sum += sb_pathtrace_radiance(&job->p, &view, job->channel, &params).radiance;
+    }
+    job->ratio[k] = 4 * M_PI * sum / (n * n * n) / job->p.solar_irradiance[job->channel];
+}
+
+static void check_furnace(void)
+{
+    struct furnace_job job = {0};
+    sb_atmosphere_preset_earth(&job.p);
+    for (int c = 0; c < 3; c++) {
+        job.p.mie_absorption_per_km[c] = job.p.ozone_absorption_per_km[c] = 0;
+        job.p.ground_albedo[c] = 1;
+        job.p.mie_scattering_per_km[c] *= 10; /* more orders, and the Mie sampling's weights */
+    }
+    job.channel = 2; /* blue: the most scattering */
+    sb_parallel_for(FURNACE_REPLICAS, furnace_replica, &job);
+    double mean = 0, var = 0;
+    for (int k = 0; k < FURNACE_REPLICAS; k++)
+        mean += job.ratio[k] / FURNACE_REPLICAS;
+    for (int k = 0; k < FURNACE_REPLICAS; k++)
+        var += (job.ratio[k] - mean) * (job.ratio[k] - mean) / (FURNACE_REPLICAS - 1);
+    double error = sqrt(var / FURNACE_REPLICAS);
+    /* b = top - (top - R) s^2, dense at the rim's inner edge */
+    double R = job.p.ground_radius_km, top = job.p.top_radius_km, direct = 0, s[48], w[48];
+    gauss_legendre(48, 0, 1, s, w);
+    for (int i = 0; i < 48; i++) {
+        double b = top - (top - R) * s[i] * s[i], db = (top - R) * 2 * s[i] * w[i], t[3];
+        sb_ref_transmittance(&job.p, top, -sqrt(1 - (b / top) * (b / top)), 4, t);
+        direct += 2 / (top * top) * t[job.channel] * b * db;
+    }
+    double expected = 1 - direct;
+    printf("furnace: outgoing over incoming flux %.5f +- %.2g, expected %.5f (%.1f sigma)\n", mean, error, expected,
+           fabs(mean - expected) / error);
+    CHECK(error <= 3e-3, "furnace: standard error %.3g", error);
+    CHECK(fabs(mean - expected) <= 5 * error, "furnace: %.5f of the flux leaves, expected %.5f", mean, expected);
+}
+
 struct repeat_job {
     struct sb_atmosphere_params p;
     struct sb_pathtrace_result r[8];
@@ -331,6 +409,7 @@ int main(void)
     check_single_scattering("earth", &earth);
     check_single_scattering("mars", &mars);
     check_double_scattering();
+    check_furnace();
     check_reproducible();
     return test_finish("pathtrace");
 }
