@@ -12,6 +12,7 @@
 #include <time.h>
 #include <unistd.h>
 
+#include "json.h"
 #include "log.h"
 
 #define HILLAIRE "Hillaire 2020 (40-step march, offset 0.3)"
@@ -334,12 +335,7 @@ static cJSON *report_json(const struct sb_bench_report *report, const struct sb_
 void sb_bench_print(const struct sb_bench_report *report, const struct sb_vk *vk, bool json)
 {
     if (json) {
-        cJSON *root = report_json(report, vk);
-        char *text = cJSON_Print(root);
-        if (text)
-            printf("%s\n", text);
-        free(text);
-        cJSON_Delete(root);
+        sb_json_emit(stdout, report_json(report, vk));
         return;
     }
     printf("skybake bench on %s (%s); GPU time is the median of the repeats\n", vk->properties.deviceName,

@@ -14,7 +14,9 @@
 #include "bake.h"
 #include "bench.h"
 #include "context.h"
+#include "json.h"
 #include "log.h"
+#include "pack_info.h"
 #include "scene.h"
 #include "skybake_version.h"
 #include "sky_error.h"
@@ -31,6 +33,7 @@ static void usage(FILE *f)
     fprintf(f, "usage: skybake bake SCENE -o OUT_DIR [options]\n"
                "       skybake bench [SCENE] [--product NAME]... [--json] [-o DIR] [--repeat N] [--quick]\n"
                "       skybake sky-error [SCENE]... [--paths N] [--seed N] [--sun DEG]... [--json]\n"
+               "       skybake info PACK [--json]\n"
                "       skybake --version | --help\n"
                "\n"
                "Bakes what SCENE (JSON, see docs/scene.md) needs into the pack OUT_DIR:\n"
@@ -60,6 +63,9 @@ static void usage(FILE *f)
                "camera altitude (docs/accuracy.md). --paths N per direction and channel\n"
                "(default 16384); --seed N (default 1).\n"
                "\n"
+               "info: what PACK holds (products, sizes, settings and errors, hashes, device,\n"
+               "version), after verifying all of it; exit 2 if it is not a valid pack.\n"
+               "\n"
                "exit codes: 0 ok, 1 bake failed, 2 usage or scene error, 3 no Vulkan device,\n"
                "            4 validation messages\n");
 }
@@ -83,11 +89,7 @@ static void print_json(const char *out_dir, const struct sb_vk *vk, const struct
         cJSON_AddStringToObject(o, "content_hash", a->content_hash);
         cJSON_AddItemToArray(arr, o);
     }
-    char *text = cJSON_Print(root);
-    if (text)
-        printf("%s\n", text);
-    free(text);
-    cJSON_Delete(root);
+    sb_json_emit(stdout, root);
 }
 
 /* The options bake and bench share; returns false for an unknown one. */
@@ -338,6 +340,41 @@ done:
     return rc;
 }
 
+static int cmd_info(int argc, char **argv)
+{
+    const char *dir = NULL;
+    struct sb_vk_params unused = {0};
+    bool json = false;
+    for (int i = 0; i < argc; i++) {
+        const char *a = argv[i];
+        if (common_option(argc, argv, &i, &unused, &json))
+            continue;
+        if (a[0] == '-' && a[1]) {
+            fprintf(stderr, "skybake: unknown or incomplete option '%s'\n", a);
+            usage(stderr);
+            return EXIT_USAGE;
+        }
+        if (dir) {
+            fprintf(stderr, "skybake: unexpected argument '%s'\n", a);
+            return EXIT_USAGE;
+        }
+        dir = a;
+    }
+    if (!dir) {
+        fprintf(stderr, "skybake: info needs a PACK\n");
+        return EXIT_USAGE;
+    }
+    struct sb_pack pack;
+    enum sb_result res = sb_pack_open(dir, &pack);
+    if (res) {
+        sb_error("%s: not a valid pack (%s)", dir, sb_result_name(res));
+        return EXIT_USAGE;
+    }
+    sb_pack_info_print(&pack, dir, json);
+    sb_pack_close(&pack);
+    return 0;
+}
+
 int main(int argc, char **argv)
 {
     if (argc < 2) {
@@ -356,6 +393,8 @@ int main(int argc, char **argv)
         return cmd_bake(argc - 2, argv + 2);
     if (!strcmp(argv[1], "bench"))
         return cmd_bench(argc - 2, argv + 2);
+    if (!strcmp(argv[1], "info"))
+        return cmd_info(argc - 2, argv + 2);
     if (!strcmp(argv[1], "sky-error"))
         return cmd_sky_error(argc - 2, argv + 2);
     fprintf(stderr, "skybake: unknown command '%s'\n", argv[1]);

@@ -9,6 +9,7 @@
 
 #include "atmosphere.h"
 #include "atmosphere_ref.h"
+#include "json.h"
 #include "log.h"
 #include "parallel.h"
 #include "pathtrace.h"
@@ -217,11 +218,7 @@ void sb_sky_error_print(const struct sb_sky_error_report *reports, int count, bo
             }
             cJSON_AddItemToArray(root, o);
         }
-        char *text = cJSON_Print(root);
-        if (text)
-            printf("%s\n", text);
-        free(text);
-        cJSON_Delete(root);
+        sb_json_emit(stdout, root);
         return;
     }
     for (int i = 0; i < count; i++) {

@@ -107,3 +107,12 @@ enum sb_result sb_json_check_duplicates(const cJSON *object, const char *source,
             }
     return SB_OK;
 }
+
+bool sb_json_emit(FILE *out, cJSON *root)
+{
+    char *text = root ? cJSON_Print(root) : NULL;
+    bool ok = text && fprintf(out, "%s\n", text) >= 0;
+    free(text);
+    cJSON_Delete(root);
+    return ok;
+}

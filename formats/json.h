@@ -9,6 +9,7 @@
 #include <cJSON.h>
 #include <stdbool.h>
 #include <stddef.h>
+#include <stdio.h>
 
 #include "result.h"
 
@@ -25,5 +26,9 @@ enum sb_result sb_json_load(int dir, const char *path, const char *source, size_
 
 /* SB_ERR_DUPLICATE_KEY, logged as source: where.key, if `object` has a key twice. */
 enum sb_result sb_json_check_duplicates(const cJSON *object, const char *source, const char *where);
+
+/* Print `root` formatted, and a newline, to `out`, then cJSON_Delete it
+ * (accepts NULL). False when memory or the write failed. */
+bool sb_json_emit(FILE *out, cJSON *root);
 
 #endif

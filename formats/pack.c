@@ -5,6 +5,7 @@
 #include <errno.h>
 #include <fcntl.h>
 #include <libgen.h>
+#include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -326,16 +327,37 @@ void sb_pack_writer_destroy(struct sb_pack_writer **writer)
 
 #define PACK_MANIFEST_MAX_BYTES (1u << 20)
 
+/* The member `key` of `object`, or NULL, logged as missing. */
+static const cJSON *manifest_item(const cJSON *object, const char *key, const char *source, const char *where)
+{
+    const cJSON *item = cJSON_GetObjectItemCaseSensitive(object, key);
+    if (!item)
+        sb_error("%s: %s%s: missing", source, where, key);
+    return item;
+}
+
+/* A number member, or NULL with *res saying why. */
+static const cJSON *manifest_number(const cJSON *object, const char *key, const char *source, const char *where,
+                                    enum sb_result *res)
+{
+    const cJSON *item = manifest_item(object, key, source, where);
+    *res = item ? SB_OK : SB_ERR_MISSING_FIELD;
+    if (item && !cJSON_IsNumber(item)) {
+        sb_error("%s: %s%s: expected a number", source, where, key);
+        *res = SB_ERR_WRONG_TYPE;
+        item = NULL;
+    }
+    return item;
+}
+
 /* A string member of `object`, copied into out[size]; absent, another type
  * or too long is an error naming where. */
 static enum sb_result manifest_string(const cJSON *object, const char *key, char *out, size_t size, const char *source,
                                       const char *where)
 {
-    const cJSON *item = cJSON_GetObjectItemCaseSensitive(object, key);
-    if (!item) {
-        sb_error("%s: %s%s: missing", source, where, key);
+    const cJSON *item = manifest_item(object, key, source, where);
+    if (!item)
         return SB_ERR_MISSING_FIELD;
-    }
     if (!cJSON_IsString(item)) {
         sb_error("%s: %s%s: expected a string", source, where, key);
         return SB_ERR_WRONG_TYPE;
@@ -348,19 +370,31 @@ static enum sb_result manifest_string(const cJSON *object, const char *key, char
     return SB_OK;
 }
 
+/* An integer member in [0, 2^32). */
+static enum sb_result manifest_u32(const cJSON *object, const char *key, uint32_t *out, const char *source,
+                                   const char *where)
+{
+    enum sb_result res;
+    const cJSON *item = manifest_number(object, key, source, where, &res);
+    if (!item)
+        return res;
+    double v = item->valuedouble;
+    if (!(v >= 0 && v <= 4294967295.0) || v != floor(v)) {
+        sb_error("%s: %s%s: expected an integer in [0, 2^32), got %g", source, where, key, v);
+        return SB_ERR_OUT_OF_RANGE;
+    }
+    *out = (uint32_t)v;
+    return SB_OK;
+}
+
 /* An integer member that must equal `expect`. */
 static enum sb_result manifest_expect_int(const cJSON *object, const char *key, uint32_t expect, const char *source,
                                           const char *where, const char *product)
 {
-    const cJSON *item = cJSON_GetObjectItemCaseSensitive(object, key);
-    if (!item) {
-        sb_error("%s: %s%s: missing", source, where, key);
-        return SB_ERR_MISSING_FIELD;
-    }
-    if (!cJSON_IsNumber(item)) {
-        sb_error("%s: %s%s: expected a number", source, where, key);
-        return SB_ERR_WRONG_TYPE;
-    }
+    enum sb_result res;
+    const cJSON *item = manifest_number(object, key, source, where, &res);
+    if (!item)
+        return res;
     if (item->valuedouble != (double)expect) {
         sb_error("%s: %s%s: %s of format version %d has %u, the manifest says %g", source, where, key, product,
                  SB_PACK_FORMAT_VERSION, expect, item->valuedouble);
@@ -592,6 +626,13 @@ enum sb_result sb_pack_open(const char *dir, struct sb_pack *pack)
         res = manifest_string(device, "name", pack->device.name, sizeof(pack->device.name), source, "device.");
     if (!res)
         res = manifest_string(device, "driver", pack->device.driver, sizeof(pack->device.driver), source, "device.");
+    if (!res)
+        res = manifest_string(device, "api_version", pack->device.api_version, sizeof(pack->device.api_version), source,
+                              "device.");
+    if (!res)
+        res = manifest_u32(device, "vendor_id", &pack->device.vendor_id, source, "device.");
+    if (!res)
+        res = manifest_u32(device, "device_id", &pack->device.device_id, source, "device.");
     const cJSON *artifacts = res ? NULL : cJSON_GetObjectItemCaseSensitive(root, "artifacts");
     if (!res && !cJSON_IsArray(artifacts)) {
         sb_error("%s: artifacts: %s", source, artifacts ? "expected an array" : "missing");

@@ -36,6 +36,13 @@ check "hashes equal in --json and manifest" test "$(hashes "$tmp/a.json" | tr -d
 for f in manifest.json transmittance.exr multiscattering.exr irradiance_ground.exr irradiance_sky.exr; do
     check "pack holds $f" test -s "$tmp/a/$f"
 done
+check "info on a pack" expect_exit 0 "$skybake" info "$tmp/a"
+check "info names the device" grep -q "^device: " "$tmp/out"
+check "info lists the four products" test "$(grep -Ec '^(transmittance|multiscattering|irradiance_ground|irradiance_sky) ' "$tmp/out")" = 4
+check "info --json" expect_exit 0 "$skybake" info "$tmp/a" --json
+check "info --json has the manifest's hashes" test "$(hashes "$tmp/out" | tr -d ' ,\t')" = "$(hashes "$tmp/a/manifest.json" | tr -d ' ,\t')"
+check "info needs a pack" expect_exit 2 "$skybake" info
+check "info refuses what is not a pack" expect_exit 2 "$skybake" info "$root/data"
 check "manifest has format_version 1" grep -Eq '"format_version":[[:space:]]*1,' "$tmp/a/manifest.json"
 
 # Rebaking over a pack replaces it whole; a failed bake leaves it as it was.
