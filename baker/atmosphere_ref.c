@@ -20,27 +20,13 @@ struct gl_rule {
 static struct gl_rule gl8, gl16;
 static pthread_once_t gl_once = PTHREAD_ONCE_INIT;
 
+static void gl_node(int k, int n, double a, double b, double *x, double *w);
+
 static void gl_compute(struct gl_rule *g, int n)
 {
     g->n = n;
-    for (int i = 0; i < n; i++) {
-        double z = cos(REF_PI * (i + 0.75) / (n + 0.5)), dp = 1;
-        for (int it = 0; it < 100; it++) {
-            double p0 = 1, p1 = 0;
-            for (int j = 1; j <= n; j++) {
-                double p2 = p1;
-                p1 = p0;
-                p0 = ((2.0 * j - 1) * z * p1 - (j - 1.0) * p2) / j;
-            }
-            dp = n * (z * p0 - p1) / (z * z - 1);
-            double dz = p0 / dp;
-            z -= dz;
-            if (fabs(dz) < 1e-16)
-                break;
-        }
-        g->x[n - 1 - i] = z;
-        g->w[n - 1 - i] = 2 / ((1 - z * z) * dp * dp);
-    }
+    for (int i = 0; i < n; i++)
+        gl_node(i, n, -1.0, 1.0, &g->x[i], &g->w[i]);
 }
 
 static void gl_init(void)
@@ -396,6 +382,12 @@ static void integrate_ray(const struct sb_atmosphere_params *p, double r0, doubl
         o->transmittance[c] = exp(-tau[c]);
 }
 
+void sb_ref_gauss_legendre(int n, double a, double b, double *x, double *w)
+{
+    for (int k = 0; k < n; k++)
+        gl_node(k, n, a, b, &x[k], &w[k]);
+}
+
 static struct sb_ref_quality resolve(const struct sb_ref_quality *q)
 {
     struct sb_ref_quality r = q ? *q : (struct sb_ref_quality){0};
@@ -410,7 +402,7 @@ static struct sb_ref_quality resolve(const struct sb_ref_quality *q)
     return r;
 }
 
-/* Gauss-Legendre node k of n on [a, b], fp64, for any n (<= 256). */
+/* Gauss-Legendre node k of n on [a, b], ascending, fp64, for any n (<= 256). */
 static void gl_node(int k, int n, double a, double b, double *x, double *w)
 {
     double z = cos(REF_PI * (k + 0.75) / (n + 0.5)), dp = 1;

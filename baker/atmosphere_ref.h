@@ -28,6 +28,9 @@ struct sb_ref_quality {
  * fp64 rounding). */
 void sb_ref_transmittance(const struct sb_atmosphere_params *p, double r, double mu, int subdivisions, double out[3]);
 
+/* The n-point Gauss-Legendre rule on [a, b]: nodes x[n] ascending, weights w[n]. */
+void sb_ref_gauss_legendre(int n, double a, double b, double *x, double *w);
+
 /* Optical depth along the ray from radius r (km) with cosine mu, between
  * the distances t_from <= t_to (km) on it, at the same precision; the
  * segment must stay in the atmosphere. */

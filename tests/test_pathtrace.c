@@ -178,28 +178,6 @@ struct double_job {
     double inner[L2_NODES][3]; /* sigma_r int p_r L1 dw' at each node */
 };
 
-static void gauss_legendre(int n, double a, double b, double *x, double *w)
-{
-    for (int i = 0; i < n; i++) {
-        double z = cos(M_PI * (i + 0.75) / (n + 0.5)), dp = 1;
-        for (int it = 0; it < 100; it++) {
-            double p0 = 1, p1 = 0;
-            for (int j = 1; j <= n; j++) {
-                double p2 = p1;
-                p1 = p0;
-                p0 = ((2.0 * j - 1) * z * p1 - (j - 1.0) * p2) / j;
-            }
-            dp = n * (z * p0 - p1) / (z * z - 1);
-            double dz = p0 / dp;
-            z -= dz;
-            if (fabs(dz) < 1e-15)
-                break;
-        }
-        x[i] = 0.5 * (a + b) - 0.5 * (b - a) * z;
-        w[i] = (b - a) / ((1 - z * z) * dp * dp);
-    }
-}
-
 static void double_node(void *user, int i)
 {
     struct double_job *job = user;
@@ -215,8 +193,8 @@ static void double_node(void *user, int i)
     double up[3] = {x[0] / r, 0, x[2] / r}, e1[3] = {up[2], 0, -up[0]}, e2[3] = {0, 1, 0};
     double mu_h = -sqrt(fmax(1 - (R / r) * (R / r), 0));
     double mus[2 * L2_MU], wmu[2 * L2_MU];
-    gauss_legendre(L2_MU, -1, mu_h, mus, wmu);
-    gauss_legendre(L2_MU, mu_h, 1, mus + L2_MU, wmu + L2_MU);
+    sb_ref_gauss_legendre(L2_MU, -1, mu_h, mus, wmu);
+    sb_ref_gauss_legendre(L2_MU, mu_h, 1, mus + L2_MU, wmu + L2_MU);
     double mu_s_here = sun[0] * up[0] + sun[1] * up[1] + sun[2] * up[2];
     double sum[3] = {0, 0, 0};
     struct sb_ref_quality q = {.level_steps = 1, .transmittance_subdivisions = 1};
@@ -253,7 +231,7 @@ static void check_double_scattering(void)
     double t_end = -R * job->mu0 + sqrt(R * R * (job->mu0 * job->mu0 - 1) + top * top);
     /* nodes in s with t = t_end s^2: dense where the air is */
     double s[L2_NODES], ws[L2_NODES];
-    gauss_legendre(L2_NODES, 0, 1, s, ws);
+    sb_ref_gauss_legendre(L2_NODES, 0, 1, s, ws);
     for (int i = 0; i < L2_NODES; i++) {
         job->t[i] = t_end * s[i] * s[i];
         job->w[i] = t_end * 2 * s[i] * ws[i];
@@ -342,7 +320,7 @@ static void check_furnace(void)
     double error = sqrt(var / FURNACE_REPLICAS);
     /* b = top - (top - R) s^2, dense at the rim's inner edge */
     double R = job.p.ground_radius_km, top = job.p.top_radius_km, direct = 0, s[48], w[48];
-    gauss_legendre(48, 0, 1, s, w);
+    sb_ref_gauss_legendre(48, 0, 1, s, w);
     for (int i = 0; i < 48; i++) {
         double b = top - (top - R) * s[i] * s[i], db = (top - R) * 2 * s[i] * w[i], t[3];
         sb_ref_transmittance(&job.p, top, -sqrt(1 - (b / top) * (b / top)), 4, t);
