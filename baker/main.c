@@ -271,8 +271,8 @@ static int cmd_sky_error(int argc, char **argv)
         if (common_option(argc, argv, &i, &vk_params, &json))
             continue;
         if (!strcmp(a, "--paths") && i + 1 < argc) {
-            if (!parse_number(argv[++i], 32, 1e8, &v)) {
-                fprintf(stderr, "skybake: sky-error: --paths takes 32 to 1e8\n");
+            if (!parse_number(argv[++i], 32, 1e8, &v) || v != floor(v)) {
+                fprintf(stderr, "skybake: sky-error: --paths takes an integer from 32 to 1e8\n");
                 return EXIT_USAGE;
             }
             params.paths = (int)v;
