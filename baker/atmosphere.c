@@ -142,7 +142,8 @@ uint64_t sb_atmosphere_settings_cost(enum sb_product_id id, const struct sb_atmo
 {
     struct sb_atmosphere_settings s = resolve_settings(id, settings);
     if (id != SB_PRODUCT_TRANSMITTANCE)
-        return (uint64_t)SB_SPHERE_MAX_PIECES * s.directions_mu * s.directions_phi;
+        return (uint64_t)(SB_SPHERE_MAX_PIECES + (id == SB_PRODUCT_MULTISCATTERING ? 0 : SB_SPHERE_CAP_PIECES)) *
+               s.directions_mu * s.directions_phi;
     if (s.quadrature == SB_QUADRATURE_GAUSS_LEGENDRE)
         return 5ull * s.samples * s.subdivisions; /* five pieces, as on the earth */
     return s.quadrature == SB_QUADRATURE_TRAPEZOID ? s.samples + 1ull : s.samples;
@@ -173,6 +174,7 @@ struct sb_atmosphere_baker {
     struct sb_buffer scratch; /* sphere.glsl's sums between passes */
     struct sb_buffer outputs[SB_PRODUCT_COUNT];
     struct sb_buffer lookups[SB_PRODUCT_COUNT]; /* the form later bakes read (config.h) */
+    bool sky_cap; /* irradiance_sky integrates Mie's peak on a cap (sphere.glsl) */
 };
 
 enum sb_result sb_atmosphere_baker_create(struct sb_vk *vk, const struct sb_atmosphere_params *params,
@@ -183,6 +185,7 @@ enum sb_result sb_atmosphere_baker_create(struct sb_vk *vk, const struct sb_atmo
     if (!b)
         return SB_ERR_NOMEM;
     b->vk = vk;
+    b->sky_cap = fabs(params->mie_g) >= SB_CAP_MIN_G;
     struct sb_atmosphere_gpu gpu;
     sb_atmosphere_gpu_pack(params, &gpu);
     enum sb_result res = sb_buffer_create(vk, sizeof(gpu), "atmosphere parameters", &b->params);
@@ -217,12 +220,13 @@ void sb_atmosphere_baker_destroy(struct sb_atmosphere_baker **pb)
  * Run a kernel with the parameters and every product baked so far bound (a
  * product is never bound as its own input), writing `output`. The kernel
  * runs SB_WORKGROUP_X x SB_WORKGROUP_Y texels a workgroup in one dispatch,
- * or, for sphere.glsl's integrals, one workgroup per texel in passes of
+ * or, for sphere.glsl's integrals over at most `directions` directions
+ * (else 0), one workgroup per texel in passes of
  * SB_SPHERE_STEPS_PER_PASS directions per invocation, the partial sums kept
  * in the scratch buffer; *gpu_ms sums the passes.
  */
 static enum sb_result run(struct sb_atmosphere_baker *b, const uint32_t *spirv, size_t spirv_size, const char *name,
-                          struct sb_buffer *output, uint32_t width, uint32_t height, bool workgroup_per_texel,
+                          struct sb_buffer *output, uint32_t width, uint32_t height, uint64_t directions,
                           const struct sb_atmosphere_settings *s, double *gpu_ms)
 {
     uint32_t directions_mu = s->directions_mu, directions_phi = s->directions_phi;
@@ -237,8 +241,8 @@ static enum sb_result run(struct sb_atmosphere_baker *b, const uint32_t *spirv, 
         .subdivisions = s->subdivisions,
     };
     enum sb_result res = SB_OK;
+    bool workgroup_per_texel = directions > 0;
     if (workgroup_per_texel) {
-        uint64_t directions = (uint64_t)SB_SPHERE_MAX_PIECES * directions_mu * directions_phi;
         push.step_count = (uint32_t)((directions + SB_SPHERE_THREADS - 1) / SB_SPHERE_THREADS);
         size_t bytes = 16 + (size_t)width * height * SB_SPHERE_THREADS * SB_SPHERE_MAX_SUMS * sizeof(float);
         if (b->scratch.size < bytes) {
@@ -346,8 +350,14 @@ enum sb_result sb_atmosphere_bake(struct sb_atmosphere_baker *b, enum sb_product
         id == SB_PRODUCT_TRANSMITTANCE
             ? &transmittance_shaders[s.quadrature == SB_QUADRATURE_GAUSS_LEGENDRE ? s.samples : 0]
             : &scattering_shaders[id];
-    if ((res = run(b, shader->words, shader->size, sb_product_name(id), &b->outputs[id], width, height,
-                   prod->workgroup_per_texel, &s, gpu_ms)))
+    /* the most directions a texel can have: the zenith grid's pieces, and the cap's where it has one */
+    uint64_t directions = 0;
+    if (prod->workgroup_per_texel) {
+        bool cap = id == SB_PRODUCT_IRRADIANCE_GROUND || (id == SB_PRODUCT_IRRADIANCE_SKY && b->sky_cap);
+        directions = (uint64_t)(SB_SPHERE_MAX_PIECES + (cap ? SB_SPHERE_CAP_PIECES : 0)) * s.directions_mu * s.directions_phi;
+    }
+    if ((res = run(b, shader->words, shader->size, sb_product_name(id), &b->outputs[id], width, height, directions, &s,
+                   gpu_ms)))
         goto cleanup;
     memcpy(image->data, b->outputs[id].mapped, bytes);
     /* A resolution other than the format's is a measurement: later bakes
@@ -378,7 +388,7 @@ enum sb_result sb_atmosphere_run_kernel(struct sb_atmosphere_baker *b, const uin
     uint32_t width = record_count < per_row ? record_count : per_row;
     uint32_t height = (record_count + per_row - 1) / per_row;
     struct sb_atmosphere_settings s = {.directions_mu = record_count, .directions_phi = record_floats};
-    res = run(b, spirv, spirv_size, "kernel", &io, width, height, false, &s, NULL);
+    res = run(b, spirv, spirv_size, "kernel", &io, width, height, 0, &s, NULL);
     if (!res)
         memcpy(records, io.mapped, bytes);
     sb_buffer_destroy(b->vk, &io);

@@ -1,5 +1,7 @@
 #include "atmosphere_ref.h"
 
+#include "config.h"
+
 #include <math.h>
 #include <pthread.h>
 #include <stdbool.h>
@@ -510,21 +512,13 @@ static int zenith_pieces(const struct sb_atmosphere_params *p, double h, bool wh
     return n;
 }
 
+static double crowd(double u, bool lo, bool hi, double *dx);
+
 static void zenith_node(const struct zenith_piece *piece, int k, int n, double *mu, double *w)
 {
-    double s, ws;
+    double s, ws, dx;
     gl_node(k, n, 0.0, 1.0, &s, &ws);
-    double x = s, dx = 1.0;
-    if (piece->crowd_lo && piece->crowd_hi) {
-        x = s * s * (3 - 2 * s);
-        dx = 6 * s * (1 - s);
-    } else if (piece->crowd_lo) {
-        x = s * s;
-        dx = 2 * s;
-    } else if (piece->crowd_hi) {
-        x = 1 - (1 - s) * (1 - s);
-        dx = 2 * (1 - s);
-    }
+    double x = crowd(s, piece->crowd_lo, piece->crowd_hi, &dx);
     *mu = piece->lo + (piece->hi - piece->lo) * x;
     *w = (piece->hi - piece->lo) * dx * ws;
 }
@@ -577,6 +571,164 @@ static int directions(const struct sb_atmosphere_params *p, const struct sb_ref_
     return n;
 }
 
+/*
+ * Mie single scattering, E_sun P_M(nu) S(w) with S = integral of T sigma_M
+ * T_sun dt, has a peak of its own: at the sun (at the anti-sun for g < 0),
+ * about 1 - |g| wide, which a grid fixed to the zenith does not resolve for
+ * g near +-1 (at g = 0.999, 24^2 directions left 10% errors). So it gets a
+ * cap around the peak's axis, where the phase function takes the share
+ * alpha and the zenith grid the rest, 1 - alpha:
+ * - over a hemisphere (irradiance_ground) the cap is all of it, alpha = 1;
+ * - over the sphere (irradiance_sky), where the light can come mostly from
+ *   far from the peak (below the horizon, from high up), the cap has radius
+ *   SB_CAP_THETA and alpha falls smoothly to 0 at twice that, and only for
+ *   |g| >= SB_CAP_MIN_G: below it the zenith grid, crowded toward the sun,
+ *   resolves the peak.
+ *
+ * The cap's directions: o = 1 - nu' (nu' = sign(g) nu, the cosine to the
+ * axis; o is exact near the peak, where nu is not in fp32) and psi =
+ * azimuth about the axis from its vertical plane (toward the zenith),
+ * d(solid angle) = do dpsi. The rings of constant o take Gauss-Legendre
+ * nodes in t = ln((1 - |g|)^2 + 2 |g| o), in which Henyey-Greenstein's
+ * peak is a plain exponential, so the nodes spread evenly in the log of the
+ * angle from the axis and resolve both the peak and S far from it;
+ * P_M do = k (1 + nu^2) dt / (2 |g| sqrt(e^t)), without cancellation.
+ *
+ * The horizon cuts the rings: mu = mu_a nu' + sin_a sin' cos(psi) (mu_a:
+ * the axis's cosine) meets mu_h at psi_h, where S jumps (rays toward the
+ * ground) or, for a hemisphere, the integration ends. Each ring is split
+ * there, nodes crowded toward the cut (S goes like sqrt(mu - mu_h) there, as
+ * in the zenith grid). The rings that touch the horizon, at angles
+ * |e_a - e_h| and pi - |e_a + e_h| from the axis (e: elevations), cut o
+ * into pieces, their nodes crowded toward those cuts, where the rings'
+ * split appears.
+ */
+static bool cap_active(const struct sb_atmosphere_params *p, bool whole_sphere)
+{
+    return !whole_sphere || fabs(p->mie_g) >= SB_CAP_MIN_G;
+}
+
+/* alpha at o = 1 - nu'. */
+static double cap_window_o(const struct sb_atmosphere_params *p, bool whole_sphere, double o)
+{
+    if (!cap_active(p, whole_sphere))
+        return 0.0;
+    if (!whole_sphere)
+        return 1.0;
+    double o_1 = 2 * sin(0.5 * SB_CAP_THETA) * sin(0.5 * SB_CAP_THETA), o_2 = 2 * sin(SB_CAP_THETA) * sin(SB_CAP_THETA);
+    double x = fmax(0.0, fmin(1.0, (o_2 - o) / (o_2 - o_1)));
+    return x * x * (3 - 2 * x);
+}
+
+/* alpha at a zenith-grid direction with sun cosine nu. */
+static double cap_window(const struct sb_atmosphere_params *p, bool whole_sphere, double nu)
+{
+    return cap_window_o(p, whole_sphere, 1 - (p->mie_g < 0 ? -nu : nu));
+}
+
+/* Nodes crowded toward an end, or both: x(u) in [0, 1] with dx = x'(u),
+ * flat (as u^2) at a crowded end. */
+static double crowd(double u, bool lo, bool hi, double *dx)
+{
+    *dx = 1.0;
+    if (lo && hi) {
+        *dx = 6 * u * (1 - u);
+        return u * u * (3 - 2 * u);
+    }
+    if (lo) {
+        *dx = 2 * u;
+        return u * u;
+    }
+    if (hi) {
+        *dx = 2 * (1 - u);
+        return 1 - (1 - u) * (1 - u);
+    }
+    return u;
+}
+
+/* A direction of the cap: phase_weight = P_M(nu) alpha times its solid angle. */
+struct cap_direction {
+    double mu, nu, phase_weight;
+    bool ground;
+};
+
+/* Every direction of the cap; the caller frees *out. Returns the count, or
+ * -1 when out of memory. */
+static int cap_directions(const struct sb_atmosphere_params *p, const struct sb_ref_quality *q, double h, double mu_s,
+                          bool whole_sphere, struct cap_direction **out)
+{
+    double R = p->ground_radius_km, r = R + h, g = fabs(p->mie_g), sign = p->mie_g < 0 ? -1.0 : 1.0;
+    double mu_h = whole_sphere ? -sqrt(fmax(1.0 - (R / r) * (R / r), 0.0)) : 0.0;
+    double mu_a = sign * mu_s, e_a = asin(mu_a), e_h = asin(mu_h);
+    double reach = whole_sphere ? 2 * SB_CAP_THETA : REF_PI;
+    double o_end = whole_sphere ? 2 * sin(SB_CAP_THETA) * sin(SB_CAP_THETA) : 2.0;
+    double a = 0.5 * fabs(e_a - e_h), b = 0.5 * fabs(e_a + e_h);
+    double cuts[2] = {2 * sin(a) * sin(a), 2 * cos(b) * cos(b)};
+    struct {
+        double lo, hi;
+        bool crowd_lo, crowd_hi;
+    } pieces[3];
+    int piece_count = 0;
+    double from = 0.0;
+    for (int i = 0; i < 2; i++)
+        if (cuts[i] > from && cuts[i] < o_end) {
+            pieces[piece_count].lo = from;
+            pieces[piece_count].hi = cuts[i];
+            pieces[piece_count].crowd_lo = from > 0;
+            pieces[piece_count++].crowd_hi = true;
+            from = cuts[i];
+        }
+    pieces[piece_count].lo = from;
+    pieces[piece_count].hi = o_end;
+    pieces[piece_count].crowd_lo = from > 0;
+    pieces[piece_count++].crowd_hi = false;
+    int side_first = e_a - e_h > -reach ? 0 : 1, side_end = whole_sphere && e_a - e_h < reach ? 2 : 1;
+    *out = malloc((size_t)piece_count * q->directions_mu * (side_end - side_first) * q->directions_phi * sizeof(**out));
+    if (!*out)
+        return -1;
+    double qg = (1 - g) * (1 - g), k_phase = 3.0 / (8.0 * REF_PI) * (1 - g * g) / (2 + g * g);
+    double sin_a = sqrt(fmax(1 - mu_s * mu_s, 0.0));
+    int n = 0;
+    for (int pc = 0; pc < piece_count; pc++)
+        for (int k = 0; k < q->directions_mu; k++) {
+            double u, w_u, dx, lo = pieces[pc].lo, hi = pieces[pc].hi, o, phase_do;
+            gl_node(k, q->directions_mu, 0.0, 1.0, &u, &w_u);
+            double x = crowd(u, pieces[pc].crowd_lo, pieces[pc].crowd_hi, &dx);
+            if (g < 0.01) {
+                o = lo + (hi - lo) * x;
+                phase_do = k_phase * (1 + (1 - o) * (1 - o)) / pow(qg + 2 * g * o, 1.5) * (hi - lo) * dx * w_u;
+            } else {
+                double t_lo = log(qg + 2 * g * lo), t_hi = log(qg + 2 * g * hi);
+                double e = exp(t_lo + (t_hi - t_lo) * x);
+                o = fmax(lo, fmin(hi, (e - qg) / (2 * g)));
+                phase_do = k_phase * (1 + (1 - o) * (1 - o)) * (t_hi - t_lo) * dx * w_u / (2 * g * sqrt(e));
+            }
+            double nu_a = 1 - o, sin_v = sqrt(fmax(o * (2 - o), 0.0));
+            double radius = sin_a * sin_v, centre = mu_a * nu_a;
+            /* psi_h: the ring is above the horizon for psi < psi_h */
+            double psi_h = radius > 0 ? acos(fmax(-1.0, fmin(1.0, (mu_h - centre) / radius)))
+                                      : (centre >= mu_h ? REF_PI : 0.0);
+            double alpha = cap_window_o(p, whole_sphere, o);
+            for (int side = side_first; side < side_end; side++) {
+                double psi_lo = side ? psi_h : 0.0, psi_hi = side ? REF_PI : psi_h;
+                for (int ip = 0; ip < q->directions_phi; ip++) {
+                    double v, w_v, dy;
+                    gl_node(ip, q->directions_phi, 0.0, 1.0, &v, &w_v);
+                    /* crowded toward psi_h: the end of the sky side, the start of the ground side */
+                    double y = crowd(v, side == 1, side == 0, &dy);
+                    double mu = fmax(-1.0, fmin(1.0, centre + radius * cos(psi_lo + (psi_hi - psi_lo) * y)));
+                    (*out)[n++] = (struct cap_direction){
+                        .mu = side ? fmin(mu, mu_h) : fmax(mu, mu_h),
+                        .nu = sign * nu_a,
+                        .phase_weight = 2 * phase_do * alpha * (psi_hi - psi_lo) * dy * w_v,
+                        .ground = side == 1,
+                    };
+                }
+            }
+        }
+    return n;
+}
+
 void sb_ref_multiscattering(const struct sb_atmosphere_params *p, double h, double mu_s,
                             const struct sb_ref_quality *quality, double out[3])
 {
@@ -610,6 +762,32 @@ void sb_ref_multiscattering(const struct sb_atmosphere_params *p, double h, doub
     }
 }
 
+/* Add the cap's share of Mie single scattering, E_sun P_M alpha S [mu], to
+ * out[0..2], scaled by `scale`; with !whole_sphere over the upper
+ * hemisphere, weighted by mu. Returns false when out of memory. */
+static bool add_mie_cap(const struct sb_atmosphere_params *p, const struct sb_ref_quality *q, double h, double mu_s,
+                        bool whole_sphere, double scale, double out[3])
+{
+    if (!cap_active(p, whole_sphere))
+        return true;
+    double r = p->ground_radius_km + h;
+    struct cap_direction *dirs;
+    int n = cap_directions(p, q, h, mu_s, whole_sphere, &dirs);
+    for (int i = 0; i < n; i++) {
+        const struct cap_direction *d = &dirs[i];
+        if (d->phase_weight <= 0)
+            continue;
+        struct ray_sums rs;
+        integrate_ray(p, r, d->mu, mu_s, d->nu, d->ground, NULL, NULL, q, &rs);
+        double w = scale * d->phase_weight * (whole_sphere ? 1.0 : d->mu);
+        for (int c = 0; c < 3; c++)
+            out[c] += w * p->solar_irradiance[c] * rs.sun_mie[c];
+    }
+    if (n >= 0)
+        free(dirs);
+    return n >= 0;
+}
+
 void sb_ref_irradiance_ground(const struct sb_atmosphere_params *p, double h, double mu_s,
                               const struct sb_image *ms_lut, const struct sb_ref_quality *quality, double direct[3],
                               double sky[3])
@@ -621,22 +799,23 @@ void sb_ref_irradiance_ground(const struct sb_atmosphere_params *p, double h, do
     if (mu_s > 0)
         sb_ref_transmittance(p, r, mu_s, 8, t);
     struct direction *dirs;
-    int n = directions(p, &q, h, mu_s, false, true, &dirs);
+    int n = directions(p, &q, h, mu_s, false, false, &dirs); /* Mie's peak: on the cap */
     for (int c = 0; c < 3; c++) {
         direct[c] = mu_s > 0 ? p->solar_irradiance[c] * t[c] * mu_s : 0.0;
-        sky[c] = n ? 0.0 : NAN;
+        sky[c] = 0.0;
     }
     for (int i = 0; i < n; i++) {
         const struct direction *d = &dirs[i];
         struct ray_sums rs;
         integrate_ray(p, r, d->mu, mu_s, d->nu, false, ms_lut, NULL, &q, &rs);
-        double w = d->weight * d->mu;
+        double w = d->weight * d->mu, mie = phase_mie(p->mie_g, d->nu) * (1 - cap_window(p, false, d->nu));
         for (int c = 0; c < 3; c++)
-            sky[c] += w * (p->solar_irradiance[c] * (rs.sun_rayleigh[c] * phase_rayleigh(d->nu) +
-                                                     rs.sun_mie[c] * phase_mie(p->mie_g, d->nu)) +
+            sky[c] += w * (p->solar_irradiance[c] * (rs.sun_rayleigh[c] * phase_rayleigh(d->nu) + rs.sun_mie[c] * mie) +
                            rs.ms_rayleigh[c] + rs.ms_mie[c]);
     }
     free(dirs);
+    if (!n || !add_mie_cap(p, &q, h, mu_s, false, 1.0, sky))
+        sky[0] = sky[1] = sky[2] = NAN;
 }
 
 void sb_ref_irradiance_sky(const struct sb_atmosphere_params *p, double h, double mu_s, const struct sb_image *ms_lut,
@@ -648,25 +827,29 @@ void sb_ref_irradiance_sky(const struct sb_atmosphere_params *p, double h, doubl
     struct direction *dirs;
     int n = directions(p, &q, h, mu_s, true, true, &dirs);
     for (int c = 0; c < 9; c++)
-        out[c] = n ? 0.0 : NAN;
+        out[c] = 0.0;
     for (int i = 0; i < n; i++) {
         const struct direction *d = &dirs[i];
         double w = d->weight / (4 * REF_PI), nu = d->nu;
+        double mie = phase_mie(p->mie_g, nu) * (1 - cap_window(p, true, nu));
         struct ray_sums rs;
         integrate_ray(p, r, d->mu, mu_s, nu, d->ground, ms_lut, NULL, &q, &rs);
         double eg[3] = {0};
-        if (d->ground) {
+        if (d->ground && ig_lut) {
             double mu_sp = fmax(-1.0, fmin(1.0, (r * mu_s + rs.t_end * nu) / R));
             lut_log_cubic(ig_lut, mu_sp * 0.5 + 0.5, 0.0, 3, eg); /* direct + sky */
         }
         for (int c = 0; c < 3; c++) {
             out[c] += w * (p->solar_irradiance[c] * rs.sun_rayleigh[c] * phase_rayleigh(nu) + rs.ms_rayleigh[c]);
-            out[3 + c] += w * (p->solar_irradiance[c] * rs.sun_mie[c] * phase_mie(p->mie_g, nu) + rs.ms_mie[c]);
+            out[3 + c] += w * (p->solar_irradiance[c] * rs.sun_mie[c] * mie + rs.ms_mie[c]);
             if (d->ground)
                 out[6 + c] += w * rs.transmittance[c] * p->ground_albedo[c] / REF_PI * eg[c];
         }
     }
     free(dirs);
+    if (!n || !add_mie_cap(p, &q, h, mu_s, true, 1 / (4 * REF_PI), out + 3))
+        for (int c = 0; c < 9; c++)
+            out[c] = NAN;
 }
 
 void sb_ref_sky_radiance(const struct sb_atmosphere_params *p, double h, double mu, double mu_s, double nu,

@@ -60,7 +60,8 @@ void sb_ref_irradiance_ground(const struct sb_atmosphere_params *p, double h, do
                               const struct sb_image *multiscattering, const struct sb_ref_quality *q, double direct[3],
                               double sky[3]);
 
-/* Sky irradiance split rayleigh.rgb, mie.rgb, ground.rgb (see irradiance_sky.comp). */
+/* Sky irradiance split rayleigh.rgb, mie.rgb, ground.rgb (see irradiance_sky.comp);
+ * with irradiance_ground NULL, no light from the ground. */
 void sb_ref_irradiance_sky(const struct sb_atmosphere_params *p, double h, double mu_s,
                            const struct sb_image *multiscattering, const struct sb_image *irradiance_ground,
                            const struct sb_ref_quality *q, double out[9]);

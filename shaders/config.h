@@ -39,6 +39,13 @@
 #define SB_MAX_DIRECTIONS_MU 64
 #define SB_MAX_DIRECTIONS_PHI 256
 #define SB_SPHERE_MAX_PIECES 9
+/* Mie single scattering's cap around its peak (sphere.glsl): over the whole
+ * sphere, for |g| >= SB_CAP_MIN_G, radius SB_CAP_THETA (radians), the
+ * window falling to 0 at twice that; up to three rings' pieces times two
+ * sides of the horizon. */
+#define SB_CAP_THETA 0.3
+#define SB_CAP_MIN_G 0.85
+#define SB_SPHERE_CAP_PIECES 6
 
 /* Every atmosphere bake pipeline has the same descriptor set layout: six
  * storage buffers. Inputs a product does not read are bound to a dummy.

@@ -25,18 +25,29 @@ void main()
     float r = ground_radius() + h;
     vec3 sun = atm.solar_irradiance.rgb;
     float sin_s = sqrt(max(1.0 - mu_s * mu_s, 0.0));
-    sphere_init(pc.directions_mu);
+    sphere_init(pc.directions_mu, pc.directions_phi, true);
     SpherePieces pieces = sphere_pieces(h, true, mu_s, true);
+    SphereCap cap = sphere_cap(h, true, mu_s);
 
     sphere_begin();
     uint count = sphere_direction_count(pieces, pc.directions_mu, pc.directions_phi);
-    for (uint d = sphere_first_direction(); d < sphere_end_direction(count); d += SB_SPHERE_THREADS) {
+    uint total = count + sphere_cap_direction_count(cap, pc.directions_mu, pc.directions_phi);
+    for (uint d = sphere_first_direction(); d < sphere_end_direction(total); d += SB_SPHERE_THREADS) {
+        if (d >= count) { /* Mie single scattering's peak */
+            CapDirection cd = sphere_cap_direction(cap, d - count, pc.directions_mu, pc.directions_phi);
+            if (cd.phase_weight > 0.0) {
+                RayIntegrals ri = integrate_ray(h, cd.mu, mu_s, cd.nu, cd.toward_ground, false);
+                sphere_add3(3u, cd.phase_weight * sun * ri.sun_mie);
+            }
+            continue;
+        }
         SphereDirection s = sphere_direction(pieces, d, pc.directions_mu, pc.directions_phi);
         float sin_v = sqrt(max(1.0 - s.mu * s.mu, 0.0));
         float nu = clamp(sin_v * sin_s * s.cos_phi + s.mu * mu_s, -1.0, 1.0);
         RayIntegrals ri = integrate_ray(h, s.mu, mu_s, nu, s.toward_ground, true);
         sphere_add3(0u, s.weight * (sun * ri.sun_rayleigh * phase_rayleigh(nu) + ri.ms_rayleigh));
-        sphere_add3(3u, s.weight * (sun * ri.sun_mie * phase_mie(nu) + ri.ms_mie));
+        float mie = phase_mie(nu) * (1.0 - sphere_cap_window(true, nu));
+        sphere_add3(3u, s.weight * (sun * ri.sun_mie * mie + ri.ms_mie));
         if (s.toward_ground) {
             float mu_sp = clamp((r * mu_s + ri.t_end * nu) / ground_radius(), -1.0, 1.0);
             sphere_add3(6u, s.weight * ri.transmittance * atm.ground_albedo.rgb / PI * ground_irradiance_sample(mu_sp));

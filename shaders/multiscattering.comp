@@ -21,7 +21,7 @@ void main()
     float h = geometry.x, mu_s = geometry.y;
     float r = ground_radius() + h;
     float sin_s = sqrt(max(1.0 - mu_s * mu_s, 0.0));
-    sphere_init(pc.directions_mu);
+    sphere_init(pc.directions_mu, pc.directions_phi, false);
     SpherePieces pieces = sphere_pieces(h, true, mu_s, false);
 
     sphere_begin();

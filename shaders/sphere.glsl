@@ -40,6 +40,8 @@ layout(push_constant) uniform Push { sb_bake_push pc; };
 
 shared float sphere_node[SB_MAX_DIRECTIONS_MU];
 shared float sphere_weight[SB_MAX_DIRECTIONS_MU];
+shared float sphere_phi_node[SB_MAX_DIRECTIONS_PHI]; /* Gauss-Legendre on [0, 1], for the cap */
+shared float sphere_phi_weight[SB_MAX_DIRECTIONS_PHI];
 shared float sphere_partial[SB_SPHERE_THREADS * SB_SPHERE_MAX_SUMS];
 
 layout(std430, set = 0, binding = SB_BINDING_SCRATCH) buffer SphereScratch {
@@ -147,9 +149,9 @@ SpherePieces sphere_pieces(float h, bool whole_sphere, float mu_s, bool peaked)
     return sp;
 }
 
-/* Gauss-Legendre nodes and weights on [-1, 1], ascending; every invocation
- * of the workgroup must call it. */
-void sphere_init(uint n_mu)
+/* Gauss-Legendre nodes and weights, ascending: n_mu on [-1, 1] and, with
+ * `cap`, n_phi on [0, 1]; every invocation of the workgroup must call it. */
+void sphere_init(uint n_mu, uint n_phi, bool cap)
 {
     uint i = gl_LocalInvocationIndex;
     if (i < n_mu) {
@@ -157,6 +159,12 @@ void sphere_init(uint n_mu)
         gauss_legendre(int(i), int(n_mu), -1.0, 1.0, x, w);
         sphere_node[i] = x;
         sphere_weight[i] = w;
+    }
+    for (uint k = i; cap && k < n_phi; k += SB_SPHERE_THREADS) {
+        float x, w;
+        gauss_legendre(int(k), int(n_phi), 0.0, 1.0, x, w);
+        sphere_phi_node[k] = x;
+        sphere_phi_weight[k] = w;
     }
     barrier();
 }
@@ -209,6 +217,155 @@ SphereDirection sphere_direction(SpherePieces sp, uint d, uint n_mu, uint n_phi)
     s.cos_phi = cos(phi);
     s.weight = (hi - lo) * dx * w_u * 2.0 * dphi / float(n_phi);
     return s;
+}
+
+/*
+ * Mie single scattering's peak, at the sun (at the anti-sun for g < 0),
+ * about 1 - |g| wide: its own grid, a cap around that axis (the fp64
+ * reference, cap_directions in baker/atmosphere_ref.c, explains it). A
+ * product integrates P_M (1 - alpha) S on the zenith grid above and
+ * P_M alpha S on the cap, alpha = sphere_cap_window. Over a hemisphere the
+ * cap is the whole of it (alpha = 1); over the sphere it has radius
+ * SB_CAP_THETA, alpha falling to 0 at twice that, and only for |g| >=
+ * SB_CAP_MIN_G (below it the zenith grid resolves the peak).
+ *
+ * Angles from the axis are held as o = 1 - nu' (nu' = sign(g) nu), exact
+ * near the peak where nu itself is not in fp32. A ring's nodes are even in
+ * t = ln((1 - |g|)^2 + 2 |g| o), in which Henyey-Greenstein's peak is an
+ * exponential: P_M do = k (1 + nu^2) dt / (2 |g| sqrt(e^t)).
+ */
+struct SphereCap {
+    float o_lo[3], o_hi[3]; /* pieces in o, from the axis out */
+    bool crowd_lo[3], crowd_hi[3];
+    int count;
+    uint side_first, side_end; /* sides of the horizon: 0 sky, 1 ground */
+    float mu_a, sin_a, mu_h, sign, g;
+    bool whole_sphere;
+};
+
+bool sphere_cap_active(bool whole_sphere)
+{
+    return !whole_sphere || abs(atm.mie_extinction.w) >= SB_CAP_MIN_G;
+}
+
+float sphere_cap_window_o(bool whole_sphere, float o)
+{
+    if (!sphere_cap_active(whole_sphere))
+        return 0.0;
+    if (!whole_sphere)
+        return 1.0;
+    float o_1 = 2.0 * sin(0.5 * SB_CAP_THETA) * sin(0.5 * SB_CAP_THETA), o_2 = 2.0 * sin(SB_CAP_THETA) * sin(SB_CAP_THETA);
+    float x = clamp((o_2 - o) / (o_2 - o_1), 0.0, 1.0);
+    return x * x * (3.0 - 2.0 * x);
+}
+
+/* alpha at a zenith-grid direction with sun cosine nu. */
+float sphere_cap_window(bool whole_sphere, float nu)
+{
+    return sphere_cap_window_o(whole_sphere, 1.0 - (atm.mie_extinction.w < 0.0 ? -nu : nu));
+}
+
+SphereCap sphere_cap(float h, bool whole_sphere, float mu_s)
+{
+    SphereCap c;
+    c.whole_sphere = whole_sphere;
+    float r = ground_radius() + h;
+    c.g = abs(atm.mie_extinction.w);
+    c.sign = atm.mie_extinction.w < 0.0 ? -1.0 : 1.0;
+    c.mu_h = whole_sphere ? -horizon_distance(h) / r : 0.0;
+    c.mu_a = c.sign * mu_s;
+    c.sin_a = sqrt(max(1.0 - mu_s * mu_s, 0.0));
+    float e_a = asin(clamp(c.mu_a, -1.0, 1.0)), e_h = asin(c.mu_h);
+    float reach = whole_sphere ? 2.0 * SB_CAP_THETA : PI; /* the cap's radius */
+    float o_end = whole_sphere ? 2.0 * sin(SB_CAP_THETA) * sin(SB_CAP_THETA) : 2.0;
+    /* the rings that touch the horizon: angles |e_a - e_h| and pi - |e_a + e_h| */
+    float a = 0.5 * abs(e_a - e_h), b = 0.5 * abs(e_a + e_h);
+    float cuts[2] = float[2](2.0 * sin(a) * sin(a), 2.0 * cos(b) * cos(b));
+    c.count = 0;
+    float from = 0.0;
+    for (int i = 0; i < 2; i++)
+        if (cuts[i] > from && cuts[i] < o_end) {
+            c.o_lo[c.count] = from;
+            c.o_hi[c.count] = cuts[i];
+            c.crowd_lo[c.count] = from > 0.0;
+            c.crowd_hi[c.count] = true;
+            c.count++;
+            from = cuts[i];
+        }
+    c.o_lo[c.count] = from;
+    c.o_hi[c.count] = o_end;
+    c.crowd_lo[c.count] = from > 0.0;
+    c.crowd_hi[c.count] = false;
+    c.count++;
+    bool sky = e_a - e_h > -reach, ground = whole_sphere && e_a - e_h < reach;
+    c.side_first = sky ? 0u : 1u;
+    c.side_end = ground ? 2u : 1u;
+    return c;
+}
+
+uint sphere_cap_direction_count(SphereCap c, uint n_mu, uint n_phi)
+{
+    return sphere_cap_active(c.whole_sphere) ? uint(c.count) * n_mu * (c.side_end - c.side_first) * n_phi : 0u;
+}
+
+struct CapDirection {
+    float mu, nu;
+    float phase_weight;  /* P_M(nu) alpha times the solid angle, both halves */
+    bool toward_ground;
+};
+
+float sphere_crowd(float u, bool lo, bool hi, out float dx)
+{
+    dx = 1.0;
+    if (lo && hi) {
+        dx = 6.0 * u * (1.0 - u);
+        return u * u * (3.0 - 2.0 * u);
+    }
+    if (lo) {
+        dx = 2.0 * u;
+        return u * u;
+    }
+    if (hi) {
+        dx = 2.0 * (1.0 - u);
+        return 1.0 - (1.0 - u) * (1.0 - u);
+    }
+    return u;
+}
+
+CapDirection sphere_cap_direction(SphereCap c, uint d, uint n_mu, uint n_phi)
+{
+    uint sides = c.side_end - c.side_first;
+    uint p = d % n_phi, side = c.side_first + (d / n_phi) % sides;
+    uint k = (d / (n_phi * sides)) % n_mu, piece = d / (n_phi * sides * n_mu);
+    float u = 0.5 + 0.5 * sphere_node[k], w_u = 0.5 * sphere_weight[k], dx;
+    float x = sphere_crowd(u, c.crowd_lo[piece], c.crowd_hi[piece], dx);
+    float lo = c.o_lo[piece], hi = c.o_hi[piece], o, phase_do;
+    float q = (1.0 - c.g) * (1.0 - c.g), kk = 3.0 / (8.0 * PI) * (1.0 - c.g * c.g) / (2.0 + c.g * c.g);
+    if (c.g < 0.01) {
+        o = lo + (hi - lo) * x;
+        float nu_a = 1.0 - o;
+        phase_do = kk * (1.0 + nu_a * nu_a) / pow(q + 2.0 * c.g * o, 1.5) * (hi - lo) * dx * w_u;
+    } else {
+        float t_lo = log(q + 2.0 * c.g * lo), t_hi = log(q + 2.0 * c.g * hi);
+        float e = exp(t_lo + (t_hi - t_lo) * x);
+        o = clamp((e - q) / (2.0 * c.g), lo, hi);
+        float nu_a = 1.0 - o;
+        phase_do = kk * (1.0 + nu_a * nu_a) * (t_hi - t_lo) * dx * w_u / (2.0 * c.g * sqrt(e));
+    }
+    float nu_a = 1.0 - o, sin_v = sqrt(max(o * (2.0 - o), 0.0));
+    float radius = c.sin_a * sin_v, centre = c.mu_a * nu_a;
+    float psi_h = radius > 0.0 ? acos(clamp((c.mu_h - centre) / radius, -1.0, 1.0)) : (centre >= c.mu_h ? PI : 0.0);
+    float a = side == 1u ? psi_h : 0.0, b = side == 1u ? PI : psi_h;
+    float dt;
+    /* crowded toward psi_h: the end of the sky side, the start of the ground side */
+    float y = sphere_crowd(sphere_phi_node[p], side == 1u, side == 0u, dt);
+    float mu = clamp(centre + radius * cos(a + (b - a) * y), -1.0, 1.0);
+    CapDirection cd;
+    cd.toward_ground = side == 1u;
+    cd.mu = cd.toward_ground ? min(mu, c.mu_h) : max(mu, c.mu_h);
+    cd.nu = c.sign * nu_a;
+    cd.phase_weight = 2.0 * phase_do * sphere_cap_window_o(c.whole_sphere, o) * (b - a) * dt * sphere_phi_weight[p];
+    return cd;
 }
 
 /* Sum `count` values per invocation, stored at sphere_partial[i *

@@ -122,22 +122,22 @@ static void check_non_negative(const char *name, enum sb_product_id id, const st
 /*
  * Known limits, not tolerances: where the default direction counts do not
  * reach 1e-3 against fp64 (measured on lavapipe, 2026-11). Each stays a
- * failure to fix (issue 4 stays open); the bound here only catches it
- * getting worse (the largest of lavapipe and the H200). Peaked phase functions (|g| >= 0.99) concentrate single
- * scattering within (1 - |g|) rad of the sun or its opposite, narrower than
- * the sphere quadrature's crowding; in the atmosphere as thick as its planet
- * the error sits at altitudes of ~2000 km with the sun far below the
- * horizon, where the sums are a few ulp of the channel's largest value.
+ * failure to fix; the bound here only catches it getting worse (the
+ * largest of lavapipe and the H200). In the atmosphere as thick as its
+ * planet, at 2052 km with the sun 42.6 deg below the horizontal (1.8 deg
+ * below the horizon there), psi_ms comes only from the lit air at the limb,
+ * a band about 5e-3 wide in mu at the horizon. There psi_ms is 6e-5 of the
+ * channel's largest value (under the comparison's floor of 1e-3 of it):
+ * 16 nodes a piece miss it by 22%, 1.4e-2 of the floor; the fp64 reference
+ * itself moves by 1% from 32 to 64 nodes. (Peaked phase functions,
+ * |g| >= 0.99, were limits here until Mie single scattering got its own
+ * grid around the peak; see cap_directions in baker/atmosphere_ref.c.)
  */
 static const struct {
     const char *scene;
     enum sb_product_id product;
     double measured;
 } known_limits[] = {
-    {"earth-g-backward.json", SB_PRODUCT_IRRADIANCE_SKY, 6.3e-3},
-    {"earth-g-forward.json", SB_PRODUCT_IRRADIANCE_GROUND, 9.3e-3},
-    {"earth-g-forward.json", SB_PRODUCT_IRRADIANCE_SKY, 4.5e-2}, /* lavapipe 3.75e-2, H200 4.5e-2 */
-    {"haze.json", SB_PRODUCT_IRRADIANCE_GROUND, 4.1e-2},
     {"thick-atmosphere.json", SB_PRODUCT_MULTISCATTERING, 1.5e-2},
     {"thick-atmosphere.json", SB_PRODUCT_IRRADIANCE_SKY, 7e-3},
 };
