@@ -138,12 +138,18 @@ static enum sb_result check_settings(enum sb_product_id id, const struct sb_atmo
     return SB_OK;
 }
 
+/* The most directions a texel of sphere.glsl's integrals has: the zenith
+ * grid's pieces, and with `cap` those of the cap around Mie's peak. */
+static uint64_t sphere_directions(const struct sb_atmosphere_settings *s, bool cap)
+{
+    return (uint64_t)(SB_SPHERE_MAX_PIECES + (cap ? SB_SPHERE_CAP_PIECES : 0)) * s->directions_mu * s->directions_phi;
+}
+
 uint64_t sb_atmosphere_settings_cost(enum sb_product_id id, const struct sb_atmosphere_settings *settings)
 {
     struct sb_atmosphere_settings s = resolve_settings(id, settings);
     if (id != SB_PRODUCT_TRANSMITTANCE)
-        return (uint64_t)(SB_SPHERE_MAX_PIECES + (id == SB_PRODUCT_MULTISCATTERING ? 0 : SB_SPHERE_CAP_PIECES)) *
-               s.directions_mu * s.directions_phi;
+        return sphere_directions(&s, id != SB_PRODUCT_MULTISCATTERING);
     if (s.quadrature == SB_QUADRATURE_GAUSS_LEGENDRE)
         return 5ull * s.samples * s.subdivisions; /* five pieces, as on the earth */
     return s.quadrature == SB_QUADRATURE_TRAPEZOID ? s.samples + 1ull : s.samples;
@@ -350,12 +356,8 @@ enum sb_result sb_atmosphere_bake(struct sb_atmosphere_baker *b, enum sb_product
         id == SB_PRODUCT_TRANSMITTANCE
             ? &transmittance_shaders[s.quadrature == SB_QUADRATURE_GAUSS_LEGENDRE ? s.samples : 0]
             : &scattering_shaders[id];
-    /* the most directions a texel can have: the zenith grid's pieces, and the cap's where it has one */
-    uint64_t directions = 0;
-    if (prod->workgroup_per_texel) {
-        bool cap = id == SB_PRODUCT_IRRADIANCE_GROUND || (id == SB_PRODUCT_IRRADIANCE_SKY && b->sky_cap);
-        directions = (uint64_t)(SB_SPHERE_MAX_PIECES + (cap ? SB_SPHERE_CAP_PIECES : 0)) * s.directions_mu * s.directions_phi;
-    }
+    bool cap = id == SB_PRODUCT_IRRADIANCE_GROUND || (id == SB_PRODUCT_IRRADIANCE_SKY && b->sky_cap);
+    uint64_t directions = prod->workgroup_per_texel ? sphere_directions(&s, cap) : 0;
     if ((res = run(b, shader->words, shader->size, sb_product_name(id), &b->outputs[id], width, height, directions, &s,
                    gpu_ms)))
         goto cleanup;

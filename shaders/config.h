@@ -43,7 +43,7 @@
  * sphere, for |g| >= SB_CAP_MIN_G, radius SB_CAP_THETA (radians), the
  * window falling to 0 at twice that; up to three rings' pieces times two
  * sides of the horizon. */
-#define SB_CAP_THETA 0.3
+#define SB_CAP_THETA 0.5
 #define SB_CAP_MIN_G 0.85
 #define SB_SPHERE_CAP_PIECES 6
 

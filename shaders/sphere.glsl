@@ -169,6 +169,26 @@ void sphere_init(uint n_mu, uint n_phi, bool cap)
     barrier();
 }
 
+/* Nodes crowded toward an end of [0, 1], or both: x(u) with dx = x'(u), flat
+ * (as u^2) at a crowded end. */
+float sphere_crowd(float u, bool lo, bool hi, out float dx)
+{
+    dx = 1.0;
+    if (lo && hi) {
+        dx = 6.0 * u * (1.0 - u);
+        return u * u * (3.0 - 2.0 * u);
+    }
+    if (lo) {
+        dx = 2.0 * u;
+        return u * u;
+    }
+    if (hi) {
+        dx = 2.0 * (1.0 - u);
+        return 1.0 - (1.0 - u) * (1.0 - u);
+    }
+    return u;
+}
+
 struct SphereDirection {
     float mu;            /* cosine of the zenith angle */
     float cos_phi;       /* azimuth from the sun's vertical plane */
@@ -194,17 +214,8 @@ SphereDirection sphere_direction(SpherePieces sp, uint d, uint n_mu, uint n_phi)
     bool peaked = sp.peak <= 1.0;
     bool at_lo = int(piece) == sp.first_sky || (peaked && !s.toward_ground && lo >= sp.peak);
     bool at_hi = int(piece) + 1 == sp.first_sky || (peaked && !s.toward_ground && hi <= sp.peak);
-    float x = u, dx = 1.0;
-    if (at_lo && at_hi) {
-        x = u * u * (3.0 - 2.0 * u);
-        dx = 6.0 * u * (1.0 - u);
-    } else if (at_lo) {
-        x = u * u;
-        dx = 2.0 * u;
-    } else if (at_hi) {
-        x = 1.0 - (1.0 - u) * (1.0 - u);
-        dx = 2.0 * (1.0 - u);
-    }
+    float dx;
+    float x = sphere_crowd(u, at_lo, at_hi, dx);
     s.mu = lo + (hi - lo) * x;
     /* Azimuth: midpoint rule in v; with a peak, phi = pi (v - sin(2 pi v) /
      * (2 pi)), which crowds the nodes toward the sun's side (phi = 0, where
@@ -243,6 +254,10 @@ struct SphereCap {
     bool whole_sphere;
 };
 
+/* o at the window's ends (constant expressions: folded at compile time) */
+const float SPHERE_CAP_O_1 = 2.0 * sin(0.5 * SB_CAP_THETA) * sin(0.5 * SB_CAP_THETA);
+const float SPHERE_CAP_O_2 = 2.0 * sin(SB_CAP_THETA) * sin(SB_CAP_THETA);
+
 bool sphere_cap_active(bool whole_sphere)
 {
     return !whole_sphere || abs(atm.mie_extinction.w) >= SB_CAP_MIN_G;
@@ -254,8 +269,7 @@ float sphere_cap_window_o(bool whole_sphere, float o)
         return 0.0;
     if (!whole_sphere)
         return 1.0;
-    float o_1 = 2.0 * sin(0.5 * SB_CAP_THETA) * sin(0.5 * SB_CAP_THETA), o_2 = 2.0 * sin(SB_CAP_THETA) * sin(SB_CAP_THETA);
-    float x = clamp((o_2 - o) / (o_2 - o_1), 0.0, 1.0);
+    float x = clamp((SPHERE_CAP_O_2 - o) / (SPHERE_CAP_O_2 - SPHERE_CAP_O_1), 0.0, 1.0);
     return x * x * (3.0 - 2.0 * x);
 }
 
@@ -277,7 +291,7 @@ SphereCap sphere_cap(float h, bool whole_sphere, float mu_s)
     c.sin_a = sqrt(max(1.0 - mu_s * mu_s, 0.0));
     float e_a = asin(clamp(c.mu_a, -1.0, 1.0)), e_h = asin(c.mu_h);
     float reach = whole_sphere ? 2.0 * SB_CAP_THETA : PI; /* the cap's radius */
-    float o_end = whole_sphere ? 2.0 * sin(SB_CAP_THETA) * sin(SB_CAP_THETA) : 2.0;
+    float o_end = whole_sphere ? SPHERE_CAP_O_2 : 2.0;
     /* the rings that touch the horizon: angles |e_a - e_h| and pi - |e_a + e_h| */
     float a = 0.5 * abs(e_a - e_h), b = 0.5 * abs(e_a + e_h);
     float cuts[2] = float[2](2.0 * sin(a) * sin(a), 2.0 * cos(b) * cos(b));
@@ -313,24 +327,6 @@ struct CapDirection {
     float phase_weight;  /* P_M(nu) alpha times the solid angle, both halves */
     bool toward_ground;
 };
-
-float sphere_crowd(float u, bool lo, bool hi, out float dx)
-{
-    dx = 1.0;
-    if (lo && hi) {
-        dx = 6.0 * u * (1.0 - u);
-        return u * u * (3.0 - 2.0 * u);
-    }
-    if (lo) {
-        dx = 2.0 * u;
-        return u * u;
-    }
-    if (hi) {
-        dx = 2.0 * (1.0 - u);
-        return 1.0 - (1.0 - u) * (1.0 - u);
-    }
-    return u;
-}
 
 CapDirection sphere_cap_direction(SphereCap c, uint d, uint n_mu, uint n_phi)
 {
