@@ -34,11 +34,11 @@
  * every invocation far below llvmpipe's 65535 loop iterations. */
 #define SB_SPHERE_STEPS_PER_PASS 8
 /* Gauss-Legendre nodes in cos(zenith) per piece, at most, and the pieces
- * (sphere.glsl): three of the ground, four of the sky, cut again at the
+ * (sphere.glsl): three of the ground, five of the sky, cut again at the
  * sun and at its mirror image. */
 #define SB_MAX_DIRECTIONS_MU 64
 #define SB_MAX_DIRECTIONS_PHI 256
-#define SB_SPHERE_MAX_PIECES 9
+#define SB_SPHERE_MAX_PIECES 10
 /* Mie single scattering's cap around its peak (sphere.glsl): over the whole
  * sphere, for |g| >= SB_CAP_MIN_G, radius SB_CAP_THETA (radians), the
  * window falling to 0 at twice that; up to three rings' pieces times two

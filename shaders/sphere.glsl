@@ -61,6 +61,9 @@ float sphere_acc[SB_SPHERE_MAX_SUMS]; /* this invocation's sums */
  *   sphere_pieces);
  * - above it, where the ray's tangent point sits at an ozone corner (the
  *   density's kinks make the ray integral kink as a function of mu);
+ * - above those, where the ray's tangent altitude z is 25 largest scale
+ *   heights: the light of the air fades as exp(-z / H), and from high up
+ *   a piece reaching the zenith would be too long for that fade;
  * - at the sun's mirror image in the horizontal plane, mu = -mu_s: there
  *   the azimuthal integral kinks, since the rays that start out parallel to
  *   the planet's shadow boundary (mu = mu_s nu) reach azimuth pi there;
@@ -143,6 +146,11 @@ SpherePieces sphere_pieces(float h, bool whole_sphere, float mu_s, bool peaked)
     sp.lo[sp.count] = from;
     sp.hi[sp.count] = 1.0;
     sp.count++;
+    /* Above those cuts, the light of the air fades as exp(-z / H) with the
+     * ray's tangent altitude z: from high up, cut where it has faded. */
+    float z_fade = 25.0 * max(atm.rayleigh_scattering.w, atm.mie_scattering.w);
+    if (whole_sphere && z_fade < h)
+        sphere_split(sp, -sqrt(max((h - z_fade) * (r + ground_radius() + z_fade), 0.0)) / r);
     sphere_split(sp, -mu_s);
     if (peaked)
         sphere_split(sp, mu_s);

@@ -120,26 +120,30 @@ static void check_non_negative(const char *name, enum sb_product_id id, const st
 }
 
 /*
- * Known limits, not tolerances: where the default direction counts do not
- * reach 1e-3 against fp64 (measured on lavapipe, 2026-11). Each stays a
- * failure to fix; the bound here only catches it getting worse (the
- * largest of lavapipe and the H200). In the atmosphere as thick as its
- * planet, at 2052 km with the sun 42.6 deg below the horizontal (1.8 deg
- * below the horizon there), psi_ms comes only from the lit air at the limb,
- * a band about 5e-3 wide in mu at the horizon. There psi_ms is 6e-5 of the
- * channel's largest value (under the comparison's floor of 1e-3 of it):
- * 16 nodes a piece miss it by 22%, 1.4e-2 of the floor; the fp64 reference
- * itself moves by 1% from 32 to 64 nodes. (Peaked phase functions,
- * |g| >= 0.99, were limits here until Mie single scattering got its own
- * grid around the peak; see cap_directions in baker/atmosphere_ref.c.)
+ * Known limits: where the default direction counts do not reach 1e-3
+ * against fp64 (measured on lavapipe, 2026-11), each held to its measured
+ * value plus a tenth so that it cannot grow unnoticed, each with its cause.
+ * In the atmosphere as thick as its planet, high up, the planet's shadow
+ * and the terminator on the ground cross the azimuth grid along curves, where
+ * the azimuthal integrands kink; the midpoint rule converges as n^-2 across
+ * a kink. At its top with the sun 5.6 deg above the horizontal,
+ * multiscattering moves by 1.1e-3 from 12 to 16 azimuth nodes and by 4e-5
+ * from 16 to 64; irradiance_sky's Mie at 3816 km, the sun 29.5 deg below
+ * the horizontal, moves by 2e-3 between 16 and 32 (fp64 reference,
+ * docs/accuracy.md). The fix would cut the azimuth at those crossings; a
+ * scene that needs 1e-3 there asks for a tolerance instead. (The limb's
+ * light fading above the ozone, a 1.4e-2 / 6.6e-3 limit here, went with the
+ * cut at 25 scale heights of tangent altitude in sphere.glsl; peaked phase
+ * functions, |g| >= 0.99, with Mie's own grid around the peak,
+ * cap_directions in baker/atmosphere_ref.c.)
  */
 static const struct {
     const char *scene;
     enum sb_product_id product;
     double measured;
 } known_limits[] = {
-    {"thick-atmosphere.json", SB_PRODUCT_MULTISCATTERING, 1.5e-2},
-    {"thick-atmosphere.json", SB_PRODUCT_IRRADIANCE_SKY, 7e-3},
+    {"thick-atmosphere.json", SB_PRODUCT_MULTISCATTERING, 1.11e-3},
+    {"thick-atmosphere.json", SB_PRODUCT_IRRADIANCE_SKY, 1.33e-3},
 };
 
 static double known_limit(const char *scene, enum sb_product_id id)
@@ -162,8 +166,9 @@ static void check_reference(const char *name, const struct baked *b)
         struct sb_error e;
         sb_accuracy_measure(ref, &b->luts[p], false, &e);
         double tolerance = id == SB_PRODUCT_TRANSMITTANCE ? 1e-5 : 1e-3, known = known_limit(name, id);
-        printf("%s: %-17s max rel error %.3g, rms %.3g over %u values (%s)%s\n", name, sb_product_name(id), e.max_rel,
-               e.rms_rel, e.count, sb_accuracy_ref_probe(ref), known ? "; a known limit, see known_limits" : "");
+        printf("%s: %-17s max rel error %.3g (texel %u, %u channel %u), rms %.3g over %u values (%s)%s\n", name,
+               sb_product_name(id), e.max_rel, e.worst_x, e.worst_y, e.worst_channel, e.rms_rel, e.count,
+               sb_accuracy_ref_probe(ref), known ? "; a known limit, see known_limits" : "");
         if (known) /* the measured value plus a tenth, so that any growth fails */
             tolerance = 1.1 * known;
         CHECK(e.max_rel <= tolerance, "%s: %s is %.3g from fp64 (tolerance %g) at texel (%u, %u) channel %u", name,
