@@ -375,6 +375,38 @@ cleanup:
     return res;
 }
 
+enum sb_result sb_atmosphere_adopt(struct sb_atmosphere_baker *b, enum sb_product_id id, const struct sb_image *image)
+{
+    const struct sb_product_format *format = sb_product_format(id);
+    if (image->width != format->width || image->height != format->height ||
+        image->channel_count != format->channel_count)
+        return SB_ERR_BAD_IMAGE;
+    sb_buffer_destroy(b->vk, &b->outputs[id]);
+    sb_buffer_destroy(b->vk, &b->lookups[id]);
+    size_t bytes = sb_image_float_count(image) * sizeof(float);
+    enum sb_result res = sb_buffer_create(b->vk, bytes, sb_product_name(id), &b->outputs[id]);
+    if (res)
+        return res;
+    memcpy(b->outputs[id].mapped, image->data, bytes);
+    return make_lookup(b, id, image);
+}
+
+void sb_atmosphere_code_hash(enum sb_product_id id, char out[SB_HASH_HEX_SIZE])
+{
+    /* The hashes of each kernel, then the constants, as one text. */
+    char text[(SB_GL_MAX_ORDER + 1) * SB_HASH_HEX_SIZE + 256];
+    size_t n = 0;
+    const struct spirv *shaders = id == SB_PRODUCT_TRANSMITTANCE ? transmittance_shaders : &scattering_shaders[id];
+    int count = id == SB_PRODUCT_TRANSMITTANCE ? SB_GL_MAX_ORDER + 1 : 1;
+    for (int i = 0; i < count; i++) {
+        sb_hash_bytes(shaders[i].words, shaders[i].size, text + n);
+        n += SB_HASH_HEX_SIZE - 1;
+    }
+    snprintf(text + n, sizeof(text) - n, " recipe %d cap %a %a %d", SB_ATMOSPHERE_RECIPE, (double)SB_CAP_MIN_G,
+             (double)SB_CAP_THETA, SB_SPHERE_CAP_PIECES);
+    sb_hash_bytes(text, strlen(text), out);
+}
+
 enum sb_result sb_atmosphere_run_kernel(struct sb_atmosphere_baker *b, const uint32_t *spirv, size_t spirv_size,
                                         float *records, uint32_t record_count, uint32_t record_floats)
 {
@@ -416,9 +448,10 @@ void sb_atmosphere_settings_json(enum sb_product_id id, const struct sb_atmosphe
     }
     const char *zenith_cuts = id == SB_PRODUCT_IRRADIANCE_GROUND ? "the sun's mirror and the sun (upper hemisphere)"
                               : id == SB_PRODUCT_MULTISCATTERING
-                                  ? "the horizon, two ground depths, the ozone corners and the sun's mirror"
-                                  : "the horizon, two ground depths, the ozone corners, the sun's mirror and "
-                                    "the sun";
+                                  ? "the horizon, two ground depths, the ozone corners, 25 scale heights of "
+                                    "tangent altitude and the sun's mirror"
+                                  : "the horizon, two ground depths, the ozone corners, 25 scale heights of "
+                                    "tangent altitude, the sun's mirror and the sun";
     snprintf(out, size,
              "{\"directions_mu\":%u,\"directions_phi\":%u,"
              "\"zenith\":\"gauss-legendre per piece, cut at %s\","

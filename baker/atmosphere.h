@@ -77,6 +77,24 @@ enum sb_result sb_atmosphere_bake(struct sb_atmosphere_baker *baker, enum sb_pro
 enum sb_result sb_atmosphere_run_kernel(struct sb_atmosphere_baker *baker, const uint32_t *spirv, size_t spirv_size,
                                         float *records, uint32_t record_count, uint32_t record_floats);
 
+/*
+ * Give the baker a product baked before (read back from a pack whose key
+ * says it is what this bake would make), for the products that read it.
+ */
+enum sb_result sb_atmosphere_adopt(struct sb_atmosphere_baker *baker, enum sb_product_id id,
+                                   const struct sb_image *image);
+
+/*
+ * What a product's bake runs, for its bake key: XXH3-128 of the SPIR-V of
+ * every kernel the product may use, of the host-side choices that shape a
+ * bake (config.h's cap constants), and of SB_ATMOSPHERE_RECIPE.
+ */
+void sb_atmosphere_code_hash(enum sb_product_id id, char out[SB_HASH_HEX_SIZE]);
+
+/* Bumped by hand whenever host code changes what a product's values are
+ * without changing its kernel's SPIR-V (atmosphere.c, physics.c's lookups). */
+#define SB_ATMOSPHERE_RECIPE 1
+
 /* The manifest's settings object for a product baked with `settings`. */
 void sb_atmosphere_settings_json(enum sb_product_id id, const struct sb_atmosphere_settings *settings, char *out,
                                  size_t size);

@@ -1,15 +1,18 @@
 #include "bake.h"
 
 #include <math.h>
+#include <stdarg.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 #include <time.h>
+#include <unistd.h>
 
 #include "accuracy.h"
 #include "atmosphere.h"
 #include "bench.h"
 #include "log.h"
+#include "skybake_version.h"
 
 static double now_ms(void)
 {
@@ -101,14 +104,133 @@ static void add_error_json(char *json, size_t size, double tolerance, const stru
              tolerance, e->max_rel, e->rms_rel, e->count, probe);
 }
 
+/* Append printf-style text to a key's text at *n (of `size`). */
+#if defined(__GNUC__)
+__attribute__((format(printf, 4, 5)))
+#endif
+static void key_add(char *text, size_t size, size_t *n, const char *fmt, ...)
+{
+    va_list ap;
+    va_start(ap, fmt);
+    if (*n < size) {
+        int w = vsnprintf(text + *n, size - *n, fmt, ap);
+        *n += w > 0 ? (size_t)w : 0;
+    }
+    va_end(ap);
+}
+
+static void key_add3(char *text, size_t size, size_t *n, const char *name, const double v[3])
+{
+    key_add(text, size, n, " %s=%a,%a,%a", name, v[0], v[1], v[2]);
+}
+
+/* The parameters a product's kernels read: the medium for all; the ground's
+ * albedo and the sun's irradiance for the scattering products; Mie's g for
+ * those whose phase functions are not isotropic (multiscattering's is). */
+static void key_params(enum sb_product_id id, const struct sb_atmosphere_params *p, char *text, size_t size, size_t *n)
+{
+    key_add(text, size, n, " ground_radius_km=%a top_radius_km=%a rayleigh_scale_height_km=%a mie_scale_height_km=%a",
+            p->ground_radius_km, p->top_radius_km, p->rayleigh_scale_height_km, p->mie_scale_height_km);
+    key_add3(text, size, n, "rayleigh_scattering_per_km", p->rayleigh_scattering_per_km);
+    key_add3(text, size, n, "mie_scattering_per_km", p->mie_scattering_per_km);
+    key_add3(text, size, n, "mie_absorption_per_km", p->mie_absorption_per_km);
+    key_add3(text, size, n, "ozone_absorption_per_km", p->ozone_absorption_per_km);
+    key_add(text, size, n, " ozone_center_km=%a ozone_half_width_km=%a", p->ozone_center_km, p->ozone_half_width_km);
+    if (id == SB_PRODUCT_TRANSMITTANCE)
+        return;
+    key_add3(text, size, n, "ground_albedo", p->ground_albedo);
+    key_add3(text, size, n, "solar_irradiance", p->solar_irradiance);
+    if (id != SB_PRODUCT_MULTISCATTERING)
+        key_add(text, size, n, " mie_g=%a", p->mie_g);
+}
+
+void sb_bake_keys(const struct sb_scene *scene, uint32_t mask, char out[SB_PRODUCT_COUNT][SB_HASH_HEX_SIZE])
+{
+    char text[8192], settings[1024], code[SB_HASH_HEX_SIZE];
+    for (int p = 0; p < SB_PRODUCT_COUNT; p++) {
+        out[p][0] = '\0';
+        if (!(mask & (1u << p)))
+            continue;
+        enum sb_product_id id = (enum sb_product_id)p;
+        size_t n = 0;
+        key_add(text, sizeof(text), &n, "skybake-bake-key-v1 format %d skybake %s product %s", SB_PACK_FORMAT_VERSION,
+                SKYBAKE_VERSION, sb_product_name(id));
+        key_params(id, &scene->atmosphere, text, sizeof(text), &n);
+        if (scene->tolerance[p] > 0) {
+            key_add(text, sizeof(text), &n, " tolerance=%a candidates", scene->tolerance[p]);
+            int count;
+            const struct sb_atmosphere_settings *candidates = sb_bench_candidates(id, &count);
+            for (int i = 0; i < count; i++) {
+                sb_atmosphere_settings_json(id, &candidates[i], settings, sizeof(settings));
+                key_add(text, sizeof(text), &n, " %s", settings);
+            }
+        } else {
+            sb_atmosphere_settings_json(id, &sb_atmosphere_product(id)->defaults, settings, sizeof(settings));
+            key_add(text, sizeof(text), &n, " defaults %s", settings);
+        }
+        sb_atmosphere_code_hash(id, code);
+        key_add(text, sizeof(text), &n, " code %s", code);
+        /* Dependencies point to lower ids: their keys are ready. */
+        uint32_t inputs = sb_atmosphere_product(id)->depends_on;
+        for (int d = 0; d < p; d++)
+            if (inputs & (1u << d))
+                key_add(text, sizeof(text), &n, " input %s=%s", sb_product_name((enum sb_product_id)d), out[d]);
+        sb_hash_bytes(text, n < sizeof(text) ? n : sizeof(text) - 1, out[p]);
+    }
+}
+
+/* The first problem an old pack's reading logged: why it is not reused. */
+static void first_message(void *user, enum sb_log_level level, const char *message)
+{
+    char *first = user;
+    if (level <= SB_LOG_WARN && !first[0])
+        snprintf(first, 512, "%s", message);
+}
+
+/*
+ * The pack at out_dir, when its artifacts may be reused: it verifies and was
+ * baked on this device. Returns false (with *old empty) otherwise, saying
+ * why unless out_dir holds no pack at all.
+ */
+static bool open_previous(struct sb_vk *vk, const char *out_dir, struct sb_pack *old)
+{
+    char manifest[4200];
+    snprintf(manifest, sizeof(manifest), "%s/%s", out_dir, SB_PACK_MANIFEST);
+    memset(old, 0, sizeof(*old));
+    if (access(manifest, F_OK) != 0)
+        return false;
+    char first[512] = "";
+    sb_log_set_sink(first_message, first);
+    enum sb_result res = sb_pack_open(out_dir, old);
+    sb_log_set_sink(NULL, NULL);
+    if (res) {
+        sb_warn("%s: not reusing any artifact: the pack there does not verify (%s)", out_dir, first);
+        return false;
+    }
+    struct sb_device_info device;
+    sb_vk_device_info(vk, &device);
+    if (strcmp(device.name, old->device.name) || strcmp(device.driver, old->device.driver) ||
+        device.vendor_id != old->device.vendor_id || device.device_id != old->device.device_id) {
+        sb_info("%s: not reusing any artifact: the pack there was baked on %s (%s)", out_dir, old->device.name,
+                old->device.driver);
+        sb_pack_close(old);
+        return false;
+    }
+    return true;
+}
+
 enum sb_result sb_bake_scene(struct sb_vk *vk, const struct sb_scene *scene, const char *out_dir,
-                             struct sb_bake_report *report)
+                             const struct sb_bake_options *options, struct sb_bake_report *report)
 {
     struct sb_pack_writer *writer = NULL;
     struct sb_atmosphere_baker *baker = NULL;
     struct sb_image baked[SB_PRODUCT_COUNT] = {0};
     char *scene_json = NULL;
     memset(report, 0, sizeof(*report));
+    struct sb_pack *old = calloc(1, sizeof(*old));
+    if (!old)
+        return SB_ERR_NOMEM;
+    bool reuse = !(options && options->force) && open_previous(vk, out_dir, old);
 
     enum sb_result res = sb_pack_writer_create(out_dir, &writer);
     if (res)
@@ -117,6 +239,8 @@ enum sb_result sb_bake_scene(struct sb_vk *vk, const struct sb_scene *scene, con
         goto cleanup;
 
     uint32_t mask = sb_bake_closure(scene);
+    char keys[SB_PRODUCT_COUNT][SB_HASH_HEX_SIZE];
+    sb_bake_keys(scene, mask, keys);
     for (int p = 0; p < SB_PRODUCT_COUNT; p++) {
         if (!(mask & (1u << p)))
             continue;
@@ -127,6 +251,34 @@ enum sb_result sb_bake_scene(struct sb_vk *vk, const struct sb_scene *scene, con
         a->product = id;
         snprintf(a->file, sizeof(a->file), "%s.exr", sb_product_name(id));
         snprintf(a->parameterization, sizeof(a->parameterization), "%s", sb_product_format(id)->parameterization);
+        snprintf(a->key, sizeof(a->key), "%s", keys[p]);
+
+        if (reuse && old->present[p] && !strcmp(old->artifacts[p].key, keys[p])) {
+            /* Verified when the old pack was opened; the writer hashes it again. */
+            const struct sb_artifact *was = &old->artifacts[p];
+            snprintf(a->settings_json, sizeof(a->settings_json), "%s", was->settings_json);
+            a->bake_ms = was->bake_ms;
+            a->gpu_ms = was->gpu_ms;
+            baked[p] = old->images[p];
+            old->images[p] = (struct sb_image){0};
+            if ((res = sb_atmosphere_adopt(baker, id, &baked[p])) ||
+                (res = sb_pack_writer_add_image(writer, a, &baked[p])))
+                goto cleanup;
+            if (strcmp(a->content_hash, was->content_hash) != 0) {
+                sb_error("%s: %s: content hash %s on writing, %s when read", out_dir, sb_product_name(id),
+                         a->content_hash, was->content_hash);
+                res = SB_ERR_HASH_MISMATCH;
+                goto cleanup;
+            }
+            report->reused[report->artifact_count] = true;
+            report->shapes[report->artifact_count][0] = baked[p].width;
+            report->shapes[report->artifact_count][1] = baked[p].height;
+            report->shapes[report->artifact_count][2] = baked[p].channel_count;
+            report->artifact_count++;
+            sb_info("%-18s %4ux%-3u x%u  reused (key unchanged)                  %s", sb_product_name(id),
+                    baked[p].width, baked[p].height, baked[p].channel_count, a->content_hash);
+            continue;
+        }
 
         double t0 = now_ms();
         struct sb_image *image = &baked[p];
@@ -165,6 +317,8 @@ enum sb_result sb_bake_scene(struct sb_vk *vk, const struct sb_scene *scene, con
 
 cleanup:
     free(scene_json);
+    sb_pack_close(old);
+    free(old);
     for (int p = 0; p < SB_PRODUCT_COUNT; p++)
         sb_image_finish(&baked[p]);
     sb_atmosphere_baker_destroy(&baker);

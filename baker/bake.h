@@ -2,6 +2,15 @@
  * Bake a scene into a pack: resolve which products the scene needs (its
  * requests plus their dependencies), bake them in dependency order on one
  * device, check every value is finite, and publish the pack atomically.
+ *
+ * The bake graph: each product has a key, XXH3-128 of everything its values
+ * depend on: the format version, the skybake version, the parameters its
+ * kernels read (normalised: each as a hexadecimal float), what the scene asks
+ * of it (a tolerance and the candidate settings, or the default settings),
+ * its kernels' SPIR-V and the host-side recipe (sb_atmosphere_code_hash),
+ * and the keys of the products it reads. Baking into an existing pack reuses
+ * every artifact whose key is unchanged, baked on the same device, after the
+ * pack verified (content hashes recomputed); the rest is baked.
  */
 #ifndef SB_BAKER_BAKE_H
 #define SB_BAKER_BAKE_H
@@ -10,18 +19,27 @@
 #include "pack.h"
 #include "scene.h"
 
+struct sb_bake_options {
+    bool force; /* bake every product, reusing nothing */
+};
+
 struct sb_bake_report {
     int artifact_count;
     struct sb_artifact artifacts[SB_PRODUCT_COUNT];
     uint32_t shapes[SB_PRODUCT_COUNT][3]; /* width, height, channels */
+    bool reused[SB_PRODUCT_COUNT];        /* per artifact: taken from the pack there before */
 };
 
 /* Products to bake: the scene's requests closed over dependencies (bit mask). */
 uint32_t sb_bake_closure(const struct sb_scene *scene);
 
+/* The bake key of every product in `mask` (see above), in out[id]. */
+void sb_bake_keys(const struct sb_scene *scene, uint32_t mask, char out[SB_PRODUCT_COUNT][SB_HASH_HEX_SIZE]);
+
 /* Bake `scene` on `vk` into a pack at out_dir. On failure the previous pack at
- * out_dir (if any) is untouched and no temporary files remain. */
+ * out_dir (if any) is untouched and no temporary files remain. `options`
+ * may be NULL. */
 enum sb_result sb_bake_scene(struct sb_vk *vk, const struct sb_scene *scene, const char *out_dir,
-                             struct sb_bake_report *report);
+                             const struct sb_bake_options *options, struct sb_bake_report *report);
 
 #endif

@@ -1,8 +1,9 @@
 /*
  * skybake: bake the lighting data a scene needs into a versioned pack.
  *
- * Exit codes: 0 success; 1 the bake or the pack failed; 2 bad command line or
- * bad scene; 3 no Vulkan device; 4 validation layers reported messages.
+ * Exit codes: 0 success; 1 the bake failed or the pack did not verify; 2 bad
+ * command line, bad scene or a pack that cannot be read; 3 no Vulkan device;
+ * 4 validation layers reported messages. diff has its own (see usage()).
  */
 #include <cJSON.h>
 #include <math.h>
@@ -16,7 +17,7 @@
 #include "context.h"
 #include "json.h"
 #include "log.h"
-#include "pack_info.h"
+#include "pack_tools.h"
 #include "scene.h"
 #include "skybake_version.h"
 #include "sky_error.h"
@@ -26,6 +27,9 @@ enum {
     EXIT_USAGE = 2,
     EXIT_NO_DEVICE = 3,
     EXIT_VALIDATION = 4,
+    EXIT_DIFF_WITHIN = 1, /* diff: every difference within --tol */
+    EXIT_DIFF_DIFFERENT = 5,
+    EXIT_DIFF_MISSING = 6,
 };
 
 static void usage(FILE *f)
@@ -34,14 +38,20 @@ static void usage(FILE *f)
                "       skybake bench [SCENE] [--product NAME]... [--json] [-o DIR] [--repeat N] [--quick]\n"
                "       skybake sky-error [SCENE]... [--paths N] [--seed N] [--sun DEG]... [--json]\n"
                "       skybake info PACK [--json]\n"
+               "       skybake verify PACK [--json]\n"
+               "       skybake diff A B [--tol REL] [--floor F] [--json]\n"
                "       skybake --version | --help\n"
                "\n"
                "Bakes what SCENE (JSON, see docs/scene.md) needs into the pack OUT_DIR:\n"
                "manifest.json plus one EXR per product. The pack is replaced atomically;\n"
-               "a failed bake leaves the previous pack as it was.\n"
+               "a failed bake leaves the previous pack as it was. Baking into a pack\n"
+               "reuses every artifact whose bake key (its parameters, settings, kernels\n"
+               "and inputs' keys) is unchanged, when that pack verifies and was baked on\n"
+               "the same device.\n"
                "\n"
                "options:\n"
                "  -o, --output DIR    the pack to write (required)\n"
+               "  --force             bake every product, reusing nothing\n"
                "  --device NAME|INDEX Vulkan device by index or name substring\n"
                "                      (default: first discrete GPU, else the first device)\n"
                "  --validate          enable Vulkan validation; any message fails the bake\n"
@@ -66,6 +76,18 @@ static void usage(FILE *f)
                "info: what PACK holds (products, sizes, settings and errors, hashes, device,\n"
                "version), after verifying all of it; exit 2 if it is not a valid pack.\n"
                "\n"
+               "verify: re-read every artifact, recompute its content hash and check the\n"
+               "manifest against the files (names, dimensions, channels, types, no file\n"
+               "unlisted); names every problem found. Exit 0 when all holds, else 1.\n"
+               "\n"
+               "diff: per artifact of packs A and B (both verified first): identical,\n"
+               "within tolerance, different, or missing from one, with the largest\n"
+               "absolute and relative differences and where. Relative difference:\n"
+               "|a - b| / max(|a|, |b|, F x the channel's largest value), F = --floor\n"
+               "(default 1e-3); --tol REL (default 0). Exit 0 identical, 1 within\n"
+               "tolerance, 5 different, 6 an artifact missing from one pack (the worst\n"
+               "artifact decides), 2 usage or a pack that does not verify.\n"
+               "\n"
                "exit codes: 0 ok, 1 bake failed, 2 usage or scene error, 3 no Vulkan device,\n"
                "            4 validation messages\n");
 }
@@ -87,6 +109,8 @@ static void print_json(const char *out_dir, const struct sb_vk *vk, const struct
         cJSON_AddNumberToObject(o, "gpu_ms", a->gpu_ms);
         cJSON_AddNumberToObject(o, "bake_ms", a->bake_ms);
         cJSON_AddStringToObject(o, "content_hash", a->content_hash);
+        cJSON_AddStringToObject(o, "key", a->key);
+        cJSON_AddBoolToObject(o, "reused", report->reused[i]);
         cJSON_AddItemToArray(arr, o);
     }
     sb_json_emit(stdout, root);
@@ -120,6 +144,7 @@ static bool validate_from_env(void)
 static int cmd_bake(int argc, char **argv)
 {
     const char *scene_path = NULL, *out_dir = NULL;
+    struct sb_bake_options options = {0};
     struct sb_vk_params params = {.validate = validate_from_env()};
     bool json = false;
     for (int i = 0; i < argc; i++) {
@@ -128,6 +153,8 @@ static int cmd_bake(int argc, char **argv)
             continue;
         if ((!strcmp(a, "-o") || !strcmp(a, "--output")) && i + 1 < argc)
             out_dir = argv[++i];
+        else if (!strcmp(a, "--force"))
+            options.force = true;
         else if (a[0] == '-' && a[1]) {
             fprintf(stderr, "skybake: unknown or incomplete option '%s'\n", a);
             usage(stderr);
@@ -157,7 +184,7 @@ static int cmd_bake(int argc, char **argv)
             vk->driver_name);
 
     struct sb_bake_report report;
-    res = sb_bake_scene(vk, &scene, out_dir, &report);
+    res = sb_bake_scene(vk, &scene, out_dir, &options, &report);
     unsigned messages = sb_vk_validation_messages(vk);
     if (!res && json)
         print_json(out_dir, vk, &report);
@@ -340,30 +367,47 @@ done:
     return rc;
 }
 
-static int cmd_info(int argc, char **argv)
+/* The arguments of info, verify and diff: `count` packs and --json; diff's
+ * --tol and --floor when `tolerance` is not NULL. */
+static bool pack_args(int argc, char **argv, const char *command, const char **dirs, int count, bool *json,
+                      double *tolerance, double *floor)
 {
-    const char *dir = NULL;
+    int n = 0;
     struct sb_vk_params unused = {0};
-    bool json = false;
     for (int i = 0; i < argc; i++) {
         const char *a = argv[i];
-        if (common_option(argc, argv, &i, &unused, &json))
+        if (common_option(argc, argv, &i, &unused, json))
             continue;
-        if (a[0] == '-' && a[1]) {
+        if (tolerance && (!strcmp(a, "--tol") || !strcmp(a, "--floor")) && i + 1 < argc) {
+            double *out = !strcmp(a, "--tol") ? tolerance : floor;
+            if (!parse_number(argv[++i], 0, 1e30, out)) {
+                fprintf(stderr, "skybake: %s: %s takes a number >= 0, got '%s'\n", command, a, argv[i]);
+                return false;
+            }
+        } else if (a[0] == '-' && a[1]) {
             fprintf(stderr, "skybake: unknown or incomplete option '%s'\n", a);
             usage(stderr);
-            return EXIT_USAGE;
-        }
-        if (dir) {
+            return false;
+        } else if (n < count) {
+            dirs[n++] = a;
+        } else {
             fprintf(stderr, "skybake: unexpected argument '%s'\n", a);
-            return EXIT_USAGE;
+            return false;
         }
-        dir = a;
     }
-    if (!dir) {
-        fprintf(stderr, "skybake: info needs a PACK\n");
+    if (n < count) {
+        fprintf(stderr, "skybake: %s needs %s\n", command, count == 1 ? "a PACK" : "two packs, A and B");
+        return false;
+    }
+    return true;
+}
+
+static int cmd_info(int argc, char **argv)
+{
+    const char *dir;
+    bool json = false;
+    if (!pack_args(argc, argv, "info", &dir, 1, &json, NULL, NULL))
         return EXIT_USAGE;
-    }
     struct sb_pack pack;
     enum sb_result res = sb_pack_open(dir, &pack);
     if (res) {
@@ -373,6 +417,44 @@ static int cmd_info(int argc, char **argv)
     sb_pack_info_print(&pack, dir, json);
     sb_pack_close(&pack);
     return 0;
+}
+
+static int cmd_verify(int argc, char **argv)
+{
+    const char *dir;
+    bool json = false;
+    if (!pack_args(argc, argv, "verify", &dir, 1, &json, NULL, NULL))
+        return EXIT_USAGE;
+    return sb_pack_verify_print(dir, json) ? EXIT_BAKE_FAILED : 0;
+}
+
+static int cmd_diff(int argc, char **argv)
+{
+    const char *dirs[2];
+    bool json = false;
+    double tolerance = 0, floor = 1e-3;
+    if (!pack_args(argc, argv, "diff", dirs, 2, &json, &tolerance, &floor))
+        return EXIT_USAGE;
+    struct sb_pack *packs = calloc(2, sizeof(*packs));
+    struct sb_artifact_diff diffs[SB_PRODUCT_COUNT];
+    if (!packs)
+        return EXIT_BAKE_FAILED;
+    int rc = EXIT_USAGE;
+    for (int i = 0; i < 2; i++)
+        if (sb_pack_open(dirs[i], &packs[i])) {
+            sb_error("%s: not a valid pack; run skybake verify %s for every problem", dirs[i], dirs[i]);
+            goto done;
+        }
+    static const int codes[] = {[SB_DIFF_IDENTICAL] = 0, [SB_DIFF_WITHIN] = EXIT_DIFF_WITHIN,
+                                [SB_DIFF_DIFFERENT] = EXIT_DIFF_DIFFERENT, [SB_DIFF_MISSING] = EXIT_DIFF_MISSING};
+    enum sb_diff_outcome worst = sb_pack_diff(&packs[0], &packs[1], tolerance, floor, diffs);
+    sb_pack_diff_print(&packs[0], dirs[0], &packs[1], dirs[1], tolerance, floor, diffs, json);
+    rc = codes[worst];
+done:
+    sb_pack_close(&packs[0]);
+    sb_pack_close(&packs[1]);
+    free(packs);
+    return rc;
 }
 
 int main(int argc, char **argv)
@@ -395,6 +477,10 @@ int main(int argc, char **argv)
         return cmd_bench(argc - 2, argv + 2);
     if (!strcmp(argv[1], "info"))
         return cmd_info(argc - 2, argv + 2);
+    if (!strcmp(argv[1], "verify"))
+        return cmd_verify(argc - 2, argv + 2);
+    if (!strcmp(argv[1], "diff"))
+        return cmd_diff(argc - 2, argv + 2);
     if (!strcmp(argv[1], "sky-error"))
         return cmd_sky_error(argc - 2, argv + 2);
     fprintf(stderr, "skybake: unknown command '%s'\n", argv[1]);

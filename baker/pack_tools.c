@@ -1,11 +1,14 @@
-#include "pack_info.h"
+#include "pack_tools.h"
 
 #include <cJSON.h>
+#include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
+#include <string.h>
 #include <sys/stat.h>
 
 #include "json.h"
+#include "log.h"
 #include "scene.h"
 
 static long long file_bytes(const char *dir, const char *file)
@@ -87,4 +90,185 @@ void sb_pack_info_print(const struct sb_pack *pack, const char *dir, bool json)
         printf("%-18s %-9s %-28s %10lld %9.3f  %-32s  %s\n", sb_product_name((enum sb_product_id)p), size, channels,
                file_bytes(dir, a->file), a->gpu_ms, a->content_hash, a->settings_json);
     }
+}
+
+/* verify --json: every problem's message, as logged. */
+static void collect_problem(void *user, enum sb_log_level level, const char *message)
+{
+    if (level <= SB_LOG_WARN)
+        cJSON_AddItemToArray(user, cJSON_CreateString(message));
+}
+
+enum sb_result sb_pack_verify_print(const char *dir, bool json)
+{
+    cJSON *problems = json ? cJSON_CreateArray() : NULL;
+    if (json)
+        sb_log_set_sink(collect_problem, problems);
+    unsigned count = 0;
+    enum sb_result res = sb_pack_verify(dir, &count);
+    if (json) {
+        sb_log_set_sink(NULL, NULL);
+        cJSON *root = cJSON_CreateObject();
+        cJSON_AddStringToObject(root, "pack", dir);
+        cJSON_AddBoolToObject(root, "ok", res == SB_OK);
+        cJSON_AddStringToObject(root, "first_problem", sb_result_name(res));
+        cJSON_AddNumberToObject(root, "problem_count", count);
+        cJSON_AddItemToObject(root, "problems", problems);
+        sb_json_emit(stdout, root);
+    } else if (res) {
+        printf("%s: %u problem%s (the first: %s)\n", dir, count, count == 1 ? "" : "s", sb_result_name(res));
+    } else {
+        printf("%s: verified\n", dir);
+    }
+    return res;
+}
+
+const char *sb_diff_outcome_name(enum sb_diff_outcome outcome)
+{
+    static const char *const names[] = {"identical", "within-tolerance", "different", "missing"};
+    return (unsigned)outcome <= SB_DIFF_MISSING ? names[outcome] : "unknown";
+}
+
+double sb_diff_relative(double a, double b, double peak, double floor)
+{
+    double scale = fmax(fmax(fabs(a), fabs(b)), floor * peak);
+    return scale > 0 ? fabs(a - b) / scale : 0.0;
+}
+
+static void diff_images(const struct sb_image *a, const struct sb_image *b, double tolerance, double floor,
+                        struct sb_artifact_diff *d)
+{
+    if (a->width != b->width || a->height != b->height || a->channel_count != b->channel_count) {
+        d->outcome = SB_DIFF_DIFFERENT;
+        return;
+    }
+    uint32_t nc = a->channel_count;
+    uint64_t pixels = (uint64_t)a->width * a->height;
+    double peak[SB_IMAGE_MAX_CHANNELS] = {0};
+    for (uint64_t i = 0; i < pixels; i++)
+        for (uint32_t c = 0; c < nc; c++)
+            peak[c] = fmax(peak[c], fmax(fabs(a->data[i * nc + c]), fabs(b->data[i * nc + c])));
+    d->values = pixels * nc;
+    for (uint64_t i = 0; i < pixels; i++) {
+        for (uint32_t c = 0; c < nc; c++) {
+            float va = a->data[i * nc + c], vb = b->data[i * nc + c];
+            if (memcmp(&va, &vb, sizeof(va)) == 0)
+                continue;
+            d->differing++;
+            struct sb_value_place at = {(uint32_t)(i % a->width), (uint32_t)(i / a->width), c};
+            double abs_diff = fabs((double)va - (double)vb), rel = sb_diff_relative(va, vb, peak[c], floor);
+            if (abs_diff > d->max_abs) {
+                d->max_abs = abs_diff;
+                d->max_abs_at = at;
+            }
+            if (rel > d->max_rel) {
+                d->max_rel = rel;
+                d->max_rel_at = at;
+            }
+            if (!(rel <= tolerance))
+                d->beyond++;
+        }
+    }
+    d->outcome = !d->differing ? SB_DIFF_IDENTICAL : d->beyond ? SB_DIFF_DIFFERENT : SB_DIFF_WITHIN;
+}
+
+enum sb_diff_outcome sb_pack_diff(const struct sb_pack *a, const struct sb_pack *b, double tolerance, double floor,
+                                  struct sb_artifact_diff out[SB_PRODUCT_COUNT])
+{
+    enum sb_diff_outcome worst = SB_DIFF_IDENTICAL;
+    for (int p = 0; p < SB_PRODUCT_COUNT; p++) {
+        struct sb_artifact_diff *d = &out[p];
+        memset(d, 0, sizeof(*d));
+        d->product = (enum sb_product_id)p;
+        d->in_a = a->present[p];
+        d->in_b = b->present[p];
+        if (d->in_a != d->in_b)
+            d->outcome = SB_DIFF_MISSING;
+        else if (d->in_a)
+            diff_images(&a->images[p], &b->images[p], tolerance, floor, d);
+        if (d->outcome > worst)
+            worst = d->outcome;
+    }
+    return worst;
+}
+
+static void place_text(const struct sb_image *image, struct sb_value_place at, char *out, size_t size)
+{
+    snprintf(out, size, "(%u, %u) %s", at.x, at.y, image->channel_names[at.channel]);
+}
+
+void sb_pack_diff_print(const struct sb_pack *a, const char *dir_a, const struct sb_pack *b, const char *dir_b,
+                        double tolerance, double floor, const struct sb_artifact_diff diffs[SB_PRODUCT_COUNT],
+                        bool json)
+{
+    bool same_scene = !strcmp(a->scene_hash, b->scene_hash);
+    enum sb_diff_outcome worst = SB_DIFF_IDENTICAL;
+    for (int p = 0; p < SB_PRODUCT_COUNT; p++)
+        if (diffs[p].outcome > worst)
+            worst = diffs[p].outcome;
+    cJSON *root = json ? cJSON_CreateObject() : NULL, *arr = NULL;
+    if (json) {
+        cJSON_AddStringToObject(root, "a", dir_a);
+        cJSON_AddStringToObject(root, "b", dir_b);
+        cJSON_AddNumberToObject(root, "tolerance", tolerance);
+        cJSON_AddNumberToObject(root, "floor", floor);
+        cJSON_AddBoolToObject(root, "same_scene", same_scene);
+        cJSON_AddStringToObject(root, "device_a", a->device.name);
+        cJSON_AddStringToObject(root, "device_b", b->device.name);
+        cJSON_AddStringToObject(root, "outcome", sb_diff_outcome_name(worst));
+        arr = cJSON_AddArrayToObject(root, "artifacts");
+    } else {
+        printf("A %s: %s, on %s\nB %s: %s, on %s\n", dir_a, a->scene_hash, a->device.name, dir_b, b->scene_hash,
+               b->device.name);
+        if (!same_scene)
+            printf("the packs were baked from different scenes\n");
+        printf("relative difference: |a - b| / max(|a|, |b|, %g x the channel's largest value); tolerance %g\n", floor,
+               tolerance);
+    }
+    for (int p = 0; p < SB_PRODUCT_COUNT; p++) {
+        const struct sb_artifact_diff *d = &diffs[p];
+        if (!d->in_a && !d->in_b)
+            continue;
+        const char *name = sb_product_name(d->product);
+        const struct sb_image *image = d->in_a ? &a->images[p] : &b->images[p];
+        char abs_at[80] = "", rel_at[80] = "";
+        if (d->differing) {
+            place_text(image, d->max_abs_at, abs_at, sizeof(abs_at));
+            place_text(image, d->max_rel_at, rel_at, sizeof(rel_at));
+        }
+        if (json) {
+            cJSON *o = cJSON_CreateObject();
+            cJSON_AddStringToObject(o, "name", name);
+            cJSON_AddStringToObject(o, "outcome", sb_diff_outcome_name(d->outcome));
+            if (d->outcome == SB_DIFF_MISSING)
+                cJSON_AddStringToObject(o, "missing_from", d->in_a ? "b" : "a");
+            if (d->differing) {
+                cJSON_AddNumberToObject(o, "values", (double)d->values);
+                cJSON_AddNumberToObject(o, "differing", (double)d->differing);
+                cJSON_AddNumberToObject(o, "beyond_tolerance", (double)d->beyond);
+                cJSON_AddNumberToObject(o, "max_abs", d->max_abs);
+                cJSON_AddStringToObject(o, "max_abs_at", abs_at);
+                cJSON_AddNumberToObject(o, "max_rel", d->max_rel);
+                cJSON_AddStringToObject(o, "max_rel_at", rel_at);
+            }
+            cJSON_AddItemToArray(arr, o);
+            continue;
+        }
+        if (d->outcome == SB_DIFF_MISSING)
+            printf("%-18s missing from %s\n", name, d->in_a ? "B" : "A");
+        else if (d->outcome == SB_DIFF_IDENTICAL)
+            printf("%-18s identical\n", name);
+        else if (!d->differing)
+            printf("%-18s different shapes\n", name);
+        else
+            printf("%-18s %s: %llu of %llu values differ, %llu beyond the tolerance; max abs %.3g at %s, max rel "
+                   "%.3g at %s\n",
+                   name, sb_diff_outcome_name(d->outcome), (unsigned long long)d->differing,
+                   (unsigned long long)d->values, (unsigned long long)d->beyond, d->max_abs, abs_at, d->max_rel,
+                   rel_at);
+    }
+    if (json)
+        sb_json_emit(stdout, root);
+    else
+        printf("outcome: %s\n", sb_diff_outcome_name(worst));
 }

@@ -253,6 +253,8 @@ static char *manifest_json(const struct sb_pack_writer *w, const char *scene_jso
         cJSON_AddNumberToObject(o, "bake_ms", a->bake_ms);
         cJSON_AddNumberToObject(o, "gpu_ms", a->gpu_ms);
         cJSON_AddStringToObject(o, "content_hash", a->content_hash);
+        if (a->key[0])
+            cJSON_AddStringToObject(o, "key", a->key);
         cJSON_AddItemToArray(arr, o);
     }
     char *text = cJSON_Print(root);
@@ -430,6 +432,7 @@ static enum sb_result read_artifact_entry(const cJSON *entry, int index, struct 
     const struct sb_product_format *format = sb_product_format(id);
     struct sb_artifact *a = &pack->artifacts[id];
     a->product = id;
+    pack->present[id] = true; /* listed, whether or not the rest of the entry holds */
     if ((res = manifest_string(entry, "file", a->file, sizeof(a->file), source, where)) ||
         (res = manifest_string(entry, "content_hash", a->content_hash, sizeof(a->content_hash), source, where)) ||
         (res = manifest_string(entry, "parameterization", a->parameterization, sizeof(a->parameterization), source,
@@ -487,6 +490,11 @@ static enum sb_result read_artifact_entry(const cJSON *entry, int index, struct 
     a->bake_ms = cJSON_IsNumber(ms) ? ms->valuedouble : 0.0;
     ms = cJSON_GetObjectItemCaseSensitive(entry, "gpu_ms");
     a->gpu_ms = cJSON_IsNumber(ms) ? ms->valuedouble : 0.0;
+    /* Optional: without a key (or with one this build cannot hold) the
+     * artifact is never reused, only rebaked. */
+    const cJSON *key = cJSON_GetObjectItemCaseSensitive(entry, "key");
+    if (cJSON_IsString(key) && strlen(key->valuestring) < sizeof(a->key))
+        snprintf(a->key, sizeof(a->key), "%s", key->valuestring);
     *out_id = id;
     return SB_OK;
 }
@@ -573,15 +581,98 @@ static enum sb_result read_scene(const cJSON *root, struct sb_pack *pack, const 
     return SB_OK;
 }
 
-enum sb_result sb_pack_open(const char *dir, struct sb_pack *pack)
+/* Problems found so far: the first one's code and how many. */
+struct pack_problems {
+    enum sb_result first;
+    unsigned count;
+};
+
+static enum sb_result note(struct pack_problems *p, enum sb_result res)
+{
+    if (res) {
+        if (!p->first)
+            p->first = res;
+        p->count++;
+    }
+    return res;
+}
+
+/* The manifest's header: what the rest is read as. Problems here end the
+ * reading, since nothing after them can be trusted to mean anything. */
+static enum sb_result read_header(const cJSON *root, struct sb_pack *pack, const char *source)
+{
+    char format[32];
+    enum sb_result res = manifest_string(root, "format", format, sizeof(format), source, "");
+    if (res)
+        return res;
+    if (strcmp(format, "skybake-pack") != 0) {
+        sb_error("%s: format: \"%s\" is not a skybake pack", source, format);
+        return SB_ERR_VERSION;
+    }
+    const cJSON *version = cJSON_GetObjectItemCaseSensitive(root, "format_version");
+    if (!cJSON_IsNumber(version)) {
+        sb_error("%s: format_version: %s", source, version ? "expected a number" : "missing");
+        return version ? SB_ERR_WRONG_TYPE : SB_ERR_MISSING_FIELD;
+    }
+    if (version->valuedouble != SB_PACK_FORMAT_VERSION) {
+        sb_error("%s: format_version %g; this build reads version %d only: rebake needed", source,
+                 version->valuedouble, SB_PACK_FORMAT_VERSION);
+        return SB_ERR_VERSION;
+    }
+    pack->format_version = SB_PACK_FORMAT_VERSION;
+    return SB_OK;
+}
+
+static enum sb_result read_device(const cJSON *root, struct sb_device_info *d, const char *source)
+{
+    const cJSON *device = cJSON_GetObjectItemCaseSensitive(root, "device");
+    if (!cJSON_IsObject(device)) {
+        sb_error("%s: device: %s", source, device ? "expected an object" : "missing");
+        return device ? SB_ERR_WRONG_TYPE : SB_ERR_MISSING_FIELD;
+    }
+    struct pack_problems p = {0};
+    note(&p, manifest_string(device, "name", d->name, sizeof(d->name), source, "device."));
+    note(&p, manifest_string(device, "driver", d->driver, sizeof(d->driver), source, "device."));
+    note(&p, manifest_string(device, "api_version", d->api_version, sizeof(d->api_version), source, "device."));
+    note(&p, manifest_u32(device, "vendor_id", &d->vendor_id, source, "device."));
+    note(&p, manifest_u32(device, "device_id", &d->device_id, source, "device."));
+    return p.first;
+}
+
+/* Files in the pack's directory that its manifest does not list. */
+static void find_unlisted(const char *dir, const struct sb_pack *pack, struct pack_problems *p)
+{
+    DIR *d = opendir(dir);
+    if (!d)
+        return; /* already reported: the manifest could not be read either */
+    struct dirent *e;
+    while ((e = readdir(d))) {
+        if (!strcmp(e->d_name, ".") || !strcmp(e->d_name, "..") || !strcmp(e->d_name, SB_PACK_MANIFEST))
+            continue;
+        bool listed = false;
+        for (int i = 0; i < SB_PRODUCT_COUNT && !listed; i++)
+            listed = pack->present[i] && !strcmp(pack->artifacts[i].file, e->d_name);
+        if (!listed) {
+            sb_error("%s/%s: not listed in the manifest", dir, e->d_name);
+            note(p, SB_ERR_UNLISTED_FILE);
+        }
+    }
+    closedir(d);
+}
+
+/* Read and verify the pack, going on past every problem that leaves the
+ * rest readable, so that each is logged. */
+static enum sb_result pack_read(const char *dir, struct sb_pack *pack, unsigned *problem_count)
 {
     memset(pack, 0, sizeof(*pack));
+    struct pack_problems p = {0};
     char source[4200];
     snprintf(source, sizeof(source), "%s/%s", dir, SB_PACK_MANIFEST);
     int dir_fd = open(dir, O_RDONLY | O_DIRECTORY | O_CLOEXEC);
     if (dir_fd < 0) {
         sb_error("%s: cannot open the pack: %s", dir, strerror(errno));
-        return SB_ERR_IO;
+        note(&p, SB_ERR_IO);
+        goto done;
     }
     cJSON *root = NULL;
     enum sb_result res = sb_json_load(dir_fd, SB_PACK_MANIFEST, source, PACK_MANIFEST_MAX_BYTES, false, &root);
@@ -591,71 +682,67 @@ enum sb_result sb_pack_open(const char *dir, struct sb_pack *pack)
     }
     if (!res)
         res = sb_json_check_duplicates(root, source, "");
-    char format[32];
-    if (!res && !(res = manifest_string(root, "format", format, sizeof(format), source, "")) &&
-        strcmp(format, "skybake-pack") != 0) {
-        sb_error("%s: format: \"%s\" is not a skybake pack", source, format);
-        res = SB_ERR_VERSION;
-    }
-    if (!res) {
-        const cJSON *version = cJSON_GetObjectItemCaseSensitive(root, "format_version");
-        if (!cJSON_IsNumber(version)) {
-            sb_error("%s: format_version: %s", source, version ? "expected a number" : "missing");
-            res = version ? SB_ERR_WRONG_TYPE : SB_ERR_MISSING_FIELD;
-        } else if (version->valuedouble != SB_PACK_FORMAT_VERSION) {
-            sb_error("%s: format_version %g; this build reads version %d only: rebake needed", source,
-                     version->valuedouble, SB_PACK_FORMAT_VERSION);
-            res = SB_ERR_VERSION;
-        } else {
-            pack->format_version = SB_PACK_FORMAT_VERSION;
-        }
-    }
     if (!res)
-        res =
-            manifest_string(root, "skybake_version", pack->skybake_version, sizeof(pack->skybake_version), source, "");
-    if (!res)
-        res = manifest_string(root, "scene_hash", pack->scene_hash, sizeof(pack->scene_hash), source, "");
-    if (!res)
-        res = read_scene(root, pack, source);
-    const cJSON *device = res ? NULL : cJSON_GetObjectItemCaseSensitive(root, "device");
-    if (!res && !cJSON_IsObject(device)) {
-        sb_error("%s: device: %s", source, device ? "expected an object" : "missing");
-        res = device ? SB_ERR_WRONG_TYPE : SB_ERR_MISSING_FIELD;
-    }
-    if (!res)
-        res = manifest_string(device, "name", pack->device.name, sizeof(pack->device.name), source, "device.");
-    if (!res)
-        res = manifest_string(device, "driver", pack->device.driver, sizeof(pack->device.driver), source, "device.");
-    if (!res)
-        res = manifest_string(device, "api_version", pack->device.api_version, sizeof(pack->device.api_version), source,
-                              "device.");
-    if (!res)
-        res = manifest_u32(device, "vendor_id", &pack->device.vendor_id, source, "device.");
-    if (!res)
-        res = manifest_u32(device, "device_id", &pack->device.device_id, source, "device.");
-    const cJSON *artifacts = res ? NULL : cJSON_GetObjectItemCaseSensitive(root, "artifacts");
-    if (!res && !cJSON_IsArray(artifacts)) {
+        res = read_header(root, pack, source);
+    if (note(&p, res))
+        goto done_root;
+    note(&p, manifest_string(root, "skybake_version", pack->skybake_version, sizeof(pack->skybake_version), source,
+                             ""));
+    if (!note(&p, manifest_string(root, "scene_hash", pack->scene_hash, sizeof(pack->scene_hash), source, "")))
+        note(&p, read_scene(root, pack, source));
+    note(&p, read_device(root, &pack->device, source));
+    const cJSON *artifacts = cJSON_GetObjectItemCaseSensitive(root, "artifacts");
+    if (!cJSON_IsArray(artifacts)) {
         sb_error("%s: artifacts: %s", source, artifacts ? "expected an array" : "missing");
-        res = artifacts ? SB_ERR_WRONG_TYPE : SB_ERR_MISSING_FIELD;
+        note(&p, artifacts ? SB_ERR_WRONG_TYPE : SB_ERR_MISSING_FIELD);
+        goto done_root;
     }
     /* Every entry is checked before any pixel is read. */
     int index = 0;
     const cJSON *entry;
-    if (!res)
-        cJSON_ArrayForEach(entry, artifacts)
-        {
-            enum sb_product_id id;
-            if ((res = read_artifact_entry(entry, index++, pack, source, &id)))
-                break;
-            pack->present[id] = true;
+    bool entry_ok[SB_PRODUCT_COUNT] = {0};
+    cJSON_ArrayForEach(entry, artifacts)
+    {
+        enum sb_product_id id;
+        if (index >= PACK_MAX_ARTIFACTS) {
+            sb_error("%s: artifacts: more than %d entries", source, PACK_MAX_ARTIFACTS);
+            note(&p, SB_ERR_OUT_OF_RANGE);
+            break;
         }
-    for (int p = 0; p < SB_PRODUCT_COUNT && !res; p++)
-        if (pack->present[p])
-            res = read_artifact_image(dir, dir_fd, pack, (enum sb_product_id)p);
+        if (!note(&p, read_artifact_entry(entry, index++, pack, source, &id)))
+            entry_ok[id] = true;
+    }
+    for (int i = 0; i < SB_PRODUCT_COUNT; i++)
+        if (entry_ok[i])
+            note(&p, read_artifact_image(dir, dir_fd, pack, (enum sb_product_id)i));
+    find_unlisted(dir, pack, &p);
+done_root:
     cJSON_Delete(root);
-    close(dir_fd);
-    if (res)
+done:
+    if (dir_fd >= 0)
+        close(dir_fd);
+    if (p.first)
         sb_pack_close(pack);
+    if (problem_count)
+        *problem_count = p.count;
+    return p.first;
+}
+
+enum sb_result sb_pack_open(const char *dir, struct sb_pack *pack)
+{
+    return pack_read(dir, pack, NULL);
+}
+
+enum sb_result sb_pack_verify(const char *dir, unsigned *problem_count)
+{
+    struct sb_pack *pack = malloc(sizeof(*pack));
+    if (!pack) {
+        *problem_count = 1;
+        return SB_ERR_NOMEM;
+    }
+    enum sb_result res = pack_read(dir, pack, problem_count);
+    sb_pack_close(pack);
+    free(pack);
     return res;
 }
 

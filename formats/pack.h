@@ -47,6 +47,7 @@ struct sb_artifact {
     double bake_ms;            /* wall time of the product's bake, host side */
     double gpu_ms;             /* GPU time between the product's timestamps */
     char content_hash[SB_HASH_HEX_SIZE];
+    char key[SB_HASH_HEX_SIZE]; /* the bake key (baker/bake.h); "" when not recorded */
 };
 
 struct sb_device_info {
@@ -107,11 +108,23 @@ struct sb_pack {
  * file (a plain name inside the pack, not a symbolic link), dimensions,
  * channels and pixel type against the product's format (checked before any
  * pixel is read), the EXR itself, that it holds only finite values, and its
- * content hash against the manifest's; and the scene the manifest records
- * (a valid scene, whose normalised form hashes to scene_hash). Any failure is logged naming the
- * pack, the artifact and the reason; *pack is then empty.
+ * content hash against the manifest's; the scene the manifest records
+ * (a valid scene, whose normalised form hashes to scene_hash); and that the
+ * pack holds no file the manifest does not list. Every problem is logged
+ * naming the pack, the artifact and the reason; the first one's code is
+ * returned, and *pack is then empty.
  */
 enum sb_result sb_pack_open(const char *dir, struct sb_pack *pack);
+
+/*
+ * Everything sb_pack_open checks, and files in the pack that the manifest
+ * does not list (SB_ERR_UNLISTED_FILE), going on past each problem that
+ * leaves the rest readable, so that every one is logged: each artifact's
+ * entry and file is checked whatever the others' state. Returns the first
+ * problem's code (SB_OK when all holds); *problem_count counts them.
+ * sb_pack_open reads the same way.
+ */
+enum sb_result sb_pack_verify(const char *dir, unsigned *problem_count);
 
 /* Free the images; accepts an empty or closed pack. */
 void sb_pack_close(struct sb_pack *pack);

@@ -30,10 +30,15 @@ enum sb_result {
     SB_ERR_HASH_MISMATCH,   /* an artifact's content differs from the hash its manifest records */
     SB_ERR_UNSAFE_PATH,     /* a path that leaves the pack or goes through a symbolic link */
     SB_ERR_TOLERANCE,       /* no setting of a product reaches the scene's tolerance */
+    SB_ERR_UNLISTED_FILE,   /* a pack holds a file its manifest does not list */
     SB_RESULT_COUNT,
 };
 
-/* Short stable name of a code, e.g. "out-of-range". Never NULL. */
+/* Short stable name of a code, e.g. "out-of-range"; "unknown" outside the
+ * set. Never NULL. */
 const char *sb_result_name(enum sb_result result);
+
+/* What a code means, in a few words. Never NULL. */
+const char *sb_result_description(enum sb_result result);
 
 #endif

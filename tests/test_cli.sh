@@ -45,6 +45,30 @@ check "info needs a pack" expect_exit 2 "$skybake" info
 check "info refuses what is not a pack" expect_exit 2 "$skybake" info "$root/data"
 check "manifest has format_version 1" grep -Eq '"format_version":[[:space:]]*1,' "$tmp/a/manifest.json"
 
+# verify: exit 0 when all holds; else 1, naming every problem.
+check "verify a pack" expect_exit 0 "$skybake" verify "$tmp/a"
+check "verify says verified" grep -q "verified" "$tmp/out"
+cp -r "$tmp/a" "$tmp/broken"
+head -c 3000 "$tmp/a/transmittance.exr" >"$tmp/broken/transmittance.exr"
+rm "$tmp/broken/irradiance_sky.exr"
+echo stray >"$tmp/broken/notes.txt"
+check "verify a broken pack is exit 1" expect_exit 1 "$skybake" verify "$tmp/broken"
+check "verify names the truncated file" grep -q "broken/transmittance.exr" "$tmp/err"
+check "verify names the missing file" grep -q "irradiance_sky.exr" "$tmp/err"
+check "verify names the unlisted file" grep -q "notes.txt: not listed" "$tmp/err"
+check "verify counts three problems" grep -q "3 problems" "$tmp/out"
+check "verify --json lists them" expect_exit 1 "$skybake" verify "$tmp/broken" --json
+check "verify --json has ok false and 3 problems" grep -Eq '"problem_count":[[:space:]]*3' "$tmp/out"
+check "verify of a missing pack is exit 1" expect_exit 1 "$skybake" verify "$tmp/nope"
+check "verify needs a pack" expect_exit 2 "$skybake" verify
+
+# diff: the exit code says identical (0), within --tol (1), different (5),
+# missing (6); 2 for a pack that does not verify.
+check "diff of packs baked with 1 and 2 threads" expect_exit 0 "$skybake" diff "$tmp/a" "$tmp/b"
+check "diff says identical for each product" test "$(grep -Ec "^[a-z_]+ +identical$" "$tmp/out")" = 4
+check "diff against a broken pack is exit 2" expect_exit 2 "$skybake" diff "$tmp/a" "$tmp/broken"
+check "diff refuses a negative --tol" expect_exit 2 "$skybake" diff "$tmp/a" "$tmp/b" --tol -1
+
 # Rebaking over a pack replaces it whole; a failed bake leaves it as it was.
 check "rebake over a pack" expect_exit 0 "$skybake" bake "$scene" -o "$tmp/a" -q
 before=$(cat "$tmp/a/manifest.json")
@@ -55,6 +79,39 @@ check "refuses to replace a directory that is not a pack" expect_exit 1 "$skybak
 check "foreign directory untouched" test "$(cat "$tmp/notapack/file.txt")" = keep
 check "no temporary directories left" test -z "$(ls -d "$tmp"/*.tmp-* 2>/dev/null)"
 check "output into a missing parent fails" expect_exit 1 "$skybake" bake "$scene" -o "$tmp/missing/parent/p"
+
+# The bake graph: baking into a pack reuses each artifact whose key (its
+# parameters, settings, kernels and inputs' keys) is unchanged, and the
+# result equals a fresh bake.
+reused() { # the names of the reused artifacts in a bake's --json ($tmp/out)
+    python3 -c 'import json, sys
+print(" ".join(a["name"] for a in json.load(open(sys.argv[1]))["artifacts"] if a["reused"]))' "$tmp/out"
+}
+graph='{"atmosphere":{"preset":"earth"%s},"products":["irradiance_ground"]}'
+printf "$graph" '' >"$tmp/g1.json"
+printf "$graph" ',"mie_g":0.7' >"$tmp/g2.json"
+printf "$graph" ',"mie_g":0.7,"ground_albedo":0.1' >"$tmp/g3.json"
+check "bake three products" expect_exit 0 "$skybake" bake "$tmp/g1.json" -o "$tmp/g" -q --json
+check "a first bake reuses nothing" test -z "$(reused)"
+check "the same scene again" expect_exit 0 "$skybake" bake "$tmp/g1.json" -o "$tmp/g" -q --json
+check "the same scene reuses all three" test "$(reused)" = "transmittance multiscattering irradiance_ground"
+check "still verifies" expect_exit 0 "$skybake" verify "$tmp/g"
+check "mie_g changed" expect_exit 0 "$skybake" bake "$tmp/g2.json" -o "$tmp/g" -q --json
+check "mie_g rebakes irradiance_ground only (multiscattering's phase is isotropic)" test "$(reused)" = "transmittance multiscattering"
+check "a fresh bake of the changed scene" expect_exit 0 "$skybake" bake "$tmp/g2.json" -o "$tmp/gfresh" -q
+check "the rebaked pack is identical to the fresh one" expect_exit 0 "$skybake" diff "$tmp/g" "$tmp/gfresh"
+check "ground albedo changed" expect_exit 0 "$skybake" bake "$tmp/g3.json" -o "$tmp/g" -q --json
+check "the albedo rebakes multiscattering and irradiance_ground" test "$(reused)" = "transmittance"
+check "--force" expect_exit 0 "$skybake" bake "$tmp/g3.json" -o "$tmp/g" -q --json --force
+check "--force reuses nothing" test -z "$(reused)"
+sed -i 's/"name":[[:space:]]*"llvmpipe[^"]*"/"name": "another device"/' "$tmp/g/manifest.json"
+check "a pack from another device" expect_exit 0 "$skybake" bake "$tmp/g3.json" -o "$tmp/g" --json
+check "a pack from another device is not reused" test -z "$(reused)"
+check "and says so" grep -q "baked on another device" "$tmp/err"
+head -c 2000 "$tmp/gfresh/multiscattering.exr" >"$tmp/gfresh/t" && mv "$tmp/gfresh/t" "$tmp/gfresh/multiscattering.exr"
+check "a pack that does not verify" expect_exit 0 "$skybake" bake "$tmp/g2.json" -o "$tmp/gfresh" --json
+check "a pack that does not verify is not reused" test -z "$(reused)"
+check "and the warning names the file" grep -q "multiscattering.exr" "$tmp/err"
 
 # Refused parameter values (docs/scene.md), each naming its key.
 for bad in 'top_radius_km:6360' 'top_radius_km:6000' 'top_radius_km:6360.000001' 'ground_radius_km:0' \
@@ -81,6 +138,24 @@ samples=$(json_number "$tmp/tol/manifest.json" max_samples)
 check "recorded error ($err) is within the tolerance" awk -v e="$err" 'BEGIN { exit !(e != "" && e <= 1e-3) }'
 check "a loose tolerance picks a cheaper setting than the default's 40 samples ($samples)" test "${samples:-40}" -lt 40
 check "the default bake records no tolerance" test -z "$(grep -o tolerance "$tmp/a/manifest.json")"
+# The same products at other settings: diff within and beyond a tolerance,
+# and a pack holding fewer products.
+cp -r "$tmp/a" "$tmp/tonly"
+rm "$tmp/tonly/multiscattering.exr" "$tmp/tonly/irradiance_ground.exr" "$tmp/tonly/irradiance_sky.exr"
+python3 -c 'import json, sys
+p = sys.argv[1] + "/manifest.json"
+m = json.load(open(p))
+m["artifacts"] = [a for a in m["artifacts"] if a["name"] == "transmittance"]
+json.dump(m, open(p, "w"), indent=1)' "$tmp/tonly"
+check "a pack cut to transmittance verifies" expect_exit 0 "$skybake" verify "$tmp/tonly"
+check "diff within --tol 1e-2 is exit 1" expect_exit 1 "$skybake" diff "$tmp/tonly" "$tmp/tol" --tol 1e-2
+check "diff reports where the largest difference is" grep -Eq "max rel [0-9.e-]+ at \([0-9]+, [0-9]+\) [rgb]" "$tmp/out"
+check "diff notes the scenes differ" grep -q "different scenes" "$tmp/out"
+check "diff beyond --tol 1e-7 is exit 5" expect_exit 5 "$skybake" diff "$tmp/tonly" "$tmp/tol" --tol 1e-7
+check "diff --json says different" expect_exit 5 "$skybake" diff "$tmp/tonly" "$tmp/tol" --tol 1e-7 --json
+check "diff --json outcome" grep -Eq '"outcome":[[:space:]]*"different"' "$tmp/out"
+check "diff with products missing is exit 6" expect_exit 6 "$skybake" diff "$tmp/a" "$tmp/tol" --tol 1
+check "diff names what is missing" test "$(grep -c "missing from B" "$tmp/out")" = 3
 printf '{"atmosphere":{"preset":"earth"},"products":["transmittance"],"tolerance":1e-7}' >"$tmp/tight.json"
 check "unreachable tolerance is exit 2" expect_exit 2 "$skybake" bake "$tmp/tight.json" -o "$tmp/tight"
 check "unreachable tolerance names the best reachable" grep -q "best reachable is" "$tmp/err"

@@ -115,6 +115,15 @@ static void test_scenes(void)
         {"{\"atmosphere\":{\"preset\":\"earth\"},\"products\":[\"clouds\"]}", SB_ERR_UNKNOWN_PRODUCT},
         {"{\"atmosphere\":{\"preset\":\"earth\"},\"products\":[]}", SB_ERR_OUT_OF_RANGE},
         {"{\"atmosphere\":{\"preset\":\"earth\"},\"version\":2}", SB_ERR_OUT_OF_RANGE},
+        {"{\"atmosphere\":{\"preset\":\"earth\",\"mie_g\":NaN}}", SB_ERR_JSON_SYNTAX},
+        {"{\"atmosphere\":{\"preset\":\"earth\",\"mie_g\":Infinity}}", SB_ERR_JSON_SYNTAX},
+        {"{\"atmosphere\":{\"preset\":\"earth\",\"top_radius_km\":1e308}}", SB_ERR_OUT_OF_RANGE},
+        {"{\"atmosphere\":{\"preset\":\"earth\",\"mie_scale_height_km\":1e-320}}", SB_ERR_OUT_OF_RANGE},
+        {"{\"atmosphere\":\"earth\"}", SB_ERR_WRONG_TYPE},
+        {"{\"atmosphere\":{\"preset\":\"earth\",\"ground_albedo\":[0.1,[0.2],0.3]}}", SB_ERR_WRONG_TYPE},
+        {"{\"atmosphere\":{\"preset\":\"earth\"},\"products\":[\"transmittance\",\"transmittance\"]}", SB_ERR_DUPLICATE_KEY},
+        {"\x89PNG\r\n\x1a\n\xff\xfe{[", SB_ERR_JSON_SYNTAX},
+        {"{\"atmosphere\":{\"preset\":\"earth}}", SB_ERR_JSON_SYNTAX},
     };
     for (size_t i = 0; i < sizeof(cases) / sizeof(cases[0]); i++) {
         struct sb_scene scene;
@@ -122,6 +131,22 @@ static void test_scenes(void)
         CHECK(got == cases[i].expect, "case %zu (%s): got %s, expected %s", i, cases[i].json, sb_result_name(got),
               sb_result_name(cases[i].expect));
     }
+    /* Deep nesting (cJSON stops at 1000 levels) and a NUL inside the text. */
+    size_t depth = 100000;
+    char *deep = malloc(2 * depth + 1);
+    for (size_t i = 0; i < depth; i++) {
+        deep[i] = '[';
+        deep[2 * depth - 1 - i] = ']';
+    }
+    deep[2 * depth] = '\0';
+    struct sb_scene nested;
+    enum sb_result got = sb_scene_parse(deep, 2 * depth, "deep", &nested);
+    CHECK(got == SB_ERR_JSON_SYNTAX, "100000 nested arrays: got %s", sb_result_name(got));
+    free(deep);
+    static const char with_nul[] = "{\"atmosphere\":{\"preset\":\"earth\"}}\0{}";
+    got = sb_scene_parse(with_nul, sizeof(with_nul) - 1, "nul", &nested);
+    CHECK(got == SB_ERR_JSON_SYNTAX, "a NUL byte in the text: got %s", sb_result_name(got));
+
     /* Overrides apply and normalisation is stable. */
     struct sb_scene a, b;
     const char *ja = "{\"atmosphere\":{\"preset\":\"earth\",\"mie_g\":0.76}}";
@@ -286,6 +311,18 @@ static void edit_no_scene(cJSON *r)
 {
     cJSON_DeleteItemFromObject(r, "scene");
 }
+static void edit_format(cJSON *r)
+{
+    set_string(r, "format", "other-pack");
+}
+static void edit_artifacts_type(cJSON *r)
+{
+    cJSON_ReplaceItemInObject(r, "artifacts", cJSON_CreateObject());
+}
+static void edit_artifact_number(cJSON *r)
+{
+    cJSON_ReplaceItemInArray(cJSON_GetObjectItem(r, "artifacts"), 1, cJSON_CreateNumber(1));
+}
 
 static void test_pack_reader(void)
 {
@@ -297,6 +334,14 @@ static void test_pack_reader(void)
     snprintf(bad, sizeof(bad), "%s/bad", pack_root);
     struct sb_image images[SB_PRODUCT_COUNT] = {0};
     write_test_pack(good, images);
+    struct sb_image nan_image;
+    char nan_path[300];
+    snprintf(nan_path, sizeof(nan_path), "%s/nan.exr", pack_root);
+    sb_image_init(&nan_image, images[SB_PRODUCT_MULTISCATTERING].width, images[SB_PRODUCT_MULTISCATTERING].height, 3);
+    sb_image_set_channel_names(&nan_image, "r,g,b");
+    nan_image.data[100] = NAN;
+    CHECK(sb_exr_write(nan_path, &nan_image, NULL, 0) == SB_OK, "write an EXR holding NaN");
+    sb_image_finish(&nan_image);
 
     struct sb_pack *pack = calloc(1, sizeof(*pack));
     CHECK(sb_pack_open(good, pack) == SB_OK, "a pack just written opens");
@@ -355,12 +400,31 @@ static void test_pack_reader(void)
         {"manifest over 1 MiB", NULL, "head -c 1100000 /dev/zero | tr '\\\\0' ' ' >> manifest.json",
          SB_ERR_OUT_OF_RANGE},
         {"no manifest", NULL, "rm manifest.json", SB_ERR_IO},
+        {"file the manifest does not list", NULL, "echo x > notes.txt", SB_ERR_UNLISTED_FILE},
+        {"directory the manifest does not list", NULL, "mkdir sub", SB_ERR_UNLISTED_FILE},
+        {"another format", edit_format, NULL, SB_ERR_VERSION},
+        {"artifacts not an array", edit_artifacts_type, NULL, SB_ERR_WRONG_TYPE},
+        {"artifact entry not an object", edit_artifact_number, NULL, SB_ERR_WRONG_TYPE},
+        {"key given twice in the manifest", NULL, "sed -i '0,/\"skybake_version\"/s//\"skybake_version\": \"x\", \"skybake_version\"/' manifest.json",
+         SB_ERR_DUPLICATE_KEY},
+        {"artifact holding NaN", NULL, "cp ../nan.exr multiscattering.exr", SB_ERR_NUMERIC},
+        {"pack directory replaced by a file", NULL, "cd .. && rm -rf bad && echo x > bad", SB_ERR_IO},
     };
     for (size_t i = 0; i < sizeof(cases) / sizeof(cases[0]); i++) {
         enum sb_result got = open_edited(good, bad, cases[i].edit, cases[i].shell);
         CHECK(got == cases[i].expect, "pack with %s: got %s, expected %s", cases[i].what, sb_result_name(got),
               sb_result_name(cases[i].expect));
     }
+    /* verify goes on past each problem: three of them, each counted. */
+    open_edited(good, bad, edit_hash, "rm irradiance_ground.exr && echo x > notes.txt");
+    unsigned problems = 0;
+    enum sb_result got_code = sb_pack_verify(bad, &problems);
+    CHECK(got_code == SB_ERR_HASH_MISMATCH && problems == 3, "verify of a pack with three problems: %s, %u problems",
+          sb_result_name(got_code), problems);
+    got_code = sb_pack_verify(good, &problems);
+    CHECK(got_code == SB_OK && problems == 0, "verify of a good pack: %s, %u problems", sb_result_name(got_code),
+          problems);
+
     /* A well-formed EXR whose pixels differ from what the manifest recorded. */
     open_edited(good, bad, NULL, NULL);
     char path[512];
@@ -381,10 +445,26 @@ static void test_pack_reader(void)
     run(cmd);
 }
 
+/* The codes are a closed set: each has its own name and a description. */
+static void test_result_codes(void)
+{
+    for (int i = 0; i < SB_RESULT_COUNT; i++) {
+        const char *name = sb_result_name((enum sb_result)i);
+        CHECK(strcmp(name, "unknown") != 0 && strlen(sb_result_description((enum sb_result)i)) > 4,
+              "code %d has a name and a description", i);
+        for (int j = 0; j < i; j++)
+            CHECK(strcmp(name, sb_result_name((enum sb_result)j)) != 0, "codes %d and %d share the name %s", j, i,
+                  name);
+    }
+    CHECK(!strcmp(sb_result_name(SB_RESULT_COUNT), "unknown") && !strcmp(sb_result_name((enum sb_result)-1), "unknown"),
+          "outside the set: unknown");
+}
+
 int main(void)
 {
     if (!getenv("SKYBAKE_TEST_VERBOSE"))
         sb_log_set_sink(quiet, NULL);
+    test_result_codes();
     test_exr_round_trip();
     test_scenes();
     test_pack_reader();

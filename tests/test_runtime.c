@@ -352,7 +352,7 @@ int main(int argc, char **argv)
     sb_atmosphere_preset_earth(&scene.atmosphere);
     scene.wants[SB_PRODUCT_IRRADIANCE_GROUND] = true;
     struct sb_bake_report report;
-    CHECK(sb_bake_scene(vk, &scene, pack_dir, &report) == SB_OK, "bake");
+    CHECK(sb_bake_scene(vk, &scene, pack_dir, NULL, &report) == SB_OK, "bake");
     CHECK(sb_pack_open(pack_dir, &pack) == SB_OK, "the pack opens");
     CHECK(sb_world_load(world_path, &world) == SB_OK, "the world loads");
 
