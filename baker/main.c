@@ -7,6 +7,7 @@
  */
 #include <cJSON.h>
 #include <math.h>
+#include <signal.h>
 #include <stdbool.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -457,8 +458,29 @@ done:
     return rc;
 }
 
+/* SIGINT, SIGTERM, SIGHUP: remove the pack's temporary files, then end as the signal would. */
+static void on_stop_signal(int sig)
+{
+    sb_pack_writers_remove_temporaries();
+    signal(sig, SIG_DFL);
+    raise(sig);
+}
+
+static void install_signal_handlers(void)
+{
+    struct sigaction sa = {.sa_handler = on_stop_signal};
+    sigemptyset(&sa.sa_mask);
+    sigaction(SIGINT, &sa, NULL);
+    sigaction(SIGTERM, &sa, NULL);
+    sigaction(SIGHUP, &sa, NULL);
+    /* A file size limit (ulimit -f) then fails the write with EFBIG, which
+     * is reported and cleaned up, instead of killing the process. */
+    signal(SIGXFSZ, SIG_IGN);
+}
+
 int main(int argc, char **argv)
 {
+    install_signal_handlers();
     if (argc < 2) {
         usage(stderr);
         return EXIT_USAGE;

@@ -10,16 +10,23 @@
 
 #define EXR_DEFAULT_MAX_PIXELS (64ull << 20)
 
+/* OpenEXR's own message for the last error of this thread: it names the
+ * system's reason (e.g. "File too large"), which the codes do not. */
+static _Thread_local char last_message[256];
+
 static void silent_errors(exr_const_context_t ctxt, exr_result_t code, const char *msg)
 {
     (void)ctxt;
+    snprintf(last_message, sizeof(last_message), "%s", msg ? msg : "");
     sb_debug("openexr: %s (%d)", msg, (int)code);
 }
 
 static enum sb_result exr_fail(const char *path, const char *what, exr_result_t rv)
 {
-    sb_error("%s: %s: %s", path, what, exr_get_default_error_message(rv));
-    return rv == EXR_ERR_FILE_ACCESS ? SB_ERR_IO : SB_ERR_EXR;
+    sb_error("%s: %s: %s%s%s", path, what, exr_get_default_error_message(rv), last_message[0] ? ": " : "",
+             last_message);
+    last_message[0] = '\0';
+    return rv == EXR_ERR_FILE_ACCESS || rv == EXR_ERR_WRITE_IO ? SB_ERR_IO : SB_ERR_EXR;
 }
 
 enum sb_result sb_exr_write(const char *path, const struct sb_image *image, const struct sb_exr_attribute *attributes,
@@ -126,7 +133,7 @@ enum sb_result sb_exr_read(const char *path, const char *channel_order, uint64_t
     rv = exr_start_read(&ctxt, path, &init);
     if (rv != EXR_ERR_SUCCESS) {
         sb_error("%s: not a readable EXR file: %s", path, exr_get_default_error_message(rv));
-        return rv == EXR_ERR_FILE_ACCESS ? SB_ERR_IO : SB_ERR_EXR;
+        return rv == EXR_ERR_FILE_ACCESS || rv == EXR_ERR_WRITE_IO ? SB_ERR_IO : SB_ERR_EXR;
     }
     int parts = 0;
     EXR_TRY(exr_get_count(ctxt, &parts), "counting parts");

@@ -6,6 +6,7 @@
 #include <fcntl.h>
 #include <libgen.h>
 #include <math.h>
+#include <signal.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -57,6 +58,9 @@ bool sb_product_from_name(const char *name, enum sb_product_id *id)
 struct sb_pack_writer {
     char out_dir[4000];
     char tmp_dir[4096];
+    int tmp_fd;                   /* the temporary directory, for removing it from a signal handler */
+    const char *volatile pending; /* the file being written, not yet an artifact */
+    volatile sig_atomic_t publishing; /* renaming into place: the signal handler leaves it alone */
     int artifact_count;
     struct sb_artifact artifacts[PACK_MAX_ARTIFACTS];
     struct {
@@ -64,6 +68,46 @@ struct sb_pack_writer {
         char channels[SB_IMAGE_MAX_CHANNELS][SB_CHANNEL_NAME_MAX];
     } shapes[PACK_MAX_ARTIFACTS];
 };
+
+/* Fault injection for the tests: with SKYBAKE_FAULT=NAME the process kills
+ * itself (SIGKILL) at the point of publishing so named: "artifact" (the first
+ * artifact written), "manifest" (written, not yet flushed), "publish" (just
+ * before the rename), "published" (after it, before the old copy is removed). */
+static void fault_point(const char *name)
+{
+    const char *want = getenv("SKYBAKE_FAULT");
+    if (want && !strcmp(want, name))
+        raise(SIGKILL);
+}
+
+/* Writers that own a temporary directory, for sb_pack_writers_remove_temporaries. */
+#define PACK_MAX_WRITERS 8
+static struct sb_pack_writer *volatile live_writers[PACK_MAX_WRITERS];
+
+static void writer_register(struct sb_pack_writer *w, bool live)
+{
+    for (int i = 0; i < PACK_MAX_WRITERS; i++)
+        if (live_writers[i] == (live ? NULL : w)) {
+            live_writers[i] = live ? w : NULL;
+            return;
+        }
+}
+
+void sb_pack_writers_remove_temporaries(void)
+{
+    /* Only async-signal-safe calls: unlinkat and rmdir. */
+    for (int i = 0; i < PACK_MAX_WRITERS; i++) {
+        struct sb_pack_writer *w = live_writers[i];
+        if (!w || w->publishing)
+            continue;
+        for (int a = 0; a < w->artifact_count; a++)
+            unlinkat(w->tmp_fd, w->artifacts[a].file, 0);
+        if (w->pending)
+            unlinkat(w->tmp_fd, w->pending, 0);
+        unlinkat(w->tmp_fd, SB_PACK_MANIFEST, 0);
+        rmdir(w->tmp_dir);
+    }
+}
 
 /* Remove the regular files of a flat directory, then the directory. */
 static int remove_flat_dir(const char *dir)
@@ -120,6 +164,37 @@ static void parent_of(const char *path, char *out, size_t size)
     snprintf(out, size, "%s", dirname(tmp));
 }
 
+/*
+ * Temporary directories beside out_dir ("NAME.tmp-PID-XXXXXX") left by a
+ * bake that was killed (its process no longer exists): removed, since
+ * SIGKILL gives no chance to clean up.
+ */
+static void remove_stale_temporaries(const char *out_dir)
+{
+    char parent[4096], base[4096], tmp[4096];
+    parent_of(out_dir, parent, sizeof(parent));
+    snprintf(tmp, sizeof(tmp), "%s", out_dir);
+    snprintf(base, sizeof(base), "%s.tmp-", basename(tmp));
+    DIR *d = opendir(parent);
+    if (!d)
+        return;
+    size_t base_len = strlen(base);
+    struct dirent *e;
+    while ((e = readdir(d))) {
+        if (strncmp(e->d_name, base, base_len) != 0)
+            continue;
+        char *end;
+        long pid = strtol(e->d_name + base_len, &end, 10);
+        if (end == e->d_name + base_len || *end != '-' || pid <= 0 || kill((pid_t)pid, 0) == 0 || errno != ESRCH)
+            continue; /* not ours, or its process is still running */
+        char path[8200];
+        snprintf(path, sizeof(path), "%s/%s", parent, e->d_name);
+        if (remove_flat_dir(path) == 0)
+            sb_info("%s: removed, left by a bake that was stopped (process %ld)", path, pid);
+    }
+    closedir(d);
+}
+
 enum sb_result sb_pack_writer_create(const char *out_dir, struct sb_pack_writer **out)
 {
     *out = NULL;
@@ -154,7 +229,8 @@ enum sb_result sb_pack_writer_create(const char *out_dir, struct sb_pack_writer 
         return SB_ERR_IO;
     }
 
-    snprintf(w->tmp_dir, sizeof(w->tmp_dir), "%s.tmp-XXXXXX", w->out_dir);
+    remove_stale_temporaries(w->out_dir);
+    snprintf(w->tmp_dir, sizeof(w->tmp_dir), "%s.tmp-%ld-XXXXXX", w->out_dir, (long)getpid());
     if (!mkdtemp(w->tmp_dir)) {
         char parent[4096];
         parent_of(w->out_dir, parent, sizeof(parent));
@@ -162,6 +238,14 @@ enum sb_result sb_pack_writer_create(const char *out_dir, struct sb_pack_writer 
         free(w);
         return SB_ERR_IO;
     }
+    w->tmp_fd = open(w->tmp_dir, O_RDONLY | O_DIRECTORY | O_CLOEXEC);
+    if (w->tmp_fd < 0) {
+        sb_error("%s: %s", w->tmp_dir, strerror(errno));
+        rmdir(w->tmp_dir);
+        free(w);
+        return SB_ERR_IO;
+    }
+    writer_register(w, true);
     /* mkdtemp makes 0700; a pack gets the permissions the umask gives. */
     mode_t mask = umask(0);
     umask(mask);
@@ -203,11 +287,18 @@ enum sb_result sb_pack_writer_add_image(struct sb_pack_writer *w, struct sb_arti
 
     char path[8192];
     snprintf(path, sizeof(path), "%s/%s", w->tmp_dir, artifact->file);
-    enum sb_result res = sb_exr_write(path, image, attrs, n);
-    if (res)
-        return res;
-    int i = w->artifact_count++;
+    int i = w->artifact_count;
     w->artifacts[i] = *artifact;
+    w->pending = w->artifacts[i].file;
+    enum sb_result res = sb_exr_write(path, image, attrs, n);
+    if (res) {
+        unlink(path);
+        w->pending = NULL;
+        return res;
+    }
+    w->artifact_count++;
+    w->pending = NULL;
+    fault_point("artifact");
     w->shapes[i].width = image->width;
     w->shapes[i].height = image->height;
     w->shapes[i].channel_count = image->channel_count;
@@ -279,6 +370,7 @@ enum sb_result sb_pack_writer_commit(struct sb_pack_writer **writer, const char 
         sb_error("%s: cannot write the manifest: %s", path, strerror(errno));
         return SB_ERR_IO;
     }
+    fault_point("manifest");
     /* Everything reaches the disk before the pack becomes visible. */
     for (int i = 0; i < w->artifact_count; i++) {
         snprintf(path, sizeof(path), "%s/%s", w->tmp_dir, w->artifacts[i].file);
@@ -293,22 +385,29 @@ enum sb_result sb_pack_writer_commit(struct sb_pack_writer **writer, const char 
         return SB_ERR_IO;
     }
 
+    fault_point("publish");
     struct stat st;
+    w->publishing = 1;
     if (lstat(w->out_dir, &st) == 0) {
         /* Swap atomically; the old pack ends up at the temporary name. */
         if (renameat2(AT_FDCWD, w->tmp_dir, AT_FDCWD, w->out_dir, RENAME_EXCHANGE) != 0) {
             sb_error("%s: cannot replace the pack: %s", w->out_dir, strerror(errno));
+            w->publishing = 0;
             return SB_ERR_IO;
         }
+        fault_point("published");
         if (remove_flat_dir(w->tmp_dir) != 0)
             sb_warn("%s: the previous pack was replaced but its old copy could not be removed", w->tmp_dir);
     } else if (rename(w->tmp_dir, w->out_dir) != 0) {
         sb_error("%s: cannot publish the pack: %s", w->out_dir, strerror(errno));
+        w->publishing = 0;
         return SB_ERR_IO;
     }
     char parent[4096];
     parent_of(w->out_dir, parent, sizeof(parent));
     fsync_path(parent, true);
+    writer_register(w, false);
+    close(w->tmp_fd);
     free(w);
     *writer = NULL;
     return SB_OK;
@@ -319,8 +418,10 @@ void sb_pack_writer_destroy(struct sb_pack_writer **writer)
     struct sb_pack_writer *w = *writer;
     if (!w)
         return;
+    writer_register(w, false);
     if (remove_flat_dir(w->tmp_dir) != 0 && errno != ENOENT)
         sb_warn("%s: could not remove the temporary directory", w->tmp_dir);
+    close(w->tmp_fd);
     free(w);
     *writer = NULL;
 }

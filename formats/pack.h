@@ -84,6 +84,15 @@ enum sb_result sb_pack_writer_commit(struct sb_pack_writer **writer, const char 
 void sb_pack_writer_destroy(struct sb_pack_writer **writer);
 
 /*
+ * Remove the temporary directory of every writer not yet publishing, with
+ * async-signal-safe calls only: for a SIGINT or SIGTERM handler, which then
+ * ends the process. (A writer killed outright leaves its directory, named
+ * NAME.tmp-PID-XXXXXX; the next writer for NAME removes it once that
+ * process is gone.)
+ */
+void sb_pack_writers_remove_temporaries(void);
+
+/*
  * A pack as read back: the manifest's fields and every artifact's image,
  * each verified. Products the pack does not hold have present[id] false.
  */
