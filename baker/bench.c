@@ -266,6 +266,7 @@ enum sb_result sb_bench_run(struct sb_vk *vk, const struct sb_atmosphere_params 
         }
         sb_accuracy_ref_destroy(&ref);
         /* Later sweeps read this product at its defaults again. */
+        sb_image_finish(&image);
         if (!res)
             res = sb_atmosphere_bake(baker, id, NULL, &image, NULL, NULL);
     }

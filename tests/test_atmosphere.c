@@ -10,7 +10,7 @@
 #include "atmosphere_probe.spv.h"
 #include "atmosphere_ref.h"
 #include "context.h"
-#include "harness.h"
+#include "harness_vk.h"
 #include "log.h"
 #include "parallel.h"
 
@@ -492,14 +492,9 @@ int main(void)
     sb_atmosphere_preset_earth(&earth);
     test_reference_directions();
     struct sb_vk *vk = NULL;
-    /* Validation is on unless SKYBAKE_VALIDATE=0 says otherwise (for devices
-     * without the layers, e.g. accuracy runs on the lent GPU); CI keeps it on. */
-    const char *env = getenv("SKYBAKE_VALIDATE");
-    struct sb_vk_params params = {.validate = !(env && !strcmp(env, "0"))};
-    enum sb_result res = sb_vk_create(&params, &vk);
+    enum sb_result res = test_vulkan(false, &vk);
     if (res == SB_ERR_NO_DEVICE)
         return TEST_SKIP;
-    CHECK(res == SB_OK, "creating the Vulkan context: %s", sb_result_name(res));
     if (res)
         return test_finish("atmosphere");
     struct sb_atmosphere_baker *baker = NULL;

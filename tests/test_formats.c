@@ -48,6 +48,7 @@ static void test_exr_round_trip(void)
     struct sb_image reordered;
     CHECK(sb_exr_read(path, "b,r,g", 0, &reordered, NULL, NULL) == SB_OK, "reorder");
     CHECK(reordered.data && reordered.data[0] == img.data[2] && reordered.data[1] == img.data[0], "order");
+    sb_image_finish(&reordered);
     CHECK(sb_exr_read(path, "r,g", 0, &reordered, NULL, NULL) == SB_ERR_BAD_IMAGE, "channel count mismatch");
     CHECK(sb_exr_read(path, NULL, 10, &reordered, NULL, NULL) == SB_ERR_BAD_IMAGE, "size cap");
     /* Every truncated prefix is refused cleanly. */

@@ -10,7 +10,7 @@
 
 #include "atmosphere_ref.h"
 #include "bake.h"
-#include "harness.h"
+#include "harness_vk.h"
 #include "log.h"
 #include "pack.h"
 #include "parallel.h"
@@ -332,12 +332,9 @@ int main(int argc, char **argv)
 {
     /* The world file; argv[1] overrides the source tree's (for runs elsewhere). */
     const char *world_path = argc > 1 ? argv[1] : TEST_WORLD;
-    const char *env = getenv("SKYBAKE_VALIDATE");
-    struct sb_vk_params params = {.validate = !(env && !strcmp(env, "0")), .graphics = true};
-    enum sb_result res = sb_vk_create(&params, &vk);
+    enum sb_result res = test_vulkan(true, &vk);
     if (res == SB_ERR_NO_DEVICE)
         return TEST_SKIP;
-    CHECK(res == SB_OK, "creating the Vulkan context: %s", sb_result_name(res));
     if (res)
         return test_finish("runtime");
 
