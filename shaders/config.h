@@ -213,4 +213,37 @@ struct sb_view_push {
     SB_UINT pad;
 };
 
+/* Cloud noise (noise.glsl, clouds.comp, baker/clouds.h): one invocation
+ * per texel in 4x4x4 workgroups, up to SB_NOISE_MAX_CHANNELS channels, each
+ * a recipe: kind (SB_NOISE_*), integers a, b, c and a seed.
+ * - PERLIN_WORLEY: a Perlin period, b octaves, c Worley cells;
+ * - WORLEY_FBM: a cells;
+ * - PERLIN_FBM: a period, b octaves, c: stretched by 2^c about 1/2;
+ * - CURL: a period, b octaves, c the component (0 to 2).
+ * Texel (i, j, k) sits at ((i, j, k) + 0.5) * inv; 2D textures (size_z 1)
+ * at z = slice_z. */
+#define SB_NOISE_GROUP 4
+#define SB_NOISE_MAX_CHANNELS 4
+#define SB_NOISE_MAX_OCTAVES 8
+#define SB_NOISE_PERLIN_WORLEY 0
+#define SB_NOISE_WORLEY_FBM 1
+#define SB_NOISE_PERLIN_FBM 2
+#define SB_NOISE_CURL 3
+
+struct sb_noise_push {
+    SB_UINT size_x;
+    SB_UINT size_y;
+    SB_UINT size_z;
+    SB_UINT channel_count;
+    float inv_x;
+    float inv_y;
+    float inv_z;
+    float slice_z;
+    SB_UVEC4(kind);
+    SB_UVEC4(a);
+    SB_UVEC4(b);
+    SB_UVEC4(c);
+    SB_UVEC4(seed);
+};
+
 #endif
