@@ -13,7 +13,8 @@
  *   its z offset by seed * 0x9E3779B9; unit(h) = (h >> 8) * 2^-24 in [0, 1).
  * - perlin(p, P, seed): x = p P, c = floor(x), f = x - c; gradient of corner
  *   c + o is the cube edge direction (+-1, +-1, 0), (+-1, 0, +-1) or
- *   (0, +-1, +-1) chosen by hash.x mod 12; the corners' g . (f - o) are
+ *   (0, +-1, +-1) chosen by ((hash.x >> 8) 12) >> 24, in [0, 12) (12 (h mod 2^24) / 2^24:
+ *   no integer division, which llvmpipe cannot vectorise); the corners' g . (f - o) are
  *   blended with the fade u = f^3 (f (6 f - 15) + 10), x then y then z.
  * - perlin_fbm(p, P, n, seed) = clamp(1/2 + 1/2 norm_n
  *   sum_{k<n} 2^-k perlin(p, P 2^k, seed + k), 0, 1), norm_n = 1 / sum 2^-k.

@@ -37,7 +37,7 @@ static void hash3(uint32_t v[3])
 static void lattice(const int c[3], int period, uint32_t seed, uint32_t out[3])
 {
     for (int i = 0; i < 3; i++)
-        out[i] = (uint32_t)(c[i] + period) % (uint32_t)period;
+        out[i] = (uint32_t)(c[i] >= period ? c[i] - period : c[i] < 0 ? c[i] + period : c[i]);
     out[2] += seed * 0x9E3779B9u;
     hash3(out);
 }
@@ -94,7 +94,7 @@ static float perlin(const float p[3], int period, uint32_t seed)
         int o[3] = {k & 1, (k >> 1) & 1, (k >> 2) & 1}, at[3] = {c[0] + o[0], c[1] + o[1], c[2] + o[2]};
         uint32_t h[3];
         lattice(at, period, seed, h);
-        uint32_t g = h[0] % 12u, axis = g >> 2;
+        uint32_t g = ((h[0] >> 8) * 12u) >> 24, axis = g >> 2;
         float d[3] = {f[0] - (float)o[0], f[1] - (float)o[1], f[2] - (float)o[2]};
         float s0 = (g & 1u) ? -1.0f : 1.0f, s1 = (g & 2u) ? -1.0f : 1.0f;
         corner[k] = axis == 0 ? s0 * d[0] + s1 * d[1] : axis == 1 ? s0 * d[0] + s1 * d[2] : s0 * d[1] + s1 * d[2];
@@ -128,7 +128,7 @@ static float worley(const float p[3], int cells, uint32_t seed)
         f[i] = x - cf;
     }
     float best = 8.0f;
-    for (int k = 0; k < 27; k++) {
+    for (int k = 0; k < 27; k++) { /* x fastest, as noise.glsl's loops */
         int o[3] = {k % 3 - 1, (k / 3) % 3 - 1, k / 9 - 1}, at[3] = {c[0] + o[0], c[1] + o[1], c[2] + o[2]};
         uint32_t h[3];
         lattice(at, cells, seed, h);

@@ -27,8 +27,10 @@ uvec3 noise_hash(uvec3 v)
  * seeded noise. */
 uvec3 noise_lattice(ivec3 c, int period, uint seed)
 {
-    uvec3 w = uvec3(c + period) % uint(period);
-    return noise_hash(w + uvec3(0u, 0u, seed * 0x9E3779B9u));
+    /* no integer division: llvmpipe has no vector form of it */
+    ivec3 w = mix(c, c - period, greaterThanEqual(c, ivec3(period)));
+    w = mix(w, w + period, lessThan(w, ivec3(0)));
+    return noise_hash(uvec3(w) + uvec3(0u, 0u, seed * 0x9E3779B9u));
 }
 
 /* [0, 1) from the top 24 bits: exact in fp32. */
@@ -64,7 +66,7 @@ float noise_perlin(vec3 p, int period, uint seed)
     float corner[8];
     for (int k = 0; k < 8; k++) {
         ivec3 o = ivec3(k & 1, (k >> 1) & 1, (k >> 2) & 1);
-        uint h = noise_lattice(c + o, period, seed).x % 12u;
+        uint h = ((noise_lattice(c + o, period, seed).x >> 8u) * 12u) >> 24u; /* in [0, 12) */
         precise vec3 d = f - vec3(o);
         /* (+-1, +-1, 0), (+-1, 0, +-1), (0, +-1, +-1) */
         float s0 = (h & 1u) != 0u ? -1.0 : 1.0, s1 = (h & 2u) != 0u ? -1.0 : 1.0;
@@ -109,12 +111,14 @@ float noise_worley(vec3 p, int cells, uint seed)
     ivec3 c = ivec3(cf);
     precise vec3 f = x - cf; /* within the cell: the same bits one period on */
     precise float best = 8.0;
-    for (int k = 0; k < 27; k++) {
-        ivec3 o = ivec3(k % 3, (k / 3) % 3, k / 9) - 1;
-        precise vec3 d = f - vec3(o) - noise_unit(noise_lattice(c + o, cells, seed));
-        precise float d2 = d.x * d.x + d.y * d.y + d.z * d.z;
-        best = min(best, d2);
-    }
+    for (int oz = -1; oz <= 1; oz++)
+        for (int oy = -1; oy <= 1; oy++)
+            for (int ox = -1; ox <= 1; ox++) {
+                ivec3 o = ivec3(ox, oy, oz);
+                precise vec3 d = f - vec3(o) - noise_unit(noise_lattice(c + o, cells, seed));
+                precise float d2 = d.x * d.x + d.y * d.y + d.z * d.z;
+                best = min(best, d2);
+            }
     precise float v = 1.0 - noise_sqrt(min(best, 1.0));
     return v;
 }
