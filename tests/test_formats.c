@@ -13,6 +13,7 @@
 #include "log.h"
 #include "pack.h"
 #include "scene.h"
+#include "synthetic_pack.h"
 
 static void quiet(void *user, enum sb_log_level level, const char *msg)
 {
@@ -170,33 +171,6 @@ static void run(const char *command)
     CHECK(system(command) == 0, "%s", command);
 }
 
-/* A pack of every product with synthetic, finite content. */
-static void write_test_pack(const char *dir, struct sb_image images[SB_PRODUCT_COUNT])
-{
-    struct sb_pack_writer *w = NULL;
-    CHECK(sb_pack_writer_create(dir, &w) == SB_OK, "writer");
-    for (int p = 0; p < SB_PRODUCT_COUNT && w; p++) {
-        const struct sb_product_format *f = sb_product_format((enum sb_product_id)p);
-        sb_image_init(&images[p], f->width, f->height, f->channel_count);
-        sb_image_set_channel_names(&images[p], f->channel_names);
-        for (uint64_t i = 0; i < sb_image_float_count(&images[p]); i++)
-            images[p].data[i] = (float)((double)(i * 2654435761u % 1000003u) * 1e-6 + p);
-        struct sb_artifact a = {.product = (enum sb_product_id)p};
-        snprintf(a.file, sizeof(a.file), "%s.exr", f->name);
-        snprintf(a.parameterization, sizeof(a.parameterization), "%s", f->parameterization);
-        CHECK(sb_pack_writer_add_image(w, &a, &images[p]) == SB_OK, "add %s", f->name);
-    }
-    struct sb_device_info device = {.name = "test device", .driver = "none"};
-    struct sb_scene scene = {.name = "test", .preset = "earth"};
-    sb_atmosphere_preset_earth(&scene.atmosphere);
-    for (int p = 0; p < SB_PRODUCT_COUNT; p++)
-        scene.wants[p] = true;
-    char *scene_json = sb_scene_normalized_json(&scene);
-    CHECK(w && scene_json && sb_pack_writer_commit(&w, scene_json, &device) == SB_OK, "commit");
-    free(scene_json);
-    sb_pack_writer_destroy(&w);
-}
-
 /* Copy the good pack to `bad`, let `edit` change its manifest (may be NULL), and return the code opening it gives. */
 static enum sb_result open_edited(const char *good, const char *bad, void (*edit)(cJSON *root), const char *shell)
 {
@@ -334,7 +308,7 @@ static void test_pack_reader(void)
     snprintf(good, sizeof(good), "%s/good", pack_root);
     snprintf(bad, sizeof(bad), "%s/bad", pack_root);
     struct sb_image images[SB_PRODUCT_COUNT] = {0};
-    write_test_pack(good, images);
+    CHECK(write_synthetic_pack(good, "test", images) == SB_OK, "a synthetic pack");
     struct sb_image nan_image;
     char nan_path[300];
     snprintf(nan_path, sizeof(nan_path), "%s/nan.exr", pack_root);

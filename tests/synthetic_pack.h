@@ -1,0 +1,53 @@
+/*
+ * A pack of every product with synthetic, finite content, written through
+ * the pack writer: what the pack reader's tests and the manifest fuzzer
+ * open. `images` (may be NULL) receives each product's image, which the
+ * caller finishes; `name` is the scene's and the device's.
+ */
+#ifndef SB_TEST_SYNTHETIC_PACK_H
+#define SB_TEST_SYNTHETIC_PACK_H
+
+#include <stdio.h>
+#include <stdlib.h>
+
+#include "pack.h"
+#include "scene.h"
+
+static inline enum sb_result write_synthetic_pack(const char *dir, const char *name,
+                                                  struct sb_image images[SB_PRODUCT_COUNT])
+{
+    struct sb_pack_writer *w = NULL;
+    enum sb_result res = sb_pack_writer_create(dir, &w);
+    for (int p = 0; p < SB_PRODUCT_COUNT && !res; p++) {
+        const struct sb_product_format *f = sb_product_format((enum sb_product_id)p);
+        struct sb_image image;
+        if ((res = sb_image_init(&image, f->width, f->height, f->channel_count)))
+            break;
+        sb_image_set_channel_names(&image, f->channel_names);
+        for (uint64_t i = 0; i < sb_image_float_count(&image); i++)
+            image.data[i] = (float)((double)(i * 2654435761u % 1000003u) * 1e-6 + p);
+        struct sb_artifact a = {.product = (enum sb_product_id)p};
+        snprintf(a.file, sizeof(a.file), "%s.exr", f->name);
+        snprintf(a.parameterization, sizeof(a.parameterization), "%s", f->parameterization);
+        res = sb_pack_writer_add_image(w, &a, &image);
+        if (images)
+            images[p] = image;
+        else
+            sb_image_finish(&image);
+    }
+    struct sb_device_info device = {.driver = "none"};
+    struct sb_scene scene = {.preset = "earth"};
+    snprintf(device.name, sizeof(device.name), "%s device", name);
+    snprintf(scene.name, sizeof(scene.name), "%s", name);
+    sb_atmosphere_preset_earth(&scene.atmosphere);
+    for (int p = 0; p < SB_PRODUCT_COUNT; p++)
+        scene.wants[p] = true;
+    char *scene_json = res ? NULL : sb_scene_normalized_json(&scene);
+    if (!res)
+        res = scene_json ? sb_pack_writer_commit(&w, scene_json, &device) : SB_ERR_NOMEM;
+    free(scene_json);
+    sb_pack_writer_destroy(&w);
+    return res;
+}
+
+#endif
