@@ -90,9 +90,8 @@ enum sb_result sb_cloud_bake(struct sb_vk *vk, enum sb_cloud_product product, co
     if (!res) {
         const struct sb_buffer *bindings[1] = {&out};
         sb_pipeline_bind(vk, &pipeline, bindings);
-        uint32_t g = SB_NOISE_GROUP;
-        res = sb_dispatch(vk, &pipeline, &pc, (pc.size_x + g - 1) / g, (pc.size_y + g - 1) / g,
-                          (pc.size_z + g - 1) / g, gpu_ms);
+        res = sb_dispatch(vk, &pipeline, &pc, (pc.size_x + SB_WORKGROUP_X - 1) / SB_WORKGROUP_X,
+                          (pc.size_y + SB_WORKGROUP_Y - 1) / SB_WORKGROUP_Y, pc.size_z, gpu_ms);
     }
     if (!res) {
         volume->data = malloc(values * sizeof(float));

@@ -7,7 +7,7 @@
 #include "config.h"
 #include "noise.glsl"
 
-layout(local_size_x = SB_NOISE_GROUP, local_size_y = SB_NOISE_GROUP, local_size_z = SB_NOISE_GROUP) in;
+layout(local_size_x = SB_WORKGROUP_X, local_size_y = SB_WORKGROUP_Y, local_size_z = 1) in;
 layout(push_constant) uniform Push { sb_noise_push pc; };
 layout(std430, set = 0, binding = 0) writeonly buffer Output { float result[]; };
 

@@ -214,7 +214,8 @@ struct sb_view_push {
 };
 
 /* Cloud noise (noise.glsl, clouds.comp, baker/clouds.h): one invocation
- * per texel in 4x4x4 workgroups, up to SB_NOISE_MAX_CHANNELS channels, each
+ * per texel in workgroups of one 8x8 tile of one slice (a 2D texture has
+ * one slice), up to SB_NOISE_MAX_CHANNELS channels, each
  * a recipe: kind (SB_NOISE_*), integers a, b, c and a seed.
  * - PERLIN_WORLEY: a Perlin period, b octaves, c Worley cells;
  * - WORLEY_FBM: a cells;
@@ -222,7 +223,6 @@ struct sb_view_push {
  * - CURL: a period, b octaves, c the component (0 to 2).
  * Texel (i, j, k) sits at ((i, j, k) + 0.5) * inv; 2D textures (size_z 1)
  * at z = slice_z. */
-#define SB_NOISE_GROUP 4
 #define SB_NOISE_MAX_CHANNELS 4
 #define SB_NOISE_MAX_OCTAVES 8
 #define SB_NOISE_PERLIN_WORLEY 0
