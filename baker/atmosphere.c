@@ -1,5 +1,7 @@
 #include "atmosphere.h"
 
+#include <assert.h>
+
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -22,7 +24,7 @@
 
 #define BIT(p) (1u << (p))
 
-static const struct sb_atmosphere_product products[SB_PRODUCT_COUNT] = {
+static const struct sb_atmosphere_product products[SB_ATMOSPHERE_PRODUCT_COUNT] = {
     [SB_PRODUCT_TRANSMITTANCE] =
         {
             .id = SB_PRODUCT_TRANSMITTANCE,
@@ -67,7 +69,7 @@ static const struct spirv transmittance_shaders[SB_GL_MAX_ORDER + 1] = {
     SPIRV(transmittance_gl3), SPIRV(transmittance_gl4), SPIRV(transmittance_gl5),
     SPIRV(transmittance_gl6), SPIRV(transmittance_gl7), SPIRV(transmittance_gl8),
 };
-static const struct spirv scattering_shaders[SB_PRODUCT_COUNT] = {
+static const struct spirv scattering_shaders[SB_ATMOSPHERE_PRODUCT_COUNT] = {
     [SB_PRODUCT_MULTISCATTERING] = SPIRV(multiscattering),
     [SB_PRODUCT_IRRADIANCE_GROUND] = SPIRV(irradiance_ground),
     [SB_PRODUCT_IRRADIANCE_SKY] = SPIRV(irradiance_sky),
@@ -76,6 +78,7 @@ static const struct spirv scattering_shaders[SB_PRODUCT_COUNT] = {
 
 const struct sb_atmosphere_product *sb_atmosphere_product(enum sb_product_id id)
 {
+    assert((unsigned)id < SB_ATMOSPHERE_PRODUCT_COUNT);
     return &products[id];
 }
 
@@ -178,8 +181,8 @@ struct sb_atmosphere_baker {
     struct sb_buffer params;
     struct sb_buffer dummy;
     struct sb_buffer scratch; /* sphere.glsl's sums between passes */
-    struct sb_buffer outputs[SB_PRODUCT_COUNT];
-    struct sb_buffer lookups[SB_PRODUCT_COUNT]; /* the form later bakes read (config.h) */
+    struct sb_buffer outputs[SB_ATMOSPHERE_PRODUCT_COUNT];
+    struct sb_buffer lookups[SB_ATMOSPHERE_PRODUCT_COUNT]; /* the form later bakes read (config.h) */
     bool sky_cap; /* irradiance_sky integrates Mie's peak on a cap (sphere.glsl) */
 };
 
@@ -211,7 +214,7 @@ void sb_atmosphere_baker_destroy(struct sb_atmosphere_baker **pb)
     struct sb_atmosphere_baker *b = *pb;
     if (!b)
         return;
-    for (int p = 0; p < SB_PRODUCT_COUNT; p++) {
+    for (int p = 0; p < SB_ATMOSPHERE_PRODUCT_COUNT; p++) {
         sb_buffer_destroy(b->vk, &b->outputs[p]);
         sb_buffer_destroy(b->vk, &b->lookups[p]);
     }
@@ -327,14 +330,14 @@ enum sb_result sb_atmosphere_bake(struct sb_atmosphere_baker *b, enum sb_product
                                   const struct sb_atmosphere_settings *settings, struct sb_image *image,
                                   struct sb_atmosphere_settings *used, double *gpu_ms)
 {
-    const struct sb_atmosphere_product *prod = &products[id];
+    const struct sb_atmosphere_product *prod = sb_atmosphere_product(id);
     struct sb_atmosphere_settings s = resolve_settings(id, settings);
     if (used)
         *used = s;
     enum sb_result res = check_settings(id, &s);
     if (res)
         return res;
-    for (int dep = 0; dep < SB_PRODUCT_COUNT; dep++)
+    for (int dep = 0; dep < SB_ATMOSPHERE_PRODUCT_COUNT; dep++)
         if ((prod->depends_on & BIT(dep)) && !b->outputs[dep].buffer) {
             sb_error("%s: needs %s, which has not been baked", sb_product_name(id),
                      sb_product_name((enum sb_product_id)dep));

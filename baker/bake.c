@@ -11,6 +11,7 @@
 #include "accuracy.h"
 #include "atmosphere.h"
 #include "bench.h"
+#include "clouds.h"
 #include "log.h"
 #include "skybake_version.h"
 
@@ -27,8 +28,9 @@ uint32_t sb_bake_closure(const struct sb_scene *scene)
     for (int p = 0; p < SB_PRODUCT_COUNT; p++)
         if (scene->wants[p])
             mask |= 1u << p;
-    /* Dependencies point to lower ids, so one pass from the top closes the set. */
-    for (int p = SB_PRODUCT_COUNT - 1; p >= 0; p--)
+    /* Dependencies point to lower ids, so one pass from the top closes the
+     * set. The cloud noise reads nothing. */
+    for (int p = SB_ATMOSPHERE_PRODUCT_COUNT - 1; p >= 0; p--)
         if (mask & (1u << p))
             mask |= sb_atmosphere_product((enum sb_product_id)p)->depends_on;
     return mask;
@@ -144,6 +146,20 @@ static void key_params(enum sb_product_id id, const struct sb_atmosphere_params 
         key_add(text, size, n, " mie_g=%a", p->mie_g);
 }
 
+/* A cloud product's recipe, every field of its push constants, and its kernel. */
+static void key_cloud(enum sb_product_id id, const struct sb_cloud_params *params, char *text, size_t size, size_t *n)
+{
+    struct sb_noise_push pc;
+    sb_cloud_recipe(id, params, &pc);
+    key_add(text, size, n, " size=%u,%u,%u inv=%a,%a,%a slice_z=%a", pc.size_x, pc.size_y, pc.size_z,
+            (double)pc.inv_x, (double)pc.inv_y, (double)pc.inv_z, (double)pc.slice_z);
+    for (uint32_t c = 0; c < pc.channel_count; c++)
+        key_add(text, size, n, " channel%u=%u,%u,%u,%u,%u", c, pc.kind[c], pc.a[c], pc.b[c], pc.c[c], pc.seed[c]);
+    char code[SB_HASH_HEX_SIZE];
+    sb_cloud_code_hash(code);
+    key_add(text, size, n, " code %s", code);
+}
+
 void sb_bake_keys(const struct sb_scene *scene, uint32_t mask, char out[SB_PRODUCT_COUNT][SB_HASH_HEX_SIZE])
 {
     char text[8192], settings[1024], code[SB_HASH_HEX_SIZE];
@@ -153,8 +169,13 @@ void sb_bake_keys(const struct sb_scene *scene, uint32_t mask, char out[SB_PRODU
             continue;
         enum sb_product_id id = (enum sb_product_id)p;
         size_t n = 0;
-        key_add(text, sizeof(text), &n, "skybake-bake-key-v1 format %d skybake %s product %s", SB_PACK_FORMAT_VERSION,
-                SKYBAKE_VERSION, sb_product_name(id));
+        key_add(text, sizeof(text), &n, "skybake-bake-key-v1 format %d skybake %s product %s stored %s",
+                SB_PACK_FORMAT_VERSION, SKYBAKE_VERSION, sb_product_name(id), sb_product_format(id)->pixel_type);
+        if (sb_product_is_cloud(id)) {
+            key_cloud(id, &scene->clouds, text, sizeof(text), &n);
+            sb_hash_bytes(text, n < sizeof(text) ? n : sizeof(text) - 1, out[p]);
+            continue;
+        }
         key_params(id, &scene->atmosphere, text, sizeof(text), &n);
         if (scene->tolerance[p] > 0) {
             key_add(text, sizeof(text), &n, " tolerance=%a candidates", scene->tolerance[p]);
@@ -219,6 +240,45 @@ static bool open_previous(struct sb_vk *vk, const char *out_dir, struct sb_pack 
     return true;
 }
 
+/* Bake one cloud product into *image, rounded as its file stores it. */
+static enum sb_result bake_cloud(struct sb_vk *vk, const struct sb_scene *scene, enum sb_product_id id,
+                                 struct sb_image *image, struct sb_artifact *a)
+{
+    enum sb_result res = sb_cloud_bake(vk, id, &scene->clouds, image, &a->gpu_ms);
+    if (res)
+        return res;
+    struct sb_noise_push pc;
+    sb_cloud_recipe(id, &scene->clouds, &pc);
+    sb_cloud_recipe_json(&pc, a->settings_json, sizeof(a->settings_json));
+    /* The noise lies in [0, 1]: binary16 cannot overflow. */
+    if (sb_product_format(id)->storage == SB_STORAGE_VDB_HALF)
+        res = sb_image_round_to_half(image, NULL);
+    return res;
+}
+
+static void report_add(struct sb_bake_report *report, const struct sb_artifact *a, const struct sb_image *image,
+                       bool reused)
+{
+    int i = report->artifact_count++;
+    report->artifacts[i] = *a;
+    report->reused[i] = reused;
+    report->shapes[i][0] = image->width;
+    report->shapes[i][1] = image->height;
+    report->shapes[i][2] = image->depth;
+    report->shapes[i][3] = image->channel_count;
+    char size[48];
+    if (image->depth > 1)
+        snprintf(size, sizeof(size), "%ux%ux%u", image->width, image->height, image->depth);
+    else
+        snprintf(size, sizeof(size), "%ux%u", image->width, image->height);
+    if (reused)
+        sb_info("%-18s %11s x%u  reused (key unchanged)                  %s", sb_product_name(a->product), size,
+                image->channel_count, a->content_hash);
+    else
+        sb_info("%-18s %11s x%u  gpu %9.3f ms  bake %9.3f ms  %s", sb_product_name(a->product), size,
+                image->channel_count, a->gpu_ms, a->bake_ms, a->content_hash);
+}
+
 enum sb_result sb_bake_scene(struct sb_vk *vk, const struct sb_scene *scene, const char *out_dir,
                              const struct sb_bake_options *options, struct sb_bake_report *report)
 {
@@ -232,26 +292,25 @@ enum sb_result sb_bake_scene(struct sb_vk *vk, const struct sb_scene *scene, con
         return SB_ERR_NOMEM;
     bool reuse = !(options && options->force) && open_previous(vk, out_dir, old);
 
+    uint32_t mask = sb_bake_closure(scene);
     enum sb_result res = sb_pack_writer_create(out_dir, &writer);
     if (res)
         goto cleanup;
-    if ((res = sb_atmosphere_baker_create(vk, &scene->atmosphere, &baker)))
+    if ((mask & ((1u << SB_ATMOSPHERE_PRODUCT_COUNT) - 1)) &&
+        (res = sb_atmosphere_baker_create(vk, &scene->atmosphere, &baker)))
         goto cleanup;
 
-    uint32_t mask = sb_bake_closure(scene);
     char keys[SB_PRODUCT_COUNT][SB_HASH_HEX_SIZE];
     sb_bake_keys(scene, mask, keys);
     for (int p = 0; p < SB_PRODUCT_COUNT; p++) {
         if (!(mask & (1u << p)))
             continue;
         enum sb_product_id id = (enum sb_product_id)p;
-        struct sb_artifact *a = &report->artifacts[report->artifact_count];
-        struct sb_atmosphere_settings used;
-        memset(a, 0, sizeof(*a));
-        a->product = id;
-        snprintf(a->file, sizeof(a->file), "%s.exr", sb_product_name(id));
-        snprintf(a->parameterization, sizeof(a->parameterization), "%s", sb_product_format(id)->parameterization);
-        snprintf(a->key, sizeof(a->key), "%s", keys[p]);
+        const struct sb_product_format *format = sb_product_format(id);
+        struct sb_artifact artifact = {.product = id}, *a = &artifact;
+        snprintf(a->file, sizeof(a->file), "%s.%s", format->name, format->extension);
+        snprintf(a->parameterization, sizeof(a->parameterization), "%s", format->parameterization);
+        memcpy(a->key, keys[p], SB_HASH_HEX_SIZE);
 
         if (reuse && old->present[p] && !strcmp(old->artifacts[p].key, keys[p])) {
             /* Verified when the old pack was opened; the writer hashes it again. */
@@ -261,7 +320,7 @@ enum sb_result sb_bake_scene(struct sb_vk *vk, const struct sb_scene *scene, con
             a->gpu_ms = was->gpu_ms;
             baked[p] = old->images[p];
             old->images[p] = (struct sb_image){0};
-            if ((res = sb_atmosphere_adopt(baker, id, &baked[p])) ||
+            if ((!sb_product_is_cloud(id) && (res = sb_atmosphere_adopt(baker, id, &baked[p]))) ||
                 (res = sb_pack_writer_add_image(writer, a, &baked[p])))
                 goto cleanup;
             if (strcmp(a->content_hash, was->content_hash) != 0) {
@@ -270,40 +329,36 @@ enum sb_result sb_bake_scene(struct sb_vk *vk, const struct sb_scene *scene, con
                 res = SB_ERR_HASH_MISMATCH;
                 goto cleanup;
             }
-            report->reused[report->artifact_count] = true;
-            report->shapes[report->artifact_count][0] = baked[p].width;
-            report->shapes[report->artifact_count][1] = baked[p].height;
-            report->shapes[report->artifact_count][2] = baked[p].channel_count;
-            report->artifact_count++;
-            sb_info("%-18s %4ux%-3u x%u  reused (key unchanged)                  %s", sb_product_name(id),
-                    baked[p].width, baked[p].height, baked[p].channel_count, a->content_hash);
+            report_add(report, a, &baked[p], true);
             continue;
         }
 
         double t0 = now_ms();
         struct sb_image *image = &baked[p];
-        struct sb_error error;
-        char probe[96];
-        double tolerance = scene->tolerance[p];
-        if (tolerance > 0)
-            res = bake_to_tolerance(baker, &scene->atmosphere, id, tolerance, baked, image, &used, &error, probe,
-                                    sizeof(probe), &a->gpu_ms);
-        else
-            res = sb_atmosphere_bake(baker, id, NULL, image, &used, &a->gpu_ms);
-        if (res)
-            goto cleanup;
-        a->bake_ms = now_ms() - t0;
-        sb_atmosphere_settings_json(id, &used, a->settings_json, sizeof(a->settings_json));
-        if (tolerance > 0)
-            add_error_json(a->settings_json, sizeof(a->settings_json), tolerance, &error, probe);
+        if (sb_product_is_cloud(id)) {
+            if ((res = bake_cloud(vk, scene, id, image, a)))
+                goto cleanup;
+            a->bake_ms = now_ms() - t0;
+        } else {
+            struct sb_atmosphere_settings used;
+            struct sb_error error;
+            char probe[96];
+            double tolerance = scene->tolerance[p];
+            if (tolerance > 0)
+                res = bake_to_tolerance(baker, &scene->atmosphere, id, tolerance, baked, image, &used, &error, probe,
+                                        sizeof(probe), &a->gpu_ms);
+            else
+                res = sb_atmosphere_bake(baker, id, NULL, image, &used, &a->gpu_ms);
+            if (res)
+                goto cleanup;
+            a->bake_ms = now_ms() - t0;
+            sb_atmosphere_settings_json(id, &used, a->settings_json, sizeof(a->settings_json));
+            if (tolerance > 0)
+                add_error_json(a->settings_json, sizeof(a->settings_json), tolerance, &error, probe);
+        }
         if ((res = sb_pack_writer_add_image(writer, a, image)))
             goto cleanup;
-        report->shapes[report->artifact_count][0] = image->width;
-        report->shapes[report->artifact_count][1] = image->height;
-        report->shapes[report->artifact_count][2] = image->channel_count;
-        report->artifact_count++;
-        sb_info("%-18s %4ux%-3u x%u  gpu %9.3f ms  bake %9.3f ms  %s", sb_product_name(id), image->width, image->height,
-                image->channel_count, a->gpu_ms, a->bake_ms, a->content_hash);
+        report_add(report, a, image, false);
     }
 
     scene_json = sb_scene_normalized_json(scene);

@@ -5,10 +5,11 @@
  *
  * The bake graph: each product has a key, XXH3-128 of everything its values
  * depend on: the format version, the skybake version, the parameters its
- * kernels read (normalised: each as a hexadecimal float), what the scene asks
- * of it (a tolerance and the candidate settings, or the default settings),
- * its kernels' SPIR-V and the host-side recipe (sb_atmosphere_code_hash),
- * and the keys of the products it reads. Baking into an existing pack reuses
+ * kernels read (normalised: each as a hexadecimal float; for the cloud
+ * noise, its channel recipes), what the scene asks of it (a tolerance and
+ * the candidate settings, or the default settings), its kernels' SPIR-V and
+ * the host-side recipe (sb_atmosphere_code_hash, sb_cloud_code_hash), how
+ * its file stores it, and the keys of the products it reads. Baking into an existing pack reuses
  * every artifact whose key is unchanged, baked on the same device, after the
  * pack verified (content hashes recomputed); the rest is baked.
  */
@@ -26,7 +27,7 @@ struct sb_bake_options {
 struct sb_bake_report {
     int artifact_count;
     struct sb_artifact artifacts[SB_PRODUCT_COUNT];
-    uint32_t shapes[SB_PRODUCT_COUNT][3]; /* width, height, channels */
+    uint32_t shapes[SB_PRODUCT_COUNT][4]; /* width, height, depth, channels */
     bool reused[SB_PRODUCT_COUNT];        /* per artifact: taken from the pack there before */
 };
 

@@ -1,5 +1,7 @@
 #include "bench.h"
 
+#include "clouds.h"
+
 #include <cJSON.h>
 #include <errno.h>
 #include <math.h>
@@ -136,8 +138,8 @@ const struct sb_atmosphere_settings *sb_bench_candidates(enum sb_product_id id, 
     /* Built once per product, sorted by cost (stable: ties keep the sweep's
      * order, so the choice is the same on every run). Not thread safe on
      * first use, like the logger. */
-    static struct sb_atmosphere_settings lists[SB_PRODUCT_COUNT][32];
-    static int counts[SB_PRODUCT_COUNT] = {-1, -1, -1, -1};
+    static struct sb_atmosphere_settings lists[SB_ATMOSPHERE_PRODUCT_COUNT][32];
+    static int counts[SB_ATMOSPHERE_PRODUCT_COUNT] = {-1, -1, -1, -1};
     if (counts[id] < 0) {
         int n = 0;
         for (int w = 0; w < SB_BENCH_SWEEP_COUNT; w++) {
@@ -193,6 +195,56 @@ static void mark_pareto(struct sb_bench_row *rows, int count)
     }
 }
 
+/* The cloud noise: GPU bakes (median of the repeats) against the reference
+ * on this thread, every texel compared. */
+static enum sb_result bench_clouds(struct sb_vk *vk, const struct sb_bench_params *params, int repeat, double *times,
+                                   struct sb_bench_report *report)
+{
+    enum sb_result res = SB_OK;
+    for (int p = SB_ATMOSPHERE_PRODUCT_COUNT; p < SB_PRODUCT_COUNT && !res; p++) {
+        if (!params->clouds[p])
+            continue;
+        enum sb_product_id id = (enum sb_product_id)p;
+        struct sb_bench_cloud_row *row = &report->cloud_rows[report->cloud_row_count++];
+        row->product = id;
+        struct sb_image image = {0};
+        /* one untimed bake first when timing repeats, as for the atmosphere */
+        for (int k = repeat >= 3 ? -1 : 0; k < repeat && !res; k++) {
+            double ms;
+            sb_image_finish(&image);
+            res = sb_cloud_bake(vk, id, &params->cloud_params, &image, k >= 0 ? &times[k] : &ms);
+        }
+        if (res)
+            break;
+        qsort(times, (size_t)repeat, sizeof(double), compare_doubles);
+        row->gpu_ms = times[repeat / 2];
+        row->gpu_ms_min = times[0];
+        row->shape[0] = image.width;
+        row->shape[1] = image.height;
+        row->shape[2] = image.depth;
+        row->channel_count = image.channel_count;
+        struct sb_noise_push pc;
+        sb_cloud_recipe(id, &params->cloud_params, &pc);
+        float *ref = malloc(sb_image_float_count(&image) * sizeof(float));
+        if (!ref) {
+            sb_image_finish(&image);
+            res = SB_ERR_NOMEM;
+            break;
+        }
+        double t0 = now_s();
+        sb_cloud_ref(&pc, 0, (uint64_t)image.width * image.height * image.depth, ref);
+        row->reference_ms = (now_s() - t0) * 1e3;
+        row->values = sb_image_float_count(&image);
+        for (uint64_t i = 0; i < row->values; i++)
+            row->differing += memcmp(&ref[i], &image.data[i], sizeof(float)) != 0;
+        free(ref);
+        sb_image_finish(&image);
+        sb_info("%s: gpu %.3f ms, reference %.0f ms, %llu of %llu values differ", sb_product_name(id), row->gpu_ms,
+                row->reference_ms, (unsigned long long)row->differing, (unsigned long long)row->values);
+    }
+    return res;
+}
+
 enum sb_result sb_bench_run(struct sb_vk *vk, const struct sb_atmosphere_params *atmosphere,
                             const struct sb_bench_params *params, struct sb_bench_report *report)
 {
@@ -216,7 +268,7 @@ enum sb_result sb_bench_run(struct sb_vk *vk, const struct sb_atmosphere_params 
     for (int w = 0; w < SB_BENCH_SWEEP_COUNT; w++)
         if (params->sweeps[w])
             need |= sb_atmosphere_product(sweeps[w].product)->depends_on | 1u << sweeps[w].product;
-    for (int p = 0; p < SB_PRODUCT_COUNT && !res; p++)
+    for (int p = 0; p < SB_ATMOSPHERE_PRODUCT_COUNT && !res; p++)
         if (need & 1u << p)
             res = sb_atmosphere_bake(baker, (enum sb_product_id)p, NULL, &inputs[p], NULL, NULL);
 
@@ -271,9 +323,11 @@ enum sb_result sb_bench_run(struct sb_vk *vk, const struct sb_atmosphere_params 
             res = sb_atmosphere_bake(baker, id, NULL, &image, NULL, NULL);
     }
     if (!res)
+        res = bench_clouds(vk, params, repeat, times, report);
+    if (!res)
         mark_pareto(report->rows, report->row_count);
     sb_image_finish(&image);
-    for (int p = 0; p < SB_PRODUCT_COUNT; p++)
+    for (int p = 0; p < SB_ATMOSPHERE_PRODUCT_COUNT; p++)
         sb_image_finish(&inputs[p]);
     sb_accuracy_ref_destroy(&ref);
     sb_atmosphere_baker_destroy(&baker);
@@ -330,6 +384,24 @@ static cJSON *report_json(const struct sb_bench_report *report, const struct sb_
         cJSON_AddBoolToObject(o, "pareto", r->pareto);
         cJSON_AddItemToArray(rows, o);
     }
+    if (report->cloud_row_count) {
+        cJSON *clouds = cJSON_AddArrayToObject(root, "clouds");
+        for (int i = 0; i < report->cloud_row_count; i++) {
+            const struct sb_bench_cloud_row *r = &report->cloud_rows[i];
+            cJSON *o = cJSON_CreateObject();
+            cJSON_AddStringToObject(o, "product", sb_product_name(r->product));
+            cJSON_AddItemToObject(o, "shape", cJSON_CreateIntArray((const int[]){(int)r->shape[0], (int)r->shape[1],
+                                                                                 (int)r->shape[2]},
+                                                                   3));
+            cJSON_AddNumberToObject(o, "channels", r->channel_count);
+            cJSON_AddNumberToObject(o, "gpu_ms", r->gpu_ms);
+            cJSON_AddNumberToObject(o, "gpu_ms_min", r->gpu_ms_min);
+            cJSON_AddNumberToObject(o, "reference_ms_one_core", r->reference_ms);
+            cJSON_AddNumberToObject(o, "values", (double)r->values);
+            cJSON_AddNumberToObject(o, "differing", (double)r->differing);
+            cJSON_AddItemToArray(clouds, o);
+        }
+    }
     return root;
 }
 
@@ -358,6 +430,23 @@ void sb_bench_print(const struct sb_bench_report *report, const struct sb_vk *vk
                    r->error.rms_rel, r->error_half.max_rel, r->anchor ? r->anchor : "");
         }
     }
+    if (!report->cloud_row_count)
+        return;
+    printf("\ncloud noise (the GPU against the CPU reference on one core, every value compared)\n");
+    printf("  %-14s %-12s %11s %11s %14s %9s  %s\n", "product", "size", "gpu ms", "gpu ms min", "reference ms",
+           "speedup", "values differing");
+    double gpu = 0, ref = 0;
+    for (int i = 0; i < report->cloud_row_count; i++) {
+        const struct sb_bench_cloud_row *r = &report->cloud_rows[i];
+        char size[48];
+        snprintf(size, sizeof(size), "%ux%ux%u", r->shape[0], r->shape[1], r->shape[2]);
+        printf("  %-14s %-12s %11.4f %11.4f %14.1f %9.1f  %llu of %llu\n", sb_product_name(r->product), size,
+               r->gpu_ms, r->gpu_ms_min, r->reference_ms, r->reference_ms / fmax(r->gpu_ms, 1e-9),
+               (unsigned long long)r->differing, (unsigned long long)r->values);
+        gpu += r->gpu_ms;
+        ref += r->reference_ms;
+    }
+    printf("  %-14s %-12s %11.4f %11s %14.1f %9.1f\n", "all", "", gpu, "", ref, ref / fmax(gpu, 1e-9));
 }
 
 static enum sb_result write_text(const char *dir, const char *name, const char *text)
@@ -520,6 +609,19 @@ enum sb_result sb_bench_write(const struct sb_bench_report *report, const struct
     if (!res)
         res = all.failed ? SB_ERR_NOMEM : write_text(dir, "bench.csv", all.data);
     free(all.data);
+    if (!res && report->cloud_row_count) {
+        struct text clouds = {0};
+        text_add(&clouds, "product,width,height,depth,channels,gpu_ms,gpu_ms_min,reference_ms_one_core,values,"
+                          "differing\n");
+        for (int i = 0; i < report->cloud_row_count; i++) {
+            const struct sb_bench_cloud_row *r = &report->cloud_rows[i];
+            text_add(&clouds, "%s,%u,%u,%u,%u,%.6g,%.6g,%.6g,%llu,%llu\n", sb_product_name(r->product), r->shape[0],
+                     r->shape[1], r->shape[2], r->channel_count, r->gpu_ms, r->gpu_ms_min, r->reference_ms,
+                     (unsigned long long)r->values, (unsigned long long)r->differing);
+        }
+        res = clouds.failed ? SB_ERR_NOMEM : write_text(dir, "bench_clouds.csv", clouds.data);
+        free(clouds.data);
+    }
     if (!res) {
         cJSON *root = report_json(report, vk);
         char *text = cJSON_Print(root);
@@ -527,7 +629,7 @@ enum sb_result sb_bench_write(const struct sb_bench_report *report, const struct
         free(text);
         cJSON_Delete(root);
     }
-    if (!res)
+    if (!res && report->row_count)
         res = write_plot(report, vk, dir);
     return res;
 }

@@ -8,6 +8,10 @@
  * trapezoid for transmittance. The Pareto front (no other setting both
  * faster and more accurate) is marked, and the default setting's error in
  * half precision is reported (what fp16 storage would cost).
+ *
+ * For the cloud noise, which matches its reference bit for bit, speed
+ * alone: each product's bake timed on the device, against the CPU
+ * reference on one core over every texel, with the values compared.
  */
 #ifndef SB_BAKER_BENCH_H
 #define SB_BAKER_BENCH_H
@@ -44,8 +48,19 @@ struct sb_bench_row {
     bool pareto;
 };
 
+/* A cloud product: the device against the CPU reference on one core. */
+struct sb_bench_cloud_row {
+    enum sb_product_id product;
+    uint32_t shape[3], channel_count;
+    double gpu_ms, gpu_ms_min; /* median, min over the repeats */
+    double reference_ms;       /* sb_cloud_ref over every texel, one thread */
+    uint64_t values, differing; /* the GPU's values against the reference's */
+};
+
 struct sb_bench_params {
     bool sweeps[SB_BENCH_SWEEP_COUNT]; /* which to run */
+    bool clouds[SB_PRODUCT_COUNT];     /* which cloud products to time */
+    struct sb_cloud_params cloud_params;
     int repeat;                        /* bakes per setting; the median is reported */
     bool quick;                        /* only the settings marked quick (meson's benchmark) */
 };
@@ -55,6 +70,8 @@ struct sb_bench_report {
     struct sb_bench_row *rows;
     double reference_s[SB_BENCH_SWEEP_COUNT]; /* wall time of each fp64 reference */
     char probe[SB_BENCH_SWEEP_COUNT][96];
+    int cloud_row_count;
+    struct sb_bench_cloud_row cloud_rows[SB_PRODUCT_COUNT - SB_ATMOSPHERE_PRODUCT_COUNT];
 };
 
 const char *sb_bench_sweep_name(enum sb_bench_sweep sweep);
@@ -71,8 +88,9 @@ void sb_bench_report_finish(struct sb_bench_report *report);
 /* Print the tables (text) or the report as JSON on stdout. */
 void sb_bench_print(const struct sb_bench_report *report, const struct sb_vk *vk, bool json);
 
-/* Write bench.csv, bench.json, bench.gp and bench.svg (drawn by gnuplot)
- * into dir, created if missing. */
+/* Write bench.csv, bench.json, bench.gp and bench.svg (drawn by gnuplot;
+ * the CSV and the plot when an atmosphere sweep ran) and bench_clouds.csv
+ * (when cloud products were timed) into dir, created if missing. */
 enum sb_result sb_bench_write(const struct sb_bench_report *report, const struct sb_vk *vk, const char *dir);
 
 #endif

@@ -29,8 +29,10 @@
  * for 1/sqrt from an integer first guess, then x * y; every expression is
  * evaluated in the same order, unfused, on both sides.
  *
- * The products' channels (defaults; sizes, periods, octaves and the seed
- * are scene parameters):
+ * The products' channels (defaults; sizes, periods, Worley cell counts,
+ * octaves and the seed are scene parameters, struct sb_cloud_params in
+ * formats/scene.h; each channel's seed is the scene's plus the constant
+ * sb_cloud_recipe adds, so that channels differ):
  * - cloud_shape 128^3: r = Perlin-Worley, remap(perlin_fbm(P 4, 4
  *   octaves), 0, 1, worley_fbm(C 4), 1) = w + v (1 - w); g, b, a =
  *   worley_fbm with C = 4, 8, 16. (TileableVolumeNoise, which Schneider's
@@ -56,41 +58,28 @@
 #include "config.h"
 #include "context.h"
 #include "image.h"
+#include "pack.h"
+#include "scene.h"
 
-enum sb_cloud_product {
-    SB_CLOUD_SHAPE,
-    SB_CLOUD_DETAIL,
-    SB_CLOUD_CURL,
-    SB_CLOUD_WEATHER,
-    SB_CLOUD_COUNT,
-};
+/* The channel recipes of a cloud product (config.h's sb_noise_push, filled
+ * for it from the scene's parameters). */
+void sb_cloud_recipe(enum sb_product_id product, const struct sb_cloud_params *params, struct sb_noise_push *push);
 
-/* A volume of fp32 channels, interleaved, x fastest. */
-struct sb_volume {
-    uint32_t width, height, depth, channel_count;
-    float *data; /* owned */
-};
-
-void sb_volume_finish(struct sb_volume *volume);
-
-struct sb_cloud_params {
-    uint32_t size[SB_CLOUD_COUNT]; /* edge in texels: 128, 32, 128, 512 by default */
-    uint32_t seed;
-};
-
-void sb_cloud_params_default(struct sb_cloud_params *params);
-
-/* The channel recipes of a product (config.h's sb_noise_push, filled for it). */
-void sb_cloud_recipe(enum sb_cloud_product product, const struct sb_cloud_params *params, struct sb_noise_push *push);
-
-const char *sb_cloud_product_name(enum sb_cloud_product product);
+/* The recipe as a JSON object (the manifest's settings): each channel's
+ * noise, periods or cells, octaves and seed. */
+void sb_cloud_recipe_json(const struct sb_noise_push *push, char *out, size_t size);
 
 /* The CPU reference: texels [first, first + count) of the product, in
- * x-fastest order, their channels interleaved, into out. */
+ * x-fastest order, their channels interleaved, into out. Thread-safe. */
 void sb_cloud_ref(const struct sb_noise_push *push, uint64_t first, uint64_t count, float *out);
 
-/* Bake a product on the device into *volume (2D products have depth 1). */
-enum sb_result sb_cloud_bake(struct sb_vk *vk, enum sb_cloud_product product, const struct sb_cloud_params *params,
-                             struct sb_volume *volume, double *gpu_ms);
+/* Bake a cloud product on the device into *image (fp32, as computed; 2D
+ * products have depth 1), named as the pack names its channels. */
+enum sb_result sb_cloud_bake(struct sb_vk *vk, enum sb_product_id product, const struct sb_cloud_params *params,
+                             struct sb_image *image, double *gpu_ms);
+
+/* XXH3-128 of what a cloud product's values depend on besides its recipe:
+ * the kernel's SPIR-V (for the bake keys). */
+void sb_cloud_code_hash(char out[SB_HASH_HEX_SIZE]);
 
 #endif

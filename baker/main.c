@@ -63,8 +63,10 @@ static void usage(FILE *f)
                "\n"
                "bench: speed against error for each product's settings, on the device,\n"
                "against the fp64 reference (docs/accuracy.md). Products: transmittance,\n"
-               "transmittance_resolution, multiscattering, irradiance_ground, irradiance_sky\n"
-               "(default: all). -o DIR writes bench.csv, bench.json and bench.svg (gnuplot).\n"
+               "transmittance_resolution, multiscattering, irradiance_ground, irradiance_sky;\n"
+               "and the cloud noise (cloud_shape, cloud_detail, cloud_curl, weather, at the\n"
+               "SCENE's sizes), timed against its CPU reference on one core (default: all).\n"
+               "-o DIR writes bench.csv, bench.json, bench.svg (gnuplot), bench_clouds.csv.\n"
                "--repeat N bakes each setting N times (default 3) and reports the median;\n"
                "--quick runs a short sweep (the meson benchmark).\n"
                "\n"
@@ -106,7 +108,8 @@ static void print_json(const char *out_dir, const struct sb_vk *vk, const struct
         cJSON_AddStringToObject(o, "file", a->file);
         cJSON_AddNumberToObject(o, "width", report->shapes[i][0]);
         cJSON_AddNumberToObject(o, "height", report->shapes[i][1]);
-        cJSON_AddNumberToObject(o, "channels", report->shapes[i][2]);
+        cJSON_AddNumberToObject(o, "depth", report->shapes[i][2]);
+        cJSON_AddNumberToObject(o, "channels", report->shapes[i][3]);
         cJSON_AddNumberToObject(o, "gpu_ms", a->gpu_ms);
         cJSON_AddNumberToObject(o, "bake_ms", a->bake_ms);
         cJSON_AddStringToObject(o, "content_hash", a->content_hash);
@@ -216,7 +219,12 @@ static int cmd_bench(int argc, char **argv)
         if ((!strcmp(a, "-o") || !strcmp(a, "--output")) && i + 1 < argc) {
             out_dir = argv[++i];
         } else if (!strcmp(a, "--product") && i + 1 < argc) {
-            if (!sb_bench_sweep_from_name(argv[++i], &sweep)) {
+            enum sb_product_id id;
+            if (sb_product_from_name(argv[++i], &id) && sb_product_is_cloud(id)) {
+                params.clouds[id] = any = true;
+                continue;
+            }
+            if (!sb_bench_sweep_from_name(argv[i], &sweep)) {
                 fprintf(stderr, "skybake: bench: unknown product '%s'\n", argv[i]);
                 return EXIT_USAGE;
             }
@@ -242,14 +250,20 @@ static int cmd_bench(int argc, char **argv)
             return EXIT_USAGE;
         }
     }
-    if (!any)
+    if (!any) {
         for (int w = 0; w < SB_BENCH_SWEEP_COUNT; w++)
             params.sweeps[w] = true;
+        for (int p = SB_ATMOSPHERE_PRODUCT_COUNT; p < SB_PRODUCT_COUNT; p++)
+            params.clouds[p] = true;
+    }
     struct sb_scene scene = {0};
     if (scene_path && sb_scene_load(scene_path, &scene))
         return EXIT_USAGE;
-    if (!scene_path)
+    if (!scene_path) {
         sb_atmosphere_preset_earth(&scene.atmosphere);
+        sb_cloud_params_default(&scene.clouds);
+    }
+    params.cloud_params = scene.clouds;
 
     struct sb_vk *vk = NULL;
     enum sb_result res = sb_vk_create(&vk_params, &vk);

@@ -55,6 +55,7 @@ static cJSON *info_json(const struct sb_pack *pack, const char *dir)
         cJSON_AddNumberToObject(o, "bytes", (double)file_bytes(dir, a->file));
         cJSON_AddNumberToObject(o, "width", image->width);
         cJSON_AddNumberToObject(o, "height", image->height);
+        cJSON_AddNumberToObject(o, "depth", image->depth);
         cJSON_AddStringToObject(o, "channels", channels);
         cJSON_AddStringToObject(o, "parameterization", a->parameterization);
         cJSON_AddNumberToObject(o, "gpu_ms", a->gpu_ms);
@@ -77,7 +78,7 @@ void sb_pack_info_print(const struct sb_pack *pack, const char *dir, bool json)
     printf("scene: %s (hash %s)\n", pack->scene && pack->scene->name[0] ? pack->scene->name : "(unnamed)",
            pack->scene_hash);
     printf("device: %s (%s, Vulkan %s)\n", pack->device.name, pack->device.driver, pack->device.api_version);
-    printf("%-18s %-9s %-28s %10s %9s  %-32s  %s\n", "product", "size", "channels", "bytes", "gpu ms", "content hash",
+    printf("%-18s %-11s %-28s %10s %9s  %-32s  %s\n", "product", "size", "channels", "bytes", "gpu ms", "content hash",
            "settings");
     for (int p = 0; p < SB_PRODUCT_COUNT; p++) {
         if (!pack->present[p])
@@ -85,9 +86,12 @@ void sb_pack_info_print(const struct sb_pack *pack, const char *dir, bool json)
         const struct sb_artifact *a = &pack->artifacts[p];
         const struct sb_image *image = &pack->images[p];
         char size[32], channels[256];
-        snprintf(size, sizeof(size), "%ux%u", image->width, image->height);
+        if (image->depth > 1)
+            snprintf(size, sizeof(size), "%ux%ux%u", image->width, image->height, image->depth);
+        else
+            snprintf(size, sizeof(size), "%ux%u", image->width, image->height);
         channel_list(image, channels, sizeof(channels));
-        printf("%-18s %-9s %-28s %10lld %9.3f  %-32s  %s\n", sb_product_name((enum sb_product_id)p), size, channels,
+        printf("%-18s %-11s %-28s %10lld %9.3f  %-32s  %s\n", sb_product_name((enum sb_product_id)p), size, channels,
                file_bytes(dir, a->file), a->gpu_ms, a->content_hash, a->settings_json);
     }
 }
@@ -138,12 +142,12 @@ double sb_diff_relative(double a, double b, double peak, double floor)
 static void diff_images(const struct sb_image *a, const struct sb_image *b, double tolerance, double floor,
                         struct sb_artifact_diff *d)
 {
-    if (a->width != b->width || a->height != b->height || a->channel_count != b->channel_count) {
+    if (a->width != b->width || a->height != b->height || a->depth != b->depth || a->channel_count != b->channel_count) {
         d->outcome = SB_DIFF_DIFFERENT;
         return;
     }
     uint32_t nc = a->channel_count;
-    uint64_t pixels = (uint64_t)a->width * a->height;
+    uint64_t pixels = (uint64_t)a->width * a->height * a->depth;
     double peak[SB_IMAGE_MAX_CHANNELS] = {0};
     for (uint64_t i = 0; i < pixels; i++)
         for (uint32_t c = 0; c < nc; c++)
@@ -155,7 +159,8 @@ static void diff_images(const struct sb_image *a, const struct sb_image *b, doub
             if (memcmp(&va, &vb, sizeof(va)) == 0)
                 continue;
             d->differing++;
-            struct sb_value_place at = {(uint32_t)(i % a->width), (uint32_t)(i / a->width), c};
+            struct sb_value_place at = {(uint32_t)(i % a->width), (uint32_t)(i / a->width % a->height),
+                                        (uint32_t)(i / a->width / a->height), c};
             double abs_diff = fabs((double)va - (double)vb), rel = sb_diff_relative(va, vb, peak[c], floor);
             if (abs_diff > d->max_abs) {
                 d->max_abs = abs_diff;
@@ -194,7 +199,10 @@ enum sb_diff_outcome sb_pack_diff(const struct sb_pack *a, const struct sb_pack 
 
 static void place_text(const struct sb_image *image, struct sb_value_place at, char *out, size_t size)
 {
-    snprintf(out, size, "(%u, %u) %s", at.x, at.y, image->channel_names[at.channel]);
+    if (image->depth > 1)
+        snprintf(out, size, "(%u, %u, %u) %s", at.x, at.y, at.z, image->channel_names[at.channel]);
+    else
+        snprintf(out, size, "(%u, %u) %s", at.x, at.y, image->channel_names[at.channel]);
 }
 
 void sb_pack_diff_print(const struct sb_pack *a, const char *dir_a, const struct sb_pack *b, const char *dir_b,

@@ -30,7 +30,7 @@ enum sb_diff_outcome {
 };
 
 struct sb_value_place {
-    uint32_t x, y, channel;
+    uint32_t x, y, z, channel;
 };
 
 struct sb_artifact_diff {

@@ -166,7 +166,7 @@ enum sb_result sb_sky_error_run(struct sb_vk *vk, const char *scene_name, const 
         summarise(&report->suns[s]);
 
 done:
-    for (int i = 0; i < SB_PRODUCT_COUNT; i++)
+    for (int i = 0; i < SB_ATMOSPHERE_PRODUCT_COUNT; i++)
         sb_image_finish(&luts[i]);
     return res;
 }

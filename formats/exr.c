@@ -29,7 +29,7 @@ static enum sb_result exr_fail(const char *path, const char *what, exr_result_t 
     return rv == EXR_ERR_FILE_ACCESS || rv == EXR_ERR_WRITE_IO ? SB_ERR_IO : SB_ERR_EXR;
 }
 
-enum sb_result sb_exr_write(const char *path, const struct sb_image *image, const struct sb_exr_attribute *attributes,
+enum sb_result sb_exr_write(const char *path, const struct sb_image *image, const struct sb_attribute *attributes,
                             int attribute_count)
 {
     exr_context_initializer_t init = EXR_DEFAULT_CONTEXT_INITIALIZER;
@@ -41,6 +41,10 @@ enum sb_result sb_exr_write(const char *path, const struct sb_image *image, cons
     exr_result_t rv;
     int part = 0;
 
+    if (image->depth != 1) {
+        sb_error("%s: a volume (depth %u) cannot be written as an EXR image", path, image->depth);
+        return SB_ERR_BAD_IMAGE;
+    }
     rv = exr_start_write(&ctxt, path, EXR_WRITE_FILE_DIRECTLY, &init);
     if (rv != EXR_ERR_SUCCESS) {
         sb_error("%s: cannot create EXR file: %s", path, exr_get_default_error_message(rv));
@@ -113,7 +117,7 @@ cleanup:
 }
 
 enum sb_result sb_exr_read(const char *path, const char *channel_order, uint64_t max_pixels, struct sb_image *image,
-                           struct sb_exr_attribute *attributes, int *attribute_count)
+                           struct sb_attribute *attributes, int *attribute_count)
 {
     exr_context_initializer_t init = EXR_DEFAULT_CONTEXT_INITIALIZER;
     init.error_handler_fn = silent_errors;
@@ -249,13 +253,13 @@ enum sb_result sb_exr_read(const char *path, const char *channel_order, uint64_t
     if (attributes && attribute_count) {
         int32_t n = 0;
         EXR_TRY(exr_get_attribute_count(ctxt, 0, &n), "counting attributes");
-        for (int32_t i = 0; i < n && *attribute_count < SB_EXR_MAX_ATTRIBUTES; i++) {
+        for (int32_t i = 0; i < n && *attribute_count < SB_FILE_MAX_ATTRIBUTES; i++) {
             const exr_attribute_t *attr = NULL;
             if (exr_get_attribute_by_index(ctxt, 0, EXR_ATTR_LIST_FILE_ORDER, i, &attr) != EXR_ERR_SUCCESS)
                 continue;
             if (attr->type != EXR_ATTR_STRING || strncmp(attr->name, "skybake.", 8) != 0)
                 continue;
-            struct sb_exr_attribute *out = &attributes[(*attribute_count)++];
+            struct sb_attribute *out = &attributes[(*attribute_count)++];
             snprintf(out->name, sizeof(out->name), "%s", attr->name);
             snprintf(out->value, sizeof(out->value), "%.*s", attr->string->length, attr->string->str);
         }

@@ -8,19 +8,12 @@
 
 #include "image.h"
 
-#define SB_EXR_MAX_ATTRIBUTES 8
-
-struct sb_exr_attribute {
-    char name[48];
-    char value[128];
-};
-
 /*
  * Write `image` to `path` (created or replaced). Channels keep the image's
  * names; EXR stores them sorted, which readers undo by name. Returns SB_OK,
  * SB_ERR_IO or SB_ERR_EXR, logging the path and OpenEXR's reason.
  */
-enum sb_result sb_exr_write(const char *path, const struct sb_image *image, const struct sb_exr_attribute *attributes,
+enum sb_result sb_exr_write(const char *path, const struct sb_image *image, const struct sb_attribute *attributes,
                             int attribute_count);
 
 /*
@@ -32,6 +25,6 @@ enum sb_result sb_exr_write(const char *path, const struct sb_image *image, cons
  * Refuses images larger than max_pixels (0: 64 Mpixel) before allocating.
  */
 enum sb_result sb_exr_read(const char *path, const char *channel_order, uint64_t max_pixels, struct sb_image *image,
-                           struct sb_exr_attribute *attributes, int *attribute_count);
+                           struct sb_attribute *attributes, int *attribute_count);
 
 #endif

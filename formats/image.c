@@ -6,18 +6,28 @@
 #include <string.h>
 #include <xxhash.h>
 
-enum sb_result sb_image_init(struct sb_image *image, uint32_t width, uint32_t height, uint32_t channel_count)
+enum sb_result sb_image_init_volume(struct sb_image *image, uint32_t width, uint32_t height, uint32_t depth,
+                                    uint32_t channel_count)
 {
     memset(image, 0, sizeof(*image));
-    if (!width || !height || !channel_count || channel_count > SB_IMAGE_MAX_CHANNELS)
+    if (!width || !height || !depth || !channel_count || channel_count > SB_IMAGE_MAX_CHANNELS)
         return SB_ERR_BAD_IMAGE;
-    image->data = calloc((size_t)width * height * channel_count, sizeof(float));
+    uint64_t count = (uint64_t)width * height * depth * channel_count;
+    if (count > SIZE_MAX / sizeof(float))
+        return SB_ERR_NOMEM;
+    image->data = calloc((size_t)count, sizeof(float));
     if (!image->data)
         return SB_ERR_NOMEM;
     image->width = width;
     image->height = height;
+    image->depth = depth;
     image->channel_count = channel_count;
     return SB_OK;
+}
+
+enum sb_result sb_image_init(struct sb_image *image, uint32_t width, uint32_t height, uint32_t channel_count)
+{
+    return sb_image_init_volume(image, width, height, 1, channel_count);
 }
 
 void sb_image_finish(struct sb_image *image)
@@ -62,7 +72,7 @@ void sb_image_content_hash(const struct sb_image *image, char out[SB_HASH_HEX_SI
     put_u32_le(state, 1); /* element type: binary32 */
     put_u32_le(state, image->width);
     put_u32_le(state, image->height);
-    put_u32_le(state, 1); /* depth */
+    put_u32_le(state, image->depth);
     put_u32_le(state, image->channel_count);
     for (uint32_t c = 0; c < image->channel_count; c++)
         XXH3_128bits_update(state, image->channel_names[c], strlen(image->channel_names[c]) + 1);
@@ -96,5 +106,91 @@ int64_t sb_image_find_nonfinite(const struct sb_image *image)
     for (uint64_t i = 0; i < n; i++)
         if (!isfinite(image->data[i]))
             return (int64_t)i;
+    return -1;
+}
+
+uint16_t sb_half_from_float(float value)
+{
+    uint32_t bits;
+    memcpy(&bits, &value, 4);
+    uint16_t sign = (uint16_t)((bits >> 16) & 0x8000u);
+    uint32_t magnitude = bits & 0x7fffffffu;
+    if (magnitude > 0x7f800000u)
+        return sign | 0x7e00u; /* NaN, quiet */
+    int32_t exponent = (int32_t)(magnitude >> 23) - 127 + 15; /* the half's biased exponent */
+    uint32_t mantissa = magnitude & 0x7fffffu;
+    if (exponent >= 31)
+        return sign | 0x7c00u; /* too large, or infinite */
+    /* The value as an integer q of half units plus a remainder of `shift`
+     * bits, rounded to nearest, ties to even. A carry out of the mantissa
+     * moves to the next binade (or to infinity), as it should. */
+    uint32_t q, remainder, shift;
+    if (exponent > 0) {
+        shift = 13;
+        q = ((uint32_t)exponent << 10) | (mantissa >> shift);
+        remainder = mantissa & 0x1fffu;
+    } else {
+        if (magnitude < 0x33000000u) /* below half the smallest subnormal, 2^-25 (or zero) */
+            return sign;
+        uint32_t significand = mantissa | 0x800000u;
+        shift = (uint32_t)(14 - exponent); /* 14 .. 24 */
+        q = significand >> shift;
+        remainder = significand & ((1u << shift) - 1);
+    }
+    uint32_t halfway = 1u << (shift - 1);
+    if (remainder > halfway || (remainder == halfway && (q & 1)))
+        q++;
+    return (uint16_t)(sign | q);
+}
+
+float sb_half_to_float(uint16_t half)
+{
+    uint32_t sign = (uint32_t)(half & 0x8000u) << 16, exponent = (half >> 10) & 0x1fu, mantissa = half & 0x3ffu;
+    uint32_t bits;
+    if (exponent == 31) {
+        bits = sign | 0x7f800000u | (mantissa << 13);
+    } else if (exponent) {
+        bits = sign | ((exponent + 127 - 15) << 23) | (mantissa << 13);
+    } else if (!mantissa) {
+        bits = sign;
+    } else {
+        /* Subnormal: normalise (mantissa 2^-24 units, at most 10 bits). */
+        int32_t e = 127 - 15 + 1;
+        while (!(mantissa & 0x400u)) {
+            mantissa <<= 1;
+            e--;
+        }
+        bits = sign | ((uint32_t)e << 23) | ((mantissa & 0x3ffu) << 13);
+    }
+    float value;
+    memcpy(&value, &bits, 4);
+    return value;
+}
+
+enum sb_result sb_image_round_to_half(struct sb_image *image, int64_t *bad)
+{
+    uint64_t n = sb_image_float_count(image);
+    for (uint64_t i = 0; i < n; i++)
+        if (isfinite(image->data[i]) && !isfinite(sb_half_to_float(sb_half_from_float(image->data[i])))) {
+            if (bad)
+                *bad = (int64_t)i;
+            return SB_ERR_NUMERIC;
+        }
+    for (uint64_t i = 0; i < n; i++)
+        image->data[i] = sb_half_to_float(sb_half_from_float(image->data[i]));
+    if (bad)
+        *bad = -1;
+    return SB_OK;
+}
+
+int64_t sb_image_find_not_half(const struct sb_image *image)
+{
+    uint64_t n = sb_image_float_count(image);
+    for (uint64_t i = 0; i < n; i++) {
+        float v = image->data[i];
+        float h = sb_half_to_float(sb_half_from_float(v));
+        if (memcmp(&v, &h, 4) != 0 && !(isnan(v) && isnan(h)))
+            return (int64_t)i;
+    }
     return -1;
 }

@@ -1,8 +1,8 @@
 /*
- * A 2D image of fp32 channels, interleaved, rows from y = 0 upward in memory
- * (pixel (x, y) at data[(y * width + x) * channel_count]). The shape every
- * product of format version 1 has, and what EXR files and content hashes
- * are made of.
+ * An image of fp32 channels, 2D or 3D, interleaved, x fastest, then y, then
+ * z (texel (x, y, z) at data[((z * height + y) * width + x) * channel_count];
+ * rows from y = 0 upward). The shape of every product, what EXR and VDB
+ * files and content hashes are made of.
  */
 #ifndef SB_IMAGE_H
 #define SB_IMAGE_H
@@ -18,6 +18,7 @@
 struct sb_image {
     uint32_t width;
     uint32_t height;
+    uint32_t depth; /* 1 for a 2D image */
     uint32_t channel_count;
     char channel_names[SB_IMAGE_MAX_CHANNELS][SB_CHANNEL_NAME_MAX];
     float *data; /* owned: width * height * channel_count floats */
@@ -25,21 +26,30 @@ struct sb_image {
 
 /* Allocate zeroed data for the given shape; names are set by the caller. */
 enum sb_result sb_image_init(struct sb_image *image, uint32_t width, uint32_t height, uint32_t channel_count);
+enum sb_result sb_image_init_volume(struct sb_image *image, uint32_t width, uint32_t height, uint32_t depth,
+                                    uint32_t channel_count);
 /* Free the data; accepts a zeroed or already finished image. */
 void sb_image_finish(struct sb_image *image);
 
 /* Number of floats in the image. */
 static inline uint64_t sb_image_float_count(const struct sb_image *image)
 {
-    return (uint64_t)image->width * image->height * image->channel_count;
+    return (uint64_t)image->width * image->height * image->depth * image->channel_count;
 }
 
 /* Set channel names from one comma-separated list ("r,g,b"). */
 void sb_image_set_channel_names(struct sb_image *image, const char *names);
 
+/* A "skybake.*" string attribute of a file (EXR header, VDB metadata). */
+#define SB_FILE_MAX_ATTRIBUTES 8
+struct sb_attribute {
+    char name[48];
+    char value[128];
+};
+
 /*
  * Content hash: XXH3-128 over the canonical content (a tag, the element type,
- * width, height, depth 1, channel count, the NUL-terminated channel names,
+ * width, height, depth, channel count, the NUL-terminated channel names,
  * then the values as little-endian IEEE binary32), written as 32 lowercase
  * hex digits plus NUL. It does not depend on the file that holds the image.
  */
@@ -51,5 +61,19 @@ void sb_hash_bytes(const void *data, size_t size, char out[SB_HASH_HEX_SIZE]);
 
 /* First NaN or infinite value, as a float index, or -1 when all are finite. */
 int64_t sb_image_find_nonfinite(const struct sb_image *image);
+
+/* IEEE binary16 (half): fp32 to the nearest half, ties to even (subnormals
+ * kept, beyond 65504 infinity, NaN quiet), and back (exact). */
+uint16_t sb_half_from_float(float value);
+float sb_half_to_float(uint16_t half);
+
+/*
+ * Round every value to the nearest binary16, as a file stored as half holds
+ * it. Refuses (SB_ERR_NUMERIC, values unchanged) when a finite value would
+ * become infinite; returns the first such value's index in *bad (may be NULL).
+ * First value not a binary16 value: sb_image_find_not_half (-1: none).
+ */
+enum sb_result sb_image_round_to_half(struct sb_image *image, int64_t *bad);
+int64_t sb_image_find_not_half(const struct sb_image *image);
 
 #endif

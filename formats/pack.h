@@ -1,6 +1,6 @@
 /*
  * Packs: a directory holding manifest.json and one file per artifact.
- * This header names the products of format version 1 and writes packs
+ * This header names the products of format version 2 and writes packs
  * atomically: everything goes into a temporary directory beside the
  * destination, which is renamed into place only when complete, so a failed
  * bake leaves the previous pack as it was. docs/pack.md describes the format.
@@ -15,28 +15,64 @@
 #include "image.h"
 #include "result.h"
 
-#define SB_PACK_FORMAT_VERSION 1
+/* The version this build writes; it reads this one and every older one
+ * (each a subset of the next; docs/pack.md). */
+#define SB_PACK_FORMAT_VERSION 2
+#define SB_PACK_FORMAT_VERSION_OLDEST 1
 #define SB_PACK_MANIFEST "manifest.json"
 
 enum sb_product_id {
+    /* The atmosphere (format version 1 on). */
     SB_PRODUCT_TRANSMITTANCE,
     SB_PRODUCT_MULTISCATTERING,
     SB_PRODUCT_IRRADIANCE_GROUND,
     SB_PRODUCT_IRRADIANCE_SKY,
+    /* Cloud noise (format version 2 on). */
+    SB_PRODUCT_CLOUD_SHAPE,
+    SB_PRODUCT_CLOUD_DETAIL,
+    SB_PRODUCT_CLOUD_CURL,
+    SB_PRODUCT_WEATHER,
     SB_PRODUCT_COUNT,
+};
+
+/* Ids below this are the atmosphere's, the rest cloud noise. */
+#define SB_ATMOSPHERE_PRODUCT_COUNT SB_PRODUCT_CLOUD_SHAPE
+
+static inline bool sb_product_is_cloud(enum sb_product_id id)
+{
+    return id >= SB_PRODUCT_CLOUD_SHAPE && id < SB_PRODUCT_COUNT;
+}
+
+/* How an artifact is stored. */
+enum sb_storage {
+    SB_STORAGE_EXR_FLOAT32, /* EXR, FLOAT channels (exr.h) */
+    SB_STORAGE_VDB_HALF,    /* OpenVDB, one half-stored FloatGrid per channel (vdb.h) */
 };
 
 /* What a product's file holds in this format version. */
 struct sb_product_format {
-    const char *name; /* "transmittance", "multiscattering", "irradiance_ground", "irradiance_sky" */
-    uint32_t width, height, channel_count;
+    const char *name; /* "transmittance", ..., "cloud_shape", "cloud_detail", "cloud_curl", "weather" */
+    uint32_t width, height, depth; /* 0: set by the scene (sb_product_shape) */
+    uint32_t channel_count;
     const char *channel_names;    /* comma-separated, in storage order */
     const char *parameterization; /* mapping id, see docs/pack.md */
+    int since_version;            /* the first format version holding the product */
+    enum sb_storage storage;
+    const char *pixel_type; /* the manifest's pixel_type: "float32", "float16" */
+    const char *extension;  /* of its file: "exr", "vdb" */
 };
 
 const struct sb_product_format *sb_product_format(enum sb_product_id id);
 const char *sb_product_name(enum sb_product_id id);
 bool sb_product_from_name(const char *name, enum sb_product_id *id);
+
+/* The product's width, height and depth for `scene` (the cloud products'
+ * sizes are scene parameters; the atmosphere's are fixed). */
+struct sb_scene;
+void sb_product_shape(const struct sb_scene *scene, enum sb_product_id id, uint32_t shape[3]);
+
+/* XXH3-128 of a file's bytes, as hex (the manifest's file_hash). */
+enum sb_result sb_file_hash(int dir_fd, const char *name, char out[SB_HASH_HEX_SIZE]);
 
 /* One artifact of a manifest. Strings are copied when the artifact is added. */
 struct sb_artifact {
@@ -47,7 +83,8 @@ struct sb_artifact {
     double bake_ms;            /* wall time of the product's bake, host side */
     double gpu_ms;             /* GPU time between the product's timestamps */
     char content_hash[SB_HASH_HEX_SIZE];
-    char key[SB_HASH_HEX_SIZE]; /* the bake key (baker/bake.h); "" when not recorded */
+    char file_hash[SB_HASH_HEX_SIZE]; /* of the file's bytes; "" in a version 1 pack */
+    char key[SB_HASH_HEX_SIZE];       /* the bake key (baker/bake.h); "" when not recorded */
 };
 
 struct sb_device_info {
@@ -67,8 +104,11 @@ struct sb_pack_writer;
  */
 enum sb_result sb_pack_writer_create(const char *out_dir, struct sb_pack_writer **writer);
 
-/* Write one artifact's EXR into the pack and record it; fills
- * artifact->content_hash from the image. */
+/* Write one artifact's file into the pack (EXR or VDB, as its product is
+ * stored) and record it; fills artifact->content_hash from the image and
+ * artifact->file_hash from the file. A product stored as half must hold
+ * binary16 values already (sb_image_round_to_half), so that its content
+ * hash is that of what the file holds. */
 enum sb_result sb_pack_writer_add_image(struct sb_pack_writer *writer, struct sb_artifact *artifact,
                                         const struct sb_image *image);
 
@@ -93,10 +133,10 @@ void sb_pack_writer_destroy(struct sb_pack_writer **writer);
 void sb_pack_writers_remove_temporaries(void);
 
 /*
- * A pack as read back: the manifest's fields and every artifact's image,
- * each verified. Products the pack does not hold have present[id] false.
+ * A pack as read back: the manifest's fields and every artifact's image
+ * (volumes: depth > 1), each verified. Products the pack does not hold have
+ * present[id] false.
  */
-struct sb_scene;
 
 struct sb_pack {
     int format_version;
@@ -116,8 +156,9 @@ struct sb_pack {
  * a guess), every artifact's name (a product of this version, at most once),
  * file (a plain name inside the pack, not a symbolic link), dimensions,
  * channels and pixel type against the product's format (checked before any
- * pixel is read), the EXR itself, that it holds only finite values, and its
- * content hash against the manifest's; the scene the manifest records
+ * pixel is read), the file's bytes against its file_hash (version 2 on;
+ * before the file is parsed), the EXR or VDB itself, that it holds only
+ * finite values, and its content hash against the manifest's; the scene the manifest records
  * (a valid scene, whose normalised form hashes to scene_hash); and that the
  * pack holds no file the manifest does not list. Every problem is logged
  * naming the pack, the artifact and the reason; the first one's code is

@@ -28,6 +28,7 @@ static const struct {
     [SB_ERR_UNSAFE_PATH] = {"unsafe-path", "a path that leaves the pack or goes through a symbolic link"},
     [SB_ERR_TOLERANCE] = {"tolerance", "no setting of a product reaches the scene's tolerance"},
     [SB_ERR_UNLISTED_FILE] = {"unlisted-file", "a file in a pack that its manifest does not list"},
+    [SB_ERR_VDB] = {"vdb", "OpenVDB refused the file or the data"},
 };
 
 const char *sb_result_name(enum sb_result result)

@@ -31,6 +31,7 @@ enum sb_result {
     SB_ERR_UNSAFE_PATH,     /* a path that leaves the pack or goes through a symbolic link */
     SB_ERR_TOLERANCE,       /* no setting of a product reaches the scene's tolerance */
     SB_ERR_UNLISTED_FILE,   /* a pack holds a file its manifest does not list */
+    SB_ERR_VDB,             /* OpenVDB refused the file or the data */
     SB_RESULT_COUNT,
 };
 

@@ -9,6 +9,7 @@
 
 #include <stdbool.h>
 #include <stddef.h>
+#include <stdint.h>
 
 #include "pack.h"
 #include "result.h"
@@ -38,14 +39,50 @@ struct sb_scene_view {
     double sun_elevation_deg; /* the sun above the horizon, [-90, 90] */
 };
 
+/* A Perlin fBm's lattice period (cells per texture) and octave count. */
+struct sb_noise_octaves {
+    uint32_t period;
+    uint32_t octaves;
+};
+
+/*
+ * The cloud noise textures (baker/clouds.h defines each noise and channel).
+ * Sizes are texels per edge; periods and Worley cell counts are per texture
+ * edge (each noise tiles the texture); every octave doubles the period.
+ * Defaults in brackets; docs/scene.md gives the caps.
+ */
+struct sb_cloud_params {
+    uint32_t seed;                   /* [0] */
+    uint32_t shape_size;             /* [128] */
+    struct sb_noise_octaves shape_perlin; /* Perlin-Worley's Perlin [4, 4 octaves] */
+    uint32_t shape_worley_cells[3];  /* [4, 8, 16]: channel 0's Worley is the first */
+    uint32_t detail_size;            /* [32] */
+    uint32_t detail_worley_cells[3]; /* [2, 4, 8] */
+    uint32_t curl_size;              /* [128] */
+    struct sb_noise_octaves curl;    /* the potential's [4, 3 octaves] */
+    uint32_t weather_size;           /* [512] */
+    struct sb_noise_octaves coverage;      /* [4, 5 octaves] */
+    struct sb_noise_octaves precipitation; /* [8, 4 octaves] */
+    struct sb_noise_octaves cloud_type;    /* [2, 3 octaves] */
+};
+
+void sb_cloud_params_default(struct sb_cloud_params *params);
+
+/* Validate, logging "source: clouds.path: reason" for the first problem. */
+enum sb_result sb_cloud_params_validate(const struct sb_cloud_params *params, const char *source);
+
 struct sb_scene {
     char name[64];
     char preset[32];
     struct sb_atmosphere_params atmosphere;
-    /* Products the scene asks for, before dependencies are pulled in. */
+    bool has_clouds;               /* a "clouds" object was given */
+    struct sb_cloud_params clouds; /* the defaults unless given */
+    /* Products the scene asks for, before dependencies are pulled in
+     * (without a "products" list: the atmosphere's). */
     bool wants[SB_PRODUCT_COUNT];
-    /* Largest relative error against the fp64 reference each product may
-     * have (0: none asked; the product's default settings). */
+    /* Largest relative error against the fp64 reference each atmosphere
+     * product may have (0: none asked; the product's default settings). The
+     * cloud noise matches its reference exactly and takes none. */
     double tolerance[SB_PRODUCT_COUNT];
     bool has_view;
     struct sb_scene_view view; /* 2 m up, the sun at 30 degrees unless the scene says */

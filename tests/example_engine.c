@@ -27,8 +27,8 @@ int main(int argc, char **argv)
         if (!pack.present[p])
             continue;
         const struct sb_image *image = &pack.images[p];
-        printf("%s %ux%u x%u first value %g hash %s\n", sb_product_name((enum sb_product_id)p), image->width,
-               image->height, image->channel_count, image->data[0], pack.artifacts[p].content_hash);
+        printf("%s %ux%ux%u x%u first value %g hash %s\n", sb_product_name((enum sb_product_id)p), image->width,
+               image->height, image->depth, image->channel_count, image->data[0], pack.artifacts[p].content_hash);
     }
     sb_pack_close(&pack);
     return 0;

@@ -1,7 +1,8 @@
 /*
  * A pack of every product with synthetic, finite content, written through
  * the pack writer: what the pack reader's tests and the manifest fuzzer
- * open. `images` (may be NULL) receives each product's image, which the
+ * open. The cloud products are small (the scene's sizes: 16^3, 8^3, 8^2,
+ * 8^2). `images` (may be NULL) receives each product's image, which the
  * caller finishes; `name` is the scene's and the device's.
  */
 #ifndef SB_TEST_SYNTHETIC_PACK_H
@@ -16,18 +17,41 @@
 static inline enum sb_result write_synthetic_pack(const char *dir, const char *name,
                                                   struct sb_image images[SB_PRODUCT_COUNT])
 {
+    struct sb_scene scene = {.preset = "earth"};
+    snprintf(scene.name, sizeof(scene.name), "%s", name);
+    sb_atmosphere_preset_earth(&scene.atmosphere);
+    for (int p = 0; p < SB_PRODUCT_COUNT; p++)
+        scene.wants[p] = true;
+    scene.clouds = (struct sb_cloud_params){
+        .seed = 7,
+        .shape_size = 16,
+        .shape_perlin = {2, 2},
+        .shape_worley_cells = {1, 2, 4},
+        .detail_size = 8,
+        .detail_worley_cells = {1, 1, 2},
+        .curl_size = 8,
+        .curl = {2, 2},
+        .weather_size = 8,
+        .coverage = {2, 2},
+        .precipitation = {4, 1},
+        .cloud_type = {1, 3},
+    };
     struct sb_pack_writer *w = NULL;
     enum sb_result res = sb_pack_writer_create(dir, &w);
     for (int p = 0; p < SB_PRODUCT_COUNT && !res; p++) {
         const struct sb_product_format *f = sb_product_format((enum sb_product_id)p);
+        uint32_t shape[3];
+        sb_product_shape(&scene, (enum sb_product_id)p, shape);
         struct sb_image image;
-        if ((res = sb_image_init(&image, f->width, f->height, f->channel_count)))
+        if ((res = sb_image_init_volume(&image, shape[0], shape[1], shape[2], f->channel_count)))
             break;
         sb_image_set_channel_names(&image, f->channel_names);
         for (uint64_t i = 0; i < sb_image_float_count(&image); i++)
             image.data[i] = (float)((double)(i * 2654435761u % 1000003u) * 1e-6 + p);
+        if (f->storage == SB_STORAGE_VDB_HALF)
+            sb_image_round_to_half(&image, NULL);
         struct sb_artifact a = {.product = (enum sb_product_id)p};
-        snprintf(a.file, sizeof(a.file), "%s.exr", f->name);
+        snprintf(a.file, sizeof(a.file), "%s.%s", f->name, f->extension);
         snprintf(a.parameterization, sizeof(a.parameterization), "%s", f->parameterization);
         res = sb_pack_writer_add_image(w, &a, &image);
         if (images)
@@ -36,12 +60,7 @@ static inline enum sb_result write_synthetic_pack(const char *dir, const char *n
             sb_image_finish(&image);
     }
     struct sb_device_info device = {.driver = "none"};
-    struct sb_scene scene = {.preset = "earth"};
     snprintf(device.name, sizeof(device.name), "%s device", name);
-    snprintf(scene.name, sizeof(scene.name), "%s", name);
-    sb_atmosphere_preset_earth(&scene.atmosphere);
-    for (int p = 0; p < SB_PRODUCT_COUNT; p++)
-        scene.wants[p] = true;
     char *scene_json = res ? NULL : sb_scene_normalized_json(&scene);
     if (!res)
         res = scene_json ? sb_pack_writer_commit(&w, scene_json, &device) : SB_ERR_NOMEM;

@@ -499,7 +499,7 @@ int main(void)
         return test_finish("atmosphere");
     struct sb_atmosphere_baker *baker = NULL;
     CHECK(sb_atmosphere_baker_create(vk, &earth, &baker) == SB_OK, "baker");
-    for (int p = 0; p < SB_PRODUCT_COUNT; p++) {
+    for (int p = 0; p < SB_ATMOSPHERE_PRODUCT_COUNT; p++) {
         double ms;
         res = sb_atmosphere_bake(baker, (enum sb_product_id)p, NULL, &luts[p], NULL, &ms);
         CHECK(res == SB_OK, "baking %s", sb_product_name((enum sb_product_id)p));

@@ -30,6 +30,10 @@ cp "$tmp/out" "$tmp/a.json"
 check "bake with 2 threads" expect_exit 0 env LP_NUM_THREADS=2 "$skybake" bake "$scene" -o "$tmp/b" --json -q
 cp "$tmp/out" "$tmp/b.json"
 hashes() { grep '"content_hash"' "$1"; }
+content_hash_of() { # manifest product: that artifact's content hash
+    python3 -c 'import json, sys
+print(next(a["content_hash"] for a in json.load(open(sys.argv[1]))["artifacts"] if a["name"] == sys.argv[2]))' "$1" "$2"
+}
 check "four artifacts" test "$(hashes "$tmp/a/manifest.json" | wc -l)" = 4
 check "hashes equal across thread counts" test "$(hashes "$tmp/a/manifest.json")" = "$(hashes "$tmp/b/manifest.json")"
 check "hashes equal in --json and manifest" test "$(hashes "$tmp/a.json" | tr -d ' ,')" = "$(hashes "$tmp/a/manifest.json" | tr -d ' ,')"
@@ -43,7 +47,8 @@ check "info --json" expect_exit 0 "$skybake" info "$tmp/a" --json
 check "info --json has the manifest's hashes" test "$(hashes "$tmp/out" | tr -d ' ,\t')" = "$(hashes "$tmp/a/manifest.json" | tr -d ' ,\t')"
 check "info needs a pack" expect_exit 2 "$skybake" info
 check "info refuses what is not a pack" expect_exit 2 "$skybake" info "$root/data"
-check "manifest has format_version 1" grep -Eq '"format_version":[[:space:]]*1,' "$tmp/a/manifest.json"
+check "manifest has format_version 2" grep -Eq '"format_version":[[:space:]]*2,' "$tmp/a/manifest.json"
+check "no cloud products unless asked for" test ! -e "$tmp/a/cloud_shape.vdb"
 
 # verify: exit 0 when all holds; else 1, naming every problem.
 check "verify a pack" expect_exit 0 "$skybake" verify "$tmp/a"
@@ -113,6 +118,60 @@ check "a pack that does not verify" expect_exit 0 "$skybake" bake "$tmp/g2.json"
 check "a pack that does not verify is not reused" test -z "$(reused)"
 check "and the warning names the file" grep -q "multiscattering.exr" "$tmp/err"
 
+# Cloud noise: the default scene data/scenes/earth-clouds.json asks for it;
+# volumes as OpenVDB (vdb_print reads them: grids, sizes, fog volumes stored
+# as half, our metadata), the 2D ones as EXR; the same hashes whatever the
+# thread count; keys per product.
+clouds=$root/data/scenes/earth-clouds.json
+check "bake earth-clouds.json" expect_exit 0 "$skybake" bake "$clouds" -o "$tmp/ec" -q --json
+check "eight artifacts" test "$(hashes "$tmp/ec/manifest.json" | wc -l)" = 8
+check "earth-clouds verifies" expect_exit 0 "$skybake" verify "$tmp/ec"
+check "info lists the volumes with their depth" expect_exit 0 "$skybake" info "$tmp/ec"
+check "info shows 128x128x128" grep -Eq '^cloud_shape +128x128x128 ' "$tmp/out"
+check "vdb_print reads cloud_shape" expect_exit 0 vdb_print "$tmp/ec/cloud_shape.vdb"
+for grid in perlin_worley worley.0 worley.1 worley.2; do
+    check "cloud_shape has grid $grid, 128^3" grep -Eq "^$grid +float \(0,0,0\)->\(127,127,127\) +128x128x128 " "$tmp/out"
+done
+check "cloud_shape holds four grids" test "$(wc -l <"$tmp/out")" = 4
+check "vdb_print reads cloud_detail" expect_exit 0 vdb_print "$tmp/ec/cloud_detail.vdb"
+for grid in worley.0 worley.1 worley.2; do
+    check "cloud_detail has grid $grid, 32^3" grep -Eq "^$grid +float \(0,0,0\)->\(31,31,31\) +32x32x32 " "$tmp/out"
+done
+check "cloud_detail holds three grids" test "$(wc -l <"$tmp/out")" = 3
+check "vdb_print -l -m on cloud_detail" expect_exit 0 vdb_print -l -m "$tmp/ec/cloud_detail.vdb"
+check "fog volumes" test "$(grep -c 'class: fog volume' "$tmp/out")" = 3
+check "stored as half" test "$(grep -c 'is_saved_as_half_float: true' "$tmp/out")" = 3
+check "Blosc-compressed" test "$(grep -c 'file_compression: blosc' "$tmp/out")" = 3
+check "dense: every voxel active, no tiles" test "$(grep -Ec 'Number of active voxels: +32,768' "$tmp/out")" = 3
+check "the product in the metadata" grep -q 'skybake.product: cloud_detail' "$tmp/out"
+check "the content hash in the metadata" grep -q "skybake.content_hash: $(content_hash_of "$tmp/ec/manifest.json" cloud_detail)" "$tmp/out"
+check "weather and curl are EXR" test -s "$tmp/ec/weather.exr" -a -s "$tmp/ec/cloud_curl.exr"
+printf '{"atmosphere":{"preset":"earth"},"products":["cloud_shape","cloud_detail","cloud_curl","weather"]%s}' '' >"$tmp/c1.json"
+check "clouds with 1 thread" expect_exit 0 env LP_NUM_THREADS=1 "$skybake" bake "$tmp/c1.json" -o "$tmp/c1" -q
+check "clouds with 2 threads" expect_exit 0 env LP_NUM_THREADS=2 "$skybake" bake "$tmp/c1.json" -o "$tmp/c2" -q
+check "cloud hashes equal across thread counts" expect_exit 0 "$skybake" diff "$tmp/c1" "$tmp/c2"
+check "cloud files identical byte for byte" cmp -s "$tmp/c1/cloud_shape.vdb" "$tmp/c2/cloud_shape.vdb"
+check "the clouds equal earth-clouds' (the atmosphere does not touch them)" test \
+    "$(grep -A1 cloud_shape "$tmp/c1/manifest.json" | grep content_hash)" = "$(grep -A1 cloud_shape "$tmp/ec/manifest.json" | grep content_hash)"
+printf '{"atmosphere":{"preset":"earth"},"products":["cloud_shape","cloud_detail","cloud_curl","weather"],"clouds":{%s}}' \
+    '"cloud_detail":{"size":16,"worley_cells":[1,2,4]}' >"$tmp/c2.json"
+check "a cloud size changed" expect_exit 0 "$skybake" bake "$tmp/c2.json" -o "$tmp/c1" -q --json
+check "it rebakes cloud_detail only" test "$(reused)" = "cloud_shape cloud_curl weather"
+printf '{"atmosphere":{"preset":"earth"},"products":["cloud_shape","cloud_detail","cloud_curl","weather"],"clouds":{%s}}' \
+    '"seed":1,"cloud_detail":{"size":16,"worley_cells":[1,2,4]}' >"$tmp/c3.json"
+check "the seed changed" expect_exit 0 "$skybake" bake "$tmp/c3.json" -o "$tmp/c1" -q --json
+check "it rebakes every cloud product" test -z "$(reused)"
+printf '{"atmosphere":{"preset":"earth","mie_g":0.7},"products":["cloud_curl"]}' >"$tmp/c4.json"
+check "the atmosphere changed" expect_exit 0 "$skybake" bake "$tmp/c4.json" -o "$tmp/c2" -q --json
+check "the cloud noise is reused" test "$(reused)" = "cloud_curl"
+for bad in '"clouds":{"cloud_shape":{"size":512}}' '"clouds":{"seed":-1}' '"clouds":{"weather":{"coverage_octaves":9}}' \
+    '"clouds":{"cloud_detail":{"worley_cells":[2,4,9]}}' '"tolerance":{"weather":1e-3}'; do
+    printf '{"atmosphere":{"preset":"earth"},"products":["weather"],%s}' "$bad" >"$tmp/badcloud.json"
+    check "refuses $bad" expect_exit 2 "$skybake" bake "$tmp/badcloud.json" -o "$tmp/p"
+    check "names the field of $bad" grep -Eq "(clouds|tolerance)\.[a-z_]+" "$tmp/err"
+done
+check "no pack after refused cloud parameters" test ! -e "$tmp/p"
+
 # Refused parameter values (docs/scene.md), each naming its key.
 for bad in 'top_radius_km:6360' 'top_radius_km:6000' 'top_radius_km:6360.000001' 'ground_radius_km:0' \
     'ground_radius_km:-1' 'mie_g:1' 'mie_g:-1' 'mie_g:0.9995' 'rayleigh_scattering_per_km:-1e-3' \
@@ -176,6 +235,10 @@ check "bench has Bruneton's row" grep -q "trapezoid-500,.*Bruneton" "$tmp/bench/
 check "bench marks a Pareto front" grep -Eq '"pareto":[[:space:]]*true' "$tmp/bench/bench.json"
 check "bench table names the default" grep -q '^.\*gl8x1' "$tmp/out"
 check "bench refuses an unknown product" expect_exit 2 "$skybake" bench --product sky
+check "bench of the cloud noise" expect_exit 0 "$skybake" bench --product cloud_detail --product cloud_curl --repeat 1 -q -o "$tmp/benchc"
+check "bench_clouds.csv: two products, every value equal to the reference" \
+    test "$(grep -Ec '^cloud_(detail|curl),.*,0$' "$tmp/benchc/bench_clouds.csv")" = 2
+check "the cloud table names the reference" grep -q "CPU reference on one core" "$tmp/out"
 
 # sky-error: the runtime's sky against the path tracer.
 check "sky-error runs" expect_exit 0 "$skybake" sky-error "$scene" --paths 64 --sun 30 --sun -4 --json -q

@@ -74,6 +74,13 @@ rm -rf "$tmp/fresh"
 check "a full disk with no previous pack is exit 1" expect_exit 1 sh -c 'ulimit -f 64 && exec "$@"' sh "$skybake" bake "$tmp/new.json" -o "$tmp/fresh"
 check "and leaves no pack" test ! -e "$tmp/fresh"
 check "and no temporary files" test -z "$(ls -d "$tmp"/fresh.tmp-* 2>/dev/null)"
+# The same for a volume (OpenVDB's bytes go through write(2), so the reason
+# survives): cloud_detail's file is larger than the limit.
+printf '{"atmosphere":{"preset":"earth"},"products":["cloud_detail"]}' >"$tmp/volume.json"
+check "a full disk under a volume is exit 1" expect_exit 1 sh -c 'ulimit -f 64 && exec "$@"' sh "$skybake" bake "$tmp/volume.json" -o "$tmp/fresh"
+check "and names the reason and the VDB file" grep -Eqi "cloud_detail.vdb.*file too large" "$tmp/err"
+check "and leaves no pack" test ! -e "$tmp/fresh"
+check "and no temporary files" test -z "$(ls -d "$tmp"/fresh.tmp-* 2>/dev/null)"
 
 # An unwritable parent (as an unprivileged user when run as root, since
 # root writes anywhere), a parent on a read-only file system, an output

@@ -1,6 +1,7 @@
 /* formats/: EXR round trips, content hashes, scene parsing and validation,
  * packs written and read back, and packs that must be refused. */
 #include <cJSON.h>
+#include <fcntl.h>
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
@@ -14,6 +15,7 @@
 #include "pack.h"
 #include "scene.h"
 #include "synthetic_pack.h"
+#include "vdb.h"
 
 static void quiet(void *user, enum sb_log_level level, const char *msg)
 {
@@ -32,9 +34,9 @@ static void test_exr_round_trip(void)
     char path[] = "/tmp/skybake-test-XXXXXX.exr";
     int fd = mkstemps(path, 4);
     close(fd);
-    struct sb_exr_attribute attrs[2] = {{"skybake.product", "transmittance"}, {"skybake.content_hash", "abc"}};
+    struct sb_attribute attrs[2] = {{"skybake.product", "transmittance"}, {"skybake.content_hash", "abc"}};
     CHECK(sb_exr_write(path, &img, attrs, 2) == SB_OK, "write");
-    struct sb_exr_attribute got[SB_EXR_MAX_ATTRIBUTES];
+    struct sb_attribute got[SB_FILE_MAX_ATTRIBUTES];
     int ngot = 0;
     CHECK(sb_exr_read(path, "r,g,b", 0, &back, got, &ngot) == SB_OK, "read");
     CHECK(back.width == 37 && back.height == 11 && back.channel_count == 3, "shape %ux%ux%u", back.width, back.height,
@@ -88,6 +90,8 @@ struct scene_case {
     enum sb_result expect;
 };
 
+#define EARTH "{\"atmosphere\":{\"preset\":\"earth\"},"
+
 static void test_scenes(void)
 {
     static const struct scene_case cases[] = {
@@ -126,6 +130,35 @@ static void test_scenes(void)
         {"{\"atmosphere\":{\"preset\":\"earth\"},\"products\":[\"transmittance\",\"transmittance\"]}", SB_ERR_DUPLICATE_KEY},
         {"\x89PNG\r\n\x1a\n\xff\xfe{[", SB_ERR_JSON_SYNTAX},
         {"{\"atmosphere\":{\"preset\":\"earth}}", SB_ERR_JSON_SYNTAX},
+        /* Cloud noise. */
+        {"{\"atmosphere\":{\"preset\":\"earth\"},\"products\":[\"cloud_shape\",\"weather\"]}", SB_OK},
+        {EARTH "\"clouds\":{\"seed\":4294967295,\"cloud_shape\":{\"size\":96,\"worley_cells\":[3,6,24]},"
+               "\"weather\":{\"size\":1024,\"coverage_period\":64,\"coverage_octaves\":5}}}",
+         SB_OK},
+        {EARTH "\"clouds\":{\"seed\":4294967296}}", SB_ERR_OUT_OF_RANGE},
+        {EARTH "\"clouds\":{\"seed\":-1}}", SB_ERR_OUT_OF_RANGE},
+        {EARTH "\"clouds\":{\"seed\":1.5}}", SB_ERR_OUT_OF_RANGE},
+        {EARTH "\"clouds\":{\"seed\":\"7\"}}", SB_ERR_WRONG_TYPE},
+        {EARTH "\"clouds\":[]}", SB_ERR_WRONG_TYPE},
+        {EARTH "\"clouds\":{\"cloud_shape\":7}}", SB_ERR_WRONG_TYPE},
+        {EARTH "\"clouds\":{\"cloud_shape\":{\"size\":512}}}", SB_ERR_OUT_OF_RANGE},
+        {EARTH "\"clouds\":{\"cloud_shape\":{\"size\":4}}}", SB_ERR_OUT_OF_RANGE},
+        {EARTH "\"clouds\":{\"weather\":{\"size\":2048}}}", SB_ERR_OUT_OF_RANGE},
+        {EARTH "\"clouds\":{\"cloud_shape\":{\"perlin_octaves\":0}}}", SB_ERR_OUT_OF_RANGE},
+        {EARTH "\"clouds\":{\"cloud_shape\":{\"perlin_octaves\":9}}}", SB_ERR_OUT_OF_RANGE},
+        /* finer than a texel: 16 cells x 2^3 over 64 texels; 32 cells x 4 over 128 */
+        {EARTH "\"clouds\":{\"cloud_shape\":{\"size\":64,\"perlin_period\":16}}}", SB_ERR_OUT_OF_RANGE},
+        {EARTH "\"clouds\":{\"cloud_shape\":{\"worley_cells\":[4,8,33]}}}", SB_ERR_OUT_OF_RANGE},
+        {EARTH "\"clouds\":{\"cloud_detail\":{\"size\":16}}}", SB_ERR_OUT_OF_RANGE},
+        {EARTH "\"clouds\":{\"cloud_shape\":{\"worley_cells\":[4,8]}}}", SB_ERR_WRONG_TYPE},
+        {EARTH "\"clouds\":{\"cloud_shape\":{\"worley_cells\":[4,8,0]}}}", SB_ERR_OUT_OF_RANGE},
+        {EARTH "\"clouds\":{\"cloud_shape\":{\"worley_cells\":[4,\"8\",16]}}}", SB_ERR_WRONG_TYPE},
+        {EARTH "\"clouds\":{\"cloud_shape\":{\"cells\":[4,8,16]}}}", SB_ERR_UNKNOWN_KEY},
+        {EARTH "\"clouds\":{\"size\":128}}", SB_ERR_UNKNOWN_KEY},
+        {EARTH "\"clouds\":{\"shape\":{}}}", SB_ERR_UNKNOWN_KEY},
+        {EARTH "\"clouds\":{\"weather\":{\"size\":8,\"size\":16}}}", SB_ERR_DUPLICATE_KEY},
+        {EARTH "\"clouds\":{\"cloud_curl\":{\"period\":0}}}", SB_ERR_OUT_OF_RANGE},
+        {EARTH "\"tolerance\":{\"cloud_shape\":1e-3}}", SB_ERR_OUT_OF_RANGE},
     };
     for (size_t i = 0; i < sizeof(cases) / sizeof(cases[0]); i++) {
         struct sb_scene scene;
@@ -160,47 +193,223 @@ static void test_scenes(void)
     free(na);
     free(nb);
     CHECK(sb_scene_load("/nonexistent/scene.json", &a) == SB_ERR_IO, "missing file");
+
+    /* Without clouds asked for or given, the normalised scene has no
+     * "clouds" (its hash is what format version 1 gave) and the atmosphere's
+     * products are wanted; the cloud parameters are the defaults, resolved
+     * in full when asked for, and read back to the same form. */
+    CHECK(sb_scene_parse(ja, strlen(ja), "a", &a) == SB_OK, "parse");
+    na = sb_scene_normalized_json(&a);
+    CHECK(na && !strstr(na, "clouds") && a.wants[SB_PRODUCT_IRRADIANCE_SKY] && !a.wants[SB_PRODUCT_CLOUD_SHAPE] &&
+              !a.wants[SB_PRODUCT_WEATHER],
+          "an atmosphere scene: %s", na);
+    free(na);
+    const char *jc = EARTH "\"products\":[\"cloud_detail\"],\"clouds\":{\"cloud_detail\":{\"size\":48}}}";
+    CHECK(sb_scene_parse(jc, strlen(jc), "c", &a) == SB_OK && a.clouds.detail_size == 48 &&
+              a.clouds.shape_size == 128 && a.clouds.detail_worley_cells[2] == 8 && a.clouds.cloud_type.octaves == 3,
+          "cloud parameters: given ones and defaults");
+    na = sb_scene_normalized_json(&a);
+    CHECK(na && sb_scene_parse(na, strlen(na), "normalised", &b) == SB_OK, "the normalised cloud scene parses");
+    nb = sb_scene_normalized_json(&b);
+    CHECK(na && nb && !strcmp(na, nb) && strstr(na, "\"type_octaves\":3"), "cloud scene normalisation is stable: %s",
+          nb);
+    free(na);
+    free(nb);
+}
+
+
+/* binary16 against an independent reference: every half widens and narrows
+ * back to itself; between each two neighbouring finite halves, the float
+ * just below their midpoint (computed exactly in double) rounds down, just
+ * above rounds up, and the midpoint itself to the even one; overflow. */
+static void test_half(void)
+{
+    unsigned identity = 0, rounding = 0;
+    for (uint32_t h = 0; h < 0x10000u; h++) {
+        float f = sb_half_to_float((uint16_t)h);
+        bool nan = (h & 0x7c00u) == 0x7c00u && (h & 0x3ffu);
+        identity += nan ? !(isnan(f) && (sb_half_from_float(f) & 0x7e00u) == 0x7e00u)
+                        : sb_half_from_float(f) != h;
+    }
+    for (uint32_t h = 0; h < 0x7bffu; h++) {
+        for (int sign = 0; sign < 2; sign++) {
+            uint16_t lo = (uint16_t)(h | (sign << 15)), hi = (uint16_t)((h + 1) | (sign << 15));
+            double mid = ((double)sb_half_to_float(lo) + (double)sb_half_to_float(hi)) / 2;
+            float m = (float)mid; /* exact: 12 significant bits */
+            uint16_t even = (h & 1) ? hi : lo;
+            rounding += (double)m != mid;
+            rounding += sb_half_from_float(m) != even;
+            rounding += sb_half_from_float(nextafterf(m, 0.0f)) != lo;
+            rounding += sb_half_from_float(nextafterf(m, sign ? -INFINITY : INFINITY)) != hi;
+        }
+    }
+    CHECK(identity == 0, "%u halves do not survive a round trip through fp32", identity);
+    CHECK(rounding == 0, "%u roundings to the nearest half differ from the midpoint reference", rounding);
+    CHECK(sb_half_from_float(65504.0f) == 0x7bffu && sb_half_from_float(65519.99f) == 0x7bffu &&
+              sb_half_from_float(65520.0f) == 0x7c00u && sb_half_from_float(-1e9f) == 0xfc00u &&
+              sb_half_from_float(0x1p-25f) == 0 && sb_half_from_float(nextafterf(0x1p-25f, 1.0f)) == 1 &&
+              sb_half_from_float(-0.0f) == 0x8000u,
+          "overflow, the smallest subnormal's half and the sign of zero");
+    struct sb_image big;
+    sb_image_init(&big, 2, 1, 1);
+    big.data[0] = 0.5f;
+    big.data[1] = 70000.0f;
+    int64_t bad = -1;
+    CHECK(sb_image_round_to_half(&big, &bad) == SB_ERR_NUMERIC && bad == 1 && big.data[0] == 0.5f,
+          "a value beyond binary16 is refused and nothing is changed");
+    sb_image_finish(&big);
+}
+
+static bool files_equal(const char *a, const char *b)
+{
+    char cmd[600];
+    snprintf(cmd, sizeof(cmd), "cmp -s '%s' '%s'", a, b);
+    return system(cmd) == 0;
+}
+
+/* VDB volumes: exact at half precision, deterministic bytes, and refusals. */
+static void test_vdb(void)
+{
+    struct sb_image v, back;
+    CHECK(sb_image_init_volume(&v, 13, 9, 20, 4) == SB_OK, "init"); /* not multiples of the 8^3 leaves */
+    sb_image_set_channel_names(&v, "perlin_worley,worley.0,worley.1,worley.2");
+    uint32_t state = 12345;
+    for (uint64_t i = 0; i < sb_image_float_count(&v); i++) {
+        state = state * 1664525u + 1013904223u;
+        v.data[i] = (float)(state >> 8) * 0x1p-24f; /* [0, 1) */
+    }
+    v.data[0] = 0.0f;
+    v.data[1] = 1.0f;
+    v.data[2] = 3e-7f; /* subnormal in binary16 */
+    v.data[3] = 6.1e-5f;
+    char path[] = "/tmp/skybake-test-XXXXXX.vdb", again[] = "/tmp/skybake-test-XXXXXX.vdb";
+    close(mkstemps(path, 4));
+    close(mkstemps(again, 4));
+    struct sb_attribute attrs[2] = {{"skybake.product", "cloud_shape"}, {"skybake.content_hash", "abc"}};
+    CHECK(sb_vdb_write(path, &v, attrs, 2) == SB_ERR_NUMERIC, "a value that is not a binary16 one is refused");
+    CHECK(sb_image_round_to_half(&v, NULL) == SB_OK, "round");
+    CHECK(sb_vdb_write(path, &v, attrs, 2) == SB_OK, "write");
+    CHECK(sb_vdb_write(again, &v, attrs, 2) == SB_OK && files_equal(path, again),
+          "the same volume gives the same bytes (OpenVDB's random UUID replaced)");
+    struct sb_attribute got[SB_FILE_MAX_ATTRIBUTES];
+    int ngot = 0;
+    CHECK(sb_vdb_read(path, "perlin_worley,worley.0,worley.1,worley.2", 0, &back, got, &ngot) == SB_OK, "read");
+    CHECK(back.width == 13 && back.height == 9 && back.depth == 20 && back.channel_count == 4, "shape %ux%ux%u x%u",
+          back.width, back.height, back.depth, back.channel_count);
+    CHECK(back.data && !memcmp(back.data, v.data, sb_image_float_count(&v) * sizeof(float)),
+          "every value reads back bit for bit");
+    char ha[SB_HASH_HEX_SIZE], hb[SB_HASH_HEX_SIZE];
+    sb_image_content_hash(&v, ha);
+    sb_image_content_hash(&back, hb);
+    CHECK(!strcmp(ha, hb), "content hashes agree");
+    bool found = false;
+    for (int i = 0; i < ngot; i++)
+        found |= !strcmp(got[i].name, "skybake.product") && !strcmp(got[i].value, "cloud_shape");
+    CHECK(ngot == 2 && found, "attributes read back (%d)", ngot);
+    sb_image_finish(&back);
+
+    /* Refusals, each before or instead of a guess. */
+    CHECK(sb_vdb_read(path, "worley.0,worley.1,worley.2", 0, &back, NULL, NULL) == SB_ERR_BAD_IMAGE,
+          "other channels");
+    CHECK(sb_vdb_read(path, "perlin_worley,worley.0,worley.1,worley.x", 0, &back, NULL, NULL) == SB_ERR_BAD_IMAGE,
+          "a channel it does not hold");
+    CHECK(sb_vdb_read(path, "perlin_worley,worley.0,worley.1,worley.2", 13 * 9 * 20 - 1, &back, NULL, NULL) ==
+              SB_ERR_BAD_IMAGE,
+          "more voxels than allowed, refused from the metadata");
+    CHECK(!back.data, "a refused volume is left empty");
+    CHECK(sb_vdb_read("/nonexistent.vdb", "a", 0, &back, NULL, NULL) == SB_ERR_IO, "no file");
+    CHECK(sb_vdb_read("/tmp", "a", 0, &back, NULL, NULL) == SB_ERR_IO, "a directory");
+    FILE *f = fopen(again, "wb");
+    fputs("not a vdb file at all, just some text", f);
+    fclose(f);
+    CHECK(sb_vdb_read(again, "a", 0, &back, NULL, NULL) == SB_ERR_VDB, "bad magic");
+    f = fopen(again, "wb");
+    fclose(f);
+    CHECK(sb_vdb_read(again, "a", 0, &back, NULL, NULL) == SB_ERR_VDB, "empty file");
+    CHECK(sb_vdb_write("/nonexistent/dir/x.vdb", &v, NULL, 0) == SB_ERR_IO, "unwritable path");
+    struct sb_image flat;
+    sb_image_init(&flat, 4, 4, 1);
+    sb_image_set_channel_names(&flat, "a");
+    CHECK(sb_exr_write(again, &v, NULL, 0) == SB_ERR_BAD_IMAGE, "EXR refuses a volume");
+    sb_image_finish(&flat);
+    unlink(path);
+    unlink(again);
+    sb_image_finish(&v);
 }
 
 /* ---- packs ---------------------------------------------------------------------- */
 
 static char pack_root[200];
 
+#define FLIP_BYTE                                                                                                      \
+    "printf '\\x55' | dd of=multiscattering.exr bs=1 seek=$(( $(stat -c %s multiscattering.exr) - 40 )) "            \
+    "conv=notrunc 2>/dev/null"
+
 static void run(const char *command)
 {
     CHECK(system(command) == 0, "%s", command);
 }
 
-/* Copy the good pack to `bad`, let `edit` change its manifest (may be NULL), and return the code opening it gives. */
-static enum sb_result open_edited(const char *good, const char *bad, void (*edit)(cJSON *root), const char *shell)
+/* Let `edit` change the manifest of the pack in `dir`. */
+static void edit_manifest(const char *dir, void (*edit)(cJSON *root))
+{
+    char path[512];
+    snprintf(path, sizeof(path), "%s/manifest.json", dir);
+    FILE *f = fopen(path, "rb");
+    char *text = calloc(1, 1 << 20);
+    size_t n = f ? fread(text, 1, (1 << 20) - 1, f) : 0;
+    if (f)
+        fclose(f);
+    cJSON *root = cJSON_ParseWithLength(text, n);
+    free(text);
+    CHECK(root != NULL, "manifest parses");
+    if (!root)
+        return;
+    edit(root);
+    char *out = cJSON_Print(root);
+    cJSON_Delete(root);
+    f = fopen(path, "wb");
+    fputs(out, f);
+    fclose(f);
+    free(out);
+}
+
+/* A hostile manifest that vouches for the files as they are now: each
+ * artifact's file_hash recomputed, so that what is inside the files is
+ * what gets checked. */
+static const char *restamp_dir;
+static void edit_restamp(cJSON *r)
+{
+    int fd = open(restamp_dir, O_RDONLY | O_DIRECTORY);
+    const cJSON *a;
+    cJSON_ArrayForEach(a, cJSON_GetObjectItem(r, "artifacts"))
+    {
+        char hash[SB_HASH_HEX_SIZE];
+        const cJSON *file = cJSON_GetObjectItem(a, "file");
+        if (cJSON_IsString(file) && sb_file_hash(fd, file->valuestring, hash) == SB_OK)
+            cJSON_ReplaceItemInObject((cJSON *)a, "file_hash", cJSON_CreateString(hash));
+    }
+    close(fd);
+}
+
+/* Copy the good pack to `bad`, let `edit` change its manifest (may be NULL),
+ * run `shell` in it (may be NULL), restamp the file hashes if asked, and
+ * return the code opening it gives. */
+static enum sb_result open_edited(const char *good, const char *bad, void (*edit)(cJSON *root), const char *shell,
+                                  bool restamp)
 {
     char cmd[1024];
     snprintf(cmd, sizeof(cmd), "rm -rf '%s' && cp -r '%s' '%s'", bad, good, bad);
     run(cmd);
-    if (edit) {
-        char path[512];
-        snprintf(path, sizeof(path), "%s/manifest.json", bad);
-        FILE *f = fopen(path, "rb");
-        char *text = calloc(1, 1 << 20);
-        size_t n = f ? fread(text, 1, (1 << 20) - 1, f) : 0;
-        if (f)
-            fclose(f);
-        cJSON *root = cJSON_ParseWithLength(text, n);
-        free(text);
-        CHECK(root != NULL, "manifest parses");
-        if (!root)
-            return SB_OK;
-        edit(root);
-        char *out = cJSON_Print(root);
-        cJSON_Delete(root);
-        f = fopen(path, "wb");
-        fputs(out, f);
-        fclose(f);
-        free(out);
-    }
+    if (edit)
+        edit_manifest(bad, edit);
     if (shell) {
         snprintf(cmd, sizeof(cmd), "cd '%s' && %s", bad, shell);
         run(cmd);
+    }
+    if (restamp) {
+        restamp_dir = bad;
+        edit_manifest(bad, edit_restamp);
     }
     struct sb_pack *pack = calloc(1, sizeof(*pack));
     enum sb_result res = sb_pack_open(bad, pack);
@@ -221,7 +430,63 @@ static void set_string(cJSON *object, const char *key, const char *value)
 
 static void edit_version(cJSON *r)
 {
-    cJSON_ReplaceItemInObject(r, "format_version", cJSON_CreateNumber(2));
+    cJSON_ReplaceItemInObject(r, "format_version", cJSON_CreateNumber(SB_PACK_FORMAT_VERSION + 1));
+}
+static void edit_version_1(cJSON *r)
+{
+    cJSON_ReplaceItemInObject(r, "format_version", cJSON_CreateNumber(1));
+}
+/* The scene_hash of the manifest's scene as it now is: an edit the hash
+ * does not give away. */
+static void rehash_scene(cJSON *r)
+{
+    char *text = cJSON_PrintUnformatted(cJSON_GetObjectItem(r, "scene"));
+    struct sb_scene parsed;
+    CHECK(sb_scene_parse(text, strlen(text), "edit", &parsed) == SB_OK, "the edited scene parses");
+    char *normal = sb_scene_normalized_json(&parsed), hash[SB_HASH_HEX_SIZE];
+    sb_hash_bytes(normal, strlen(normal), hash);
+    set_string(r, "scene_hash", hash);
+    free(normal);
+    free(text);
+}
+/* What version 1 wrote: no cloud products (in the scene or the pack), no
+ * file_hash; the scene's hash recomputed for the scene without clouds. */
+static void edit_make_version_1(cJSON *r)
+{
+    edit_version_1(r);
+    cJSON *artifacts = cJSON_GetObjectItem(r, "artifacts");
+    for (int i = cJSON_GetArraySize(artifacts) - 1; i >= 0; i--) {
+        cJSON *a = cJSON_GetArrayItem(artifacts, i);
+        enum sb_product_id id;
+        if (sb_product_from_name(cJSON_GetObjectItem(a, "name")->valuestring, &id) && sb_product_is_cloud(id))
+            cJSON_DeleteItemFromArray(artifacts, i);
+        else
+            cJSON_DeleteItemFromObject(a, "file_hash");
+    }
+    cJSON *scene = cJSON_GetObjectItem(r, "scene");
+    cJSON_DeleteItemFromObject(scene, "clouds");
+    cJSON *products = cJSON_GetObjectItem(scene, "products");
+    while (cJSON_GetArraySize(products) > SB_ATMOSPHERE_PRODUCT_COUNT)
+        cJSON_DeleteItemFromArray(products, SB_ATMOSPHERE_PRODUCT_COUNT);
+    rehash_scene(r);
+}
+static void edit_no_file_hash(cJSON *r)
+{
+    cJSON_DeleteItemFromObject(artifact(r, 4), "file_hash");
+}
+static void edit_volume_depth(cJSON *r)
+{
+    cJSON_ReplaceItemInObject(artifact(r, 4), "depth", cJSON_CreateNumber(8));
+}
+static void edit_volume_pixel_type(cJSON *r)
+{
+    set_string(artifact(r, 4), "pixel_type", "float32");
+}
+static void edit_cloud_size(cJSON *r)
+{
+    cJSON *clouds = cJSON_GetObjectItem(cJSON_GetObjectItem(r, "scene"), "clouds");
+    cJSON_ReplaceItemInObject(cJSON_GetObjectItem(clouds, "cloud_detail"), "size", cJSON_CreateNumber(16));
+    rehash_scene(r);
 }
 static void edit_no_version(cJSON *r)
 {
@@ -338,60 +603,76 @@ static void test_pack_reader(void)
         void (*edit)(cJSON *root);
         const char *shell;
         enum sb_result expect;
+        bool restamp;
     } cases[] = {
-        {"unchanged copy", NULL, NULL, SB_OK},
-        {"unknown format version", edit_version, NULL, SB_ERR_VERSION},
-        {"no format version", edit_no_version, NULL, SB_ERR_MISSING_FIELD},
-        {"file in the parent directory", edit_parent_path, NULL, SB_ERR_UNSAFE_PATH},
-        {"absolute file", edit_absolute_path, NULL, SB_ERR_UNSAFE_PATH},
-        {"hidden file", edit_hidden_path, NULL, SB_ERR_UNSAFE_PATH},
+        {"unchanged copy", NULL, NULL, SB_OK, false},
+        {"unknown format version", edit_version, NULL, SB_ERR_VERSION, false},
+        {"no format version", edit_no_version, NULL, SB_ERR_MISSING_FIELD, false},
+        {"file in the parent directory", edit_parent_path, NULL, SB_ERR_UNSAFE_PATH, false},
+        {"absolute file", edit_absolute_path, NULL, SB_ERR_UNSAFE_PATH, false},
+        {"hidden file", edit_hidden_path, NULL, SB_ERR_UNSAFE_PATH, false},
         {"artifact that is a symbolic link", NULL, "mv transmittance.exr t.exr && ln -s t.exr transmittance.exr",
-         SB_ERR_UNSAFE_PATH},
-        {"manifest that is a symbolic link", NULL, "mv manifest.json m && ln -s m manifest.json", SB_ERR_UNSAFE_PATH},
-        {"missing artifact", NULL, "rm multiscattering.exr", SB_ERR_IO},
-        {"recorded hash differs", edit_hash, NULL, SB_ERR_HASH_MISMATCH},
+         SB_ERR_UNSAFE_PATH, false},
+        {"manifest that is a symbolic link", NULL, "mv manifest.json m && ln -s m manifest.json", SB_ERR_UNSAFE_PATH, false},
+        {"missing artifact", NULL, "rm multiscattering.exr", SB_ERR_IO, false},
+        {"recorded hash differs", edit_hash, NULL, SB_ERR_HASH_MISMATCH, false},
         {"artifact replaced by another product's file", NULL, "cp irradiance_sky.exr irradiance_ground.exr",
-         SB_ERR_BAD_IMAGE},
-        {"truncated artifact", NULL, "head -c 3000 transmittance.exr > t && mv t transmittance.exr", SB_ERR_EXR},
-        {"one flipped byte in the compressed pixels", NULL,
-         "printf '\\x55' | dd of=multiscattering.exr bs=1 seek=$(( $(stat -c %s multiscattering.exr) - 40 )) "
-         "conv=notrunc 2>/dev/null",
-         SB_ERR_EXR},
-        {"width differs from the product's", edit_width, NULL, SB_ERR_BAD_IMAGE},
-        {"absurd height", edit_huge, NULL, SB_ERR_BAD_IMAGE},
-        {"channels of the wrong type", edit_channels, NULL, SB_ERR_WRONG_TYPE},
-        {"pixel type", edit_pixel_type, NULL, SB_ERR_BAD_IMAGE},
-        {"device without a name", edit_device, NULL, SB_ERR_MISSING_FIELD},
-        {"scene edited", edit_scene_value, NULL, SB_ERR_HASH_MISMATCH},
-        {"scene out of range", edit_scene_invalid, NULL, SB_ERR_OUT_OF_RANGE},
-        {"no scene", edit_no_scene, NULL, SB_ERR_MISSING_FIELD},
-        {"unknown product", edit_unknown, NULL, SB_ERR_UNKNOWN_PRODUCT},
-        {"product listed twice", edit_duplicate, NULL, SB_ERR_DUPLICATE_KEY},
+         SB_ERR_HASH_MISMATCH, false},
+        {"artifact replaced by another product's file, vouched for", NULL,
+         "cp irradiance_sky.exr irradiance_ground.exr", SB_ERR_BAD_IMAGE, true},
+        {"truncated artifact", NULL, "head -c 3000 transmittance.exr > t && mv t transmittance.exr",
+         SB_ERR_HASH_MISMATCH, false},
+        {"truncated artifact, vouched for", NULL, "head -c 3000 transmittance.exr > t && mv t transmittance.exr",
+         SB_ERR_EXR, true},
+        {"one flipped byte in the compressed pixels", NULL, FLIP_BYTE, SB_ERR_HASH_MISMATCH, false},
+        {"one flipped byte in the compressed pixels, vouched for", NULL, FLIP_BYTE, SB_ERR_EXR, true},
+        {"format version 1, as version 1 wrote it", edit_make_version_1,
+         "rm cloud_shape.vdb cloud_detail.vdb cloud_curl.exr weather.exr", SB_OK, false},
+        {"format version 1 listing cloud products", edit_version_1, NULL, SB_ERR_UNKNOWN_PRODUCT, false},
+        {"truncated volume", NULL, "head -c 3000 cloud_shape.vdb > t && mv t cloud_shape.vdb", SB_ERR_HASH_MISMATCH, false},
+        {"volume without a file hash", edit_no_file_hash, NULL, SB_ERR_MISSING_FIELD, false},
+        {"volume replaced by the other volume, vouched for", NULL, "cp cloud_detail.vdb cloud_shape.vdb",
+         SB_ERR_BAD_IMAGE, true},
+        {"volume replaced by an EXR, vouched for", NULL, "cp weather.exr cloud_detail.vdb", SB_ERR_VDB, true},
+        {"volume's depth differs from the scene's", edit_volume_depth, NULL, SB_ERR_BAD_IMAGE, false},
+        {"volume's pixel type", edit_volume_pixel_type, NULL, SB_ERR_BAD_IMAGE, false},
+        {"scene's cloud size edited", edit_cloud_size, NULL, SB_ERR_BAD_IMAGE, false},
+        {"width differs from the product's", edit_width, NULL, SB_ERR_BAD_IMAGE, false},
+        {"absurd height", edit_huge, NULL, SB_ERR_BAD_IMAGE, false},
+        {"channels of the wrong type", edit_channels, NULL, SB_ERR_WRONG_TYPE, false},
+        {"pixel type", edit_pixel_type, NULL, SB_ERR_BAD_IMAGE, false},
+        {"device without a name", edit_device, NULL, SB_ERR_MISSING_FIELD, false},
+        {"scene edited", edit_scene_value, NULL, SB_ERR_HASH_MISMATCH, false},
+        {"scene out of range", edit_scene_invalid, NULL, SB_ERR_OUT_OF_RANGE, false},
+        {"no scene", edit_no_scene, NULL, SB_ERR_MISSING_FIELD, false},
+        {"unknown product", edit_unknown, NULL, SB_ERR_UNKNOWN_PRODUCT, false},
+        {"product listed twice", edit_duplicate, NULL, SB_ERR_DUPLICATE_KEY, false},
         {"manifest is binary garbage", NULL, "printf '\\211PNG\\r\\n\\032\\n\\000\\377{[' > manifest.json",
-         SB_ERR_JSON_SYNTAX},
+         SB_ERR_JSON_SYNTAX, false},
         {"manifest is a truncated object", NULL, "head -c 200 manifest.json > m && mv m manifest.json",
-         SB_ERR_JSON_SYNTAX},
-        {"manifest is empty", NULL, ": > manifest.json", SB_ERR_JSON_SYNTAX},
+         SB_ERR_JSON_SYNTAX, false},
+        {"manifest is empty", NULL, ": > manifest.json", SB_ERR_JSON_SYNTAX, false},
         {"manifest over 1 MiB", NULL, "head -c 1100000 /dev/zero | tr '\\\\0' ' ' >> manifest.json",
-         SB_ERR_OUT_OF_RANGE},
-        {"no manifest", NULL, "rm manifest.json", SB_ERR_IO},
-        {"file the manifest does not list", NULL, "echo x > notes.txt", SB_ERR_UNLISTED_FILE},
-        {"directory the manifest does not list", NULL, "mkdir sub", SB_ERR_UNLISTED_FILE},
-        {"another format", edit_format, NULL, SB_ERR_VERSION},
-        {"artifacts not an array", edit_artifacts_type, NULL, SB_ERR_WRONG_TYPE},
-        {"artifact entry not an object", edit_artifact_number, NULL, SB_ERR_WRONG_TYPE},
+         SB_ERR_OUT_OF_RANGE, false},
+        {"no manifest", NULL, "rm manifest.json", SB_ERR_IO, false},
+        {"file the manifest does not list", NULL, "echo x > notes.txt", SB_ERR_UNLISTED_FILE, false},
+        {"directory the manifest does not list", NULL, "mkdir sub", SB_ERR_UNLISTED_FILE, false},
+        {"another format", edit_format, NULL, SB_ERR_VERSION, false},
+        {"artifacts not an array", edit_artifacts_type, NULL, SB_ERR_WRONG_TYPE, false},
+        {"artifact entry not an object", edit_artifact_number, NULL, SB_ERR_WRONG_TYPE, false},
         {"key given twice in the manifest", NULL, "sed -i '0,/\"skybake_version\"/s//\"skybake_version\": \"x\", \"skybake_version\"/' manifest.json",
-         SB_ERR_DUPLICATE_KEY},
-        {"artifact holding NaN", NULL, "cp ../nan.exr multiscattering.exr", SB_ERR_NUMERIC},
-        {"pack directory replaced by a file", NULL, "cd .. && rm -rf bad && echo x > bad", SB_ERR_IO},
+         SB_ERR_DUPLICATE_KEY, false},
+        {"artifact holding NaN", NULL, "cp ../nan.exr multiscattering.exr", SB_ERR_HASH_MISMATCH, false},
+        {"artifact holding NaN, vouched for", NULL, "cp ../nan.exr multiscattering.exr", SB_ERR_NUMERIC, true},
+        {"pack directory replaced by a file", NULL, "cd .. && rm -rf bad && echo x > bad", SB_ERR_IO, false},
     };
     for (size_t i = 0; i < sizeof(cases) / sizeof(cases[0]); i++) {
-        enum sb_result got = open_edited(good, bad, cases[i].edit, cases[i].shell);
+        enum sb_result got = open_edited(good, bad, cases[i].edit, cases[i].shell, cases[i].restamp);
         CHECK(got == cases[i].expect, "pack with %s: got %s, expected %s", cases[i].what, sb_result_name(got),
               sb_result_name(cases[i].expect));
     }
     /* verify goes on past each problem: three of them, each counted. */
-    open_edited(good, bad, edit_hash, "rm irradiance_ground.exr && echo x > notes.txt");
+    open_edited(good, bad, edit_hash, "rm irradiance_ground.exr && echo x > notes.txt", false);
     unsigned problems = 0;
     enum sb_result got_code = sb_pack_verify(bad, &problems);
     CHECK(got_code == SB_ERR_HASH_MISMATCH && problems == 3, "verify of a pack with three problems: %s, %u problems",
@@ -401,7 +682,7 @@ static void test_pack_reader(void)
           problems);
 
     /* A well-formed EXR whose pixels differ from what the manifest recorded. */
-    open_edited(good, bad, NULL, NULL);
+    open_edited(good, bad, NULL, NULL, false);
     char path[512];
     snprintf(path, sizeof(path), "%s/transmittance.exr", bad);
     struct sb_image t;
@@ -409,10 +690,39 @@ static void test_pack_reader(void)
     t.data[7] = nextafterf(t.data[7], 2.0f);
     CHECK(sb_exr_write(path, &t, NULL, 0) == SB_OK, "rewrite");
     sb_image_finish(&t);
+    restamp_dir = bad;
+    edit_manifest(bad, edit_restamp);
     pack = calloc(1, sizeof(*pack));
     enum sb_result got = sb_pack_open(bad, pack);
     CHECK(got == SB_ERR_HASH_MISMATCH, "one ulp changed in a pixel: got %s", sb_result_name(got));
     CHECK(!pack->present[0] && !pack->images[0].data, "a refused pack is left empty");
+
+    /* A well-formed VDB whose values differ by one half-ulp, vouched for. */
+    open_edited(good, bad, NULL, NULL, false);
+    snprintf(path, sizeof(path), "%s/cloud_shape.vdb", bad);
+    const char *shape_channels = sb_product_format(SB_PRODUCT_CLOUD_SHAPE)->channel_names;
+    CHECK(sb_vdb_read(path, shape_channels, 0, &t, NULL, NULL) == SB_OK, "read the volume");
+    t.data[100] = sb_half_to_float((uint16_t)(sb_half_from_float(t.data[100]) + 1));
+    CHECK(sb_vdb_write(path, &t, NULL, 0) == SB_OK, "rewrite the volume");
+    sb_image_finish(&t);
+    edit_manifest(bad, edit_restamp);
+    got = sb_pack_open(bad, pack);
+    CHECK(got == SB_ERR_HASH_MISMATCH, "one half-ulp changed in a voxel: got %s", sb_result_name(got));
+
+    /* Every truncated prefix of a volume is refused by its file hash before
+     * OpenVDB sees a byte (its reader is not hardened against such files). */
+    open_edited(good, bad, NULL, NULL, false);
+    struct stat st;
+    CHECK(stat(path, &st) == 0, "the volume's size");
+    unsigned refused = 0, prefixes = 0;
+    for (off_t n = 0; n < st.st_size; n += st.st_size / 97 + 1, prefixes++) {
+        char cmd[2048];
+        snprintf(cmd, sizeof(cmd), "cp '%s/cloud_shape.vdb' '%s/t' && truncate -s %lld '%s/t' && mv '%s/t' '%s'",
+                 good, bad, (long long)n, bad, bad, path);
+        run(cmd);
+        refused += sb_pack_open(bad, pack) == SB_ERR_HASH_MISMATCH;
+    }
+    CHECK(refused == prefixes, "%u of %u truncated volumes refused with hash-mismatch", refused, prefixes);
     free(pack);
 
     char cmd[512];
@@ -441,6 +751,8 @@ int main(void)
         sb_log_set_sink(quiet, NULL);
     test_result_codes();
     test_exr_round_trip();
+    test_half();
+    test_vdb();
     test_scenes();
     test_pack_reader();
     return test_finish("formats");

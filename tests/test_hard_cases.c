@@ -157,7 +157,7 @@ static double known_limit(const char *scene, enum sb_product_id id)
 
 static void check_reference(const char *name, const struct baked *b)
 {
-    for (int p = 0; p < SB_PRODUCT_COUNT; p++) {
+    for (int p = 0; p < SB_ATMOSPHERE_PRODUCT_COUNT; p++) {
         enum sb_product_id id = (enum sb_product_id)p;
         struct sb_accuracy_ref *ref = NULL;
         enum sb_result res = sb_accuracy_ref_create(&b->params, id, SB_ACCURACY_SPARSE, 0, 0, b->luts, &ref);
@@ -223,7 +223,7 @@ static bool bake_all(struct sb_vk *vk, const char *name, struct baked *b)
 {
     struct sb_atmosphere_baker *baker = NULL;
     bool ok = sb_atmosphere_baker_create(vk, &b->params, &baker) == SB_OK;
-    for (int p = 0; p < SB_PRODUCT_COUNT && ok; p++) {
+    for (int p = 0; p < SB_ATMOSPHERE_PRODUCT_COUNT && ok; p++) {
         enum sb_product_id id = (enum sb_product_id)p;
         ok = sb_atmosphere_bake(baker, id, NULL, &b->luts[p], NULL, NULL) == SB_OK;
         CHECK(ok, "%s: baking %s", name, sb_product_name(id));
@@ -278,7 +278,7 @@ int main(int argc, char **argv)
                 continue;
             check_transmittance_shape(names[i], &b->luts[SB_PRODUCT_TRANSMITTANCE]);
             check_transmittance_rays(names[i], &b->params, &b->luts[SB_PRODUCT_TRANSMITTANCE]);
-            for (int p = SB_PRODUCT_MULTISCATTERING; p < SB_PRODUCT_COUNT; p++)
+            for (int p = SB_PRODUCT_MULTISCATTERING; p < SB_ATMOSPHERE_PRODUCT_COUNT; p++)
                 check_non_negative(names[i], (enum sb_product_id)p, &b->luts[p]);
             check_reference(names[i], b);
         }

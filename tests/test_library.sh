@@ -25,12 +25,15 @@ check "the example builds against the static library" \
 check "the shared build links libskybake-formats.so" sh -c "ldd '$tmp/example_shared' | grep -q 'libskybake-formats.so'"
 check "the static build does not" sh -c "! ldd '$tmp/example_static' | grep -q 'libskybake-formats.so'"
 
-printf '{"atmosphere":{"preset":"earth"},"products":["transmittance"]}' >"$tmp/t.json"
+printf '{"atmosphere":{"preset":"earth"},"products":["transmittance","cloud_detail"],%s}' \
+    '"clouds":{"cloud_detail":{"size":16,"worley_cells":[1,2,4]}}' >"$tmp/t.json"
 check "bake a pack" expect_exit 0 "$skybake" bake "$tmp/t.json" -o "$tmp/pack" -q
-hash=$(sed -n 's/.*"content_hash":[[:space:]]*"\([0-9a-f]*\)".*/\1/p' "$tmp/pack/manifest.json")
+hash=$(sed -n 's/.*"content_hash":[[:space:]]*"\([0-9a-f]*\)".*/\1/p' "$tmp/pack/manifest.json" | head -n 1)
+volume_hash=$(sed -n 's/.*"content_hash":[[:space:]]*"\([0-9a-f]*\)".*/\1/p' "$tmp/pack/manifest.json" | tail -n 1)
 for kind in shared static; do
     check "the $kind example loads the pack" expect_exit 0 env LD_LIBRARY_PATH="$build/formats" "$tmp/example_$kind" "$tmp/pack"
-    check "the $kind example reads the transmittance" grep -q "^transmittance 256x64 x3 first value 0\.[0-9]* hash $hash" "$tmp/out"
+    check "the $kind example reads the transmittance" grep -q "^transmittance 256x64x1 x3 first value 0\.[0-9]* hash $hash" "$tmp/out"
+    check "the $kind example reads the volume (OpenVDB)" grep -q "^cloud_detail 16x16x16 x3 first value 0\.[0-9]* hash $volume_hash" "$tmp/out"
 done
 echo x >"$tmp/pack/stray"
 check "the example refuses a pack that does not verify" expect_exit 1 env LD_LIBRARY_PATH="$build/formats" "$tmp/example_shared" "$tmp/pack"

@@ -21,8 +21,10 @@ enum sb_result sb_buffer_create(struct sb_vk *vk, VkDeviceSize size, const char 
     VkMemoryRequirements req;
     vkGetBufferMemoryRequirements(vk->device, b->buffer, &req);
     const VkMemoryPropertyFlags host = VK_MEMORY_PROPERTY_HOST_VISIBLE_BIT | VK_MEMORY_PROPERTY_HOST_COHERENT_BIT;
-    if ((res = sb_vk_allocate(vk, &req, host, VK_MEMORY_PROPERTY_DEVICE_LOCAL_BIT, name, &b->memory)))
+    VkMemoryPropertyFlags flags = 0;
+    if ((res = sb_vk_allocate(vk, &req, host, VK_MEMORY_PROPERTY_DEVICE_LOCAL_BIT, name, &b->memory, &flags)))
         goto cleanup;
+    b->host_cached = flags & VK_MEMORY_PROPERTY_HOST_CACHED_BIT;
     VK(vkBindBufferMemory(vk->device, b->buffer, b->memory, 0));
     VK(vkMapMemory(vk->device, b->memory, 0, VK_WHOLE_SIZE, 0, &b->mapped));
     memset(b->mapped, 0, size);
@@ -31,6 +33,67 @@ enum sb_result sb_buffer_create(struct sb_vk *vk, VkDeviceSize size, const char 
 
 cleanup:
     sb_buffer_destroy(vk, b);
+    return res;
+}
+
+enum sb_result sb_buffer_read(struct sb_vk *vk, const struct sb_buffer *b, void *out)
+{
+    if (b->host_cached) {
+        memcpy(out, b->mapped, b->size);
+        return SB_OK;
+    }
+    enum sb_result res = SB_OK;
+    VkBuffer staging = VK_NULL_HANDLE;
+    VkDeviceMemory memory = VK_NULL_HANDLE;
+    VkCommandBuffer cmd = VK_NULL_HANDLE;
+    void *mapped = NULL;
+    VkBufferCreateInfo info = {
+        .sType = VK_STRUCTURE_TYPE_BUFFER_CREATE_INFO,
+        .size = b->size,
+        .usage = VK_BUFFER_USAGE_TRANSFER_DST_BIT,
+        .sharingMode = VK_SHARING_MODE_EXCLUSIVE,
+    };
+    VK(vkCreateBuffer(vk->device, &info, NULL, &staging));
+    sb_vk_name(vk, VK_OBJECT_TYPE_BUFFER, (uint64_t)staging, "readback");
+    VkMemoryRequirements req;
+    vkGetBufferMemoryRequirements(vk->device, staging, &req);
+    VkMemoryPropertyFlags flags = 0;
+    if ((res = sb_vk_allocate(vk, &req, VK_MEMORY_PROPERTY_HOST_VISIBLE_BIT | VK_MEMORY_PROPERTY_HOST_COHERENT_BIT,
+                              VK_MEMORY_PROPERTY_HOST_CACHED_BIT, "readback", &memory, &flags)))
+        goto cleanup;
+    if (!(flags & VK_MEMORY_PROPERTY_HOST_CACHED_BIT)) {
+        /* No cached type: the staging copy would be as slow to read. */
+        memcpy(out, b->mapped, b->size);
+        goto cleanup;
+    }
+    VK(vkBindBufferMemory(vk->device, staging, memory, 0));
+    VK(vkMapMemory(vk->device, memory, 0, VK_WHOLE_SIZE, 0, &mapped));
+    if ((res = sb_vk_begin_once(vk, &cmd)))
+        goto cleanup;
+    VkMemoryBarrier before = {
+        .sType = VK_STRUCTURE_TYPE_MEMORY_BARRIER,
+        .srcAccessMask = VK_ACCESS_SHADER_WRITE_BIT | VK_ACCESS_HOST_WRITE_BIT,
+        .dstAccessMask = VK_ACCESS_TRANSFER_READ_BIT,
+    };
+    vkCmdPipelineBarrier(cmd, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT | VK_PIPELINE_STAGE_HOST_BIT,
+                         VK_PIPELINE_STAGE_TRANSFER_BIT, 0, 1, &before, 0, NULL, 0, NULL);
+    vkCmdCopyBuffer(cmd, b->buffer, staging, 1, &(VkBufferCopy){.size = b->size});
+    VkMemoryBarrier after = {
+        .sType = VK_STRUCTURE_TYPE_MEMORY_BARRIER,
+        .srcAccessMask = VK_ACCESS_TRANSFER_WRITE_BIT,
+        .dstAccessMask = VK_ACCESS_HOST_READ_BIT,
+    };
+    vkCmdPipelineBarrier(cmd, VK_PIPELINE_STAGE_TRANSFER_BIT, VK_PIPELINE_STAGE_HOST_BIT, 0, 1, &after, 0, NULL, 0,
+                         NULL);
+    if ((res = sb_vk_end_once(vk, cmd)))
+        goto cleanup;
+    memcpy(out, mapped, b->size);
+
+cleanup:
+    if (staging)
+        vkDestroyBuffer(vk->device, staging, NULL);
+    if (memory)
+        vkFreeMemory(vk->device, memory, NULL);
     return res;
 }
 

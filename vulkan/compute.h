@@ -2,11 +2,13 @@
  * Storage buffers and compute pipelines on an sb_vk context, and timed,
  * synchronous dispatches. Buffers live in memory the host can map (device
  * local where the device offers such a type), which is right for the small
- * LUTs skybake bakes; all functions are for one thread at a time.
+ * LUTs skybake bakes; large results are read back with sb_buffer_read. All
+ * functions are for one thread at a time.
  */
 #ifndef SB_VK_COMPUTE_H
 #define SB_VK_COMPUTE_H
 
+#include <stdbool.h>
 #include <stddef.h>
 #include <stdint.h>
 
@@ -16,13 +18,23 @@ struct sb_buffer {
     VkBuffer buffer;
     VkDeviceMemory memory;
     VkDeviceSize size;
-    void *mapped; /* persistently mapped, coherent */
+    void *mapped;     /* persistently mapped, coherent */
+    bool host_cached; /* the host reads `mapped` at memory speed */
 };
 
 /* A zero-filled storage buffer of `size` bytes (> 0). */
 enum sb_result sb_buffer_create(struct sb_vk *vk, VkDeviceSize size, const char *name, struct sb_buffer *buffer);
 /* Free a buffer; accepts a zeroed one. */
 void sb_buffer_destroy(struct sb_vk *vk, struct sb_buffer *buffer);
+
+/*
+ * Copy the whole buffer into `out` (buffer->size bytes), after the work
+ * submitted so far. Device-local memory that the host can map is uncached:
+ * reading it directly crawls over the bus (1.5 s for 32 MB on an H200), so
+ * unless the buffer's memory is cached on the host, the device copies it
+ * into a cached staging buffer first.
+ */
+enum sb_result sb_buffer_read(struct sb_vk *vk, const struct sb_buffer *buffer, void *out);
 
 struct sb_pipeline {
     VkDescriptorSetLayout set_layout;

@@ -316,7 +316,8 @@ static int memory_type(const struct sb_vk *vk, uint32_t type_bits, VkMemoryPrope
 }
 
 enum sb_result sb_vk_allocate(struct sb_vk *vk, const VkMemoryRequirements *req, VkMemoryPropertyFlags required,
-                              VkMemoryPropertyFlags preferred, const char *name, VkDeviceMemory *memory)
+                              VkMemoryPropertyFlags preferred, const char *name, VkDeviceMemory *memory,
+                              VkMemoryPropertyFlags *flags)
 {
     enum sb_result res = SB_OK;
     *memory = VK_NULL_HANDLE;
@@ -333,6 +334,8 @@ enum sb_result sb_vk_allocate(struct sb_vk *vk, const VkMemoryRequirements *req,
         .memoryTypeIndex = (uint32_t)type,
     };
     VK(vkAllocateMemory(vk->device, &alloc, NULL, memory));
+    if (flags)
+        *flags = vk->memory_properties.memoryTypes[type].propertyFlags;
 cleanup:
     return res;
 }

@@ -68,11 +68,13 @@ enum sb_result sb_vk_end_once(struct sb_vk *vk, VkCommandBuffer cmd);
 
 /*
  * Allocate memory for `req`: of a type with every flag of `required` and,
- * where one exists, of `preferred` too. SB_ERR_VULKAN, naming `name`, when
- * no type qualifies or the allocation fails.
+ * where one exists, of `preferred` too; *flags (may be NULL) receives the
+ * chosen type's. SB_ERR_VULKAN, naming `name`, when no type qualifies or
+ * the allocation fails.
  */
 enum sb_result sb_vk_allocate(struct sb_vk *vk, const VkMemoryRequirements *req, VkMemoryPropertyFlags required,
-                              VkMemoryPropertyFlags preferred, const char *name, VkDeviceMemory *memory);
+                              VkMemoryPropertyFlags preferred, const char *name, VkDeviceMemory *memory,
+                              VkMemoryPropertyFlags *flags);
 
 /* Name, driver and ids of the device, for manifests. */
 void sb_vk_device_info(const struct sb_vk *vk, struct sb_device_info *info);

@@ -41,7 +41,7 @@ enum sb_result sb_texture_create(struct sb_vk *vk, const struct sb_texture_param
     sb_vk_name(vk, VK_OBJECT_TYPE_IMAGE, (uint64_t)t->image, params->name);
     VkMemoryRequirements req;
     vkGetImageMemoryRequirements(vk->device, t->image, &req);
-    if ((res = sb_vk_allocate(vk, &req, 0, VK_MEMORY_PROPERTY_DEVICE_LOCAL_BIT, params->name, &t->memory)))
+    if ((res = sb_vk_allocate(vk, &req, 0, VK_MEMORY_PROPERTY_DEVICE_LOCAL_BIT, params->name, &t->memory, NULL)))
         goto cleanup;
     VK(vkBindImageMemory(vk->device, t->image, t->memory, 0));
 

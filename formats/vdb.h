@@ -1,0 +1,68 @@
+/*
+ * OpenVDB files of skybake volumes, through the one C++ file of skybake
+ * (vdb.cpp), since OpenVDB has no C API.
+ *
+ * A volume of C channels is C FloatGrids (VDB has no 4-vector grid), each
+ * named after its channel, in channel order:
+ * - class fog volume, background 0;
+ * - dense: every voxel of the volume is active and stored in its leaf node;
+ *   nothing is pruned to tiles, whatever the values;
+ * - voxel (i, j, k) = texel (x, y, z); the index-to-world transform scales by
+ *   1 / N per axis and shifts by half a voxel, so that world coordinates are
+ *   the texture's coordinates in [0, 1)^3 (voxel centres at (i + 0.5) / N);
+ * - stored as binary16 ("save float as half"), Blosc-compressed with the
+ *   active mask;
+ * - string metadata: the `attributes` (skybake.product, .format_version,
+ *   .content_hash, .parameterization) on every grid and on the file.
+ * The file's UUID, which OpenVDB draws at random, is derived from the
+ * volume's content hash and the attributes, so that the same volume always
+ * gives the same bytes.
+ */
+#ifndef SB_VDB_H
+#define SB_VDB_H
+
+#include <stdint.h>
+
+#include "image.h"
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+/*
+ * Write `volume` to `path` (created or replaced). Every value must already
+ * be a binary16 value (sb_image_round_to_half): the file stores binary16,
+ * and a value that is not one is refused (SB_ERR_NUMERIC) rather than
+ * silently changed. Returns SB_OK, SB_ERR_IO (naming the system's reason),
+ * SB_ERR_VDB or SB_ERR_NUMERIC, logging the path and the reason.
+ * Thread-safe.
+ */
+enum sb_result sb_vdb_write(const char *path, const struct sb_image *volume, const struct sb_attribute *attributes,
+                            int attribute_count);
+
+/*
+ * Read a file written by sb_vdb_write into `volume` (fp32, exact: binary16
+ * values widened). The grids must be the channels named in channel_order
+ * ("r,g,b"), in that order, and nothing else; each a dense fog-volume
+ * FloatGrid stored as half whose active voxels are exactly the box from the
+ * origin to the volume's size, the same for every grid. Files larger than
+ * 1 GiB, and volumes of more than max_voxels voxels (0: 2^28), are refused
+ * before their grids are read. String metadata whose names start with
+ * "skybake." (the first grid's, which every grid must repeat) are returned
+ * in `attributes` (may be NULL; at most SB_FILE_MAX_ATTRIBUTES).
+ * Returns SB_OK, SB_ERR_IO, SB_ERR_VDB (OpenVDB refused the file) or
+ * SB_ERR_BAD_IMAGE (a file that is not such a volume), logging the path and
+ * the reason; *volume is then empty. Thread-safe.
+ *
+ * OpenVDB's reader is not hardened against hostile files: read only files
+ * whose bytes are vouched for (a pack checks each file's hash before its
+ * grids are parsed; docs/pack.md).
+ */
+enum sb_result sb_vdb_read(const char *path, const char *channel_order, uint64_t max_voxels, struct sb_image *volume,
+                           struct sb_attribute *attributes, int *attribute_count);
+
+#ifdef __cplusplus
+}
+#endif
+
+#endif
