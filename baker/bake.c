@@ -110,7 +110,8 @@ static void add_error_json(char *json, size_t size, double tolerance, const stru
 #if defined(__GNUC__)
 __attribute__((format(printf, 4, 5)))
 #endif
-static void key_add(char *text, size_t size, size_t *n, const char *fmt, ...)
+static void
+key_add(char *text, size_t size, size_t *n, const char *fmt, ...)
 {
     va_list ap;
     va_start(ap, fmt);
@@ -151,8 +152,8 @@ static void key_cloud(enum sb_product_id id, const struct sb_cloud_params *param
 {
     struct sb_noise_push pc;
     sb_cloud_recipe(id, params, &pc);
-    key_add(text, size, n, " size=%u,%u,%u inv=%a,%a,%a slice_z=%a", pc.size_x, pc.size_y, pc.size_z,
-            (double)pc.inv_x, (double)pc.inv_y, (double)pc.inv_z, (double)pc.slice_z);
+    key_add(text, size, n, " size=%u,%u,%u inv=%a,%a,%a slice_z=%a", pc.size_x, pc.size_y, pc.size_z, (double)pc.inv_x,
+            (double)pc.inv_y, (double)pc.inv_z, (double)pc.slice_z);
     for (uint32_t c = 0; c < pc.channel_count; c++)
         key_add(text, size, n, " channel%u=%u,%u,%u,%u,%u", c, pc.kind[c], pc.a[c], pc.b[c], pc.c[c], pc.seed[c]);
     char code[SB_HASH_HEX_SIZE];

@@ -390,9 +390,9 @@ static cJSON *report_json(const struct sb_bench_report *report, const struct sb_
             const struct sb_bench_cloud_row *r = &report->cloud_rows[i];
             cJSON *o = cJSON_CreateObject();
             cJSON_AddStringToObject(o, "product", sb_product_name(r->product));
-            cJSON_AddItemToObject(o, "shape", cJSON_CreateIntArray((const int[]){(int)r->shape[0], (int)r->shape[1],
-                                                                                 (int)r->shape[2]},
-                                                                   3));
+            cJSON_AddItemToObject(
+                o, "shape",
+                cJSON_CreateIntArray((const int[]){(int)r->shape[0], (int)r->shape[1], (int)r->shape[2]}, 3));
             cJSON_AddNumberToObject(o, "channels", r->channel_count);
             cJSON_AddNumberToObject(o, "gpu_ms", r->gpu_ms);
             cJSON_AddNumberToObject(o, "gpu_ms_min", r->gpu_ms_min);
@@ -440,8 +440,8 @@ void sb_bench_print(const struct sb_bench_report *report, const struct sb_vk *vk
         const struct sb_bench_cloud_row *r = &report->cloud_rows[i];
         char size[48];
         snprintf(size, sizeof(size), "%ux%ux%u", r->shape[0], r->shape[1], r->shape[2]);
-        printf("  %-14s %-12s %11.4f %11.4f %14.1f %9.1f  %llu of %llu\n", sb_product_name(r->product), size,
-               r->gpu_ms, r->gpu_ms_min, r->reference_ms, r->reference_ms / fmax(r->gpu_ms, 1e-9),
+        printf("  %-14s %-12s %11.4f %11.4f %14.1f %9.1f  %llu of %llu\n", sb_product_name(r->product), size, r->gpu_ms,
+               r->gpu_ms_min, r->reference_ms, r->reference_ms / fmax(r->gpu_ms, 1e-9),
                (unsigned long long)r->differing, (unsigned long long)r->values);
         gpu += r->gpu_ms;
         ref += r->reference_ms;

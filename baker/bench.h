@@ -52,8 +52,8 @@ struct sb_bench_row {
 struct sb_bench_cloud_row {
     enum sb_product_id product;
     uint32_t shape[3], channel_count;
-    double gpu_ms, gpu_ms_min; /* median, min over the repeats */
-    double reference_ms;       /* sb_cloud_ref over every texel, one thread */
+    double gpu_ms, gpu_ms_min;  /* median, min over the repeats */
+    double reference_ms;        /* sb_cloud_ref over every texel, one thread */
     uint64_t values, differing; /* the GPU's values against the reference's */
 };
 
@@ -61,8 +61,8 @@ struct sb_bench_params {
     bool sweeps[SB_BENCH_SWEEP_COUNT]; /* which to run */
     bool clouds[SB_PRODUCT_COUNT];     /* which cloud products to time */
     struct sb_cloud_params cloud_params;
-    int repeat;                        /* bakes per setting; the median is reported */
-    bool quick;                        /* only the settings marked quick (meson's benchmark) */
+    int repeat; /* bakes per setting; the median is reported */
+    bool quick; /* only the settings marked quick (meson's benchmark) */
 };
 
 struct sb_bench_report {

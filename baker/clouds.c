@@ -67,8 +67,7 @@ void sb_cloud_recipe(enum sb_product_id product, const struct sb_cloud_params *p
         break;
     default:
         channel(pc, SB_NOISE_PERLIN_FBM, params->coverage.period, params->coverage.octaves, 1, seed + 8000u);
-        channel(pc, SB_NOISE_PERLIN_FBM, params->precipitation.period, params->precipitation.octaves, 1,
-                seed + 8032u);
+        channel(pc, SB_NOISE_PERLIN_FBM, params->precipitation.period, params->precipitation.octaves, 1, seed + 8032u);
         channel(pc, SB_NOISE_PERLIN_FBM, params->cloud_type.period, params->cloud_type.octaves, 0, seed + 8064u);
         break;
     }
@@ -98,9 +97,8 @@ void sb_cloud_recipe_json(const struct sb_noise_push *pc, char *out, size_t size
             break;
         default:
             n += (size_t)snprintf(out + n, size - n,
-                                  "%s{\"noise\":\"%s\",\"period\":%u,\"octaves\":%u,\"stretched\":%s,\"seed\":%u}",
-                                  sep, kinds[pc->kind[i] & 3], pc->a[i], pc->b[i], pc->c[i] ? "true" : "false",
-                                  pc->seed[i]);
+                                  "%s{\"noise\":\"%s\",\"period\":%u,\"octaves\":%u,\"stretched\":%s,\"seed\":%u}", sep,
+                                  kinds[pc->kind[i] & 3], pc->a[i], pc->b[i], pc->c[i] ? "true" : "false", pc->seed[i]);
             break;
         }
     }

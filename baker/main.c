@@ -20,8 +20,8 @@
 #include "log.h"
 #include "pack_tools.h"
 #include "scene.h"
-#include "skybake_version.h"
 #include "sky_error.h"
+#include "skybake_version.h"
 
 enum {
     EXIT_BAKE_FAILED = 1,
@@ -460,8 +460,10 @@ static int cmd_diff(int argc, char **argv)
             sb_error("%s: not a valid pack; run skybake verify %s for every problem", dirs[i], dirs[i]);
             goto done;
         }
-    static const int codes[] = {[SB_DIFF_IDENTICAL] = 0, [SB_DIFF_WITHIN] = EXIT_DIFF_WITHIN,
-                                [SB_DIFF_DIFFERENT] = EXIT_DIFF_DIFFERENT, [SB_DIFF_MISSING] = EXIT_DIFF_MISSING};
+    static const int codes[] = {[SB_DIFF_IDENTICAL] = 0,
+                                [SB_DIFF_WITHIN] = EXIT_DIFF_WITHIN,
+                                [SB_DIFF_DIFFERENT] = EXIT_DIFF_DIFFERENT,
+                                [SB_DIFF_MISSING] = EXIT_DIFF_MISSING};
     enum sb_diff_outcome worst = sb_pack_diff(&packs[0], &packs[1], tolerance, floor, diffs);
     sb_pack_diff_print(&packs[0], dirs[0], &packs[1], dirs[1], tolerance, floor, diffs, json);
     rc = codes[worst];

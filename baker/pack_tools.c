@@ -142,7 +142,8 @@ double sb_diff_relative(double a, double b, double peak, double floor)
 static void diff_images(const struct sb_image *a, const struct sb_image *b, double tolerance, double floor,
                         struct sb_artifact_diff *d)
 {
-    if (a->width != b->width || a->height != b->height || a->depth != b->depth || a->channel_count != b->channel_count) {
+    if (a->width != b->width || a->height != b->height || a->depth != b->depth ||
+        a->channel_count != b->channel_count) {
         d->outcome = SB_DIFF_DIFFERENT;
         return;
     }

@@ -116,7 +116,7 @@ uint16_t sb_half_from_float(float value)
     uint16_t sign = (uint16_t)((bits >> 16) & 0x8000u);
     uint32_t magnitude = bits & 0x7fffffffu;
     if (magnitude > 0x7f800000u)
-        return sign | 0x7e00u; /* NaN, quiet */
+        return sign | 0x7e00u;                                /* NaN, quiet */
     int32_t exponent = (int32_t)(magnitude >> 23) - 127 + 15; /* the half's biased exponent */
     uint32_t mantissa = magnitude & 0x7fffffu;
     if (exponent >= 31)

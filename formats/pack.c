@@ -29,8 +29,8 @@ static const struct sb_product_format product_formats[SB_PRODUCT_COUNT] = {
                                   SB_TRANSMITTANCE_CHANNELS, "r,g,b", "transmittance-hillaire2020-v1", 1,
                                   SB_STORAGE_EXR_FLOAT32, "float32", "exr"},
     [SB_PRODUCT_MULTISCATTERING] = {"multiscattering", SB_MULTISCATTERING_SIZE, SB_MULTISCATTERING_SIZE, 1,
-                                    SB_MULTISCATTERING_CHANNELS, "r,g,b", "multiscattering-hillaire2020-subtexel-v1",
-                                    1, SB_STORAGE_EXR_FLOAT32, "float32", "exr"},
+                                    SB_MULTISCATTERING_CHANNELS, "r,g,b", "multiscattering-hillaire2020-subtexel-v1", 1,
+                                    SB_STORAGE_EXR_FLOAT32, "float32", "exr"},
     [SB_PRODUCT_IRRADIANCE_GROUND] = {"irradiance_ground", SB_IRRADIANCE_WIDTH, SB_IRRADIANCE_HEIGHT, 1,
                                       SB_IRRADIANCE_GROUND_CHANNELS, "direct.r,direct.g,direct.b,sky.r,sky.g,sky.b",
                                       "irradiance-bruneton2017-subtexel-v1", 1, SB_STORAGE_EXR_FLOAT32, "float32",
@@ -110,8 +110,8 @@ bool sb_product_from_name(const char *name, enum sb_product_id *id)
 struct sb_pack_writer {
     char out_dir[4000];
     char tmp_dir[4096];
-    int tmp_fd;                   /* the temporary directory, for removing it from a signal handler */
-    const char *volatile pending; /* the file being written, not yet an artifact */
+    int tmp_fd;                       /* the temporary directory, for removing it from a signal handler */
+    const char *volatile pending;     /* the file being written, not yet an artifact */
     volatile sig_atomic_t publishing; /* renaming into place: the signal handler leaves it alone */
     int artifact_count;
     struct sb_artifact artifacts[PACK_MAX_ARTIFACTS];
@@ -559,8 +559,7 @@ static enum sb_result manifest_expect_int(const cJSON *object, const char *key, 
     if (!item)
         return res;
     if (item->valuedouble != (double)expect) {
-        sb_error("%s: %s%s: %s has %u, the manifest says %g", source, where, key, product, expect,
-                 item->valuedouble);
+        sb_error("%s: %s%s: %s has %u, the manifest says %g", source, where, key, product, expect, item->valuedouble);
         return SB_ERR_BAD_IMAGE;
     }
     return SB_OK;
@@ -584,8 +583,7 @@ static enum sb_result read_artifact_entry(const cJSON *entry, int index, struct 
         return res;
     enum sb_product_id id;
     if (!sb_product_from_name(name, &id) || sb_product_format(id)->since_version > pack->format_version) {
-        sb_error("%s: %sname: \"%s\" is not a product of format version %d", source, where, name,
-                 pack->format_version);
+        sb_error("%s: %sname: \"%s\" is not a product of format version %d", source, where, name, pack->format_version);
         return SB_ERR_UNKNOWN_PRODUCT;
     }
     if (pack->present[id]) {
@@ -602,9 +600,16 @@ static enum sb_result read_artifact_entry(const cJSON *entry, int index, struct 
                                where)))
         return res;
     /* Version 2 on: the file's bytes are checked before they are parsed. */
-    if (pack->format_version >= 2 || cJSON_GetObjectItemCaseSensitive(entry, "file_hash"))
+    if (pack->format_version >= 2 || cJSON_GetObjectItemCaseSensitive(entry, "file_hash")) {
         if ((res = manifest_string(entry, "file_hash", a->file_hash, sizeof(a->file_hash), source, where)))
             return res;
+        if (strlen(a->file_hash) != SB_HASH_HEX_SIZE - 1 ||
+            strspn(a->file_hash, "0123456789abcdef") != SB_HASH_HEX_SIZE - 1) {
+            sb_error("%s: %sfile_hash: \"%s\" is not 32 lowercase hex digits", source, where, a->file_hash);
+            a->file_hash[0] = '\0';
+            return SB_ERR_OUT_OF_RANGE;
+        }
+    }
     if (!a->file[0] || strchr(a->file, '/') || a->file[0] == '.') {
         sb_error("%s: %sfile: \"%s\" is not a plain file name inside the pack; refused", source, where, a->file);
         return SB_ERR_UNSAFE_PATH;
@@ -882,8 +887,8 @@ static enum sb_result pack_read(const char *dir, struct sb_pack *pack, unsigned 
         res = read_header(root, pack, source);
     if (note(&p, res))
         goto done_root;
-    note(&p, manifest_string(root, "skybake_version", pack->skybake_version, sizeof(pack->skybake_version), source,
-                             ""));
+    note(&p,
+         manifest_string(root, "skybake_version", pack->skybake_version, sizeof(pack->skybake_version), source, ""));
     bool scene_ok = false;
     if (!note(&p, manifest_string(root, "scene_hash", pack->scene_hash, sizeof(pack->scene_hash), source, "")))
         scene_ok = !note(&p, read_scene(root, pack, source));

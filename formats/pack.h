@@ -51,7 +51,7 @@ enum sb_storage {
 
 /* What a product's file holds in this format version. */
 struct sb_product_format {
-    const char *name; /* "transmittance", ..., "cloud_shape", "cloud_detail", "cloud_curl", "weather" */
+    const char *name;              /* "transmittance", ..., "cloud_shape", "cloud_detail", "cloud_curl", "weather" */
     uint32_t width, height, depth; /* 0: set by the scene (sb_product_shape) */
     uint32_t channel_count;
     const char *channel_names;    /* comma-separated, in storage order */

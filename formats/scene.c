@@ -183,7 +183,10 @@ struct cloud_field {
     uint32_t min, max;
 };
 
-#define C(object, key, member, count, lo, hi) {object, key, offsetof(struct sb_cloud_params, member), count, lo, hi}
+#define C(object, key, member, count, lo, hi)                                                                          \
+    {                                                                                                                  \
+        object, key, offsetof(struct sb_cloud_params, member), count, lo, hi                                           \
+    }
 static const struct cloud_field cloud_fields[] = {
     C(NULL, "seed", seed, 1, 0, UINT32_MAX),
     C("cloud_shape", "size", shape_size, 1, 8, 256),
@@ -259,8 +262,7 @@ enum sb_result sb_cloud_params_validate(const struct sb_cloud_params *p, const c
         res = check_finest(p->shape_worley_cells[c], 3, p->shape_size, source, path, "clouds.cloud_shape.size");
         snprintf(path, sizeof(path), "clouds.cloud_detail.worley_cells[%d]", c);
         if (!res)
-            res = check_finest(p->detail_worley_cells[c], 3, p->detail_size, source, path,
-                               "clouds.cloud_detail.size");
+            res = check_finest(p->detail_worley_cells[c], 3, p->detail_size, source, path, "clouds.cloud_detail.size");
     }
     const struct {
         const struct sb_noise_octaves *noise;
@@ -339,7 +341,8 @@ static enum sb_result parse_cloud_object(const cJSON *obj, const char *object, s
         }
         const struct cloud_field *f = NULL;
         for (size_t i = 0; i < CLOUD_FIELD_COUNT && !f; i++)
-            if ((object ? cloud_fields[i].object && !strcmp(cloud_fields[i].object, object) : !cloud_fields[i].object) &&
+            if ((object ? cloud_fields[i].object && !strcmp(cloud_fields[i].object, object)
+                        : !cloud_fields[i].object) &&
                 !strcmp(cloud_fields[i].key, item->string))
                 f = &cloud_fields[i];
         if (!f) {

@@ -52,15 +52,15 @@ struct sb_noise_octaves {
  * Defaults in brackets; docs/scene.md gives the caps.
  */
 struct sb_cloud_params {
-    uint32_t seed;                   /* [0] */
-    uint32_t shape_size;             /* [128] */
-    struct sb_noise_octaves shape_perlin; /* Perlin-Worley's Perlin [4, 4 octaves] */
-    uint32_t shape_worley_cells[3];  /* [4, 8, 16]: channel 0's Worley is the first */
-    uint32_t detail_size;            /* [32] */
-    uint32_t detail_worley_cells[3]; /* [2, 4, 8] */
-    uint32_t curl_size;              /* [128] */
-    struct sb_noise_octaves curl;    /* the potential's [4, 3 octaves] */
-    uint32_t weather_size;           /* [512] */
+    uint32_t seed;                         /* [0] */
+    uint32_t shape_size;                   /* [128] */
+    struct sb_noise_octaves shape_perlin;  /* Perlin-Worley's Perlin [4, 4 octaves] */
+    uint32_t shape_worley_cells[3];        /* [4, 8, 16]: channel 0's Worley is the first */
+    uint32_t detail_size;                  /* [32] */
+    uint32_t detail_worley_cells[3];       /* [2, 4, 8] */
+    uint32_t curl_size;                    /* [128] */
+    struct sb_noise_octaves curl;          /* the potential's [4, 3 octaves] */
+    uint32_t weather_size;                 /* [512] */
     struct sb_noise_octaves coverage;      /* [4, 5 octaves] */
     struct sb_noise_octaves precipitation; /* [8, 4 octaves] */
     struct sb_noise_octaves cloud_type;    /* [2, 3 octaves] */

@@ -27,7 +27,8 @@ extern "C" {
 #include "vdb.h"
 }
 
-namespace {
+namespace
+{
 
 constexpr uint64_t kDefaultMaxVoxels = 1ull << 28;
 constexpr uint64_t kMaxFileBytes = 1ull << 30;
@@ -41,8 +42,9 @@ constexpr size_t kUuidSize = 36;
 
 // Archive::write(std::ostream&, ..., seekable) is protected; the stream is a
 // seekable buffer, so the file gets grid offsets as io::File writes them.
-class BufferWriter : public openvdb::io::Archive {
-public:
+class BufferWriter : public openvdb::io::Archive
+{
+  public:
     void write_to(std::ostream &os, const openvdb::GridCPtrVec &grids, const openvdb::MetaMap &meta) const
     {
         this->write(os, grids, /*seekable=*/true, meta);
@@ -294,15 +296,16 @@ extern "C" enum sb_result sb_vdb_read(const char *path, const char *channel_orde
                 voxels *= box_max[a] >= 0 && box_max[a] < (1 << 20) ? uint64_t(box_max[a]) + 1 : max_voxels + 1;
             if (box_min != openvdb::Vec3i(0, 0, 0) || lo->value() != box_min || hi->value() != box_max ||
                 voxels > max_voxels) {
-                sb_error("%s: grid \"%s\": voxels from (%d, %d, %d) to (%d, %d, %d); expected a box from the origin, the "
-                         "same for every grid, of at most %llu voxels",
-                         path, name, lo->value()[0], lo->value()[1], lo->value()[2], hi->value()[0], hi->value()[1],
-                         hi->value()[2], static_cast<unsigned long long>(max_voxels));
+                sb_error(
+                    "%s: grid \"%s\": voxels from (%d, %d, %d) to (%d, %d, %d); expected a box from the origin, the "
+                    "same for every grid, of at most %llu voxels",
+                    path, name, lo->value()[0], lo->value()[1], lo->value()[2], hi->value()[0], hi->value()[1],
+                    hi->value()[2], static_cast<unsigned long long>(max_voxels));
                 return SB_ERR_BAD_IMAGE;
             }
         }
-        res = sb_image_init_volume(volume, uint32_t(box_max[0]) + 1, uint32_t(box_max[1]) + 1,
-                                   uint32_t(box_max[2]) + 1, expect_count);
+        res = sb_image_init_volume(volume, uint32_t(box_max[0]) + 1, uint32_t(box_max[1]) + 1, uint32_t(box_max[2]) + 1,
+                                   expect_count);
         if (res)
             return res;
         sb_image_set_channel_names(volume, channel_order);

@@ -21,8 +21,7 @@ static float at(const struct sb_image *v, uint32_t x, uint32_t y, uint32_t z, ui
 }
 
 /* The GPU's values against the reference's, every `stride`-th texel. */
-static void check_reference(const char *name, const struct sb_noise_push *pc, const struct sb_image *v,
-                            uint64_t stride)
+static void check_reference(const char *name, const struct sb_noise_push *pc, const struct sb_image *v, uint64_t stride)
 {
     uint64_t n = texels(v), compared = 0, differ = 0;
     uint32_t worst_ulps = 0;
@@ -64,7 +63,8 @@ static void check_range(const char *name, const struct sb_image *v)
             sum2 += x * x;
         }
         double mean = sum / (double)n, sd = sqrt(fmax(sum2 / (double)n - mean * mean, 0));
-        printf("%s channel %u: mean %.3f, sd %.3f, %.2f%% at 0 or 1\n", name, c, mean, sd, 100.0 * (double)ends / (double)n);
+        printf("%s channel %u: mean %.3f, sd %.3f, %.2f%% at 0 or 1\n", name, c, mean, sd,
+               100.0 * (double)ends / (double)n);
         CHECK(outside == 0, "%s channel %u: %llu values outside [0, 1]", name, c, (unsigned long long)outside);
         CHECK(mean >= 0.15 && mean <= 0.85 && sd >= 0.04, "%s channel %u: mean %.3f, sd %.3f", name, c, mean, sd);
         CHECK(ends <= n / 5, "%s channel %u: %.1f%% of the values clamped", name, c, 100.0 * (double)ends / (double)n);
@@ -172,19 +172,19 @@ int main(void)
     /* The defaults (power-of-two sizes), and sizes, periods, cells,
      * octaves and a seed of a scene's own choosing. */
     struct sb_cloud_params defaults, custom = {
-        .seed = 99,
-        .shape_size = 96,
-        .shape_perlin = {4, 3},
-        .shape_worley_cells = {4, 12, 8},
-        .detail_size = 40,
-        .detail_worley_cells = {4, 8, 4},
-        .curl_size = 100,
-        .curl = {4, 3},
-        .weather_size = 200,
-        .coverage = {4, 5},
-        .precipitation = {8, 4},
-        .cloud_type = {4, 2},
-    };
+                                         .seed = 99,
+                                         .shape_size = 96,
+                                         .shape_perlin = {4, 3},
+                                         .shape_worley_cells = {4, 12, 8},
+                                         .detail_size = 40,
+                                         .detail_worley_cells = {4, 8, 4},
+                                         .curl_size = 100,
+                                         .curl = {4, 3},
+                                         .weather_size = 200,
+                                         .coverage = {4, 5},
+                                         .precipitation = {8, 4},
+                                         .cloud_type = {4, 2},
+                                     };
     sb_cloud_params_default(&defaults);
     CHECK(sb_cloud_params_validate(&custom, "custom") == SB_OK, "the custom parameters are valid");
     for (int set = 0; set < 2; set++) {

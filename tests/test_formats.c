@@ -127,7 +127,8 @@ static void test_scenes(void)
         {"{\"atmosphere\":{\"preset\":\"earth\",\"mie_scale_height_km\":1e-320}}", SB_ERR_OUT_OF_RANGE},
         {"{\"atmosphere\":\"earth\"}", SB_ERR_WRONG_TYPE},
         {"{\"atmosphere\":{\"preset\":\"earth\",\"ground_albedo\":[0.1,[0.2],0.3]}}", SB_ERR_WRONG_TYPE},
-        {"{\"atmosphere\":{\"preset\":\"earth\"},\"products\":[\"transmittance\",\"transmittance\"]}", SB_ERR_DUPLICATE_KEY},
+        {"{\"atmosphere\":{\"preset\":\"earth\"},\"products\":[\"transmittance\",\"transmittance\"]}",
+         SB_ERR_DUPLICATE_KEY},
         {"\x89PNG\r\n\x1a\n\xff\xfe{[", SB_ERR_JSON_SYNTAX},
         {"{\"atmosphere\":{\"preset\":\"earth}}", SB_ERR_JSON_SYNTAX},
         /* Cloud noise. */
@@ -217,7 +218,6 @@ static void test_scenes(void)
     free(nb);
 }
 
-
 /* binary16 against an independent reference: every half widens and narrows
  * back to itself; between each two neighbouring finite halves, the float
  * just below their midpoint (computed exactly in double) rounds down, just
@@ -228,8 +228,7 @@ static void test_half(void)
     for (uint32_t h = 0; h < 0x10000u; h++) {
         float f = sb_half_to_float((uint16_t)h);
         bool nan = (h & 0x7c00u) == 0x7c00u && (h & 0x3ffu);
-        identity += nan ? !(isnan(f) && (sb_half_from_float(f) & 0x7e00u) == 0x7e00u)
-                        : sb_half_from_float(f) != h;
+        identity += nan ? !(isnan(f) && (sb_half_from_float(f) & 0x7e00u) == 0x7e00u) : sb_half_from_float(f) != h;
     }
     for (uint32_t h = 0; h < 0x7bffu; h++) {
         for (int sign = 0; sign < 2; sign++) {
@@ -309,8 +308,7 @@ static void test_vdb(void)
     sb_image_finish(&back);
 
     /* Refusals, each before or instead of a guess. */
-    CHECK(sb_vdb_read(path, "worley.0,worley.1,worley.2", 0, &back, NULL, NULL) == SB_ERR_BAD_IMAGE,
-          "other channels");
+    CHECK(sb_vdb_read(path, "worley.0,worley.1,worley.2", 0, &back, NULL, NULL) == SB_ERR_BAD_IMAGE, "other channels");
     CHECK(sb_vdb_read(path, "perlin_worley,worley.0,worley.1,worley.x", 0, &back, NULL, NULL) == SB_ERR_BAD_IMAGE,
           "a channel it does not hold");
     CHECK(sb_vdb_read(path, "perlin_worley,worley.0,worley.1,worley.2", 13 * 9 * 20 - 1, &back, NULL, NULL) ==
@@ -342,7 +340,7 @@ static void test_vdb(void)
 static char pack_root[200];
 
 #define FLIP_BYTE                                                                                                      \
-    "printf '\\x55' | dd of=multiscattering.exr bs=1 seek=$(( $(stat -c %s multiscattering.exr) - 40 )) "            \
+    "printf '\\x55' | dd of=multiscattering.exr bs=1 seek=$(( $(stat -c %s multiscattering.exr) - 40 )) "              \
     "conv=notrunc 2>/dev/null"
 
 static void run(const char *command)
@@ -473,6 +471,10 @@ static void edit_make_version_1(cJSON *r)
 static void edit_no_file_hash(cJSON *r)
 {
     cJSON_DeleteItemFromObject(artifact(r, 4), "file_hash");
+}
+static void edit_empty_file_hash(cJSON *r)
+{
+    set_string(artifact(r, 1), "file_hash", "");
 }
 static void edit_volume_depth(cJSON *r)
 {
@@ -613,7 +615,8 @@ static void test_pack_reader(void)
         {"hidden file", edit_hidden_path, NULL, SB_ERR_UNSAFE_PATH, false},
         {"artifact that is a symbolic link", NULL, "mv transmittance.exr t.exr && ln -s t.exr transmittance.exr",
          SB_ERR_UNSAFE_PATH, false},
-        {"manifest that is a symbolic link", NULL, "mv manifest.json m && ln -s m manifest.json", SB_ERR_UNSAFE_PATH, false},
+        {"manifest that is a symbolic link", NULL, "mv manifest.json m && ln -s m manifest.json", SB_ERR_UNSAFE_PATH,
+         false},
         {"missing artifact", NULL, "rm multiscattering.exr", SB_ERR_IO, false},
         {"recorded hash differs", edit_hash, NULL, SB_ERR_HASH_MISMATCH, false},
         {"artifact replaced by another product's file", NULL, "cp irradiance_sky.exr irradiance_ground.exr",
@@ -629,8 +632,10 @@ static void test_pack_reader(void)
         {"format version 1, as version 1 wrote it", edit_make_version_1,
          "rm cloud_shape.vdb cloud_detail.vdb cloud_curl.exr weather.exr", SB_OK, false},
         {"format version 1 listing cloud products", edit_version_1, NULL, SB_ERR_UNKNOWN_PRODUCT, false},
-        {"truncated volume", NULL, "head -c 3000 cloud_shape.vdb > t && mv t cloud_shape.vdb", SB_ERR_HASH_MISMATCH, false},
+        {"truncated volume", NULL, "head -c 3000 cloud_shape.vdb > t && mv t cloud_shape.vdb", SB_ERR_HASH_MISMATCH,
+         false},
         {"volume without a file hash", edit_no_file_hash, NULL, SB_ERR_MISSING_FIELD, false},
+        {"an empty file hash", edit_empty_file_hash, NULL, SB_ERR_OUT_OF_RANGE, false},
         {"volume replaced by the other volume, vouched for", NULL, "cp cloud_detail.vdb cloud_shape.vdb",
          SB_ERR_BAD_IMAGE, true},
         {"volume replaced by an EXR, vouched for", NULL, "cp weather.exr cloud_detail.vdb", SB_ERR_VDB, true},
@@ -660,7 +665,8 @@ static void test_pack_reader(void)
         {"another format", edit_format, NULL, SB_ERR_VERSION, false},
         {"artifacts not an array", edit_artifacts_type, NULL, SB_ERR_WRONG_TYPE, false},
         {"artifact entry not an object", edit_artifact_number, NULL, SB_ERR_WRONG_TYPE, false},
-        {"key given twice in the manifest", NULL, "sed -i '0,/\"skybake_version\"/s//\"skybake_version\": \"x\", \"skybake_version\"/' manifest.json",
+        {"key given twice in the manifest", NULL,
+         "sed -i '0,/\"skybake_version\"/s//\"skybake_version\": \"x\", \"skybake_version\"/' manifest.json",
          SB_ERR_DUPLICATE_KEY, false},
         {"artifact holding NaN", NULL, "cp ../nan.exr multiscattering.exr", SB_ERR_HASH_MISMATCH, false},
         {"artifact holding NaN, vouched for", NULL, "cp ../nan.exr multiscattering.exr", SB_ERR_NUMERIC, true},
@@ -717,8 +723,8 @@ static void test_pack_reader(void)
     unsigned refused = 0, prefixes = 0;
     for (off_t n = 0; n < st.st_size; n += st.st_size / 97 + 1, prefixes++) {
         char cmd[2048];
-        snprintf(cmd, sizeof(cmd), "cp '%s/cloud_shape.vdb' '%s/t' && truncate -s %lld '%s/t' && mv '%s/t' '%s'",
-                 good, bad, (long long)n, bad, bad, path);
+        snprintf(cmd, sizeof(cmd), "cp '%s/cloud_shape.vdb' '%s/t' && truncate -s %lld '%s/t' && mv '%s/t' '%s'", good,
+                 bad, (long long)n, bad, bad, path);
         run(cmd);
         refused += sb_pack_open(bad, pack) == SB_ERR_HASH_MISMATCH;
     }
@@ -741,7 +747,8 @@ static void test_result_codes(void)
             CHECK(strcmp(name, sb_result_name((enum sb_result)j)) != 0, "codes %d and %d share the name %s", j, i,
                   name);
     }
-    CHECK(!strcmp(sb_result_name(SB_RESULT_COUNT), "unknown") && !strcmp(sb_result_name((enum sb_result)-1), "unknown"),
+    CHECK(!strcmp(sb_result_name(SB_RESULT_COUNT), "unknown") &&
+              !strcmp(sb_result_name((enum sb_result) - 1), "unknown"),
           "outside the set: unknown");
 }
 
