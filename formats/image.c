@@ -1,9 +1,12 @@
 #include "image.h"
 
+#include <errno.h>
+#include <fcntl.h>
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <unistd.h>
 #include <xxhash.h>
 
 enum sb_result sb_image_init_volume(struct sb_image *image, uint32_t width, uint32_t height, uint32_t depth,
@@ -98,6 +101,31 @@ void sb_image_content_hash(const struct sb_image *image, char out[SB_HASH_HEX_SI
 void sb_hash_bytes(const void *data, size_t size, char out[SB_HASH_HEX_SIZE])
 {
     hex128(XXH3_128bits(data, size), out);
+}
+
+enum sb_result sb_hash_file(int dir_fd, const char *name, char out[SB_HASH_HEX_SIZE])
+{
+    int fd = openat(dir_fd, name, O_RDONLY | O_CLOEXEC | O_NOFOLLOW);
+    if (fd < 0)
+        return SB_ERR_IO;
+    XXH3_state_t *state = XXH3_createState();
+    if (!state) {
+        close(fd);
+        return SB_ERR_NOMEM;
+    }
+    XXH3_128bits_reset(state);
+    static _Thread_local unsigned char chunk[1 << 16];
+    ssize_t n;
+    while ((n = read(fd, chunk, sizeof(chunk))) > 0 || (n < 0 && errno == EINTR))
+        if (n > 0)
+            XXH3_128bits_update(state, chunk, (size_t)n);
+    int err = errno;
+    close(fd);
+    if (n == 0)
+        hex128(XXH3_128bits_digest(state), out);
+    XXH3_freeState(state);
+    errno = err;
+    return n == 0 ? SB_OK : SB_ERR_IO;
 }
 
 int64_t sb_image_find_nonfinite(const struct sb_image *image)

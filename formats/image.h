@@ -59,6 +59,11 @@ void sb_image_content_hash(const struct sb_image *image, char out[SB_HASH_HEX_SI
 /* 128-bit XXH3 of bytes as hex (for scenes and other canonical text). */
 void sb_hash_bytes(const void *data, size_t size, char out[SB_HASH_HEX_SIZE]);
 
+/* The same of the bytes of file `name` in directory dir_fd (AT_FDCWD, or an
+ * open directory), not following a final symbolic link: a manifest's
+ * file_hash. SB_ERR_IO (errno set) when it cannot be read. */
+enum sb_result sb_hash_file(int dir_fd, const char *name, char out[SB_HASH_HEX_SIZE]);
+
 /* First NaN or infinite value, as a float index, or -1 when all are finite. */
 int64_t sb_image_find_nonfinite(const struct sb_image *image);
 

@@ -12,7 +12,6 @@
 #include <string.h>
 #include <sys/stat.h>
 #include <unistd.h>
-#include <xxhash.h>
 
 #include "config.h"
 #include "json.h"
@@ -60,31 +59,6 @@ void sb_product_shape(const struct sb_scene *scene, enum sb_product_id id, uint3
     shape[0] = f->width ? f->width : n;
     shape[1] = f->height ? f->height : n;
     shape[2] = f->depth ? f->depth : n;
-}
-
-enum sb_result sb_file_hash(int dir_fd, const char *name, char out[SB_HASH_HEX_SIZE])
-{
-    int fd = openat(dir_fd, name, O_RDONLY | O_CLOEXEC | O_NOFOLLOW);
-    if (fd < 0)
-        return SB_ERR_IO;
-    XXH3_state_t *state = XXH3_createState();
-    if (!state) {
-        close(fd);
-        return SB_ERR_NOMEM;
-    }
-    XXH3_128bits_reset(state);
-    static _Thread_local unsigned char chunk[1 << 16];
-    ssize_t n;
-    while ((n = read(fd, chunk, sizeof(chunk))) > 0 || (n < 0 && errno == EINTR))
-        if (n > 0)
-            XXH3_128bits_update(state, chunk, (size_t)n);
-    XXH128_hash_t h = XXH3_128bits_digest(state);
-    XXH3_freeState(state);
-    close(fd);
-    if (n < 0)
-        return SB_ERR_IO;
-    snprintf(out, SB_HASH_HEX_SIZE, "%016llx%016llx", (unsigned long long)h.high64, (unsigned long long)h.low64);
-    return SB_OK;
 }
 
 const struct sb_product_format *sb_product_format(enum sb_product_id id)
@@ -346,7 +320,7 @@ enum sb_result sb_pack_writer_add_image(struct sb_pack_writer *w, struct sb_arti
     w->pending = w->artifacts[i].file;
     enum sb_result res = format->storage == SB_STORAGE_VDB_HALF ? sb_vdb_write(path, image, attrs, n)
                                                                 : sb_exr_write(path, image, attrs, n);
-    if (!res && (res = sb_file_hash(w->tmp_fd, artifact->file, artifact->file_hash)))
+    if (!res && (res = sb_hash_file(w->tmp_fd, artifact->file, artifact->file_hash)))
         sb_error("%s: cannot read the file back: %s", path, strerror(errno));
     if (res) {
         unlink(path);
@@ -703,7 +677,7 @@ static enum sb_result read_artifact_image(const char *dir, int dir_fd, struct sb
     }
     if (a->file_hash[0]) {
         char hash[SB_HASH_HEX_SIZE];
-        enum sb_result res = sb_file_hash(dir_fd, a->file, hash);
+        enum sb_result res = sb_hash_file(dir_fd, a->file, hash);
         if (res) {
             sb_error("%s: %s: cannot read: %s", path, name, strerror(errno));
             return res;

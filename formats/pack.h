@@ -71,9 +71,6 @@ bool sb_product_from_name(const char *name, enum sb_product_id *id);
 struct sb_scene;
 void sb_product_shape(const struct sb_scene *scene, enum sb_product_id id, uint32_t shape[3]);
 
-/* XXH3-128 of a file's bytes, as hex (the manifest's file_hash). */
-enum sb_result sb_file_hash(int dir_fd, const char *name, char out[SB_HASH_HEX_SIZE]);
-
 /* One artifact of a manifest. Strings are copied when the artifact is added. */
 struct sb_artifact {
     enum sb_product_id product;

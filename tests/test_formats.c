@@ -384,7 +384,7 @@ static void edit_restamp(cJSON *r)
     {
         char hash[SB_HASH_HEX_SIZE];
         const cJSON *file = cJSON_GetObjectItem(a, "file");
-        if (cJSON_IsString(file) && sb_file_hash(fd, file->valuestring, hash) == SB_OK)
+        if (cJSON_IsString(file) && sb_hash_file(fd, file->valuestring, hash) == SB_OK)
             cJSON_ReplaceItemInObject((cJSON *)a, "file_hash", cJSON_CreateString(hash));
     }
     close(fd);
