@@ -201,7 +201,7 @@ static enum sb_result bench_clouds(struct sb_vk *vk, const struct sb_bench_param
                                    struct sb_bench_report *report)
 {
     enum sb_result res = SB_OK;
-    for (int p = SB_ATMOSPHERE_PRODUCT_COUNT; p < SB_PRODUCT_COUNT && !res; p++) {
+    for (int p = 0; p < SB_PRODUCT_COUNT && !res; p++) {
         if (!params->clouds[p])
             continue;
         enum sb_product_id id = (enum sb_product_id)p;

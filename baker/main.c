@@ -222,7 +222,7 @@ static int cmd_bench(int argc, char **argv)
             out_dir = argv[++i];
         } else if (!strcmp(a, "--product") && i + 1 < argc) {
             enum sb_product_id id;
-            if (sb_product_from_name(argv[++i], &id) && sb_product_is_cloud(id)) {
+            if (sb_product_from_name(argv[++i], &id) && sb_product_format(id)->family == SB_FAMILY_CLOUDS) {
                 params.clouds[id] = any = true;
                 continue;
             }
@@ -255,8 +255,8 @@ static int cmd_bench(int argc, char **argv)
     if (!any) {
         for (int w = 0; w < SB_BENCH_SWEEP_COUNT; w++)
             params.sweeps[w] = true;
-        for (int p = SB_ATMOSPHERE_PRODUCT_COUNT; p < SB_PRODUCT_COUNT; p++)
-            params.clouds[p] = true;
+        for (int p = 0; p < SB_PRODUCT_COUNT; p++)
+            params.clouds[p] = sb_product_format((enum sb_product_id)p)->family == SB_FAMILY_CLOUDS;
     }
     struct sb_scene scene = {0};
     if (scene_path && sb_scene_load(scene_path, &scene))

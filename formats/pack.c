@@ -14,6 +14,7 @@
 #include <unistd.h>
 
 #include "config.h"
+#include "family.h"
 #include "json.h"
 #include "log.h"
 #include "scene.h"
@@ -26,36 +27,34 @@
 static const struct sb_product_format product_formats[SB_PRODUCT_COUNT] = {
     [SB_PRODUCT_TRANSMITTANCE] = {"transmittance", SB_TRANSMITTANCE_WIDTH, SB_TRANSMITTANCE_HEIGHT, 1,
                                   SB_TRANSMITTANCE_CHANNELS, "r,g,b", "transmittance-hillaire2020-v1", 1,
-                                  SB_STORAGE_EXR_FLOAT32, "float32", "exr"},
+                                  SB_STORAGE_EXR_FLOAT32, "float32", "exr", SB_FAMILY_ATMOSPHERE},
     [SB_PRODUCT_MULTISCATTERING] = {"multiscattering", SB_MULTISCATTERING_SIZE, SB_MULTISCATTERING_SIZE, 1,
                                     SB_MULTISCATTERING_CHANNELS, "r,g,b", "multiscattering-hillaire2020-subtexel-v1", 1,
-                                    SB_STORAGE_EXR_FLOAT32, "float32", "exr"},
+                                    SB_STORAGE_EXR_FLOAT32, "float32", "exr", SB_FAMILY_ATMOSPHERE},
     [SB_PRODUCT_IRRADIANCE_GROUND] = {"irradiance_ground", SB_IRRADIANCE_WIDTH, SB_IRRADIANCE_HEIGHT, 1,
                                       SB_IRRADIANCE_GROUND_CHANNELS, "direct.r,direct.g,direct.b,sky.r,sky.g,sky.b",
                                       "irradiance-bruneton2017-subtexel-v1", 1, SB_STORAGE_EXR_FLOAT32, "float32",
-                                      "exr"},
+                                      "exr", SB_FAMILY_ATMOSPHERE},
     [SB_PRODUCT_IRRADIANCE_SKY] = {"irradiance_sky", SB_IRRADIANCE_WIDTH, SB_IRRADIANCE_HEIGHT, 1,
                                    SB_IRRADIANCE_SKY_CHANNELS,
                                    "rayleigh.r,rayleigh.g,rayleigh.b,mie.r,mie.g,mie.b,ground.r,ground.g,ground.b",
-                                   "irradiance-bruneton2017-subtexel-v1", 1, SB_STORAGE_EXR_FLOAT32, "float32", "exr"},
+                                   "irradiance-bruneton2017-subtexel-v1", 1, SB_STORAGE_EXR_FLOAT32, "float32", "exr",
+                                   SB_FAMILY_ATMOSPHERE},
     [SB_PRODUCT_CLOUD_SHAPE] = {"cloud_shape", 0, 0, 0, 4, "perlin_worley,worley.0,worley.1,worley.2",
-                                CLOUD_PARAMETERIZATION, 2, SB_STORAGE_VDB_HALF, "float16", "vdb"},
+                                CLOUD_PARAMETERIZATION, 2, SB_STORAGE_VDB_HALF, "float16", "vdb", SB_FAMILY_CLOUDS},
     [SB_PRODUCT_CLOUD_DETAIL] = {"cloud_detail", 0, 0, 0, 3, "worley.0,worley.1,worley.2", CLOUD_PARAMETERIZATION, 2,
-                                 SB_STORAGE_VDB_HALF, "float16", "vdb"},
+                                 SB_STORAGE_VDB_HALF, "float16", "vdb", SB_FAMILY_CLOUDS},
     [SB_PRODUCT_CLOUD_CURL] = {"cloud_curl", 0, 0, 1, 3, "curl.x,curl.y,curl.z", CLOUD_PARAMETERIZATION, 2,
-                               SB_STORAGE_EXR_FLOAT32, "float32", "exr"},
+                               SB_STORAGE_EXR_FLOAT32, "float32", "exr", SB_FAMILY_CLOUDS},
     [SB_PRODUCT_WEATHER] = {"weather", 0, 0, 1, 3, "coverage,precipitation,type", CLOUD_PARAMETERIZATION, 2,
-                            SB_STORAGE_EXR_FLOAT32, "float32", "exr"},
+                            SB_STORAGE_EXR_FLOAT32, "float32", "exr", SB_FAMILY_CLOUDS},
 };
 
 void sb_product_shape(const struct sb_scene *scene, enum sb_product_id id, uint32_t shape[3])
 {
     const struct sb_product_format *f = &product_formats[id];
-    const struct sb_cloud_params *c = &scene->clouds;
-    uint32_t n = id == SB_PRODUCT_CLOUD_SHAPE    ? c->shape_size
-                 : id == SB_PRODUCT_CLOUD_DETAIL ? c->detail_size
-                 : id == SB_PRODUCT_CLOUD_CURL   ? c->curl_size
-                                                 : c->weather_size;
+    const struct sb_family_format *family = sb_family_format(f->family);
+    uint32_t n = family->product_size ? family->product_size(scene, id) : 0;
     shape[0] = f->width ? f->width : n;
     shape[1] = f->height ? f->height : n;
     shape[2] = f->depth ? f->depth : n;

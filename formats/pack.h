@@ -43,6 +43,14 @@ static inline bool sb_product_is_cloud(enum sb_product_id id)
     return id >= SB_PRODUCT_CLOUD_SHAPE && id < SB_PRODUCT_COUNT;
 }
 
+/* Families of products: each is one file of its own per tier plus a row in
+ * the family tables (formats/family.h, baker/family.h). */
+enum sb_family {
+    SB_FAMILY_ATMOSPHERE,
+    SB_FAMILY_CLOUDS,
+    SB_FAMILY_COUNT,
+};
+
 /* How an artifact is stored. */
 enum sb_storage {
     SB_STORAGE_EXR_FLOAT32, /* EXR, FLOAT channels (exr.h) */
@@ -60,14 +68,16 @@ struct sb_product_format {
     enum sb_storage storage;
     const char *pixel_type; /* the manifest's pixel_type: "float32", "float16" */
     const char *extension;  /* of its file: "exr", "vdb" */
+    enum sb_family family;
 };
 
 const struct sb_product_format *sb_product_format(enum sb_product_id id);
 const char *sb_product_name(enum sb_product_id id);
 bool sb_product_from_name(const char *name, enum sb_product_id *id);
 
-/* The product's width, height and depth for `scene` (the cloud products'
- * sizes are scene parameters; the atmosphere's are fixed). */
+/* The product's width, height and depth for `scene` (fixed by its format,
+ * or, where the format says 0, set by its family's scene parameters: the
+ * cloud products' sizes). */
 struct sb_scene;
 void sb_product_shape(const struct sb_scene *scene, enum sb_product_id id, uint32_t shape[3]);
 

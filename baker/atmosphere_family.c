@@ -1,0 +1,181 @@
+/*
+ * The atmosphere family (Hillaire 2020's LUTs, Bruneton 2017's irradiance):
+ * keys, bakes at the default settings or the cheapest within a scene's
+ * tolerance, and adoption of reused products (family.h).
+ */
+#include <math.h>
+#include <stdio.h>
+#include <string.h>
+
+#include "accuracy.h"
+#include "atmosphere.h"
+#include "bench.h"
+#include "family.h"
+#include "log.h"
+
+/*
+ * Bake product `id` with the cheapest setting (device-independent cost,
+ * sb_atmosphere_settings_cost) whose max relative error against the fp64
+ * reference, at the probe points accuracy.h names, is within `tolerance`.
+ * Candidates are baked cheapest first until one is; *image holds it and the
+ * baker keeps it for the products that read it.
+ */
+static enum sb_result bake_to_tolerance(struct sb_atmosphere_baker *baker, const struct sb_atmosphere_params *params,
+                                        enum sb_product_id id, double tolerance,
+                                        const struct sb_image baked[SB_PRODUCT_COUNT], struct sb_image *image,
+                                        struct sb_atmosphere_settings *used, struct sb_error *error, char *probe,
+                                        size_t probe_size, double *gpu_ms)
+{
+    const char *name = sb_product_name(id);
+    struct sb_accuracy_ref *ref = NULL;
+    enum sb_result res = sb_accuracy_ref_create(params, id, false, 0, 0, baked, &ref);
+    if (res)
+        return res;
+    snprintf(probe, probe_size, "%s", sb_accuracy_ref_probe(ref));
+    int count;
+    const struct sb_atmosphere_settings *candidates = sb_bench_candidates(id, &count);
+    double best = INFINITY;
+    char best_label[48] = "", label[48];
+    double total_ms = 0;
+    res = SB_ERR_TOLERANCE;
+    for (int i = 0; i < count; i++) {
+        double ms = 0;
+        sb_image_finish(image);
+        enum sb_result r = sb_atmosphere_bake(baker, id, &candidates[i], image, used, &ms);
+        if (r) {
+            res = r;
+            break;
+        }
+        total_ms += ms;
+        sb_accuracy_measure(ref, image, false, error);
+        sb_atmosphere_settings_label(id, used, label, sizeof(label));
+        sb_debug("%s: %s: max rel error %.3g (tolerance %g)", name, label, error->max_rel, tolerance);
+        if (error->max_rel < best) {
+            best = error->max_rel;
+            snprintf(best_label, sizeof(best_label), "%s", label);
+        }
+        if (error->max_rel <= tolerance) {
+            sb_info("%s: %s is the cheapest setting within tolerance %g (max rel error %.3g at %s)", name, label,
+                    tolerance, error->max_rel, probe);
+            res = SB_OK;
+            break;
+        }
+    }
+    if (res == SB_ERR_TOLERANCE)
+        sb_error("%s: no setting reaches tolerance %g; the best reachable is %.3g (%s), at %s", name, tolerance, best,
+                 best_label, probe);
+    if (res)
+        sb_image_finish(image);
+    *gpu_ms = total_ms;
+    sb_accuracy_ref_destroy(&ref);
+    return res;
+}
+
+/* The settings' JSON object with the tolerance and the measured error added. */
+static void add_error_json(char *json, size_t size, double tolerance, const struct sb_error *e, const char *probe)
+{
+    size_t len = strlen(json);
+    if (!len || json[len - 1] != '}')
+        return;
+    snprintf(json + len - 1, size - (len - 1),
+             ",\"tolerance\":%.17g,\"error\":{\"max_rel\":%.6g,\"rms_rel\":%.6g,\"values\":%u,"
+             "\"against\":\"fp64 reference\",\"at\":\"%s\"}}",
+             tolerance, e->max_rel, e->rms_rel, e->count, probe);
+}
+
+/* The parameters a product's kernels read: the medium for all; the ground's
+ * albedo and the sun's irradiance for the scattering products; Mie's g for
+ * those whose phase functions are not isotropic (multiscattering's is). */
+static void key_params(enum sb_product_id id, const struct sb_atmosphere_params *p, struct sb_key_text *key)
+{
+    sb_key_add(key, " ground_radius_km=%a top_radius_km=%a rayleigh_scale_height_km=%a mie_scale_height_km=%a",
+               p->ground_radius_km, p->top_radius_km, p->rayleigh_scale_height_km, p->mie_scale_height_km);
+    sb_key_add3(key, "rayleigh_scattering_per_km", p->rayleigh_scattering_per_km);
+    sb_key_add3(key, "mie_scattering_per_km", p->mie_scattering_per_km);
+    sb_key_add3(key, "mie_absorption_per_km", p->mie_absorption_per_km);
+    sb_key_add3(key, "ozone_absorption_per_km", p->ozone_absorption_per_km);
+    sb_key_add(key, " ozone_center_km=%a ozone_half_width_km=%a", p->ozone_center_km, p->ozone_half_width_km);
+    if (id == SB_PRODUCT_TRANSMITTANCE)
+        return;
+    sb_key_add3(key, "ground_albedo", p->ground_albedo);
+    sb_key_add3(key, "solar_irradiance", p->solar_irradiance);
+    if (id != SB_PRODUCT_MULTISCATTERING)
+        sb_key_add(key, " mie_g=%a", p->mie_g);
+}
+
+static uint32_t atmosphere_depends_on(enum sb_product_id id)
+{
+    return sb_atmosphere_product(id)->depends_on;
+}
+
+static void atmosphere_key(const struct sb_scene *scene, enum sb_product_id id, struct sb_key_text *key)
+{
+    char settings[1024], code[SB_HASH_HEX_SIZE];
+    key_params(id, &scene->atmosphere, key);
+    if (scene->tolerance[id] > 0) {
+        sb_key_add(key, " tolerance=%a candidates", scene->tolerance[id]);
+        int count;
+        const struct sb_atmosphere_settings *candidates = sb_bench_candidates(id, &count);
+        for (int i = 0; i < count; i++) {
+            sb_atmosphere_settings_json(id, &candidates[i], settings, sizeof(settings));
+            sb_key_add(key, " %s", settings);
+        }
+    } else {
+        sb_atmosphere_settings_json(id, &sb_atmosphere_product(id)->defaults, settings, sizeof(settings));
+        sb_key_add(key, " defaults %s", settings);
+    }
+    sb_atmosphere_code_hash(id, code);
+    sb_key_add(key, " code %s", code);
+}
+
+static enum sb_result atmosphere_create(struct sb_vk *vk, const struct sb_scene *scene, void **state)
+{
+    struct sb_atmosphere_baker *baker = NULL;
+    enum sb_result res = sb_atmosphere_baker_create(vk, &scene->atmosphere, &baker);
+    *state = baker;
+    return res;
+}
+
+static void atmosphere_destroy(void **state)
+{
+    struct sb_atmosphere_baker *baker = *state;
+    sb_atmosphere_baker_destroy(&baker);
+    *state = NULL;
+}
+
+static enum sb_result atmosphere_bake(void *state, struct sb_vk *vk, const struct sb_scene *scene,
+                                      enum sb_product_id id, const struct sb_image baked[SB_PRODUCT_COUNT],
+                                      struct sb_image *image, struct sb_artifact *a)
+{
+    struct sb_atmosphere_baker *baker = state;
+    struct sb_atmosphere_settings used;
+    struct sb_error error;
+    char probe[96];
+    double tolerance = scene->tolerance[id];
+    enum sb_result res;
+    if (tolerance > 0)
+        res = bake_to_tolerance(baker, &scene->atmosphere, id, tolerance, baked, image, &used, &error, probe,
+                                sizeof(probe), &a->gpu_ms);
+    else
+        res = sb_atmosphere_bake(baker, id, NULL, image, &used, &a->gpu_ms);
+    if (res)
+        return res;
+    sb_atmosphere_settings_json(id, &used, a->settings_json, sizeof(a->settings_json));
+    if (tolerance > 0)
+        add_error_json(a->settings_json, sizeof(a->settings_json), tolerance, &error, probe);
+    return SB_OK;
+}
+
+static enum sb_result atmosphere_adopt(void *state, enum sb_product_id id, const struct sb_image *image)
+{
+    return sb_atmosphere_adopt(state, id, image);
+}
+
+const struct sb_family_baker sb_atmosphere_family = {
+    .depends_on = atmosphere_depends_on,
+    .key = atmosphere_key,
+    .create = atmosphere_create,
+    .destroy = atmosphere_destroy,
+    .bake = atmosphere_bake,
+    .adopt = atmosphere_adopt,
+};

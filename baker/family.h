@@ -1,0 +1,67 @@
+/*
+ * The baker's half of a product family (the formats' half is
+ * formats/family.h): how its products' bake keys are written, how they are
+ * baked, and how a product reused from an older pack is handed back to the
+ * family for the products that read it. bake.c drives every family through
+ * this table alone; a new family is one file (atmosphere_family.c,
+ * clouds_family.c) and one row in family.c.
+ */
+#ifndef SB_BAKER_FAMILY_H
+#define SB_BAKER_FAMILY_H
+
+#include <stddef.h>
+#include <stdint.h>
+
+#include "context.h"
+#include "image.h"
+#include "pack.h"
+#include "scene.h"
+
+/* A bake key's text, before it is hashed (bake.h says what goes in). */
+struct sb_key_text {
+    char text[8192];
+    size_t length; /* may exceed sizeof(text) - 1 when cut; hashing takes what fits */
+};
+
+/* Append printf-style text to a key's text. */
+#if defined(__GNUC__)
+__attribute__((format(printf, 2, 3)))
+#endif
+void sb_key_add(struct sb_key_text *key, const char *fmt, ...);
+
+/* Append " name=%a,%a,%a" (hexadecimal floats: exact). */
+void sb_key_add3(struct sb_key_text *key, const char *name, const double v[3]);
+
+struct sb_family_baker {
+    /* The products `id` reads (bit mask of sb_product_id, all of lower ids
+     * than id); NULL when the family's products read none. */
+    uint32_t (*depends_on)(enum sb_product_id id);
+    /* Append everything the product's values depend on but its inputs'
+     * keys (bake.c adds those): parameters, settings, kernels. */
+    void (*key)(const struct sb_scene *scene, enum sb_product_id id, struct sb_key_text *key);
+    /* The family's state for one bake (NULL create: none). Created when the
+     * bake needs any of its products; destroy accepts a pointer to NULL. */
+    enum sb_result (*create)(struct sb_vk *vk, const struct sb_scene *scene, void **state);
+    void (*destroy)(void **state);
+    /* Bake `id` into *image (values as the pack's file stores them) and
+     * fill the artifact's settings_json and gpu_ms. baked[] holds every
+     * product of lower id that this bake made or reused. */
+    enum sb_result (*bake)(void *state, struct sb_vk *vk, const struct sb_scene *scene, enum sb_product_id id,
+                           const struct sb_image baked[SB_PRODUCT_COUNT], struct sb_image *image,
+                           struct sb_artifact *artifact);
+    /* A product reused from an older pack, for the family's later bakes
+     * that read it; NULL when they read baked[] only. */
+    enum sb_result (*adopt)(void *state, enum sb_product_id id, const struct sb_image *image);
+};
+
+/* The baker of `family` (< SB_FAMILY_COUNT). */
+const struct sb_family_baker *sb_family_baker(enum sb_family family);
+
+/* The family baker of product `id`. */
+const struct sb_family_baker *sb_product_baker(enum sb_product_id id);
+
+/* The rows (each family's file). */
+extern const struct sb_family_baker sb_atmosphere_family;
+extern const struct sb_family_baker sb_clouds_family;
+
+#endif

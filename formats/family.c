@@ -1,0 +1,27 @@
+#include "family.h"
+
+#include <assert.h>
+
+static const struct sb_family_format families[SB_FAMILY_COUNT] = {
+    [SB_FAMILY_ATMOSPHERE] =
+        {
+            .name = "atmosphere",
+            .default_products = true,
+        },
+    [SB_FAMILY_CLOUDS] =
+        {
+            .name = "clouds",
+            .section = "clouds",
+            .parse_section = sb_clouds_section_parse,
+            .section_json = sb_clouds_section_json,
+            .product_size = sb_clouds_product_size,
+            .no_tolerance = "the cloud noise is baked exactly (bit for bit with its CPU reference) and takes no "
+                            "tolerance",
+        },
+};
+
+const struct sb_family_format *sb_family_format(enum sb_family family)
+{
+    assert((unsigned)family < SB_FAMILY_COUNT);
+    return &families[family];
+}

@@ -1,0 +1,52 @@
+/*
+ * Product families: what the formats tier knows of each family of products
+ * (the atmosphere, the cloud noise, ...). A family is its products' rows in
+ * the format table (pack.c), its scene section (parsed, validated and
+ * normalised by the family's own file: scene_clouds.c for the clouds) and
+ * one entry here. The baker's half of a family (its keys, bakes, references)
+ * is baker/family.h. Internal to skybake; not installed.
+ */
+#ifndef SB_FAMILY_H
+#define SB_FAMILY_H
+
+#include <stdbool.h>
+#include <stdint.h>
+
+#include "pack.h"
+#include "result.h"
+
+struct cJSON;
+struct sb_scene;
+
+struct sb_family_format {
+    const char *name; /* "atmosphere", "clouds" */
+    /* The scene's optional top-level key for the family's parameters, or
+     * NULL. (The atmosphere's section is the scene's core: required, parsed
+     * by scene.c.) */
+    const char *section;
+    /* Parse and validate the section into *scene, logging "source: path:
+     * reason" for the first problem. */
+    enum sb_result (*parse_section)(const struct cJSON *section, struct sb_scene *scene, const char *source);
+    /* The normalised section (every parameter resolved, keys in a fixed
+     * order), or NULL when the scene leaves it out. Written after the
+     * scene's "view", in table order, so that families added later leave
+     * older scenes' hashes alone. */
+    struct cJSON *(*section_json)(const struct sb_scene *scene);
+    /* Edge length in texels for a product whose format leaves its size to
+     * the scene (a 0 in sb_product_format); NULL when none does. */
+    uint32_t (*product_size)(const struct sb_scene *scene, enum sb_product_id id);
+    bool default_products; /* baked when a scene names no products */
+    /* Why a scene may not give the family's products a tolerance; NULL when
+     * it may (the bake then picks the cheapest setting within it). */
+    const char *no_tolerance;
+};
+
+/* The family's entry; `family` < SB_FAMILY_COUNT. */
+const struct sb_family_format *sb_family_format(enum sb_family family);
+
+/* The clouds' section (scene_clouds.c). */
+enum sb_result sb_clouds_section_parse(const struct cJSON *section, struct sb_scene *scene, const char *source);
+struct cJSON *sb_clouds_section_json(const struct sb_scene *scene);
+uint32_t sb_clouds_product_size(const struct sb_scene *scene, enum sb_product_id id);
+
+#endif
