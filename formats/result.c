@@ -29,6 +29,8 @@ static const struct {
     [SB_ERR_TOLERANCE] = {"tolerance", "no setting of a product reaches the scene's tolerance"},
     [SB_ERR_UNLISTED_FILE] = {"unlisted-file", "a file in a pack that its manifest does not list"},
     [SB_ERR_VDB] = {"vdb", "OpenVDB refused the file or the data"},
+    [SB_ERR_MESH] = {"mesh", "a mesh file assimp refuses, or one with no usable triangle"},
+    [SB_ERR_TOO_LARGE] = {"too-large", "a file or count past its documented cap"},
 };
 
 const char *sb_result_name(enum sb_result result)

@@ -32,6 +32,8 @@ enum sb_result {
     SB_ERR_TOLERANCE,       /* no setting of a product reaches the scene's tolerance */
     SB_ERR_UNLISTED_FILE,   /* a pack holds a file its manifest does not list */
     SB_ERR_VDB,             /* OpenVDB refused the file or the data */
+    SB_ERR_MESH,            /* a mesh file assimp refuses, or one with no usable triangle */
+    SB_ERR_TOO_LARGE,       /* a file or count past its documented cap, refused before allocating */
     SB_RESULT_COUNT,
 };
 

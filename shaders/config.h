@@ -246,4 +246,26 @@ struct sb_noise_push {
     SB_UVEC4(seed);
 };
 
+/* Ray casts against a BVH (geometry/bvh.h, bvh.glsl, raycast.comp): leaves
+ * of at most SB_BVH_MAX_LEAF triangles, a tree at most SB_BVH_MAX_DEPTH
+ * deep (the root at 0), so that the traversal's stack of that many
+ * entries never overflows. */
+#define SB_BVH_MAX_LEAF 4
+#define SB_BVH_MAX_DEPTH 40
+#define SB_BVH_MISS 0xffffffffu
+#define SB_BVH_BACK_FACE 0x80000000u /* set in a hit's triangle when the ray met its back */
+#define SB_RAYCAST_BINDING_NODES 0
+#define SB_RAYCAST_BINDING_TRIANGLES 1
+#define SB_RAYCAST_BINDING_RAYS 2 /* two vec4s a ray: origin, tmin; direction, tmax */
+#define SB_RAYCAST_BINDING_HITS 3 /* one vec4 a ray: t, triangle | SB_BVH_BACK_FACE (bits), u, v */
+#define SB_RAYCAST_BINDING_COUNT 4
+#define SB_RAYCAST_WORKGROUP 64
+
+struct sb_raycast_push {
+    SB_UINT ray_count; /* rays in the buffer */
+    SB_UINT any_hit;   /* 1: stop at the first hit found (visibility) */
+    SB_UINT first;     /* the dispatch's first ray (dispatches are at most 65535 workgroups) */
+    SB_UINT pad;
+};
+
 #endif

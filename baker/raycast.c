@@ -1,0 +1,91 @@
+#include "raycast.h"
+
+#include <stdlib.h>
+#include <string.h>
+
+#include "log.h"
+#include "raycast.spv.h"
+
+enum sb_result sb_raycaster_create(struct sb_vk *vk, const struct sb_bvh *bvh, struct sb_raycaster **out)
+{
+    *out = NULL;
+    struct sb_raycaster *rc = calloc(1, sizeof(*rc));
+    if (!rc)
+        return SB_ERR_NOMEM;
+    rc->vk = vk;
+    enum sb_result res;
+    VkDeviceSize node_bytes = (VkDeviceSize)bvh->node_count * sizeof(*bvh->nodes);
+    VkDeviceSize triangle_bytes = (VkDeviceSize)bvh->triangle_count * sizeof(*bvh->triangles);
+    if ((res = sb_buffer_create(vk, node_bytes, "bvh nodes", &rc->nodes)) ||
+        (res = sb_buffer_create(vk, triangle_bytes, "bvh triangles", &rc->triangles)))
+        goto fail;
+    memcpy(rc->nodes.mapped, bvh->nodes, node_bytes);
+    memcpy(rc->triangles.mapped, bvh->triangles, triangle_bytes);
+    const struct sb_pipeline_params params = {
+        .spirv = sb_spv_raycast,
+        .spirv_size = sizeof(sb_spv_raycast),
+        .binding_count = SB_RAYCAST_BINDING_COUNT,
+        .push_size = sizeof(struct sb_raycast_push),
+        .name = "raycast",
+    };
+    if ((res = sb_pipeline_create(vk, &params, &rc->pipeline)))
+        goto fail;
+    *out = rc;
+    return SB_OK;
+fail:
+    sb_raycaster_destroy(&rc);
+    return res;
+}
+
+void sb_raycaster_destroy(struct sb_raycaster **raycaster)
+{
+    struct sb_raycaster *rc = *raycaster;
+    if (!rc)
+        return;
+    sb_pipeline_destroy(rc->vk, &rc->pipeline);
+    sb_buffer_destroy(rc->vk, &rc->rays);
+    sb_buffer_destroy(rc->vk, &rc->hits);
+    sb_buffer_destroy(rc->vk, &rc->nodes);
+    sb_buffer_destroy(rc->vk, &rc->triangles);
+    free(rc);
+    *raycaster = NULL;
+}
+
+enum sb_result sb_raycaster_cast(struct sb_raycaster *rc, const float *rays, uint32_t count, bool any, float *hits,
+                                 double *gpu_ms)
+{
+    if (gpu_ms)
+        *gpu_ms = 0;
+    if (!count)
+        return SB_OK;
+    enum sb_result res;
+    if (count != rc->capacity) { /* sb_buffer_read reads whole buffers */
+        sb_buffer_destroy(rc->vk, &rc->rays);
+        sb_buffer_destroy(rc->vk, &rc->hits);
+        rc->capacity = 0;
+        if ((res = sb_buffer_create(rc->vk, (VkDeviceSize)count * 8 * sizeof(float), "rays", &rc->rays)) ||
+            (res = sb_buffer_create(rc->vk, (VkDeviceSize)count * 4 * sizeof(float), "hits", &rc->hits)))
+            return res;
+        rc->capacity = count;
+    }
+    memcpy(rc->rays.mapped, rays, (size_t)count * 8 * sizeof(float));
+    const struct sb_buffer *bindings[SB_RAYCAST_BINDING_COUNT] = {
+        [SB_RAYCAST_BINDING_NODES] = &rc->nodes,
+        [SB_RAYCAST_BINDING_TRIANGLES] = &rc->triangles,
+        [SB_RAYCAST_BINDING_RAYS] = &rc->rays,
+        [SB_RAYCAST_BINDING_HITS] = &rc->hits,
+    };
+    sb_pipeline_bind(rc->vk, &rc->pipeline, bindings);
+    const uint32_t per_dispatch = 65535u * SB_RAYCAST_WORKGROUP;
+    for (uint32_t first = 0; first < count; first += per_dispatch) {
+        uint32_t n = count - first < per_dispatch ? count - first : per_dispatch;
+        struct sb_raycast_push pc = {.ray_count = count, .any_hit = any, .first = first};
+        double ms = 0;
+        if ((res = sb_dispatch(rc->vk, &rc->pipeline, &pc, (n + SB_RAYCAST_WORKGROUP - 1) / SB_RAYCAST_WORKGROUP, 1, 1,
+                               &ms)))
+            return res;
+        if (gpu_ms)
+            *gpu_ms += ms;
+    }
+    return sb_buffer_read(rc->vk, &rc->hits, hits);
+}

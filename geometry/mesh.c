@@ -1,0 +1,585 @@
+#include "mesh.h"
+
+#include <assimp/cimport.h>
+#include <assimp/material.h>
+#include <assimp/postprocess.h>
+#include <assimp/scene.h>
+#include <errno.h>
+#include <math.h>
+#include <poll.h>
+#include <signal.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <sys/resource.h>
+#include <sys/stat.h>
+#include <sys/wait.h>
+#include <time.h>
+#include <unistd.h>
+#include <xxhash.h>
+
+#include "log.h"
+
+/* Node trees deeper than this are refused (a file can make them cyclic). */
+#define MESH_MAX_NODE_DEPTH 128
+
+static enum sb_result grow(void **data, size_t *capacity, size_t need, size_t element)
+{
+    if (need <= *capacity)
+        return SB_OK;
+    size_t n = *capacity ? *capacity : 64;
+    while (n < need)
+        n *= 2;
+    void *p = realloc(*data, n * element);
+    if (!p)
+        return SB_ERR_NOMEM;
+    *data = p;
+    *capacity = n;
+    return SB_OK;
+}
+
+enum sb_result sb_mesh_add_material(struct sb_mesh *mesh, const char *name, const double albedo[3], uint32_t *index)
+{
+    if (mesh->material_count >= SB_MESH_MAX_MATERIALS) {
+        sb_error("%s: more than %u materials", name, SB_MESH_MAX_MATERIALS);
+        return SB_ERR_TOO_LARGE;
+    }
+    enum sb_result res = grow((void **)&mesh->material_list, &mesh->capacity_materials, mesh->material_count + 1,
+                              sizeof(*mesh->material_list));
+    if (res)
+        return res;
+    struct sb_mesh_material *m = &mesh->material_list[mesh->material_count];
+    memset(m, 0, sizeof(*m));
+    snprintf(m->name, sizeof(m->name), "%s", name);
+    for (int c = 0; c < 3; c++)
+        m->albedo[c] = (float)fmin(fmax(isfinite(albedo[c]) ? albedo[c] : 0.0, 0.0), 1.0);
+    *index = mesh->material_count++;
+    return SB_OK;
+}
+
+static bool coordinate_ok(const double p[3])
+{
+    for (int i = 0; i < 3; i++)
+        if (!isfinite(p[i]) || fabs(p[i]) > SB_MESH_MAX_EXTENT_M)
+            return false;
+    return true;
+}
+
+/* Twice the area, from the float coordinates the mesh will hold. */
+static double doubled_area(const float *a, const float *b, const float *c)
+{
+    double e1[3], e2[3];
+    for (int i = 0; i < 3; i++) {
+        e1[i] = (double)b[i] - a[i];
+        e2[i] = (double)c[i] - a[i];
+    }
+    double n[3] = {e1[1] * e2[2] - e1[2] * e2[1], e1[2] * e2[0] - e1[0] * e2[2], e1[0] * e2[1] - e1[1] * e2[0]};
+    return sqrt(n[0] * n[0] + n[1] * n[1] + n[2] * n[2]);
+}
+
+enum sb_result sb_mesh_add_triangle(struct sb_mesh *mesh, const double a[3], const double b[3], const double c[3],
+                                    uint32_t material, const char *source)
+{
+    const double *v[3] = {a, b, c};
+    for (int k = 0; k < 3; k++)
+        if (!coordinate_ok(v[k])) {
+            sb_error("%s: triangle %u: vertex (%g, %g, %g) is not finite or lies more than %g m from the origin",
+                     source, mesh->triangle_count + mesh->dropped_degenerate, v[k][0], v[k][1], v[k][2],
+                     SB_MESH_MAX_EXTENT_M);
+            return SB_ERR_NUMERIC;
+        }
+    if (material >= mesh->material_count) {
+        sb_error("%s: triangle %u: material %u of %u", source, mesh->triangle_count, material, mesh->material_count);
+        return SB_ERR_OUT_OF_RANGE;
+    }
+    float f[3][3];
+    for (int k = 0; k < 3; k++)
+        for (int i = 0; i < 3; i++)
+            f[k][i] = (float)v[k][i];
+    if (!(doubled_area(f[0], f[1], f[2]) > 0.0)) {
+        mesh->dropped_degenerate++;
+        return SB_OK;
+    }
+    if (mesh->triangle_count >= SB_MESH_MAX_TRIANGLES || mesh->vertex_count + 3 > SB_MESH_MAX_VERTICES) {
+        sb_error("%s: more than %u triangles", source, SB_MESH_MAX_TRIANGLES);
+        return SB_ERR_TOO_LARGE;
+    }
+    enum sb_result res;
+    if ((res = grow((void **)&mesh->positions, &mesh->capacity_vertices, (size_t)mesh->vertex_count + 3,
+                    3 * sizeof(float))) ||
+        (res = grow((void **)&mesh->indices, &mesh->capacity_triangles, (size_t)mesh->triangle_count + 1,
+                    3 * sizeof(uint32_t))))
+        return res;
+    /* materials[] shares the triangles' capacity */
+    uint32_t *materials = realloc(mesh->materials, mesh->capacity_triangles * sizeof(uint32_t));
+    if (!materials)
+        return SB_ERR_NOMEM;
+    mesh->materials = materials;
+    for (int k = 0; k < 3; k++) {
+        memcpy(&mesh->positions[3 * (size_t)(mesh->vertex_count + k)], f[k], sizeof(f[k]));
+        mesh->indices[3 * (size_t)mesh->triangle_count + k] = mesh->vertex_count + k;
+    }
+    mesh->materials[mesh->triangle_count++] = material;
+    mesh->vertex_count += 3;
+    return SB_OK;
+}
+
+/* ---- assimp ------------------------------------------------------------------------ */
+
+/* 4x4, row-major, column vectors: p' = M p. */
+struct mat4 {
+    double m[4][4];
+};
+
+static struct mat4 mat_mul(const struct mat4 *a, const struct mat4 *b)
+{
+    struct mat4 r;
+    for (int i = 0; i < 4; i++)
+        for (int j = 0; j < 4; j++) {
+            double s = 0;
+            for (int k = 0; k < 4; k++)
+                s += a->m[i][k] * b->m[k][j];
+            r.m[i][j] = s;
+        }
+    return r;
+}
+
+static struct mat4 mat_from_ai(const struct aiMatrix4x4 *t)
+{
+    return (struct mat4){{{t->a1, t->a2, t->a3, t->a4},
+                          {t->b1, t->b2, t->b3, t->b4},
+                          {t->c1, t->c2, t->c3, t->c4},
+                          {t->d1, t->d2, t->d3, t->d4}}};
+}
+
+static struct mat4 mat_identity(void)
+{
+    return (struct mat4){{{1, 0, 0, 0}, {0, 1, 0, 0}, {0, 0, 1, 0}, {0, 0, 0, 1}}};
+}
+
+/* The scene's transform (mesh.h) as a matrix applied after the file's own. */
+static struct mat4 mat_world(const struct sb_mesh_transform *t)
+{
+    double s = (t->units_m > 0 ? t->units_m : 1.0) * (t->scale > 0 ? t->scale : 1.0);
+    struct mat4 m = mat_identity();
+    for (int i = 0; i < 3; i++)
+        m.m[i][i] = s;
+    if (t->up_z) { /* (x, y, z) -> (x, z, -y) */
+        struct mat4 up = {{{1, 0, 0, 0}, {0, 0, 1, 0}, {0, -1, 0, 0}, {0, 0, 0, 1}}};
+        m = mat_mul(&up, &m);
+    }
+    for (int axis = 0; axis < 3; axis++) {
+        double r = t->rotate_deg[axis] * (M_PI / 180.0), c = cos(r), sn = sin(r);
+        struct mat4 rot = mat_identity();
+        int i = (axis + 1) % 3, j = (axis + 2) % 3;
+        rot.m[i][i] = c;
+        rot.m[i][j] = -sn;
+        rot.m[j][i] = sn;
+        rot.m[j][j] = c;
+        m = mat_mul(&rot, &m);
+    }
+    for (int i = 0; i < 3; i++)
+        m.m[i][3] += t->translate_m[i];
+    return m;
+}
+
+static void transform_point(const struct mat4 *m, const struct aiVector3D *p, double out[3])
+{
+    for (int i = 0; i < 3; i++)
+        out[i] = m->m[i][0] * p->x + m->m[i][1] * p->y + m->m[i][2] * p->z + m->m[i][3];
+}
+
+struct importer {
+    const char *path;
+    const struct aiScene *scene;
+    const struct sb_mesh_load_params *params;
+    struct sb_mesh *mesh;
+    uint32_t *material_map; /* the file's material -> the mesh's */
+    uint64_t triangles;     /* counted before anything is added */
+};
+
+/* Count the triangles the node tree instances, refusing deep trees and
+ * counts past the cap before any is allocated. */
+static enum sb_result count_node(struct importer *im, const struct aiNode *node, int depth)
+{
+    if (depth > MESH_MAX_NODE_DEPTH) {
+        sb_error("%s: the node tree is deeper than %d (cyclic?)", im->path, MESH_MAX_NODE_DEPTH);
+        return SB_ERR_MESH;
+    }
+    for (unsigned i = 0; i < node->mNumMeshes; i++) {
+        if (node->mMeshes[i] >= im->scene->mNumMeshes) {
+            sb_error("%s: node \"%s\" names mesh %u of %u", im->path, node->mName.data, node->mMeshes[i],
+                     im->scene->mNumMeshes);
+            return SB_ERR_MESH;
+        }
+        im->triangles += im->scene->mMeshes[node->mMeshes[i]]->mNumFaces;
+        if (im->triangles > SB_MESH_MAX_TRIANGLES) {
+            sb_error("%s: more than %u triangles (after instancing)", im->path, SB_MESH_MAX_TRIANGLES);
+            return SB_ERR_TOO_LARGE;
+        }
+    }
+    enum sb_result res = SB_OK;
+    for (unsigned c = 0; c < node->mNumChildren && !res; c++)
+        res = count_node(im, node->mChildren[c], depth + 1);
+    return res;
+}
+
+static enum sb_result add_node(struct importer *im, const struct aiNode *node, const struct mat4 *parent)
+{
+    struct mat4 local = mat_from_ai(&node->mTransformation);
+    struct mat4 m = mat_mul(parent, &local);
+    for (unsigned i = 0; i < node->mNumMeshes; i++) {
+        const struct aiMesh *am = im->scene->mMeshes[node->mMeshes[i]];
+        if (!(am->mPrimitiveTypes & aiPrimitiveType_TRIANGLE))
+            continue;
+        uint32_t material = im->material_map[am->mMaterialIndex < im->scene->mNumMaterials ? am->mMaterialIndex : 0];
+        for (unsigned f = 0; f < am->mNumFaces; f++) {
+            const struct aiFace *face = &am->mFaces[f];
+            if (face->mNumIndices != 3)
+                continue; /* points and lines */
+            double p[3][3];
+            for (int k = 0; k < 3; k++) {
+                if (face->mIndices[k] >= am->mNumVertices) {
+                    sb_error("%s: mesh \"%s\" face %u: vertex %u of %u", im->path, am->mName.data, f, face->mIndices[k],
+                             am->mNumVertices);
+                    return SB_ERR_MESH;
+                }
+                transform_point(&m, &am->mVertices[face->mIndices[k]], p[k]);
+            }
+            enum sb_result res = sb_mesh_add_triangle(im->mesh, p[0], p[1], p[2], material, im->path);
+            if (res)
+                return res;
+        }
+    }
+    for (unsigned c = 0; c < node->mNumChildren; c++) {
+        enum sb_result res = add_node(im, node->mChildren[c], &m);
+        if (res)
+            return res;
+    }
+    return SB_OK;
+}
+
+static enum sb_result add_materials(struct importer *im)
+{
+    const struct sb_mesh_load_params *params = im->params;
+    unsigned count = im->scene->mNumMaterials ? im->scene->mNumMaterials : 1;
+    if (count > SB_MESH_MAX_MATERIALS) {
+        sb_error("%s: %u materials, at most %u", im->path, count, SB_MESH_MAX_MATERIALS);
+        return SB_ERR_TOO_LARGE;
+    }
+    im->material_map = calloc(count, sizeof(uint32_t));
+    if (!im->material_map)
+        return SB_ERR_NOMEM;
+    for (unsigned i = 0; i < count; i++) {
+        const struct aiMaterial *mat = i < im->scene->mNumMaterials ? im->scene->mMaterials[i] : NULL;
+        struct aiString name = {0};
+        char label[SB_MESH_MATERIAL_NAME_MAX];
+        if (mat && aiGetMaterialString(mat, AI_MATKEY_NAME, &name) == aiReturn_SUCCESS && name.length)
+            snprintf(label, sizeof(label), "%.*s", (int)sizeof(label) - 1, name.data);
+        else
+            snprintf(label, sizeof(label), "material%u", i);
+        double d = params->default_albedo > 0 ? params->default_albedo : 0.5;
+        double albedo[3] = {d, d, d};
+        struct aiColor4D color;
+        if (mat && (aiGetMaterialColor(mat, AI_MATKEY_BASE_COLOR, &color) == aiReturn_SUCCESS ||
+                    aiGetMaterialColor(mat, AI_MATKEY_COLOR_DIFFUSE, &color) == aiReturn_SUCCESS)) {
+            albedo[0] = color.r;
+            albedo[1] = color.g;
+            albedo[2] = color.b;
+        }
+        for (int o = 0; o < params->override_count; o++) {
+            const struct sb_mesh_albedo_override *ov = &params->overrides[o];
+            if (!strcmp(ov->material, "*") || !strcmp(ov->material, label))
+                memcpy(albedo, ov->albedo, sizeof(albedo));
+        }
+        enum sb_result res = sb_mesh_add_material(im->mesh, label, albedo, &im->material_map[i]);
+        if (res)
+            return res;
+    }
+    return SB_OK;
+}
+
+/* The import itself, into a fresh mesh, in the importing child: the
+ * file's materials, then every instanced triangle. */
+static enum sb_result import(const char *path, const struct sb_mesh_load_params *params, struct sb_mesh *mesh)
+{
+    struct importer im = {.path = path, .params = params, .mesh = mesh};
+    im.scene = aiImportFile(path, aiProcess_Triangulate | aiProcess_SortByPType | aiProcess_ValidateDataStructure);
+    enum sb_result res = SB_OK;
+    if (!im.scene || !im.scene->mRootNode || (im.scene->mFlags & AI_SCENE_FLAGS_INCOMPLETE)) {
+        sb_error("%s: assimp cannot read it: %s", path, im.scene ? "the scene is incomplete" : aiGetErrorString());
+        res = SB_ERR_MESH;
+        goto done;
+    }
+    if ((res = count_node(&im, im.scene->mRootNode, 0)) || (res = add_materials(&im)))
+        goto done;
+    struct mat4 world = mat_world(&params->transform);
+    if ((res = add_node(&im, im.scene->mRootNode, &world)))
+        goto done;
+    if (!mesh->triangle_count) {
+        sb_error("%s: no triangle of non-zero area (%u left out as degenerate)", path, mesh->dropped_degenerate);
+        res = SB_ERR_MESH;
+    }
+done:
+    free(im.material_map);
+    aiReleaseImport(im.scene);
+    return res;
+}
+
+/* ---- the importing child --------------------------------------------------------------- */
+
+/*
+ * assimp is not hardened: on this machine a PLY header claiming 10^11
+ * vertices made it loop for ever, and a reader can crash. So a child
+ * process imports, under a CPU-time and (without sanitizers) an
+ * address-space limit, and sends the mesh back through a pipe; the parent
+ * reads it with a deadline, checks every count against the caps, and turns
+ * a hang, a crash or a limit into SB_ERR_MESH naming the file.
+ */
+#if defined(__SANITIZE_ADDRESS__)
+#define MESH_UNDER_ASAN 1 /* its shadow memory needs the address space */
+#elif defined(__has_feature)
+#if __has_feature(address_sanitizer)
+#define MESH_UNDER_ASAN 1
+#endif
+#endif
+#define IMPORT_ADDRESS_SPACE (16ull << 30)
+#define IMPORT_MAGIC 0x534b424d /* "SKBM" */
+
+struct import_header {
+    uint32_t magic;
+    int32_t result;
+    uint32_t vertex_count, triangle_count, material_count, dropped_degenerate;
+    char message[512];
+};
+
+static void first_error(void *user, enum sb_log_level level, const char *message)
+{
+    char *first = user;
+    if (level <= SB_LOG_WARN && !first[0])
+        snprintf(first, 512, "%s", message);
+    if (level > SB_LOG_WARN)
+        fprintf(stderr, "%s\n", message);
+}
+
+static bool write_all(int fd, const void *data, size_t size)
+{
+    const char *p = data;
+    while (size) {
+        ssize_t n = write(fd, p, size);
+        if (n < 0 && errno == EINTR)
+            continue;
+        if (n <= 0)
+            return false;
+        p += n;
+        size -= (size_t)n;
+    }
+    return true;
+}
+
+static _Noreturn void import_child(int fd, const char *path, const struct sb_mesh_load_params *params)
+{
+    rlim_t seconds = params->time_limit_s ? params->time_limit_s : SB_MESH_IMPORT_SECONDS;
+    struct rlimit cpu = {seconds, seconds + 5};
+    setrlimit(RLIMIT_CPU, &cpu);
+#if !defined(MESH_UNDER_ASAN)
+    struct rlimit as = {IMPORT_ADDRESS_SPACE, IMPORT_ADDRESS_SPACE};
+    setrlimit(RLIMIT_AS, &as);
+#endif
+    struct import_header h = {.magic = IMPORT_MAGIC};
+    sb_log_set_sink(first_error, h.message);
+    struct sb_mesh mesh = {0};
+    h.result = import(path, params, &mesh);
+    if (!h.result) {
+        h.vertex_count = mesh.vertex_count;
+        h.triangle_count = mesh.triangle_count;
+        h.material_count = mesh.material_count;
+        h.dropped_degenerate = mesh.dropped_degenerate;
+    }
+    bool ok = write_all(fd, &h, sizeof(h));
+    if (!h.result && ok)
+        ok = write_all(fd, mesh.material_list, (size_t)mesh.material_count * sizeof(*mesh.material_list)) &&
+             write_all(fd, mesh.positions, (size_t)mesh.vertex_count * 3 * sizeof(float)) &&
+             write_all(fd, mesh.materials, (size_t)mesh.triangle_count * sizeof(uint32_t));
+    _exit(ok ? 0 : 1);
+}
+
+/* Read exactly `size` bytes before the deadline (CLOCK_MONOTONIC seconds). */
+static bool read_all(int fd, void *data, size_t size, double deadline)
+{
+    char *p = data;
+    while (size) {
+        struct timespec ts;
+        clock_gettime(CLOCK_MONOTONIC, &ts);
+        double left = deadline - (ts.tv_sec + ts.tv_nsec * 1e-9);
+        struct pollfd pfd = {.fd = fd, .events = POLLIN};
+        if (left <= 0 || poll(&pfd, 1, (int)(left * 1e3) + 1) == 0)
+            return false;
+        ssize_t n = read(fd, p, size);
+        if (n < 0 && errno == EINTR)
+            continue;
+        if (n <= 0)
+            return false;
+        p += n;
+        size -= (size_t)n;
+    }
+    return true;
+}
+
+/* Append what the child sent: the materials, then the triangles through
+ * the checks every triangle meets. */
+static enum sb_result receive(int fd, const char *path, unsigned seconds, double deadline, struct sb_mesh *mesh)
+{
+    struct import_header h;
+    if (!read_all(fd, &h, sizeof(h), deadline) || h.magic != IMPORT_MAGIC) {
+        sb_error("%s: assimp did not finish reading it (it crashed, ran out of memory or took more than %u s)", path,
+                 seconds);
+        return SB_ERR_MESH;
+    }
+    h.message[sizeof(h.message) - 1] = '\0';
+    if (h.result) {
+        sb_error("%s", h.message[0] ? h.message : "the import failed");
+        return (unsigned)h.result < SB_RESULT_COUNT ? (enum sb_result)h.result : SB_ERR_MESH;
+    }
+    if (h.triangle_count > SB_MESH_MAX_TRIANGLES || h.vertex_count != 3 * h.triangle_count ||
+        h.material_count > SB_MESH_MAX_MATERIALS || mesh->triangle_count + h.triangle_count > SB_MESH_MAX_TRIANGLES) {
+        sb_error("%s: %u triangles, %u materials: past the caps (%u triangles in all, %u materials)", path,
+                 h.triangle_count, h.material_count, SB_MESH_MAX_TRIANGLES, SB_MESH_MAX_MATERIALS);
+        return SB_ERR_TOO_LARGE;
+    }
+    struct sb_mesh_material *materials = malloc((h.material_count + 1) * sizeof(*materials));
+    float *positions = malloc((size_t)h.vertex_count * 3 * sizeof(float) + 1);
+    uint32_t *triangle_materials = malloc((size_t)h.triangle_count * sizeof(uint32_t) + 1);
+    enum sb_result res = materials && positions && triangle_materials ? SB_OK : SB_ERR_NOMEM;
+    if (!res && !(read_all(fd, materials, h.material_count * sizeof(*materials), deadline) &&
+                  read_all(fd, positions, (size_t)h.vertex_count * 3 * sizeof(float), deadline) &&
+                  read_all(fd, triangle_materials, (size_t)h.triangle_count * sizeof(uint32_t), deadline))) {
+        sb_error("%s: the import stopped half way", path);
+        res = SB_ERR_MESH;
+    }
+    uint32_t first = mesh->material_count;
+    for (uint32_t m = 0; m < h.material_count && !res; m++) {
+        double albedo[3] = {materials[m].albedo[0], materials[m].albedo[1], materials[m].albedo[2]};
+        uint32_t index;
+        materials[m].name[sizeof(materials[m].name) - 1] = '\0';
+        res = sb_mesh_add_material(mesh, materials[m].name, albedo, &index);
+    }
+    uint32_t dropped = mesh->dropped_degenerate;
+    for (uint32_t t = 0; t < h.triangle_count && !res; t++) {
+        double p[3][3];
+        for (int k = 0; k < 3; k++)
+            for (int i = 0; i < 3; i++)
+                p[k][i] = positions[9 * (size_t)t + 3 * k + i];
+        if (triangle_materials[t] >= h.material_count) {
+            sb_error("%s: triangle %u: material %u of %u", path, t, triangle_materials[t], h.material_count);
+            res = SB_ERR_MESH;
+            break;
+        }
+        res = sb_mesh_add_triangle(mesh, p[0], p[1], p[2], first + triangle_materials[t], path);
+    }
+    mesh->dropped_degenerate = dropped + h.dropped_degenerate;
+    free(materials);
+    free(positions);
+    free(triangle_materials);
+    return res;
+}
+
+enum sb_result sb_mesh_load(const char *path, const struct sb_mesh_load_params *params, struct sb_mesh *mesh)
+{
+    static const struct sb_mesh_load_params defaults = {0};
+    params = params ? params : &defaults;
+    struct stat st;
+    if (stat(path, &st) != 0) {
+        sb_error("%s: cannot read the mesh: %s", path, strerror(errno));
+        return SB_ERR_IO;
+    }
+    if (!S_ISREG(st.st_mode)) {
+        sb_error("%s: not a regular file", path);
+        return SB_ERR_IO;
+    }
+    if ((unsigned long long)st.st_size > SB_MESH_MAX_FILE_BYTES) {
+        sb_error("%s: %llu bytes; meshes are read up to %llu MiB", path, (unsigned long long)st.st_size,
+                 SB_MESH_MAX_FILE_BYTES >> 20);
+        return SB_ERR_TOO_LARGE;
+    }
+    int fds[2];
+    if (pipe(fds) != 0) {
+        sb_error("%s: pipe: %s", path, strerror(errno));
+        return SB_ERR_IO;
+    }
+    fflush(NULL);
+    pid_t child = fork();
+    if (child < 0) {
+        sb_error("%s: fork: %s", path, strerror(errno));
+        close(fds[0]);
+        close(fds[1]);
+        return SB_ERR_IO;
+    }
+    if (child == 0) {
+        close(fds[0]);
+        import_child(fds[1], path, params);
+    }
+    close(fds[1]);
+    /* Keep a copy of the counts: a failure leaves *mesh as it was. */
+    struct sb_mesh before = *mesh;
+    struct timespec ts;
+    clock_gettime(CLOCK_MONOTONIC, &ts);
+    unsigned seconds = params->time_limit_s ? params->time_limit_s : SB_MESH_IMPORT_SECONDS;
+    /* CPU time limits the child; the wall-clock deadline covers a child that sleeps */
+    double deadline = ts.tv_sec + ts.tv_nsec * 1e-9 + 2.0 * seconds + 10;
+    enum sb_result res = receive(fds[0], path, seconds, deadline, mesh);
+    close(fds[0]);
+    kill(child, SIGKILL); /* done or stuck: either way it has nothing more to say */
+    int status;
+    while (waitpid(child, &status, 0) < 0 && errno == EINTR)
+        ;
+    if (res) {
+        mesh->vertex_count = before.vertex_count;
+        mesh->triangle_count = before.triangle_count;
+        mesh->material_count = before.material_count;
+        mesh->dropped_degenerate = before.dropped_degenerate;
+    } else if (mesh->dropped_degenerate > before.dropped_degenerate) {
+        sb_info("%s: %u zero-area triangles left out", path, mesh->dropped_degenerate - before.dropped_degenerate);
+    }
+    return res;
+}
+
+bool sb_mesh_bounds(const struct sb_mesh *mesh, float min[3], float max[3])
+{
+    if (!mesh->vertex_count)
+        return false;
+    for (int i = 0; i < 3; i++)
+        min[i] = max[i] = mesh->positions[i];
+    for (size_t v = 0; v < mesh->vertex_count; v++)
+        for (int i = 0; i < 3; i++) {
+            min[i] = fminf(min[i], mesh->positions[3 * v + i]);
+            max[i] = fmaxf(max[i], mesh->positions[3 * v + i]);
+        }
+    return true;
+}
+
+void sb_mesh_hash(const struct sb_mesh *mesh, char out[33])
+{
+    XXH3_state_t *st = XXH3_createState();
+    XXH3_128bits_reset(st);
+    XXH3_128bits_update(st, "skybake-mesh-v1", 15);
+    uint32_t counts[3] = {mesh->vertex_count, mesh->triangle_count, mesh->material_count};
+    XXH3_128bits_update(st, counts, sizeof(counts));
+    XXH3_128bits_update(st, mesh->positions, (size_t)mesh->vertex_count * 3 * sizeof(float));
+    XXH3_128bits_update(st, mesh->indices, (size_t)mesh->triangle_count * 3 * sizeof(uint32_t));
+    XXH3_128bits_update(st, mesh->materials, (size_t)mesh->triangle_count * sizeof(uint32_t));
+    for (uint32_t m = 0; m < mesh->material_count; m++)
+        XXH3_128bits_update(st, mesh->material_list[m].albedo, sizeof(mesh->material_list[m].albedo));
+    XXH128_hash_t h = XXH3_128bits_digest(st);
+    XXH3_freeState(st);
+    snprintf(out, 33, "%016llx%016llx", (unsigned long long)h.high64, (unsigned long long)h.low64);
+}
+
+void sb_mesh_finish(struct sb_mesh *mesh)
+{
+    free(mesh->positions);
+    free(mesh->indices);
+    free(mesh->materials);
+    free(mesh->material_list);
+    memset(mesh, 0, sizeof(*mesh));
+}

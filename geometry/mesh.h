@@ -1,0 +1,118 @@
+/*
+ * Scene geometry as the baker sees it: one triangle soup in world space
+ * (metres, y up, the runtime's convention), each triangle with a material
+ * (a name and a linear albedo). Meshes come from files through assimp
+ * (glTF 2.0, GLB, OBJ, PLY, IFC and the other formats it reads) or from
+ * code (the runtime's procedural test world, the tests' analytic shapes)
+ * through sb_mesh_add_triangle; both paths meet the same checks.
+ *
+ * Everything a file could make huge is checked before it is allocated:
+ * the file's size, then assimp's counts against the caps below.
+ */
+#ifndef SB_GEOMETRY_MESH_H
+#define SB_GEOMETRY_MESH_H
+
+#include <stdbool.h>
+#include <stddef.h>
+#include <stdint.h>
+
+#include "result.h"
+
+/* Caps: a mesh file larger than this is refused before it is read. */
+#define SB_MESH_MAX_FILE_BYTES (512ull << 20)
+/* Triangles and vertices a mesh may hold (a BVH node index fits in 31 bits). */
+#define SB_MESH_MAX_TRIANGLES (16u << 20)
+#define SB_MESH_MAX_VERTICES (48u << 20)
+#define SB_MESH_MAX_MATERIALS 4096
+#define SB_MESH_MATERIAL_NAME_MAX 64
+/* Coordinates beyond this many metres from the origin (after the
+ * transform) are refused: fp32 steps there are 1 mm. */
+#define SB_MESH_MAX_EXTENT_M 1.0e4
+/* assimp imports in a child process (it is not hardened against hostile
+ * files: one made it loop for ever here) under this CPU-time limit, and
+ * 16 GiB of address space. */
+#define SB_MESH_IMPORT_SECONDS 300
+
+struct sb_mesh_material {
+    char name[SB_MESH_MATERIAL_NAME_MAX];
+    float albedo[3]; /* linear, [0, 1] */
+};
+
+struct sb_mesh {
+    uint32_t vertex_count, triangle_count, material_count;
+    float *positions;                       /* owned: 3 per vertex, metres */
+    uint32_t *indices;                      /* owned: 3 per triangle, < vertex_count */
+    uint32_t *materials;                    /* owned: one per triangle, < material_count */
+    struct sb_mesh_material *material_list; /* owned */
+    uint32_t dropped_degenerate;            /* zero-area triangles left out on loading */
+    size_t capacity_vertices, capacity_triangles, capacity_materials;
+};
+
+/* How a file's coordinates become world coordinates: p_world = translate +
+ * R(rotate) * (scale * units_m * p_file), R the rotations about x, then y,
+ * then z (degrees), after assimp has applied the file's own node transforms
+ * and, for a z-up file (up_z), turned z-up into y-up. Zero means default:
+ * units_m and scale 0 read as 1. */
+struct sb_mesh_transform {
+    double units_m; /* metres per file unit [1] */
+    double scale;   /* [1] */
+    double rotate_deg[3];
+    double translate_m[3];
+    bool up_z; /* the file is z-up (turn +z to +y) */
+};
+
+/* A material's albedo given by the scene instead of the file's. */
+struct sb_mesh_albedo_override {
+    const char *material; /* the material's name in the file, or "*" for every material */
+    double albedo[3];
+};
+
+struct sb_mesh_load_params {
+    struct sb_mesh_transform transform;
+    const struct sb_mesh_albedo_override *overrides;
+    int override_count;
+    /* Albedo of a material whose file gives no base or diffuse colour [0.5]. */
+    double default_albedo;
+    /* CPU seconds the import may take [SB_MESH_IMPORT_SECONDS]. */
+    unsigned time_limit_s;
+};
+
+/*
+ * Append the triangles of the mesh file at `path` to *mesh (which may hold
+ * triangles already, or be zeroed). Every triangle of every mesh of the
+ * file's node tree, with the nodes' transforms; points and lines are left
+ * out; polygons are triangulated. Materials take the file's base colour
+ * (glTF's baseColorFactor) or else its diffuse colour, clamped to [0, 1],
+ * unless an override names them.
+ *
+ * Refuses, naming the file and the reason, and leaving *mesh as it was: a
+ * file that cannot be read or is over SB_MESH_MAX_FILE_BYTES
+ * (SB_ERR_IO, SB_ERR_TOO_LARGE), one assimp refuses, crashes on or does
+ * not finish within the time limit (SB_ERR_MESH), a
+ * non-finite or out-of-extent coordinate (SB_ERR_NUMERIC), counts past the
+ * caps (SB_ERR_TOO_LARGE), and a file with no triangle of non-zero area
+ * (SB_ERR_MESH). Zero-area triangles are left out and counted.
+ */
+enum sb_result sb_mesh_load(const char *path, const struct sb_mesh_load_params *params, struct sb_mesh *mesh);
+
+/* Add a material; returns its index in *index. */
+enum sb_result sb_mesh_add_material(struct sb_mesh *mesh, const char *name, const double albedo[3], uint32_t *index);
+
+/* Append one triangle (world space, metres) with material `material`.
+ * Refuses non-finite or out-of-extent coordinates; a zero-area triangle is
+ * dropped (counted) and SB_OK returned. `source` names the caller in
+ * messages. */
+enum sb_result sb_mesh_add_triangle(struct sb_mesh *mesh, const double a[3], const double b[3], const double c[3],
+                                    uint32_t material, const char *source);
+
+/* The bounds of every vertex; false when the mesh is empty. */
+bool sb_mesh_bounds(const struct sb_mesh *mesh, float min[3], float max[3]);
+
+/* XXH3-128 of the positions, indices, materials and albedos: what a bake
+ * that reads the mesh depends on. */
+void sb_mesh_hash(const struct sb_mesh *mesh, char out[33]);
+
+/* Free the arrays and zero *mesh; accepts a zeroed mesh. */
+void sb_mesh_finish(struct sb_mesh *mesh);
+
+#endif
