@@ -268,4 +268,23 @@ struct sb_raycast_push {
     SB_UINT pad;
 };
 
+/* Sky-visibility probes (sky_visibility.comp, baker/sky_visibility.h): one
+ * workgroup a probe, each invocation a share of the probe's rays, in the
+ * raycast kernel's bindings (nodes, triangles; probes: one vec4 a probe,
+ * its position in m; out: SB_VISIBILITY_FLOATS a probe). Ray i of n leaves along
+ * the spherical Fibonacci direction y = 1 - (2 i + 1) / n, azimuth 2 pi
+ * frac(i x 0x9E3779B9 / 2^32) (y up). SH: the real basis of order 2 in
+ * Sloan's order over world (x, y, z), z the polar axis of the formulas. */
+#define SB_PROBE_THREADS 64
+#define SB_PROBE_MAX_RAYS 65536
+#define SB_PROBE_SH 9
+#define SB_VISIBILITY_FLOATS 12 /* sh[9], back-face fraction, hit fraction, mean hit distance (m) */
+
+struct sb_probe_push {
+    SB_UINT probe_count;
+    SB_UINT ray_count; /* a multiple of SB_PROBE_THREADS */
+    float tmin_m;      /* rays start this far out */
+    float tmax_m;      /* and see the sky past this distance */
+};
+
 #endif

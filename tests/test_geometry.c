@@ -5,10 +5,8 @@
  * Embree, the independent reference, on every test ray but a stated band of
  * rays that graze an edge or a vertex (measured and reported).
  */
-#include <embree3/rtcore.h>
 #include <fcntl.h>
 #include <math.h>
-#include <pthread.h>
 #include <stdint.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -17,6 +15,7 @@
 #include <unistd.h>
 
 #include "bvh.h"
+#include "embree_ref.h"
 #include "harness_vk.h"
 #include "log.h"
 #include "mesh.h"
@@ -70,94 +69,6 @@ static void random_direction(float d[3])
     d[0] = (float)(r * cos(phi));
     d[1] = (float)z;
     d[2] = (float)(r * sin(phi));
-}
-
-/* ---- Embree ------------------------------------------------------------------------------ */
-
-struct embree {
-    RTCDevice device;
-    RTCScene scene;
-};
-
-static bool embree_create(const struct sb_mesh *mesh, struct embree *e)
-{
-    e->device = rtcNewDevice(NULL);
-    if (!e->device)
-        return false;
-    e->scene = rtcNewScene(e->device);
-    rtcSetSceneFlags(e->scene, RTC_SCENE_FLAG_ROBUST);
-    RTCGeometry g = rtcNewGeometry(e->device, RTC_GEOMETRY_TYPE_TRIANGLE);
-    float *v =
-        rtcSetNewGeometryBuffer(g, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT3, 3 * sizeof(float), mesh->vertex_count);
-    unsigned *idx = rtcSetNewGeometryBuffer(g, RTC_BUFFER_TYPE_INDEX, 0, RTC_FORMAT_UINT3, 3 * sizeof(unsigned),
-                                            mesh->triangle_count);
-    memcpy(v, mesh->positions, (size_t)mesh->vertex_count * 3 * sizeof(float));
-    memcpy(idx, mesh->indices, (size_t)mesh->triangle_count * 3 * sizeof(unsigned));
-    rtcCommitGeometry(g);
-    rtcAttachGeometry(e->scene, g);
-    rtcReleaseGeometry(g);
-    rtcCommitScene(e->scene);
-    return true;
-}
-
-static void embree_destroy(struct embree *e)
-{
-    rtcReleaseScene(e->scene);
-    rtcReleaseDevice(e->device);
-}
-
-struct embree_job {
-    const struct embree *e;
-    const float *rays;
-    float *hits;
-    uint32_t first, count;
-};
-
-static void *embree_worker(void *arg)
-{
-    struct embree_job *job = arg;
-    struct RTCIntersectContext ctx;
-    rtcInitIntersectContext(&ctx);
-    for (uint32_t i = job->first; i < job->first + job->count; i++) {
-        const float *r = &job->rays[8 * (size_t)i];
-        struct RTCRayHit rh = {0};
-        rh.ray.org_x = r[0];
-        rh.ray.org_y = r[1];
-        rh.ray.org_z = r[2];
-        rh.ray.tnear = r[3];
-        rh.ray.dir_x = r[4];
-        rh.ray.dir_y = r[5];
-        rh.ray.dir_z = r[6];
-        rh.ray.tfar = r[7];
-        rh.ray.mask = ~0u;
-        rh.hit.geomID = RTC_INVALID_GEOMETRY_ID;
-        rtcIntersect1(job->e->scene, &ctx, &rh);
-        float *h = &job->hits[4 * (size_t)i];
-        uint32_t tri = rh.hit.geomID == RTC_INVALID_GEOMETRY_ID ? SB_BVH_MISS : rh.hit.primID;
-        h[0] = rh.ray.tfar;
-        memcpy(&h[1], &tri, sizeof(tri));
-        h[2] = rh.hit.u;
-        h[3] = rh.hit.v;
-    }
-    return NULL;
-}
-
-/* Cast on every core; returns the wall time in seconds. */
-static double embree_cast(const struct embree *e, const float *rays, uint32_t count, float *hits)
-{
-    long cores = sysconf(_SC_NPROCESSORS_ONLN);
-    int n = cores < 1 ? 1 : cores > 64 ? 64 : (int)cores;
-    pthread_t threads[64];
-    struct embree_job jobs[64];
-    double t0 = now_s();
-    for (int i = 0; i < n; i++) {
-        uint32_t first = (uint32_t)((uint64_t)count * i / n), end = (uint32_t)((uint64_t)count * (i + 1) / n);
-        jobs[i] = (struct embree_job){e, rays, hits, first, end - first};
-        pthread_create(&threads[i], NULL, embree_worker, &jobs[i]);
-    }
-    for (int i = 0; i < n; i++)
-        pthread_join(threads[i], NULL);
-    return now_s() - t0;
 }
 
 /* ---- the fp64 look at a disagreement ------------------------------------------------------ */

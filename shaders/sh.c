@@ -1,0 +1,94 @@
+#include "sh.h"
+
+#include <math.h>
+#include <string.h>
+
+void sb_sh9_basis(const double d[3], double y[SB_PROBE_SH])
+{
+    double x = d[0], yy = d[1], z = d[2];
+    y[0] = 0.28209479177387814;
+    y[1] = 0.4886025119029199 * yy;
+    y[2] = 0.4886025119029199 * z;
+    y[3] = 0.4886025119029199 * x;
+    y[4] = 1.0925484305920792 * x * yy;
+    y[5] = 1.0925484305920792 * yy * z;
+    y[6] = 0.31539156525252005 * (3.0 * z * z - 1.0);
+    y[7] = 1.0925484305920792 * x * z;
+    y[8] = 0.5462742152960396 * (x * x - yy * yy);
+}
+
+void sb_probe_direction(uint32_t i, uint32_t n, double d[3])
+{
+    double y = 1.0 - (2.0 * i + 1.0) / n;
+    double phi = 2.0 * M_PI * ((double)(uint32_t)(i * 0x9E3779B9u) * 0x1p-32);
+    double r = sqrt(fmax(0.0, 1.0 - y * y));
+    d[0] = r * cos(phi);
+    d[1] = y;
+    d[2] = r * sin(phi);
+}
+
+double sb_sh9_eval(const double c[SB_PROBE_SH], const double d[3])
+{
+    double y[SB_PROBE_SH], sum = 0;
+    sb_sh9_basis(d, y);
+    for (int k = 0; k < SB_PROBE_SH; k++)
+        sum += c[k] * y[k];
+    return sum;
+}
+
+void sb_sh9_from_zonal(const double z[3], const double axis[3], double c[SB_PROBE_SH])
+{
+    double y[SB_PROBE_SH];
+    sb_sh9_basis(axis, y);
+    static const int band[SB_PROBE_SH] = {0, 1, 1, 1, 2, 2, 2, 2, 2};
+    for (int k = 0; k < SB_PROBE_SH; k++)
+        c[k] = sqrt(4.0 * M_PI / (2 * band[k] + 1)) * z[band[k]] * y[k];
+}
+
+double sb_sh9_min(const double c[SB_PROBE_SH], double where[3])
+{
+    double lowest = INFINITY;
+    for (uint32_t i = 0; i < SB_SH_TEST_DIRECTIONS; i++) {
+        double d[3];
+        sb_probe_direction(i, SB_SH_TEST_DIRECTIONS, d);
+        double v = sb_sh9_eval(c, d);
+        if (v < lowest) {
+            lowest = v;
+            if (where)
+                memcpy(where, d, sizeof(d));
+        }
+    }
+    return lowest;
+}
+
+static void window(const double c[SB_PROBE_SH], double h, double out[SB_PROBE_SH])
+{
+    /* Hann for order 2 (bands 1, 3/4, 1/4), then towards the constant band alone */
+    static const double hann[3] = {1.0, 0.75, 0.25};
+    static const int band[SB_PROBE_SH] = {0, 1, 1, 1, 2, 2, 2, 2, 2};
+    for (int k = 0; k < SB_PROBE_SH; k++) {
+        int l = band[k];
+        double w = h <= 1.0 ? 1.0 - h * (1.0 - hann[l]) : (l ? hann[l] * (2.0 - h) : 1.0);
+        out[k] = c[k] * w;
+    }
+}
+
+double sb_sh9_dering(double c[SB_PROBE_SH], double *min_before)
+{
+    double lowest = sb_sh9_min(c, NULL);
+    *min_before = lowest;
+    if (lowest >= 0.0)
+        return 0.0;
+    double lo = 0.0, hi = 2.0, w[SB_PROBE_SH];
+    for (int it = 0; it < 20; it++) {
+        double mid = 0.5 * (lo + hi);
+        window(c, mid, w);
+        if (sb_sh9_min(w, NULL) >= 0.0)
+            hi = mid;
+        else
+            lo = mid;
+    }
+    window(c, hi, w);
+    memcpy(c, w, sizeof(w));
+    return hi;
+}

@@ -1,0 +1,40 @@
+/*
+ * The C half of sh.glsl: the order-2 real SH basis (Sloan 2008), the probe
+ * rays' directions, and deringing. Pure, thread safe, fp64.
+ */
+#ifndef SB_SHADERS_SH_H
+#define SB_SHADERS_SH_H
+
+#include <stdint.h>
+
+#include "config.h"
+
+/* The 9 basis functions at unit direction d (world axes). */
+void sb_sh9_basis(const double d[3], double y[SB_PROBE_SH]);
+
+/* Ray i of n of a probe (config.h: spherical Fibonacci, y up), in fp64. */
+void sb_probe_direction(uint32_t i, uint32_t n, double d[3]);
+
+/* The SH reconstruction sum_k c[k] Y_k(d). */
+double sb_sh9_eval(const double c[SB_PROBE_SH], const double d[3]);
+
+/* A zonal function about unit axis a with zonal coefficients z[l] (l = 0..2)
+ * in the basis: c_lm = sqrt(4 pi / (2 l + 1)) z_l Y_lm(a). */
+void sb_sh9_from_zonal(const double z[3], const double axis[3], double c[SB_PROBE_SH]);
+
+/* The smallest reconstruction over SB_SH_TEST_DIRECTIONS directions (a
+ * spherical Fibonacci set), and where. */
+#define SB_SH_TEST_DIRECTIONS 2048
+double sb_sh9_min(const double c[SB_PROBE_SH], double where[3]);
+
+/*
+ * Dering: window the bands so that the reconstruction is never negative
+ * (on the test directions). The window is h in [0, 2]: from 0 (none)
+ * through 1 (Hann: bands scaled 1, 3/4, 1/4) to 2 (the constant band
+ * alone, which is never negative for a non-negative function's
+ * projection); the smallest h that works is found by bisection to 2^-20.
+ * Returns h; *min_before gets the smallest value before (>= 0: nothing done).
+ */
+double sb_sh9_dering(double c[SB_PROBE_SH], double *min_before);
+
+#endif

@@ -1,0 +1,66 @@
+#version 450
+// Sky visibility at probes: every ray that escapes the geometry (misses
+// every triangle within tmax) adds the SH basis of its direction, weighted
+// 4 pi / n; rays that hit count back faces (a probe inside geometry sees
+// mostly back faces) and their distances. One workgroup a probe; the
+// partial sums are added in a fixed tree order, so results do not depend
+// on scheduling.
+#extension GL_GOOGLE_include_directive : require
+#include "config.h"
+
+layout(local_size_x = SB_PROBE_THREADS) in;
+layout(std430, binding = SB_RAYCAST_BINDING_NODES) readonly buffer Nodes { vec4 bvh_nodes[]; };
+layout(std430, binding = SB_RAYCAST_BINDING_TRIANGLES) readonly buffer Triangles { vec4 bvh_triangles[]; };
+layout(std430, binding = SB_RAYCAST_BINDING_RAYS) readonly buffer Probes { vec4 probes[]; };
+layout(std430, binding = SB_RAYCAST_BINDING_HITS) writeonly buffer Out { float results[]; };
+layout(push_constant) uniform Push { sb_probe_push pc; };
+
+#include "bvh.glsl"
+#include "sh.glsl"
+
+#define SUMS (SB_PROBE_SH + 3)
+shared float partial[SUMS][SB_PROBE_THREADS];
+
+void main()
+{
+    uint probe = gl_WorkGroupID.x + gl_WorkGroupID.y * gl_NumWorkGroups.x;
+    uint lane = gl_LocalInvocationID.x;
+    if (probe >= pc.probe_count)
+        return; // whole workgroups only: no barrier is skipped by part of one
+    vec3 origin = probes[probe].xyz;
+    float sums[SUMS];
+    for (int k = 0; k < SUMS; k++)
+        sums[k] = 0.0;
+    for (uint i = lane; i < pc.ray_count; i += SB_PROBE_THREADS) {
+        vec3 d = probe_direction(i, pc.ray_count);
+        BvhHit hit = bvh_trace(origin, d, pc.tmin_m, pc.tmax_m, false);
+        if (hit.triangle == SB_BVH_MISS) {
+            float y[SB_PROBE_SH];
+            sh9_basis(d, y);
+            for (int k = 0; k < SB_PROBE_SH; k++)
+                sums[k] += y[k];
+        } else {
+            sums[SB_PROBE_SH] += (hit.triangle & SB_BVH_BACK_FACE) != 0u ? 1.0 : 0.0;
+            sums[SB_PROBE_SH + 1] += 1.0;
+            sums[SB_PROBE_SH + 2] += hit.t;
+        }
+    }
+    for (int k = 0; k < SUMS; k++)
+        partial[k][lane] = sums[k];
+    barrier();
+    for (uint stride = SB_PROBE_THREADS / 2; stride > 0; stride /= 2) {
+        if (lane < stride)
+            for (int k = 0; k < SUMS; k++)
+                partial[k][lane] += partial[k][lane + stride];
+        barrier();
+    }
+    if (lane == 0) {
+        float n = float(pc.ray_count), hits = partial[SB_PROBE_SH + 1][0];
+        uint base = probe * SB_VISIBILITY_FLOATS;
+        for (int k = 0; k < SB_PROBE_SH; k++)
+            results[base + k] = partial[k][0] * (12.566370614359172 / n);
+        results[base + SB_PROBE_SH] = hits > 0.0 ? partial[SB_PROBE_SH][0] / n : 0.0;
+        results[base + SB_PROBE_SH + 1] = hits / n;
+        results[base + SB_PROBE_SH + 2] = hits > 0.0 ? partial[SB_PROBE_SH + 2][0] / hits : 0.0;
+    }
+}
