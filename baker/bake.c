@@ -167,6 +167,7 @@ enum sb_result sb_bake_scene(struct sb_vk *vk, const struct sb_scene *scene, con
             snprintf(a->settings_json, sizeof(a->settings_json), "%s", was->settings_json);
             a->bake_ms = was->bake_ms;
             a->gpu_ms = was->gpu_ms;
+            a->probes = was->probes;
             baked[p] = old->images[p];
             old->images[p] = (struct sb_image){0};
             if ((family->adopt && (res = family->adopt(state, id, &baked[p]))) ||

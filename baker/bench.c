@@ -324,6 +324,8 @@ enum sb_result sb_bench_run(struct sb_vk *vk, const struct sb_atmosphere_params 
     }
     if (!res)
         res = bench_clouds(vk, params, repeat, times, report);
+    if (!res && params->probes)
+        res = sb_bench_probes(vk, params, report);
     if (!res)
         mark_pareto(report->rows, report->row_count);
     sb_image_finish(&image);
@@ -384,6 +386,25 @@ static cJSON *report_json(const struct sb_bench_report *report, const struct sb_
         cJSON_AddBoolToObject(o, "pareto", r->pareto);
         cJSON_AddItemToArray(rows, o);
     }
+    for (int i = 0; i < report->probe_row_count; i++) {
+        const struct sb_bench_probe_row *r = &report->probe_rows[i];
+        cJSON *arr = cJSON_GetObjectItem(root, "sky_visibility");
+        if (!arr)
+            arr = cJSON_AddArrayToObject(root, "sky_visibility");
+        cJSON *o = cJSON_CreateObject();
+        cJSON_AddStringToObject(o, "scene", r->scene);
+        cJSON_AddNumberToObject(o, "triangles", r->triangles);
+        cJSON_AddNumberToObject(o, "probes", r->probes);
+        cJSON_AddNumberToObject(o, "rays_per_probe", r->rays_per_probe);
+        cJSON_AddNumberToObject(o, "bvh_ms", r->bvh_ms);
+        cJSON_AddNumberToObject(o, "gpu_ms", r->gpu_ms);
+        cJSON_AddNumberToObject(o, "gpu_rays_per_s", r->gpu_rays_per_s);
+        cJSON_AddNumberToObject(o, "embree_s", r->embree_s);
+        cJSON_AddNumberToObject(o, "embree_threads", r->embree_threads);
+        cJSON_AddNumberToObject(o, "embree_rays_per_s", r->embree_rays_per_s);
+        cJSON_AddNumberToObject(o, "hits_differ", (double)r->hits_differ);
+        cJSON_AddItemToArray(arr, o);
+    }
     if (report->cloud_row_count) {
         cJSON *clouds = cJSON_AddArrayToObject(root, "clouds");
         for (int i = 0; i < report->cloud_row_count; i++) {
@@ -430,8 +451,10 @@ void sb_bench_print(const struct sb_bench_report *report, const struct sb_vk *vk
                    r->error.rms_rel, r->error_half.max_rel, r->anchor ? r->anchor : "");
         }
     }
-    if (!report->cloud_row_count)
+    if (!report->cloud_row_count) {
+        sb_bench_probes_print(report);
         return;
+    }
     printf("\ncloud noise (the GPU against the CPU reference on one core, every value compared)\n");
     printf("  %-14s %-12s %11s %11s %14s %9s  %s\n", "product", "size", "gpu ms", "gpu ms min", "reference ms",
            "speedup", "values differing");
@@ -447,6 +470,7 @@ void sb_bench_print(const struct sb_bench_report *report, const struct sb_vk *vk
         ref += r->reference_ms;
     }
     printf("  %-14s %-12s %11.4f %11s %14.1f %9.1f\n", "all", "", gpu, "", ref, ref / fmax(gpu, 1e-9));
+    sb_bench_probes_print(report);
 }
 
 static enum sb_result write_text(const char *dir, const char *name, const char *text)
@@ -621,6 +645,11 @@ enum sb_result sb_bench_write(const struct sb_bench_report *report, const struct
         }
         res = clouds.failed ? SB_ERR_NOMEM : write_text(dir, "bench_clouds.csv", clouds.data);
         free(clouds.data);
+    }
+    if (!res && report->probe_row_count) {
+        char path[4200];
+        snprintf(path, sizeof(path), "%s/bench_probes.csv", dir);
+        res = sb_bench_probes_csv(report, path);
     }
     if (!res) {
         cJSON *root = report_json(report, vk);

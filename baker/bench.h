@@ -57,9 +57,21 @@ struct sb_bench_cloud_row {
     uint64_t values, differing; /* the GPU's values against the reference's */
 };
 
+/* sky_visibility: rays per second on the device and Embree's (bench_probes.c). */
+struct sb_bench_probe_row {
+    char scene[32];
+    uint32_t triangles, probes, rays_per_probe;
+    double bvh_ms;                  /* the BVH's build on one thread */
+    double gpu_ms, gpu_rays_per_s;  /* the bake (median of the repeats) */
+    double embree_s, embree_rays_per_s;
+    int embree_threads;
+    uint64_t rays, hits_differ; /* rays whose hit or miss differ, summed over probes */
+};
+
 struct sb_bench_params {
     bool sweeps[SB_BENCH_SWEEP_COUNT]; /* which to run */
     bool clouds[SB_PRODUCT_COUNT];     /* which cloud products to time */
+    bool probes;                       /* sky_visibility */
     struct sb_cloud_params cloud_params;
     int repeat; /* bakes per setting; the median is reported */
     bool quick; /* only the settings marked quick (meson's benchmark) */
@@ -72,7 +84,14 @@ struct sb_bench_report {
     char probe[SB_BENCH_SWEEP_COUNT][96];
     int cloud_row_count;
     struct sb_bench_cloud_row cloud_rows[SB_PRODUCT_COUNT - SB_ATMOSPHERE_PRODUCT_COUNT];
+    int probe_row_count;
+    struct sb_bench_probe_row probe_rows[2];
 };
+
+/* bench_probes.c */
+enum sb_result sb_bench_probes(struct sb_vk *vk, const struct sb_bench_params *params, struct sb_bench_report *report);
+void sb_bench_probes_print(const struct sb_bench_report *report);
+enum sb_result sb_bench_probes_csv(const struct sb_bench_report *report, const char *path);
 
 const char *sb_bench_sweep_name(enum sb_bench_sweep sweep);
 bool sb_bench_sweep_from_name(const char *name, enum sb_bench_sweep *sweep);

@@ -45,7 +45,9 @@ static void usage(FILE *f)
                "\n"
                "Bakes what SCENE (JSON, see docs/scene.md) needs into the pack OUT_DIR:\n"
                "manifest.json plus one file per product: EXR for 2D data, OpenVDB for the\n"
-               "cloud volumes (baked when the scene lists them, as earth-clouds.json does).\n"
+               "cloud volumes (baked when the scene lists them, as earth-clouds.json does),\n"
+               "a probe file for the sky-visibility probes over the scene's world (a mesh\n"
+               "file read through assimp, as ifc-house.json bakes).\n"
                "The pack is replaced atomically;\n"
                "a failed bake leaves the previous pack as it was. Baking into a pack\n"
                "reuses every artifact whose bake key (its parameters, settings, kernels\n"
@@ -67,8 +69,11 @@ static void usage(FILE *f)
                "against the fp64 reference (docs/accuracy.md). Products: transmittance,\n"
                "transmittance_resolution, multiscattering, irradiance_ground, irradiance_sky;\n"
                "and the cloud noise (cloud_shape, cloud_detail, cloud_curl, weather, at the\n"
-               "SCENE's sizes), timed against its CPU reference on one core (default: all).\n"
-               "-o DIR writes bench.csv, bench.json, bench.svg (gnuplot), bench_clouds.csv.\n"
+               "SCENE's sizes), timed against its CPU reference on one core; and\n"
+               "sky_visibility: 4096 probes' rays per second on the device against Embree's\n"
+               "on every core, over the IFC house and a terrain of a million triangles\n"
+               "(default: all). -o DIR writes bench.csv, bench.json, bench.svg (gnuplot),\n"
+               "bench_clouds.csv, bench_probes.csv.\n"
                "--repeat N bakes each setting N times (default 3) and reports the median;\n"
                "--quick runs a short sweep (the meson benchmark).\n"
                "\n"
@@ -222,8 +227,13 @@ static int cmd_bench(int argc, char **argv)
             out_dir = argv[++i];
         } else if (!strcmp(a, "--product") && i + 1 < argc) {
             enum sb_product_id id;
-            if (sb_product_from_name(argv[++i], &id) && sb_product_format(id)->family == SB_FAMILY_CLOUDS) {
+            bool known = sb_product_from_name(argv[++i], &id);
+            if (known && sb_product_format(id)->family == SB_FAMILY_CLOUDS) {
                 params.clouds[id] = any = true;
+                continue;
+            }
+            if (known && id == SB_PRODUCT_SKY_VISIBILITY) {
+                params.probes = any = true;
                 continue;
             }
             if (!sb_bench_sweep_from_name(argv[i], &sweep)) {
@@ -257,6 +267,7 @@ static int cmd_bench(int argc, char **argv)
             params.sweeps[w] = true;
         for (int p = 0; p < SB_PRODUCT_COUNT; p++)
             params.clouds[p] = sb_product_format((enum sb_product_id)p)->family == SB_FAMILY_CLOUDS;
+        params.probes = true;
     }
     struct sb_scene scene = {0};
     if (scene_path && sb_scene_load(scene_path, &scene))

@@ -64,3 +64,8 @@ done:
     sb_buffer_destroy(vk, &probes);
     return res;
 }
+
+void sb_sky_visibility_code_hash(char out[33])
+{
+    sb_hash_bytes(sb_spv_sky_visibility, sizeof(sb_spv_sky_visibility), out);
+}

@@ -31,4 +31,7 @@ struct sb_sky_visibility_params {
 enum sb_result sb_sky_visibility_bake(struct sb_raycaster *raycaster, const float *positions, uint32_t probe_count,
                                       const struct sb_sky_visibility_params *params, float *out, double *gpu_ms);
 
+/* XXH3-128 of the kernel's SPIR-V, for bake keys. */
+void sb_sky_visibility_code_hash(char out[33]);
+
 #endif

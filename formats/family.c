@@ -18,6 +18,14 @@ static const struct sb_family_format families[SB_FAMILY_COUNT] = {
             .no_tolerance = "the cloud noise is baked exactly (bit for bit with its CPU reference) and takes no "
                             "tolerance",
         },
+    [SB_FAMILY_PROBES] =
+        {
+            .name = "probes",
+            .section = "probes",
+            .parse_section = sb_probes_section_parse,
+            .section_json = sb_probes_section_json,
+            .no_tolerance = "the probes' error is set by their ray count (probes.rays), not by a tolerance",
+        },
 };
 
 const struct sb_family_format *sb_family_format(enum sb_family family)

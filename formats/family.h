@@ -49,4 +49,10 @@ enum sb_result sb_clouds_section_parse(const struct cJSON *section, struct sb_sc
 struct cJSON *sb_clouds_section_json(const struct sb_scene *scene);
 uint32_t sb_clouds_product_size(const struct sb_scene *scene, enum sb_product_id id);
 
+/* The world's and the probes' sections (scene_world.c). */
+enum sb_result sb_world_section_parse(const struct cJSON *section, struct sb_scene *scene, const char *source);
+struct cJSON *sb_world_section_json(const struct sb_scene *scene);
+enum sb_result sb_probes_section_parse(const struct cJSON *section, struct sb_scene *scene, const char *source);
+struct cJSON *sb_probes_section_json(const struct sb_scene *scene);
+
 #endif

@@ -2,7 +2,9 @@
 
 #include <errno.h>
 #include <fcntl.h>
+#include <math.h>
 #include <stdint.h>
+#include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 #include <sys/stat.h>
@@ -115,4 +117,36 @@ bool sb_json_emit(FILE *out, cJSON *root)
     free(text);
     cJSON_Delete(root);
     return ok;
+}
+
+enum sb_result sb_json_number(const cJSON *item, const char *source, const char *path, double lo, double hi,
+                              double *out)
+{
+    if (!cJSON_IsNumber(item)) {
+        sb_error("%s: %s: expected a number", source, path);
+        return SB_ERR_WRONG_TYPE;
+    }
+    if (!isfinite(item->valuedouble) || item->valuedouble < lo || item->valuedouble > hi) {
+        sb_error("%s: %s: %.17g is out of range, expected %g to %g", source, path, item->valuedouble, lo, hi);
+        return SB_ERR_OUT_OF_RANGE;
+    }
+    *out = item->valuedouble;
+    return SB_OK;
+}
+
+enum sb_result sb_json_vec3(const cJSON *item, const char *source, const char *path, double lo, double hi,
+                            double out[3])
+{
+    if (!cJSON_IsArray(item) || cJSON_GetArraySize(item) != 3) {
+        sb_error("%s: %s: expected an array of 3 numbers", source, path);
+        return SB_ERR_WRONG_TYPE;
+    }
+    char element[160];
+    for (int i = 0; i < 3; i++) {
+        snprintf(element, sizeof(element), "%s[%d]", path, i);
+        enum sb_result res = sb_json_number(cJSON_GetArrayItem(item, i), source, element, lo, hi, &out[i]);
+        if (res)
+            return res;
+    }
+    return SB_OK;
 }

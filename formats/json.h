@@ -31,4 +31,12 @@ enum sb_result sb_json_check_duplicates(const cJSON *object, const char *source,
  * (accepts NULL). False when memory or the write failed. */
 bool sb_json_emit(FILE *out, cJSON *root);
 
+/* A number in [lo, hi]; logs "source: path: reason" otherwise. */
+enum sb_result sb_json_number(const cJSON *item, const char *source, const char *path, double lo, double hi,
+                              double *out);
+
+/* An array of three numbers, each in [lo, hi]. */
+enum sb_result sb_json_vec3(const cJSON *item, const char *source, const char *path, double lo, double hi,
+                            double out[3]);
+
 #endif

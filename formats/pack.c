@@ -48,6 +48,9 @@ static const struct sb_product_format product_formats[SB_PRODUCT_COUNT] = {
                                SB_STORAGE_EXR_FLOAT32, "float32", "exr", SB_FAMILY_CLOUDS},
     [SB_PRODUCT_WEATHER] = {"weather", 0, 0, 1, 3, "coverage,precipitation,type", CLOUD_PARAMETERIZATION, 2,
                             SB_STORAGE_EXR_FLOAT32, "float32", "exr", SB_FAMILY_CLOUDS},
+    [SB_PRODUCT_SKY_VISIBILITY] = {"sky_visibility", 0, 1, 1, SB_SKY_VISIBILITY_CHANNEL_COUNT,
+                                   SB_SKY_VISIBILITY_CHANNELS, "probes-sh2-fibonacci-v1", 3, SB_STORAGE_PROBES,
+                                   "float32", "sbprobes", SB_FAMILY_PROBES},
 };
 
 void sb_product_shape(const struct sb_scene *scene, enum sb_product_id id, uint32_t shape[3])
@@ -317,8 +320,15 @@ enum sb_result sb_pack_writer_add_image(struct sb_pack_writer *w, struct sb_arti
     int i = w->artifact_count;
     w->artifacts[i] = *artifact;
     w->pending = w->artifacts[i].file;
-    enum sb_result res = format->storage == SB_STORAGE_VDB_HALF ? sb_vdb_write(path, image, attrs, n)
-                                                                : sb_exr_write(path, image, attrs, n);
+    enum sb_result res;
+    if (format->storage == SB_STORAGE_PROBES) {
+        snprintf(artifact->probes.key, sizeof(artifact->probes.key), "%s", artifact->key);
+        w->artifacts[i] = *artifact;
+        res = sb_probes_write(path, &artifact->probes, image);
+    } else {
+        res = format->storage == SB_STORAGE_VDB_HALF ? sb_vdb_write(path, image, attrs, n)
+                                                     : sb_exr_write(path, image, attrs, n);
+    }
     if (!res && (res = sb_hash_file(w->tmp_fd, artifact->file, artifact->file_hash)))
         sb_error("%s: cannot read the file back: %s", path, strerror(errno));
     if (res) {
@@ -542,7 +552,8 @@ static enum sb_result manifest_expect_int(const cJSON *object, const char *key, 
  * format and, for the shapes the scene sets, the pack's scene (NULL when it
  * did not read). */
 static enum sb_result read_artifact_entry(const cJSON *entry, int index, struct sb_pack *pack,
-                                          const struct sb_scene *scene, const char *source, enum sb_product_id *out_id)
+                                          const struct sb_scene *scene, const char *source, enum sb_product_id *out_id,
+                                          uint32_t out_shape[3])
 {
     char where[64];
     snprintf(where, sizeof(where), "artifacts[%d].", index);
@@ -599,6 +610,14 @@ static enum sb_result read_artifact_entry(const cJSON *entry, int index, struct 
     uint32_t shape[3] = {format->width, format->height, format->depth};
     if (scene)
         sb_product_shape(scene, id, shape);
+    /* A probe product's count follows from the world's geometry, which this
+     * tier does not read: the manifest says it, the file must agree. */
+    if (format->storage == SB_STORAGE_PROBES && ((res = manifest_u32(entry, "width", &shape[0], source, where)) ||
+                                                 !shape[0] || shape[0] > SB_PROBES_MAX_COUNT)) {
+        sb_error("%s: %swidth: %s needs 1 to %u probes", source, where, name, SB_PROBES_MAX_COUNT);
+        return res ? res : SB_ERR_OUT_OF_RANGE;
+    }
+    memcpy(out_shape, shape, sizeof(shape));
     if ((res = manifest_expect_int(entry, "width", shape[0], source, where, name)) ||
         (res = manifest_expect_int(entry, "height", shape[1], source, where, name)) ||
         (res = manifest_expect_int(entry, "depth", shape[2], source, where, name)))
@@ -687,16 +706,27 @@ static enum sb_result read_artifact_image(const char *dir, int dir_fd, struct sb
                      path, name, hash, a->file_hash);
             return SB_ERR_HASH_MISMATCH;
         }
-    } else if (format->storage == SB_STORAGE_VDB_HALF) {
-        /* OpenVDB's reader is not hardened: never parse bytes nobody vouched for. */
+    } else if (format->storage != SB_STORAGE_EXR_FLOAT32) {
+        /* OpenVDB's reader is not hardened, and probe files are version 3 on:
+         * never parse bytes nobody vouched for. */
         sb_error("%s: %s: no file_hash; refused", path, name);
         return SB_ERR_MISSING_FIELD;
     }
     struct sb_image *image = &pack->images[id];
     uint64_t texels = (uint64_t)shape[0] * shape[1] * shape[2];
-    enum sb_result res = format->storage == SB_STORAGE_VDB_HALF
-                             ? sb_vdb_read(path, format->channel_names, texels, image, NULL, NULL)
-                             : sb_exr_read(path, format->channel_names, texels, image, NULL, NULL);
+    enum sb_result res;
+    if (format->storage == SB_STORAGE_PROBES) {
+        res = sb_probes_read(path, format->channel_names, shape[0], &a->probes, image);
+        if (!res && strcmp(a->probes.key, a->key) != 0) {
+            sb_error("%s: %s: the file was baked with key %s, the manifest records %s", path, name, a->probes.key,
+                     a->key);
+            res = SB_ERR_HASH_MISMATCH;
+        }
+    } else {
+        res = format->storage == SB_STORAGE_VDB_HALF
+                  ? sb_vdb_read(path, format->channel_names, texels, image, NULL, NULL)
+                  : sb_exr_read(path, format->channel_names, texels, image, NULL, NULL);
+    }
     if (res)
         return res;
     if (image->width != shape[0] || image->height != shape[1] || image->depth != shape[2]) {
@@ -876,6 +906,7 @@ static enum sb_result pack_read(const char *dir, struct sb_pack *pack, unsigned 
     int index = 0;
     const cJSON *entry;
     bool entry_ok[SB_PRODUCT_COUNT] = {0};
+    uint32_t entry_shape[SB_PRODUCT_COUNT][3] = {{0}};
     cJSON_ArrayForEach(entry, artifacts)
     {
         enum sb_product_id id;
@@ -884,17 +915,16 @@ static enum sb_result pack_read(const char *dir, struct sb_pack *pack, unsigned 
             note(&p, SB_ERR_OUT_OF_RANGE);
             break;
         }
-        if (!note(&p, read_artifact_entry(entry, index++, pack, scene_ok ? pack->scene : NULL, source, &id)))
+        uint32_t shape[3];
+        if (!note(&p, read_artifact_entry(entry, index++, pack, scene_ok ? pack->scene : NULL, source, &id, shape))) {
             entry_ok[id] = true;
+            memcpy(entry_shape[id], shape, sizeof(shape));
+        }
     }
     for (int i = 0; i < SB_PRODUCT_COUNT; i++) {
         if (!entry_ok[i])
             continue;
-        const struct sb_product_format *f = sb_product_format((enum sb_product_id)i);
-        uint32_t shape[3] = {f->width, f->height, f->depth};
-        if (scene_ok)
-            sb_product_shape(pack->scene, (enum sb_product_id)i, shape);
-        note(&p, read_artifact_image(dir, dir_fd, pack, (enum sb_product_id)i, shape));
+        note(&p, read_artifact_image(dir, dir_fd, pack, (enum sb_product_id)i, entry_shape[i]));
     }
     find_unlisted(dir, pack, &p);
 done_root:

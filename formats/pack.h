@@ -13,11 +13,12 @@
 
 #include "exr.h"
 #include "image.h"
+#include "probes.h"
 #include "result.h"
 
 /* The version this build writes; it reads this one and every older one
  * (each a subset of the next; docs/pack.md). */
-#define SB_PACK_FORMAT_VERSION 2
+#define SB_PACK_FORMAT_VERSION 3
 #define SB_PACK_FORMAT_VERSION_OLDEST 1
 #define SB_PACK_MANIFEST "manifest.json"
 
@@ -32,6 +33,8 @@ enum sb_product_id {
     SB_PRODUCT_CLOUD_DETAIL,
     SB_PRODUCT_CLOUD_CURL,
     SB_PRODUCT_WEATHER,
+    /* Probes over the scene's world (format version 3 on). */
+    SB_PRODUCT_SKY_VISIBILITY,
     SB_PRODUCT_COUNT,
 };
 
@@ -40,7 +43,7 @@ enum sb_product_id {
 
 static inline bool sb_product_is_cloud(enum sb_product_id id)
 {
-    return id >= SB_PRODUCT_CLOUD_SHAPE && id < SB_PRODUCT_COUNT;
+    return id >= SB_PRODUCT_CLOUD_SHAPE && id <= SB_PRODUCT_WEATHER;
 }
 
 /* Families of products: each is one file of its own per tier plus a row in
@@ -48,6 +51,7 @@ static inline bool sb_product_is_cloud(enum sb_product_id id)
 enum sb_family {
     SB_FAMILY_ATMOSPHERE,
     SB_FAMILY_CLOUDS,
+    SB_FAMILY_PROBES,
     SB_FAMILY_COUNT,
 };
 
@@ -55,6 +59,7 @@ enum sb_family {
 enum sb_storage {
     SB_STORAGE_EXR_FLOAT32, /* EXR, FLOAT channels (exr.h) */
     SB_STORAGE_VDB_HALF,    /* OpenVDB, one half-stored FloatGrid per channel (vdb.h) */
+    SB_STORAGE_PROBES,      /* skybake's probe file, one fp32 record a probe (probes.h) */
 };
 
 /* What a product's file holds in this format version. */
@@ -92,6 +97,7 @@ struct sb_artifact {
     char content_hash[SB_HASH_HEX_SIZE];
     char file_hash[SB_HASH_HEX_SIZE]; /* of the file's bytes; "" in a version 1 pack */
     char key[SB_HASH_HEX_SIZE];       /* the bake key (baker/bake.h); "" when not recorded */
+    struct sb_probe_layout probes;    /* where a probe product's probes are (its file's header) */
 };
 
 struct sb_device_info {

@@ -31,6 +31,7 @@ static const struct {
     [SB_ERR_VDB] = {"vdb", "OpenVDB refused the file or the data"},
     [SB_ERR_MESH] = {"mesh", "a mesh file assimp refuses, or one with no usable triangle"},
     [SB_ERR_TOO_LARGE] = {"too-large", "a file or count past its documented cap"},
+    [SB_ERR_PROBES] = {"probes", "not a probe file, or a header field out of range"},
 };
 
 const char *sb_result_name(enum sb_result result)

@@ -34,6 +34,7 @@ enum sb_result {
     SB_ERR_VDB,             /* OpenVDB refused the file or the data */
     SB_ERR_MESH,            /* a mesh file assimp refuses, or one with no usable triangle */
     SB_ERR_TOO_LARGE,       /* a file or count past its documented cap, refused before allocating */
+    SB_ERR_PROBES,          /* not a probe file, or a header field out of range */
     SB_RESULT_COUNT,
 };
 

@@ -389,6 +389,7 @@ static enum sb_result parse_root(const cJSON *root, struct sb_scene *scene, cons
     bool have_atmosphere = false, have_products = false;
     scene->view = (struct sb_scene_view){.altitude_km = 0.002, .sun_elevation_deg = 30.0};
     sb_cloud_params_default(&scene->clouds);
+    sb_probe_params_default(&scene->probes);
     for (const cJSON *item = root->child; item; item = item->next) {
         if (strcmp(item->string, "version") == 0) {
             if (!cJSON_IsNumber(item)) {
@@ -420,6 +421,9 @@ static enum sb_result parse_root(const cJSON *root, struct sb_scene *scene, cons
         } else if (strcmp(item->string, "view") == 0) {
             if ((res = parse_view(item, scene, source)))
                 return res;
+        } else if (strcmp(item->string, "world") == 0) {
+            if ((res = sb_world_section_parse(item, scene, source)))
+                return res;
         } else if (strcmp(item->string, "tolerance") == 0) {
             if ((res = parse_tolerance(item, scene, source)))
                 return res;
@@ -433,6 +437,10 @@ static enum sb_result parse_root(const cJSON *root, struct sb_scene *scene, cons
     }
     if (!have_atmosphere) {
         sb_error("%s: atmosphere: missing", source);
+        return SB_ERR_MISSING_FIELD;
+    }
+    if (scene->wants[SB_PRODUCT_SKY_VISIBILITY] && !scene->has_world) {
+        sb_error("%s: products: sky_visibility needs a \"world\" (the geometry the probes see)", source);
         return SB_ERR_MISSING_FIELD;
     }
     if (!have_products)
@@ -464,7 +472,18 @@ enum sb_result sb_scene_load(const char *path, struct sb_scene *scene)
     memset(scene, 0, sizeof(*scene));
     cJSON *root;
     enum sb_result res = sb_json_load(AT_FDCWD, path, path, SCENE_MAX_BYTES, true, &root);
-    return res ? res : scene_from_root(root, path, scene);
+    res = res ? res : scene_from_root(root, path, scene);
+    if (!res) { /* the world's file is found beside the scene's */
+        const char *slash = strrchr(path, '/');
+        size_t length = slash ? (slash == path ? 1 : (size_t)(slash - path)) : 0;
+        if (length >= sizeof(scene->directory)) {
+            sb_error("%s: the scene's directory is longer than %zu bytes", path, sizeof(scene->directory) - 1);
+            memset(scene, 0, sizeof(*scene));
+            return SB_ERR_OUT_OF_RANGE;
+        }
+        snprintf(scene->directory, sizeof(scene->directory), "%.*s", (int)length, path);
+    }
+    return res;
 }
 
 char *sb_scene_normalized_json(const struct sb_scene *scene)
@@ -506,6 +525,9 @@ char *sb_scene_normalized_json(const struct sb_scene *scene)
         if (section)
             cJSON_AddItemToObject(root, family->section, section);
     }
+    cJSON *world = sb_world_section_json(scene);
+    if (world)
+        cJSON_AddItemToObject(root, "world", world);
     cJSON *tolerance = NULL;
     for (int p = 0; p < SB_PRODUCT_COUNT; p++) {
         if (scene->tolerance[p] <= 0)

@@ -71,6 +71,36 @@ void sb_cloud_params_default(struct sb_cloud_params *params);
 /* Validate, logging "source: clouds.path: reason" for the first problem. */
 enum sb_result sb_cloud_params_validate(const struct sb_cloud_params *params, const char *source);
 
+/* The scene's "world": a mesh file (read by the baker through assimp,
+ * geometry/mesh.h) and how it is placed. Defaults in brackets. */
+#define SB_WORLD_MAX_OVERRIDES 16
+struct sb_world_params {
+    char file[1024];       /* as the scene gives it; relative to the scene file's directory */
+    double units_m;        /* metres per file unit [1] */
+    double scale;          /* [1] */
+    bool up_z;             /* "up": "z" turns a z-up file y-up ["y"] */
+    double rotate_deg[3];  /* about x, then y, then z [0] */
+    double translate_m[3]; /* [0] */
+    int override_count;
+    struct {
+        char material[64]; /* a material's name in the file, or "*" */
+        double albedo[3];
+    } overrides[SB_WORLD_MAX_OVERRIDES];
+};
+
+/* The scene's "probes": where the sky-visibility probes go. */
+#define SB_PROBES_MAX_EXPLICIT 256
+struct sb_probe_params {
+    double spacing_m;       /* a grid over the world's bounds, this far apart [2]; 0: none */
+    double margin_m;        /* the grid's bounds: the world's, grown by this [0] */
+    uint32_t rays;          /* per probe, a multiple of 64 [2048] */
+    double inside_fraction; /* more back-face hits than this: inside geometry [0.25] */
+    int explicit_count;
+    double positions_m[SB_PROBES_MAX_EXPLICIT][3];
+};
+
+void sb_probe_params_default(struct sb_probe_params *params);
+
 struct sb_scene {
     char name[64];
     char preset[32];
@@ -86,6 +116,11 @@ struct sb_scene {
     double tolerance[SB_PRODUCT_COUNT];
     bool has_view;
     struct sb_scene_view view; /* 2 m up, the sun at 30 degrees unless the scene says */
+    bool has_world;
+    struct sb_world_params world;
+    char directory[1024]; /* the scene file's directory, for the world's file ("" from memory: the current one) */
+    bool has_probes;
+    struct sb_probe_params probes;
 };
 
 /* Tolerances a scene may ask for: [SB_TOLERANCE_MIN, SB_TOLERANCE_MAX]. */

@@ -2,12 +2,14 @@
  * A pack of every product with synthetic, finite content, written through
  * the pack writer: what the pack reader's tests and the manifest fuzzer
  * open. The cloud products are small (the scene's sizes: 16^3, 8^3, 8^2,
- * 8^2). `images` (may be NULL) receives each product's image, which the
+ * 8^2); the probes are 5 explicit ones over a world "world.obj" that the
+ * pack does not need. `images` (may be NULL) receives each product's image, which the
  * caller finishes; `name` is the scene's and the device's.
  */
 #ifndef SB_TEST_SYNTHETIC_PACK_H
 #define SB_TEST_SYNTHETIC_PACK_H
 
+#include <stdbool.h>
 #include <stdio.h>
 #include <stdlib.h>
 
@@ -36,21 +38,29 @@ static inline enum sb_result write_synthetic_pack(const char *dir, const char *n
         .precipitation = {4, 1},
         .cloud_type = {1, 3},
     };
+    scene.has_world = true;
+    scene.world = (struct sb_world_params){.file = "world.obj", .units_m = 1, .scale = 1};
+    sb_probe_params_default(&scene.probes);
     struct sb_pack_writer *w = NULL;
     enum sb_result res = sb_pack_writer_create(dir, &w);
     for (int p = 0; p < SB_PRODUCT_COUNT && !res; p++) {
         const struct sb_product_format *f = sb_product_format((enum sb_product_id)p);
         uint32_t shape[3];
         sb_product_shape(&scene, (enum sb_product_id)p, shape);
+        bool probes = f->storage == SB_STORAGE_PROBES;
+        if (probes)
+            shape[0] = 5;
         struct sb_image image;
         if ((res = sb_image_init_volume(&image, shape[0], shape[1], shape[2], f->channel_count)))
             break;
         sb_image_set_channel_names(&image, f->channel_names);
         for (uint64_t i = 0; i < sb_image_float_count(&image); i++)
-            image.data[i] = (float)((double)(i * 2654435761u % 1000003u) * 1e-6 + p);
+            image.data[i] = probes ? (i % f->channel_count == 6 ? 1.0f : (float)(i * 2654435761u % 1000u) * 1e-3f)
+                                   : (float)((double)(i * 2654435761u % 1000003u) * 1e-6 + p);
         if (f->storage == SB_STORAGE_VDB_HALF)
             sb_image_round_to_half(&image, NULL);
-        struct sb_artifact a = {.product = (enum sb_product_id)p};
+        struct sb_artifact a = {.product = (enum sb_product_id)p,
+                                .probes = {.explicit_count = probes ? shape[0] : 0, .ray_count = 64}};
         snprintf(a.file, sizeof(a.file), "%s.%s", f->name, f->extension);
         snprintf(a.parameterization, sizeof(a.parameterization), "%s", f->parameterization);
         res = sb_pack_writer_add_image(w, &a, &image);

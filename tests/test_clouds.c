@@ -189,7 +189,7 @@ int main(void)
     CHECK(sb_cloud_params_validate(&custom, "custom") == SB_OK, "the custom parameters are valid");
     for (int set = 0; set < 2; set++) {
         const struct sb_cloud_params *cp = set ? &custom : &defaults;
-        for (int p = SB_PRODUCT_CLOUD_SHAPE; p < SB_PRODUCT_COUNT; p++) {
+        for (int p = SB_PRODUCT_CLOUD_SHAPE; p <= SB_PRODUCT_WEATHER; p++) {
             enum sb_product_id product = (enum sb_product_id)p;
             char name[64];
             snprintf(name, sizeof(name), "%s%s", sb_product_name(product), set ? " (custom)" : "");

@@ -7,12 +7,14 @@
 #include <string.h>
 #include <sys/stat.h>
 #include <unistd.h>
+#include <xxhash.h>
 
 #include "exr.h"
 #include "harness.h"
 #include "image.h"
 #include "log.h"
 #include "pack.h"
+#include "probes.h"
 #include "scene.h"
 #include "synthetic_pack.h"
 #include "vdb.h"
@@ -447,6 +449,10 @@ static void rehash_scene(cJSON *r)
     free(normal);
     free(text);
 }
+static void edit_version_2(cJSON *r)
+{
+    cJSON_ReplaceItemInObject(r, "format_version", cJSON_CreateNumber(2));
+}
 /* What version 1 wrote: no cloud products (in the scene or the pack), no
  * file_hash; the scene's hash recomputed for the scene without clouds. */
 static void edit_make_version_1(cJSON *r)
@@ -456,13 +462,16 @@ static void edit_make_version_1(cJSON *r)
     for (int i = cJSON_GetArraySize(artifacts) - 1; i >= 0; i--) {
         cJSON *a = cJSON_GetArrayItem(artifacts, i);
         enum sb_product_id id;
-        if (sb_product_from_name(cJSON_GetObjectItem(a, "name")->valuestring, &id) && sb_product_is_cloud(id))
+        if (sb_product_from_name(cJSON_GetObjectItem(a, "name")->valuestring, &id) &&
+            sb_product_format(id)->family != SB_FAMILY_ATMOSPHERE)
             cJSON_DeleteItemFromArray(artifacts, i);
         else
             cJSON_DeleteItemFromObject(a, "file_hash");
     }
     cJSON *scene = cJSON_GetObjectItem(r, "scene");
     cJSON_DeleteItemFromObject(scene, "clouds");
+    cJSON_DeleteItemFromObject(scene, "probes");
+    cJSON_DeleteItemFromObject(scene, "world");
     cJSON *products = cJSON_GetObjectItem(scene, "products");
     while (cJSON_GetArraySize(products) > SB_ATMOSPHERE_PRODUCT_COUNT)
         cJSON_DeleteItemFromArray(products, SB_ATMOSPHERE_PRODUCT_COUNT);
@@ -630,7 +639,12 @@ static void test_pack_reader(void)
         {"one flipped byte in the compressed pixels", NULL, FLIP_BYTE, SB_ERR_HASH_MISMATCH, false},
         {"one flipped byte in the compressed pixels, vouched for", NULL, FLIP_BYTE, SB_ERR_EXR, true},
         {"format version 1, as version 1 wrote it", edit_make_version_1,
-         "rm cloud_shape.vdb cloud_detail.vdb cloud_curl.exr weather.exr", SB_OK, false},
+         "rm cloud_shape.vdb cloud_detail.vdb cloud_curl.exr weather.exr sky_visibility.sbprobes", SB_OK, false},
+        {"format version 2 listing sky_visibility", edit_version_2, NULL, SB_ERR_UNKNOWN_PRODUCT, false},
+        {"truncated probe file", NULL, "head -c 200 sky_visibility.sbprobes > t && mv t sky_visibility.sbprobes",
+         SB_ERR_HASH_MISMATCH, false},
+        {"truncated probe file, vouched for", NULL,
+         "head -c 200 sky_visibility.sbprobes > t && mv t sky_visibility.sbprobes", SB_ERR_BAD_IMAGE, true},
         {"format version 1 listing cloud products", edit_version_1, NULL, SB_ERR_UNKNOWN_PRODUCT, false},
         {"truncated volume", NULL, "head -c 3000 cloud_shape.vdb > t && mv t cloud_shape.vdb", SB_ERR_HASH_MISMATCH,
          false},
@@ -752,6 +766,119 @@ static void test_result_codes(void)
           "outside the set: unknown");
 }
 
+/* Probe files: a round trip, and every truncated prefix, every bit flipped
+ * in every byte, trailing bytes, a newer version and hostile fields
+ * (re-checksummed, so that the field's own check is what refuses them). */
+static void restamp(uint8_t *b, size_t size)
+{
+    uint64_t h = XXH3_64bits(b, size - 8);
+    for (int i = 0; i < 8; i++)
+        b[size - 8 + i] = (uint8_t)(h >> (8 * i));
+}
+
+static void test_probes(void)
+{
+    char dir[] = "/tmp/skybake-probes-XXXXXX", path[256];
+    CHECK(mkdtemp(dir) != NULL, "temporary directory");
+    snprintf(path, sizeof(path), "%s/p.sbprobes", dir);
+    struct sb_image img = {0}, back;
+    const uint32_t n = 2 * 1 * 2 + 1, ch = SB_SKY_VISIBILITY_CHANNEL_COUNT;
+    CHECK(sb_image_init(&img, n, 1, ch) == SB_OK, "image");
+    sb_image_set_channel_names(&img, SB_SKY_VISIBILITY_CHANNELS);
+    for (uint32_t i = 0; i < n * ch; i++) {
+        uint32_t c = i % ch;
+        img.data[i] = c == 6 ? 1.0f : c >= 7 && c <= 8 ? 0.25f : c == 10 ? 0.5f : (float)(i % 7) * 0.125f - 0.3f;
+        if (c == 9)
+            img.data[i] = 3.5f;
+    }
+    struct sb_probe_layout layout = {.grid = {2, 1, 2},
+                                     .explicit_count = 1,
+                                     .origin_m = {-1, 0.5f, 2},
+                                     .spacing_m = {1.5f, 1, 2},
+                                     .ray_count = 2048,
+                                     .key = "0123456789abcdef0123456789abcdef"},
+                           got;
+    CHECK(sb_probes_write(path, &layout, &img) == SB_OK, "write");
+    CHECK(sb_probes_read(path, SB_SKY_VISIBILITY_CHANNELS, 1000, &got, &back) == SB_OK, "read back");
+    CHECK(back.width == n && back.channel_count == ch && !memcmp(back.data, img.data, sizeof(float) * n * ch) &&
+              !memcmp(got.grid, layout.grid, sizeof(got.grid)) && got.explicit_count == layout.explicit_count &&
+              !memcmp(got.origin_m, layout.origin_m, sizeof(got.origin_m)) &&
+              !memcmp(got.spacing_m, layout.spacing_m, sizeof(got.spacing_m)) && got.ray_count == layout.ray_count &&
+              !strcmp(got.key, layout.key),
+          "the round trip is exact");
+    sb_image_finish(&back);
+    FILE *f = fopen(path, "rb");
+    uint8_t bytes[4096];
+    size_t size = f ? fread(bytes, 1, sizeof(bytes), f) : 0;
+    if (f)
+        fclose(f);
+    CHECK(size == SB_PROBES_HEADER_BYTES + (size_t)n * ch * 4 + 8, "size %zu", size);
+    int refused = 0, tried = 0;
+    for (size_t cut = 0; cut < size; cut++, tried++)
+        refused += sb_probes_parse(bytes, cut, "cut", SB_SKY_VISIBILITY_CHANNELS, 1000, &got, &back) != SB_OK;
+    CHECK(refused == tried, "every truncated prefix is refused (%d of %d)", refused, tried);
+    refused = tried = 0;
+    for (size_t i = 0; i < size; i++)
+        for (int bit = 0; bit < 8; bit++, tried++) {
+            bytes[i] ^= (uint8_t)(1u << bit);
+            enum sb_result res = sb_probes_parse(bytes, size, "flip", SB_SKY_VISIBILITY_CHANNELS, 1000, &got, &back);
+            refused += res != SB_OK;
+            if (res == SB_OK)
+                sb_image_finish(&back);
+            bytes[i] ^= (uint8_t)(1u << bit);
+        }
+    CHECK(refused == tried, "every bit flip is refused (%d of %d)", refused, tried);
+    uint8_t longer[4200];
+    memcpy(longer, bytes, size);
+    longer[size] = 0;
+    CHECK(sb_probes_parse(longer, size + 1, "trailing", SB_SKY_VISIBILITY_CHANNELS, 1000, &got, &back) ==
+              SB_ERR_BAD_IMAGE,
+          "a trailing byte");
+    CHECK(sb_probes_parse(bytes, size, "channels", "a,b,c", 1000, &got, &back) == SB_ERR_BAD_IMAGE, "other channels");
+    CHECK(sb_probes_parse(bytes, size, "cap", SB_SKY_VISIBILITY_CHANNELS, 4, &got, &back) == SB_ERR_PROBES,
+          "more probes than the cap");
+    struct {
+        size_t offset;
+        uint32_t value;
+        enum sb_result want;
+        const char *what;
+    } fields[] = {
+        {8, 2, SB_ERR_VERSION, "a newer version"},
+        {8, 0, SB_ERR_VERSION, "version 0"},
+        {12, 0x04030201, SB_ERR_PROBES, "big endian"},
+        {16, 116, SB_ERR_PROBES, "another header size"},
+        {24, 0xffffffff, SB_ERR_PROBES, "a huge count"},
+        {28, 0, SB_ERR_PROBES, "a grid with a zero axis"},
+        {36, 5000, SB_ERR_PROBES, "a grid past its cap"},
+        {40, 2, SB_ERR_PROBES, "counts that do not add up"},
+        {56, 0xbf800000, SB_ERR_PROBES, "a negative spacing"},
+        {48, 0x7fc00000, SB_ERR_PROBES, "a NaN origin"},
+        {72, 0x41414141, SB_ERR_PROBES, "a key that is not hex"},
+        {108, 1, SB_ERR_PROBES, "a reserved byte"},
+        {SB_PROBES_HEADER_BYTES + 6 * 4, 0x3f000000, SB_ERR_NUMERIC, "valid = 0.5"},
+        {SB_PROBES_HEADER_BYTES + 7 * 4, 0x40000000, SB_ERR_NUMERIC, "a fraction of 2"},
+        {SB_PROBES_HEADER_BYTES + 9 * 4, 0xbf800000, SB_ERR_NUMERIC, "a negative distance"},
+        {SB_PROBES_HEADER_BYTES + 12 * 4, 0x41200000, SB_ERR_NUMERIC, "an SH coefficient of 10"},
+        {SB_PROBES_HEADER_BYTES + 0 * 4, 0x7f800000, SB_ERR_NUMERIC, "an infinite position"},
+    };
+    for (size_t i = 0; i < sizeof(fields) / sizeof(fields[0]); i++) {
+        uint8_t edited[4096];
+        memcpy(edited, bytes, size);
+        for (int k = 0; k < 4; k++)
+            edited[fields[i].offset + k] = (uint8_t)(fields[i].value >> (8 * k));
+        restamp(edited, size);
+        enum sb_result res = sb_probes_parse(edited, size, "edited", SB_SKY_VISIBILITY_CHANNELS, 1000, &got, &back);
+        CHECK(res == fields[i].want, "%s: %s, expected %s", fields[i].what, sb_result_name(res),
+              sb_result_name(fields[i].want));
+        if (res == SB_OK)
+            sb_image_finish(&back);
+    }
+    CHECK(sb_probes_read(dir, SB_SKY_VISIBILITY_CHANNELS, 1000, &got, &back) == SB_ERR_IO, "a directory");
+    unlink(path);
+    rmdir(dir);
+    sb_image_finish(&img);
+}
+
 int main(void)
 {
     if (!getenv("SKYBAKE_TEST_VERBOSE"))
@@ -762,5 +889,6 @@ int main(void)
     test_vdb();
     test_scenes();
     test_pack_reader();
+    test_probes();
     return test_finish("formats");
 }

@@ -260,12 +260,12 @@ static void test_gpu_against_embree(struct sb_vk *vk, const char *name, const st
     if (res)
         return;
     struct sb_raycaster *rc = NULL;
-    struct embree e = {0};
+    struct sb_embree e = {0};
     float *rays = malloc((size_t)count * 8 * sizeof(float));
     float *gpu = malloc((size_t)count * 4 * sizeof(float)), *any = malloc((size_t)count * 4 * sizeof(float));
     float *ref = malloc((size_t)count * 4 * sizeof(float));
     CHECK(rays && gpu && any && ref, "allocation");
-    CHECK(embree_create(m, &e), "%s: Embree", name);
+    CHECK(sb_embree_create(m, &e), "%s: Embree", name);
     res = sb_raycaster_create(vk, &bvh, &rc);
     CHECK(res == SB_OK, "%s: raycaster: %s", name, sb_result_name(res));
     for (int kind = 0; kind < RAY_KIND_COUNT && rc && rays && gpu && any && ref && e.scene; kind++) {
@@ -277,7 +277,7 @@ static void test_gpu_against_embree(struct sb_vk *vk, const char *name, const st
         CHECK(res == SB_OK, "%s: cast: %s", name, sb_result_name(res));
         res = sb_raycaster_cast(rc, rays, count, true, any, &any_ms);
         CHECK(res == SB_OK, "%s: any-hit cast: %s", name, sb_result_name(res));
-        double embree_s = embree_cast(&e, rays, count, ref);
+        double embree_s = sb_embree_cast(&e, rays, count, ref);
         struct agreement a;
         compare(name, m, rays, count, gpu, ref, &a);
         uint32_t any_differ = 0;
@@ -307,7 +307,7 @@ static void test_gpu_against_embree(struct sb_vk *vk, const char *name, const st
            bvh.node_count, bvh.depth, bvh.max_leaf, build_s);
     sb_raycaster_destroy(&rc);
     if (e.device)
-        embree_destroy(&e);
+        sb_embree_destroy(&e);
     free(rays);
     free(gpu);
     free(any);

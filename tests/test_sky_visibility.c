@@ -233,8 +233,8 @@ static void test_house(struct sb_vk *vk)
     float *out = malloc(sizeof(float) * SB_VISIBILITY_FLOATS * N);
     float *again = malloc(sizeof(float) * SB_VISIBILITY_FLOATS * N);
     float *rays = malloc(sizeof(float) * 8 * RAYS), *hits = malloc(sizeof(float) * 4 * RAYS);
-    struct embree e = {0};
-    CHECK(out && again && rays && hits && embree_create(&house.mesh, &e), "setup");
+    struct sb_embree e = {0};
+    CHECK(out && again && rays && hits && sb_embree_create(&house.mesh, &e), "setup");
     if (out && again && rays && hits && e.scene && bake(&house, positions, N, out) &&
         bake(&house, positions, N, again)) {
         CHECK(!memcmp(out, again, sizeof(float) * SB_VISIBILITY_FLOATS * N), "two bakes differ");
@@ -252,7 +252,7 @@ static void test_house(struct sb_vk *vk)
                     ray[4 + k] = (float)d[k];
                 ray[7] = 1e30f;
             }
-            embree_cast(&e, rays, RAYS, hits);
+            sb_embree_cast(&e, rays, RAYS, hits);
             uint32_t hit_count = 0;
             for (uint32_t r = 0; r < RAYS; r++) {
                 uint32_t t;
@@ -294,7 +294,7 @@ static void test_house(struct sb_vk *vk)
         CHECK(open > 0 && inside > 0, "the grid should hold open and enclosed probes (%d, %d)", open, inside);
     }
     if (e.device)
-        embree_destroy(&e);
+        sb_embree_destroy(&e);
     free(out);
     free(again);
     free(rays);

@@ -1,34 +1,18 @@
-/*
- * Embree (robust mode), the tests' independent reference for ray casts:
- * a scene of one mesh, and closest-hit casts of the raycast kernel's ray
- * and hit layouts (raycast.h) on every core.
- */
-#ifndef SB_TEST_EMBREE_REF_H
-#define SB_TEST_EMBREE_REF_H
+#include "embree_ref.h"
 
-#include <embree3/rtcore.h>
 #include <pthread.h>
-#include <stdbool.h>
 #include <string.h>
 #include <time.h>
 #include <unistd.h>
 
-#include "bvh.h"
-#include "mesh.h"
-
-static inline double embree_now_s(void)
+static double embree_now_s(void)
 {
     struct timespec ts;
     clock_gettime(CLOCK_MONOTONIC, &ts);
     return ts.tv_sec + ts.tv_nsec * 1e-9;
 }
 
-struct embree {
-    RTCDevice device;
-    RTCScene scene;
-};
-
-static inline bool embree_create(const struct sb_mesh *mesh, struct embree *e)
+bool sb_embree_create(const struct sb_mesh *mesh, struct sb_embree *e)
 {
     e->device = rtcNewDevice(NULL);
     if (!e->device)
@@ -49,22 +33,22 @@ static inline bool embree_create(const struct sb_mesh *mesh, struct embree *e)
     return true;
 }
 
-static inline void embree_destroy(struct embree *e)
+void sb_embree_destroy(struct sb_embree *e)
 {
     rtcReleaseScene(e->scene);
     rtcReleaseDevice(e->device);
 }
 
-struct embree_job {
-    const struct embree *e;
+struct sb_embree_job {
+    const struct sb_embree *e;
     const float *rays;
     float *hits;
     uint32_t first, count;
 };
 
-static inline void *embree_worker(void *arg)
+static void *sb_embree_worker(void *arg)
 {
-    struct embree_job *job = arg;
+    struct sb_embree_job *job = arg;
     struct RTCIntersectContext ctx;
     rtcInitIntersectContext(&ctx);
     for (uint32_t i = job->first; i < job->first + job->count; i++) {
@@ -92,21 +76,19 @@ static inline void *embree_worker(void *arg)
 }
 
 /* Cast on every core; returns the wall time in seconds. */
-static inline double embree_cast(const struct embree *e, const float *rays, uint32_t count, float *hits)
+double sb_embree_cast(const struct sb_embree *e, const float *rays, uint32_t count, float *hits)
 {
     long cores = sysconf(_SC_NPROCESSORS_ONLN);
     int n = cores < 1 ? 1 : cores > 64 ? 64 : (int)cores;
     pthread_t threads[64];
-    struct embree_job jobs[64];
+    struct sb_embree_job jobs[64];
     double t0 = embree_now_s();
     for (int i = 0; i < n; i++) {
         uint32_t first = (uint32_t)((uint64_t)count * i / n), end = (uint32_t)((uint64_t)count * (i + 1) / n);
-        jobs[i] = (struct embree_job){e, rays, hits, first, end - first};
-        pthread_create(&threads[i], NULL, embree_worker, &jobs[i]);
+        jobs[i] = (struct sb_embree_job){e, rays, hits, first, end - first};
+        pthread_create(&threads[i], NULL, sb_embree_worker, &jobs[i]);
     }
     for (int i = 0; i < n; i++)
         pthread_join(threads[i], NULL);
     return embree_now_s() - t0;
 }
-
-#endif

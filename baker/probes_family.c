@@ -1,0 +1,279 @@
+/*
+ * The probe family: sky visibility at probes over the scene's world
+ * (family.h). A bake reads the world's mesh (geometry/mesh.h), builds its
+ * BVH, places probes (a grid over the world's bounds, then the scene's
+ * explicit ones), bakes them (sky_visibility.h), pushes the probes found
+ * inside geometry out to free space where it can (recording the offset)
+ * and flags the rest invalid, and derings every probe's SH.
+ *
+ * The key holds the world file's bytes' hash, its placement, the probe
+ * settings and the kernel: the atmosphere does not rebake probes; a vertex
+ * does.
+ */
+#include <fcntl.h>
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "bvh.h"
+#include "family.h"
+#include "log.h"
+#include "mesh.h"
+#include "raycast.h"
+#include "sh.h"
+#include "sky_visibility.h"
+
+/* Candidate offsets for a probe inside geometry: the 26 neighbour
+ * directions at these fractions of the spacing (or of 1 m without a grid),
+ * tried in a fixed order with PUSH_RAYS rays each. */
+static const double push_steps[] = {0.25, 0.5};
+#define PUSH_RAYS 256
+#define PROBES_RECIPE 1
+
+static void world_path(const struct sb_scene *scene, char *out, size_t size)
+{
+    if (scene->world.file[0] == '/' || !scene->directory[0])
+        snprintf(out, size, "%s", scene->world.file);
+    else
+        snprintf(out, size, "%s/%s", scene->directory, scene->world.file);
+}
+
+static void probes_key(const struct sb_scene *scene, enum sb_product_id id, struct sb_key_text *key)
+{
+    const struct sb_world_params *w = &scene->world;
+    const struct sb_probe_params *p = &scene->probes;
+    char path[2100], hash[SB_HASH_HEX_SIZE] = "unreadable", code[SB_HASH_HEX_SIZE];
+    world_path(scene, path, sizeof(path));
+    if (sb_hash_file(AT_FDCWD, path, hash))
+        snprintf(hash, sizeof(hash), "unreadable");
+    sb_key_add(key, " recipe %d world-bytes %s units_m=%a scale=%a up_z=%d", PROBES_RECIPE, hash, w->units_m, w->scale,
+               w->up_z);
+    sb_key_add3(key, "rotate_deg", w->rotate_deg);
+    sb_key_add3(key, "translate_m", w->translate_m);
+    for (int i = 0; i < w->override_count; i++)
+        sb_key_add3(key, w->overrides[i].material, w->overrides[i].albedo);
+    sb_key_add(key, " spacing_m=%a margin_m=%a rays=%u inside=%a", p->spacing_m, p->margin_m, p->rays,
+               p->inside_fraction);
+    for (int i = 0; i < p->explicit_count; i++)
+        sb_key_add3(key, "at", p->positions_m[i]);
+    sb_sky_visibility_code_hash(code);
+    sb_key_add(key, " code %s", code);
+}
+
+/* The grid over the world's bounds, centred on them. */
+static enum sb_result place(const struct sb_scene *scene, const struct sb_mesh *mesh, struct sb_probe_layout *layout,
+                            float **positions, uint32_t *count)
+{
+    const struct sb_probe_params *p = &scene->probes;
+    uint64_t grid = 0;
+    if (p->spacing_m > 0) {
+        float lo[3], hi[3];
+        sb_mesh_bounds(mesh, lo, hi);
+        grid = 1;
+        for (int k = 0; k < 3; k++) {
+            double extent = (double)hi[k] - lo[k] + 2 * p->margin_m;
+            double n = floor(extent / p->spacing_m) + 1;
+            if (n > SB_PROBES_MAX_GRID) {
+                sb_error("probes: %.0f probes along axis %d (the world is %.1f m across with a %g m margin); at most "
+                         "%d: raise probes.spacing_m",
+                         n, k, (double)hi[k] - lo[k], p->margin_m, SB_PROBES_MAX_GRID);
+                return SB_ERR_TOO_LARGE;
+            }
+            layout->grid[k] = (uint32_t)n;
+            layout->spacing_m[k] = (float)p->spacing_m;
+            layout->origin_m[k] = (float)(0.5 * ((double)lo[k] + hi[k]) - 0.5 * (n - 1) * p->spacing_m);
+            grid *= (uint64_t)n;
+        }
+    }
+    if (grid + (uint64_t)p->explicit_count > SB_PROBES_MAX_COUNT) {
+        sb_error("probes: %llu probes; at most %u: raise probes.spacing_m",
+                 (unsigned long long)(grid + p->explicit_count), SB_PROBES_MAX_COUNT);
+        return SB_ERR_TOO_LARGE;
+    }
+    layout->explicit_count = (uint32_t)p->explicit_count;
+    layout->ray_count = p->rays;
+    *count = (uint32_t)grid + (uint32_t)p->explicit_count;
+    *positions = malloc((size_t)*count * 3 * sizeof(float));
+    if (!*positions)
+        return SB_ERR_NOMEM;
+    for (uint32_t i = 0; i < grid; i++) {
+        uint32_t c[3] = {i % layout->grid[0], i / layout->grid[0] % layout->grid[1],
+                         i / layout->grid[0] / layout->grid[1]};
+        for (int k = 0; k < 3; k++)
+            (*positions)[3 * (size_t)i + k] = (float)(layout->origin_m[k] + (double)c[k] * layout->spacing_m[k]);
+    }
+    for (int e = 0; e < p->explicit_count; e++)
+        for (int k = 0; k < 3; k++)
+            (*positions)[3 * (grid + e) + k] = (float)p->positions_m[e][k];
+    return SB_OK;
+}
+
+/*
+ * Probes with more back-face hits than the scene allows sit inside
+ * geometry: try the candidate offsets, all in one batch of few rays, and
+ * move each to the first that is free; flag the rest invalid.
+ */
+static enum sb_result push_out(struct sb_raycaster *rc, const struct sb_scene *scene, float *positions, float *offsets,
+                               float *valid, const float *results, uint32_t count, uint32_t *inside, uint32_t *pushed)
+{
+    const int per = 26 * (int)(sizeof(push_steps) / sizeof(push_steps[0]));
+    double unit = scene->probes.spacing_m > 0 ? scene->probes.spacing_m : 1.0;
+    uint32_t *which = NULL, n = 0;
+    float *candidates = NULL, *trial = NULL;
+    enum sb_result res = SB_OK;
+    for (uint32_t i = 0; i < count; i++) {
+        valid[i] = results[SB_VISIBILITY_FLOATS * (size_t)i + SB_PROBE_SH] <= scene->probes.inside_fraction;
+        n += valid[i] == 0.0f;
+    }
+    *inside = n;
+    *pushed = 0;
+    if (!n)
+        return SB_OK;
+    which = malloc(n * sizeof(*which));
+    candidates = malloc((size_t)n * per * 3 * sizeof(float));
+    trial = malloc((size_t)n * per * SB_VISIBILITY_FLOATS * sizeof(float));
+    if (!which || !candidates || !trial) {
+        res = SB_ERR_NOMEM;
+        goto done;
+    }
+    n = 0;
+    for (uint32_t i = 0; i < count; i++)
+        if (valid[i] == 0.0f)
+            which[n++] = i;
+    for (uint32_t j = 0; j < n; j++) {
+        int c = 0;
+        for (size_t s = 0; s < sizeof(push_steps) / sizeof(push_steps[0]); s++)
+            for (int d = 0; d < 27; d++) {
+                if (d == 13)
+                    continue; /* the probe itself */
+                int dx = d % 3 - 1, dy = d / 3 % 3 - 1, dz = d / 9 - 1;
+                double len = sqrt((double)(dx * dx + dy * dy + dz * dz)), step = push_steps[s] * unit / len;
+                float *q = &candidates[3 * ((size_t)j * per + c++)];
+                q[0] = (float)(positions[3 * (size_t)which[j]] + dx * step);
+                q[1] = (float)(positions[3 * (size_t)which[j] + 1] + dy * step);
+                q[2] = (float)(positions[3 * (size_t)which[j] + 2] + dz * step);
+            }
+    }
+    struct sb_sky_visibility_params quick = {.ray_count = PUSH_RAYS};
+    if ((res = sb_sky_visibility_bake(rc, candidates, n * per, &quick, trial, NULL)))
+        goto done;
+    for (uint32_t j = 0; j < n; j++)
+        for (int c = 0; c < per; c++) {
+            const float *r = &trial[SB_VISIBILITY_FLOATS * ((size_t)j * per + c)];
+            if (r[SB_PROBE_SH] > scene->probes.inside_fraction)
+                continue;
+            uint32_t i = which[j];
+            for (int k = 0; k < 3; k++) {
+                float to = candidates[3 * ((size_t)j * per + c) + k];
+                offsets[3 * (size_t)i + k] = to - positions[3 * (size_t)i + k];
+                positions[3 * (size_t)i + k] = to;
+            }
+            valid[i] = 1.0f;
+            (*pushed)++;
+            break;
+        }
+done:
+    free(which);
+    free(candidates);
+    free(trial);
+    return res;
+}
+
+static enum sb_result probes_bake(void *state, struct sb_vk *vk, const struct sb_scene *scene, enum sb_product_id id,
+                                  const struct sb_image baked[SB_PRODUCT_COUNT], struct sb_image *image,
+                                  struct sb_artifact *a)
+{
+    const struct sb_world_params *w = &scene->world;
+    char path[2100];
+    world_path(scene, path, sizeof(path));
+    struct sb_mesh_albedo_override overrides[SB_WORLD_MAX_OVERRIDES];
+    for (int i = 0; i < w->override_count; i++) {
+        overrides[i].material = w->overrides[i].material;
+        memcpy(overrides[i].albedo, w->overrides[i].albedo, sizeof(overrides[i].albedo));
+    }
+    struct sb_mesh_load_params load = {
+        .transform = {.units_m = w->units_m, .scale = w->scale, .up_z = w->up_z},
+        .overrides = overrides,
+        .override_count = w->override_count,
+    };
+    memcpy(load.transform.rotate_deg, w->rotate_deg, sizeof(w->rotate_deg));
+    memcpy(load.transform.translate_m, w->translate_m, sizeof(w->translate_m));
+    struct sb_mesh mesh = {0};
+    struct sb_bvh bvh = {0};
+    struct sb_raycaster *rc = NULL;
+    float *positions = NULL, *offsets = NULL, *valid = NULL, *results = NULL;
+    uint32_t count = 0, inside = 0, pushed = 0, deringed = 0;
+    double lowest = 0, gpu_ms = 0;
+    struct sb_probe_layout *layout = &a->probes;
+    memset(layout, 0, sizeof(*layout));
+    enum sb_result res;
+    if ((res = sb_mesh_load(path, &load, &mesh)) || (res = sb_bvh_build(&mesh, &bvh)) ||
+        (res = sb_raycaster_create(vk, &bvh, &rc)) || (res = place(scene, &mesh, layout, &positions, &count)))
+        goto done;
+    offsets = calloc((size_t)count * 3, sizeof(float));
+    valid = calloc(count, sizeof(float));
+    results = malloc((size_t)count * SB_VISIBILITY_FLOATS * sizeof(float));
+    if (!offsets || !valid || !results) {
+        res = SB_ERR_NOMEM;
+        goto done;
+    }
+    struct sb_sky_visibility_params params = {.ray_count = scene->probes.rays};
+    double ms = 0;
+    if ((res = sb_sky_visibility_bake(rc, positions, count, &params, results, &ms)))
+        goto done;
+    gpu_ms += ms;
+    if ((res = push_out(rc, scene, positions, offsets, valid, results, count, &inside, &pushed)))
+        goto done;
+    if (pushed && (res = sb_sky_visibility_bake(rc, positions, count, &params, results, &ms)))
+        goto done;
+    gpu_ms += pushed ? ms : 0;
+    if ((res = sb_image_init(image, count, 1, SB_SKY_VISIBILITY_CHANNEL_COUNT)))
+        goto done;
+    sb_image_set_channel_names(image, SB_SKY_VISIBILITY_CHANNELS);
+    for (uint32_t i = 0; i < count; i++) {
+        float *o = &image->data[(size_t)i * SB_SKY_VISIBILITY_CHANNEL_COUNT];
+        const float *r = &results[(size_t)i * SB_VISIBILITY_FLOATS];
+        double c[SB_PROBE_SH], before;
+        for (int k = 0; k < SB_PROBE_SH; k++)
+            c[k] = r[k];
+        double window = sb_sh9_dering(c, &before);
+        deringed += window > 0;
+        lowest = fmin(lowest, before);
+        for (int k = 0; k < 3; k++) {
+            o[k] = positions[3 * (size_t)i + k];
+            o[3 + k] = offsets[3 * (size_t)i + k];
+        }
+        o[6] = valid[i];
+        o[7] = r[SB_PROBE_SH];
+        o[8] = r[SB_PROBE_SH + 1];
+        o[9] = r[SB_PROBE_SH + 2];
+        o[10] = (float)window;
+        for (int k = 0; k < SB_PROBE_SH; k++)
+            o[11 + k] = (float)c[k];
+    }
+    a->gpu_ms = gpu_ms;
+    snprintf(a->settings_json, sizeof(a->settings_json),
+             "{\"rays\":%u,\"grid\":[%u,%u,%u],\"spacing_m\":%.9g,\"explicit\":%u,\"triangles\":%u,"
+             "\"inside\":%u,\"pushed_out\":%u,\"invalid\":%u,\"deringed\":%u,\"lowest_before_dering\":%.6g}",
+             layout->ray_count, layout->grid[0], layout->grid[1], layout->grid[2], (double)layout->spacing_m[0],
+             layout->explicit_count, mesh.triangle_count, inside, pushed, inside - pushed, deringed, lowest);
+    sb_info("sky_visibility: %u probes over %u triangles; %u inside geometry, %u pushed out; %u deringed", count,
+            mesh.triangle_count, inside, pushed, deringed);
+done:
+    if (res)
+        sb_image_finish(image);
+    free(positions);
+    free(offsets);
+    free(valid);
+    free(results);
+    sb_raycaster_destroy(&rc);
+    sb_bvh_finish(&bvh);
+    sb_mesh_finish(&mesh);
+    return res;
+}
+
+const struct sb_family_baker sb_probes_family = {
+    .key = probes_key,
+    .bake = probes_bake,
+};

@@ -1,0 +1,297 @@
+#include "probes.h"
+
+#include <errno.h>
+#include <fcntl.h>
+#include <math.h>
+#include <stdbool.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <sys/stat.h>
+#include <unistd.h>
+#include <xxhash.h>
+
+#include "log.h"
+
+static const char magic[8] = {'S', 'B', 'P', 'R', 'O', 'B', 'E', 'S'};
+#define BYTE_ORDER_MARK 0x01020304u
+
+static void put_u32(uint8_t *p, uint32_t v)
+{
+    for (int i = 0; i < 4; i++)
+        p[i] = (uint8_t)(v >> (8 * i));
+}
+
+static uint32_t get_u32(const uint8_t *p)
+{
+    return (uint32_t)p[0] | (uint32_t)p[1] << 8 | (uint32_t)p[2] << 16 | (uint32_t)p[3] << 24;
+}
+
+static void put_f32(uint8_t *p, float f)
+{
+    uint32_t v;
+    memcpy(&v, &f, 4);
+    put_u32(p, v);
+}
+
+static float get_f32(const uint8_t *p)
+{
+    uint32_t v = get_u32(p);
+    float f;
+    memcpy(&f, &v, 4);
+    return f;
+}
+
+static void put_u64(uint8_t *p, uint64_t v)
+{
+    put_u32(p, (uint32_t)v);
+    put_u32(p + 4, (uint32_t)(v >> 32));
+}
+
+static uint64_t get_u64(const uint8_t *p)
+{
+    return get_u32(p) | (uint64_t)get_u32(p + 4) << 32;
+}
+
+/* The range a channel's values must lie in, by its name. */
+static void channel_range(const char *name, double *lo, double *hi)
+{
+    *lo = -1e5;
+    *hi = 1e5; /* positions and offsets (m): the mesh's 10 km extent and more */
+    if (!strcmp(name, "valid")) {
+        *lo = 0;
+        *hi = 1;
+    } else if (strstr(name, "_fraction")) {
+        *lo = 0;
+        *hi = 1;
+    } else if (!strncmp(name, "sh.", 3)) { /* |c_k| <= the norm of a function in [0, 1]: sqrt(4 pi) */
+        *lo = -3.5449077018110318;
+        *hi = 3.5449077018110318;
+    } else if (!strcmp(name, "dering_window")) {
+        *lo = 0;
+        *hi = 2;
+    } else if (!strcmp(name, "mean_distance_m")) {
+        *lo = 0;
+    }
+}
+
+static size_t file_size(uint32_t probes, uint32_t channels)
+{
+    return SB_PROBES_HEADER_BYTES + (size_t)probes * channels * 4 + 8;
+}
+
+enum sb_result sb_probes_write(const char *path, const struct sb_probe_layout *layout, const struct sb_image *image)
+{
+    size_t size = file_size(image->width, image->channel_count);
+    uint8_t *bytes = calloc(1, size);
+    if (!bytes)
+        return SB_ERR_NOMEM;
+    memcpy(bytes, magic, 8);
+    put_u32(bytes + 8, SB_PROBES_VERSION);
+    put_u32(bytes + 12, BYTE_ORDER_MARK);
+    put_u32(bytes + 16, SB_PROBES_HEADER_BYTES);
+    put_u32(bytes + 20, image->channel_count);
+    put_u32(bytes + 24, image->width);
+    for (int i = 0; i < 3; i++) {
+        put_u32(bytes + 28 + 4 * i, layout->grid[i]);
+        put_f32(bytes + 44 + 4 * i, layout->origin_m[i]);
+        put_f32(bytes + 56 + 4 * i, layout->spacing_m[i]);
+    }
+    put_u32(bytes + 40, layout->explicit_count);
+    put_u32(bytes + 68, layout->ray_count);
+    memcpy(bytes + 72, layout->key, strnlen(layout->key, 32));
+    uint8_t *p = bytes + SB_PROBES_HEADER_BYTES;
+    for (uint64_t i = 0; i < (uint64_t)image->width * image->channel_count; i++, p += 4)
+        put_f32(p, image->data[i]);
+    put_u64(p, XXH3_64bits(bytes, size - 8));
+
+    enum sb_result res = SB_OK;
+    int fd = open(path, O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0644);
+    if (fd < 0) {
+        sb_error("%s: cannot create: %s", path, strerror(errno));
+        res = SB_ERR_IO;
+    } else {
+        for (size_t done = 0; done < size && !res;) {
+            ssize_t n = write(fd, bytes + done, size - done);
+            if (n < 0 && errno == EINTR)
+                continue;
+            if (n <= 0) {
+                sb_error("%s: cannot write: %s", path, n < 0 ? strerror(errno) : "no progress");
+                res = SB_ERR_IO;
+            } else {
+                done += (size_t)n;
+            }
+        }
+        if (close(fd) != 0 && !res) {
+            sb_error("%s: cannot write: %s", path, strerror(errno));
+            res = SB_ERR_IO;
+        }
+        if (res)
+            unlink(path);
+    }
+    free(bytes);
+    return res;
+}
+
+enum sb_result sb_probes_parse(const void *data, size_t size, const char *source, const char *channel_names,
+                               uint32_t max_probes, struct sb_probe_layout *layout, struct sb_image *image)
+{
+    const uint8_t *b = data;
+    memset(layout, 0, sizeof(*layout));
+    memset(image, 0, sizeof(*image));
+    if (size < 16 || memcmp(b, magic, 8) != 0) {
+        sb_error("%s: not a skybake probe file (magic)", source);
+        return SB_ERR_PROBES;
+    }
+    uint32_t version = get_u32(b + 8);
+    if (version > SB_PROBES_VERSION || version == 0) {
+        sb_error("%s: probe file version %u; this skybake reads 1 to %d: rebake needed", source, version,
+                 SB_PROBES_VERSION);
+        return SB_ERR_VERSION;
+    }
+    if (get_u32(b + 12) != BYTE_ORDER_MARK) {
+        sb_error("%s: byte-order mark 0x%08x, expected 0x%08x (little endian)", source, get_u32(b + 12),
+                 BYTE_ORDER_MARK);
+        return SB_ERR_PROBES;
+    }
+    if (size < SB_PROBES_HEADER_BYTES + 8) {
+        sb_error("%s: %zu bytes, shorter than the header and checksum", source, size);
+        return SB_ERR_BAD_IMAGE;
+    }
+    uint32_t header = get_u32(b + 16), channels = get_u32(b + 20), count = get_u32(b + 24);
+    uint32_t grid[3] = {get_u32(b + 28), get_u32(b + 32), get_u32(b + 36)}, explicit_count = get_u32(b + 40);
+    if (header != SB_PROBES_HEADER_BYTES) {
+        sb_error("%s: header of %u bytes, version 1 has %d", source, header, SB_PROBES_HEADER_BYTES);
+        return SB_ERR_PROBES;
+    }
+    struct sb_image names = {0};
+    sb_image_set_channel_names(&names, channel_names);
+    uint32_t expect = 0;
+    while (expect < SB_IMAGE_MAX_CHANNELS && names.channel_names[expect][0])
+        expect++;
+    if (channels != expect) {
+        sb_error("%s: %u channels a probe, the product has %u (%s)", source, channels, expect, channel_names);
+        return SB_ERR_BAD_IMAGE;
+    }
+    uint64_t grid_count = 1;
+    for (int i = 0; i < 3; i++) {
+        if (grid[i] > SB_PROBES_MAX_GRID || (!grid[i]) != (!grid[0])) {
+            sb_error("%s: grid %u x %u x %u: each 1 to %u, or all 0", source, grid[0], grid[1], grid[2],
+                     SB_PROBES_MAX_GRID);
+            return SB_ERR_PROBES;
+        }
+        grid_count *= grid[i];
+    }
+    if (!count || count > max_probes || count > SB_PROBES_MAX_COUNT || grid_count + explicit_count != count) {
+        sb_error("%s: %u probes (grid %llu, explicit %u): expected their sum, 1 to %u", source, count,
+                 (unsigned long long)grid_count, explicit_count,
+                 max_probes < SB_PROBES_MAX_COUNT ? max_probes : SB_PROBES_MAX_COUNT);
+        return SB_ERR_PROBES;
+    }
+    if (size != file_size(count, channels)) {
+        sb_error("%s: %zu bytes, %u probes of %u channels take %zu", source, size, count, channels,
+                 file_size(count, channels));
+        return SB_ERR_BAD_IMAGE;
+    }
+    if (get_u64(b + size - 8) != XXH3_64bits(b, size - 8)) {
+        sb_error("%s: the checksum does not match: the file was changed or corrupted", source);
+        return SB_ERR_HASH_MISMATCH;
+    }
+    for (int i = 104; i < SB_PROBES_HEADER_BYTES; i++)
+        if (b[i]) {
+            sb_error("%s: reserved header byte %d is not zero", source, i);
+            return SB_ERR_PROBES;
+        }
+    for (int i = 0; i < 3; i++) {
+        layout->grid[i] = grid[i];
+        layout->origin_m[i] = get_f32(b + 44 + 4 * i);
+        layout->spacing_m[i] = get_f32(b + 56 + 4 * i);
+        if (!isfinite(layout->origin_m[i]) || !isfinite(layout->spacing_m[i]) ||
+            (grid[0] && !(layout->spacing_m[i] > 0))) {
+            sb_error("%s: grid origin or spacing %d is not finite, or a spacing not positive", source, i);
+            memset(layout, 0, sizeof(*layout));
+            return SB_ERR_PROBES;
+        }
+    }
+    layout->explicit_count = explicit_count;
+    layout->ray_count = get_u32(b + 68);
+    for (int i = 0; i < 32; i++) {
+        char c = (char)b[72 + i];
+        if (!(c >= '0' && c <= '9') && !(c >= 'a' && c <= 'f') && !(c == 0 && i == 0)) {
+            sb_error("%s: the bake key is not 32 lowercase hex digits (or empty)", source);
+            memset(layout, 0, sizeof(*layout));
+            return SB_ERR_PROBES;
+        }
+        if (c == 0)
+            break;
+    }
+    memcpy(layout->key, b + 72, 32);
+    layout->key[32] = '\0';
+    enum sb_result res = sb_image_init(image, count, 1, channels);
+    if (res) {
+        memset(layout, 0, sizeof(*layout));
+        return res;
+    }
+    sb_image_set_channel_names(image, channel_names);
+    const uint8_t *p = b + SB_PROBES_HEADER_BYTES;
+    for (uint32_t c = 0; c < channels && !res; c++) {
+        double lo, hi;
+        channel_range(image->channel_names[c], &lo, &hi);
+        for (uint32_t i = 0; i < count; i++) {
+            float v = get_f32(p + 4 * ((size_t)i * channels + c));
+            bool flag = !strcmp(image->channel_names[c], "valid"); /* 0 or 1, nothing between */
+            if (!isfinite(v) || v < lo || v > hi || (flag && v != 0.0f && v != 1.0f)) {
+                sb_error("%s: probe %u channel %s is %g, expected a finite value in [%g, %g]", source, i,
+                         image->channel_names[c], v, lo, hi);
+                res = SB_ERR_NUMERIC;
+                break;
+            }
+            image->data[(size_t)i * channels + c] = v;
+        }
+    }
+    if (res) {
+        sb_image_finish(image);
+        memset(layout, 0, sizeof(*layout));
+    }
+    return res;
+}
+
+enum sb_result sb_probes_read(const char *path, const char *channel_names, uint32_t max_probes,
+                              struct sb_probe_layout *layout, struct sb_image *image)
+{
+    memset(layout, 0, sizeof(*layout));
+    memset(image, 0, sizeof(*image));
+    int fd = open(path, O_RDONLY | O_CLOEXEC | O_NOFOLLOW);
+    struct stat st;
+    if (fd < 0 || fstat(fd, &st) != 0) {
+        sb_error("%s: cannot read: %s", path, strerror(errno));
+        if (fd >= 0)
+            close(fd);
+        return SB_ERR_IO;
+    }
+    size_t largest = file_size(SB_PROBES_MAX_COUNT, SB_IMAGE_MAX_CHANNELS);
+    if (!S_ISREG(st.st_mode) || (uint64_t)st.st_size > largest) {
+        sb_error("%s: not a regular file of at most %zu bytes", path, largest);
+        close(fd);
+        return S_ISREG(st.st_mode) ? SB_ERR_TOO_LARGE : SB_ERR_IO;
+    }
+    size_t size = (size_t)st.st_size;
+    uint8_t *bytes = malloc(size ? size : 1);
+    enum sb_result res = bytes ? SB_OK : SB_ERR_NOMEM;
+    for (size_t done = 0; done < size && !res;) {
+        ssize_t n = read(fd, bytes + done, size - done);
+        if (n < 0 && errno == EINTR)
+            continue;
+        if (n <= 0) {
+            sb_error("%s: cannot read: %s", path, n < 0 ? strerror(errno) : "shorter than it was");
+            res = SB_ERR_IO;
+        } else {
+            done += (size_t)n;
+        }
+    }
+    close(fd);
+    if (!res)
+        res = sb_probes_parse(bytes, size, path, channel_names, max_probes, layout, image);
+    free(bytes);
+    return res;
+}

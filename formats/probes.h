@@ -1,0 +1,84 @@
+/*
+ * Probe files (.sbprobes): a set of probes with one fp32 record each, in
+ * skybake's own small binary format (docs/pack.md, "Probe files"). Little
+ * endian throughout:
+ *
+ *   offset  size  field
+ *        0     8  magic "SBPROBES"
+ *        8     4  format version (1)
+ *       12     4  byte-order mark 0x01020304
+ *       16     4  header bytes (112)
+ *       20     4  channels per probe
+ *       24     4  probe count (grid probes, then explicit ones)
+ *       28    12  grid probes along x, y, z (0 0 0: no grid)
+ *       40     4  explicit probes
+ *       44    12  the grid's first probe, metres
+ *       56    12  the grid's spacing, metres
+ *       68     4  rays per probe
+ *       72    32  the bake key that produced it, lowercase hex
+ *      104     8  reserved, zero
+ *      112     -  probe count x channels x float32, probe by probe
+ *      end     8  XXH3-64 of every byte before it
+ *
+ * The reader trusts nothing: every field is checked against the format's
+ * caps and the others before anything is allocated, the size must match
+ * exactly (no truncation, nothing trailing), the checksum must hold and
+ * every value must be finite and in its channel's range. A newer version
+ * is SB_ERR_VERSION ("rebake needed"), never a guess.
+ */
+#ifndef SB_PROBES_H
+#define SB_PROBES_H
+
+#include <stddef.h>
+#include <stdint.h>
+
+#include "image.h"
+#include "result.h"
+
+#define SB_PROBES_VERSION 1
+#define SB_PROBES_HEADER_BYTES 112
+#define SB_PROBES_MAX_COUNT (1u << 20)
+#define SB_PROBES_MAX_GRID 1024 /* probes along one axis */
+
+/* The sky-visibility product's channels (docs/pack.md): where the probe
+ * is (after any push out of geometry) and how far it was moved; 1 when
+ * valid (0: inside geometry, not to be used); the fractions of its rays
+ * that met a back face or anything, their mean distance; the deringing
+ * window applied (sh.h); the order-2 SH of the sky's visibility. */
+#define SB_SKY_VISIBILITY_CHANNELS                                                                                     \
+    "position.x,position.y,position.z,offset.x,offset.y,offset.z,valid,back_fraction,hit_fraction,"                    \
+    "mean_distance_m,dering_window,sh.0,sh.1,sh.2,sh.3,sh.4,sh.5,sh.6,sh.7,sh.8"
+#define SB_SKY_VISIBILITY_CHANNEL_COUNT 20
+
+/* Where the probes are: a grid (x fastest) then explicit ones. */
+struct sb_probe_layout {
+    uint32_t grid[3];
+    uint32_t explicit_count;
+    float origin_m[3];
+    float spacing_m[3];
+    uint32_t ray_count;
+    char key[33]; /* the bake key, or "" */
+};
+
+/* Write the probes (image: width = probe count, height = depth = 1, the
+ * channels in the product's order) with their layout. Atomic only as the
+ * pack is (the writer's temporary directory). */
+enum sb_result sb_probes_write(const char *path, const struct sb_probe_layout *layout, const struct sb_image *image);
+
+/*
+ * Parse a probe file's bytes (source names it in messages). channel_names
+ * (comma-separated) must be the file's channels, in order; max_probes caps
+ * the count. On success *image holds the records and *layout the layout;
+ * on failure both are zeroed. Codes: SB_ERR_PROBES (not a probe file, or a
+ * header field out of range), SB_ERR_VERSION, SB_ERR_BAD_IMAGE (size,
+ * counts or channels that do not match), SB_ERR_HASH_MISMATCH (checksum),
+ * SB_ERR_NUMERIC (a value not finite or out of its range), SB_ERR_NOMEM.
+ */
+enum sb_result sb_probes_parse(const void *bytes, size_t size, const char *source, const char *channel_names,
+                               uint32_t max_probes, struct sb_probe_layout *layout, struct sb_image *image);
+
+/* Read and parse the file at path (at most the largest legal size). */
+enum sb_result sb_probes_read(const char *path, const char *channel_names, uint32_t max_probes,
+                              struct sb_probe_layout *layout, struct sb_image *image);
+
+#endif

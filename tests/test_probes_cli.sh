@@ -1,0 +1,87 @@
+#!/bin/sh
+# Sky-visibility probes as a user bakes them: a scene with a world, the
+# bake graph (the atmosphere does not rebake probes; a vertex does), verify,
+# info and diff, and bad worlds refused with the file named and the old
+# pack left whole. Usage: test_probes_cli.sh SKYBAKE SOURCE_ROOT
+set -u
+skybake=$1
+root=$2
+. "$root/tests/cli_lib.sh"
+export SKYBAKE_VALIDATE=1
+
+# A small world: a ground, a table-like slab on four legs, a closed box.
+cat >"$tmp/world.obj" <<'OBJ'
+v -10 0 -10
+v -10 0 10
+v 10 0 10
+v 10 0 -10
+f 1 2 3
+f 1 3 4
+v -2 2 -2
+v 2 2 -2
+v 2 2 2
+v -2 2 2
+f 5 6 7
+f 5 7 8
+f 5 8 7
+f 5 7 6
+OBJ
+scene() { # products-json atmosphere-json extra
+    printf '{"version":1,"name":"probes","atmosphere":%s,"products":%s,"world":{"file":"world.obj"},"probes":{"spacing_m":4,"rays":512%s}}' "$2" "$1" "$3"
+}
+scene '["sky_visibility"]' '{"preset":"earth"}' '' >"$tmp/s.json"
+scene '["sky_visibility"]' '{"preset":"earth","mie_g":0.7}' '' >"$tmp/s_g.json"
+check "bake probes" expect_exit 0 "$skybake" bake "$tmp/s.json" -o "$tmp/p" --json -q
+check "the pack holds the probe file" test -s "$tmp/p/sky_visibility.sbprobes"
+check "only what was asked for" test ! -e "$tmp/p/transmittance.exr"
+check "verify" expect_exit 0 "$skybake" verify "$tmp/p"
+check "info lists sky_visibility" expect_exit 0 "$skybake" info "$tmp/p"
+check "info shows the grid" grep -q '"grid":\[6,1,6\]' "$tmp/out"
+check "manifest has format_version 3" grep -Eq '"format_version":[[:space:]]*3,' "$tmp/p/manifest.json"
+check "diff with itself" expect_exit 0 "$skybake" diff "$tmp/p" "$tmp/p"
+hash() { sed -n 's/.*"content_hash":[[:space:]]*"\([0-9a-f]*\)".*/\1/p' "$tmp/p/manifest.json"; }
+first=$(hash)
+check "a rebake reuses the probes" expect_exit 0 "$skybake" bake "$tmp/s.json" -o "$tmp/p"
+check "reused (key unchanged)" grep -q "sky_visibility.*reused" "$tmp/err"
+check "another atmosphere: the probes are reused" expect_exit 0 "$skybake" bake "$tmp/s_g.json" -o "$tmp/p"
+check "reused after an atmosphere change" grep -q "sky_visibility.*reused" "$tmp/err"
+check "the same probes" test "$(hash)" = "$first"
+sed -i 's/^v 2 2 2$/v 2 2.5 2/' "$tmp/world.obj"
+check "a vertex moved: rebaked" expect_exit 0 "$skybake" bake "$tmp/s.json" -o "$tmp/p"
+check "not reused after a vertex moved" sh -c "! grep -q 'sky_visibility.*reused' '$tmp/err'"
+check "other probes" test "$(hash)" != "$first"
+check "forced rebake, same bytes" expect_exit 0 "$skybake" bake "$tmp/s.json" -o "$tmp/q" --force -q
+check "deterministic" cmp -s "$tmp/p/sky_visibility.sbprobes" "$tmp/q/sky_visibility.sbprobes"
+
+# Bad worlds: named, exit 1 at bake (2 for the scene), the old pack whole.
+cp -r "$tmp/p" "$tmp/before"
+scene '["sky_visibility"]' '{"preset":"earth"}' '' | sed 's/world.obj/missing.obj/' >"$tmp/missing.json"
+check "a missing world file is a failed bake" expect_exit 1 "$skybake" bake "$tmp/missing.json" -o "$tmp/p"
+check "it names the file" grep -q "missing.obj" "$tmp/err"
+printf 'not a mesh at all' >"$tmp/garbage.obj"
+scene '["sky_visibility"]' '{"preset":"earth"}' '' | sed 's/world.obj/garbage.obj/' >"$tmp/garbage.json"
+check "a file assimp refuses is a failed bake" expect_exit 1 "$skybake" bake "$tmp/garbage.json" -o "$tmp/p"
+check "it names that file" grep -q "garbage.obj" "$tmp/err"
+check "the old pack is whole" diff -r "$tmp/p" "$tmp/before"
+printf '{"atmosphere":{"preset":"earth"},"products":["sky_visibility"]}' >"$tmp/noworld.json"
+check "sky_visibility without a world is a scene error" expect_exit 2 "$skybake" bake "$tmp/noworld.json" -o "$tmp/n"
+check "it says what is missing" grep -q "needs a \"world\"" "$tmp/err"
+for bad in '"spacing_m":-1' '"rays":100' '"rays":1e9' '"inside_fraction":2' '"positions_m":[[1,2]]' '"nope":1' '"spacing_m":0'; do
+    printf '{"atmosphere":{"preset":"earth"},"products":["sky_visibility"],"world":{"file":"world.obj"},"probes":{%s}}' "$bad" >"$tmp/bad.json"
+    check "probes {$bad} is a scene error" expect_exit 2 "$skybake" bake "$tmp/bad.json" -o "$tmp/n"
+    check "it names probes" grep -q "probes" "$tmp/err"
+done
+scene '["sky_visibility"]' '{"preset":"earth"}' '' | sed 's/"spacing_m":4/"spacing_m":0.01/' >"$tmp/dense.json"
+check "a grid past the caps is refused" expect_exit 1 "$skybake" bake "$tmp/dense.json" -o "$tmp/n"
+check "it says to raise the spacing" grep -q "raise probes.spacing_m" "$tmp/err"
+check "the tolerance is refused for probes" sh -c "printf '{\"atmosphere\":{\"preset\":\"earth\"},\"products\":[\"sky_visibility\"],\"world\":{\"file\":\"w.obj\"},\"tolerance\":{\"sky_visibility\":0.01}}' >'$tmp/tol.json'; '$skybake' bake '$tmp/tol.json' -o '$tmp/n' 2>/dev/null; test \$? = 2"
+
+# A probe file edited in the pack: verify names it.
+cp -r "$tmp/p" "$tmp/edited"
+printf '\001' | dd of="$tmp/edited/sky_visibility.sbprobes" bs=1 seek=200 conv=notrunc 2>/dev/null
+check "verify refuses an edited probe file" expect_exit 1 "$skybake" verify "$tmp/edited"
+check "naming it" grep -q "sky_visibility" "$tmp/err"
+
+echo "probes cli: $checks checks, $fails failed"
+echo "$((checks - fails)) passed, $fails failed"
+[ "$fails" = 0 ]
