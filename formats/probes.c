@@ -11,6 +11,7 @@
 #include <unistd.h>
 #include <xxhash.h>
 
+#include "io.h"
 #include "log.h"
 
 static const char magic[8] = {'S', 'B', 'P', 'R', 'O', 'B', 'E', 'S'};
@@ -105,30 +106,7 @@ enum sb_result sb_probes_write(const char *path, const struct sb_probe_layout *l
         put_f32(p, image->data[i]);
     put_u64(p, XXH3_64bits(bytes, size - 8));
 
-    enum sb_result res = SB_OK;
-    int fd = open(path, O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0644);
-    if (fd < 0) {
-        sb_error("%s: cannot create: %s", path, strerror(errno));
-        res = SB_ERR_IO;
-    } else {
-        for (size_t done = 0; done < size && !res;) {
-            ssize_t n = write(fd, bytes + done, size - done);
-            if (n < 0 && errno == EINTR)
-                continue;
-            if (n <= 0) {
-                sb_error("%s: cannot write: %s", path, n < 0 ? strerror(errno) : "no progress");
-                res = SB_ERR_IO;
-            } else {
-                done += (size_t)n;
-            }
-        }
-        if (close(fd) != 0 && !res) {
-            sb_error("%s: cannot write: %s", path, strerror(errno));
-            res = SB_ERR_IO;
-        }
-        if (res)
-            unlink(path);
-    }
+    enum sb_result res = sb_write_file(path, bytes, size, "probe file");
     free(bytes);
     return res;
 }
@@ -278,16 +256,9 @@ enum sb_result sb_probes_read(const char *path, const char *channel_names, uint3
     size_t size = (size_t)st.st_size;
     uint8_t *bytes = malloc(size ? size : 1);
     enum sb_result res = bytes ? SB_OK : SB_ERR_NOMEM;
-    for (size_t done = 0; done < size && !res;) {
-        ssize_t n = read(fd, bytes + done, size - done);
-        if (n < 0 && errno == EINTR)
-            continue;
-        if (n <= 0) {
-            sb_error("%s: cannot read: %s", path, n < 0 ? strerror(errno) : "shorter than it was");
-            res = SB_ERR_IO;
-        } else {
-            done += (size_t)n;
-        }
+    if (!res && !sb_read_all(fd, bytes, size)) {
+        sb_error("%s: cannot read: %s", path, errno ? strerror(errno) : "shorter than it was");
+        res = SB_ERR_IO;
     }
     close(fd);
     if (!res)

@@ -332,18 +332,9 @@ static enum sb_result view_number(const cJSON *obj, const char *key, double lo, 
                                   double *out)
 {
     const cJSON *item = cJSON_GetObjectItemCaseSensitive(obj, key);
-    if (!item)
-        return SB_OK;
-    if (!cJSON_IsNumber(item)) {
-        sb_error("%s: view.%s: expected a number", source, key);
-        return SB_ERR_WRONG_TYPE;
-    }
-    if (!isfinite(item->valuedouble) || item->valuedouble < lo || item->valuedouble > hi) {
-        sb_error("%s: view.%s: %.17g is out of range, expected %g to %g", source, key, item->valuedouble, lo, hi);
-        return SB_ERR_OUT_OF_RANGE;
-    }
-    *out = item->valuedouble;
-    return SB_OK;
+    char path[64];
+    snprintf(path, sizeof(path), "view.%s", key);
+    return item ? sb_json_number(item, source, path, lo, hi, out) : SB_OK;
 }
 
 static enum sb_result parse_view(const cJSON *obj, struct sb_scene *scene, const char *source)

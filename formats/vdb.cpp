@@ -23,6 +23,7 @@
 #include <unistd.h>
 
 extern "C" {
+#include "io.h"
 #include "log.h"
 #include "vdb.h"
 }
@@ -82,28 +83,7 @@ bool looks_like_uuid(const std::string &bytes, size_t at)
 
 enum sb_result write_bytes(const char *path, const std::string &bytes)
 {
-    int fd = open(path, O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0666);
-    if (fd < 0) {
-        sb_error("%s: cannot create the VDB file: %s", path, strerror(errno));
-        return SB_ERR_IO;
-    }
-    size_t done = 0;
-    while (done < bytes.size()) {
-        ssize_t n = ::write(fd, bytes.data() + done, bytes.size() - done);
-        if (n < 0 && errno == EINTR)
-            continue;
-        if (n <= 0) {
-            sb_error("%s: cannot write the VDB file: %s", path, n < 0 ? strerror(errno) : "no progress");
-            close(fd);
-            return SB_ERR_IO;
-        }
-        done += static_cast<size_t>(n);
-    }
-    if (close(fd) != 0) {
-        sb_error("%s: cannot write the VDB file: %s", path, strerror(errno));
-        return SB_ERR_IO;
-    }
-    return SB_OK;
+    return sb_write_file(path, bytes.data(), bytes.size(), "VDB file");
 }
 
 openvdb::math::Transform::Ptr texture_transform(uint32_t width, uint32_t height, uint32_t depth)

@@ -18,6 +18,7 @@
 #include <unistd.h>
 #include <xxhash.h>
 
+#include "io.h"
 #include "log.h"
 
 /* Node trees deeper than this are refused (a file can make them cyclic). */
@@ -362,21 +363,6 @@ static void first_error(void *user, enum sb_log_level level, const char *message
         fprintf(stderr, "%s\n", message);
 }
 
-static bool write_all(int fd, const void *data, size_t size)
-{
-    const char *p = data;
-    while (size) {
-        ssize_t n = write(fd, p, size);
-        if (n < 0 && errno == EINTR)
-            continue;
-        if (n <= 0)
-            return false;
-        p += n;
-        size -= (size_t)n;
-    }
-    return true;
-}
-
 static _Noreturn void import_child(int fd, const char *path, const struct sb_mesh_load_params *params)
 {
     rlim_t seconds = params->time_limit_s ? params->time_limit_s : SB_MESH_IMPORT_SECONDS;
@@ -396,11 +382,11 @@ static _Noreturn void import_child(int fd, const char *path, const struct sb_mes
         h.material_count = mesh.material_count;
         h.dropped_degenerate = mesh.dropped_degenerate;
     }
-    bool ok = write_all(fd, &h, sizeof(h));
+    bool ok = sb_write_all(fd, &h, sizeof(h));
     if (!h.result && ok)
-        ok = write_all(fd, mesh.material_list, (size_t)mesh.material_count * sizeof(*mesh.material_list)) &&
-             write_all(fd, mesh.positions, (size_t)mesh.vertex_count * 3 * sizeof(float)) &&
-             write_all(fd, mesh.materials, (size_t)mesh.triangle_count * sizeof(uint32_t));
+        ok = sb_write_all(fd, mesh.material_list, (size_t)mesh.material_count * sizeof(*mesh.material_list)) &&
+             sb_write_all(fd, mesh.positions, (size_t)mesh.vertex_count * 3 * sizeof(float)) &&
+             sb_write_all(fd, mesh.materials, (size_t)mesh.triangle_count * sizeof(uint32_t));
     _exit(ok ? 0 : 1);
 }
 

@@ -1,0 +1,32 @@
+/*
+ * Whole reads and writes on file descriptors, past EINTR and short
+ * transfers, and a whole file written from memory: the one place the
+ * readers and writers of formats/ (and the mesh importer's pipe) do it.
+ */
+#ifndef SB_IO_H
+#define SB_IO_H
+
+#include <stdbool.h>
+#include <stddef.h>
+
+#include "result.h"
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+/* Write all `size` bytes; false with errno set (EIO when no progress). */
+bool sb_write_all(int fd, const void *data, size_t size);
+
+/* Read exactly `size` bytes; false with errno set (0 at an early end). */
+bool sb_read_all(int fd, void *data, size_t size);
+
+/* Create (or truncate) path and write the bytes; on failure log "path:
+ * cannot write the <what>: reason", remove the file and return SB_ERR_IO. */
+enum sb_result sb_write_file(const char *path, const void *data, size_t size, const char *what);
+
+#ifdef __cplusplus
+}
+#endif
+
+#endif
