@@ -211,6 +211,141 @@ static void test_analytic(struct sb_vk *vk)
     scene_finish(&over);
 }
 
+/*
+ * Reconstruction error (Ramamoorthi and Hanrahan's measure): irradiance at
+ * probes in the IFC house under a sky of radiance L (brighter toward the
+ * horizon, nothing below it) and a sun, from the baked L2 SH of visibility
+ * as a runtime would use it, against a brute-force integral of 65536
+ * Embree rays a probe. The SH path: the L2 projection of L, the product
+ * with the visibility's SH by the triple-product tensor (truncated to L2),
+ * convolved with the clamped cosine (A_l = pi, 2 pi / 3, pi / 4); the sun:
+ * the reconstructed visibility at its direction, clamped to [0, 1].
+ */
+static double sky_radiance(const double d[3])
+{
+    return d[1] > 0 ? 1.0 + 2.0 * (1.0 - d[1]) * (1.0 - d[1]) : 0.0;
+}
+
+static const int sh_band[SB_PROBE_SH] = {0, 1, 1, 1, 2, 2, 2, 2, 2};
+
+static void reconstruction_error(const struct sb_mesh *mesh, const struct sb_embree *e, const float *positions,
+                                 const float *baked, int count)
+{
+    enum { DENSE = 65536, NORMALS = 64 };
+    static double tensor[SB_PROBE_SH][SB_PROBE_SH][SB_PROBE_SH];
+    double sky[SB_PROBE_SH] = {0};
+    const int q = 1 << 18;
+    for (int i = 0; i < q; i++) { /* dense fp64 quadrature, error ~1e-6 */
+        double d[3], y[SB_PROBE_SH];
+        sb_probe_direction((uint32_t)i, (uint32_t)q, d);
+        sb_sh9_basis(d, y);
+        double w = 4 * M_PI / q;
+        for (int a = 0; a < SB_PROBE_SH; a++) {
+            sky[a] += y[a] * sky_radiance(d) * w;
+            for (int b = 0; b < SB_PROBE_SH; b++)
+                for (int c = 0; c < SB_PROBE_SH; c++)
+                    tensor[a][b][c] += y[a] * y[b] * y[c] * w;
+        }
+    }
+    const double sun[3] = {0.664, 0.5, 0.557}, sun_irradiance = 10.0; /* 30 degrees up */
+    double sun_len = sqrt(sun[0] * sun[0] + sun[1] * sun[1] + sun[2] * sun[2]), s[3];
+    for (int k = 0; k < 3; k++)
+        s[k] = sun[k] / sun_len;
+    static const double cosine[3] = {M_PI, 2 * M_PI / 3, M_PI / 4};
+    float *rays = malloc(sizeof(float) * 8 * DENSE), *hits = malloc(sizeof(float) * 4 * DENSE);
+    double sum_sky = 0, sum_sun = 0, sum_all = 0, worst_all = 0, worst_sky = 0;
+    int samples = 0, lit = 0;
+    for (int p = 0; p < count && rays && hits; p++) {
+        const float *b = &baked[SB_VISIBILITY_FLOATS * p];
+        if (b[SB_PROBE_SH] > 0.25f || b[SB_PROBE_SH + 1] > 0.98f)
+            continue; /* inside geometry, or closed in: nothing to measure */
+        for (uint32_t r = 0; r < DENSE; r++) {
+            double d[3];
+            sb_probe_direction(r, DENSE, d);
+            float *ray = &rays[8 * r];
+            memcpy(ray, &positions[3 * p], 3 * sizeof(float));
+            ray[3] = 1e-4f;
+            for (int k = 0; k < 3; k++)
+                ray[4 + k] = (float)d[k];
+            ray[7] = 1e30f;
+        }
+        sb_embree_cast(e, rays, DENSE, hits);
+        /* the sun's ray */
+        float sun_ray[8] = {positions[3 * p], positions[3 * p + 1], positions[3 * p + 2], 1e-4f,
+                            (float)s[0],      (float)s[1],          (float)s[2],          1e30f},
+              sun_hit[4];
+        sb_embree_cast(e, sun_ray, 1, sun_hit);
+        uint32_t sun_tri;
+        memcpy(&sun_tri, &sun_hit[1], sizeof(sun_tri));
+        double sun_visible = sun_tri == SB_BVH_MISS;
+        /* the SH path: V (deringed, as baked), V x L, cosine */
+        double v[SB_PROBE_SH], vl[SB_PROBE_SH] = {0};
+        for (int k = 0; k < SB_PROBE_SH; k++)
+            v[k] = b[k];
+        for (int a = 0; a < SB_PROBE_SH; a++)
+            for (int i = 0; i < SB_PROBE_SH; i++)
+                for (int j = 0; j < SB_PROBE_SH; j++)
+                    vl[a] += tensor[a][i][j] * v[i] * sky[j];
+        double v_sun = fmin(fmax(sb_sh9_eval(v, s), 0.0), 1.0);
+        double e_ref_sky[NORMALS], e_sh_sky[NORMALS], e_ref_sun[NORMALS], e_sh_sun[NORMALS], mean_sky = 0, mean_all = 0;
+        for (int nrm = 0; nrm < NORMALS; nrm++) {
+            double n[3];
+            sb_probe_direction((uint32_t)nrm, NORMALS, n);
+            double ref_sky = 0;
+            for (uint32_t r = 0; r < DENSE; r++) {
+                uint32_t t;
+                memcpy(&t, &hits[4 * r + 1], sizeof(t));
+                if (t != SB_BVH_MISS)
+                    continue;
+                double d[3] = {rays[8 * r + 4], rays[8 * r + 5], rays[8 * r + 6]};
+                double c = d[0] * n[0] + d[1] * n[1] + d[2] * n[2];
+                if (c > 0)
+                    ref_sky += sky_radiance(d) * c * 4 * M_PI / DENSE;
+            }
+            double y[SB_PROBE_SH], sh_sky = 0;
+            sb_sh9_basis(n, y);
+            for (int k = 0; k < SB_PROBE_SH; k++)
+                sh_sky += cosine[sh_band[k]] * vl[k] * y[k];
+            double cs = fmax(0.0, s[0] * n[0] + s[1] * n[1] + s[2] * n[2]);
+            e_ref_sky[nrm] = ref_sky;
+            e_sh_sky[nrm] = fmax(sh_sky, 0.0);
+            e_ref_sun[nrm] = sun_visible * sun_irradiance * cs;
+            e_sh_sun[nrm] = v_sun * sun_irradiance * cs;
+            mean_sky += ref_sky / NORMALS;
+            mean_all += (ref_sky + e_ref_sun[nrm]) / NORMALS;
+            lit += cs > 0;
+            if (cs > 0)
+                sum_sun += fabs(e_sh_sun[nrm] - e_ref_sun[nrm]) / (sun_irradiance * cs);
+        }
+        /* errors relative to the probe's mean irradiance over normals (a dark
+         * face's tiny irradiance would make any relative error huge) */
+        for (int nrm = 0; nrm < NORMALS && mean_sky > 0; nrm++) {
+            sum_sky += fabs(e_sh_sky[nrm] - e_ref_sky[nrm]) / mean_sky;
+            double all = fabs(e_sh_sky[nrm] + e_sh_sun[nrm] - e_ref_sky[nrm] - e_ref_sun[nrm]) / mean_all;
+            sum_all += all;
+            worst_all = fmax(worst_all, all);
+            worst_sky = fmax(worst_sky, fabs(e_sh_sky[nrm] - e_ref_sky[nrm]) / mean_sky);
+            samples++;
+        }
+    }
+    free(rays);
+    free(hits);
+    if (!samples) {
+        CHECK(false, "reconstruction: no open probe to measure");
+        return;
+    }
+    printf("reconstruction (IFC house, %d open probes x %d normals, relative to each probe's mean irradiance): sky "
+           "%.1f%% mean, %.1f%% worst; the sun's visibility %.1f%% of its irradiance on average; sky and sun "
+           "together %.1f%% mean, %.0f%% worst\n",
+           samples / NORMALS, NORMALS, 100 * sum_sky / samples, 100 * worst_sky, 100 * sum_sun / fmax(lit, 1),
+           100 * sum_all / samples, 100 * worst_all);
+    /* Measured on lavapipe: the sky's mean error 5.0% (worst 24%,
+     * a face turned to a nearby opening); the sun's visibility 7.8% of its
+     * irradiance: L2 blurs a shadow's edge over tens of degrees, so the sun
+     * is where L2 is not enough (shadow maps own it). Bound: 7% mean. */
+    CHECK(sum_sky / samples < 0.07, "the sky's mean irradiance error %.3f", sum_sky / samples);
+}
+
 /* Probes in and around the IFC house against Embree's rays over the same
  * directions, projected in fp64; then determinism and deringing. */
 static void test_house(struct sb_vk *vk)
@@ -283,6 +418,7 @@ static void test_house(struct sb_vk *vk)
                 CHECK(sb_sh9_min(c, NULL) >= 0, "probe %d: negative after deringing", i);
             }
         }
+        reconstruction_error(&house.mesh, &e, positions, out, N);
         printf("IFC house, %d probes x %d rays: SH within %.2e of Embree's fp64 projection (%.2f ray quanta), hit "
                "fraction within %.2e; %d flagged inside (back faces > 25%%), %d mostly open; %d deringed (lowest "
                "%.3g before, mean window %.2f)\n",
