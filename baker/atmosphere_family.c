@@ -108,7 +108,7 @@ static uint32_t atmosphere_depends_on(enum sb_product_id id)
     return sb_atmosphere_product(id)->depends_on;
 }
 
-static void atmosphere_key(const struct sb_scene *scene, enum sb_product_id id, struct sb_key_text *key)
+static void atmosphere_key(void *state, const struct sb_scene *scene, enum sb_product_id id, struct sb_key_text *key)
 {
     char settings[1024], code[SB_HASH_HEX_SIZE];
     key_params(id, &scene->atmosphere, key);

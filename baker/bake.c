@@ -39,7 +39,8 @@ uint32_t sb_bake_closure(const struct sb_scene *scene)
     return mask;
 }
 
-void sb_bake_keys(const struct sb_scene *scene, uint32_t mask, char out[SB_PRODUCT_COUNT][SB_HASH_HEX_SIZE])
+void sb_bake_keys(const struct sb_scene *scene, uint32_t mask, void *const states[SB_FAMILY_COUNT],
+                  char out[SB_PRODUCT_COUNT][SB_HASH_HEX_SIZE])
 {
     struct sb_key_text key;
     for (int p = 0; p < SB_PRODUCT_COUNT; p++) {
@@ -50,7 +51,7 @@ void sb_bake_keys(const struct sb_scene *scene, uint32_t mask, char out[SB_PRODU
         key.length = 0;
         sb_key_add(&key, "skybake-bake-key-v1 format %d skybake %s product %s stored %s", SB_PACK_FORMAT_VERSION,
                    SKYBAKE_VERSION, sb_product_name(id), sb_product_format(id)->pixel_type);
-        sb_product_baker(id)->key(scene, id, &key);
+        sb_product_baker(id)->key(states[sb_product_format(id)->family], scene, id, &key);
         /* Dependencies point to lower ids: their keys are ready. */
         uint32_t inputs = depends_on(id);
         for (int d = 0; d < p; d++)
@@ -148,7 +149,7 @@ enum sb_result sb_bake_scene(struct sb_vk *vk, const struct sb_scene *scene, con
     }
 
     char keys[SB_PRODUCT_COUNT][SB_HASH_HEX_SIZE];
-    sb_bake_keys(scene, mask, keys);
+    sb_bake_keys(scene, mask, states, keys);
     for (int p = 0; p < SB_PRODUCT_COUNT; p++) {
         if (!(mask & (1u << p)))
             continue;

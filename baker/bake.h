@@ -35,7 +35,9 @@ struct sb_bake_report {
 uint32_t sb_bake_closure(const struct sb_scene *scene);
 
 /* The bake key of every product in `mask` (see above), in out[id]. */
-void sb_bake_keys(const struct sb_scene *scene, uint32_t mask, char out[SB_PRODUCT_COUNT][SB_HASH_HEX_SIZE]);
+/* `states`: each family's state (family.h), or NULL for families without. */
+void sb_bake_keys(const struct sb_scene *scene, uint32_t mask, void *const states[SB_FAMILY_COUNT],
+                  char out[SB_PRODUCT_COUNT][SB_HASH_HEX_SIZE]);
 
 /* Bake `scene` on `vk` into a pack at out_dir. On failure the previous pack at
  * out_dir (if any) is untouched and no temporary files remain. `options`

@@ -9,7 +9,7 @@
 #include "family.h"
 
 /* A cloud product's recipe, every field of its push constants, and its kernel. */
-static void clouds_key(const struct sb_scene *scene, enum sb_product_id id, struct sb_key_text *key)
+static void clouds_key(void *state, const struct sb_scene *scene, enum sb_product_id id, struct sb_key_text *key)
 {
     struct sb_noise_push pc;
     sb_cloud_recipe(id, &scene->clouds, &pc);

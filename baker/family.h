@@ -37,10 +37,14 @@ struct sb_family_baker {
      * than id); NULL when the family's products read none. */
     uint32_t (*depends_on)(enum sb_product_id id);
     /* Append everything the product's values depend on but its inputs'
-     * keys (bake.c adds those): parameters, settings, kernels. */
-    void (*key)(const struct sb_scene *scene, enum sb_product_id id, struct sb_key_text *key);
-    /* The family's state for one bake (NULL create: none). Created when the
-     * bake needs any of its products; destroy accepts a pointer to NULL. */
+     * keys (bake.c adds those): parameters, settings, kernels, and for a
+     * family with inputs of its own (the probes' world) what was read.
+     * `state` is the family's (NULL when it has no create). */
+    void (*key)(void *state, const struct sb_scene *scene, enum sb_product_id id, struct sb_key_text *key);
+    /* The family's state for one bake (NULL create: none), created before
+     * the keys when the bake needs any of its products: what the keys and
+     * the bakes read (the atmosphere's baker, the probes' world). destroy
+     * accepts a pointer to NULL. */
     enum sb_result (*create)(struct sb_vk *vk, const struct sb_scene *scene, void **state);
     void (*destroy)(void **state);
     /* Bake `id` into *image (values as the pack's file stores them) and

@@ -6,11 +6,10 @@
  * inside geometry out to free space where it can (recording the offset)
  * and flags the rest invalid, and derings every probe's SH.
  *
- * The key holds the world file's bytes' hash, its placement, the probe
- * settings and the kernel: the atmosphere does not rebake probes; a vertex
- * does.
+ * The key holds the world as read (its mesh's hash), the probe settings
+ * and the kernel: the atmosphere does not rebake probes; a vertex does,
+ * wherever it lives (a glTF's .bin, a linked file).
  */
-#include <fcntl.h>
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -39,20 +38,60 @@ static void world_path(const struct sb_scene *scene, char *out, size_t size)
         snprintf(out, size, "%s/%s", scene->directory, scene->world.file);
 }
 
-static void probes_key(const struct sb_scene *scene, enum sb_product_id id, struct sb_key_text *key)
+/* The world as read for this bake: the key's input and the bake's. */
+struct probes_state {
+    struct sb_mesh mesh;
+    char mesh_hash[SB_HASH_HEX_SIZE];
+};
+
+static enum sb_result probes_create(struct sb_vk *vk, const struct sb_scene *scene, void **out)
 {
     const struct sb_world_params *w = &scene->world;
-    const struct sb_probe_params *p = &scene->probes;
-    char path[2100], hash[SB_HASH_HEX_SIZE] = "unreadable", code[SB_HASH_HEX_SIZE];
+    struct probes_state *st = calloc(1, sizeof(*st));
+    if (!st)
+        return SB_ERR_NOMEM;
+    char path[2100];
     world_path(scene, path, sizeof(path));
-    if (sb_hash_file(AT_FDCWD, path, hash))
-        snprintf(hash, sizeof(hash), "unreadable");
-    sb_key_add(key, " recipe %d world-bytes %s units_m=%a scale=%a up_z=%d", PROBES_RECIPE, hash, w->units_m, w->scale,
-               w->up_z);
-    sb_key_add3(key, "rotate_deg", w->rotate_deg);
-    sb_key_add3(key, "translate_m", w->translate_m);
-    for (int i = 0; i < w->override_count; i++)
-        sb_key_add3(key, w->overrides[i].material, w->overrides[i].albedo);
+    struct sb_mesh_albedo_override overrides[SB_WORLD_MAX_OVERRIDES];
+    for (int i = 0; i < w->override_count; i++) {
+        overrides[i].material = w->overrides[i].material;
+        memcpy(overrides[i].albedo, w->overrides[i].albedo, sizeof(overrides[i].albedo));
+    }
+    struct sb_mesh_load_params load = {
+        .transform = {.units_m = w->units_m, .scale = w->scale, .up_z = w->up_z},
+        .overrides = overrides,
+        .override_count = w->override_count,
+    };
+    memcpy(load.transform.rotate_deg, w->rotate_deg, sizeof(w->rotate_deg));
+    memcpy(load.transform.translate_m, w->translate_m, sizeof(w->translate_m));
+    enum sb_result res = sb_mesh_load(path, &load, &st->mesh);
+    if (res) {
+        free(st);
+        return res;
+    }
+    sb_mesh_hash(&st->mesh, st->mesh_hash);
+    *out = st;
+    return SB_OK;
+}
+
+static void probes_destroy(void **state)
+{
+    struct probes_state *st = *state;
+    if (st)
+        sb_mesh_finish(&st->mesh);
+    free(st);
+    *state = NULL;
+}
+
+/* The world as it was read (every vertex, index, material and albedo after
+ * the placement: a glTF's external buffers and a linked file included),
+ * not the file's bytes; the probe settings; the kernel. */
+static void probes_key(void *state, const struct sb_scene *scene, enum sb_product_id id, struct sb_key_text *key)
+{
+    const struct probes_state *st = state;
+    const struct sb_probe_params *p = &scene->probes;
+    char code[SB_HASH_HEX_SIZE];
+    sb_key_add(key, " recipe %d world %s", PROBES_RECIPE, st->mesh_hash);
     sb_key_add(key, " spacing_m=%a margin_m=%a rays=%u inside=%a", p->spacing_m, p->margin_m, p->rays,
                p->inside_fraction);
     for (int i = 0; i < p->explicit_count; i++)
@@ -184,22 +223,7 @@ static enum sb_result probes_bake(void *state, struct sb_vk *vk, const struct sb
                                   const struct sb_image baked[SB_PRODUCT_COUNT], struct sb_image *image,
                                   struct sb_artifact *a)
 {
-    const struct sb_world_params *w = &scene->world;
-    char path[2100];
-    world_path(scene, path, sizeof(path));
-    struct sb_mesh_albedo_override overrides[SB_WORLD_MAX_OVERRIDES];
-    for (int i = 0; i < w->override_count; i++) {
-        overrides[i].material = w->overrides[i].material;
-        memcpy(overrides[i].albedo, w->overrides[i].albedo, sizeof(overrides[i].albedo));
-    }
-    struct sb_mesh_load_params load = {
-        .transform = {.units_m = w->units_m, .scale = w->scale, .up_z = w->up_z},
-        .overrides = overrides,
-        .override_count = w->override_count,
-    };
-    memcpy(load.transform.rotate_deg, w->rotate_deg, sizeof(w->rotate_deg));
-    memcpy(load.transform.translate_m, w->translate_m, sizeof(w->translate_m));
-    struct sb_mesh mesh = {0};
+    struct probes_state *st = state;
     struct sb_bvh bvh = {0};
     struct sb_raycaster *rc = NULL;
     float *positions = NULL, *offsets = NULL, *valid = NULL, *results = NULL;
@@ -208,8 +232,9 @@ static enum sb_result probes_bake(void *state, struct sb_vk *vk, const struct sb
     struct sb_probe_layout *layout = &a->probes;
     memset(layout, 0, sizeof(*layout));
     enum sb_result res;
-    if ((res = sb_mesh_load(path, &load, &mesh)) || (res = sb_bvh_build(&mesh, &bvh)) ||
-        (res = sb_raycaster_create(vk, &bvh, &rc)) || (res = place(scene, &mesh, layout, &positions, &count)))
+    const struct sb_mesh *mesh = &st->mesh;
+    if ((res = sb_bvh_build(mesh, &bvh)) || (res = sb_raycaster_create(vk, &bvh, &rc)) ||
+        (res = place(scene, mesh, layout, &positions, &count)))
         goto done;
     offsets = calloc((size_t)count * 3, sizeof(float));
     valid = calloc(count, sizeof(float));
@@ -257,9 +282,9 @@ static enum sb_result probes_bake(void *state, struct sb_vk *vk, const struct sb
              "{\"rays\":%u,\"grid\":[%u,%u,%u],\"spacing_m\":%.9g,\"explicit\":%u,\"triangles\":%u,"
              "\"inside\":%u,\"pushed_out\":%u,\"invalid\":%u,\"deringed\":%u,\"lowest_before_dering\":%.6g}",
              layout->ray_count, layout->grid[0], layout->grid[1], layout->grid[2], (double)layout->spacing_m[0],
-             layout->explicit_count, mesh.triangle_count, inside, pushed, inside - pushed, deringed, lowest);
+             layout->explicit_count, mesh->triangle_count, inside, pushed, inside - pushed, deringed, lowest);
     sb_info("sky_visibility: %u probes over %u triangles; %u inside geometry, %u pushed out; %u deringed", count,
-            mesh.triangle_count, inside, pushed, deringed);
+            mesh->triangle_count, inside, pushed, deringed);
 done:
     if (res)
         sb_image_finish(image);
@@ -269,11 +294,12 @@ done:
     free(results);
     sb_raycaster_destroy(&rc);
     sb_bvh_finish(&bvh);
-    sb_mesh_finish(&mesh);
     return res;
 }
 
 const struct sb_family_baker sb_probes_family = {
     .key = probes_key,
+    .create = probes_create,
+    .destroy = probes_destroy,
     .bake = probes_bake,
 };

@@ -53,6 +53,16 @@ check "other probes" test "$(hash)" != "$first"
 check "forced rebake, same bytes" expect_exit 0 "$skybake" bake "$tmp/s.json" -o "$tmp/q" --force -q
 check "deterministic" cmp -s "$tmp/p/sky_visibility.sbprobes" "$tmp/q/sky_visibility.sbprobes"
 
+# The key is the world as read, not the scene's file name: a world reached
+# through a symbolic link rebakes when the file it points to changes.
+cp "$tmp/world.obj" "$tmp/real.obj"
+ln -s real.obj "$tmp/linked.obj"
+scene '["sky_visibility"]' '{"preset":"earth"}' '' | sed 's/world.obj/linked.obj/' >"$tmp/linked.json"
+check "bake a linked world" expect_exit 0 "$skybake" bake "$tmp/linked.json" -o "$tmp/l"
+sed -i 's/^v 2 2.5 2$/v 2 3 2/' "$tmp/real.obj"
+check "rebake after the linked file changed" expect_exit 0 "$skybake" bake "$tmp/linked.json" -o "$tmp/l"
+check "not reused after the linked file changed" sh -c "! grep -q 'sky_visibility.*reused' '$tmp/err'"
+
 # Bad worlds: named, exit 1 at bake (2 for the scene), the old pack whole.
 cp -r "$tmp/p" "$tmp/before"
 scene '["sky_visibility"]' '{"preset":"earth"}' '' | sed 's/world.obj/missing.obj/' >"$tmp/missing.json"
