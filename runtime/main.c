@@ -14,6 +14,7 @@
 #include <sys/stat.h>
 
 #include "context.h"
+#include "default_world.h"
 #include "exr.h"
 #include "log.h"
 #include "pack.h"
@@ -49,7 +50,7 @@ static void usage(FILE *f)
                "                          metres (y up, origin on the ground) and degrees: yaw\n"
                "                          clockwise from north, pitch above the horizontal,\n"
                "                          vertical field of view (default 0,2,0,0,3,50)\n"
-               "  --world FILE            the world (default data/worlds/test.json)\n"
+               "  --world FILE            the world (default: built in, data/worlds/test.json)\n"
                "  --tonemap agx|aces|gt   tone mapper (default agx)\n"
                "  --exposure EV           exposure compensation (default 0)\n"
                "  --no-bloom              no bloom\n"
@@ -105,7 +106,7 @@ struct options {
 static int parse_options(int argc, char **argv, struct options *o)
 {
     memset(o, 0, sizeof(*o));
-    o->world = SKYVIEW_DEFAULT_WORLD;
+    o->world = NULL; /* the built-in test world */
     o->frames = -1;
     o->warmup = 5;
     o->view = (struct sb_view){
@@ -305,7 +306,9 @@ static int run(const struct options *o)
         return EXIT_USAGE;
     }
     struct sb_world world;
-    if (sb_world_load(o->world, &world)) {
+    if (o->world ? sb_world_load(o->world, &world)
+                 : sb_world_parse(sb_default_world_json, strlen(sb_default_world_json),
+                                  "the built-in world (data/worlds/test.json)", &world)) {
         sb_pack_close(&pack);
         return EXIT_USAGE;
     }

@@ -290,19 +290,33 @@ static enum sb_result build(struct sb_world *w)
     return SB_OK;
 }
 
-enum sb_result sb_world_load(const char *path, struct sb_world *w)
+/* A parsed root (deleted here) to a world. */
+static enum sb_result world_from_root(enum sb_result res, cJSON *root, const char *source, struct sb_world *w)
 {
-    memset(w, 0, sizeof(*w));
-    cJSON *root = NULL;
-    enum sb_result res = sb_json_load(AT_FDCWD, path, path, WORLD_MAX_BYTES, true, &root);
     if (!res)
-        res = parse(root, path, w);
+        res = parse(root, source, w);
     cJSON_Delete(root);
     if (!res)
         res = build(w);
     if (res)
         sb_world_finish(w);
     return res;
+}
+
+enum sb_result sb_world_load(const char *path, struct sb_world *w)
+{
+    memset(w, 0, sizeof(*w));
+    cJSON *root = NULL;
+    enum sb_result res = sb_json_load(AT_FDCWD, path, path, WORLD_MAX_BYTES, true, &root);
+    return world_from_root(res, root, path, w);
+}
+
+enum sb_result sb_world_parse(const char *json, size_t size, const char *source, struct sb_world *w)
+{
+    memset(w, 0, sizeof(*w));
+    cJSON *root = NULL;
+    enum sb_result res = size > WORLD_MAX_BYTES ? SB_ERR_OUT_OF_RANGE : sb_json_parse(json, size, source, &root);
+    return world_from_root(res, root, source, w);
 }
 
 void sb_world_finish(struct sb_world *w)

@@ -7,6 +7,7 @@
 #ifndef SB_RUNTIME_WORLD_H
 #define SB_RUNTIME_WORLD_H
 
+#include <stddef.h>
 #include <stdint.h>
 
 #include "config.h"
@@ -48,6 +49,8 @@ struct sb_world {
 /* Read and check a world file, then build its triangles. On failure the
  * world is zeroed and the message names the file, the field and the reason. */
 enum sb_result sb_world_load(const char *path, struct sb_world *world);
+/* The same from a world file's text; source names it in messages. */
+enum sb_result sb_world_parse(const char *json, size_t size, const char *source, struct sb_world *world);
 /* Free the triangles; accepts a zeroed world. */
 void sb_world_finish(struct sb_world *world);
 

@@ -25,6 +25,12 @@ check "bad --tonemap is a usage error" expect_exit 2 "$skyview" "$tmp/pack" -o "
 check "one frame" expect_exit 0 "$skyview" "$tmp/pack" -o "$tmp/f" $small --hdr
 check "frame_0000.png is a PNG" test "$(head -c 8 "$tmp/f/frame_0000.png" | od -An -tx1 | tr -d ' ')" = 89504e470d0a1a0a
 check "frame_0000.exr is an EXR" test "$(head -c 4 "$tmp/f/frame_0000.exr" | od -An -tx1 | tr -d ' ')" = 762f3101
+# The default world is built in: the same frame from another directory as
+# with the world file named.
+skyview_abs=$(cd "$(dirname "$skyview")" && pwd)/$(basename "$skyview")
+check "from another directory" sh -c "cd / && '$skyview_abs' '$tmp/pack' -o '$tmp/elsewhere' $small >/dev/null 2>&1"
+check "with the world file named" expect_exit 0 "$skyview" "$tmp/pack" -o "$tmp/named" $small --world "$root/data/worlds/test.json"
+check "the built-in world is data/worlds/test.json" cmp -s "$tmp/elsewhere/frame_0000.png" "$tmp/named/frame_0000.png"
 check "three frames, each tone mapper" expect_exit 0 "$skyview" "$tmp/pack" -o "$tmp/g" $small --frames 3 --tonemap gt
 check "frame_0002.png" test -s "$tmp/g/frame_0002.png"
 check "aces" expect_exit 0 "$skyview" "$tmp/pack" -o "$tmp/g" $small --tonemap aces --no-bloom
