@@ -28,7 +28,7 @@
  * tried in a fixed order with PUSH_RAYS rays each. */
 static const double push_steps[] = {0.25, 0.5};
 #define PUSH_RAYS 256
-#define PROBES_RECIPE 1
+#define PROBES_RECIPE 2 /* 2: rays cast in sb_probe_ray_order */
 
 static void world_path(const struct sb_scene *scene, char *out, size_t size)
 {

@@ -1,10 +1,59 @@
 #include "sky_visibility.h"
 
+#include <math.h>
 #include <stdlib.h>
 #include <string.h>
 
 #include "log.h"
+#include "sh.h"
 #include "sky_visibility.spv.h"
+
+/* Morton code of two 16-bit coordinates. */
+static uint32_t morton2(uint32_t x, uint32_t y)
+{
+    uint32_t code = 0;
+    for (int b = 0; b < 16; b++)
+        code |= ((x >> b) & 1u) << (2 * b) | ((y >> b) & 1u) << (2 * b + 1);
+    return code;
+}
+
+struct keyed {
+    uint32_t key, index;
+};
+
+static int compare_keyed(const void *a, const void *b)
+{
+    const struct keyed *x = a, *y = b;
+    return x->key != y->key ? (x->key < y->key ? -1 : 1) : (x->index < y->index ? -1 : x->index > y->index);
+}
+
+void sb_probe_ray_order(uint32_t n, uint32_t *order)
+{
+    struct keyed *k = malloc(n * sizeof(*k));
+    for (uint32_t i = 0; i < n; i++) {
+        double d[3];
+        sb_probe_direction(i, n, d);
+        /* octahedral map of the direction to [0, 1]^2 */
+        double l1 = fabs(d[0]) + fabs(d[1]) + fabs(d[2]), u = d[0] / l1, v = d[2] / l1;
+        if (d[1] < 0) {
+            double u2 = (1 - fabs(v)) * (u >= 0 ? 1 : -1), v2 = (1 - fabs(u)) * (v >= 0 ? 1 : -1);
+            u = u2;
+            v = v2;
+        }
+        uint32_t x = (uint32_t)fmin(65535.0, (u * 0.5 + 0.5) * 65536.0),
+                 y = (uint32_t)fmin(65535.0, (v * 0.5 + 0.5) * 65536.0);
+        if (k)
+            k[i] = (struct keyed){morton2(x, y), i};
+        else
+            order[i] = i;
+    }
+    if (!k)
+        return; /* the identity: slower, never wrong */
+    qsort(k, n, sizeof(*k), compare_keyed);
+    for (uint32_t i = 0; i < n; i++)
+        order[i] = k[i].index;
+    free(k);
+}
 
 enum sb_result sb_sky_visibility_bake(struct sb_raycaster *rc, const float *positions, uint32_t probe_count,
                                       const struct sb_sky_visibility_params *params, float *out, double *gpu_ms)
@@ -25,12 +74,12 @@ enum sb_result sb_sky_visibility_bake(struct sb_raycaster *rc, const float *posi
         return SB_ERR_OUT_OF_RANGE;
     }
     struct sb_vk *vk = rc->vk;
-    struct sb_buffer probes = {0}, results = {0};
+    struct sb_buffer probes = {0}, results = {0}, order = {0};
     struct sb_pipeline pipeline = {0};
     const struct sb_pipeline_params pp = {
         .spirv = sb_spv_sky_visibility,
         .spirv_size = sizeof(sb_spv_sky_visibility),
-        .binding_count = SB_RAYCAST_BINDING_COUNT,
+        .binding_count = SB_PROBE_BINDING_COUNT,
         .push_size = sizeof(pc),
         .name = "sky visibility",
     };
@@ -38,14 +87,17 @@ enum sb_result sb_sky_visibility_bake(struct sb_raycaster *rc, const float *posi
     if ((res = sb_buffer_create(vk, (VkDeviceSize)probe_count * 4 * sizeof(float), "probes", &probes)) ||
         (res = sb_buffer_create(vk, (VkDeviceSize)probe_count * SB_VISIBILITY_FLOATS * sizeof(float), "probe results",
                                 &results)) ||
+        (res = sb_buffer_create(vk, (VkDeviceSize)pc.ray_count * sizeof(uint32_t), "probe ray order", &order)) ||
         (res = sb_pipeline_create(vk, &pp, &pipeline)))
         goto done;
+    sb_probe_ray_order(pc.ray_count, order.mapped);
     float *p = probes.mapped;
     for (uint32_t i = 0; i < probe_count; i++) {
         memcpy(&p[4 * (size_t)i], &positions[3 * (size_t)i], 3 * sizeof(float));
         p[4 * (size_t)i + 3] = 0;
     }
-    const struct sb_buffer *bindings[SB_RAYCAST_BINDING_COUNT] = {
+    const struct sb_buffer *bindings[SB_PROBE_BINDING_COUNT] = {
+        [SB_PROBE_BINDING_ORDER] = &order,
         [SB_RAYCAST_BINDING_NODES] = &rc->nodes,
         [SB_RAYCAST_BINDING_TRIANGLES] = &rc->triangles,
         [SB_RAYCAST_BINDING_RAYS] = &probes,
@@ -62,6 +114,7 @@ done:
     sb_pipeline_destroy(vk, &pipeline);
     sb_buffer_destroy(vk, &results);
     sb_buffer_destroy(vk, &probes);
+    sb_buffer_destroy(vk, &order);
     return res;
 }
 

@@ -31,6 +31,12 @@ struct sb_sky_visibility_params {
 enum sb_result sb_sky_visibility_bake(struct sb_raycaster *raycaster, const float *positions, uint32_t probe_count,
                                       const struct sb_sky_visibility_params *params, float *out, double *gpu_ms);
 
+/* The order a probe's n rays are cast in: the directions sorted along a
+ * Morton curve of their octahedral coordinates (ties by index), so that
+ * neighbouring invocations trace neighbouring directions. A permutation of
+ * 0..n-1; the identity if memory runs out. */
+void sb_probe_ray_order(uint32_t n, uint32_t *order);
+
 /* XXH3-128 of the kernel's SPIR-V, for bake keys. */
 void sb_sky_visibility_code_hash(char out[33]);
 

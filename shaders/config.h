@@ -276,6 +276,8 @@ struct sb_raycast_push {
  * frac(i x 0x9E3779B9 / 2^32) (y up). SH: the real basis of order 2 in
  * Sloan's order over world (x, y, z), z the polar axis of the formulas. */
 #define SB_PROBE_THREADS 64
+#define SB_PROBE_BINDING_ORDER 4 /* the order the rays are cast in: one uint a ray (sky_visibility.h) */
+#define SB_PROBE_BINDING_COUNT 5
 #define SB_PROBE_MAX_RAYS 65536
 #define SB_PROBE_SH 9
 #define SB_VISIBILITY_FLOATS 12 /* sh[9], back-face fraction, hit fraction, mean hit distance (m) */

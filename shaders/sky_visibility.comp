@@ -13,6 +13,7 @@ layout(std430, binding = SB_RAYCAST_BINDING_NODES) readonly buffer Nodes { vec4 
 layout(std430, binding = SB_RAYCAST_BINDING_TRIANGLES) readonly buffer Triangles { vec4 bvh_triangles[]; };
 layout(std430, binding = SB_RAYCAST_BINDING_RAYS) readonly buffer Probes { vec4 probes[]; };
 layout(std430, binding = SB_RAYCAST_BINDING_HITS) writeonly buffer Out { float results[]; };
+layout(std430, binding = SB_PROBE_BINDING_ORDER) readonly buffer Order { uint order[]; };
 layout(push_constant) uniform Push { sb_probe_push pc; };
 
 #include "bvh.glsl"
@@ -31,8 +32,10 @@ void main()
     float sums[SUMS];
     for (int k = 0; k < SUMS; k++)
         sums[k] = 0.0;
-    for (uint i = lane; i < pc.ray_count; i += SB_PROBE_THREADS) {
-        vec3 d = probe_direction(i, pc.ray_count);
+    // Neighbouring invocations cast neighbouring directions (order[] is
+    // sorted along a space-filling curve): they traverse the same nodes.
+    for (uint k = lane; k < pc.ray_count; k += SB_PROBE_THREADS) {
+        vec3 d = probe_direction(order[k], pc.ray_count);
         BvhHit hit = bvh_trace(origin, d, pc.tmin_m, pc.tmax_m, false);
         if (hit.triangle == SB_BVH_MISS) {
             float y[SB_PROBE_SH];

@@ -457,9 +457,27 @@ static void test_dering(void)
     CHECK(fabs(before + 0.25) < 1e-3 && sb_sh9_min(c, NULL) >= 0 && h > 0, "the hemisphere rings to -1/4 (%g)", before);
 }
 
+/* The cast order is a permutation of the rays (every ray once). */
+static void test_ray_order(void)
+{
+    for (uint32_t n = 64; n <= 8192; n *= 2) {
+        uint32_t *order = malloc(n * sizeof(uint32_t));
+        uint8_t *seen = calloc(n, 1);
+        uint32_t bad = 0;
+        sb_probe_ray_order(n, order);
+        for (uint32_t i = 0; i < n; i++)
+            bad += order[i] >= n || seen[order[i]]++;
+        CHECK(order && seen && bad == 0, "the order of %u rays is not a permutation (%u repeated or out of range)", n,
+              bad);
+        free(order);
+        free(seen);
+    }
+}
+
 int main(void)
 {
     sb_log_set_level(SB_LOG_WARN);
+    test_ray_order();
     test_dering();
     struct sb_vk *vk;
     if (test_vulkan(false, &vk) == SB_ERR_NO_DEVICE)
