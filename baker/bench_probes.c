@@ -129,16 +129,8 @@ static enum sb_result bench_one(struct sb_vk *vk, const char *name, struct sb_me
     for (uint32_t first = 0; first < count; first += 64) {
         uint32_t probes = count - first < 64 ? count - first : 64;
         for (uint32_t p = 0; p < probes; p++)
-            for (uint32_t r = 0; r < rays_per_probe; r++) {
-                double d[3];
-                sb_probe_direction(r, rays_per_probe, d);
-                float *ray = &rays[8 * ((size_t)p * rays_per_probe + r)];
-                memcpy(ray, &positions[3 * (size_t)(first + p)], 3 * sizeof(float));
-                ray[3] = 1e-4f;
-                for (int k = 0; k < 3; k++)
-                    ray[4 + k] = (float)d[k];
-                ray[7] = 1e30f;
-            }
+            sb_probe_rays(&positions[3 * (size_t)(first + p)], rays_per_probe, 1e-4f,
+                          &rays[8 * (size_t)p * rays_per_probe]);
         row->embree_s += sb_embree_cast(&e, rays, probes * rays_per_probe, hits);
         for (uint32_t p = 0; p < probes; p++) {
             uint32_t n = 0;

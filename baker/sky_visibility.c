@@ -122,3 +122,17 @@ void sb_sky_visibility_code_hash(char out[33])
 {
     sb_hash_bytes(sb_spv_sky_visibility, sizeof(sb_spv_sky_visibility), out);
 }
+
+void sb_probe_rays(const float position[3], uint32_t n, float tmin, float *rays)
+{
+    for (uint32_t r = 0; r < n; r++) {
+        double d[3];
+        sb_probe_direction(r, n, d);
+        float *ray = &rays[8 * (size_t)r];
+        memcpy(ray, position, 3 * sizeof(float));
+        ray[3] = tmin;
+        for (int k = 0; k < 3; k++)
+            ray[4 + k] = (float)d[k];
+        ray[7] = 1e30f;
+    }
+}

@@ -37,6 +37,11 @@ enum sb_result sb_sky_visibility_bake(struct sb_raycaster *raycaster, const floa
  * 0..n-1; the identity if memory runs out. */
 void sb_probe_ray_order(uint32_t n, uint32_t *order);
 
+/* The n rays of a probe at `position` in the raycast kernel's layout
+ * (raycast.h: origin, tmin; direction, tmax 1e30), as the bake casts them
+ * (before its ordering): for references that cast them elsewhere (Embree). */
+void sb_probe_rays(const float position[3], uint32_t n, float tmin, float *rays);
+
 /* XXH3-128 of the kernel's SPIR-V, for bake keys. */
 void sb_sky_visibility_code_hash(char out[33]);
 

@@ -259,16 +259,7 @@ static void reconstruction_error(const struct sb_mesh *mesh, const struct sb_emb
         const float *b = &baked[SB_VISIBILITY_FLOATS * p];
         if (b[SB_PROBE_SH] > 0.25f || b[SB_PROBE_SH + 1] > 0.98f)
             continue; /* inside geometry, or closed in: nothing to measure */
-        for (uint32_t r = 0; r < DENSE; r++) {
-            double d[3];
-            sb_probe_direction(r, DENSE, d);
-            float *ray = &rays[8 * r];
-            memcpy(ray, &positions[3 * p], 3 * sizeof(float));
-            ray[3] = 1e-4f;
-            for (int k = 0; k < 3; k++)
-                ray[4 + k] = (float)d[k];
-            ray[7] = 1e30f;
-        }
+        sb_probe_rays(&positions[3 * p], DENSE, 1e-4f, rays);
         sb_embree_cast(e, rays, DENSE, hits);
         /* the sun's ray */
         float sun_ray[8] = {positions[3 * p], positions[3 * p + 1], positions[3 * p + 2], 1e-4f,
@@ -378,15 +369,7 @@ static void test_house(struct sb_vk *vk)
         double lowest = 0, window_sum = 0;
         for (int i = 0; i < N; i++) {
             double ref[SB_PROBE_SH] = {0}, d[3];
-            for (uint32_t r = 0; r < RAYS; r++) {
-                sb_probe_direction(r, RAYS, d);
-                float *ray = &rays[8 * r];
-                memcpy(ray, &positions[3 * i], 3 * sizeof(float));
-                ray[3] = 1e-4f;
-                for (int k = 0; k < 3; k++)
-                    ray[4 + k] = (float)d[k];
-                ray[7] = 1e30f;
-            }
+            sb_probe_rays(&positions[3 * i], RAYS, 1e-4f, rays);
             sb_embree_cast(&e, rays, RAYS, hits);
             uint32_t hit_count = 0;
             for (uint32_t r = 0; r < RAYS; r++) {
