@@ -20,6 +20,8 @@
 
 #include "io.h"
 #include "log.h"
+#include "scene.h"
+#include "world_file.h"
 
 /* Node trees deeper than this are refused (a file can make them cyclic). */
 #define MESH_MAX_NODE_DEPTH 128
@@ -54,6 +56,8 @@ enum sb_result sb_mesh_add_material(struct sb_mesh *mesh, const char *name, cons
     snprintf(m->name, sizeof(m->name), "%s", name);
     for (int c = 0; c < 3; c++)
         m->albedo[c] = (float)fmin(fmax(isfinite(albedo[c]) ? albedo[c] : 0.0, 0.0), 1.0);
+    m->roughness = 0.5f;
+    m->casts_shadows = true;
     *index = mesh->material_count++;
     return SB_OK;
 }
@@ -190,6 +194,15 @@ static void transform_point(const struct mat4 *m, const struct aiVector3D *p, do
         out[i] = m->m[i][0] * p->x + m->m[i][1] * p->y + m->m[i][2] * p->z + m->m[i][3];
 }
 
+void sb_mesh_transform_point(const struct sb_mesh_transform *t, const double p[3], double out[3])
+{
+    struct mat4 m = mat_world(t);
+    double q[3];
+    for (int i = 0; i < 3; i++)
+        q[i] = m.m[i][0] * p[0] + m.m[i][1] * p[1] + m.m[i][2] * p[2] + m.m[i][3];
+    memcpy(out, q, sizeof(q));
+}
+
 struct importer {
     const char *path;
     const struct aiScene *scene;
@@ -296,6 +309,13 @@ static enum sb_result add_materials(struct importer *im)
         enum sb_result res = sb_mesh_add_material(im->mesh, label, albedo, &im->material_map[i]);
         if (res)
             return res;
+        /* glTF's metallic-roughness factors, where the file has them */
+        struct sb_mesh_material *out = &im->mesh->material_list[im->material_map[i]];
+        ai_real value;
+        if (mat && aiGetMaterialFloat(mat, AI_MATKEY_ROUGHNESS_FACTOR, &value) == aiReturn_SUCCESS && isfinite(value))
+            out->roughness = fminf(fmaxf((float)value, 0.0f), 1.0f);
+        if (mat && aiGetMaterialFloat(mat, AI_MATKEY_METALLIC_FACTOR, &value) == aiReturn_SUCCESS && isfinite(value))
+            out->metallic = fminf(fmaxf((float)value, 0.0f), 1.0f);
     }
     return SB_OK;
 }
@@ -449,6 +469,11 @@ static enum sb_result receive(int fd, const char *path, unsigned seconds, double
         uint32_t index;
         materials[m].name[sizeof(materials[m].name) - 1] = '\0';
         res = sb_mesh_add_material(mesh, materials[m].name, albedo, &index);
+        if (!res) { /* the child's values, checked again */
+            struct sb_mesh_material *to = &mesh->material_list[index];
+            to->roughness = isfinite(materials[m].roughness) ? fminf(fmaxf(materials[m].roughness, 0.0f), 1.0f) : 0.5f;
+            to->metallic = isfinite(materials[m].metallic) ? fminf(fmaxf(materials[m].metallic, 0.0f), 1.0f) : 0.0f;
+        }
     }
     uint32_t dropped = mesh->dropped_degenerate;
     for (uint32_t t = 0; t < h.triangle_count && !res; t++) {
@@ -474,6 +499,9 @@ enum sb_result sb_mesh_load(const char *path, const struct sb_mesh_load_params *
 {
     static const struct sb_mesh_load_params defaults = {0};
     params = params ? params : &defaults;
+    size_t length = strlen(path);
+    if (length > 5 && !strcmp(path + length - 5, ".json"))
+        return sb_world_file_load(path, params, mesh);
     struct stat st;
     if (stat(path, &st) != 0) {
         sb_error("%s: cannot read the mesh: %s", path, strerror(errno));
@@ -568,4 +596,33 @@ void sb_mesh_finish(struct sb_mesh *mesh)
     free(mesh->materials);
     free(mesh->material_list);
     memset(mesh, 0, sizeof(*mesh));
+}
+
+enum sb_result sb_mesh_load_world(const struct sb_world_params *w, const char *directory, struct sb_mesh *mesh,
+                                  char *path_out, size_t path_size)
+{
+    char path[2100];
+    if (w->file[0] == '/' || !directory[0])
+        snprintf(path, sizeof(path), "%s", w->file);
+    else
+        snprintf(path, sizeof(path), "%s/%s", directory, w->file);
+    struct sb_mesh_albedo_override overrides[SB_WORLD_MAX_OVERRIDES];
+    for (int i = 0; i < w->override_count; i++) {
+        overrides[i].material = w->overrides[i].material;
+        memcpy(overrides[i].albedo, w->overrides[i].albedo, sizeof(overrides[i].albedo));
+    }
+    struct sb_mesh_load_params load = {
+        .transform = {.units_m = w->units_m, .scale = w->scale, .up_z = w->up_z},
+        .overrides = overrides,
+        .override_count = w->override_count,
+    };
+    memcpy(load.transform.rotate_deg, w->rotate_deg, sizeof(w->rotate_deg));
+    memcpy(load.transform.translate_m, w->translate_m, sizeof(w->translate_m));
+    enum sb_result res = sb_mesh_load(path, &load, mesh);
+    if (!res && path_out) {
+        char *absolute = realpath(path, NULL);
+        snprintf(path_out, path_size, "%s", absolute ? absolute : path);
+        free(absolute);
+    }
+    return res;
 }

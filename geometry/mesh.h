@@ -35,7 +35,10 @@
 
 struct sb_mesh_material {
     char name[SB_MESH_MATERIAL_NAME_MAX];
-    float albedo[3]; /* linear, [0, 1] */
+    float albedo[3];    /* linear, [0, 1] */
+    float roughness;    /* perceptual, [0, 1]: for the runtime's shading [0.5] */
+    float metallic;     /* [0, 1] [0] */
+    bool casts_shadows; /* false: receives only (a ground plane) [true] */
 };
 
 struct sb_mesh {
@@ -85,6 +88,10 @@ struct sb_mesh_load_params {
  * (glTF's baseColorFactor) or else its diffuse colour, clamped to [0, 1],
  * unless an override names them.
  *
+ * A file named *.json is a skybake world file instead (world_file.h: a
+ * ground, boxes and pillars), built here with the same transform and
+ * overrides.
+ *
  * Refuses, naming the file and the reason, and leaving *mesh as it was: a
  * file that cannot be read or is over SB_MESH_MAX_FILE_BYTES
  * (SB_ERR_IO, SB_ERR_TOO_LARGE), one assimp refuses, crashes on or does
@@ -95,7 +102,18 @@ struct sb_mesh_load_params {
  */
 enum sb_result sb_mesh_load(const char *path, const struct sb_mesh_load_params *params, struct sb_mesh *mesh);
 
-/* Add a material; returns its index in *index. */
+/* Where the transform takes point p (file units) in world metres. */
+void sb_mesh_transform_point(const struct sb_mesh_transform *t, const double p[3], double out[3]);
+
+/* Read a scene's world (formats/scene.h: its file, relative to
+ * `directory` unless absolute or directory is "", placed and overridden as
+ * the scene says); *path_out (may be NULL) gets the path read, absolute. */
+struct sb_world_params;
+enum sb_result sb_mesh_load_world(const struct sb_world_params *world, const char *directory, struct sb_mesh *mesh,
+                                  char *path_out, size_t path_size);
+
+/* Add a material (roughness 0.5, metallic 0, casting shadows: set the
+ * fields afterwards to change them); returns its index in *index. */
 enum sb_result sb_mesh_add_material(struct sb_mesh *mesh, const char *name, const double albedo[3], uint32_t *index);
 
 /* Append one triangle (world space, metres) with material `material`.

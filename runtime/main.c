@@ -50,7 +50,8 @@ static void usage(FILE *f)
                "                          metres (y up, origin on the ground) and degrees: yaw\n"
                "                          clockwise from north, pitch above the horizontal,\n"
                "                          vertical field of view (default 0,2,0,0,3,50)\n"
-               "  --world FILE            the world (default: built in, data/worlds/test.json)\n"
+               "  --world FILE            the world: a skybake world file (.json) or a mesh assimp\n"
+               "                          reads (default: built in, data/worlds/test.json)\n"
                "  --tonemap agx|aces|gt   tone mapper (default agx)\n"
                "  --exposure EV           exposure compensation (default 0)\n"
                "  --no-bloom              no bloom\n"
@@ -306,7 +307,7 @@ static int run(const struct options *o)
         return EXIT_USAGE;
     }
     struct sb_world world;
-    if (o->world ? sb_world_load(o->world, &world)
+    if (o->world ? sb_world_load(o->world, NULL, &world)
                  : sb_world_parse(sb_default_world_json, strlen(sb_default_world_json),
                                   "the built-in world (data/worlds/test.json)", &world)) {
         sb_pack_close(&pack);

@@ -1,8 +1,9 @@
 /*
- * The world skyview lights: a square ground plane at y = 0 and boxes and
- * pillars on it, each with a PBR material, read from a JSON file (schema in
- * docs/skyview.md; data/worlds/test.json is the default) and turned into
- * one triangle list.
+ * The world skyview draws: one triangle list of vertices with a face
+ * normal and a PBR material each, made from a mesh (geometry/mesh.h): a
+ * skybake world file (a ground and boxes and pillars, geometry/world_file.h;
+ * data/worlds/test.json is built in as the default) or any file assimp
+ * reads, placed as a scene's `world` places it.
  */
 #ifndef SB_RUNTIME_WORLD_H
 #define SB_RUNTIME_WORLD_H
@@ -11,46 +12,30 @@
 #include <stdint.h>
 
 #include "config.h"
+#include "mesh.h"
 #include "result.h"
 
-#define SB_WORLD_MAX_OBJECTS 256
-
-struct sb_material {
-    double albedo[3]; /* linear base colour, [0, 1] */
-    double roughness; /* perceptual, [0, 1] */
-    double metallic;  /* [0, 1] */
-};
-
-struct sb_world_box {
-    double center_m[3];
-    double size_m[3];
-    struct sb_material material;
-};
-
-struct sb_world_pillar {
-    double base_m[3]; /* centre of the bottom face */
-    double radius_m;
-    double height_m;
-    int sides; /* 3 to 64 */
-    struct sb_material material;
-};
-
 struct sb_world {
-    double ground_size_m; /* the ground plane is this wide, centred on the origin */
-    struct sb_material ground;
-    int box_count, pillar_count;
-    struct sb_world_box boxes[SB_WORLD_MAX_OBJECTS];
-    struct sb_world_pillar pillars[SB_WORLD_MAX_OBJECTS];
     struct sb_vertex_gpu *vertices; /* owned: vertex_count, a triangle list */
     uint32_t vertex_count;
-    uint32_t caster_first_vertex; /* the ground comes first: it receives shadows but casts none */
+    /* Triangles of materials that cast no shadow (a ground) come first:
+     * they receive shadows but are not drawn into the shadow maps. */
+    uint32_t caster_first_vertex;
+    char mesh_hash[33]; /* sb_mesh_hash of the mesh it was made from */
 };
 
-/* Read and check a world file, then build its triangles. On failure the
+/* The world of a mesh: flat shading (each triangle's own normal, from its
+ * winding), the triangle's material. */
+enum sb_result sb_world_from_mesh(const struct sb_mesh *mesh, struct sb_world *world);
+
+/* Read a mesh file (sb_mesh_load: a world file or any format assimp reads)
+ * with params (NULL: as the file is) and make its world. On failure the
  * world is zeroed and the message names the file, the field and the reason. */
-enum sb_result sb_world_load(const char *path, struct sb_world *world);
-/* The same from a world file's text; source names it in messages. */
+enum sb_result sb_world_load(const char *path, const struct sb_mesh_load_params *params, struct sb_world *world);
+
+/* A world file's text; source names it in messages. */
 enum sb_result sb_world_parse(const char *json, size_t size, const char *source, struct sb_world *world);
+
 /* Free the triangles; accepts a zeroed world. */
 void sb_world_finish(struct sb_world *world);
 

@@ -5,6 +5,7 @@
  * Embree, the independent reference, on every test ray but a stated band of
  * rays that graze an edge or a vertex (measured and reported).
  */
+#include <cJSON.h>
 #include <fcntl.h>
 #include <math.h>
 #include <stdint.h>
@@ -17,6 +18,7 @@
 #include "bvh.h"
 #include "embree_ref.h"
 #include "harness_vk.h"
+#include "json.h"
 #include "log.h"
 #include "mesh.h"
 #include "raycast.h"
@@ -451,6 +453,72 @@ static void test_loading(void)
     }
 }
 
+/*
+ * skybake's procedural world (data/worlds/test.json) through sb_mesh_load:
+ * its triangle count from its boxes and pillars, a material each, the
+ * ground receiving only, every box face wound outward, and the transform.
+ */
+static void test_world_file(void)
+{
+    struct sb_mesh m = {0}, moved = {0};
+    CHECK(sb_mesh_load(TEST_WORLD, NULL, &m) == SB_OK, "%s loads as a mesh", TEST_WORLD);
+    cJSON *root = NULL;
+    CHECK(sb_json_load(AT_FDCWD, TEST_WORLD, TEST_WORLD, 1 << 20, true, &root) == SB_OK, "and as JSON");
+    const cJSON *boxes = cJSON_GetObjectItemCaseSensitive(root, "boxes"), *pillars, *item;
+    pillars = cJSON_GetObjectItemCaseSensitive(root, "pillars");
+    uint32_t want = 2 + 12 * (uint32_t)cJSON_GetArraySize(boxes);
+    cJSON_ArrayForEach(item, pillars)
+    {
+        want += 4 * (uint32_t)cJSON_GetObjectItemCaseSensitive(item, "sides")->valuedouble;
+    }
+    CHECK(m.triangle_count == want, "the test world: %u triangles, %u expected", m.triangle_count, want);
+    CHECK(m.material_count == 1u + (uint32_t)cJSON_GetArraySize(boxes) + (uint32_t)cJSON_GetArraySize(pillars),
+          "a material for the ground and each object (%u)", m.material_count);
+    CHECK(m.material_count > 2 && !strcmp(m.material_list[0].name, "ground") && !m.material_list[0].casts_shadows &&
+              !strcmp(m.material_list[1].name, "boxes[0]") && m.material_list[1].casts_shadows,
+          "the ground receives only; objects cast");
+    /* every box triangle's winding normal points away from its box's centre */
+    int inward = 0, box = 0;
+    cJSON_ArrayForEach(item, boxes)
+    {
+        const cJSON *c = cJSON_GetObjectItemCaseSensitive(item, "center_m");
+        double centre[3];
+        for (int k = 0; k < 3; k++)
+            centre[k] = cJSON_GetArrayItem(c, k)->valuedouble;
+        for (uint32_t t = 0; t < m.triangle_count; t++) {
+            if (m.materials[t] != 1u + (uint32_t)box)
+                continue;
+            double p[3][3], e1[3], e2[3], n[3], out[3];
+            for (int v = 0; v < 3; v++)
+                for (int k = 0; k < 3; k++)
+                    p[v][k] = m.positions[3 * m.indices[3 * t + v] + k];
+            for (int k = 0; k < 3; k++) {
+                e1[k] = p[1][k] - p[0][k];
+                e2[k] = p[2][k] - p[0][k];
+                out[k] = (p[0][k] + p[1][k] + p[2][k]) / 3 - centre[k];
+            }
+            cross3d(e1, e2, n);
+            inward += dot3d(n, out) <= 0;
+        }
+        box++;
+    }
+    CHECK(inward == 0, "box faces wound outward (%d inward)", inward);
+    cJSON_Delete(root);
+    /* its ground reaches the extent cap: moved up it loads, moved sideways it is refused */
+    struct sb_mesh_load_params p = {.transform = {.translate_m = {0, 1.5, 0}}};
+    CHECK(sb_mesh_load(TEST_WORLD, &p, &moved) == SB_OK, "the test world, moved up");
+    float lo0[3], hi0[3], lo1[3], hi1[3];
+    sb_mesh_bounds(&m, lo0, hi0);
+    sb_mesh_bounds(&moved, lo1, hi1);
+    CHECK(lo1[0] == lo0[0] && lo1[1] == lo0[1] + 1.5f && hi1[1] == hi0[1] + 1.5f, "a world file takes the transform");
+    p.transform.translate_m[0] = 5;
+    uint32_t before = moved.triangle_count;
+    CHECK(sb_mesh_load(TEST_WORLD, &p, &moved) == SB_ERR_NUMERIC && moved.triangle_count == before,
+          "a ground moved past the extent cap is refused, and the mesh is kept");
+    sb_mesh_finish(&m);
+    sb_mesh_finish(&moved);
+}
+
 static void write_file(const char *path, const char *text)
 {
     FILE *f = fopen(path, "w");
@@ -477,6 +545,20 @@ static void test_hostile(void)
         {"garbage.glb", "glTF\x02\x00\x00\x00\xff\xff\xff\xff garbage", SB_ERR_MESH},
         {"garbage.ply", "ply\nformat ascii 1.0\nelement vertex 99999999999\n", SB_ERR_MESH},
         {"index.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 9\n", SB_ERR_MESH},
+        /* skybake world files, through the same call */
+        {"syntax.json", "{\"version\": 1,", SB_ERR_JSON_SYNTAX},
+        {"key.json", "{\"version\": 1, \"sky\": 1}", SB_ERR_UNKNOWN_KEY},
+        {"twice.json", "{\"version\": 1, \"version\": 1}", SB_ERR_DUPLICATE_KEY},
+        {"version.json", "{\"version\": 2}", SB_ERR_OUT_OF_RANGE},
+        {"ground.json", "{\"version\": 1, \"ground\": {\"size_m\": 30000}}", SB_ERR_OUT_OF_RANGE},
+        {"far.json", "{\"version\": 1, \"boxes\": [{\"center_m\": [9999, 0, 0], \"size_m\": [10, 1, 1]}]}",
+         SB_ERR_NUMERIC},
+        {"sides.json", "{\"version\": 1, \"pillars\": [{\"base_m\": [0, 0, 0], \"radius_m\": 1, \"height_m\": 1, "
+                       "\"sides\": 2.5}]}",
+         SB_ERR_OUT_OF_RANGE},
+        {"albedo.json", "{\"version\": 1, \"boxes\": [{\"center_m\": [0, 0, 0], \"size_m\": [1, 1, 1], "
+                        "\"albedo\": [2, 0, 0]}]}",
+         SB_ERR_OUT_OF_RANGE},
     };
     struct sb_mesh m = {0};
     uint32_t material;
@@ -555,6 +637,7 @@ int main(void)
 {
     sb_log_set_level(SB_LOG_WARN);
     test_loading();
+    test_world_file();
     test_hostile();
     test_coincident();
 

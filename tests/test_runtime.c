@@ -4,6 +4,8 @@
  * compares the frame with what physics or geometry says must be there, or
  * the sky-view LUT with the fp64 reference (baker/atmosphere_ref.c).
  */
+#include <cJSON.h>
+#include <fcntl.h>
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
@@ -11,6 +13,7 @@
 #include "atmosphere_ref.h"
 #include "bake.h"
 #include "harness_vk.h"
+#include "json.h"
 #include "log.h"
 #include "pack.h"
 #include "parallel.h"
@@ -25,6 +28,31 @@
 static struct sb_vk *vk;
 static struct sb_pack pack;
 static struct sb_world world;
+/* The test world's first two pillars, as its file gives them. */
+static struct pillar {
+    double base_m[3], radius_m, height_m;
+} pillars[2];
+static int pillar_count;
+
+static void read_pillars(const char *path)
+{
+    cJSON *root = NULL;
+    if (sb_json_load(AT_FDCWD, path, path, 1 << 20, true, &root))
+        return;
+    const cJSON *list = cJSON_GetObjectItemCaseSensitive(root, "pillars"), *item;
+    cJSON_ArrayForEach(item, list)
+    {
+        if (pillar_count == 2)
+            break;
+        const cJSON *base = cJSON_GetObjectItemCaseSensitive(item, "base_m");
+        for (int k = 0; k < 3; k++)
+            pillars[pillar_count].base_m[k] = cJSON_GetArrayItem(base, k)->valuedouble;
+        pillars[pillar_count].radius_m = cJSON_GetObjectItemCaseSensitive(item, "radius_m")->valuedouble;
+        pillars[pillar_count].height_m = cJSON_GetObjectItemCaseSensitive(item, "height_m")->valuedouble;
+        pillar_count++;
+    }
+    cJSON_Delete(root);
+}
 
 static float *frame_rgb(struct sb_renderer *r)
 {
@@ -136,8 +164,8 @@ static void test_shadows(struct sb_renderer *r)
     away[2] = -cos(sun_az);
     double side[3] = {-away[2], 0.0, away[0]};
     int checked = 0;
-    for (int i = 0; i < world.pillar_count && i < 2; i++) {
-        const struct sb_world_pillar *p = &world.pillars[i];
+    for (int i = 0; i < pillar_count; i++) {
+        const struct pillar *p = &pillars[i];
         double reach = p->height_m / tan(v.sun_elevation); /* the shadow's length on the ground */
         double d = p->radius_m + 0.3 * reach;
         double shadowed[3], lit[3];
@@ -351,7 +379,8 @@ int main(int argc, char **argv)
     struct sb_bake_report report;
     CHECK(sb_bake_scene(vk, &scene, pack_dir, NULL, &report) == SB_OK, "bake");
     CHECK(sb_pack_open(pack_dir, &pack) == SB_OK, "the pack opens");
-    CHECK(sb_world_load(world_path, &world) == SB_OK, "the world loads");
+    CHECK(sb_world_load(world_path, NULL, &world) == SB_OK, "the world loads");
+    read_pillars(world_path);
 
     struct sb_renderer *r = NULL;
     struct sb_renderer_params rp = {.width = W, .height = H, .shadow_size = 1024};

@@ -1,0 +1,374 @@
+#include "world_file.h"
+
+#include <fcntl.h>
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "json.h"
+#include "log.h"
+
+struct material {
+    double albedo[3]; /* linear base colour, [0, 1] */
+    double roughness; /* perceptual, [0, 1] */
+    double metallic;  /* [0, 1] */
+};
+
+struct box {
+    double center_m[3];
+    double size_m[3];
+    struct material material;
+};
+
+struct pillar {
+    double base_m[3]; /* centre of the bottom face */
+    double radius_m;
+    double height_m;
+    int sides; /* 3 to 64 */
+    struct material material;
+};
+
+struct world {
+    double ground_size_m; /* the ground plane is this wide, centred on the origin */
+    struct material ground;
+    int box_count, pillar_count;
+    struct box boxes[SB_WORLD_FILE_MAX_OBJECTS];
+    struct pillar pillars[SB_WORLD_FILE_MAX_OBJECTS];
+};
+
+/* ---- Parsing ------------------------------------------------------------------- */
+
+struct reader {
+    const char *source;
+    char path[128];
+};
+
+static enum sb_result number(const struct reader *rd, const cJSON *obj, const char *key, double lo, double hi,
+                             double fallback, double *out)
+{
+    const cJSON *item = cJSON_GetObjectItemCaseSensitive(obj, key);
+    if (!item) {
+        if (isnan(fallback)) {
+            sb_error("%s: %s%s: missing", rd->source, rd->path, key);
+            return SB_ERR_MISSING_FIELD;
+        }
+        *out = fallback;
+        return SB_OK;
+    }
+    if (!cJSON_IsNumber(item)) {
+        sb_error("%s: %s%s: expected a number", rd->source, rd->path, key);
+        return SB_ERR_WRONG_TYPE;
+    }
+    if (!(item->valuedouble >= lo && item->valuedouble <= hi)) {
+        sb_error("%s: %s%s: %g is outside [%g, %g]", rd->source, rd->path, key, item->valuedouble, lo, hi);
+        return SB_ERR_OUT_OF_RANGE;
+    }
+    *out = item->valuedouble;
+    return SB_OK;
+}
+
+static enum sb_result vec3(const struct reader *rd, const cJSON *obj, const char *key, double lo, double hi,
+                           const double *fallback, double out[3])
+{
+    const cJSON *item = cJSON_GetObjectItemCaseSensitive(obj, key);
+    if (!item && fallback) {
+        memcpy(out, fallback, 3 * sizeof(double));
+        return SB_OK;
+    }
+    if (!item) {
+        sb_error("%s: %s%s: missing", rd->source, rd->path, key);
+        return SB_ERR_MISSING_FIELD;
+    }
+    if (!cJSON_IsArray(item) || cJSON_GetArraySize(item) != 3) {
+        sb_error("%s: %s%s: expected an array of 3 numbers", rd->source, rd->path, key);
+        return SB_ERR_WRONG_TYPE;
+    }
+    for (int i = 0; i < 3; i++) {
+        const cJSON *v = cJSON_GetArrayItem(item, i);
+        if (!cJSON_IsNumber(v)) {
+            sb_error("%s: %s%s[%d]: expected a number", rd->source, rd->path, key, i);
+            return SB_ERR_WRONG_TYPE;
+        }
+        if (!(v->valuedouble >= lo && v->valuedouble <= hi)) {
+            sb_error("%s: %s%s[%d]: %g is outside [%g, %g]", rd->source, rd->path, key, i, v->valuedouble, lo, hi);
+            return SB_ERR_OUT_OF_RANGE;
+        }
+        out[i] = v->valuedouble;
+    }
+    return SB_OK;
+}
+
+/* Every key of `obj` must be one of `keys` (NULL-terminated). */
+static enum sb_result known_keys(const struct reader *rd, const cJSON *obj, const char *const *keys)
+{
+    if (!cJSON_IsObject(obj)) {
+        sb_error("%s: %s: expected an object", rd->source, rd->path[0] ? rd->path : "(root)");
+        return SB_ERR_WRONG_TYPE;
+    }
+    enum sb_result res = sb_json_check_duplicates(obj, rd->source, rd->path);
+    if (res)
+        return res;
+    const cJSON *item;
+    cJSON_ArrayForEach(item, obj)
+    {
+        bool found = false;
+        for (int i = 0; keys[i] && !found; i++)
+            found = strcmp(item->string, keys[i]) == 0;
+        if (!found) {
+            sb_error("%s: %s%s: unknown key", rd->source, rd->path, item->string);
+            return SB_ERR_UNKNOWN_KEY;
+        }
+    }
+    return SB_OK;
+}
+
+#define MATERIAL_KEYS "albedo", "roughness", "metallic"
+
+static enum sb_result material(const struct reader *rd, const cJSON *obj, struct material *m)
+{
+    static const double grey[3] = {0.5, 0.5, 0.5};
+    enum sb_result res = vec3(rd, obj, "albedo", 0.0, 1.0, grey, m->albedo);
+    if (!res)
+        res = number(rd, obj, "roughness", 0.0, 1.0, 0.5, &m->roughness);
+    if (!res)
+        res = number(rd, obj, "metallic", 0.0, 1.0, 0.0, &m->metallic);
+    return res;
+}
+
+static enum sb_result array(const struct reader *rd, const cJSON *root, const char *key, const cJSON **out, int *count)
+{
+    *out = cJSON_GetObjectItemCaseSensitive(root, key);
+    *count = 0;
+    if (!*out)
+        return SB_OK;
+    if (!cJSON_IsArray(*out)) {
+        sb_error("%s: %s: expected an array", rd->source, key);
+        return SB_ERR_WRONG_TYPE;
+    }
+    *count = cJSON_GetArraySize(*out);
+    if (*count > SB_WORLD_FILE_MAX_OBJECTS) {
+        sb_error("%s: %s: %d entries; at most %d", rd->source, key, *count, SB_WORLD_FILE_MAX_OBJECTS);
+        return SB_ERR_OUT_OF_RANGE;
+    }
+    return SB_OK;
+}
+
+static enum sb_result parse(const cJSON *root, const char *source, struct world *w)
+{
+    struct reader rd = {.source = source};
+    static const char *const root_keys[] = {"version", "ground", "boxes", "pillars", NULL};
+    enum sb_result res = known_keys(&rd, root, root_keys);
+    double version = 0;
+    if (!res)
+        res = number(&rd, root, "version", 1, 1, NAN, &version);
+    const cJSON *ground = res ? NULL : cJSON_GetObjectItemCaseSensitive(root, "ground");
+    if (!res && ground) {
+        static const char *const keys[] = {"size_m", MATERIAL_KEYS, NULL};
+        snprintf(rd.path, sizeof(rd.path), "ground.");
+        res = known_keys(&rd, ground, keys);
+        if (!res)
+            res = number(&rd, ground, "size_m", 1.0, 2.0 * SB_MESH_MAX_EXTENT_M, 2.0 * SB_MESH_MAX_EXTENT_M, &w->ground_size_m);
+        if (!res)
+            res = material(&rd, ground, &w->ground);
+    } else if (!res) {
+        w->ground_size_m = 2.0 * SB_MESH_MAX_EXTENT_M;
+        res = material(&rd, root, &w->ground); /* defaults */
+    }
+    const cJSON *list, *item;
+    int n = 0;
+    if (!res)
+        res = array(&rd, root, "boxes", &list, &n);
+    w->box_count = res ? 0 : n;
+    for (int i = 0; i < w->box_count && !res; i++) {
+        static const char *const keys[] = {"center_m", "size_m", MATERIAL_KEYS, NULL};
+        struct box *b = &w->boxes[i];
+        item = cJSON_GetArrayItem(list, i);
+        snprintf(rd.path, sizeof(rd.path), "boxes[%d].", i);
+        res = known_keys(&rd, item, keys);
+        if (!res)
+            res = vec3(&rd, item, "center_m", -1e5, 1e5, NULL, b->center_m);
+        if (!res)
+            res = vec3(&rd, item, "size_m", 1e-3, 1e4, NULL, b->size_m);
+        if (!res)
+            res = material(&rd, item, &b->material);
+    }
+    if (!res)
+        res = array(&rd, root, "pillars", &list, &n);
+    w->pillar_count = res ? 0 : n;
+    for (int i = 0; i < w->pillar_count && !res; i++) {
+        static const char *const keys[] = {"base_m", "radius_m", "height_m", "sides", MATERIAL_KEYS, NULL};
+        struct pillar *p = &w->pillars[i];
+        item = cJSON_GetArrayItem(list, i);
+        snprintf(rd.path, sizeof(rd.path), "pillars[%d].", i);
+        double sides = 0;
+        res = known_keys(&rd, item, keys);
+        if (!res)
+            res = vec3(&rd, item, "base_m", -1e5, 1e5, NULL, p->base_m);
+        if (!res)
+            res = number(&rd, item, "radius_m", 1e-3, 1e4, NAN, &p->radius_m);
+        if (!res)
+            res = number(&rd, item, "height_m", 1e-3, 1e4, NAN, &p->height_m);
+        if (!res)
+            res = number(&rd, item, "sides", 3, 64, 16, &sides);
+        if (!res && sides != floor(sides)) {
+            sb_error("%s: %ssides: expected a whole number", source, rd.path);
+            res = SB_ERR_OUT_OF_RANGE;
+        }
+        p->sides = (int)sides;
+        if (!res)
+            res = material(&rd, item, &p->material);
+    }
+    return res;
+}
+
+/* ---- Triangles ----------------------------------------------------------------- */
+
+struct builder {
+    struct sb_mesh *mesh;
+    const struct sb_mesh_load_params *params;
+    const char *source;
+    uint32_t material;
+    enum sb_result res;
+};
+
+/* A material named `name`, with the scene's override where one names it. */
+static void begin(struct builder *b, const char *name, const struct material *m, bool casts_shadows)
+{
+    if (b->res)
+        return;
+    double albedo[3];
+    memcpy(albedo, m->albedo, sizeof(albedo));
+    for (int o = 0; o < b->params->override_count; o++) {
+        const struct sb_mesh_albedo_override *ov = &b->params->overrides[o];
+        if (!strcmp(ov->material, "*") || !strcmp(ov->material, name))
+            memcpy(albedo, ov->albedo, sizeof(albedo));
+    }
+    if ((b->res = sb_mesh_add_material(b->mesh, name, albedo, &b->material)))
+        return;
+    struct sb_mesh_material *out = &b->mesh->material_list[b->material];
+    out->roughness = (float)m->roughness;
+    out->metallic = (float)m->metallic;
+    out->casts_shadows = casts_shadows;
+}
+
+static void triangle(struct builder *b, const double p0[3], const double p1[3], const double p2[3])
+{
+    if (b->res)
+        return;
+    double q[3][3];
+    const double *p[3] = {p0, p1, p2};
+    for (int k = 0; k < 3; k++)
+        sb_mesh_transform_point(&b->params->transform, p[k], q[k]);
+    b->res = sb_mesh_add_triangle(b->mesh, q[0], q[1], q[2], b->material, b->source);
+}
+
+/* A quad a, b, c, d (counter-clockwise seen from outside). */
+static void quad(struct builder *b, const double a[3], const double bb[3], const double c[3], const double d[3])
+{
+    triangle(b, a, bb, c);
+    triangle(b, a, c, d);
+}
+
+static void box(struct builder *b, const struct box *x)
+{
+    /* Each face: its normal axis and sign, and two tangent axes forming a right-handed frame. */
+    for (int axis = 0; axis < 3; axis++)
+        for (int sign = -1; sign <= 1; sign += 2) {
+            int u = (axis + 1) % 3, v = (axis + 2) % 3;
+            double corner[4][3];
+            static const double su[4] = {-1, 1, 1, -1}, sv[4] = {-1, -1, 1, 1};
+            for (int k = 0; k < 4; k++) {
+                corner[k][axis] = x->center_m[axis] + sign * 0.5 * x->size_m[axis];
+                corner[k][u] = x->center_m[u] + su[k] * 0.5 * x->size_m[u] * sign;
+                corner[k][v] = x->center_m[v] + sv[k] * 0.5 * x->size_m[v];
+            }
+            quad(b, corner[0], corner[1], corner[2], corner[3]);
+        }
+}
+
+/* Flat sides: the shadow test knows the exact outline. */
+static void pillar(struct builder *b, const struct pillar *x)
+{
+    double top = x->base_m[1] + x->height_m;
+    double centre_top[3] = {x->base_m[0], top, x->base_m[2]};
+    double centre_bottom[3] = {x->base_m[0], x->base_m[1], x->base_m[2]};
+    for (int i = 0; i < x->sides; i++) {
+        double a0 = 2.0 * M_PI * i / x->sides, a1 = 2.0 * M_PI * (i + 1) / x->sides;
+        double c0 = cos(a0), s0 = sin(a0), c1 = cos(a1), s1 = sin(a1);
+        double p0b[3] = {x->base_m[0] + x->radius_m * c0, x->base_m[1], x->base_m[2] - x->radius_m * s0};
+        double p1b[3] = {x->base_m[0] + x->radius_m * c1, x->base_m[1], x->base_m[2] - x->radius_m * s1};
+        double p0t[3] = {p0b[0], top, p0b[2]}, p1t[3] = {p1b[0], top, p1b[2]};
+        quad(b, p0b, p1b, p1t, p0t);
+        triangle(b, centre_top, p0t, p1t);
+        triangle(b, centre_bottom, p1b, p0b);
+    }
+}
+
+static enum sb_result build(const struct world *w, const char *source, const struct sb_mesh_load_params *params,
+                            struct sb_mesh *mesh)
+{
+    struct builder b = {.mesh = mesh, .params = params, .source = source};
+    double h = 0.5 * w->ground_size_m;
+    double g[4][3] = {{-h, 0, h}, {h, 0, h}, {h, 0, -h}, {-h, 0, -h}};
+    begin(&b, "ground", &w->ground, false);
+    quad(&b, g[0], g[1], g[2], g[3]);
+    char name[32];
+    for (int i = 0; i < w->box_count; i++) {
+        snprintf(name, sizeof(name), "boxes[%d]", i);
+        begin(&b, name, &w->boxes[i].material, true);
+        box(&b, &w->boxes[i]);
+    }
+    for (int i = 0; i < w->pillar_count; i++) {
+        snprintf(name, sizeof(name), "pillars[%d]", i);
+        begin(&b, name, &w->pillars[i].material, true);
+        pillar(&b, &w->pillars[i]);
+    }
+    return b.res;
+}
+
+/* A parsed root (deleted here) to triangles; *mesh as it was on failure. */
+static enum sb_result from_root(enum sb_result res, cJSON *root, const char *source,
+                                const struct sb_mesh_load_params *params, struct sb_mesh *mesh)
+{
+    static const struct sb_mesh_load_params defaults = {0};
+    params = params ? params : &defaults;
+    struct world *w = res ? NULL : calloc(1, sizeof(*w));
+    if (!res && !w)
+        res = SB_ERR_NOMEM;
+    if (!res)
+        res = parse(root, source, w);
+    cJSON_Delete(root);
+    struct sb_mesh before = *mesh;
+    if (!res)
+        res = build(w, source, params, mesh);
+    if (res) {
+        mesh->vertex_count = before.vertex_count;
+        mesh->triangle_count = before.triangle_count;
+        mesh->material_count = before.material_count;
+        mesh->dropped_degenerate = before.dropped_degenerate;
+    }
+    free(w);
+    return res;
+}
+
+enum sb_result sb_world_file_load(const char *path, const struct sb_mesh_load_params *params, struct sb_mesh *mesh)
+{
+    cJSON *root = NULL;
+    enum sb_result res = sb_json_load(AT_FDCWD, path, path, SB_WORLD_FILE_MAX_BYTES, true, &root);
+    return from_root(res, root, path, params, mesh);
+}
+
+enum sb_result sb_world_file_parse(const char *json, size_t size, const char *source,
+                                   const struct sb_mesh_load_params *params, struct sb_mesh *mesh)
+{
+    cJSON *root = NULL;
+    enum sb_result res = SB_OK;
+    if (size > SB_WORLD_FILE_MAX_BYTES) {
+        sb_error("%s: %zu bytes; world files are read up to %d", source, size, SB_WORLD_FILE_MAX_BYTES);
+        res = SB_ERR_TOO_LARGE;
+    }
+    if (!res)
+        res = sb_json_parse(json, size, source, &root);
+    return from_root(res, root, source, params, mesh);
+}
