@@ -30,41 +30,19 @@ static const double push_steps[] = {0.25, 0.5};
 #define PUSH_RAYS 256
 #define PROBES_RECIPE 2 /* 2: rays cast in sb_probe_ray_order */
 
-static void world_path(const struct sb_scene *scene, char *out, size_t size)
-{
-    if (scene->world.file[0] == '/' || !scene->directory[0])
-        snprintf(out, size, "%s", scene->world.file);
-    else
-        snprintf(out, size, "%s/%s", scene->directory, scene->world.file);
-}
-
 /* The world as read for this bake: the key's input and the bake's. */
 struct probes_state {
     struct sb_mesh mesh;
     char mesh_hash[SB_HASH_HEX_SIZE];
+    char path[640]; /* the world's file, absolute */
 };
 
 static enum sb_result probes_create(struct sb_vk *vk, const struct sb_scene *scene, void **out)
 {
-    const struct sb_world_params *w = &scene->world;
     struct probes_state *st = calloc(1, sizeof(*st));
     if (!st)
         return SB_ERR_NOMEM;
-    char path[2100];
-    world_path(scene, path, sizeof(path));
-    struct sb_mesh_albedo_override overrides[SB_WORLD_MAX_OVERRIDES];
-    for (int i = 0; i < w->override_count; i++) {
-        overrides[i].material = w->overrides[i].material;
-        memcpy(overrides[i].albedo, w->overrides[i].albedo, sizeof(overrides[i].albedo));
-    }
-    struct sb_mesh_load_params load = {
-        .transform = {.units_m = w->units_m, .scale = w->scale, .up_z = w->up_z},
-        .overrides = overrides,
-        .override_count = w->override_count,
-    };
-    memcpy(load.transform.rotate_deg, w->rotate_deg, sizeof(w->rotate_deg));
-    memcpy(load.transform.translate_m, w->translate_m, sizeof(w->translate_m));
-    enum sb_result res = sb_mesh_load(path, &load, &st->mesh);
+    enum sb_result res = sb_mesh_load_world(&scene->world, scene->directory, &st->mesh, st->path, sizeof(st->path));
     if (res) {
         free(st);
         return res;
@@ -94,13 +72,26 @@ static void probes_key(void *state, const struct sb_scene *scene, enum sb_produc
     sb_key_add(key, " recipe %d world %s", PROBES_RECIPE, st->mesh_hash);
     sb_key_add(key, " spacing_m=%a margin_m=%a rays=%u inside=%a", p->spacing_m, p->margin_m, p->rays,
                p->inside_fraction);
+    if (p->has_bounds) {
+        sb_key_add3(key, "bounds_min", p->bounds_m[0]);
+        sb_key_add3(key, "bounds_max", p->bounds_m[1]);
+    }
     for (int i = 0; i < p->explicit_count; i++)
         sb_key_add3(key, "at", p->positions_m[i]);
     sb_sky_visibility_code_hash(code);
     sb_key_add(key, " code %s", code);
 }
 
-/* The grid over the world's bounds, centred on them. */
+/* A path that needs no escaping in JSON (else the settings leave it out). */
+static bool json_safe(const char *s)
+{
+    for (; *s; s++)
+        if (*s == '"' || *s == '\\' || (unsigned char)*s < 0x20)
+            return false;
+    return true;
+}
+
+/* The grid over the world's bounds (or the scene's), centred on them. */
 static enum sb_result place(const struct sb_scene *scene, const struct sb_mesh *mesh, struct sb_probe_layout *layout,
                             float **positions, uint32_t *count)
 {
@@ -109,14 +100,19 @@ static enum sb_result place(const struct sb_scene *scene, const struct sb_mesh *
     if (p->spacing_m > 0) {
         float lo[3], hi[3];
         sb_mesh_bounds(mesh, lo, hi);
+        for (int k = 0; k < 3 && p->has_bounds; k++) {
+            lo[k] = (float)p->bounds_m[0][k];
+            hi[k] = (float)p->bounds_m[1][k];
+        }
         grid = 1;
         for (int k = 0; k < 3; k++) {
             double extent = (double)hi[k] - lo[k] + 2 * p->margin_m;
             double n = floor(extent / p->spacing_m) + 1;
             if (n > SB_PROBES_MAX_GRID) {
-                sb_error("probes: %.0f probes along axis %d (the world is %.1f m across with a %g m margin); at most "
-                         "%d: raise probes.spacing_m",
-                         n, k, (double)hi[k] - lo[k], p->margin_m, SB_PROBES_MAX_GRID);
+                sb_error("probes: %.0f probes along %c (the %s %.1f m across with a %g m margin); at most %d: raise "
+                         "probes.spacing_m%s",
+                         n, "xyz"[k], p -> has_bounds ? "bounds are" : "world is", (double)hi[k] - lo[k], p->margin_m,
+                         SB_PROBES_MAX_GRID, p->has_bounds ? "" : " or give probes.bounds_m");
                 return SB_ERR_TOO_LARGE;
             }
             layout->grid[k] = (uint32_t)n;
@@ -280,9 +276,11 @@ static enum sb_result probes_bake(void *state, struct sb_vk *vk, const struct sb
     a->gpu_ms = gpu_ms;
     snprintf(a->settings_json, sizeof(a->settings_json),
              "{\"rays\":%u,\"grid\":[%u,%u,%u],\"spacing_m\":%.9g,\"explicit\":%u,\"triangles\":%u,"
-             "\"inside\":%u,\"pushed_out\":%u,\"invalid\":%u,\"deringed\":%u,\"lowest_before_dering\":%.6g}",
+             "\"inside\":%u,\"pushed_out\":%u,\"invalid\":%u,\"deringed\":%u,\"lowest_before_dering\":%.6g,"
+             "\"world_hash\":\"%s\",\"world_path\":\"%s\"}",
              layout->ray_count, layout->grid[0], layout->grid[1], layout->grid[2], (double)layout->spacing_m[0],
-             layout->explicit_count, mesh->triangle_count, inside, pushed, inside - pushed, deringed, lowest);
+             layout->explicit_count, mesh->triangle_count, inside, pushed, inside - pushed, deringed, lowest,
+             st->mesh_hash, json_safe(st->path) ? st->path : "");
     sb_info("sky_visibility: %u probes over %u triangles; %u inside geometry, %u pushed out; %u deringed", count,
             mesh->triangle_count, inside, pushed, deringed);
 done:

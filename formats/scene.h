@@ -93,6 +93,8 @@ struct sb_world_params {
 struct sb_probe_params {
     double spacing_m;       /* a grid over the world's bounds, this far apart [2]; 0: none */
     double margin_m;        /* the grid's bounds: the world's, grown by this [0] */
+    bool has_bounds;        /* the grid covers bounds_m instead of the world's bounds */
+    double bounds_m[2][3];  /* min, max corners */
     uint32_t rays;          /* per probe, a multiple of 64 [2048] */
     double inside_fraction; /* more back-face hits than this: inside geometry [0.25] */
     int explicit_count;

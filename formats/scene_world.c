@@ -118,7 +118,8 @@ void sb_probe_params_default(struct sb_probe_params *p)
 
 enum sb_result sb_probes_section_parse(const cJSON *obj, struct sb_scene *scene, const char *source)
 {
-    static const char *const keys[] = {"spacing_m", "margin_m", "rays", "inside_fraction", "positions_m", NULL};
+    static const char *const keys[] = {"spacing_m",       "margin_m",    "bounds_m", "rays",
+                                       "inside_fraction", "positions_m", NULL};
     struct sb_probe_params *p = &scene->probes;
     sb_probe_params_default(p);
     scene->has_probes = true;
@@ -133,6 +134,22 @@ enum sb_result sb_probes_section_parse(const cJSON *obj, struct sb_scene *scene,
     }
     if (!res && (item = cJSON_GetObjectItemCaseSensitive(obj, "margin_m")))
         res = sb_json_number(item, source, "probes.margin_m", 0, 1000, &p->margin_m);
+    if (!res && (item = cJSON_GetObjectItemCaseSensitive(obj, "bounds_m"))) {
+        if (!cJSON_IsArray(item) || cJSON_GetArraySize(item) != 2) {
+            sb_error("%s: probes.bounds_m: expected [[min x, y, z], [max x, y, z]]", source);
+            return SB_ERR_WRONG_TYPE;
+        }
+        res = sb_json_vec3(item->child, source, "probes.bounds_m[0]", -1e4, 1e4, p->bounds_m[0]);
+        if (!res)
+            res = sb_json_vec3(item->child->next, source, "probes.bounds_m[1]", -1e4, 1e4, p->bounds_m[1]);
+        for (int k = 0; k < 3 && !res; k++)
+            if (!(p->bounds_m[1][k] >= p->bounds_m[0][k])) {
+                sb_error("%s: probes.bounds_m: the max corner's %c (%g) is below the min's (%g)", source, "xyz"[k],
+                         p -> bounds_m[1][k], p -> bounds_m[0][k]);
+                res = SB_ERR_OUT_OF_RANGE;
+            }
+        p->has_bounds = !res;
+    }
     if (!res && (item = cJSON_GetObjectItemCaseSensitive(obj, "inside_fraction")))
         res = sb_json_number(item, source, "probes.inside_fraction", 0, 1, &p->inside_fraction);
     if (!res && (item = cJSON_GetObjectItemCaseSensitive(obj, "rays"))) {
@@ -173,6 +190,11 @@ cJSON *sb_probes_section_json(const struct sb_scene *scene)
     cJSON *o = cJSON_CreateObject();
     cJSON_AddNumberToObject(o, "spacing_m", p->spacing_m);
     cJSON_AddNumberToObject(o, "margin_m", p->margin_m);
+    if (p->has_bounds) { /* only when given: scenes without keep their hash */
+        cJSON *b = cJSON_AddArrayToObject(o, "bounds_m");
+        cJSON_AddItemToArray(b, cJSON_CreateDoubleArray(p->bounds_m[0], 3));
+        cJSON_AddItemToArray(b, cJSON_CreateDoubleArray(p->bounds_m[1], 3));
+    }
     cJSON_AddNumberToObject(o, "rays", p->rays);
     cJSON_AddNumberToObject(o, "inside_fraction", p->inside_fraction);
     cJSON *list = cJSON_AddArrayToObject(o, "positions_m");

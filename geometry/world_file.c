@@ -168,7 +168,8 @@ static enum sb_result parse(const cJSON *root, const char *source, struct world 
         snprintf(rd.path, sizeof(rd.path), "ground.");
         res = known_keys(&rd, ground, keys);
         if (!res)
-            res = number(&rd, ground, "size_m", 1.0, 2.0 * SB_MESH_MAX_EXTENT_M, 2.0 * SB_MESH_MAX_EXTENT_M, &w->ground_size_m);
+            res = number(&rd, ground, "size_m", 1.0, 2.0 * SB_MESH_MAX_EXTENT_M, 2.0 * SB_MESH_MAX_EXTENT_M,
+                         &w->ground_size_m);
         if (!res)
             res = material(&rd, ground, &w->ground);
     } else if (!res) {

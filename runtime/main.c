@@ -17,9 +17,11 @@
 #include "default_world.h"
 #include "exr.h"
 #include "log.h"
+#include "mesh.h"
 #include "pack.h"
 #include "pngfile.h"
 #include "renderer.h"
+#include "scene.h"
 #include "skybake_version.h"
 #include "world.h"
 
@@ -51,7 +53,10 @@ static void usage(FILE *f)
                "                          clockwise from north, pitch above the horizontal,\n"
                "                          vertical field of view (default 0,2,0,0,3,50)\n"
                "  --world FILE            the world: a skybake world file (.json) or a mesh assimp\n"
-               "                          reads (default: built in, data/worlds/test.json)\n"
+               "                          reads (default: the world the pack's probes were baked\n"
+               "                          against, else the built-in data/worlds/test.json)\n"
+               "  --no-probes             light the world with the sky alone, ignoring the pack's\n"
+               "                          sky-visibility probes\n"
                "  --tonemap agx|aces|gt   tone mapper (default agx)\n"
                "  --exposure EV           exposure compensation (default 0)\n"
                "  --no-bloom              no bloom\n"
@@ -179,6 +184,8 @@ static int parse_options(int argc, char **argv, struct options *o)
             o->params.shadow_size = (uint32_t)v;
         } else if (!strcmp(a, "--hdr"))
             o->hdr = true;
+        else if (!strcmp(a, "--no-probes"))
+            o->params.no_probes = true;
         else if (!strcmp(a, "--bench"))
             o->bench = true;
         else if (!strcmp(a, "--device") && next)
@@ -299,6 +306,64 @@ static enum sb_result write_frame(const struct options *o, struct sb_renderer *r
     return res;
 }
 
+/* A string member of a JSON object's text; "" when missing. */
+static void settings_string(const char *json, const char *key, char *out, size_t size)
+{
+    out[0] = '\0';
+    cJSON *root = cJSON_Parse(json);
+    const cJSON *item = cJSON_GetObjectItemCaseSensitive(root, key);
+    if (cJSON_IsString(item))
+        snprintf(out, size, "%s", item->valuestring);
+    cJSON_Delete(root);
+}
+
+/*
+ * The world to draw: --world, else the world the pack's probes were baked
+ * against (its scene's world, read from where the baker read it), else the
+ * built-in one. Probes light only the world they were baked for: another
+ * world (or the same file changed since) is drawn with the sky alone.
+ */
+static enum sb_result load_world(const struct options *o, const struct sb_pack *pack, struct sb_world *world,
+                                 bool *no_probes)
+{
+    enum sb_result res;
+    const struct sb_artifact *a = &pack->artifacts[SB_PRODUCT_SKY_VISIBILITY];
+    bool probes = pack->present[SB_PRODUCT_SKY_VISIBILITY] && !o->params.no_probes;
+    char baked_hash[64] = "", baked_path[1024] = "";
+    if (probes) {
+        settings_string(a->settings_json, "world_hash", baked_hash, sizeof(baked_hash));
+        settings_string(a->settings_json, "world_path", baked_path, sizeof(baked_path));
+    }
+    if (o->world) {
+        res = sb_world_load(o->world, NULL, world);
+    } else if (probes && baked_path[0]) {
+        struct sb_world_params *params = malloc(sizeof(*params));
+        if (!params)
+            return SB_ERR_NOMEM;
+        *params = pack->scene->world;
+        snprintf(params->file, sizeof(params->file), "%s", baked_path);
+        struct sb_mesh mesh = {0};
+        res = sb_mesh_load_world(params, "", &mesh, NULL, 0);
+        if (!res)
+            res = sb_world_from_mesh(&mesh, world);
+        sb_mesh_finish(&mesh);
+        free(params);
+        if (res)
+            sb_error("%s: the world its probes were baked against cannot be read; name one with --world", o->pack);
+    } else {
+        res = sb_world_parse(sb_default_world_json, strlen(sb_default_world_json),
+                             "the built-in world (data/worlds/test.json)", world);
+    }
+    if (res)
+        return res;
+    if (probes && strcmp(baked_hash, world->mesh_hash) != 0) {
+        sb_warn("%s: its probes were baked against another world (%s, not this one's %s): lit by the sky alone",
+                o->pack, baked_hash[0] ? baked_hash : "unrecorded", world->mesh_hash);
+        *no_probes = true;
+    }
+    return SB_OK;
+}
+
 static int run(const struct options *o)
 {
     struct sb_pack pack;
@@ -307,9 +372,8 @@ static int run(const struct options *o)
         return EXIT_USAGE;
     }
     struct sb_world world;
-    if (o->world ? sb_world_load(o->world, NULL, &world)
-                 : sb_world_parse(sb_default_world_json, strlen(sb_default_world_json),
-                                  "the built-in world (data/worlds/test.json)", &world)) {
+    struct sb_renderer_params params = o->params;
+    if (load_world(o, &pack, &world, &params.no_probes)) {
         sb_pack_close(&pack);
         return EXIT_USAGE;
     }
@@ -331,7 +395,7 @@ static int run(const struct options *o)
         goto done;
     }
     sb_info("skyview %s: %s on %s (%s)", SKYBAKE_VERSION, o->pack, vk->properties.deviceName, vk->driver_name);
-    res = sb_renderer_create(vk, &pack, &world, &o->params, &r);
+    res = sb_renderer_create(vk, &pack, &world, &params, &r);
     if (res) {
         code = res == SB_ERR_USAGE ? EXIT_USAGE : EXIT_RENDER_FAILED;
         goto done;

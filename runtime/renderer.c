@@ -13,9 +13,12 @@
 #include "log.h"
 #include "physics.h"
 #include "pipeline.h"
+#include "probe_light.spv.h"
+#include "probe_sky.spv.h"
 #include "scene.h"
 #include "scene_frag.spv.h"
 #include "scene_vert.spv.h"
+#include "sh.h"
 #include "shadow_vert.spv.h"
 #include "shadows.h"
 #include "sky.spv.h"
@@ -31,10 +34,9 @@
 #define BLOOM_SETS (2 * SB_BLOOM_MAX_LEVELS)
 
 static const char *const pass_names[SB_PASS_COUNT] = {
-    [SB_PASS_SKY_VIEW] = "sky-view", [SB_PASS_AERIAL_PERSPECTIVE] = "aerial perspective",
-    [SB_PASS_SHADOWS] = "shadows",   [SB_PASS_SCENE] = "scene",
-    [SB_PASS_SKY] = "sky",           [SB_PASS_EXPOSURE] = "exposure",
-    [SB_PASS_BLOOM] = "bloom",       [SB_PASS_TONEMAP] = "tonemap",
+    [SB_PASS_SKY_VIEW] = "sky-view", [SB_PASS_PROBES] = "probes", [SB_PASS_AERIAL_PERSPECTIVE] = "aerial perspective",
+    [SB_PASS_SHADOWS] = "shadows",   [SB_PASS_SCENE] = "scene",   [SB_PASS_SKY] = "sky",
+    [SB_PASS_EXPOSURE] = "exposure", [SB_PASS_BLOOM] = "bloom",   [SB_PASS_TONEMAP] = "tonemap",
 };
 
 const char *sb_pass_name(enum sb_pass pass)
@@ -51,6 +53,8 @@ enum compute_kernel {
     KERNEL_BLOOM_DOWN,
     KERNEL_BLOOM_UP,
     KERNEL_TONEMAP,
+    KERNEL_PROBE_SKY,
+    KERNEL_PROBE_LIGHT,
     KERNEL_COUNT,
 };
 
@@ -64,6 +68,8 @@ struct sb_renderer {
 
     struct sb_buffer atmosphere, transmittance, multiscattering, irradiance_ground;
     struct sb_buffer frame, vertices, exposure;
+    struct sb_buffer probes, probe_light; /* sb_probes_gpu and its probes; the sky's and probes' SH */
+    uint32_t probe_count;                 /* grid probes lit by the probes pass (0: none) */
     struct sb_buffer read_ldr, read_hdr, read_sky_view;
 
     struct sb_texture sky_view, aerial, aerial_t, shadow, hdr, depth, bloom, ldr;
@@ -97,6 +103,8 @@ static const struct {
     [KERNEL_BLOOM_DOWN] = {sb_spv_bloom_down, sizeof(sb_spv_bloom_down), "bloom down"},
     [KERNEL_BLOOM_UP] = {sb_spv_bloom_up, sizeof(sb_spv_bloom_up), "bloom up"},
     [KERNEL_TONEMAP] = {sb_spv_tonemap, sizeof(sb_spv_tonemap), "tonemap"},
+    [KERNEL_PROBE_SKY] = {sb_spv_probe_sky, sizeof(sb_spv_probe_sky), "probe sky"},
+    [KERNEL_PROBE_LIGHT] = {sb_spv_probe_light, sizeof(sb_spv_probe_light), "probe light"},
 };
 
 /* ---- Descriptors --------------------------------------------------------------- */
@@ -122,6 +130,8 @@ static const VkDescriptorType binding_types[SB_VIEW_BINDING_COUNT] = {
     [SB_VIEW_BINDING_BLOOM_DST] = VK_DESCRIPTOR_TYPE_STORAGE_IMAGE,
     [SB_VIEW_BINDING_BLOOM] = VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER,
     [SB_VIEW_BINDING_LDR] = VK_DESCRIPTOR_TYPE_STORAGE_IMAGE,
+    [SB_VIEW_BINDING_PROBES] = VK_DESCRIPTOR_TYPE_STORAGE_BUFFER,
+    [SB_VIEW_BINDING_PROBE_LIGHT] = VK_DESCRIPTOR_TYPE_STORAGE_BUFFER,
 };
 
 /* Write every binding of `set`; the bloom step's source and target vary per set. */
@@ -138,6 +148,8 @@ static void write_set(struct sb_renderer *r, VkDescriptorSet set, VkImageView bl
         [SB_VIEW_BINDING_FRAME] = &r->frame,
         [SB_VIEW_BINDING_VERTICES] = &r->vertices,
         [SB_VIEW_BINDING_EXPOSURE] = &r->exposure,
+        [SB_VIEW_BINDING_PROBES] = &r->probes,
+        [SB_VIEW_BINDING_PROBE_LIGHT] = &r->probe_light,
     };
     const VkImageView view_of[SB_VIEW_BINDING_COUNT] = {
         [SB_VIEW_BINDING_SKY_VIEW] = r->sky_view.view,
@@ -296,6 +308,94 @@ static enum sb_result upload_atmosphere(struct sb_renderer *r, const struct sb_p
     return res;
 }
 
+/* The world's mean albedo, weighted by area: the bounce model's surfaces. */
+static void mean_albedo(const struct sb_world *world, float out[3])
+{
+    double sum[3] = {0, 0, 0}, area = 0;
+    for (uint32_t v = 0; v + 2 < world->vertex_count; v += 3) {
+        const struct sb_vertex_gpu *t = &world->vertices[v];
+        double e1[3], e2[3];
+        for (int i = 0; i < 3; i++) {
+            e1[i] = (double)t[1].position[i] - t[0].position[i];
+            e2[i] = (double)t[2].position[i] - t[0].position[i];
+        }
+        double n[3] = {e1[1] * e2[2] - e1[2] * e2[1], e1[2] * e2[0] - e1[0] * e2[2], e1[0] * e2[1] - e1[1] * e2[0]};
+        double a = 0.5 * sqrt(n[0] * n[0] + n[1] * n[1] + n[2] * n[2]);
+        for (int i = 0; i < 3; i++)
+            sum[i] += a * t[0].albedo[i];
+        area += a;
+    }
+    for (int i = 0; i < 3; i++)
+        out[i] = area > 0 ? (float)(sum[i] / area) : 0.0f;
+}
+
+/*
+ * The pack's sky-visibility probes, or none: the grid's probes (explicit
+ * ones are for other uses: a runtime interpolates a grid), each as
+ * (position, valid), its 9 SH coefficients; the tensor's non-zero entries;
+ * the light buffer the probes pass writes.
+ */
+static enum sb_result upload_probes(struct sb_renderer *r, const struct sb_pack *pack, const struct sb_world *world)
+{
+    const struct sb_probe_layout *layout = &pack->artifacts[SB_PRODUCT_SKY_VISIBILITY].probes;
+    const struct sb_image *image = &pack->images[SB_PRODUCT_SKY_VISIBILITY];
+    uint64_t grid = (uint64_t)layout->grid[0] * layout->grid[1] * layout->grid[2];
+    bool use = pack->present[SB_PRODUCT_SKY_VISIBILITY] && !r->params.no_probes && grid > 0 && grid <= image->width &&
+               image->channel_count == SB_SKY_VISIBILITY_CHANNEL_COUNT;
+    if (pack->present[SB_PRODUCT_SKY_VISIBILITY] && !r->params.no_probes && !use)
+        sb_warn("the pack's sky_visibility has no probe grid: the world is lit by the sky alone");
+    r->probe_count = use ? (uint32_t)grid : 0;
+    size_t count = r->probe_count ? r->probe_count : 1;
+    enum sb_result res =
+        upload(r->vk, NULL, sizeof(struct sb_probes_gpu) + count * 4 * 4 * sizeof(float), "probes", &r->probes);
+    if (!res)
+        res = upload(r->vk, NULL, (SB_PROBE_SH + count * SB_PROBE_SH) * 4 * sizeof(float), "probe light",
+                     &r->probe_light);
+    if (res || !r->probe_count)
+        return res;
+    struct sb_probes_gpu *g = r->probes.mapped;
+    static double t[SB_PROBE_SH][SB_PROBE_SH][SB_PROBE_SH];
+    sb_sh9_tensor(t);
+    uint32_t entries = 0;
+    for (int i = 0; i < SB_PROBE_SH; i++)
+        for (int j = 0; j < SB_PROBE_SH; j++)
+            for (int k = 0; k < SB_PROBE_SH; k++)
+                if (t[i][j][k] != 0 && entries < SB_SH_TENSOR_MAX) {
+                    float *e = g->tensor[entries++];
+                    e[0] = (float)t[i][j][k];
+                    e[1] = (float)i;
+                    e[2] = (float)j;
+                    e[3] = (float)k;
+                }
+    for (int k = 0; k < 3; k++) {
+        g->grid[k] = layout->grid[k];
+        g->origin_m[k] = layout->origin_m[k];
+        g->spacing_m[k] = layout->spacing_m[k];
+    }
+    g->grid[3] = r->probe_count;
+    g->origin_m[3] = (float)entries;
+    mean_albedo(world, g->bounce_albedo);
+    float *out = (float *)(g + 1);
+    for (uint32_t p = 0; p < r->probe_count; p++) {
+        const float *c = &image->data[(size_t)p * SB_SKY_VISIBILITY_CHANNEL_COUNT];
+        float *o = &out[16 * (size_t)p];
+        memcpy(o, c, 3 * sizeof(float)); /* position, after any push out of geometry */
+        o[3] = c[6];                     /* valid */
+        /* The visibility as projected, the deringing window undone where it
+         * can be: windowing before the product with the sky would blur the
+         * horizon into the ground (open ground lost 17% of its sky light);
+         * the irradiance is clamped at the end instead. */
+        static const int band[SB_PROBE_SH] = {0, 1, 1, 1, 2, 2, 2, 2, 2};
+        double w[3];
+        sb_sh9_window_factors(c[10], w);
+        for (int k = 0; k < SB_PROBE_SH; k++)
+            o[4 + k] = w[band[k]] > 1e-3 ? (float)(c[11 + k] / w[band[k]]) : c[11 + k];
+    }
+    sb_info("probes: %u x %u x %u, %.3g m apart, light the world", layout->grid[0], layout->grid[1], layout->grid[2],
+            (double)layout->spacing_m[0]);
+    return SB_OK;
+}
+
 static enum sb_result create_texture(struct sb_renderer *r, struct sb_texture *t, uint32_t w, uint32_t h,
                                      uint32_t depth, uint32_t layers, uint32_t mips, VkFormat format,
                                      VkImageUsageFlags usage, const char *name)
@@ -442,6 +542,8 @@ enum sb_result sb_renderer_create(struct sb_vk *vk, const struct sb_pack *pack, 
         goto cleanup;
     res = upload(vk, world->vertices, world->vertex_count * sizeof(struct sb_vertex_gpu), "world", &r->vertices);
     if (!res)
+        res = upload_probes(r, pack, world);
+    if (!res)
         res = upload(vk, NULL, sizeof(struct sb_frame_gpu), "frame constants", &r->frame);
     if (!res)
         res = upload(vk, NULL, SB_HISTOGRAM_BINS * sizeof(uint32_t) + sizeof(struct sb_exposure_gpu), "exposure",
@@ -526,7 +628,7 @@ void sb_renderer_destroy(struct sb_renderer **pr)
         sb_texture_destroy(vk, textures[i]);
     struct sb_buffer *buffers[] = {&r->atmosphere, &r->transmittance, &r->multiscattering, &r->irradiance_ground,
                                    &r->frame,      &r->vertices,      &r->exposure,        &r->read_ldr,
-                                   &r->read_hdr,   &r->read_sky_view};
+                                   &r->read_hdr,   &r->read_sky_view, &r->probes,          &r->probe_light};
     for (size_t i = 0; i < sizeof(buffers) / sizeof(buffers[0]); i++)
         sb_buffer_destroy(vk, buffers[i]);
     free(r);
@@ -774,6 +876,14 @@ enum sb_result sb_renderer_render(struct sb_renderer *r, const struct sb_view *v
     pass_begin(r, SB_PASS_SKY_VIEW);
     dispatch(r, KERNEL_SKY_VIEW, r->set, NULL, SB_SKY_VIEW_WIDTH, SB_SKY_VIEW_HEIGHT, SB_WORKGROUP_X, SB_WORKGROUP_Y);
     pass_end(r, SB_PASS_SKY_VIEW);
+
+    pass_begin(r, SB_PASS_PROBES);
+    if (r->probe_count) {
+        dispatch(r, KERNEL_PROBE_SKY, r->set, NULL, 1, 1, 1, 1);
+        barrier(r->cmd);
+        dispatch(r, KERNEL_PROBE_LIGHT, r->set, NULL, r->probe_count, 1, SB_PROBE_THREADS, 1);
+    }
+    pass_end(r, SB_PASS_PROBES);
 
     pass_begin(r, SB_PASS_AERIAL_PERSPECTIVE);
     dispatch(r, KERNEL_AERIAL, r->set, NULL, SB_AERIAL_SIZE, SB_AERIAL_SIZE, SB_WORKGROUP_X, SB_WORKGROUP_Y);

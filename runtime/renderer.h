@@ -3,8 +3,11 @@
  *   sky-view LUT -> aerial perspective -> shadow cascades -> scene -> sky ->
  *   exposure -> bloom -> tone mapping,
  * each bracketed by timestamps. The atmosphere comes from a pack (its
- * transmittance, multiple-scattering and ground-irradiance LUTs), read
- * through formats/ and uploaded once; the world from sb_world. Frames are
+ * transmittance, multiple-scattering and ground-irradiance LUTs, and its
+ * sky-visibility probes where it has them), read through formats/ and
+ * uploaded once; the world from sb_world. With probes, the world's ambient
+ * light is the probes' (relit every frame for the sun and sky: probes.glsl);
+ * without, the sky's irradiance on open ground. Frames are
  * offscreen; their pixels are read back on request. One thread at a time.
  */
 #ifndef SB_RUNTIME_RENDERER_H
@@ -24,6 +27,7 @@ struct sb_renderer_params {
     int tonemap;                     /* SB_TONEMAP_AGX (0, the default), _ACES or _GT */
     double exposure_compensation_ev; /* added to the metered exposure; 0: none */
     double bloom_strength;           /* 0: 0.15; negative: no bloom */
+    bool no_probes;                  /* light the world with the sky alone even if the pack has probes */
 };
 
 /* What one frame looks at. Angles in radians; lengths in metres. */
@@ -39,6 +43,7 @@ struct sb_view {
 
 enum sb_pass {
     SB_PASS_SKY_VIEW,
+    SB_PASS_PROBES,
     SB_PASS_AERIAL_PERSPECTIVE,
     SB_PASS_SHADOWS,
     SB_PASS_SCENE,
@@ -49,7 +54,7 @@ enum sb_pass {
     SB_PASS_COUNT,
 };
 
-/* "sky-view", "aerial perspective", "shadows", "scene", "sky", "exposure", "bloom", "tonemap". */
+/* "sky-view", "probes", "aerial perspective", "shadows", "scene", "sky", "exposure", "bloom", "tonemap". */
 const char *sb_pass_name(enum sb_pass pass);
 
 struct sb_frame_timings {

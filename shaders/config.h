@@ -155,7 +155,9 @@ struct sb_bake_push {
 #define SB_VIEW_BINDING_BLOOM_DST 17     /* image2D rgba16f: a bloom step's target (per set) */
 #define SB_VIEW_BINDING_BLOOM 18         /* sampler2D: the finished bloom, mip 0 */
 #define SB_VIEW_BINDING_LDR 19           /* image2D rgba8: the display-referred frame */
-#define SB_VIEW_BINDING_COUNT 20
+#define SB_VIEW_BINDING_PROBES 20        /* struct sb_probes_gpu, then 3 vec4 a probe (probes.glsl) */
+#define SB_VIEW_BINDING_PROBE_LIGHT 21   /* the sky's SH, then each probe's irradiance SH (probes.glsl) */
+#define SB_VIEW_BINDING_COUNT 22
 
 #define SB_SKY_VIEW_WIDTH 192 /* azimuth from the sun, 0 to pi */
 #define SB_SKY_VIEW_HEIGHT 108 /* zenith angle, the horizon between rows 53 and 54 */
@@ -197,6 +199,23 @@ struct sb_frame_gpu {
     SB_VEC4(post);             /* x: bloom threshold (exposed), y: bloom strength, z: exposure
                                   compensation (EV), w: tone mapper (SB_TONEMAP_*) */
     SB_UVEC4(size);            /* xy: frame size; z: bloom levels; w: unused */
+};
+
+/* The sky-visibility probes skyview lights the world with (probes.glsl):
+ * the grid of a pack's sky_visibility product, and the SH triple-product
+ * tensor's non-zero entries (sb_sh9_tensor). probe_sky.comp projects the
+ * sky's radiance on SH over SB_PROBE_SKY_DIRECTIONS directions, one
+ * workgroup of SB_PROBE_SKY_THREADS; probe_light.comp relights each probe,
+ * SB_PROBE_THREADS a workgroup. */
+#define SB_SH_TENSOR_MAX 128 /* 83 are not zero */
+#define SB_PROBE_SKY_THREADS 64
+#define SB_PROBE_SKY_DIRECTIONS 4096
+struct sb_probes_gpu {
+    SB_UVEC4(grid);          /* xyz: probes along each axis; w: grid probes (0: none, the sky-only ambient) */
+    SB_VEC4(origin_m);       /* xyz: the first probe (world, m); w: tensor entries */
+    SB_VEC4(spacing_m);      /* xyz: between probes; w: unused */
+    SB_VEC4(bounce_albedo);  /* rgb: the world's mean albedo by area (the bounce model); w: unused */
+    SB_VEC4(tensor[SB_SH_TENSOR_MAX]); /* x: the integral of Y_i Y_j Y_k; y, z, w: i, j, k */
 };
 
 /* What exposure.comp keeps between frames, after the histogram's bins. */

@@ -5,14 +5,17 @@
  *   between cascades);
  * - the BRDF: GGX distribution, height-correlated Smith visibility, Schlick
  *   Fresnel, Lambert diffuse (Karis 2013; Filament);
- * - the sky: irradiance_ground's sky irradiance on an upward surface, and the
- *   ground's bounce for downward ones, blended by (1 +- n.up) / 2, with
- *   Karis's analytic environment BRDF for the specular part;
+ * - the sky: with probes (probes.glsl), the irradiance they interpolate, the
+ *   sky they see and its bounce, for the normal and the mirror direction;
+ *   without (or outside their grid), irradiance_ground's sky irradiance on an
+ *   upward surface and the ground's bounce for downward ones, blended by
+ *   (1 +- n.up) / 2; Karis's analytic environment BRDF for the specular part;
  * - aerial perspective: the volume inside its range, else the same
  *   integral per fragment (cameras above the atmosphere, far geometry). */
 #extension GL_GOOGLE_include_directive : require
 #include "config.h"
 #include "view.glsl"
+#include "probes.glsl"
 
 layout(set = 0, binding = SB_VIEW_BINDING_SHADOW) uniform sampler2DArrayShadow shadow_map;
 layout(set = 0, binding = SB_VIEW_BINDING_AERIAL) uniform sampler3D aerial_inscatter;
@@ -142,6 +145,11 @@ void main()
     vec3 refl = reflect(-v, n);
     float r_up = dot(refl, up);
     vec3 l_env = (e_sky * (0.5 + 0.5 * r_up) + e_bounce * (0.5 - 0.5 * r_up)) / PI;
+    vec3 probe_n, probe_r;
+    float coverage;
+    probe_lookup(in_offset + frame.camera_m.xyz, n, refl, probe_n, probe_r, coverage);
+    e_n = mix(e_n, probe_n, coverage);
+    l_env = mix(l_env, probe_r / PI, coverage);
     const vec4 c0 = vec4(-1.0, -0.0275, -0.572, 0.022), c1 = vec4(1.0, 0.0425, 1.04, -0.04);
     vec4 rr = roughness * c0 + c1;
     float a004 = min(rr.x * rr.x, exp2(-9.28 * n_dot_v)) * rr.x + rr.y;

@@ -36,6 +36,54 @@ double sb_sh9_eval(const double c[SB_PROBE_SH], const double d[3])
     return sum;
 }
 
+/* Gauss-Legendre nodes and weights on [-1, 1] (Newton on P_n). */
+static void gauss_legendre(int n, double *x, double *w)
+{
+    for (int i = 0; i < n; i++) {
+        double z = cos(M_PI * (i + 0.75) / (n + 0.5)), dp = 1;
+        for (int it = 0; it < 100; it++) {
+            double p0 = 1, p1 = z;
+            for (int k = 2; k <= n; k++) {
+                double p2 = ((2.0 * k - 1) * z * p1 - (k - 1.0) * p0) / k;
+                p0 = p1;
+                p1 = p2;
+            }
+            dp = n * (z * p1 - p0) / (z * z - 1);
+            double step = p1 / dp;
+            z -= step;
+            if (fabs(step) < 1e-16)
+                break;
+        }
+        x[i] = z;
+        w[i] = 2 / ((1 - z * z) * dp * dp);
+    }
+}
+
+void sb_sh9_tensor(double t[SB_PROBE_SH][SB_PROBE_SH][SB_PROBE_SH])
+{
+    /* the products are polynomials of degree 6: 4 nodes in z and 7 in azimuth would do */
+    enum { NZ = 8, NPHI = 16 };
+    double zx[NZ], zw[NZ];
+    gauss_legendre(NZ, zx, zw);
+    memset(t, 0, sizeof(double) * SB_PROBE_SH * SB_PROBE_SH * SB_PROBE_SH);
+    for (int a = 0; a < NZ; a++)
+        for (int b = 0; b < NPHI; b++) {
+            double phi = 2 * M_PI * b / NPHI, r = sqrt(fmax(0.0, 1 - zx[a] * zx[a]));
+            double d[3] = {r * cos(phi), r * sin(phi), zx[a]}, y[SB_PROBE_SH];
+            sb_sh9_basis(d, y);
+            double w = zw[a] * 2 * M_PI / NPHI;
+            for (int i = 0; i < SB_PROBE_SH; i++)
+                for (int j = 0; j < SB_PROBE_SH; j++)
+                    for (int k = 0; k < SB_PROBE_SH; k++)
+                        t[i][j][k] += w * y[i] * y[j] * y[k];
+        }
+    for (int i = 0; i < SB_PROBE_SH; i++) /* the zeros are zeros */
+        for (int j = 0; j < SB_PROBE_SH; j++)
+            for (int k = 0; k < SB_PROBE_SH; k++)
+                if (fabs(t[i][j][k]) < 1e-12)
+                    t[i][j][k] = 0;
+}
+
 void sb_sh9_from_zonal(const double z[3], const double axis[3], double c[SB_PROBE_SH])
 {
     double y[SB_PROBE_SH];
@@ -61,16 +109,21 @@ double sb_sh9_min(const double c[SB_PROBE_SH], double where[3])
     return lowest;
 }
 
-static void window(const double c[SB_PROBE_SH], double h, double out[SB_PROBE_SH])
+void sb_sh9_window_factors(double h, double w[3])
 {
     /* Hann for order 2 (bands 1, 3/4, 1/4), then towards the constant band alone */
     static const double hann[3] = {1.0, 0.75, 0.25};
+    for (int l = 0; l < 3; l++)
+        w[l] = h <= 1.0 ? 1.0 - h * (1.0 - hann[l]) : (l ? hann[l] * (2.0 - h) : 1.0);
+}
+
+static void window(const double c[SB_PROBE_SH], double h, double out[SB_PROBE_SH])
+{
     static const int band[SB_PROBE_SH] = {0, 1, 1, 1, 2, 2, 2, 2, 2};
-    for (int k = 0; k < SB_PROBE_SH; k++) {
-        int l = band[k];
-        double w = h <= 1.0 ? 1.0 - h * (1.0 - hann[l]) : (l ? hann[l] * (2.0 - h) : 1.0);
-        out[k] = c[k] * w;
-    }
+    double w[3];
+    sb_sh9_window_factors(h, w);
+    for (int k = 0; k < SB_PROBE_SH; k++)
+        out[k] = c[k] * w[band[k]];
 }
 
 double sb_sh9_dering(double c[SB_PROBE_SH], double *min_before)

@@ -1,6 +1,9 @@
 // The real spherical-harmonic basis of order 2 (9 functions, Sloan 2008's
 // order and constants) of a unit direction in world axes; baker/sh.c is
 // its C twin.
+#ifndef SB_SH_GLSL
+#define SB_SH_GLSL
+
 void sh9_basis(vec3 d, out float y[SB_PROBE_SH])
 {
     y[0] = 0.28209479177387814;
@@ -23,3 +26,5 @@ vec3 probe_direction(uint i, uint n)
     float r = sqrt(max(0.0, 1.0 - y * y));
     return vec3(r * cos(phi), y, r * sin(phi));
 }
+
+#endif

@@ -18,6 +18,12 @@ void sb_probe_direction(uint32_t i, uint32_t n, double d[3]);
 /* The SH reconstruction sum_k c[k] Y_k(d). */
 double sb_sh9_eval(const double c[SB_PROBE_SH], const double d[3]);
 
+/* The triple-product tensor t[i][j][k] = the integral of Y_i Y_j Y_k over
+ * the sphere, exact to rounding (Gauss-Legendre in the polar cosine times
+ * a uniform rule in azimuth, exact for these polynomials): the SH of a
+ * product fg, truncated to order 2, is sum_ij t[i][j][k] f_i g_j. */
+void sb_sh9_tensor(double t[SB_PROBE_SH][SB_PROBE_SH][SB_PROBE_SH]);
+
 /* A zonal function about unit axis a with zonal coefficients z[l] (l = 0..2)
  * in the basis: c_lm = sqrt(4 pi / (2 l + 1)) z_l Y_lm(a). */
 void sb_sh9_from_zonal(const double z[3], const double axis[3], double c[SB_PROBE_SH]);
@@ -36,5 +42,9 @@ double sb_sh9_min(const double c[SB_PROBE_SH], double where[3]);
  * Returns h; *min_before gets the smallest value before (>= 0: nothing done).
  */
 double sb_sh9_dering(double c[SB_PROBE_SH], double *min_before);
+
+/* The window h's factor for each band l (0 to 2): what sb_sh9_dering
+ * scaled the band's coefficients by. */
+void sb_sh9_window_factors(double h, double w[3]);
 
 #endif

@@ -553,11 +553,13 @@ static void test_hostile(void)
         {"ground.json", "{\"version\": 1, \"ground\": {\"size_m\": 30000}}", SB_ERR_OUT_OF_RANGE},
         {"far.json", "{\"version\": 1, \"boxes\": [{\"center_m\": [9999, 0, 0], \"size_m\": [10, 1, 1]}]}",
          SB_ERR_NUMERIC},
-        {"sides.json", "{\"version\": 1, \"pillars\": [{\"base_m\": [0, 0, 0], \"radius_m\": 1, \"height_m\": 1, "
-                       "\"sides\": 2.5}]}",
+        {"sides.json",
+         "{\"version\": 1, \"pillars\": [{\"base_m\": [0, 0, 0], \"radius_m\": 1, \"height_m\": 1, "
+         "\"sides\": 2.5}]}",
          SB_ERR_OUT_OF_RANGE},
-        {"albedo.json", "{\"version\": 1, \"boxes\": [{\"center_m\": [0, 0, 0], \"size_m\": [1, 1, 1], "
-                        "\"albedo\": [2, 0, 0]}]}",
+        {"albedo.json",
+         "{\"version\": 1, \"boxes\": [{\"center_m\": [0, 0, 0], \"size_m\": [1, 1, 1], "
+         "\"albedo\": [2, 0, 0]}]}",
          SB_ERR_OUT_OF_RANGE},
     };
     struct sb_mesh m = {0};

@@ -76,7 +76,8 @@ check "the old pack is whole" diff -r "$tmp/p" "$tmp/before"
 printf '{"atmosphere":{"preset":"earth"},"products":["sky_visibility"]}' >"$tmp/noworld.json"
 check "sky_visibility without a world is a scene error" expect_exit 2 "$skybake" bake "$tmp/noworld.json" -o "$tmp/n"
 check "it says what is missing" grep -q "needs a \"world\"" "$tmp/err"
-for bad in '"spacing_m":-1' '"rays":100' '"rays":1e9' '"inside_fraction":2' '"positions_m":[[1,2]]' '"nope":1' '"spacing_m":0'; do
+for bad in '"bounds_m":[[0,0,0],[1,1]]' '"bounds_m":[[0,0,0],[1,-1,1]]' '"bounds_m":[[0,0,0],[1,1,2e4]]' \
+    '"spacing_m":-1' '"rays":100' '"rays":1e9' '"inside_fraction":2' '"positions_m":[[1,2]]' '"nope":1' '"spacing_m":0'; do
     printf '{"atmosphere":{"preset":"earth"},"products":["sky_visibility"],"world":{"file":"world.obj"},"probes":{%s}}' "$bad" >"$tmp/bad.json"
     check "probes {$bad} is a scene error" expect_exit 2 "$skybake" bake "$tmp/bad.json" -o "$tmp/n"
     check "it names probes" grep -q "probes" "$tmp/err"
@@ -85,6 +86,20 @@ scene '["sky_visibility"]' '{"preset":"earth"}' '' | sed 's/"spacing_m":4/"spaci
 check "a grid past the caps is refused" expect_exit 1 "$skybake" bake "$tmp/dense.json" -o "$tmp/n"
 check "it says to raise the spacing" grep -q "raise probes.spacing_m" "$tmp/err"
 check "the tolerance is refused for probes" sh -c "printf '{\"atmosphere\":{\"preset\":\"earth\"},\"products\":[\"sky_visibility\"],\"world\":{\"file\":\"w.obj\"},\"tolerance\":{\"sky_visibility\":0.01}}' >'$tmp/tol.json'; '$skybake' bake '$tmp/tol.json' -o '$tmp/n' 2>/dev/null; test \$? = 2"
+
+# The grid over given bounds instead of the world's (a world too wide for
+# a grid: the test world's 20 km ground), a skybake world file as the world.
+cat >"$tmp/outdoor.json" <<EOF
+{"version":1,"atmosphere":{"preset":"earth"},"products":["sky_visibility"],
+ "world":{"file":"$root/data/worlds/test.json"},"probes":{"spacing_m":4,"rays":256}}
+EOF
+check "the test world's bounds need probes.bounds_m" expect_exit 1 "$skybake" bake "$tmp/outdoor.json" -o "$tmp/o"
+check "it says to give bounds" grep -q "give probes.bounds_m" "$tmp/err"
+sed -i 's/"rays":256/"rays":256,"bounds_m":[[-8,0.5,-30],[8,8.5,-14]]/' "$tmp/outdoor.json"
+check "a grid over the scene's bounds" expect_exit 0 "$skybake" bake "$tmp/outdoor.json" -o "$tmp/o"
+check "5 x 3 x 5 probes" expect_exit 0 "$skybake" info "$tmp/o"
+check "info shows that grid" grep -q '"grid":\[5,3,5\]' "$tmp/out"
+check "the world's hash and path are recorded" grep -q "world_path.*data/worlds/test.json" "$tmp/out"
 
 # A probe file edited in the pack: verify names it.
 cp -r "$tmp/p" "$tmp/edited"

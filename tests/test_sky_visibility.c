@@ -233,19 +233,15 @@ static void reconstruction_error(const struct sb_mesh *mesh, const struct sb_emb
 {
     enum { DENSE = 65536, NORMALS = 64 };
     static double tensor[SB_PROBE_SH][SB_PROBE_SH][SB_PROBE_SH];
+    sb_sh9_tensor(tensor);
     double sky[SB_PROBE_SH] = {0};
     const int q = 1 << 18;
     for (int i = 0; i < q; i++) { /* dense fp64 quadrature, error ~1e-6 */
         double d[3], y[SB_PROBE_SH];
         sb_probe_direction((uint32_t)i, (uint32_t)q, d);
         sb_sh9_basis(d, y);
-        double w = 4 * M_PI / q;
-        for (int a = 0; a < SB_PROBE_SH; a++) {
-            sky[a] += y[a] * sky_radiance(d) * w;
-            for (int b = 0; b < SB_PROBE_SH; b++)
-                for (int c = 0; c < SB_PROBE_SH; c++)
-                    tensor[a][b][c] += y[a] * y[b] * y[c] * w;
-        }
+        for (int a = 0; a < SB_PROBE_SH; a++)
+            sky[a] += y[a] * sky_radiance(d) * (4 * M_PI / q);
     }
     const double sun[3] = {0.664, 0.5, 0.557}, sun_irradiance = 10.0; /* 30 degrees up */
     double sun_len = sqrt(sun[0] * sun[0] + sun[1] * sun[1] + sun[2] * sun[2]), s[3];
@@ -441,6 +437,45 @@ static void test_dering(void)
 }
 
 /* The cast order is a permutation of the rays (every ray once). */
+/* The triple-product tensor (skyview relights probes with it): against a
+ * dense quadrature of another rule, its symmetries, and closed forms:
+ * the integral of Y_0 Y_j Y_k is Y_0 delta_jk; that of Y_10^2 Y_20 is
+ * (4 / 5) sqrt(5 / (16 pi)). */
+static void test_tensor(void)
+{
+    static double t[SB_PROBE_SH][SB_PROBE_SH][SB_PROBE_SH], dense[SB_PROBE_SH][SB_PROBE_SH][SB_PROBE_SH];
+    sb_sh9_tensor(t);
+    const int q = 1 << 16;
+    for (int i = 0; i < q; i++) {
+        double d[3], y[SB_PROBE_SH];
+        sb_probe_direction((uint32_t)i, (uint32_t)q, d);
+        sb_sh9_basis(d, y);
+        for (int a = 0; a < SB_PROBE_SH; a++)
+            for (int b = 0; b < SB_PROBE_SH; b++)
+                for (int c = 0; c < SB_PROBE_SH; c++)
+                    dense[a][b][c] += y[a] * y[b] * y[c] * (4 * M_PI / q);
+    }
+    double err = 0, asym = 0, delta = 0;
+    int nonzero = 0;
+    for (int a = 0; a < SB_PROBE_SH; a++)
+        for (int b = 0; b < SB_PROBE_SH; b++)
+            for (int c = 0; c < SB_PROBE_SH; c++) {
+                err = fmax(err, fabs(t[a][b][c] - dense[a][b][c]));
+                asym = fmax(asym, fmax(fabs(t[a][b][c] - t[b][a][c]), fabs(t[a][b][c] - t[c][b][a])));
+                nonzero += t[a][b][c] != 0;
+            }
+    for (int j = 0; j < SB_PROBE_SH; j++)
+        for (int k = 0; k < SB_PROBE_SH; k++)
+            delta = fmax(delta, fabs(t[0][j][k] - (j == k ? 0.28209479177387814 : 0.0)));
+    double gaunt = 0.8 * sqrt(5.0 / (16.0 * M_PI));
+    printf("SH tensor: %d non-zero entries (skyview keeps %d); %.1e from a 65536-point quadrature, Y0 rows %.1e, "
+           "Y10 Y10 Y20 %.1e from closed forms\n",
+           nonzero, SB_SH_TENSOR_MAX, err, delta, fabs(t[2][2][6] - gaunt));
+    CHECK(err < 1e-5, "tensor within %g of the dense quadrature", err);
+    CHECK(asym < 1e-15 && delta < 1e-14 && fabs(t[2][2][6] - gaunt) < 1e-14, "tensor: symmetric, closed forms");
+    CHECK(nonzero <= SB_SH_TENSOR_MAX, "%d entries fit skyview's %d", nonzero, SB_SH_TENSOR_MAX);
+}
+
 static void test_ray_order(void)
 {
     for (uint32_t n = 64; n <= 8192; n *= 2) {
@@ -462,6 +497,7 @@ int main(void)
     sb_log_set_level(SB_LOG_WARN);
     test_ray_order();
     test_dering();
+    test_tensor();
     struct sb_vk *vk;
     if (test_vulkan(false, &vk) == SB_ERR_NO_DEVICE)
         return TEST_SKIP;

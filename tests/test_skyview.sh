@@ -37,10 +37,32 @@ check "aces" expect_exit 0 "$skyview" "$tmp/pack" -o "$tmp/g" $small --tonemap a
 check "camera above the atmosphere" expect_exit 0 "$skyview" "$tmp/pack" -o "$tmp/g" $small --camera 0,1000000,0,0,-60,60
 
 check "bench" expect_exit 0 "$skyview" "$tmp/pack" -o "$tmp/b" $small --bench --frames 3 --warmup 1
-for pass in sky-view "aerial perspective" shadows scene sky exposure bloom tonemap total; do
+for pass in sky-view probes "aerial perspective" shadows scene sky exposure bloom tonemap total; do
     check "bench table has $pass" grep -q "^$pass " "$tmp/out"
     check "bench.json has $pass" grep -q "\"pass\":[[:space:]]*\"$pass\"" "$tmp/b/bench.json"
 done
+
+# A pack with probes over the test world (its atmosphere reused from the
+# first pack): skyview draws the world they were baked against and lights
+# it with them; --no-probes and another world light it with the sky alone.
+cat >"$tmp/probes.json" <<EOF
+{"version":1,"name":"view","atmosphere":{"preset":"earth"},"products":["irradiance_ground","sky_visibility"],
+ "world":{"file":"$root/data/worlds/test.json"},
+ "probes":{"spacing_m":4,"rays":256,"bounds_m":[[-12,0.5,-40],[12,8.5,-8]]}}
+EOF
+cp -r "$tmp/pack" "$tmp/probes"
+check "bake probes into a copy of the pack" expect_exit 0 "$skybake" bake "$tmp/probes.json" -o "$tmp/probes"
+check "the atmosphere was reused" grep -q "transmittance.*reused" "$tmp/err"
+check "a frame lit by the probes" expect_exit 0 "$skyview" "$tmp/probes" -o "$tmp/p1" $small
+check "the probes light the world" grep -q "probes: 7 x 3 x 9.*light the world" "$tmp/err"
+check "--no-probes" expect_exit 0 "$skyview" "$tmp/probes" -o "$tmp/p0" $small --no-probes
+check "without them, no probe light" sh -c "! grep -q 'light the world' '$tmp/err'"
+check "the probes change the frame" sh -c "! cmp -s '$tmp/p1/frame_0000.png' '$tmp/p0/frame_0000.png'"
+check "the same world without probes is the first pack's frame" expect_exit 0 "$skyview" "$tmp/pack" -o "$tmp/p2" $small
+check "so the pack's world was the test world" cmp -s "$tmp/p0/frame_0000.png" "$tmp/p2/frame_0000.png"
+printf '{"version":1,"boxes":[{"center_m":[0,1,-10],"size_m":[1,1,1]}]}' >"$tmp/other.json"
+check "another world" expect_exit 0 "$skyview" "$tmp/probes" -o "$tmp/p3" $small --world "$tmp/other.json"
+check "is lit by the sky alone, with a warning" grep -q "baked against another world.*lit by the sky alone" "$tmp/err"
 
 # Packs that must be refused, with what is wrong named.
 cp -r "$tmp/pack" "$tmp/edited"
