@@ -19,12 +19,20 @@ static long long file_bytes(const char *dir, const char *file)
     return stat(path, &st) == 0 ? (long long)st.st_size : -1;
 }
 
+/* The channels' names, comma-separated; a list that does not fit in size
+ * ends with ",... (N channels)". */
 static void channel_list(const struct sb_image *image, char *out, size_t size)
 {
     size_t n = 0;
     out[0] = '\0';
-    for (uint32_t c = 0; c < image->channel_count && n < size; c++)
+    for (uint32_t c = 0; c < image->channel_count; c++) {
+        size_t need = strlen(image->channel_names[c]) + (c ? 1 : 0);
+        if (n + need + 24 >= size) {
+            snprintf(out + n, size - n, ",... (%u channels)", image->channel_count);
+            return;
+        }
         n += (size_t)snprintf(out + n, size - n, "%s%s", c ? "," : "", image->channel_names[c]);
+    }
 }
 
 static cJSON *info_json(const struct sb_pack *pack, const char *dir)
@@ -47,7 +55,7 @@ static cJSON *info_json(const struct sb_pack *pack, const char *dir)
             continue;
         const struct sb_artifact *a = &pack->artifacts[p];
         const struct sb_image *image = &pack->images[p];
-        char channels[256];
+        char channels[SB_IMAGE_MAX_CHANNELS * SB_CHANNEL_NAME_MAX];
         channel_list(image, channels, sizeof(channels));
         cJSON *o = cJSON_CreateObject();
         cJSON_AddStringToObject(o, "name", sb_product_name((enum sb_product_id)p));

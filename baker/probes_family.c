@@ -21,6 +21,7 @@
 #include "mesh.h"
 #include "raycast.h"
 #include "sh.h"
+#include "sky_bounce.h"
 #include "sky_visibility.h"
 
 /* Candidate offsets for a probe inside geometry: the 26 neighbour
@@ -30,11 +31,14 @@ static const double push_steps[] = {0.25, 0.5};
 #define PUSH_RAYS 256
 #define PROBES_RECIPE 2 /* 2: rays cast in sb_probe_ray_order */
 
-/* The world as read for this bake: the key's input and the bake's. */
+/* The world as read for this bake: the key's input and the bake's; its
+ * BVH on the device, built by the first product baked. */
 struct probes_state {
     struct sb_mesh mesh;
     char mesh_hash[SB_HASH_HEX_SIZE];
     char path[640]; /* the world's file, absolute */
+    struct sb_bvh bvh;
+    struct sb_raycaster *rc;
 };
 
 static enum sb_result probes_create(struct sb_vk *vk, const struct sb_scene *scene, void **out)
@@ -55,8 +59,11 @@ static enum sb_result probes_create(struct sb_vk *vk, const struct sb_scene *sce
 static void probes_destroy(void **state)
 {
     struct probes_state *st = *state;
-    if (st)
+    if (st) {
+        sb_raycaster_destroy(&st->rc);
+        sb_bvh_finish(&st->bvh);
         sb_mesh_finish(&st->mesh);
+    }
     free(st);
     *state = NULL;
 }
@@ -80,6 +87,23 @@ static void probes_key(void *state, const struct sb_scene *scene, enum sb_produc
         sb_key_add3(key, "at", p->positions_m[i]);
     sb_sky_visibility_code_hash(code);
     sb_key_add(key, " code %s", code);
+    if (id == SB_PRODUCT_SKY_BOUNCE) { /* and the visibility's key, as its input */
+        sb_sky_bounce_code_hash(code);
+        sb_key_add(key, " bounce_rays=%u secondary=%u bounce_code %s", p->bounce_rays, p->bounce_secondary, code);
+    }
+}
+
+static uint32_t probes_depends_on(enum sb_product_id id)
+{
+    return id == SB_PRODUCT_SKY_BOUNCE ? 1u << SB_PRODUCT_SKY_VISIBILITY : 0;
+}
+
+static enum sb_result raycaster(struct probes_state *st, struct sb_vk *vk)
+{
+    enum sb_result res = SB_OK;
+    if (!st->rc && !(res = sb_bvh_build(&st->mesh, &st->bvh)))
+        res = sb_raycaster_create(vk, &st->bvh, &st->rc);
+    return res;
 }
 
 /* A path that needs no escaping in JSON (else the settings leave it out). */
@@ -215,13 +239,10 @@ done:
     return res;
 }
 
-static enum sb_result probes_bake(void *state, struct sb_vk *vk, const struct sb_scene *scene, enum sb_product_id id,
-                                  const struct sb_image baked[SB_PRODUCT_COUNT], struct sb_image *image,
-                                  struct sb_artifact *a)
+static enum sb_result bake_visibility(struct probes_state *st, const struct sb_scene *scene, struct sb_image *image,
+                                      struct sb_artifact *a)
 {
-    struct probes_state *st = state;
-    struct sb_bvh bvh = {0};
-    struct sb_raycaster *rc = NULL;
+    struct sb_raycaster *rc = st->rc;
     float *positions = NULL, *offsets = NULL, *valid = NULL, *results = NULL;
     uint32_t count = 0, inside = 0, pushed = 0, deringed = 0;
     double lowest = 0, gpu_ms = 0;
@@ -229,8 +250,7 @@ static enum sb_result probes_bake(void *state, struct sb_vk *vk, const struct sb
     memset(layout, 0, sizeof(*layout));
     enum sb_result res;
     const struct sb_mesh *mesh = &st->mesh;
-    if ((res = sb_bvh_build(mesh, &bvh)) || (res = sb_raycaster_create(vk, &bvh, &rc)) ||
-        (res = place(scene, mesh, layout, &positions, &count)))
+    if ((res = place(scene, mesh, layout, &positions, &count)))
         goto done;
     offsets = calloc((size_t)count * 3, sizeof(float));
     valid = calloc(count, sizeof(float));
@@ -290,12 +310,76 @@ done:
     free(offsets);
     free(valid);
     free(results);
-    sb_raycaster_destroy(&rc);
-    sb_bvh_finish(&bvh);
     return res;
 }
 
+/* The bounce at the visibility's probes (their positions after any push
+ * out; invalid ones get zeros), over the same grid. */
+static enum sb_result bake_bounce(struct probes_state *st, const struct sb_scene *scene,
+                                  const struct sb_image *visibility, struct sb_image *image, struct sb_artifact *a)
+{
+    float *positions = NULL, *valid = NULL, *out = NULL;
+    uint32_t count = 0;
+    struct sb_probe_layout *layout = &a->probes;
+    memset(layout, 0, sizeof(*layout));
+    enum sb_result res = place(scene, &st->mesh, layout, &positions, &count);
+    if (!res && (visibility->width != count || visibility->channel_count != SB_SKY_VISIBILITY_CHANNEL_COUNT)) {
+        sb_error("sky_bounce: sky_visibility holds %u probes, the scene places %u", visibility->width, count);
+        res = SB_ERR_BAD_IMAGE;
+    }
+    if (res)
+        goto done;
+    valid = malloc(count * sizeof(float));
+    out = malloc((size_t)count * SB_BOUNCE_FLOATS * sizeof(float));
+    if (!valid || !out) {
+        res = SB_ERR_NOMEM;
+        goto done;
+    }
+    uint32_t valid_count = 0;
+    for (uint32_t i = 0; i < count; i++) {
+        const float *v = &visibility->data[(size_t)i * SB_SKY_VISIBILITY_CHANNEL_COUNT];
+        memcpy(&positions[3 * (size_t)i], v, 3 * sizeof(float));
+        valid[i] = v[6];
+        valid_count += v[6] != 0;
+    }
+    struct sb_sky_bounce_params params = {.ray_count = scene->probes.bounce_rays,
+                                          .secondary = scene->probes.bounce_secondary};
+    if ((res = sb_sky_bounce_bake(st->rc, &st->mesh, positions, valid, count, &params, out, &a->gpu_ms)) ||
+        (res = sb_image_init(image, count, 1, SB_SKY_BOUNCE_CHANNEL_COUNT)))
+        goto done;
+    sb_image_set_channel_names(image, SB_SKY_BOUNCE_CHANNELS);
+    memcpy(image->data, out, (size_t)count * SB_BOUNCE_FLOATS * sizeof(float));
+    snprintf(a->settings_json, sizeof(a->settings_json),
+             "{\"rays\":%u,\"secondary\":%u,\"grid\":[%u,%u,%u],\"spacing_m\":%.9g,\"explicit\":%u,"
+             "\"valid\":%u,\"model\":\"one Lambertian bounce; order-1 SH at the probe x order-2 SH of the light at "
+             "the surfaces\"}",
+             params.ray_count, params.secondary, layout->grid[0], layout->grid[1], layout->grid[2],
+             (double)layout->spacing_m[0], layout->explicit_count, valid_count);
+    sb_info("sky_bounce: %u probes (%u valid), %u rays each, %u from each surface hit", count, valid_count,
+            params.ray_count, params.secondary);
+done:
+    if (res)
+        sb_image_finish(image);
+    free(positions);
+    free(valid);
+    free(out);
+    return res;
+}
+
+static enum sb_result probes_bake(void *state, struct sb_vk *vk, const struct sb_scene *scene, enum sb_product_id id,
+                                  const struct sb_image baked[SB_PRODUCT_COUNT], struct sb_image *image,
+                                  struct sb_artifact *a)
+{
+    struct probes_state *st = state;
+    enum sb_result res = raycaster(st, vk);
+    if (res)
+        return res;
+    return id == SB_PRODUCT_SKY_BOUNCE ? bake_bounce(st, scene, &baked[SB_PRODUCT_SKY_VISIBILITY], image, a)
+                                       : bake_visibility(st, scene, image, a);
+}
+
 const struct sb_family_baker sb_probes_family = {
+    .depends_on = probes_depends_on,
     .key = probes_key,
     .create = probes_create,
     .destroy = probes_destroy,

@@ -51,6 +51,9 @@ static const struct sb_product_format product_formats[SB_PRODUCT_COUNT] = {
     [SB_PRODUCT_SKY_VISIBILITY] = {"sky_visibility", 0, 1, 1, SB_SKY_VISIBILITY_CHANNEL_COUNT,
                                    SB_SKY_VISIBILITY_CHANNELS, "probes-sh2-fibonacci-v1", 3, SB_STORAGE_PROBES,
                                    "float32", "sbprobes", SB_FAMILY_PROBES},
+    [SB_PRODUCT_SKY_BOUNCE] = {"sky_bounce", 0, 1, 1, SB_SKY_BOUNCE_CHANNEL_COUNT, SB_SKY_BOUNCE_CHANNELS,
+                               "probes-bounce-sh1x2-fibonacci-v1", 4, SB_STORAGE_PROBES, "float32", "sbprobes",
+                               SB_FAMILY_PROBES},
 };
 
 void sb_product_shape(const struct sb_scene *scene, enum sb_product_id id, uint32_t shape[3])
@@ -635,7 +638,7 @@ static enum sb_result read_artifact_entry(const cJSON *entry, int index, struct 
         sb_error("%s: %schannels: expected an array of names", source, where);
         return channels ? SB_ERR_WRONG_TYPE : SB_ERR_MISSING_FIELD;
     }
-    char expect[256], got[256] = "";
+    char expect[4096], got[4096] = "";
     snprintf(expect, sizeof(expect), "%s", format->channel_names);
     const cJSON *c;
     cJSON_ArrayForEach(c, channels)

@@ -18,7 +18,7 @@
 
 /* The version this build writes; it reads this one and every older one
  * (each a subset of the next; docs/pack.md). */
-#define SB_PACK_FORMAT_VERSION 3
+#define SB_PACK_FORMAT_VERSION 4
 #define SB_PACK_FORMAT_VERSION_OLDEST 1
 #define SB_PACK_MANIFEST "manifest.json"
 
@@ -35,6 +35,7 @@ enum sb_product_id {
     SB_PRODUCT_WEATHER,
     /* Probes over the scene's world (format version 3 on). */
     SB_PRODUCT_SKY_VISIBILITY,
+    SB_PRODUCT_SKY_BOUNCE, /* format version 4 on */
     SB_PRODUCT_COUNT,
 };
 

@@ -71,6 +71,10 @@ static void channel_range(const char *name, double *lo, double *hi)
     } else if (!strcmp(name, "dering_window")) {
         *lo = 0;
         *hi = 2;
+    } else if (!strncmp(name, "bounce.", 7)) {
+        /* |B| <= 4 pi max|Y_m| max|g_k| / pi, |g_k| <= pi max|Y_k|: m < 4, k < 9 */
+        *lo = -6.7079;
+        *hi = 6.7079;
     } else if (!strcmp(name, "mean_distance_m")) {
         *lo = 0;
     }

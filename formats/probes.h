@@ -50,6 +50,18 @@
     "mean_distance_m,dering_window,sh.0,sh.1,sh.2,sh.3,sh.4,sh.5,sh.6,sh.7,sh.8"
 #define SB_SKY_VISIBILITY_CHANNEL_COUNT 20
 
+/* The sky-bounce product's channels (docs/probes.md, "Bounce"): the
+ * one-bounce transfer B[m][k] per colour, m < 4 the order-1 SH of the
+ * direction at the probe, k < 9 the order-2 SH of the light reaching the
+ * surfaces its rays hit: channel "bounce.m.k.c", m, then k, then r, g, b. */
+#define SB_BOUNCE_3(m, k) "bounce." #m "." #k ".r,bounce." #m "." #k ".g,bounce." #m "." #k ".b"
+#define SB_BOUNCE_9(m)                                                                                                 \
+    SB_BOUNCE_3(m, 0)                                                                                                  \
+    "," SB_BOUNCE_3(m, 1) "," SB_BOUNCE_3(m, 2) "," SB_BOUNCE_3(m, 3) "," SB_BOUNCE_3(m, 4) "," SB_BOUNCE_3(           \
+        m, 5) "," SB_BOUNCE_3(m, 6) "," SB_BOUNCE_3(m, 7) "," SB_BOUNCE_3(m, 8)
+#define SB_SKY_BOUNCE_CHANNELS SB_BOUNCE_9(0) "," SB_BOUNCE_9(1) "," SB_BOUNCE_9(2) "," SB_BOUNCE_9(3)
+#define SB_SKY_BOUNCE_CHANNEL_COUNT 108
+
 /* Where the probes are: a grid (x fastest) then explicit ones. */
 struct sb_probe_layout {
     uint32_t grid[3];

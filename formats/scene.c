@@ -430,8 +430,9 @@ static enum sb_result parse_root(const cJSON *root, struct sb_scene *scene, cons
         sb_error("%s: atmosphere: missing", source);
         return SB_ERR_MISSING_FIELD;
     }
-    if (scene->wants[SB_PRODUCT_SKY_VISIBILITY] && !scene->has_world) {
-        sb_error("%s: products: sky_visibility needs a \"world\" (the geometry the probes see)", source);
+    if ((scene->wants[SB_PRODUCT_SKY_VISIBILITY] || scene->wants[SB_PRODUCT_SKY_BOUNCE]) && !scene->has_world) {
+        sb_error("%s: products: %s needs a \"world\" (the geometry the probes see)", source,
+                 scene->wants[SB_PRODUCT_SKY_VISIBILITY] ? "sky_visibility" : "sky_bounce");
         return SB_ERR_MISSING_FIELD;
     }
     if (!have_products)

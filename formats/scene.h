@@ -97,6 +97,8 @@ struct sb_probe_params {
     double bounds_m[2][3];  /* min, max corners */
     uint32_t rays;          /* per probe, a multiple of 64 [2048] */
     double inside_fraction; /* more back-face hits than this: inside geometry [0.25] */
+    uint32_t bounce_rays;   /* sky_bounce: rays a probe for the surfaces it sees, a multiple of 64 [256] */
+    uint32_t bounce_secondary; /* sky_bounce: rays from each surface hit, a multiple of 8 [64] */
     int explicit_count;
     double positions_m[SB_PROBES_MAX_EXPLICIT][3];
 };

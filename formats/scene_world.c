@@ -113,13 +113,14 @@ cJSON *sb_world_section_json(const struct sb_scene *scene)
 
 void sb_probe_params_default(struct sb_probe_params *p)
 {
-    *p = (struct sb_probe_params){.spacing_m = 2.0, .rays = 2048, .inside_fraction = 0.25};
+    *p = (struct sb_probe_params){
+        .spacing_m = 2.0, .rays = 2048, .inside_fraction = 0.25, .bounce_rays = 256, .bounce_secondary = 64};
 }
 
 enum sb_result sb_probes_section_parse(const cJSON *obj, struct sb_scene *scene, const char *source)
 {
-    static const char *const keys[] = {"spacing_m",       "margin_m",    "bounds_m", "rays",
-                                       "inside_fraction", "positions_m", NULL};
+    static const char *const keys[] = {"spacing_m",   "margin_m",    "bounds_m",         "rays", "inside_fraction",
+                                       "positions_m", "bounce_rays", "bounce_secondary", NULL};
     struct sb_probe_params *p = &scene->probes;
     sb_probe_params_default(p);
     scene->has_probes = true;
@@ -162,6 +163,26 @@ enum sb_result sb_probes_section_parse(const cJSON *obj, struct sb_scene *scene,
             p->rays = (uint32_t)rays;
         }
     }
+    const struct {
+        const char *key;
+        double lo, hi, multiple;
+        uint32_t *out;
+    } counts[] = {{"bounce_rays", 64, 4096, 64, &p->bounce_rays},
+                  {"bounce_secondary", 8, 1024, 8, &p->bounce_secondary}};
+    for (size_t i = 0; i < sizeof(counts) / sizeof(counts[0]) && !res; i++) {
+        if (!(item = cJSON_GetObjectItemCaseSensitive(obj, counts[i].key)))
+            continue;
+        char where[64];
+        double v;
+        snprintf(where, sizeof(where), "probes.%s", counts[i].key);
+        if ((res = sb_json_number(item, source, where, counts[i].lo, counts[i].hi, &v)))
+            break;
+        if (v != floor(v) || fmod(v, counts[i].multiple) != 0) {
+            sb_error("%s: %s: %g is not a multiple of %g", source, where, v, counts[i].multiple);
+            return SB_ERR_OUT_OF_RANGE;
+        }
+        *counts[i].out = (uint32_t)v;
+    }
     if (!res && (item = cJSON_GetObjectItemCaseSensitive(obj, "positions_m"))) {
         if (!cJSON_IsArray(item) || cJSON_GetArraySize(item) > SB_PROBES_MAX_EXPLICIT) {
             sb_error("%s: probes.positions_m: expected an array of at most %d [x, y, z]", source,
@@ -183,7 +204,7 @@ enum sb_result sb_probes_section_parse(const cJSON *obj, struct sb_scene *scene,
 
 cJSON *sb_probes_section_json(const struct sb_scene *scene)
 {
-    bool used = scene->has_probes || scene->wants[SB_PRODUCT_SKY_VISIBILITY];
+    bool used = scene->has_probes || scene->wants[SB_PRODUCT_SKY_VISIBILITY] || scene->wants[SB_PRODUCT_SKY_BOUNCE];
     if (!used)
         return NULL;
     const struct sb_probe_params *p = &scene->probes;
@@ -197,6 +218,10 @@ cJSON *sb_probes_section_json(const struct sb_scene *scene)
     }
     cJSON_AddNumberToObject(o, "rays", p->rays);
     cJSON_AddNumberToObject(o, "inside_fraction", p->inside_fraction);
+    if (scene->wants[SB_PRODUCT_SKY_BOUNCE]) { /* only then: scenes without keep their hash */
+        cJSON_AddNumberToObject(o, "bounce_rays", p->bounce_rays);
+        cJSON_AddNumberToObject(o, "bounce_secondary", p->bounce_secondary);
+    }
     cJSON *list = cJSON_AddArrayToObject(o, "positions_m");
     for (int i = 0; i < p->explicit_count; i++)
         cJSON_AddItemToArray(list, cJSON_CreateDoubleArray(p->positions_m[i], 3));

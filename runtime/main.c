@@ -328,7 +328,7 @@ static enum sb_result load_world(const struct options *o, const struct sb_pack *
 {
     enum sb_result res;
     const struct sb_artifact *a = &pack->artifacts[SB_PRODUCT_SKY_VISIBILITY];
-    bool probes = pack->present[SB_PRODUCT_SKY_VISIBILITY] && !o->params.no_probes;
+    bool probes = pack->present[SB_PRODUCT_SKY_VISIBILITY];
     char baked_hash[64] = "", baked_path[1024] = "";
     if (probes) {
         settings_string(a->settings_json, "world_hash", baked_hash, sizeof(baked_hash));
@@ -356,7 +356,7 @@ static enum sb_result load_world(const struct options *o, const struct sb_pack *
     }
     if (res)
         return res;
-    if (probes && strcmp(baked_hash, world->mesh_hash) != 0) {
+    if (probes && !o->params.no_probes && strcmp(baked_hash, world->mesh_hash) != 0) {
         sb_warn("%s: its probes were baked against another world (%s, not this one's %s): lit by the sky alone",
                 o->pack, baked_hash[0] ? baked_hash : "unrecorded", world->mesh_hash);
         *no_probes = true;

@@ -329,6 +329,10 @@ static void mean_albedo(const struct sb_world *world, float out[3])
         out[i] = area > 0 ? (float)(sum[i] / area) : 0.0f;
 }
 
+/* Floats a probe takes in the probes buffer (probes.glsl): 4 vec4s, then
+ * the bounce's 108 floats (27 vec4s). */
+#define PROBE_FLOATS (16 + SB_BOUNCE_FLOATS)
+
 /*
  * The pack's sky-visibility probes, or none: the grid's probes (explicit
  * ones are for other uses: a runtime interpolates a grid), each as
@@ -347,7 +351,7 @@ static enum sb_result upload_probes(struct sb_renderer *r, const struct sb_pack 
     r->probe_count = use ? (uint32_t)grid : 0;
     size_t count = r->probe_count ? r->probe_count : 1;
     enum sb_result res =
-        upload(r->vk, NULL, sizeof(struct sb_probes_gpu) + count * 4 * 4 * sizeof(float), "probes", &r->probes);
+        upload(r->vk, NULL, sizeof(struct sb_probes_gpu) + count * PROBE_FLOATS * sizeof(float), "probes", &r->probes);
     if (!res)
         res = upload(r->vk, NULL, (SB_PROBE_SH + count * SB_PROBE_SH) * 4 * sizeof(float), "probe light",
                      &r->probe_light);
@@ -375,10 +379,19 @@ static enum sb_result upload_probes(struct sb_renderer *r, const struct sb_pack 
     g->grid[3] = r->probe_count;
     g->origin_m[3] = (float)entries;
     mean_albedo(world, g->bounce_albedo);
+    const struct sb_image *bounce = &pack->images[SB_PRODUCT_SKY_BOUNCE];
+    const struct sb_probe_layout *bounce_layout = &pack->artifacts[SB_PRODUCT_SKY_BOUNCE].probes;
+    bool has_bounce = pack->present[SB_PRODUCT_SKY_BOUNCE] && bounce->width == image->width &&
+                      !memcmp(bounce_layout->grid, layout->grid, sizeof(layout->grid));
+    if (pack->present[SB_PRODUCT_SKY_BOUNCE] && !has_bounce)
+        sb_warn("the pack's sky_bounce has another grid than its sky_visibility: the bounce is modelled");
+    g->spacing_m[3] = has_bounce ? 1.0f : 0.0f;
     float *out = (float *)(g + 1);
     for (uint32_t p = 0; p < r->probe_count; p++) {
         const float *c = &image->data[(size_t)p * SB_SKY_VISIBILITY_CHANNEL_COUNT];
-        float *o = &out[16 * (size_t)p];
+        float *o = &out[PROBE_FLOATS * (size_t)p];
+        if (has_bounce)
+            memcpy(o + 16, &bounce->data[(size_t)p * SB_SKY_BOUNCE_CHANNEL_COUNT], SB_BOUNCE_FLOATS * sizeof(float));
         memcpy(o, c, 3 * sizeof(float)); /* position, after any push out of geometry */
         o[3] = c[6];                     /* valid */
         /* The visibility as projected, the deringing window undone where it
@@ -391,8 +404,8 @@ static enum sb_result upload_probes(struct sb_renderer *r, const struct sb_pack 
         for (int k = 0; k < SB_PROBE_SH; k++)
             o[4 + k] = w[band[k]] > 1e-3 ? (float)(c[11 + k] / w[band[k]]) : c[11 + k];
     }
-    sb_info("probes: %u x %u x %u, %.3g m apart, light the world", layout->grid[0], layout->grid[1], layout->grid[2],
-            (double)layout->spacing_m[0]);
+    sb_info("probes: %u x %u x %u, %.3g m apart, light the world (bounce %s)", layout->grid[0], layout->grid[1],
+            layout->grid[2], (double)layout->spacing_m[0], has_bounce ? "baked" : "modelled");
     return SB_OK;
 }
 

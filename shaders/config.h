@@ -213,7 +213,7 @@ struct sb_frame_gpu {
 struct sb_probes_gpu {
     SB_UVEC4(grid);          /* xyz: probes along each axis; w: grid probes (0: none, the sky-only ambient) */
     SB_VEC4(origin_m);       /* xyz: the first probe (world, m); w: tensor entries */
-    SB_VEC4(spacing_m);      /* xyz: between probes; w: unused */
+    SB_VEC4(spacing_m);      /* xyz: between probes; w: 1 when the pack's sky_bounce is in probe_data */
     SB_VEC4(bounce_albedo);  /* rgb: the world's mean albedo by area (the bounce model); w: unused */
     SB_VEC4(tensor[SB_SH_TENSOR_MAX]); /* x: the integral of Y_i Y_j Y_k; y, z, w: i, j, k */
 };
@@ -300,6 +300,27 @@ struct sb_raycast_push {
 #define SB_PROBE_MAX_RAYS 65536
 #define SB_PROBE_SH 9
 #define SB_VISIBILITY_FLOATS 12 /* sh[9], back-face fraction, hit fraction, mean hit distance (m) */
+
+/* The one-bounce transfer at probes (probe_bounce.comp, baker/sky_bounce.h):
+ * one workgroup a probe; each of ray_count rays (spherical Fibonacci) that
+ * hits a surface casts, from the hit, the directions of a 2 x secondary
+ * spherical Fibonacci set that leave the surface's side toward the probe,
+ * and projects (n.l) V(l) on order-2 SH; the hit's albedo / pi times that,
+ * times the order-1 SH of the ray's direction, 4 pi / ray_count, is summed
+ * into SB_BOUNCE_FLOATS a probe (m < 4, k < 9, rgb). Bindings: the raycast
+ * kernel's nodes and triangles; rays: one vec4 a probe (position m, 1 when
+ * valid); hits: the output; albedo: one vec4 a material. */
+#define SB_BOUNCE_BINDING_ALBEDO 4
+#define SB_BOUNCE_BINDING_COUNT 5
+#define SB_BOUNCE_SH 4 /* order 1 at the probe */
+#define SB_BOUNCE_FLOATS (SB_BOUNCE_SH * SB_PROBE_SH * 3)
+
+struct sb_bounce_push {
+    SB_UINT probe_count;
+    SB_UINT ray_count; /* a multiple of SB_PROBE_THREADS */
+    SB_UINT secondary; /* half the sphere set's size: about this many rays from each hit */
+    float tmin_m;
+};
 
 struct sb_probe_push {
     SB_UINT probe_count;

@@ -4,7 +4,9 @@
  * (docs/probes.md, "Runtime"):
  * - the sky it sees: the SH of the product of its visibility V and the
  *   sky's radiance L, by the triple-product tensor (truncated to order 2);
- * - the bounce: the directions its rays hit (the SH of 1 - V) carry the
+ * - the bounce, baked (sky_bounce): sum_k B[m][k] (L_k + E_sun Y_k(sun))
+ *   in order 1;
+ * - or, without it, modelled: the directions its rays hit (the SH of 1 - V) carry the
  *   radiance of surfaces of the world's mean albedo rho lit as the probe is
  *   on average, E = pi (mean of V L) + E_sun v_sun / 4 (v_sun: V at the sun),
  *   bounced without end: L_b = rho E / (pi (1 - rho f)), f the hit fraction;
@@ -55,10 +57,22 @@ void main()
     float hit = clamp(1.0 - v[0] * Y0, 0.0, 1.0); /* the hit fraction: 1 - V's mean */
     vec3 rho = probes.bounce_albedo.rgb;
     vec3 l_bounce = rho * e_mean / (PI * max(1.0 - rho * hit, vec3(1e-3)));
+    bool baked = probes.spacing_m.w != 0.0;
+    vec3 bounce[SB_BOUNCE_SH];
+    for (int m = 0; m < SB_BOUNCE_SH; m++) {
+        bounce[m] = vec3(0.0);
+        for (int k = 0; k < SB_PROBE_SH && baked; k++) {
+            uint at = 3u * uint(m * SB_PROBE_SH + k);
+            vec3 b;
+            for (int c = 0; c < 3; c++) /* 3 floats of the packed rgb triples */
+                b[c] = probe_data[PROBE_VEC4S * i + PROBE_BOUNCE_VEC4 + (at + uint(c)) / 4u][(at + uint(c)) % 4u];
+            bounce[m] += b * (sky_sh[k].rgb + e_sun * ys[k]);
+        }
+    }
 
     for (int k = 0; k < SB_PROBE_SH; k++) {
         float occluded = (k == 0 ? 1.0 / Y0 : 0.0) - v[k]; /* the SH of 1 - V */
-        vec3 radiance = vl[k] + l_bounce * occluded;
+        vec3 radiance = vl[k] + (baked ? (k < SB_BOUNCE_SH ? bounce[k] : vec3(0.0)) : l_bounce * occluded);
         probe_irradiance[SB_PROBE_SH * i + k] = vec4(fp16_safe(SH_COSINE[SH_BAND[k]] * radiance), 0.0);
     }
 }

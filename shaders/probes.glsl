@@ -11,7 +11,9 @@
 
 layout(std430, set = 0, binding = SB_VIEW_BINDING_PROBES) readonly buffer ProbeBuffer {
     sb_probes_gpu probes;
-    vec4 probe_data[]; /* per probe: (position m, valid), (sh 0-3), (sh 4-7), (sh 8, 0, 0, 0) */
+    /* per probe: (position m, valid), (sh 0-3), (sh 4-7), (sh 8, 0, 0, 0), then the
+     * bounce transfer B[m][k].rgb (sky_bounce's order, 27 vec4s; zeros without) */
+    vec4 probe_data[];
 };
 
 #ifdef PROBE_LIGHT_WRITABLE
@@ -23,7 +25,8 @@ layout(std430, set = 0, binding = SB_VIEW_BINDING_PROBE_LIGHT) readonly buffer P
     vec4 probe_irradiance[];    /* SB_PROBE_SH a probe, rgb: irradiance E(n) = sum_k E_k Y_k(n) */
 };
 
-#define PROBE_VEC4S 4
+#define PROBE_VEC4S 31
+#define PROBE_BOUNCE_VEC4 4
 
 /* The clamped cosine's zonal factors per band (Ramamoorthi and Hanrahan 2001). */
 const float SH_COSINE[3] = float[3](3.141592653589793, 2.0943951023931953, 0.7853981633974483);

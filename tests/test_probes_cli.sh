@@ -37,7 +37,7 @@ check "only what was asked for" test ! -e "$tmp/p/transmittance.exr"
 check "verify" expect_exit 0 "$skybake" verify "$tmp/p"
 check "info lists sky_visibility" expect_exit 0 "$skybake" info "$tmp/p"
 check "info shows the grid" grep -q '"grid":\[6,1,6\]' "$tmp/out"
-check "manifest has format_version 3" grep -Eq '"format_version":[[:space:]]*3,' "$tmp/p/manifest.json"
+check "manifest has format_version 4" grep -Eq '"format_version":[[:space:]]*4,' "$tmp/p/manifest.json"
 check "diff with itself" expect_exit 0 "$skybake" diff "$tmp/p" "$tmp/p"
 hash() { sed -n 's/.*"content_hash":[[:space:]]*"\([0-9a-f]*\)".*/\1/p' "$tmp/p/manifest.json"; }
 first=$(hash)
@@ -52,6 +52,20 @@ check "not reused after a vertex moved" sh -c "! grep -q 'sky_visibility.*reused
 check "other probes" test "$(hash)" != "$first"
 check "forced rebake, same bytes" expect_exit 0 "$skybake" bake "$tmp/s.json" -o "$tmp/q" --force -q
 check "deterministic" cmp -s "$tmp/p/sky_visibility.sbprobes" "$tmp/q/sky_visibility.sbprobes"
+
+# The bounce: a product of its own over the same probes. Asking for it
+# reuses the visibility; its own settings rebake it alone.
+scene '["sky_visibility","sky_bounce"]' '{"preset":"earth"}' ',"bounce_rays":128,"bounce_secondary":16' >"$tmp/b.json"
+check "bake the bounce" expect_exit 0 "$skybake" bake "$tmp/b.json" -o "$tmp/p"
+check "the visibility is reused" grep -q "sky_visibility.*reused" "$tmp/err"
+check "the pack holds the bounce" test -s "$tmp/p/sky_bounce.sbprobes"
+check "info lists sky_bounce" expect_exit 0 "$skybake" info "$tmp/p" --json
+check "108 channels" grep -q '"channels":[[:space:]]*"bounce.0.0.r,.*bounce.3.8.b"' "$tmp/out"
+sed -i 's/"bounce_secondary":16/"bounce_secondary":24/' "$tmp/b.json"
+check "other bounce settings" expect_exit 0 "$skybake" bake "$tmp/b.json" -o "$tmp/p"
+check "rebake the bounce alone" sh -c "grep -q 'sky_visibility.*reused' '$tmp/err' && ! grep -q 'sky_bounce.*reused' '$tmp/err'"
+check "the bounce alone asks for the visibility" sh -c "printf '{\"atmosphere\":{\"preset\":\"earth\"},\"products\":[\"sky_bounce\"],\"world\":{\"file\":\"world.obj\"},\"probes\":{\"spacing_m\":4,\"rays\":64,\"bounce_rays\":64,\"bounce_secondary\":8}}' >'$tmp/bo.json' && '$skybake' bake '$tmp/bo.json' -o '$tmp/bo' -q && test -s '$tmp/bo/sky_visibility.sbprobes'"
+check "the bounce's settings only in scenes that ask for it" sh -c "grep -q bounce_rays '$tmp/bo/manifest.json' && ! grep -q bounce_rays '$tmp/q/manifest.json'"
 
 # The key is the world as read, not the scene's file name: a world reached
 # through a symbolic link rebakes when the file it points to changes.
@@ -76,7 +90,7 @@ check "the old pack is whole" diff -r "$tmp/p" "$tmp/before"
 printf '{"atmosphere":{"preset":"earth"},"products":["sky_visibility"]}' >"$tmp/noworld.json"
 check "sky_visibility without a world is a scene error" expect_exit 2 "$skybake" bake "$tmp/noworld.json" -o "$tmp/n"
 check "it says what is missing" grep -q "needs a \"world\"" "$tmp/err"
-for bad in '"bounds_m":[[0,0,0],[1,1]]' '"bounds_m":[[0,0,0],[1,-1,1]]' '"bounds_m":[[0,0,0],[1,1,2e4]]' \
+for bad in '"bounce_rays":100' '"bounce_secondary":3' '"bounds_m":[[0,0,0],[1,1]]' '"bounds_m":[[0,0,0],[1,-1,1]]' '"bounds_m":[[0,0,0],[1,1,2e4]]' \
     '"spacing_m":-1' '"rays":100' '"rays":1e9' '"inside_fraction":2' '"positions_m":[[1,2]]' '"nope":1' '"spacing_m":0'; do
     printf '{"atmosphere":{"preset":"earth"},"products":["sky_visibility"],"world":{"file":"world.obj"},"probes":{%s}}' "$bad" >"$tmp/bad.json"
     check "probes {$bad} is a scene error" expect_exit 2 "$skybake" bake "$tmp/bad.json" -o "$tmp/n"

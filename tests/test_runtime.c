@@ -396,7 +396,7 @@ static double median_luminance(const float *rgb)
 /* Ambient light alone (the sun 4 degrees below the horizon): the ground
  * under the overhang against open ground 6 m beyond its edge, and the
  * room's inside against open ground; with the probes and without. */
-static void probe_views(struct sb_renderer *r, double out[3])
+static void probe_views(struct sb_renderer *r, double out[4])
 {
     struct sb_view v = base_view();
     v.sun_elevation = -4.0 * DEG;
@@ -406,7 +406,7 @@ static void probe_views(struct sb_renderer *r, double out[3])
     v.pitch = -4.0 * DEG;
     v.fov_y = 75.0 * DEG;
     const double under[3] = {-6.0, 0.0, -12.0}, open[3] = {-17.0, 0.0, -5.0};
-    out[0] = out[1] = out[2] = NAN;
+    out[0] = out[1] = out[2] = out[3] = NAN;
     if (!render(r, &v))
         return;
     float *rgb = frame_rgb(r);
@@ -425,6 +425,12 @@ static void probe_views(struct sb_renderer *r, double out[3])
     check_finite(rgb, "inside the room");
     out[2] = median_luminance(rgb);
     free(rgb);
+    v.sun_elevation = 30.0 * DEG; /* the sun up: walls and roof keep it out, and its bounce */
+    if (!render(r, &v))
+        return;
+    rgb = frame_rgb(r);
+    out[3] = median_luminance(rgb);
+    free(rgb);
 }
 
 static void test_probes(const char *dir)
@@ -440,6 +446,7 @@ static void test_probes(const char *dir)
     sb_atmosphere_preset_earth(&scene->atmosphere);
     scene->wants[SB_PRODUCT_IRRADIANCE_GROUND] = true;
     scene->wants[SB_PRODUCT_SKY_VISIBILITY] = true;
+    scene->wants[SB_PRODUCT_SKY_BOUNCE] = true;
     snprintf(scene->world.file, sizeof(scene->world.file), "%s", world_path);
     scene->has_world = true;
     scene->world.units_m = scene->world.scale = 1.0;
@@ -447,6 +454,8 @@ static void test_probes(const char *dir)
     sb_probe_params_default(&scene->probes);
     scene->probes.spacing_m = 1.0;
     scene->probes.rays = 1024;
+    scene->probes.bounce_rays = 128;
+    scene->probes.bounce_secondary = 32;
     scene->probes.has_bounds = true;
     const double bounds[2][3] = {{-18, 0.5, -18}, {12, 4.5, -4}};
     memcpy(scene->probes.bounds_m, bounds, sizeof(bounds));
@@ -462,7 +471,7 @@ static void test_probes(const char *dir)
     free(scene);
     if (!ok)
         return;
-    double lit[3], sky[3];
+    double lit[4], sky[4];
     for (int pass = 0; pass < 2; pass++) {
         struct sb_renderer *r = NULL;
         struct sb_renderer_params rp = {.width = W, .height = H, .shadow_size = 512, .no_probes = pass == 1};
@@ -475,15 +484,18 @@ static void test_probes(const char *dir)
      * sky, cosine weighted: F = (4 / pi) s atan(s), s = A / sqrt(1 + A^2),
      * A = 4 / 1.8: 0.14 of a uniform sky. L2 smooths the square's edge,
      * trilinear interpolation reads probes 0.5 m up and toward the edge, and
-     * the bounce adds: twice that is the bound. Open ground sees nearly all
+     * the bounce off the slab's underside adds: twice that is the bound. Open ground sees nearly all
      * the sky: the probes' L2 irradiance matches the sky-alone model's
      * within the L2 error (~10%, docs/probes.md). */
     double A = 4.0 / 1.8, sA = A / sqrt(1 + A * A), view = 1.0 - 4.0 / M_PI * sA * atan(sA);
     double overhang = lit[0] / lit[1], overhang_sky = sky[0] / sky[1];
     double room = lit[2] / lit[1], room_sky = sky[2] / sky[1];
-    printf("probes, ambient only: under the overhang %.3f of open ground (sky alone %.3f; uniform sky's view factor "
-           "%.3f); inside the closed room %.4f (sky alone %.3f); open ground %.3f of its sky-alone light\n",
-           overhang, overhang_sky, view, room, room_sky, lit[1] / sky[1]);
+    printf("probes (bounce baked), ambient only: under the overhang %.3f of open ground (sky alone %.3f; uniform "
+           "sky's view factor %.3f); inside the closed room %.4f (sky alone %.3f); open ground %.3f of its sky-alone "
+           "light; the room with the sun 30 degrees up %.2e of its sky-alone light (the air's in-scattering)\n",
+           overhang, overhang_sky, view, room, room_sky, lit[1] / sky[1], lit[3] / sky[3]);
+    CHECK(lit[3] < 0.01 * sky[3], "with the sun up the closed room stays near black: %.4f of its sky-alone light",
+          lit[3] / sky[3]);
     CHECK(overhang < 2.0 * view,
           "under the overhang: %.3f of open ground with the probes; at most twice the view "
           "factor (%.3f) expected",

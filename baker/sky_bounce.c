@@ -1,0 +1,77 @@
+#include "sky_bounce.h"
+
+#include <string.h>
+
+#include "log.h"
+#include "probe_bounce.spv.h"
+
+enum sb_result sb_sky_bounce_bake(struct sb_raycaster *rc, const struct sb_mesh *mesh, const float *positions,
+                                  const float *valid, uint32_t probe_count, const struct sb_sky_bounce_params *params,
+                                  float *out, double *gpu_ms)
+{
+    static const struct sb_sky_bounce_params defaults = {0};
+    params = params ? params : &defaults;
+    struct sb_bounce_push pc = {
+        .probe_count = probe_count,
+        .ray_count = params->ray_count ? params->ray_count : 256,
+        .secondary = params->secondary ? params->secondary : 64,
+        .tmin_m = params->tmin_m > 0 ? params->tmin_m : 1e-4f,
+    };
+    if (gpu_ms)
+        *gpu_ms = 0;
+    if (pc.ray_count % SB_PROBE_THREADS || pc.ray_count > SB_PROBE_MAX_RAYS || pc.secondary > SB_PROBE_MAX_RAYS / 2 ||
+        !probe_count || !mesh->material_count) {
+        sb_error("sky bounce: %u rays and %u from each hit for %u probes (rays: a multiple of %u up to %u)",
+                 pc.ray_count, pc.secondary, probe_count, SB_PROBE_THREADS, SB_PROBE_MAX_RAYS);
+        return SB_ERR_OUT_OF_RANGE;
+    }
+    struct sb_vk *vk = rc->vk;
+    struct sb_buffer probes = {0}, results = {0}, albedo = {0};
+    struct sb_pipeline pipeline = {0};
+    const struct sb_pipeline_params pp = {
+        .spirv = sb_spv_probe_bounce,
+        .spirv_size = sizeof(sb_spv_probe_bounce),
+        .binding_count = SB_BOUNCE_BINDING_COUNT,
+        .push_size = sizeof(pc),
+        .name = "sky bounce",
+    };
+    enum sb_result res;
+    if ((res = sb_buffer_create(vk, (VkDeviceSize)probe_count * 4 * sizeof(float), "probes", &probes)) ||
+        (res = sb_buffer_create(vk, (VkDeviceSize)probe_count * SB_BOUNCE_FLOATS * sizeof(float), "bounce results",
+                                &results)) ||
+        (res = sb_buffer_create(vk, (VkDeviceSize)mesh->material_count * 4 * sizeof(float), "albedo", &albedo)) ||
+        (res = sb_pipeline_create(vk, &pp, &pipeline)))
+        goto done;
+    float *p = probes.mapped, *a = albedo.mapped;
+    for (uint32_t i = 0; i < probe_count; i++) {
+        memcpy(&p[4 * (size_t)i], &positions[3 * (size_t)i], 3 * sizeof(float));
+        p[4 * (size_t)i + 3] = valid ? valid[i] : 1.0f;
+    }
+    for (uint32_t m = 0; m < mesh->material_count; m++) {
+        memcpy(&a[4 * (size_t)m], mesh->material_list[m].albedo, 3 * sizeof(float));
+        a[4 * (size_t)m + 3] = 0;
+    }
+    const struct sb_buffer *bindings[SB_BOUNCE_BINDING_COUNT] = {
+        [SB_RAYCAST_BINDING_NODES] = &rc->nodes, [SB_RAYCAST_BINDING_TRIANGLES] = &rc->triangles,
+        [SB_RAYCAST_BINDING_RAYS] = &probes,     [SB_RAYCAST_BINDING_HITS] = &results,
+        [SB_BOUNCE_BINDING_ALBEDO] = &albedo,
+    };
+    sb_pipeline_bind(vk, &pipeline, bindings);
+    /* workgroups in rows of at most 65535 */
+    uint32_t gx = probe_count < 65535 ? probe_count : 65535, gy = (probe_count + gx - 1) / gx;
+    double ms;
+    if ((res = sb_dispatch(vk, &pipeline, &pc, gx, gy, 1, gpu_ms ? gpu_ms : &ms)))
+        goto done;
+    res = sb_buffer_read(vk, &results, out);
+done:
+    sb_pipeline_destroy(vk, &pipeline);
+    sb_buffer_destroy(vk, &results);
+    sb_buffer_destroy(vk, &probes);
+    sb_buffer_destroy(vk, &albedo);
+    return res;
+}
+
+void sb_sky_bounce_code_hash(char out[33])
+{
+    sb_hash_bytes(sb_spv_probe_bounce, sizeof(sb_spv_probe_bounce), out);
+}

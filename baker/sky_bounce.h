@@ -1,0 +1,40 @@
+/*
+ * The one-bounce transfer at probes (issue 17's bounce term; docs/probes.md,
+ * "Bounce"): for each probe, B[m][k] per colour, m < 4 the order-1 SH of
+ * the direction w at the probe and k < 9 the order-2 SH of the light
+ * reaching the surface its ray along w hits. A runtime relights it for any
+ * sky L (SH) and sun (direction s, irradiance E): the radiance bounced
+ * toward the probe is, in the order-1 SH of w,
+ *   b_m = sum_k B[m][k] (L_k + E Y_k(s)).
+ * Lambertian surfaces, one bounce; the surfaces' own sky visibility is
+ * cast from each hit. Deterministic: fixed ray sets, a fixed sum order.
+ */
+#ifndef SB_BAKER_SKY_BOUNCE_H
+#define SB_BAKER_SKY_BOUNCE_H
+
+#include <stdint.h>
+
+#include "mesh.h"
+#include "raycast.h"
+
+struct sb_sky_bounce_params {
+    uint32_t ray_count; /* rays a probe, a multiple of SB_PROBE_THREADS [256] */
+    uint32_t secondary; /* about this many rays from each hit (a 2x spherical set, half cast) [64] */
+    float tmin_m;       /* rays start this far from the probe [1e-4] */
+};
+
+/*
+ * Bake probe_count probes at positions (xyz in m each; valid[i] 0 gives the
+ * probe zeros) against the raycaster's BVH, whose triangles' materials index
+ * mesh's material list (their albedos), into out[SB_BOUNCE_FLOATS *
+ * probe_count] (config.h: m, then k, then rgb). *gpu_ms (may be NULL) gets
+ * the GPU time.
+ */
+enum sb_result sb_sky_bounce_bake(struct sb_raycaster *raycaster, const struct sb_mesh *mesh, const float *positions,
+                                  const float *valid, uint32_t probe_count, const struct sb_sky_bounce_params *params,
+                                  float *out, double *gpu_ms);
+
+/* XXH3-128 of the kernel's SPIR-V, for bake keys. */
+void sb_sky_bounce_code_hash(char out[33]);
+
+#endif

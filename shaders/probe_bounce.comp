@@ -1,0 +1,93 @@
+#version 450
+// The one-bounce transfer at probes (config.h, sb_bounce_push): for each
+// of a probe's rays that hits a surface (albedo rho, normal n turned toward
+// the probe), the order-2 SH g_k of (n.l) V(l) over the directions l that
+// leave the surface (V: 1 where a ray from the hit escapes the geometry),
+// by a spherical Fibonacci set of 2 x secondary directions of which the
+// surface's side is cast; summed as B[m][k] += 4 pi / n Y_m(w) rho / pi g_k
+// over the probe's rays w. A runtime relights it for any environment L and
+// sun: the radiance bounced toward the probe from w is sum_k B[m][k] L_k
+// (and E_sun sum_k B[m][k] Y_k(sun)) in the order-1 SH of w. One workgroup
+// a probe; partial sums added in a fixed tree order.
+#extension GL_GOOGLE_include_directive : require
+#include "config.h"
+
+layout(local_size_x = SB_PROBE_THREADS) in;
+layout(std430, binding = SB_RAYCAST_BINDING_NODES) readonly buffer Nodes { vec4 bvh_nodes[]; };
+layout(std430, binding = SB_RAYCAST_BINDING_TRIANGLES) readonly buffer Triangles { vec4 bvh_triangles[]; };
+layout(std430, binding = SB_RAYCAST_BINDING_RAYS) readonly buffer Probes { vec4 probes[]; };
+layout(std430, binding = SB_RAYCAST_BINDING_HITS) writeonly buffer Out { float results[]; };
+layout(std430, binding = SB_BOUNCE_BINDING_ALBEDO) readonly buffer Albedo { vec4 albedo[]; };
+layout(push_constant) uniform Push { sb_bounce_push pc; };
+
+#include "bvh.glsl"
+#include "sh.glsl"
+
+shared float partial[SB_PROBE_SH * 3][SB_PROBE_THREADS];
+
+void main()
+{
+    uint probe = gl_WorkGroupID.x + gl_WorkGroupID.y * gl_NumWorkGroups.x;
+    uint lane = gl_LocalInvocationID.x;
+    if (probe >= pc.probe_count)
+        return; // whole workgroups only: no barrier is skipped by part of one
+    vec3 origin = probes[probe].xyz;
+    bool valid = probes[probe].w != 0.0;
+    vec3 acc[SB_BOUNCE_SH][SB_PROBE_SH];
+    for (int m = 0; m < SB_BOUNCE_SH; m++)
+        for (int k = 0; k < SB_PROBE_SH; k++)
+            acc[m][k] = vec3(0.0);
+    uint sphere = 2u * pc.secondary;
+    for (uint r = lane; r < pc.ray_count && valid; r += SB_PROBE_THREADS) {
+        vec3 w = probe_direction(r, pc.ray_count);
+        BvhHit hit = bvh_trace(origin, w, pc.tmin_m, 1e30, false);
+        if (hit.triangle == SB_BVH_MISS)
+            continue;
+        vec4 e1 = bvh_triangles[3 * hit.slot + 1], e2 = bvh_triangles[3 * hit.slot + 2];
+        vec3 n = normalize(cross(e1.xyz, e2.xyz));
+        if (dot(n, w) > 0.0)
+            n = -n; // the side the probe sees
+        vec3 rho = albedo[floatBitsToUint(e1.w)].rgb;
+        vec3 x = origin + w * hit.t;
+        float eps = 1e-4 + 2e-6 * max(abs(x.x), max(abs(x.y), abs(x.z)));
+        vec3 from = x + n * eps;
+        float g[SB_PROBE_SH];
+        for (int k = 0; k < SB_PROBE_SH; k++)
+            g[k] = 0.0;
+        for (uint i = 0u; i < sphere; i++) {
+            vec3 l = probe_direction(i, sphere);
+            float c = dot(n, l);
+            if (c <= 0.0)
+                continue;
+            if (bvh_trace(from, l, eps, 1e30, true).triangle != SB_BVH_MISS)
+                continue;
+            float y[SB_PROBE_SH];
+            sh9_basis(l, y);
+            for (int k = 0; k < SB_PROBE_SH; k++)
+                g[k] += c * y[k];
+        }
+        float ym[SB_PROBE_SH];
+        sh9_basis(w, ym);
+        vec3 weight = rho * (4.0 / float(sphere)); // (rho / pi) (4 pi / 2s): g's quadrature weight and rho / pi
+        for (int m = 0; m < SB_BOUNCE_SH; m++)
+            for (int k = 0; k < SB_PROBE_SH; k++)
+                acc[m][k] += (ym[m] * g[k]) * weight;
+    }
+    float scale = 12.566370614359172 / float(pc.ray_count);
+    for (int m = 0; m < SB_BOUNCE_SH; m++) {
+        for (int k = 0; k < SB_PROBE_SH; k++)
+            for (int c = 0; c < 3; c++)
+                partial[3 * k + c][lane] = acc[m][k][c];
+        barrier();
+        for (uint stride = SB_PROBE_THREADS / 2; stride > 0; stride /= 2) {
+            if (lane < stride)
+                for (int j = 0; j < SB_PROBE_SH * 3; j++)
+                    partial[j][lane] += partial[j][lane + stride];
+            barrier();
+        }
+        if (lane == 0)
+            for (int j = 0; j < SB_PROBE_SH * 3; j++)
+                results[probe * SB_BOUNCE_FLOATS + m * SB_PROBE_SH * 3 + j] = partial[j][0] * scale;
+        barrier();
+    }
+}
