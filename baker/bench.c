@@ -403,6 +403,9 @@ static cJSON *report_json(const struct sb_bench_report *report, const struct sb_
         cJSON_AddNumberToObject(o, "embree_threads", r->embree_threads);
         cJSON_AddNumberToObject(o, "embree_rays_per_s", r->embree_rays_per_s);
         cJSON_AddNumberToObject(o, "hits_differ", (double)r->hits_differ);
+        cJSON_AddNumberToObject(o, "bounce_rays", r->bounce_rays);
+        cJSON_AddNumberToObject(o, "bounce_secondary", r->bounce_secondary);
+        cJSON_AddNumberToObject(o, "bounce_gpu_ms", r->bounce_ms);
         cJSON_AddItemToArray(arr, o);
     }
     if (report->cloud_row_count) {

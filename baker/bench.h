@@ -66,6 +66,8 @@ struct sb_bench_probe_row {
     double embree_s, embree_rays_per_s;
     int embree_threads;
     uint64_t rays, hits_differ; /* rays whose hit or miss differ, summed over probes */
+    uint32_t bounce_rays, bounce_secondary;
+    double bounce_ms; /* sky_bounce at the same probes, the defaults (median of the repeats) */
 };
 
 struct sb_bench_params {

@@ -19,6 +19,7 @@
 #include "mesh.h"
 #include "raycast.h"
 #include "sh.h"
+#include "sky_bounce.h"
 #include "sky_visibility.h"
 
 #define BENCH_IFC_HOUSE "/usr/share/assimp/models/IFC/AC14-FZK-Haus.ifc"
@@ -51,6 +52,18 @@ static enum sb_result terrain(uint32_t n, struct sb_mesh *mesh)
                 res = sb_mesh_add_triangle(mesh, p[1], p[2], p[3], material, "terrain");
         }
     return res;
+}
+
+/* The median of n values (sorted in place: a handful). */
+static double median_of(double *v, int n)
+{
+    for (int a = 1; a < n; a++)
+        for (int b = a; b > 0 && v[b] < v[b - 1]; b--) {
+            double t = v[b];
+            v[b] = v[b - 1];
+            v[b - 1] = t;
+        }
+    return v[n / 2];
 }
 
 static enum sb_result bench_one(struct sb_vk *vk, const char *name, struct sb_mesh *mesh, uint32_t rays_per_probe,
@@ -87,27 +100,36 @@ static enum sb_result bench_one(struct sb_vk *vk, const char *name, struct sb_me
             positions[3 * (size_t)i + k] = lo[k] + (hi[k] - lo[k]) * (c[k] + 0.5f) / side;
     }
     struct sb_sky_visibility_params params = {.ray_count = rays_per_probe};
-    double *times = calloc((size_t)repeat, sizeof(double));
-    if (!times) {
+    struct sb_sky_bounce_params bounce = {.ray_count = rays_per_probe >= 512 ? rays_per_probe / 8 : 64,
+                                          .secondary = rays_per_probe >= 256 ? rays_per_probe / 32 : 8};
+    double *times = calloc((size_t)repeat, sizeof(double)), *bounce_times = calloc((size_t)repeat, sizeof(double));
+    float *bounced = malloc((size_t)count * SB_BOUNCE_FLOATS * sizeof(float));
+    if (!times || !bounce_times || !bounced) {
+        free(times);
+        free(bounce_times);
+        free(bounced);
         res = SB_ERR_NOMEM;
         goto done;
     }
     for (int k = repeat >= 3 ? -1 : 0; k < repeat && !res; k++) {
-        double ms;
+        double ms, bms = 0;
         res = sb_sky_visibility_bake(rc, positions, count, &params, out, &ms);
-        if (k >= 0)
+        if (!res)
+            res = sb_sky_bounce_bake(rc, mesh, positions, NULL, count, &bounce, bounced, &bms);
+        if (k >= 0) {
             times[k] = ms;
+            bounce_times[k] = bms;
+        }
     }
     if (!res) {
-        for (int a = 1; a < repeat; a++) /* insertion sort: a handful of values */
-            for (int b = a; b > 0 && times[b] < times[b - 1]; b--) {
-                double t = times[b];
-                times[b] = times[b - 1];
-                times[b - 1] = t;
-            }
-        row->gpu_ms = times[repeat / 2];
+        row->gpu_ms = median_of(times, repeat);
+        row->bounce_ms = median_of(bounce_times, repeat);
+        row->bounce_rays = bounce.ray_count;
+        row->bounce_secondary = bounce.secondary;
     }
     free(times);
+    free(bounce_times);
+    free(bounced);
     if (res)
         goto done;
     row->rays = (uint64_t)count * rays_per_probe;
@@ -185,14 +207,16 @@ void sb_bench_probes_print(const struct sb_bench_report *report)
 {
     if (!report->probe_row_count)
         return;
-    printf("\nsky visibility (4096 probes; Embree casts the same rays on every core of this machine)\n");
-    printf("%-12s %10s %7s %6s %9s %11s %12s %11s %12s %9s\n", "scene", "triangles", "probes", "rays", "bvh ms",
-           "gpu ms", "gpu Mrays/s", "embree s", "embree Mr/s", "differ");
+    printf("\nsky visibility (4096 probes; Embree casts the same rays on every core of this machine) and sky bounce "
+           "(the same probes, %u x %u rays)\n",
+           report->probe_rows[0].bounce_rays, report->probe_rows[0].bounce_secondary);
+    printf("%-12s %10s %7s %6s %9s %11s %12s %11s %12s %9s %11s\n", "scene", "triangles", "probes", "rays", "bvh ms",
+           "gpu ms", "gpu Mrays/s", "embree s", "embree Mr/s", "differ", "bounce ms");
     for (int i = 0; i < report->probe_row_count; i++) {
         const struct sb_bench_probe_row *r = &report->probe_rows[i];
-        printf("%-12s %10u %7u %6u %9.1f %11.3f %12.3f %11.3f %12.3f %9llu\n", r->scene, r->triangles, r->probes,
+        printf("%-12s %10u %7u %6u %9.1f %11.3f %12.3f %11.3f %12.3f %9llu %11.3f\n", r->scene, r->triangles, r->probes,
                r->rays_per_probe, r->bvh_ms, r->gpu_ms, r->gpu_rays_per_s * 1e-6, r->embree_s,
-               r->embree_rays_per_s * 1e-6, (unsigned long long)r->hits_differ);
+               r->embree_rays_per_s * 1e-6, (unsigned long long)r->hits_differ, r->bounce_ms);
     }
 }
 
@@ -206,12 +230,13 @@ enum sb_result sb_bench_probes_csv(const struct sb_bench_report *report, const c
         return SB_ERR_IO;
     }
     fprintf(f, "scene,triangles,probes,rays_per_probe,bvh_ms,gpu_ms,gpu_rays_per_s,embree_s,embree_threads,"
-               "embree_rays_per_s,hits_differ\n");
+               "embree_rays_per_s,hits_differ,bounce_rays,bounce_secondary,bounce_gpu_ms\n");
     for (int i = 0; i < report->probe_row_count; i++) {
         const struct sb_bench_probe_row *r = &report->probe_rows[i];
-        fprintf(f, "%s,%u,%u,%u,%.6g,%.6g,%.6g,%.6g,%d,%.6g,%llu\n", r->scene, r->triangles, r->probes,
+        fprintf(f, "%s,%u,%u,%u,%.6g,%.6g,%.6g,%.6g,%d,%.6g,%llu,%u,%u,%.6g\n", r->scene, r->triangles, r->probes,
                 r->rays_per_probe, r->bvh_ms, r->gpu_ms, r->gpu_rays_per_s, r->embree_s, r->embree_threads,
-                r->embree_rays_per_s, (unsigned long long)r->hits_differ);
+                r->embree_rays_per_s, (unsigned long long)r->hits_differ, r->bounce_rays, r->bounce_secondary,
+                r->bounce_ms);
     }
     return fclose(f) == 0 ? SB_OK : SB_ERR_IO;
 }

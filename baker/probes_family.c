@@ -19,6 +19,7 @@
 #include "family.h"
 #include "log.h"
 #include "mesh.h"
+#include "parallel.h"
 #include "raycast.h"
 #include "sh.h"
 #include "sky_bounce.h"
@@ -239,6 +240,22 @@ done:
     return res;
 }
 
+/* Deringing, a probe at a time on every core (each probe's own: the same
+ * result whatever the thread count). */
+struct dering_job {
+    const float *results;
+    double *window, *before;
+    double (*sh)[SB_PROBE_SH];
+};
+
+static void dering_one(void *user, int i)
+{
+    struct dering_job *job = user;
+    for (int k = 0; k < SB_PROBE_SH; k++)
+        job->sh[i][k] = job->results[(size_t)i * SB_VISIBILITY_FLOATS + k];
+    job->window[i] = sb_sh9_dering(job->sh[i], &job->before[i]);
+}
+
 static enum sb_result bake_visibility(struct probes_state *st, const struct sb_scene *scene, struct sb_image *image,
                                       struct sb_artifact *a)
 {
@@ -272,15 +289,24 @@ static enum sb_result bake_visibility(struct probes_state *st, const struct sb_s
     if ((res = sb_image_init(image, count, 1, SB_SKY_VISIBILITY_CHANNEL_COUNT)))
         goto done;
     sb_image_set_channel_names(image, SB_SKY_VISIBILITY_CHANNELS);
+    struct dering_job job = {.results = results,
+                             .window = malloc(count * sizeof(double)),
+                             .before = malloc(count * sizeof(double)),
+                             .sh = malloc(count * sizeof(double[SB_PROBE_SH]))};
+    if (!job.window || !job.before || !job.sh) {
+        free(job.window);
+        free(job.before);
+        free(job.sh);
+        res = SB_ERR_NOMEM;
+        goto done;
+    }
+    sb_parallel_for((int)count, dering_one, &job);
     for (uint32_t i = 0; i < count; i++) {
         float *o = &image->data[(size_t)i * SB_SKY_VISIBILITY_CHANNEL_COUNT];
         const float *r = &results[(size_t)i * SB_VISIBILITY_FLOATS];
-        double c[SB_PROBE_SH], before;
-        for (int k = 0; k < SB_PROBE_SH; k++)
-            c[k] = r[k];
-        double window = sb_sh9_dering(c, &before);
+        const double *c = job.sh[i], window = job.window[i];
         deringed += window > 0;
-        lowest = fmin(lowest, before);
+        lowest = fmin(lowest, job.before[i]);
         for (int k = 0; k < 3; k++) {
             o[k] = positions[3 * (size_t)i + k];
             o[3 + k] = offsets[3 * (size_t)i + k];
@@ -293,6 +319,9 @@ static enum sb_result bake_visibility(struct probes_state *st, const struct sb_s
         for (int k = 0; k < SB_PROBE_SH; k++)
             o[11 + k] = (float)c[k];
     }
+    free(job.window);
+    free(job.before);
+    free(job.sh);
     a->gpu_ms = gpu_ms;
     snprintf(a->settings_json, sizeof(a->settings_json),
              "{\"rays\":%u,\"grid\":[%u,%u,%u],\"spacing_m\":%.9g,\"explicit\":%u,\"triangles\":%u,"

@@ -89,3 +89,29 @@ enum sb_result sb_raycaster_cast(struct sb_raycaster *rc, const float *rays, uin
     }
     return sb_buffer_read(rc->vk, &rc->hits, hits);
 }
+
+enum sb_result sb_probe_kernel_run(struct sb_vk *vk, struct sb_pipeline *pipeline, const void *push,
+                                   uint32_t probe_count, struct sb_buffer *results, void *out, double *gpu_ms)
+{
+    uint32_t gx = probe_count < 65535 ? probe_count : 65535, gy = (probe_count + gx - 1) / gx;
+    double ms;
+    enum sb_result res = sb_dispatch(vk, pipeline, push, gx, gy, 1, gpu_ms ? gpu_ms : &ms);
+    return res ? res : sb_buffer_read(vk, results, out);
+}
+
+enum sb_result sb_probe_buffers_create(struct sb_vk *vk, const float *positions, const float *valid,
+                                       uint32_t probe_count, uint32_t floats, struct sb_buffer *probes,
+                                       struct sb_buffer *results)
+{
+    enum sb_result res = sb_buffer_create(vk, (VkDeviceSize)probe_count * 4 * sizeof(float), "probes", probes);
+    if (!res)
+        res = sb_buffer_create(vk, (VkDeviceSize)probe_count * floats * sizeof(float), "probe results", results);
+    if (res)
+        return res;
+    float *p = probes->mapped;
+    for (uint32_t i = 0; i < probe_count; i++) {
+        memcpy(&p[4 * (size_t)i], &positions[3 * (size_t)i], 3 * sizeof(float));
+        p[4 * (size_t)i + 3] = valid ? valid[i] : 1.0f;
+    }
+    return SB_OK;
+}

@@ -37,4 +37,16 @@ void sb_raycaster_destroy(struct sb_raycaster **raycaster);
 enum sb_result sb_raycaster_cast(struct sb_raycaster *raycaster, const float *rays, uint32_t count, bool any,
                                  float *hits, double *gpu_ms);
 
+/* A probe kernel's buffers: probes, one vec4 a probe (its position, then
+ * valid[i], or 1 when valid is NULL), and results, `floats` a probe. */
+enum sb_result sb_probe_buffers_create(struct sb_vk *vk, const float *positions, const float *valid,
+                                       uint32_t probe_count, uint32_t floats, struct sb_buffer *probes,
+                                       struct sb_buffer *results);
+
+/* Run a probe kernel (bound, its push constants `push`): one workgroup a
+ * probe, in rows of at most 65535; then read `results` into out. *gpu_ms
+ * (may be NULL) gets the GPU time. */
+enum sb_result sb_probe_kernel_run(struct sb_vk *vk, struct sb_pipeline *pipeline, const void *push,
+                                   uint32_t probe_count, struct sb_buffer *results, void *out, double *gpu_ms);
+
 #endif

@@ -36,17 +36,11 @@ enum sb_result sb_sky_bounce_bake(struct sb_raycaster *rc, const struct sb_mesh 
         .name = "sky bounce",
     };
     enum sb_result res;
-    if ((res = sb_buffer_create(vk, (VkDeviceSize)probe_count * 4 * sizeof(float), "probes", &probes)) ||
-        (res = sb_buffer_create(vk, (VkDeviceSize)probe_count * SB_BOUNCE_FLOATS * sizeof(float), "bounce results",
-                                &results)) ||
+    if ((res = sb_probe_buffers_create(vk, positions, valid, probe_count, SB_BOUNCE_FLOATS, &probes, &results)) ||
         (res = sb_buffer_create(vk, (VkDeviceSize)mesh->material_count * 4 * sizeof(float), "albedo", &albedo)) ||
         (res = sb_pipeline_create(vk, &pp, &pipeline)))
         goto done;
-    float *p = probes.mapped, *a = albedo.mapped;
-    for (uint32_t i = 0; i < probe_count; i++) {
-        memcpy(&p[4 * (size_t)i], &positions[3 * (size_t)i], 3 * sizeof(float));
-        p[4 * (size_t)i + 3] = valid ? valid[i] : 1.0f;
-    }
+    float *a = albedo.mapped;
     for (uint32_t m = 0; m < mesh->material_count; m++) {
         memcpy(&a[4 * (size_t)m], mesh->material_list[m].albedo, 3 * sizeof(float));
         a[4 * (size_t)m + 3] = 0;
@@ -57,12 +51,7 @@ enum sb_result sb_sky_bounce_bake(struct sb_raycaster *rc, const struct sb_mesh 
         [SB_BOUNCE_BINDING_ALBEDO] = &albedo,
     };
     sb_pipeline_bind(vk, &pipeline, bindings);
-    /* workgroups in rows of at most 65535 */
-    uint32_t gx = probe_count < 65535 ? probe_count : 65535, gy = (probe_count + gx - 1) / gx;
-    double ms;
-    if ((res = sb_dispatch(vk, &pipeline, &pc, gx, gy, 1, gpu_ms ? gpu_ms : &ms)))
-        goto done;
-    res = sb_buffer_read(vk, &results, out);
+    res = sb_probe_kernel_run(vk, &pipeline, &pc, probe_count, &results, out, gpu_ms);
 done:
     sb_pipeline_destroy(vk, &pipeline);
     sb_buffer_destroy(vk, &results);

@@ -84,18 +84,11 @@ enum sb_result sb_sky_visibility_bake(struct sb_raycaster *rc, const float *posi
         .name = "sky visibility",
     };
     enum sb_result res;
-    if ((res = sb_buffer_create(vk, (VkDeviceSize)probe_count * 4 * sizeof(float), "probes", &probes)) ||
-        (res = sb_buffer_create(vk, (VkDeviceSize)probe_count * SB_VISIBILITY_FLOATS * sizeof(float), "probe results",
-                                &results)) ||
+    if ((res = sb_probe_buffers_create(vk, positions, NULL, probe_count, SB_VISIBILITY_FLOATS, &probes, &results)) ||
         (res = sb_buffer_create(vk, (VkDeviceSize)pc.ray_count * sizeof(uint32_t), "probe ray order", &order)) ||
         (res = sb_pipeline_create(vk, &pp, &pipeline)))
         goto done;
     sb_probe_ray_order(pc.ray_count, order.mapped);
-    float *p = probes.mapped;
-    for (uint32_t i = 0; i < probe_count; i++) {
-        memcpy(&p[4 * (size_t)i], &positions[3 * (size_t)i], 3 * sizeof(float));
-        p[4 * (size_t)i + 3] = 0;
-    }
     const struct sb_buffer *bindings[SB_PROBE_BINDING_COUNT] = {
         [SB_PROBE_BINDING_ORDER] = &order,
         [SB_RAYCAST_BINDING_NODES] = &rc->nodes,
@@ -104,12 +97,7 @@ enum sb_result sb_sky_visibility_bake(struct sb_raycaster *rc, const float *posi
         [SB_RAYCAST_BINDING_HITS] = &results,
     };
     sb_pipeline_bind(vk, &pipeline, bindings);
-    /* workgroups in rows of at most 65535 */
-    uint32_t gx = probe_count < 65535 ? probe_count : 65535, gy = (probe_count + gx - 1) / gx;
-    double ms;
-    if ((res = sb_dispatch(vk, &pipeline, &pc, gx, gy, 1, gpu_ms ? gpu_ms : &ms)))
-        goto done;
-    res = sb_buffer_read(vk, &results, out);
+    res = sb_probe_kernel_run(vk, &pipeline, &pc, probe_count, &results, out, gpu_ms);
 done:
     sb_pipeline_destroy(vk, &pipeline);
     sb_buffer_destroy(vk, &results);

@@ -10,7 +10,9 @@ struct BvhHit {
     float t;
     uint triangle; // SB_BVH_MISS when none; | SB_BVH_BACK_FACE on a back face
     vec2 uv;
-    uint slot; // the triangle's place in bvh_triangles[]
+#ifdef BVH_HIT_SLOT
+    uint slot; // the triangle's place in bvh_triangles[] (kernels that define BVH_HIT_SLOT)
+#endif
 };
 
 bool bvh_hit_box(uint node, vec3 o, vec3 inv_d, float tmin, float tmax, out float t_enter)
@@ -45,7 +47,9 @@ bool bvh_hit_triangle(uint i, vec3 o, vec3 d, float tmin, float tmax, inout BvhH
         return false;
     hit.t = t;
     hit.uv = vec2(u, v);
+#ifdef BVH_HIT_SLOT
     hit.slot = i;
+#endif
     hit.triangle = floatBitsToUint(v0.w) | (det < 0.0 ? SB_BVH_BACK_FACE : 0u);
     return true;
 }
@@ -57,7 +61,9 @@ BvhHit bvh_trace(vec3 o, vec3 d, float tmin, float tmax, bool any_hit)
     hit.t = tmax;
     hit.triangle = SB_BVH_MISS;
     hit.uv = vec2(0.0);
+#ifdef BVH_HIT_SLOT
     hit.slot = 0u;
+#endif
     // a zero component: a huge but finite slope keeps the slabs NaN-free
     vec3 tiny = vec3(lessThan(d, vec3(0.0))) * -2e-30 + 1e-30;
     vec3 inv_d = 1.0 / mix(d, tiny, lessThanEqual(abs(d), vec3(1e-30)));

@@ -20,6 +20,7 @@ layout(std430, binding = SB_RAYCAST_BINDING_HITS) writeonly buffer Out { float r
 layout(std430, binding = SB_BOUNCE_BINDING_ALBEDO) readonly buffer Albedo { vec4 albedo[]; };
 layout(push_constant) uniform Push { sb_bounce_push pc; };
 
+#define BVH_HIT_SLOT
 #include "bvh.glsl"
 #include "sh.glsl"
 

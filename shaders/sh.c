@@ -1,6 +1,7 @@
 #include "sh.h"
 
 #include <math.h>
+#include <pthread.h>
 #include <string.h>
 
 void sb_sh9_basis(const double d[3], double y[SB_PROBE_SH])
@@ -93,17 +94,31 @@ void sb_sh9_from_zonal(const double z[3], const double axis[3], double c[SB_PROB
         c[k] = sqrt(4.0 * M_PI / (2 * band[k] + 1)) * z[band[k]] * y[k];
 }
 
+/* The test directions and their basis, made once (deringing evaluates
+ * them some twenty times a probe). */
+static double test_direction[SB_SH_TEST_DIRECTIONS][3], test_basis[SB_SH_TEST_DIRECTIONS][SB_PROBE_SH];
+static pthread_once_t test_once = PTHREAD_ONCE_INIT;
+
+static void make_test_directions(void)
+{
+    for (uint32_t i = 0; i < SB_SH_TEST_DIRECTIONS; i++) {
+        sb_probe_direction(i, SB_SH_TEST_DIRECTIONS, test_direction[i]);
+        sb_sh9_basis(test_direction[i], test_basis[i]);
+    }
+}
+
 double sb_sh9_min(const double c[SB_PROBE_SH], double where[3])
 {
+    pthread_once(&test_once, make_test_directions);
     double lowest = INFINITY;
     for (uint32_t i = 0; i < SB_SH_TEST_DIRECTIONS; i++) {
-        double d[3];
-        sb_probe_direction(i, SB_SH_TEST_DIRECTIONS, d);
-        double v = sb_sh9_eval(c, d);
+        double v = 0; /* sb_sh9_eval's sum, in its order */
+        for (int k = 0; k < SB_PROBE_SH; k++)
+            v += c[k] * test_basis[i][k];
         if (v < lowest) {
             lowest = v;
             if (where)
-                memcpy(where, d, sizeof(d));
+                memcpy(where, test_direction[i], sizeof(test_direction[i]));
         }
     }
     return lowest;
