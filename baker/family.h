@@ -68,5 +68,6 @@ const struct sb_family_baker *sb_product_baker(enum sb_product_id id);
 extern const struct sb_family_baker sb_atmosphere_family;
 extern const struct sb_family_baker sb_clouds_family;
 extern const struct sb_family_baker sb_probes_family;
+extern const struct sb_family_baker sb_reflection_family;
 
 #endif

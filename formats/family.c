@@ -26,6 +26,11 @@ static const struct sb_family_format families[SB_FAMILY_COUNT] = {
             .section_json = sb_probes_section_json,
             .no_tolerance = "the probes' error is set by their ray count (probes.rays), not by a tolerance",
         },
+    [SB_FAMILY_REFLECTIONS] =
+        {
+            .name = "reflections",
+            .no_tolerance = "the DFG LUT is baked at one fixed setting (within 1e-3 of its fp64 reference)",
+        },
 };
 
 const struct sb_family_format *sb_family_format(enum sb_family family)

@@ -54,6 +54,8 @@ static const struct sb_product_format product_formats[SB_PRODUCT_COUNT] = {
     [SB_PRODUCT_SKY_BOUNCE] = {"sky_bounce", 0, 1, 1, SB_SKY_BOUNCE_CHANNEL_COUNT, SB_SKY_BOUNCE_CHANNELS,
                                "probes-bounce-sh1x2-fibonacci-v1", 4, SB_STORAGE_PROBES, "float32", "sbprobes",
                                SB_FAMILY_PROBES},
+    [SB_PRODUCT_DFG] = {"dfg", SB_DFG_SIZE, SB_DFG_SIZE, 1, 2, "dfg.x,dfg.y", "dfg-ggx-smith-nv-roughness-v1", 5,
+                        SB_STORAGE_EXR_FLOAT32, "float32", "exr", SB_FAMILY_REFLECTIONS},
 };
 
 void sb_product_shape(const struct sb_scene *scene, enum sb_product_id id, uint32_t shape[3])

@@ -18,7 +18,7 @@
 
 /* The version this build writes; it reads this one and every older one
  * (each a subset of the next; docs/pack.md). */
-#define SB_PACK_FORMAT_VERSION 4
+#define SB_PACK_FORMAT_VERSION 5
 #define SB_PACK_FORMAT_VERSION_OLDEST 1
 #define SB_PACK_MANIFEST "manifest.json"
 
@@ -36,6 +36,8 @@ enum sb_product_id {
     /* Probes over the scene's world (format version 3 on). */
     SB_PRODUCT_SKY_VISIBILITY,
     SB_PRODUCT_SKY_BOUNCE, /* format version 4 on */
+    /* Reflections (format version 5 on). */
+    SB_PRODUCT_DFG,
     SB_PRODUCT_COUNT,
 };
 
@@ -53,6 +55,7 @@ enum sb_family {
     SB_FAMILY_ATMOSPHERE,
     SB_FAMILY_CLOUDS,
     SB_FAMILY_PROBES,
+    SB_FAMILY_REFLECTIONS,
     SB_FAMILY_COUNT,
 };
 

@@ -322,6 +322,23 @@ struct sb_bounce_push {
     float tmin_m;
 };
 
+/* The DFG (split-sum) LUT of GGX specular (dfg.comp, baker/dfg.h): texel
+ * (i, j) at n.v = (i + 0.5) / SB_DFG_SIZE and perceptual roughness
+ * (j + 0.5) / SB_DFG_SIZE (alpha its square); x = the integral of
+ * Fc D Vis (n.l), y = that of D Vis (n.l) (Fc = (1 - v.h)^5, Vis the
+ * height-correlated Smith visibility), each over a midpoint grid of
+ * SB_DFG_SAMPLES_SIDE^2 points of GGX's (cos theta_h, phi) inverse CDF. */
+#define SB_DFG_SIZE 128
+#define SB_DFG_SAMPLES_SIDE 128
+#define SB_DFG_BINDING_OUT 0 /* two floats a texel, row by row */
+#define SB_DFG_BINDING_COUNT 1
+
+struct sb_dfg_push {
+    SB_UINT size;
+    SB_UINT samples_side;
+    SB_UINT pad0, pad1;
+};
+
 struct sb_probe_push {
     SB_UINT probe_count;
     SB_UINT ray_count; /* a multiple of SB_PROBE_THREADS */

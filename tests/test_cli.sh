@@ -47,7 +47,7 @@ check "info --json" expect_exit 0 "$skybake" info "$tmp/a" --json
 check "info --json has the manifest's hashes" test "$(hashes "$tmp/out" | tr -d ' ,\t')" = "$(hashes "$tmp/a/manifest.json" | tr -d ' ,\t')"
 check "info needs a pack" expect_exit 2 "$skybake" info
 check "info refuses what is not a pack" expect_exit 2 "$skybake" info "$root/data"
-check "manifest has format_version 4" grep -Eq '"format_version":[[:space:]]*4,' "$tmp/a/manifest.json"
+check "manifest has format_version 5" grep -Eq '"format_version":[[:space:]]*5,' "$tmp/a/manifest.json"
 check "no cloud products unless asked for" test ! -e "$tmp/a/cloud_shape.vdb"
 
 # verify: exit 0 when all holds; else 1, naming every problem.
@@ -117,6 +117,16 @@ head -c 2000 "$tmp/gfresh/multiscattering.exr" >"$tmp/gfresh/t" && mv "$tmp/gfre
 check "a pack that does not verify" expect_exit 0 "$skybake" bake "$tmp/g2.json" -o "$tmp/gfresh" --json
 check "a pack that does not verify is not reused" test -z "$(reused)"
 check "and the warning names the file" grep -q "multiscattering.exr" "$tmp/err"
+
+# The DFG LUT: a product of its own, needing no atmosphere product; baked
+# once and then reused; atmosphere edits leave it alone.
+printf '{"atmosphere":{"preset":"earth"},"products":["dfg"]}' >"$tmp/dfg.json"
+printf '{"atmosphere":{"preset":"earth","mie_g":0.7},"products":["dfg","transmittance"]}' >"$tmp/dfg2.json"
+check "bake the DFG LUT" expect_exit 0 "$skybake" bake "$tmp/dfg.json" -o "$tmp/dfg" -q --json
+check "only the LUT" test "$(hashes "$tmp/dfg/manifest.json" | wc -l)" = 1
+check "info shows dfg 128x128, two channels" sh -c "'$skybake' info '$tmp/dfg' | grep -Eq '^dfg +128x128 +dfg.x,dfg.y '"
+check "another atmosphere" expect_exit 0 "$skybake" bake "$tmp/dfg2.json" -o "$tmp/dfg" -q --json
+check "reuses the LUT" test "$(reused)" = "dfg"
 
 # Cloud noise: the default scene data/scenes/earth-clouds.json asks for it;
 # volumes as OpenVDB (vdb_print reads them: grids, sizes, fog volumes stored

@@ -457,6 +457,10 @@ static void edit_version_3(cJSON *r)
 {
     cJSON_ReplaceItemInObject(r, "format_version", cJSON_CreateNumber(3));
 }
+static void edit_version_4(cJSON *r)
+{
+    cJSON_ReplaceItemInObject(r, "format_version", cJSON_CreateNumber(4));
+}
 /* What version 1 wrote: no cloud products (in the scene or the pack), no
  * file_hash; the scene's hash recomputed for the scene without clouds. */
 static void edit_make_version_1(cJSON *r)
@@ -643,10 +647,12 @@ static void test_pack_reader(void)
         {"one flipped byte in the compressed pixels", NULL, FLIP_BYTE, SB_ERR_HASH_MISMATCH, false},
         {"one flipped byte in the compressed pixels, vouched for", NULL, FLIP_BYTE, SB_ERR_EXR, true},
         {"format version 1, as version 1 wrote it", edit_make_version_1,
-         "rm cloud_shape.vdb cloud_detail.vdb cloud_curl.exr weather.exr sky_visibility.sbprobes sky_bounce.sbprobes",
+         "rm cloud_shape.vdb cloud_detail.vdb cloud_curl.exr weather.exr sky_visibility.sbprobes sky_bounce.sbprobes "
+         "dfg.exr",
          SB_OK, false},
         {"format version 2 listing sky_visibility", edit_version_2, NULL, SB_ERR_UNKNOWN_PRODUCT, false},
         {"format version 3 listing sky_bounce", edit_version_3, NULL, SB_ERR_UNKNOWN_PRODUCT, false},
+        {"format version 4 listing dfg", edit_version_4, NULL, SB_ERR_UNKNOWN_PRODUCT, false},
         {"truncated bounce file, vouched for", NULL, "head -c 300 sky_bounce.sbprobes > t && mv t sky_bounce.sbprobes",
          SB_ERR_BAD_IMAGE, true},
         {"truncated probe file", NULL, "head -c 200 sky_visibility.sbprobes > t && mv t sky_visibility.sbprobes",
