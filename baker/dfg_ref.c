@@ -41,14 +41,15 @@ void sb_dfg_reference(double n_v, double r, int panels, double out[2])
     /* the polar angle of h by its inverse CDF; its azimuth over the
      * interval that reaches the light's hemisphere, phi = phi_max (1 - s^2),
      * graded toward its end (n.l = 0); both signs of phi */
+    /* past xi_max l is below the horizon at every azimuth; in q = 1 - xi */
     double c_max = cos(0.5 * acos(n_v) + 0.25 * M_PI), c2 = c_max * c_max;
-    double xi_max = (1 - c2) / (1 + c2 * (a2 - 1)); /* past it l is below the horizon at every azimuth */
+    double den_max = 1 - c2 + c2 * a2, xi_max = (1 - c2) / den_max, q_min = c2 * a2 / den_max;
     for (int i = 0; i < 8 * panels; i++) {
         double t, wi;
         node(i, panels, &t, &wi);
-        double xi = xi_max * (1 - t * t * t * t);
+        double q = q_min + xi_max * t * t * t * t, den = a2 + q * (1 - a2);
         wi *= 4 * xi_max * t * t * t;
-        double cos2 = (1 - xi) / (1 + (a2 - 1) * xi), n_h = sqrt(cos2), sin_h = sqrt(fmax(1 - cos2, 0));
+        double n_h = sqrt(q / den), sin_h = sqrt(a2 * fmax(1 - q, 0) / den);
         double pm = phi_max(v[0], n_v, sin_h, n_h);
         for (int j = 0; j < 8 * panels && pm > 0; j++) {
             double s, wj;
@@ -57,7 +58,7 @@ void sb_dfg_reference(double n_v, double r, int panels, double out[2])
             double v_h = v[0] * h[0] + v[2] * h[2], n_l = 2 * v_h * n_h - n_v;
             if (n_l <= 0 || v_h <= 0)
                 continue;
-            double g = visibility(n_v, n_l, a2) * 4 * n_l * v_h / n_h, f = pow(1 - v_h, 5);
+            double g = visibility(n_v, n_l, a2) * 4 * n_l * v_h / n_h, f = pow(fmax(1 - v_h, 0.0), 5);
             double w = wi * wj * 2 * pm * s * 2 / (2 * M_PI);
             x += w * f * g;
             y += w * g;
@@ -84,7 +85,7 @@ void sb_dfg_reference_direct(double n_v, double r, int panels, double out[2])
                 continue;
             double n_h = h[2] / len, v_h = (v[0] * h[0] + v[2] * h[2]) / len;
             double dd = n_h * n_h * (a2 - 1) + 1, d = a2 / (M_PI * dd * dd);
-            double g = d * visibility(n_v, n_l, a2) * n_l, f = pow(1 - v_h, 5);
+            double g = d * visibility(n_v, n_l, a2) * n_l, f = pow(fmax(1 - v_h, 0.0), 5);
             /* dw = sin(theta) dtheta dphi over [0, pi/2] x [0, pi], doubled */
             double w = wi * wj * (0.5 * M_PI) * M_PI * s * 2;
             x += w * f * g;

@@ -48,13 +48,14 @@ void main()
     /* h past theta_v / 2 + pi / 4 sends l below the horizon at every
      * azimuth: the CDF's end there, xi = xi_max (1 - t^2), t at midpoints
      * (the azimuth interval closes like a square root there) */
+    /* in q = 1 - xi, without cancellation: cos^2 theta_h = q / (a2 + q (1 - a2)) */
     float c_max = cos(0.5 * acos(n_v) + 0.7853981633974483), c2 = c_max * c_max;
-    float xi_max = (1.0 - c2) / (1.0 + c2 * (a2 - 1.0));
+    float den_max = 1.0 - c2 + c2 * a2, xi_max = (1.0 - c2) / den_max, q_min = c2 * a2 / den_max;
     for (uint i = 0u; i < pc.samples_side; i++) {
         float t = (float(i) + 0.5) * inv;
-        float t3 = t * t * t, xi = xi_max * (1.0 - t3 * t);
-        float cos2 = (1.0 - xi) / (1.0 + (a2 - 1.0) * xi);
-        float n_h = sqrt(cos2), sin_h = sqrt(max(1.0 - cos2, 0.0));
+        float t3 = t * t * t, q = q_min + xi_max * t3 * t;
+        float den = a2 + q * (1.0 - a2);
+        float n_h = sqrt(q / den), sin_h = sqrt(a2 * max(1.0 - q, 0.0) / den);
         float phi_max = dfg_phi_max(v.x, n_v, sin_h, n_h);
         if (phi_max <= 0.0)
             continue;
@@ -68,7 +69,8 @@ void main()
             if (n_l <= 0.0 || v_h <= 0.0)
                 continue;
             float g = visibility(n_v, n_l, a2) * 4.0 * n_l * v_h / n_h * s;
-            float f = pow(1.0 - v_h, 5.0);
+            float m = max(1.0 - v_h, 0.0), m2 = m * m; /* pow of a negative is undefined (NaN on NVIDIA) */
+            float f = m2 * m2 * m;
             row_x += f * g;
             row_y += g;
         }

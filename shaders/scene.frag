@@ -131,7 +131,7 @@ void main()
     float D = a2 / (PI * dd * dd);
     float V = 0.5 / (n_dot_l * sqrt(n_dot_v * n_dot_v * (1.0 - a2) + a2) +
                      n_dot_v * sqrt(n_dot_l * n_dot_l * (1.0 - a2) + a2));
-    vec3 F = f0 + (1.0 - f0) * pow(1.0 - l_dot_h, 5.0);
+    vec3 F = f0 + (1.0 - f0) * pow(max(1.0 - l_dot_h, 0.0), 5.0); /* pow of a negative is undefined */
     vec3 brdf = diffuse_color / PI + D * V * F;
 
     vec3 e_sun = atm.solar_irradiance.rgb * sun_transmittance(h, mu_s);
