@@ -1,6 +1,7 @@
 #include "atmosphere_ref.h"
 
 #include "config.h"
+#include "physics.h"
 
 #include <math.h>
 #include <pthread.h>
@@ -22,13 +23,11 @@ struct gl_rule {
 static struct gl_rule gl8, gl16;
 static pthread_once_t gl_once = PTHREAD_ONCE_INIT;
 
-static void gl_node(int k, int n, double a, double b, double *x, double *w);
-
 static void gl_compute(struct gl_rule *g, int n)
 {
     g->n = n;
     for (int i = 0; i < n; i++)
-        gl_node(i, n, -1.0, 1.0, &g->x[i], &g->w[i]);
+        sb_gauss_legendre_node(i, n, -1.0, 1.0, &g->x[i], &g->w[i]);
 }
 
 static void gl_init(void)
@@ -387,7 +386,7 @@ static void integrate_ray(const struct sb_atmosphere_params *p, double r0, doubl
 void sb_ref_gauss_legendre(int n, double a, double b, double *x, double *w)
 {
     for (int k = 0; k < n; k++)
-        gl_node(k, n, a, b, &x[k], &w[k]);
+        sb_gauss_legendre_node(k, n, a, b, &x[k], &w[k]);
 }
 
 static struct sb_ref_quality resolve(const struct sb_ref_quality *q)
@@ -402,27 +401,6 @@ static struct sb_ref_quality resolve(const struct sb_ref_quality *q)
     if (!r.transmittance_subdivisions)
         r.transmittance_subdivisions = 2;
     return r;
-}
-
-/* Gauss-Legendre node k of n on [a, b], ascending, fp64, for any n (<= 256). */
-static void gl_node(int k, int n, double a, double b, double *x, double *w)
-{
-    double z = cos(REF_PI * (k + 0.75) / (n + 0.5)), dp = 1;
-    for (int it = 0; it < 100; it++) {
-        double p0 = 1, p1 = 0;
-        for (int j = 1; j <= n; j++) {
-            double p2 = p1;
-            p1 = p0;
-            p0 = ((2.0 * j - 1) * z * p1 - (j - 1.0) * p2) / j;
-        }
-        dp = n * (z * p0 - p1) / (z * z - 1);
-        double dz = p0 / dp;
-        z -= dz;
-        if (fabs(dz) < 1e-16)
-            break;
-    }
-    *x = 0.5 * (a + b) - 0.5 * (b - a) * z;
-    *w = (b - a) / ((1 - z * z) * dp * dp);
 }
 
 /*
@@ -525,7 +503,7 @@ static double crowd(double u, bool lo, bool hi, double *dx);
 static void zenith_node(const struct zenith_piece *piece, int k, int n, double *mu, double *w)
 {
     double s, ws, dx;
-    gl_node(k, n, 0.0, 1.0, &s, &ws);
+    sb_gauss_legendre_node(k, n, 0.0, 1.0, &s, &ws);
     double x = crowd(s, piece->crowd_lo, piece->crowd_hi, &dx);
     *mu = piece->lo + (piece->hi - piece->lo) * x;
     *w = (piece->hi - piece->lo) * dx * ws;
@@ -700,7 +678,7 @@ static int cap_directions(const struct sb_atmosphere_params *p, const struct sb_
     for (int pc = 0; pc < piece_count; pc++)
         for (int k = 0; k < q->directions_mu; k++) {
             double u, w_u, dx, lo = pieces[pc].lo, hi = pieces[pc].hi, o, phase_do;
-            gl_node(k, q->directions_mu, 0.0, 1.0, &u, &w_u);
+            sb_gauss_legendre_node(k, q->directions_mu, 0.0, 1.0, &u, &w_u);
             double x = crowd(u, pieces[pc].crowd_lo, pieces[pc].crowd_hi, &dx);
             if (g < 0.01) {
                 o = lo + (hi - lo) * x;
@@ -714,14 +692,14 @@ static int cap_directions(const struct sb_atmosphere_params *p, const struct sb_
             double nu_a = 1 - o, sin_v = sqrt(fmax(o * (2 - o), 0.0));
             double radius = sin_a * sin_v, centre = mu_a * nu_a;
             /* psi_h: the ring is above the horizon for psi < psi_h */
-            double psi_h = radius > 0 ? acos(fmax(-1.0, fmin(1.0, (mu_h - centre) / radius)))
-                                      : (centre >= mu_h ? REF_PI : 0.0);
+            double psi_h =
+                radius > 0 ? acos(fmax(-1.0, fmin(1.0, (mu_h - centre) / radius))) : (centre >= mu_h ? REF_PI : 0.0);
             double alpha = cap_window_o(p, whole_sphere, o);
             for (int side = side_first; side < side_end; side++) {
                 double psi_lo = side ? psi_h : 0.0, psi_hi = side ? REF_PI : psi_h;
                 for (int ip = 0; ip < q->directions_phi; ip++) {
                     double v, w_v, dy;
-                    gl_node(ip, q->directions_phi, 0.0, 1.0, &v, &w_v);
+                    sb_gauss_legendre_node(ip, q->directions_phi, 0.0, 1.0, &v, &w_v);
                     /* crowded toward psi_h: the end of the sky side, the start of the ground side */
                     double y = crowd(v, side == 1, side == 0, &dy);
                     double mu = fmax(-1.0, fmin(1.0, centre + radius * cos(psi_lo + (psi_hi - psi_lo) * y)));

@@ -5,11 +5,7 @@
 #include <math.h>
 
 #include "dfg.h"
-
-static const double gl8_x[8] = {-0.9602898564975363, -0.7966664774136267, -0.5255324099163290, -0.1834346424956498,
-                                0.1834346424956498,  0.5255324099163290,  0.7966664774136267,  0.9602898564975363};
-static const double gl8_w[8] = {0.1012285362903763, 0.2223810344533745, 0.3137066458778873, 0.3626837833783620,
-                                0.3626837833783620, 0.3137066458778873, 0.2223810344533745, 0.1012285362903763};
+#include "physics.h"
 
 static double visibility(double n_v, double n_l, double a2)
 {
@@ -17,12 +13,11 @@ static double visibility(double n_v, double n_l, double a2)
     return 0.5 / (gv + gl);
 }
 
-/* Composite Gauss-Legendre nodes and weights on [0, 1]. */
+/* Composite Gauss-Legendre nodes and weights on [0, 1]: 8 a panel. */
 static void node(int k, int panels, double *x, double *w)
 {
-    int p = k / 8, i = k % 8;
-    *x = (p + 0.5 + 0.5 * gl8_x[i]) / panels;
-    *w = 0.5 * gl8_w[i] / panels;
+    int p = k / 8;
+    sb_gauss_legendre_node(k % 8, 8, (double)p / panels, (double)(p + 1) / panels, x, w);
 }
 
 /* The azimuth interval |phi| < phi_max where n.l > 0 and v.h > 0. */

@@ -358,7 +358,7 @@ static enum sb_result upload_probes(struct sb_renderer *r, const struct sb_pack 
     if (res || !r->probe_count)
         return res;
     struct sb_probes_gpu *g = r->probes.mapped;
-    static double t[SB_PROBE_SH][SB_PROBE_SH][SB_PROBE_SH];
+    double t[SB_PROBE_SH][SB_PROBE_SH][SB_PROBE_SH]; /* 5.8 KB; not static: renderers on other threads */
     sb_sh9_tensor(t);
     uint32_t entries = 0;
     for (int i = 0; i < SB_PROBE_SH; i++)

@@ -83,3 +83,23 @@ void sb_lookup_fill(enum sb_product_id id, const struct sb_image *image, float *
         }
     }
 }
+
+void sb_gauss_legendre_node(int k, int n, double a, double b, double *x, double *w)
+{
+    double z = cos(M_PI * (k + 0.75) / (n + 0.5)), dp = 1;
+    for (int it = 0; it < 100; it++) {
+        double p0 = 1, p1 = 0;
+        for (int j = 1; j <= n; j++) {
+            double p2 = p1;
+            p1 = p0;
+            p0 = ((2.0 * j - 1) * z * p1 - (j - 1.0) * p2) / j;
+        }
+        dp = n * (z * p0 - p1) / (z * z - 1);
+        double dz = p0 / dp;
+        z -= dz;
+        if (fabs(dz) < 1e-16)
+            break;
+    }
+    *x = 0.5 * (a + b) - 0.5 * (b - a) * z;
+    *w = (b - a) / ((1 - z * z) * dp * dp);
+}

@@ -15,6 +15,10 @@
 #include "pack.h"
 #include "scene.h"
 
+/* Gauss-Legendre node k of n on [a, b], ascending, fp64, for any n (<= 256):
+ * the quadrature the fp64 references and sb_sh9_tensor share. */
+void sb_gauss_legendre_node(int k, int n, double a, double b, double *x, double *w);
+
 /* Fill the std430 image of the parameters (config.h) from validated ones. */
 void sb_atmosphere_gpu_pack(const struct sb_atmosphere_params *params, struct sb_atmosphere_gpu *gpu);
 

@@ -21,15 +21,8 @@ vec3 radiance(vec3 d)
     vec3 p = frame.camera_km.xyz;
     vec3 l = frame.sun_direction.xyz;
     vec3 up = normalize(p);
-    if (frame.camera_km.w < atmosphere_thickness()) {
-        float h = clamp(frame.camera_km.w, 0.0, atmosphere_thickness());
-        float mu = clamp(dot(up, d), -1.0, 1.0);
-        float mu_s = clamp(dot(up, l), -1.0, 1.0);
-        vec3 d_flat = d - up * mu, l_flat = l - up * mu_s;
-        float len = length(d_flat) * length(l_flat);
-        float cos_phi = len > 1e-7 ? clamp(dot(d_flat, l_flat) / len, -1.0, 1.0) : 1.0;
-        return textureLod(sky_view, sky_view_uv(acos(cos_phi), acos(mu), h), 0.0).rgb / frame.aerial.y;
-    }
+    if (frame.camera_km.w < atmosphere_thickness())
+        return textureLod(sky_view, sky_view_uv_toward(d), 0.0).rgb / frame.aerial.y;
     /* the world is on the ground: its sky seen from there */
     float mu = clamp(dot(up, d), -1.0, 1.0), mu_s = clamp(dot(up, l), -1.0, 1.0);
     return sky_radiance(0.0, mu, mu_s, clamp(dot(d, l), -1.0, 1.0));

@@ -1,4 +1,5 @@
 #include "sh.h"
+#include "physics.h"
 
 #include <math.h>
 #include <pthread.h>
@@ -37,35 +38,13 @@ double sb_sh9_eval(const double c[SB_PROBE_SH], const double d[3])
     return sum;
 }
 
-/* Gauss-Legendre nodes and weights on [-1, 1] (Newton on P_n). */
-static void gauss_legendre(int n, double *x, double *w)
-{
-    for (int i = 0; i < n; i++) {
-        double z = cos(M_PI * (i + 0.75) / (n + 0.5)), dp = 1;
-        for (int it = 0; it < 100; it++) {
-            double p0 = 1, p1 = z;
-            for (int k = 2; k <= n; k++) {
-                double p2 = ((2.0 * k - 1) * z * p1 - (k - 1.0) * p0) / k;
-                p0 = p1;
-                p1 = p2;
-            }
-            dp = n * (z * p1 - p0) / (z * z - 1);
-            double step = p1 / dp;
-            z -= step;
-            if (fabs(step) < 1e-16)
-                break;
-        }
-        x[i] = z;
-        w[i] = 2 / ((1 - z * z) * dp * dp);
-    }
-}
-
 void sb_sh9_tensor(double t[SB_PROBE_SH][SB_PROBE_SH][SB_PROBE_SH])
 {
     /* the products are polynomials of degree 6: 4 nodes in z and 7 in azimuth would do */
     enum { NZ = 8, NPHI = 16 };
     double zx[NZ], zw[NZ];
-    gauss_legendre(NZ, zx, zw);
+    for (int k = 0; k < NZ; k++)
+        sb_gauss_legendre_node(k, NZ, -1.0, 1.0, &zx[k], &zw[k]);
     memset(t, 0, sizeof(double) * SB_PROBE_SH * SB_PROBE_SH * SB_PROBE_SH);
     for (int a = 0; a < NZ; a++)
         for (int b = 0; b < NPHI; b++) {

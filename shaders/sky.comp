@@ -33,12 +33,7 @@ void main()
         vec3 up = normalize(p);
         float h = clamp(frame.camera_km.w, 0.0, atmosphere_thickness()); /* as the LUT was made */
         float mu = clamp(dot(up, d), -1.0, 1.0);
-        float mu_s = clamp(dot(up, l), -1.0, 1.0);
-        /* Azimuth from the sun around the zenith. */
-        vec3 d_flat = d - up * mu, l_flat = l - up * mu_s;
-        float len = length(d_flat) * length(l_flat);
-        float cos_phi = len > 1e-7 ? clamp(dot(d_flat, l_flat) / len, -1.0, 1.0) : 1.0;
-        L = textureLod(sky_view, sky_view_uv(acos(cos_phi), acos(mu), h), 0.0).rgb;
+        L = textureLod(sky_view, sky_view_uv_toward(d), 0.0).rgb;
         if (!ray_hits_ground(h, mu))
             sun_t = transmittance_lut_sample(h, mu);
     } else {

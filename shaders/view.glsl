@@ -57,6 +57,20 @@ vec2 sky_view_uv(float phi, float theta, float h)
     return vec2(sqrt(clamp(phi / PI, 0.0, 1.0)), v);
 }
 
+/* Where the sky-view LUT holds direction d from the camera (inside the
+ * atmosphere): the azimuth from the sun about the zenith, the zenith
+ * angle, at the camera's altitude. */
+vec2 sky_view_uv_toward(vec3 d)
+{
+    vec3 up = normalize(frame.camera_km.xyz), l = frame.sun_direction.xyz;
+    float h = clamp(frame.camera_km.w, 0.0, atmosphere_thickness()); /* as the LUT was made */
+    float mu = clamp(dot(up, d), -1.0, 1.0), mu_s = clamp(dot(up, l), -1.0, 1.0);
+    vec3 d_flat = d - up * mu, l_flat = l - up * mu_s;
+    float len = length(d_flat) * length(l_flat);
+    float cos_phi = len > 1e-7 ? clamp(dot(d_flat, l_flat) / len, -1.0, 1.0) : 1.0;
+    return sky_view_uv(acos(cos_phi), acos(mu), h);
+}
+
 /* Radiance of the sky along a ray from altitude h (km) with view cosine mu,
  * sun cosine mu_s and view-sun cosine nu: single scattering with the baked
  * transmittance toward the sun, multiple scattering from psi_ms, and the
