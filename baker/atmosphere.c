@@ -274,21 +274,13 @@ static enum sb_result run(struct sb_atmosphere_baker *b, const uint32_t *spirv, 
     if ((res = sb_pipeline_create(b->vk, &pp, &pipeline)))
         return res;
     const struct sb_buffer *bindings[SB_BINDING_COUNT] = {
-        [SB_BINDING_ATMOSPHERE] = &b->params,
         [SB_BINDING_OUTPUT] = output,
         [SB_BINDING_SCRATCH] = workgroup_per_texel ? &b->scratch : &b->dummy,
     };
-    static const int inputs[][2] = {
-        {SB_BINDING_TRANSMITTANCE, SB_PRODUCT_TRANSMITTANCE},
-        {SB_BINDING_MULTISCATTERING, SB_PRODUCT_MULTISCATTERING},
-        {SB_BINDING_IRRADIANCE_GROUND, SB_PRODUCT_IRRADIANCE_GROUND},
-    };
-    for (size_t i = 0; i < sizeof(inputs) / sizeof(inputs[0]); i++) {
-        const struct sb_buffer *in = &b->lookups[inputs[i][1]];
-        if (!in->buffer)
-            in = &b->outputs[inputs[i][1]];
-        bindings[inputs[i][0]] = in->buffer && in != output ? in : &b->dummy;
-    }
+    sb_atmosphere_bind_inputs(b, bindings);
+    for (int i = SB_BINDING_TRANSMITTANCE; i <= SB_BINDING_IRRADIANCE_GROUND; i++)
+        if (bindings[i] == output) /* a product is never its own input */
+            bindings[i] = &b->dummy;
     sb_pipeline_bind(b->vk, &pipeline, bindings);
     uint32_t groups_x = workgroup_per_texel ? width : (width + SB_WORKGROUP_X - 1) / SB_WORKGROUP_X;
     uint32_t groups_y = workgroup_per_texel ? height : (height + SB_WORKGROUP_Y - 1) / SB_WORKGROUP_Y;
@@ -408,6 +400,22 @@ void sb_atmosphere_code_hash(enum sb_product_id id, char out[SB_HASH_HEX_SIZE])
     snprintf(text + n, sizeof(text) - n, " recipe %d cap %a %a %d", SB_ATMOSPHERE_RECIPE, (double)SB_CAP_MIN_G,
              (double)SB_CAP_THETA, SB_SPHERE_CAP_PIECES);
     sb_hash_bytes(text, strlen(text), out);
+}
+
+void sb_atmosphere_bind_inputs(struct sb_atmosphere_baker *b, const struct sb_buffer **bindings)
+{
+    static const int inputs[][2] = {
+        {SB_BINDING_TRANSMITTANCE, SB_PRODUCT_TRANSMITTANCE},
+        {SB_BINDING_MULTISCATTERING, SB_PRODUCT_MULTISCATTERING},
+        {SB_BINDING_IRRADIANCE_GROUND, SB_PRODUCT_IRRADIANCE_GROUND},
+    };
+    bindings[SB_BINDING_ATMOSPHERE] = &b->params;
+    for (size_t i = 0; i < sizeof(inputs) / sizeof(inputs[0]); i++) {
+        const struct sb_buffer *in = &b->lookups[inputs[i][1]];
+        if (!in->buffer)
+            in = &b->outputs[inputs[i][1]];
+        bindings[inputs[i][0]] = in->buffer ? in : &b->dummy;
+    }
 }
 
 enum sb_result sb_atmosphere_run_kernel(struct sb_atmosphere_baker *b, const uint32_t *spirv, size_t spirv_size,

@@ -65,6 +65,12 @@ enum sb_result sb_atmosphere_bake(struct sb_atmosphere_baker *baker, enum sb_pro
                                   const struct sb_atmosphere_settings *settings, struct sb_image *image,
                                   struct sb_atmosphere_settings *used, double *gpu_ms);
 
+/* The buffers a kernel including atmosphere.glsl reads at bindings 0 to
+ * 3 (config.h, SB_BINDING_*): the parameters and the LUTs this baker has
+ * baked or adopted (a placeholder for those it has not), for kernels of
+ * other families (the reflection capture). bindings[] must have room for 4. */
+void sb_atmosphere_bind_inputs(struct sb_atmosphere_baker *baker, const struct sb_buffer **bindings);
+
 /*
  * Evaluate the shared GLSL model directly, for tests and tools: run a
  * kernel with the baker's parameters and products bound as in a bake, over

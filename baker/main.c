@@ -367,7 +367,7 @@ static int cmd_sky_error(int argc, char **argv)
             goto done;
     if (!scene_count) {
         sb_atmosphere_preset_earth(&loaded[0].atmosphere);
-        loaded[0].view = (struct sb_scene_view){0.002, 30};
+        loaded[0].view = (struct sb_scene_view){0.002, 30, 150};
         scenes[scene_count++] = "the earth preset";
     }
 

@@ -1,27 +1,267 @@
 /*
- * The reflection family (issue 18): so far the DFG (split-sum) LUT
- * (dfg.h), which depends on nothing but its kernel: baked once, reused by
- * every later bake whose key matches (docs/reflections.md).
+ * The reflection family (issue 18, docs/reflections.md): the DFG
+ * (split-sum) LUT (dfg.h), which depends on nothing but its kernel; the
+ * reflection probes' cubes, captured at each probe (the sky-only probe at
+ * the view's altitude first, then the scene's) and prefiltered for GGX
+ * roughness (reflection.h); and the probes' records, with the irradiance
+ * each cube sees as order-2 SH.
  */
+#include <math.h>
 #include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
 
+#include "bvh.h"
+#include "cube.h"
 #include "dfg.h"
+#include "exr.h"
 #include "family.h"
+#include "log.h"
+#include "mesh.h"
+#include "probes.h"
+#include "reflection.h"
 
 #define DFG_RECIPE 1
+#define CUBES_RECIPE 1
+#define PROBES_RECIPE 1
+/* More of a probe's view in back faces than this: inside geometry. */
+#define INSIDE_FRACTION 0.25
+
+struct reflection_state {
+    bool has_world;
+    struct sb_mesh mesh;
+    char mesh_hash[SB_HASH_HEX_SIZE];
+    struct sb_bvh bvh;
+    struct sb_raycaster *rc;
+    struct sb_atmosphere_baker *atmosphere;
+};
+
+static bool wants_cubes(const struct sb_scene *scene)
+{
+    return scene->wants[SB_PRODUCT_REFLECTION_CUBES] || scene->wants[SB_PRODUCT_REFLECTION_PROBES];
+}
+
+static enum sb_result reflection_create(struct sb_vk *vk, const struct sb_scene *scene, void **out)
+{
+    struct reflection_state *st = calloc(1, sizeof(*st));
+    if (!st)
+        return SB_ERR_NOMEM;
+    *out = st;
+    if (!wants_cubes(scene) || !scene->has_world)
+        return SB_OK;
+    enum sb_result res = sb_mesh_load_world(&scene->world, scene->directory, &st->mesh, NULL, 0);
+    if (res)
+        return res;
+    st->has_world = true;
+    sb_mesh_hash(&st->mesh, st->mesh_hash);
+    return SB_OK;
+}
+
+static void reflection_destroy(void **state)
+{
+    struct reflection_state *st = *state;
+    if (st) {
+        sb_atmosphere_baker_destroy(&st->atmosphere);
+        sb_raycaster_destroy(&st->rc);
+        sb_bvh_finish(&st->bvh);
+        sb_mesh_finish(&st->mesh);
+    }
+    free(st);
+    *state = NULL;
+}
+
+static uint32_t reflection_depends_on(enum sb_product_id id)
+{
+    if (id == SB_PRODUCT_REFLECTION_CUBES)
+        return 1u << SB_PRODUCT_TRANSMITTANCE | 1u << SB_PRODUCT_MULTISCATTERING | 1u << SB_PRODUCT_IRRADIANCE_GROUND;
+    return id == SB_PRODUCT_REFLECTION_PROBES ? 1u << SB_PRODUCT_REFLECTION_CUBES : 0;
+}
 
 static void reflection_key(void *state, const struct sb_scene *scene, enum sb_product_id id, struct sb_key_text *key)
 {
+    const struct reflection_state *st = state;
+    const struct sb_reflection_params *p = &scene->reflections;
     char code[SB_HASH_HEX_SIZE];
-    sb_dfg_code_hash(code);
-    sb_key_add(key, " recipe %d size %d samples %dx%d code %s", DFG_RECIPE, SB_DFG_SIZE, SB_DFG_SAMPLES_SIDE,
-               SB_DFG_SAMPLES_SIDE, code);
+    if (id == SB_PRODUCT_DFG) {
+        sb_dfg_code_hash(code);
+        sb_key_add(key, " recipe %d size %d samples %dx%d code %s", DFG_RECIPE, SB_DFG_SIZE, SB_DFG_SAMPLES_SIDE,
+                   SB_DFG_SAMPLES_SIDE, code);
+        return;
+    }
+    if (id == SB_PRODUCT_REFLECTION_PROBES) { /* the cubes' key is its input's */
+        sb_key_add(key, " recipe %d altitude_km=%a", PROBES_RECIPE, scene->view.altitude_km);
+        for (int i = 0; i < p->probe_count; i++) {
+            sb_key_add3(key, "at", p->probes[i].position_m);
+            sb_key_add3(key, "box_min", p->probes[i].box_m[0]);
+            sb_key_add3(key, "box_max", p->probes[i].box_m[1]);
+        }
+        return;
+    }
+    sb_reflection_code_hash(code);
+    sb_key_add(key, " recipe %d face %u samples %u ambient %u altitude_km=%a sun=%a,%a world %s code %s", CUBES_RECIPE,
+               p->face_size, p->samples, p->ambient_rays, scene->view.altitude_km, scene->view.sun_elevation_deg,
+               scene->view.sun_azimuth_deg, st->has_world ? st->mesh_hash : "none", code);
+    for (int i = 0; i < p->probe_count; i++)
+        sb_key_add3(key, "at", p->probes[i].position_m);
+}
+
+/* Where the sun is: elevation and azimuth clockwise from north (-z), as
+ * skyview has them. */
+static void sun_direction(const struct sb_scene *scene, double out[3])
+{
+    double el = scene->view.sun_elevation_deg * M_PI / 180, az = scene->view.sun_azimuth_deg * M_PI / 180;
+    out[0] = cos(el) * sin(az);
+    out[1] = sin(el);
+    out[2] = -cos(el) * cos(az);
+}
+
+/* Probe i's position (0: the sky-only probe at the view's altitude). */
+static void probe_position(const struct sb_scene *scene, int i, double out[3])
+{
+    if (i == 0) {
+        out[0] = out[2] = 0;
+        out[1] = scene->view.altitude_km * 1e3;
+    } else {
+        memcpy(out, scene->reflections.probes[i - 1].position_m, 3 * sizeof(double));
+    }
+}
+
+static enum sb_result bake_cubes(struct reflection_state *st, struct sb_vk *vk, const struct sb_scene *scene,
+                                 const struct sb_image baked[SB_PRODUCT_COUNT], struct sb_image *image,
+                                 struct sb_artifact *a)
+{
+    const struct sb_reflection_params *p = &scene->reflections;
+    uint32_t n = p->face_size, levels = sb_cube_levels(n), cubes = 1 + (uint32_t)p->probe_count;
+    enum sb_result res = SB_OK;
+    if (!st->atmosphere) {
+        static const enum sb_product_id inputs[] = {SB_PRODUCT_TRANSMITTANCE, SB_PRODUCT_MULTISCATTERING,
+                                                    SB_PRODUCT_IRRADIANCE_GROUND};
+        res = sb_atmosphere_baker_create(vk, &scene->atmosphere, &st->atmosphere);
+        for (size_t i = 0; i < sizeof(inputs) / sizeof(inputs[0]) && !res; i++)
+            res = sb_atmosphere_adopt(st->atmosphere, inputs[i], &baked[inputs[i]]);
+    }
+    if (!res && st->has_world && !st->rc && !(res = sb_bvh_build(&st->mesh, &st->bvh)))
+        res = sb_raycaster_create(vk, &st->bvh, &st->rc);
+    if (res)
+        return res;
+    uint64_t chain = sb_cube_level_offset(n, levels);
+    float *level0 = malloc((size_t)6 * n * n * 4 * sizeof(float));
+    float *filtered = malloc(chain * 4 * sizeof(float));
+    if (!level0 || !filtered || (res = sb_image_init_levels(image, n, 6 * n, cubes, 3, levels))) {
+        res = res ? res : SB_ERR_NOMEM;
+        goto done;
+    }
+    sb_image_set_channel_names(image, "R,G,B");
+    struct sb_capture_params cp = {.face_size = n, .ambient_rays = p->ambient_rays};
+    sun_direction(scene, cp.sun);
+    double gpu_ms = 0, worst_back = 0;
+    for (uint32_t i = 0; i < cubes && !res; i++) {
+        double at[3], ms = 0;
+        probe_position(scene, (int)i, at);
+        for (int k = 0; k < 3; k++)
+            cp.origin_m[k] = (float)at[k];
+        cp.altitude_km = fmax(at[1], 0.0) * 1e-3;
+        struct sb_capture_inputs in = {.atmosphere = st->atmosphere, .rc = i ? st->rc : NULL, .mesh = &st->mesh};
+        if ((res = sb_reflection_capture(vk, &in, &cp, level0, &ms)))
+            break;
+        gpu_ms += ms;
+        if (i == 0) /* the sky the surfaces of the other probes are lit by */
+            sb_reflection_sh(level0, n, 0, cp.sky_sh);
+        double back = 0;
+        for (size_t t = 0; t < (size_t)6 * n * n; t++)
+            back += level0[4 * t + 3];
+        back /= 6.0 * n * n;
+        worst_back = fmax(worst_back, back);
+        if (back > INSIDE_FRACTION) {
+            sb_error("reflections.probes[%u] at (%g, %g, %g) is inside geometry: %.0f%% of what it sees is back "
+                     "faces; move it into free space",
+                     i - 1, at[0], at[1], at[2], 100 * back);
+            res = SB_ERR_OUT_OF_RANGE;
+            break;
+        }
+        if ((res = sb_reflection_prefilter(vk, level0, n, p->samples, filtered, &ms)))
+            break;
+        gpu_ms += ms;
+        for (uint32_t l = 0; l < levels; l++) {
+            uint32_t m = n >> l;
+            const float *src = filtered + 4 * sb_cube_level_offset(n, l);
+            float *dst = image->data + sb_image_level_offset(image, l) + (size_t)i * 6 * m * m * 3;
+            for (size_t t = 0; t < (size_t)6 * m * m; t++)
+                memcpy(&dst[3 * t], &src[4 * t], 3 * sizeof(float));
+        }
+        sb_info("reflection_cubes: probe %u of %u", i + 1, cubes);
+    }
+    if (res)
+        goto done;
+    a->gpu_ms = gpu_ms;
+    snprintf(a->settings_json, sizeof(a->settings_json),
+             "{\"face_size\":%u,\"levels\":%u,\"cubes\":%u,\"samples\":%u,\"ambient_rays\":%u,"
+             "\"roughness\":\"level / (levels - 1) = r (2 - r)\",\"prefilter\":\"GGX importance sampling, "
+             "Hammersley, filtered (Colbert and Krivanek), n = v = r\",\"capture\":\"BVH ray casts; surfaces "
+             "Lambertian, lit by the sun (shadow ray) and the sky (one bounce)\",\"sun_disk\":\"left out: analytic "
+             "at runtime\",\"layout\":\"OpenEXR cube (+x,-x,+y,-y,+z,-z)\",\"most_back_faces\":%.4f,"
+             "\"world_hash\":\"%s\"}",
+             n, levels, cubes, p->samples, p->ambient_rays, worst_back, st->has_world ? st->mesh_hash : "");
+done:
+    if (res)
+        sb_image_finish(image);
+    free(level0);
+    free(filtered);
+    return res;
+}
+
+static enum sb_result bake_probes(const struct sb_scene *scene, const struct sb_image *cubes, struct sb_image *image,
+                                  struct sb_artifact *a)
+{
+    uint32_t count = cubes->depth, n = cubes->width;
+    if (count != 1 + (uint32_t)scene->reflections.probe_count) {
+        sb_error("reflection_probes: the cubes hold %u probes, the scene %d", count,
+                 1 + scene->reflections.probe_count);
+        return SB_ERR_BAD_IMAGE;
+    }
+    float *level0 = malloc((size_t)6 * n * n * 4 * sizeof(float));
+    enum sb_result res = level0 ? sb_image_init(image, count, 1, SB_REFLECTION_PROBES_CHANNEL_COUNT) : SB_ERR_NOMEM;
+    if (res) {
+        free(level0);
+        return res;
+    }
+    sb_image_set_channel_names(image, SB_REFLECTION_PROBES_CHANNELS);
+    for (uint32_t i = 0; i < count; i++) {
+        const float *src = cubes->data + (size_t)i * 6 * n * n * 3;
+        for (size_t t = 0; t < (size_t)6 * n * n; t++) {
+            memcpy(&level0[4 * t], &src[3 * t], 3 * sizeof(float));
+            level0[4 * t + 3] = 0;
+        }
+        double sh[9][3], at[3];
+        sb_reflection_sh(level0, n, 1, sh);
+        probe_position(scene, (int)i, at);
+        float *o = &image->data[(size_t)i * SB_REFLECTION_PROBES_CHANNEL_COUNT];
+        for (int k = 0; k < 3; k++) {
+            o[k] = (float)at[k];
+            o[3 + k] = i ? (float)scene->reflections.probes[i - 1].box_m[0][k] : 0.0f;
+            o[6 + k] = i ? (float)scene->reflections.probes[i - 1].box_m[1][k] : 0.0f;
+        }
+        for (int k = 0; k < 9; k++)
+            for (int c = 0; c < 3; c++)
+                o[9 + 3 * k + c] = (float)sh[k][c];
+    }
+    free(level0);
+    a->probes = (struct sb_probe_layout){.explicit_count = count, .ray_count = 6 * n * n};
+    snprintf(a->settings_json, sizeof(a->settings_json),
+             "{\"probes\":%u,\"irradiance\":\"order-2 SH of each cube's level 0 (exact texel solid angles), "
+             "cosine-convolved\",\"first\":\"the sky-only probe at the view's altitude (box zero: everywhere)\"}",
+             count);
+    return SB_OK;
 }
 
 static enum sb_result reflection_bake(void *state, struct sb_vk *vk, const struct sb_scene *scene,
                                       enum sb_product_id id, const struct sb_image baked[SB_PRODUCT_COUNT],
                                       struct sb_image *image, struct sb_artifact *a)
 {
+    if (id == SB_PRODUCT_REFLECTION_CUBES)
+        return bake_cubes(state, vk, scene, baked, image, a);
+    if (id == SB_PRODUCT_REFLECTION_PROBES)
+        return bake_probes(scene, &baked[SB_PRODUCT_REFLECTION_CUBES], image, a);
     enum sb_result res = sb_dfg_bake(vk, image, &a->gpu_ms);
     if (!res)
         snprintf(a->settings_json, sizeof(a->settings_json),
@@ -32,6 +272,9 @@ static enum sb_result reflection_bake(void *state, struct sb_vk *vk, const struc
 }
 
 const struct sb_family_baker sb_reflection_family = {
+    .depends_on = reflection_depends_on,
     .key = reflection_key,
+    .create = reflection_create,
+    .destroy = reflection_destroy,
     .bake = reflection_bake,
 };

@@ -27,4 +27,24 @@ enum sb_result sb_exr_write(const char *path, const struct sb_image *image, cons
 enum sb_result sb_exr_read(const char *path, const char *channel_order, uint64_t max_pixels, struct sb_image *image,
                            struct sb_attribute *attributes, int *attribute_count);
 
+/*
+ * Cube maps with their mip chains (exr_cube.c): `image` is a cube array,
+ * width N (a power of two), height 6 N, depth the cube count and levels
+ * log2 N + 1 (sb_cube_levels). Each cube is one part of the file ("cube.i"),
+ * tiled, mip-mapped with level sizes rounded down, ZIP, FLOAT channels,
+ * with the envmap attribute "cube": what exrheader and viewers read as a
+ * cube-face environment map. The faces are stacked as OpenEXR's envmap
+ * convention has them (+x, -x, +y, -y, +z, -z; shaders/cube.glsl maps
+ * directions). The reader takes only that shape, the channels in
+ * channel_order (every one, nothing else) and the size the caller expects,
+ * all checked before any pixel is allocated.
+ */
+#define SB_CUBE_MAX_FACE 4096
+#define SB_CUBE_MAX_COUNT 1024
+uint32_t sb_cube_levels(uint32_t face_size);
+enum sb_result sb_exr_cube_write(const char *path, const struct sb_image *image, const struct sb_attribute *attributes,
+                                 int attribute_count);
+enum sb_result sb_exr_cube_read(const char *path, const char *channel_order, uint32_t face_size, uint32_t cube_count,
+                                struct sb_image *image);
+
 #endif

@@ -14,7 +14,7 @@ static const struct sb_family_format families[SB_FAMILY_COUNT] = {
             .section = "clouds",
             .parse_section = sb_clouds_section_parse,
             .section_json = sb_clouds_section_json,
-            .product_size = sb_clouds_product_size,
+            .product_shape = sb_clouds_product_shape,
             .no_tolerance = "the cloud noise is baked exactly (bit for bit with its CPU reference) and takes no "
                             "tolerance",
         },
@@ -29,7 +29,12 @@ static const struct sb_family_format families[SB_FAMILY_COUNT] = {
     [SB_FAMILY_REFLECTIONS] =
         {
             .name = "reflections",
-            .no_tolerance = "the DFG LUT is baked at one fixed setting (within 1e-3 of its fp64 reference)",
+            .section = "reflections",
+            .parse_section = sb_reflections_section_parse,
+            .section_json = sb_reflections_section_json,
+            .product_shape = sb_reflections_product_shape,
+            .no_tolerance = "the reflections' accuracy is set by their sample counts (reflections.samples; the DFG "
+                            "LUT's is fixed, within 1e-3 of its fp64 reference)",
         },
 };
 

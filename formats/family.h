@@ -32,9 +32,10 @@ struct sb_family_format {
      * scene's "view", in table order, so that families added later leave
      * older scenes' hashes alone. */
     struct cJSON *(*section_json)(const struct sb_scene *scene);
-    /* Edge length in texels for a product whose format leaves its size to
-     * the scene (a 0 in sb_product_format); NULL when none does. */
-    uint32_t (*product_size)(const struct sb_scene *scene, enum sb_product_id id);
+    /* The shape of a product whose format leaves it to the scene: fill the
+     * zeros of shape[3] (width, height, depth, as the format has them);
+     * NULL when no product of the family does. */
+    void (*product_shape)(const struct sb_scene *scene, enum sb_product_id id, uint32_t shape[3]);
     bool default_products; /* baked when a scene names no products */
     /* Why a scene may not give the family's products a tolerance; NULL when
      * it may (the bake then picks the cheapest setting within it). */
@@ -47,12 +48,17 @@ const struct sb_family_format *sb_family_format(enum sb_family family);
 /* The clouds' section (scene_clouds.c). */
 enum sb_result sb_clouds_section_parse(const struct cJSON *section, struct sb_scene *scene, const char *source);
 struct cJSON *sb_clouds_section_json(const struct sb_scene *scene);
-uint32_t sb_clouds_product_size(const struct sb_scene *scene, enum sb_product_id id);
+void sb_clouds_product_shape(const struct sb_scene *scene, enum sb_product_id id, uint32_t shape[3]);
 
 /* The world's and the probes' sections (scene_world.c). */
 enum sb_result sb_world_section_parse(const struct cJSON *section, struct sb_scene *scene, const char *source);
 struct cJSON *sb_world_section_json(const struct sb_scene *scene);
 enum sb_result sb_probes_section_parse(const struct cJSON *section, struct sb_scene *scene, const char *source);
 struct cJSON *sb_probes_section_json(const struct sb_scene *scene);
+
+/* The reflections' section (scene_reflections.c). */
+enum sb_result sb_reflections_section_parse(const struct cJSON *section, struct sb_scene *scene, const char *source);
+struct cJSON *sb_reflections_section_json(const struct sb_scene *scene);
+void sb_reflections_product_shape(const struct sb_scene *scene, enum sb_product_id id, uint32_t shape[3]);
 
 #endif

@@ -9,14 +9,17 @@
 #include <unistd.h>
 #include <xxhash.h>
 
-enum sb_result sb_image_init_volume(struct sb_image *image, uint32_t width, uint32_t height, uint32_t depth,
-                                    uint32_t channel_count)
+enum sb_result sb_image_init_levels(struct sb_image *image, uint32_t width, uint32_t height, uint32_t depth,
+                                    uint32_t channel_count, uint32_t levels)
 {
     memset(image, 0, sizeof(*image));
-    if (!width || !height || !depth || !channel_count || channel_count > SB_IMAGE_MAX_CHANNELS)
+    if (!width || !height || !depth || !channel_count || channel_count > SB_IMAGE_MAX_CHANNELS || !levels ||
+        levels > 32)
         return SB_ERR_BAD_IMAGE;
-    uint64_t count = (uint64_t)width * height * depth * channel_count;
-    if (count > SIZE_MAX / sizeof(float))
+    struct sb_image shape = {.width = width, .height = height, .depth = depth, .channel_count = channel_count,
+                             .levels = levels};
+    uint64_t count = sb_image_float_count(&shape);
+    if (count > SIZE_MAX / sizeof(float) || (uint64_t)width * height * depth > (1ull << 40))
         return SB_ERR_NOMEM;
     image->data = calloc((size_t)count, sizeof(float));
     if (!image->data)
@@ -25,7 +28,14 @@ enum sb_result sb_image_init_volume(struct sb_image *image, uint32_t width, uint
     image->height = height;
     image->depth = depth;
     image->channel_count = channel_count;
+    image->levels = levels;
     return SB_OK;
+}
+
+enum sb_result sb_image_init_volume(struct sb_image *image, uint32_t width, uint32_t height, uint32_t depth,
+                                    uint32_t channel_count)
+{
+    return sb_image_init_levels(image, width, height, depth, channel_count, 1);
 }
 
 enum sb_result sb_image_init(struct sb_image *image, uint32_t width, uint32_t height, uint32_t channel_count)
@@ -77,6 +87,8 @@ void sb_image_content_hash(const struct sb_image *image, char out[SB_HASH_HEX_SI
     put_u32_le(state, image->height);
     put_u32_le(state, image->depth);
     put_u32_le(state, image->channel_count);
+    if (image->levels > 1) /* only then: every older hash stands */
+        put_u32_le(state, image->levels);
     for (uint32_t c = 0; c < image->channel_count; c++)
         XXH3_128bits_update(state, image->channel_names[c], strlen(image->channel_names[c]) + 1);
     /* Values in little-endian byte order, converted in chunks. */

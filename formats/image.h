@@ -3,6 +3,10 @@
  * z (texel (x, y, z) at data[((z * height + y) * width + x) * channel_count];
  * rows from y = 0 upward). The shape of every product, what EXR and VDB
  * files and content hashes are made of.
+ *
+ * An image may carry a mip chain (levels > 1: a 2D image array, the
+ * reflection cubes): level l is max(width >> l, 1) x max(height >> l, 1) x
+ * depth, stored after level l - 1 in the same order (sb_image_level_offset).
  */
 #ifndef SB_IMAGE_H
 #define SB_IMAGE_H
@@ -20,6 +24,7 @@ struct sb_image {
     uint32_t height;
     uint32_t depth; /* 1 for a 2D image */
     uint32_t channel_count;
+    uint32_t levels; /* mip levels; 0 or 1: none but the image */
     char channel_names[SB_IMAGE_MAX_CHANNELS][SB_CHANNEL_NAME_MAX];
     float *data; /* owned: width * height * channel_count floats */
 };
@@ -28,13 +33,31 @@ struct sb_image {
 enum sb_result sb_image_init(struct sb_image *image, uint32_t width, uint32_t height, uint32_t channel_count);
 enum sb_result sb_image_init_volume(struct sb_image *image, uint32_t width, uint32_t height, uint32_t depth,
                                     uint32_t channel_count);
+/* A mip-mapped 2D image array (see above), levels >= 1. */
+enum sb_result sb_image_init_levels(struct sb_image *image, uint32_t width, uint32_t height, uint32_t depth,
+                                    uint32_t channel_count, uint32_t levels);
 /* Free the data; accepts a zeroed or already finished image. */
 void sb_image_finish(struct sb_image *image);
 
-/* Number of floats in the image. */
+/* Level l's width or height from the image's. */
+static inline uint32_t sb_image_level_size(uint32_t size, uint32_t level)
+{
+    return size >> level ? size >> level : 1;
+}
+
+/* Floats before level `level` (every level's when level == levels). */
+static inline uint64_t sb_image_level_offset(const struct sb_image *image, uint32_t level)
+{
+    uint64_t n = 0;
+    for (uint32_t l = 0; l < level; l++)
+        n += (uint64_t)sb_image_level_size(image->width, l) * sb_image_level_size(image->height, l);
+    return n * image->depth * image->channel_count;
+}
+
+/* Number of floats in the image, every level included. */
 static inline uint64_t sb_image_float_count(const struct sb_image *image)
 {
-    return (uint64_t)image->width * image->height * image->depth * image->channel_count;
+    return sb_image_level_offset(image, image->levels > 1 ? image->levels : 1);
 }
 
 /* Set channel names from one comma-separated list ("r,g,b"). */
@@ -49,9 +72,9 @@ struct sb_attribute {
 
 /*
  * Content hash: XXH3-128 over the canonical content (a tag, the element type,
- * width, height, depth, channel count, the NUL-terminated channel names,
- * then the values as little-endian IEEE binary32), written as 32 lowercase
- * hex digits plus NUL. It does not depend on the file that holds the image.
+ * width, height, depth, channel count, the level count where it is above 1,
+ * the NUL-terminated channel names, then the values, every level's, as
+ * little-endian IEEE binary32), written as 32 lowercase hex digits plus NUL. It does not depend on the file that holds the image.
  */
 #define SB_HASH_HEX_SIZE 33
 void sb_image_content_hash(const struct sb_image *image, char out[SB_HASH_HEX_SIZE]);

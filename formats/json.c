@@ -150,3 +150,22 @@ enum sb_result sb_json_vec3(const cJSON *item, const char *source, const char *p
     }
     return SB_OK;
 }
+
+enum sb_result sb_json_only_keys(const cJSON *obj, const char *source, const char *section, const char *const *keys)
+{
+    if (!cJSON_IsObject(obj)) {
+        sb_error("%s: %s: expected an object", source, section);
+        return SB_ERR_WRONG_TYPE;
+    }
+    enum sb_result res = sb_json_check_duplicates(obj, source, section);
+    for (const cJSON *item = obj->child; item && !res; item = item->next) {
+        bool known = false;
+        for (const char *const *k = keys; *k; k++)
+            known |= !strcmp(*k, item->string);
+        if (!known) {
+            sb_error("%s: %s.%s: unknown key (see docs/scene.md)", source, section, item->string);
+            res = SB_ERR_UNKNOWN_KEY;
+        }
+    }
+    return res;
+}

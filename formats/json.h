@@ -31,6 +31,10 @@ enum sb_result sb_json_check_duplicates(const cJSON *object, const char *source,
  * (accepts NULL). False when memory or the write failed. */
 bool sb_json_emit(FILE *out, cJSON *root);
 
+/* `obj` must be an object of no keys but `keys` (NULL-terminated), none
+ * twice; logs "source: section.key: reason" otherwise. */
+enum sb_result sb_json_only_keys(const cJSON *obj, const char *source, const char *section, const char *const *keys);
+
 /* A number in [lo, hi]; logs "source: path: reason" otherwise. */
 enum sb_result sb_json_number(const cJSON *item, const char *source, const char *path, double lo, double hi,
                               double *out);

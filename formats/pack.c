@@ -56,16 +56,22 @@ static const struct sb_product_format product_formats[SB_PRODUCT_COUNT] = {
                                SB_FAMILY_PROBES},
     [SB_PRODUCT_DFG] = {"dfg", SB_DFG_SIZE, SB_DFG_SIZE, 1, 2, "dfg.x,dfg.y", "dfg-ggx-smith-nv-roughness-v1", 5,
                         SB_STORAGE_EXR_FLOAT32, "float32", "exr", SB_FAMILY_REFLECTIONS},
+    [SB_PRODUCT_REFLECTION_CUBES] = {"reflection_cubes", 0, 0, 0, 3, "R,G,B", "cube-exr-ggx-filament-lod-v1", 6,
+                                     SB_STORAGE_EXR_CUBE, "float32", "exr", SB_FAMILY_REFLECTIONS},
+    [SB_PRODUCT_REFLECTION_PROBES] = {"reflection_probes", 0, 1, 1, SB_REFLECTION_PROBES_CHANNEL_COUNT,
+                                      SB_REFLECTION_PROBES_CHANNELS, "reflection-probes-sh2-irradiance-v1", 6,
+                                      SB_STORAGE_PROBES, "float32", "sbprobes", SB_FAMILY_REFLECTIONS},
 };
 
 void sb_product_shape(const struct sb_scene *scene, enum sb_product_id id, uint32_t shape[3])
 {
     const struct sb_product_format *f = &product_formats[id];
     const struct sb_family_format *family = sb_family_format(f->family);
-    uint32_t n = family->product_size ? family->product_size(scene, id) : 0;
-    shape[0] = f->width ? f->width : n;
-    shape[1] = f->height ? f->height : n;
-    shape[2] = f->depth ? f->depth : n;
+    shape[0] = f->width;
+    shape[1] = f->height;
+    shape[2] = f->depth;
+    if (family->product_shape)
+        family->product_shape(scene, id, shape);
 }
 
 const struct sb_product_format *sb_product_format(enum sb_product_id id)
@@ -331,8 +337,9 @@ enum sb_result sb_pack_writer_add_image(struct sb_pack_writer *w, struct sb_arti
         w->artifacts[i] = *artifact;
         res = sb_probes_write(path, &artifact->probes, image);
     } else {
-        res = format->storage == SB_STORAGE_VDB_HALF ? sb_vdb_write(path, image, attrs, n)
-                                                     : sb_exr_write(path, image, attrs, n);
+        res = format->storage == SB_STORAGE_VDB_HALF  ? sb_vdb_write(path, image, attrs, n)
+              : format->storage == SB_STORAGE_EXR_CUBE ? sb_exr_cube_write(path, image, attrs, n)
+                                                       : sb_exr_write(path, image, attrs, n);
     }
     if (!res && (res = sb_hash_file(w->tmp_fd, artifact->file, artifact->file_hash)))
         sb_error("%s: cannot read the file back: %s", path, strerror(errno));
@@ -730,6 +737,8 @@ static enum sb_result read_artifact_image(const char *dir, int dir_fd, struct sb
     } else {
         res = format->storage == SB_STORAGE_VDB_HALF
                   ? sb_vdb_read(path, format->channel_names, texels, image, NULL, NULL)
+              : format->storage == SB_STORAGE_EXR_CUBE
+                  ? sb_exr_cube_read(path, format->channel_names, shape[0], shape[2], image)
                   : sb_exr_read(path, format->channel_names, texels, image, NULL, NULL);
     }
     if (res)

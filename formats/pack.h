@@ -18,7 +18,7 @@
 
 /* The version this build writes; it reads this one and every older one
  * (each a subset of the next; docs/pack.md). */
-#define SB_PACK_FORMAT_VERSION 5
+#define SB_PACK_FORMAT_VERSION 6
 #define SB_PACK_FORMAT_VERSION_OLDEST 1
 #define SB_PACK_MANIFEST "manifest.json"
 
@@ -38,6 +38,8 @@ enum sb_product_id {
     SB_PRODUCT_SKY_BOUNCE, /* format version 4 on */
     /* Reflections (format version 5 on). */
     SB_PRODUCT_DFG,
+    SB_PRODUCT_REFLECTION_CUBES,  /* format version 6 on */
+    SB_PRODUCT_REFLECTION_PROBES, /* format version 6 on */
     SB_PRODUCT_COUNT,
 };
 
@@ -64,6 +66,7 @@ enum sb_storage {
     SB_STORAGE_EXR_FLOAT32, /* EXR, FLOAT channels (exr.h) */
     SB_STORAGE_VDB_HALF,    /* OpenVDB, one half-stored FloatGrid per channel (vdb.h) */
     SB_STORAGE_PROBES,      /* skybake's probe file, one fp32 record a probe (probes.h) */
+    SB_STORAGE_EXR_CUBE,    /* EXR, a tiled mip-mapped cube a part, FLOAT channels (exr.h) */
 };
 
 /* What a product's file holds in this format version. */

@@ -75,6 +75,9 @@ static void channel_range(const char *name, double *lo, double *hi)
         /* |B| <= 4 pi max|Y_m| max|g_k| / pi, |g_k| <= pi max|Y_k|: m < 4, k < 9 */
         *lo = -6.7079;
         *hi = 6.7079;
+    } else if (!strncmp(name, "irradiance.", 11)) { /* radiance's units: finite is all that is known */
+        *lo = -3e38;
+        *hi = 3e38;
     } else if (!strcmp(name, "mean_distance_m")) {
         *lo = 0;
     }

@@ -62,6 +62,16 @@
 #define SB_SKY_BOUNCE_CHANNELS SB_BOUNCE_9(0) "," SB_BOUNCE_9(1) "," SB_BOUNCE_9(2) "," SB_BOUNCE_9(3)
 #define SB_SKY_BOUNCE_CHANNEL_COUNT 108
 
+/* The reflection probes' channels (docs/reflections.md): where the probe
+ * is, the box it stands for (min, max corners; the sky-only probe's is
+ * zero), and the order-2 SH of the irradiance its cube sees (the cosine
+ * convolution of its radiance, per colour): channel "irradiance.k.c". */
+#define SB_IRRADIANCE_3(k) "irradiance." #k ".r,irradiance." #k ".g,irradiance." #k ".b"
+#define SB_REFLECTION_PROBES_CHANNELS                                                                                  \
+    "position.x,position.y,position.z,box_min.x,box_min.y,box_min.z,box_max.x,box_max.y,box_max.z," SB_IRRADIANCE_3( \
+        0) "," SB_IRRADIANCE_3(1) "," SB_IRRADIANCE_3(2) "," SB_IRRADIANCE_3(3) "," SB_IRRADIANCE_3(4) "," SB_IRRADIANCE_3(5) "," SB_IRRADIANCE_3(6) "," SB_IRRADIANCE_3(7) "," SB_IRRADIANCE_3(8)
+#define SB_REFLECTION_PROBES_CHANNEL_COUNT 36
+
 /* Where the probes are: a grid (x fastest) then explicit ones. */
 struct sb_probe_layout {
     uint32_t grid[3];

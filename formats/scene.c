@@ -345,14 +345,17 @@ static enum sb_result parse_view(const cJSON *obj, struct sb_scene *scene, const
     }
     enum sb_result res = sb_json_check_duplicates(obj, source, "view");
     for (const cJSON *item = obj->child; item && !res; item = item->next)
-        if (strcmp(item->string, "altitude_km") && strcmp(item->string, "sun_elevation_deg")) {
-            sb_error("%s: view.%s: unknown key (altitude_km, sun_elevation_deg)", source, item->string);
+        if (strcmp(item->string, "altitude_km") && strcmp(item->string, "sun_elevation_deg") &&
+            strcmp(item->string, "sun_azimuth_deg")) {
+            sb_error("%s: view.%s: unknown key (altitude_km, sun_elevation_deg, sun_azimuth_deg)", source, item->string);
             res = SB_ERR_UNKNOWN_KEY;
         }
     if (!res)
         res = view_number(obj, "altitude_km", 0.0, 1e6, source, &scene->view.altitude_km);
     if (!res)
         res = view_number(obj, "sun_elevation_deg", -90.0, 90.0, source, &scene->view.sun_elevation_deg);
+    if (!res)
+        res = view_number(obj, "sun_azimuth_deg", -360.0, 360.0, source, &scene->view.sun_azimuth_deg);
     scene->has_view = true;
     return res;
 }
@@ -378,9 +381,10 @@ static enum sb_result parse_root(const cJSON *root, struct sb_scene *scene, cons
     if (res)
         return res;
     bool have_atmosphere = false, have_products = false;
-    scene->view = (struct sb_scene_view){.altitude_km = 0.002, .sun_elevation_deg = 30.0};
+    scene->view = (struct sb_scene_view){.altitude_km = 0.002, .sun_elevation_deg = 30.0, .sun_azimuth_deg = 150.0};
     sb_cloud_params_default(&scene->clouds);
     sb_probe_params_default(&scene->probes);
+    sb_reflection_params_default(&scene->reflections);
     for (const cJSON *item = root->child; item; item = item->next) {
         if (strcmp(item->string, "version") == 0) {
             if (!cJSON_IsNumber(item)) {
@@ -510,6 +514,8 @@ char *sb_scene_normalized_json(const struct sb_scene *scene)
         cJSON *view = cJSON_AddObjectToObject(root, "view");
         cJSON_AddNumberToObject(view, "altitude_km", scene->view.altitude_km);
         cJSON_AddNumberToObject(view, "sun_elevation_deg", scene->view.sun_elevation_deg);
+        if (scene->view.sun_azimuth_deg != 150.0) /* the default's absence keeps older scenes' hashes */
+            cJSON_AddNumberToObject(view, "sun_azimuth_deg", scene->view.sun_azimuth_deg);
     }
     for (int f = 0; f < SB_FAMILY_COUNT; f++) {
         const struct sb_family_format *family = sb_family_format((enum sb_family)f);

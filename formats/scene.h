@@ -37,6 +37,7 @@ struct sb_atmosphere_params {
 struct sb_scene_view {
     double altitude_km;       /* the camera above the ground, [0, 1e6] */
     double sun_elevation_deg; /* the sun above the horizon, [-90, 90] */
+    double sun_azimuth_deg;   /* clockwise from north (-z), [-360, 360] [150]: skyview's default */
 };
 
 /* A Perlin fBm's lattice period (cells per texture) and octave count. */
@@ -105,6 +106,22 @@ struct sb_probe_params {
 
 void sb_probe_params_default(struct sb_probe_params *params);
 
+/* Reflection probes (docs/reflections.md): the sky-only probe at the
+ * view's altitude, then these, each with the box it stands for. */
+#define SB_REFLECTION_MAX_PROBES 64
+struct sb_reflection_params {
+    uint32_t face_size;    /* texels along a cube face's edge, a power of two in [16, 1024] [128] */
+    uint32_t samples;      /* GGX samples a texel of each rough level, a multiple of 16 in [16, 16384] [512] */
+    uint32_t ambient_rays; /* rays from each captured surface for the sky's light, a multiple of 8 in [8, 1024] [64] */
+    int probe_count;
+    struct {
+        double position_m[3];
+        double box_m[2][3]; /* min, max corners: the box it is parallax-corrected against and blends over */
+    } probes[SB_REFLECTION_MAX_PROBES];
+};
+
+void sb_reflection_params_default(struct sb_reflection_params *params);
+
 struct sb_scene {
     char name[64];
     char preset[32];
@@ -125,6 +142,8 @@ struct sb_scene {
     char directory[1024]; /* the scene file's directory, for the world's file ("" from memory: the current one) */
     bool has_probes;
     struct sb_probe_params probes;
+    bool has_reflections;
+    struct sb_reflection_params reflections;
 };
 
 /* Tolerances a scene may ask for: [SB_TOLERANCE_MIN, SB_TOLERANCE_MAX]. */

@@ -249,19 +249,14 @@ cJSON *sb_clouds_section_json(const struct sb_scene *scene)
     return clouds;
 }
 
-uint32_t sb_clouds_product_size(const struct sb_scene *scene, enum sb_product_id id)
+void sb_clouds_product_shape(const struct sb_scene *scene, enum sb_product_id id, uint32_t shape[3])
 {
     const struct sb_cloud_params *c = &scene->clouds;
-    switch (id) {
-    case SB_PRODUCT_CLOUD_SHAPE:
-        return c->shape_size;
-    case SB_PRODUCT_CLOUD_DETAIL:
-        return c->detail_size;
-    case SB_PRODUCT_CLOUD_CURL:
-        return c->curl_size;
-    case SB_PRODUCT_WEATHER:
-        return c->weather_size;
-    default:
-        return 0;
-    }
+    uint32_t n = id == SB_PRODUCT_CLOUD_SHAPE    ? c->shape_size
+                 : id == SB_PRODUCT_CLOUD_DETAIL ? c->detail_size
+                 : id == SB_PRODUCT_CLOUD_CURL   ? c->curl_size
+                 : id == SB_PRODUCT_WEATHER      ? c->weather_size
+                                                 : 0;
+    for (int k = 0; k < 3; k++)
+        shape[k] = shape[k] ? shape[k] : n;
 }

@@ -14,24 +14,6 @@
 #include "log.h"
 #include "scene.h"
 
-static enum sb_result only_keys(const cJSON *obj, const char *source, const char *section, const char *const *keys)
-{
-    if (!cJSON_IsObject(obj)) {
-        sb_error("%s: %s: expected an object", source, section);
-        return SB_ERR_WRONG_TYPE;
-    }
-    enum sb_result res = sb_json_check_duplicates(obj, source, section);
-    for (const cJSON *item = obj->child; item && !res; item = item->next) {
-        bool known = false;
-        for (const char *const *k = keys; *k; k++)
-            known |= !strcmp(*k, item->string);
-        if (!known) {
-            sb_error("%s: %s.%s: unknown key (see docs/scene.md)", source, section, item->string);
-            res = SB_ERR_UNKNOWN_KEY;
-        }
-    }
-    return res;
-}
 
 enum sb_result sb_world_section_parse(const cJSON *obj, struct sb_scene *scene, const char *source)
 {
@@ -39,7 +21,7 @@ enum sb_result sb_world_section_parse(const cJSON *obj, struct sb_scene *scene, 
     struct sb_world_params *w = &scene->world;
     *w = (struct sb_world_params){.units_m = 1, .scale = 1};
     scene->has_world = true;
-    enum sb_result res = only_keys(obj, source, "world", keys);
+    enum sb_result res = sb_json_only_keys(obj, source, "world", keys);
     if (res)
         return res;
     const cJSON *item = cJSON_GetObjectItemCaseSensitive(obj, "file");
@@ -124,7 +106,7 @@ enum sb_result sb_probes_section_parse(const cJSON *obj, struct sb_scene *scene,
     struct sb_probe_params *p = &scene->probes;
     sb_probe_params_default(p);
     scene->has_probes = true;
-    enum sb_result res = only_keys(obj, source, "probes", keys);
+    enum sb_result res = sb_json_only_keys(obj, source, "probes", keys);
     const cJSON *item;
     if (!res && (item = cJSON_GetObjectItemCaseSensitive(obj, "spacing_m")) &&
         (res = sb_json_number(item, source, "probes.spacing_m", 0, 1000, &p->spacing_m)))

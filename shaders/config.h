@@ -346,4 +346,46 @@ struct sb_probe_push {
     float tmax_m;      /* and see the sky past this distance */
 };
 
+/* Reflection probes (baker/reflection.h, docs/reflections.md). Cube
+ * texels are stored as OpenEXR's cube layout has them (cube.glsl): face f
+ * of an N x 6N image is rows [f N, (f + 1) N), the faces +x, -x, +y, -y,
+ * +z, -z. Buffers hold one vec4 a texel (rgb, then a flag), level by
+ * level of one cube. */
+/* Capture (reflection_capture.comp): one invocation a texel of level 0;
+ * the atmosphere's bindings 0 to 3 (atmosphere.glsl). */
+#define SB_CAPTURE_BINDING_OUT 4       /* rgb radiance; w: 1 where the ray met a back face */
+#define SB_CAPTURE_BINDING_NODES 5     /* the BVH (bvh.glsl) */
+#define SB_CAPTURE_BINDING_TRIANGLES 6
+#define SB_CAPTURE_BINDING_ALBEDO 7    /* one vec4 a material */
+#define SB_CAPTURE_BINDING_SKY_SH 8    /* 9 vec4: the sky's radiance in order-2 SH, rgb */
+#define SB_CAPTURE_BINDING_COUNT 9
+
+struct sb_capture_push {
+    SB_VEC4(origin_m);      /* the probe; w: its altitude, km */
+    SB_VEC4(sun_direction); /* world space, y up */
+    SB_UINT face_size;
+    SB_UINT has_world;      /* 0: the sky alone */
+    SB_UINT ambient_rays;   /* from each hit: a sphere set of 2x this, the surface's side cast */
+    float tmin_m;
+};
+
+/* GGX prefiltering (reflection_prefilter.comp): one invocation a texel of
+ * level `level`, reading the source cube's box-filtered mip chain. */
+#define SB_PREFILTER_BINDING_SOURCE 0 /* the source's levels, vec4 a texel */
+#define SB_PREFILTER_BINDING_OUT 1    /* the output's levels, vec4 a texel */
+#define SB_PREFILTER_BINDING_COUNT 2
+#define SB_PREFILTER_MAX_LEVELS 12
+
+struct sb_prefilter_push {
+    SB_UINT face_size;   /* level 0's */
+    SB_UINT levels;      /* log2 face_size + 1 */
+    SB_UINT level;       /* written by this dispatch */
+    SB_UINT samples;     /* GGX samples a texel (a Hammersley set) */
+    float roughness;     /* perceptual; alpha = roughness^2 */
+    SB_UINT out_offset;  /* the level's first texel in the output */
+    float lod_bias;      /* added to filtered importance sampling's lod */
+    float max_lod;       /* samples read no coarser source level than this */
+    SB_UVEC4(source_offsets[SB_PREFILTER_MAX_LEVELS / 4]); /* each source level's first texel */
+};
+
 #endif

@@ -8,6 +8,7 @@
 
 #define SB_SUN_TRANSMITTANCE_LUT
 #include "atmosphere.glsl"
+#include "sky_radiance.glsl"
 
 layout(std430, set = 0, binding = SB_VIEW_BINDING_FRAME) readonly buffer FrameBuffer {
     sb_frame_gpu frame;
@@ -69,24 +70,6 @@ vec2 sky_view_uv_toward(vec3 d)
     float len = length(d_flat) * length(l_flat);
     float cos_phi = len > 1e-7 ? clamp(dot(d_flat, l_flat) / len, -1.0, 1.0) : 1.0;
     return sky_view_uv(acos(cos_phi), acos(mu), h);
-}
-
-/* Radiance of the sky along a ray from altitude h (km) with view cosine mu,
- * sun cosine mu_s and view-sun cosine nu: single scattering with the baked
- * transmittance toward the sun, multiple scattering from psi_ms, and the
- * lit ground where the ray ends on it. The sun itself is not included. */
-vec3 sky_radiance(float h, float mu, float mu_s, float nu)
-{
-    bool ground = ray_hits_ground(h, mu);
-    RayIntegrals ri = integrate_ray(h, mu, mu_s, nu, ground, true);
-    vec3 sun = atm.solar_irradiance.rgb;
-    vec3 L = sun * (ri.sun_rayleigh * phase_rayleigh(nu) + ri.sun_mie * phase_mie(nu)) + ri.ms_rayleigh + ri.ms_mie;
-    if (ground) {
-        float r = ground_radius() + h;
-        float mu_sp = clamp((r * mu_s + ri.t_end * nu) / ground_radius(), -1.0, 1.0);
-        L += ri.transmittance * atm.ground_albedo.rgb / PI * ground_irradiance_sample(mu_sp);
-    }
-    return L;
 }
 
 /* The sun's disk along a view direction at angle cos_angle from its centre:

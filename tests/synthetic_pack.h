@@ -3,7 +3,7 @@
  * the pack writer: what the pack reader's tests and the manifest fuzzer
  * open. The cloud products are small (the scene's sizes: 16^3, 8^3, 8^2,
  * 8^2); the probes are 5 explicit ones over a world "world.obj" that the
- * pack does not need. `images` (may be NULL) receives each product's image, which the
+ * pack does not need; the reflection cubes 2 of 16^2 a face. `images` (may be NULL) receives each product's image, which the
  * caller finishes; `name` is the scene's and the device's.
  */
 #ifndef SB_TEST_SYNTHETIC_PACK_H
@@ -41,6 +41,14 @@ static inline enum sb_result write_synthetic_pack(const char *dir, const char *n
     scene.has_world = true;
     scene.world = (struct sb_world_params){.file = "world.obj", .units_m = 1, .scale = 1};
     sb_probe_params_default(&scene.probes);
+    sb_reflection_params_default(&scene.reflections);
+    scene.has_reflections = true;
+    scene.reflections.face_size = 16;
+    scene.reflections.probe_count = 1;
+    scene.reflections.probes[0].position_m[1] = 1;
+    scene.reflections.probes[0].box_m[0][1] = -1;
+    for (int k = 0; k < 3; k++)
+        scene.reflections.probes[0].box_m[1][k] = 2;
     struct sb_pack_writer *w = NULL;
     enum sb_result res = sb_pack_writer_create(dir, &w);
     for (int p = 0; p < SB_PRODUCT_COUNT && !res; p++) {
@@ -48,10 +56,11 @@ static inline enum sb_result write_synthetic_pack(const char *dir, const char *n
         uint32_t shape[3];
         sb_product_shape(&scene, (enum sb_product_id)p, shape);
         bool probes = f->storage == SB_STORAGE_PROBES;
-        if (probes)
+        if (probes && !shape[0])
             shape[0] = 5;
         struct sb_image image;
-        if ((res = sb_image_init_volume(&image, shape[0], shape[1], shape[2], f->channel_count)))
+        uint32_t levels = f->storage == SB_STORAGE_EXR_CUBE ? sb_cube_levels(shape[0]) : 1;
+        if ((res = sb_image_init_levels(&image, shape[0], shape[1], shape[2], f->channel_count, levels)))
             break;
         sb_image_set_channel_names(&image, f->channel_names);
         for (uint64_t i = 0; i < sb_image_float_count(&image); i++)

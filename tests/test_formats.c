@@ -87,6 +87,84 @@ static void test_exr_round_trip(void)
     sb_image_finish(&reordered);
 }
 
+/* Cube arrays with their mip chains: bit-exact round trip, the shape
+ * exrheader sees, every hostile variant refused before allocation. */
+static void test_exr_cube(void)
+{
+    struct sb_image img, back;
+    const uint32_t n = 32, cubes = 3;
+    CHECK(sb_cube_levels(32) == 6 && sb_cube_levels(1) == 1 && sb_cube_levels(1024) == 11, "levels");
+    CHECK(sb_image_init_levels(&img, n, 6 * n, cubes, 3, sb_cube_levels(n)) == SB_OK, "init");
+    sb_image_set_channel_names(&img, "R,G,B");
+    CHECK(sb_image_float_count(&img) == (uint64_t)3 * cubes * 6 * (1024 + 256 + 64 + 16 + 4 + 1), "count %llu",
+          (unsigned long long)sb_image_float_count(&img));
+    for (uint64_t i = 0; i < sb_image_float_count(&img); i++)
+        img.data[i] = (float)((double)i * 0.37 - 1e3) * (i % 11 == 0 ? 1e-30f : 1.0f);
+    char path[] = "/tmp/skybake-cube-XXXXXX.exr";
+    int fd = mkstemps(path, 4);
+    close(fd);
+    struct sb_attribute attrs[1] = {{"skybake.product", "reflection_cubes"}};
+    CHECK(sb_exr_cube_write(path, &img, attrs, 1) == SB_OK, "write");
+    CHECK(sb_exr_cube_read(path, "R,G,B", n, cubes, &back) == SB_OK, "read");
+    CHECK(back.levels == img.levels && back.depth == cubes && back.height == 6 * n, "shape");
+    uint64_t first = 0;
+    while (back.data && first < sb_image_float_count(&img) && back.data[first] == img.data[first])
+        first++;
+    CHECK(back.data && first == sb_image_float_count(&img), "data differs from float %llu (%g, not %g)",
+          (unsigned long long)first, back.data ? back.data[first] : 0.0, img.data[first]);
+    char h1[SB_HASH_HEX_SIZE], h2[SB_HASH_HEX_SIZE];
+    sb_image_content_hash(&img, h1);
+    sb_image_content_hash(&back, h2);
+    CHECK(!strcmp(h1, h2), "hash changed by the round trip");
+    /* A mip-less image of the same top level hashes otherwise. */
+    struct sb_image flat = img;
+    flat.levels = 1;
+    sb_image_content_hash(&flat, h2);
+    CHECK(strcmp(h1, h2) != 0, "levels must be hashed");
+    sb_image_finish(&back);
+    /* What the caller does not expect is refused. */
+    CHECK(sb_exr_cube_read(path, "R,G,B", 16, cubes, &back) == SB_ERR_BAD_IMAGE, "other size");
+    CHECK(sb_exr_cube_read(path, "R,G,B", n, 2, &back) == SB_ERR_BAD_IMAGE, "other count");
+    CHECK(sb_exr_cube_read(path, "R,G", n, cubes, &back) == SB_ERR_BAD_IMAGE, "other channels");
+    CHECK(sb_exr_cube_read(path, "R,G,B", 0, cubes, &back) == SB_ERR_BAD_IMAGE, "size 0");
+    CHECK(sb_exr_cube_read(path, "R,G,B", 65536, cubes, &back) == SB_ERR_BAD_IMAGE, "size 65536");
+    CHECK(sb_exr_cube_read(path, "R,G,B", 24, cubes, &back) == SB_ERR_BAD_IMAGE, "not a power of two");
+    /* A scanline EXR is not a cube. */
+    struct sb_image plain;
+    CHECK(sb_image_init(&plain, n, 6 * n, 3) == SB_OK, "plain");
+    sb_image_set_channel_names(&plain, "R,G,B");
+    char path2[] = "/tmp/skybake-plain-XXXXXX.exr";
+    close(mkstemps(path2, 4));
+    CHECK(sb_exr_write(path2, &plain, NULL, 0) == SB_OK, "plain write");
+    CHECK(sb_exr_cube_read(path2, "R,G,B", n, 1, &back) == SB_ERR_BAD_IMAGE, "scanline refused");
+    unlink(path2);
+    sb_image_finish(&plain);
+    /* Every truncated prefix, and flipped bytes past the header, are refused
+     * or read as what the file says (never a crash). */
+    FILE *f = fopen(path, "rb");
+    fseek(f, 0, SEEK_END);
+    long size = ftell(f);
+    rewind(f);
+    unsigned char *bytes = malloc(size);
+    CHECK(fread(bytes, 1, size, f) == (size_t)size, "read back");
+    fclose(f);
+    int accepted = 0;
+    for (long cut = 0; cut < size; cut += (cut < 1024 ? 7 : 331)) {
+        f = fopen(path, "wb");
+        fwrite(bytes, 1, cut, f);
+        fclose(f);
+        struct sb_image t;
+        if (sb_exr_cube_read(path, "R,G,B", n, cubes, &t) == SB_OK) {
+            accepted++;
+            sb_image_finish(&t);
+        }
+    }
+    CHECK(accepted == 0, "%d truncated cube files were accepted", accepted);
+    free(bytes);
+    unlink(path);
+    sb_image_finish(&img);
+}
+
 struct scene_case {
     const char *json;
     enum sb_result expect;
@@ -162,6 +240,32 @@ static void test_scenes(void)
         {EARTH "\"clouds\":{\"weather\":{\"size\":8,\"size\":16}}}", SB_ERR_DUPLICATE_KEY},
         {EARTH "\"clouds\":{\"cloud_curl\":{\"period\":0}}}", SB_ERR_OUT_OF_RANGE},
         {EARTH "\"tolerance\":{\"cloud_shape\":1e-3}}", SB_ERR_OUT_OF_RANGE},
+        /* Reflections. */
+        {EARTH "\"products\":[\"reflection_cubes\"]}", SB_OK},
+        {EARTH "\"reflections\":{\"face_size\":64,\"samples\":256,\"probes\":[{\"position_m\":[0,1,0],"
+               "\"box_m\":[[-5,0,-5],[5,3,5]]}]}}",
+         SB_OK},
+        {EARTH "\"reflections\":{\"probes\":[]}}", SB_OK},
+        {EARTH "\"reflections\":{\"face_size\":0}}", SB_ERR_OUT_OF_RANGE},
+        {EARTH "\"reflections\":{\"face_size\":1}}", SB_ERR_OUT_OF_RANGE},
+        {EARTH "\"reflections\":{\"face_size\":65536}}", SB_ERR_OUT_OF_RANGE},
+        {EARTH "\"reflections\":{\"face_size\":96}}", SB_ERR_OUT_OF_RANGE},
+        {EARTH "\"reflections\":{\"samples\":100}}", SB_ERR_OUT_OF_RANGE},
+        {EARTH "\"reflections\":{\"ambient_rays\":0}}", SB_ERR_OUT_OF_RANGE},
+        {EARTH "\"reflections\":{\"size\":64}}", SB_ERR_UNKNOWN_KEY},
+        {EARTH "\"reflections\":{\"probes\":[{\"position_m\":[0,1,0]}]}}", SB_ERR_MISSING_FIELD},
+        {EARTH "\"reflections\":{\"probes\":[{\"position_m\":[0,1,0],\"box_m\":[[0,0,0],[0,3,5]]}]}}",
+         SB_ERR_OUT_OF_RANGE},
+        {EARTH "\"reflections\":{\"probes\":[{\"position_m\":[0,1,0],\"box_m\":[[5,0,5],[-5,3,-5]]}]}}",
+         SB_ERR_OUT_OF_RANGE},
+        {EARTH "\"reflections\":{\"probes\":[{\"position_m\":[0,9,0],\"box_m\":[[-5,0,-5],[5,3,5]]}]}}",
+         SB_ERR_OUT_OF_RANGE},
+        {EARTH "\"reflections\":{\"probes\":[{\"position_m\":[0,1,0],\"box_m\":[[-5,0],[5,3,5]]}]}}",
+         SB_ERR_WRONG_TYPE},
+        {EARTH "\"reflections\":{\"probes\":{}}}", SB_ERR_WRONG_TYPE},
+        {EARTH "\"tolerance\":{\"reflection_cubes\":1e-2}}", SB_ERR_OUT_OF_RANGE},
+        {EARTH "\"view\":{\"sun_azimuth_deg\":400}}", SB_ERR_OUT_OF_RANGE},
+        {EARTH "\"view\":{\"sun_azimuth_deg\":40}}", SB_OK},
     };
     for (size_t i = 0; i < sizeof(cases) / sizeof(cases[0]); i++) {
         struct sb_scene scene;
@@ -461,6 +565,11 @@ static void edit_version_4(cJSON *r)
 {
     cJSON_ReplaceItemInObject(r, "format_version", cJSON_CreateNumber(4));
 }
+/* Version 5 with the DFG alone of the reflections: what version 5 wrote. */
+static void edit_version_5(cJSON *r)
+{
+    cJSON_ReplaceItemInObject(r, "format_version", cJSON_CreateNumber(5));
+}
 /* What version 1 wrote: no cloud products (in the scene or the pack), no
  * file_hash; the scene's hash recomputed for the scene without clouds. */
 static void edit_make_version_1(cJSON *r)
@@ -480,6 +589,7 @@ static void edit_make_version_1(cJSON *r)
     cJSON_DeleteItemFromObject(scene, "clouds");
     cJSON_DeleteItemFromObject(scene, "probes");
     cJSON_DeleteItemFromObject(scene, "world");
+    cJSON_DeleteItemFromObject(scene, "reflections");
     cJSON *products = cJSON_GetObjectItem(scene, "products");
     while (cJSON_GetArraySize(products) > SB_ATMOSPHERE_PRODUCT_COUNT)
         cJSON_DeleteItemFromArray(products, SB_ATMOSPHERE_PRODUCT_COUNT);
@@ -648,11 +758,18 @@ static void test_pack_reader(void)
         {"one flipped byte in the compressed pixels, vouched for", NULL, FLIP_BYTE, SB_ERR_EXR, true},
         {"format version 1, as version 1 wrote it", edit_make_version_1,
          "rm cloud_shape.vdb cloud_detail.vdb cloud_curl.exr weather.exr sky_visibility.sbprobes sky_bounce.sbprobes "
-         "dfg.exr",
+         "dfg.exr reflection_cubes.exr reflection_probes.sbprobes",
          SB_OK, false},
         {"format version 2 listing sky_visibility", edit_version_2, NULL, SB_ERR_UNKNOWN_PRODUCT, false},
         {"format version 3 listing sky_bounce", edit_version_3, NULL, SB_ERR_UNKNOWN_PRODUCT, false},
         {"format version 4 listing dfg", edit_version_4, NULL, SB_ERR_UNKNOWN_PRODUCT, false},
+        {"format version 5 listing reflection_cubes", edit_version_5, NULL, SB_ERR_UNKNOWN_PRODUCT, false},
+        {"cube file truncated, vouched for", NULL,
+         "head -c 4000 reflection_cubes.exr > t && mv t reflection_cubes.exr", SB_ERR_EXR, true},
+        {"cube file replaced by the DFG's EXR, vouched for", NULL, "cp dfg.exr reflection_cubes.exr",
+         SB_ERR_BAD_IMAGE, true},
+        {"reflection probes truncated, vouched for", NULL,
+         "head -c 200 reflection_probes.sbprobes > t && mv t reflection_probes.sbprobes", SB_ERR_BAD_IMAGE, true},
         {"truncated bounce file, vouched for", NULL, "head -c 300 sky_bounce.sbprobes > t && mv t sky_bounce.sbprobes",
          SB_ERR_BAD_IMAGE, true},
         {"truncated probe file", NULL, "head -c 200 sky_visibility.sbprobes > t && mv t sky_visibility.sbprobes",
@@ -899,6 +1016,7 @@ int main(void)
         sb_log_set_sink(quiet, NULL);
     test_result_codes();
     test_exr_round_trip();
+    test_exr_cube();
     test_half();
     test_vdb();
     test_scenes();

@@ -37,7 +37,7 @@ check "only what was asked for" test ! -e "$tmp/p/transmittance.exr"
 check "verify" expect_exit 0 "$skybake" verify "$tmp/p"
 check "info lists sky_visibility" expect_exit 0 "$skybake" info "$tmp/p"
 check "info shows the grid" grep -q '"grid":\[6,1,6\]' "$tmp/out"
-check "manifest has format_version 5" grep -Eq '"format_version":[[:space:]]*5,' "$tmp/p/manifest.json"
+check "manifest has format_version 6" grep -Eq '"format_version":[[:space:]]*6,' "$tmp/p/manifest.json"
 check "diff with itself" expect_exit 0 "$skybake" diff "$tmp/p" "$tmp/p"
 hash() { sed -n 's/.*"content_hash":[[:space:]]*"\([0-9a-f]*\)".*/\1/p' "$tmp/p/manifest.json"; }
 first=$(hash)
@@ -120,6 +120,32 @@ cp -r "$tmp/p" "$tmp/edited"
 printf '\001' | dd of="$tmp/edited/sky_visibility.sbprobes" bs=1 seek=200 conv=notrunc 2>/dev/null
 check "verify refuses an edited probe file" expect_exit 1 "$skybake" verify "$tmp/edited"
 check "naming it" grep -q "sky_visibility" "$tmp/err"
+
+# Reflection probes over the test world: the cubes open in OpenEXR's own
+# tools as a mip-mapped cube-face map; a probe inside geometry is refused
+# naming it, and nothing is written.
+refl() { # probes-json
+    printf '{"version":1,"name":"refl","atmosphere":{"preset":"earth"},"products":["reflection_probes"],"world":{"file":"%s"},"reflections":{"face_size":16,"samples":64,"ambient_rays":8,"probes":%s}}' \
+        "$root/data/worlds/test.json" "$1"
+}
+refl '[{"position_m":[0,1.5,-20],"box_m":[[-12,0,-40],[12,10,-8]]}]' >"$tmp/r.json"
+check "bake reflection probes" expect_exit 0 "$skybake" bake "$tmp/r.json" -o "$tmp/r"
+check "the cubes are in the pack" test -s "$tmp/r/reflection_cubes.exr"
+check "and the probes' records" test -s "$tmp/r/reflection_probes.sbprobes"
+check "verify the reflection pack" expect_exit 0 "$skybake" verify "$tmp/r"
+if command -v exrheader >/dev/null; then
+    check "exrheader reads the cubes" expect_exit 0 exrheader "$tmp/r/reflection_cubes.exr"
+    check "as cube-face maps" grep -q "envmap (type envmap): cube-face map" "$tmp/out"
+    check "mip-mapped" grep -q "mip-map" "$tmp/out"
+    check "two parts: the sky's probe and the scene's" grep -q "part 1:" "$tmp/out"
+fi
+refl '[{"position_m":[0,0.5,-18],"box_m":[[-12,0,-40],[12,10,-8]]}]' >"$tmp/r_inside.json"
+check "a probe inside the metal box is refused" expect_exit 1 "$skybake" bake "$tmp/r_inside.json" -o "$tmp/r_inside"
+check "naming it" grep -q "reflections.probes\[0\].*inside geometry" "$tmp/err"
+check "and nothing is written" test ! -e "$tmp/r_inside"
+refl '[{"position_m":[0,1,0],"box_m":[[0,0,0],[0,3,5]]}]' >"$tmp/r_flat.json"
+check "a flat box is refused" expect_exit 2 "$skybake" bake "$tmp/r_flat.json" -o "$tmp/r_flat"
+check "naming the field" grep -q "reflections.probes\[0\].box_m" "$tmp/err"
 
 echo "probes cli: $checks checks, $fails failed"
 echo "$((checks - fails)) passed, $fails failed"

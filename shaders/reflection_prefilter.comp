@@ -1,0 +1,102 @@
+#version 450
+// GGX prefiltering of a cube (config.h, sb_prefilter_push), Karis 2013's
+// split-sum form with n = v = r: per texel of level `level`, the mean of
+// L(l) (n.l) over a Hammersley set of half vectors drawn from GGX's
+// D(h) (n.h) at alpha = roughness^2, divided by the sum of n.l, each
+// sample read from the source's box-filtered mip chain at the level whose
+// texels match its share of the lobe (Colbert and Krivanek 2007's filtered
+// importance sampling: lod = 0.5 log2(omega_s / omega_p) + 1). The same
+// set for every texel in a frame that turns smoothly with n: no noise
+// pattern changes across a face's edge, and the source is read across
+// edges by direction, so the result has no seams.
+#extension GL_GOOGLE_include_directive : require
+#include "config.h"
+
+layout(local_size_x = SB_WORKGROUP_X, local_size_y = SB_WORKGROUP_Y) in;
+layout(std430, binding = SB_PREFILTER_BINDING_SOURCE) readonly buffer Source { vec4 source[]; };
+layout(std430, binding = SB_PREFILTER_BINDING_OUT) writeonly buffer Out { vec4 result[]; };
+layout(push_constant) uniform Push { sb_prefilter_push pc; };
+
+#include "cube.glsl"
+
+const float PI = 3.14159265358979;
+
+uint source_offset(uint level)
+{
+    return pc.source_offsets[level / 4u][level % 4u];
+}
+
+// Bilinear within the face (texel centres; clamped at its edges) at one
+// source level.
+vec3 fetch(vec3 d, uint level)
+{
+    uint n = max(pc.face_size >> level, 1u);
+    vec2 uv;
+    uint face = cube_face(d, uv);
+    vec2 p = clamp((uv * 0.5 + 0.5) * float(n) - 0.5, vec2(0.0), vec2(float(n) - 1.0));
+    uvec2 i0 = uvec2(p);
+    uvec2 i1 = min(i0 + 1u, uvec2(n - 1u));
+    vec2 f = p - vec2(i0);
+    uint base = source_offset(level) + face * n * n;
+    vec3 a = source[base + i0.y * n + i0.x].rgb, b = source[base + i0.y * n + i1.x].rgb;
+    vec3 c = source[base + i1.y * n + i0.x].rgb, e = source[base + i1.y * n + i1.x].rgb;
+    vec3 top = a + (b - a) * f.x, bottom = c + (e - c) * f.x;
+    return top + (bottom - top) * f.y; // exact where the texels are equal, unlike mix
+}
+
+vec3 fetch_lod(vec3 d, float lod)
+{
+    float top = float(pc.levels - 1u);
+    lod = clamp(lod, 0.0, top);
+    uint l0 = uint(lod);
+    float f = lod - float(l0);
+    vec3 a = fetch(d, l0);
+    return f > 0.0 ? a + (fetch(d, min(l0 + 1u, pc.levels - 1u)) - a) * f : a;
+}
+
+float radical_inverse(uint i)
+{
+    return float(bitfieldReverse(i)) * 2.3283064365386963e-10;
+}
+
+void main()
+{
+    uvec2 t = gl_GlobalInvocationID.xy;
+    uint n = max(pc.face_size >> pc.level, 1u);
+    if (t.x >= n || t.y >= 6u * n)
+        return;
+    uint face = t.y / n;
+    vec2 uv = (vec2(t.x, t.y - face * n) + 0.5) / float(n) * 2.0 - 1.0;
+    vec3 N = normalize(cube_direction(face, uv));
+    float a = pc.roughness * pc.roughness, a2 = a * a;
+    // A frame about N that turns smoothly except at the poles (Frisvad).
+    vec3 up = abs(N.y) < 0.999 ? vec3(0.0, 1.0, 0.0) : vec3(1.0, 0.0, 0.0);
+    vec3 T = normalize(cross(up, N)), B = cross(N, T);
+    float omega_p = 4.0 * PI / (6.0 * float(pc.face_size) * float(pc.face_size));
+    // Sums of deviations from the cube's mean (its last level): a constant
+    // environment comes out exactly, and rounding is relative to the
+    // lobe's contrast, not its level.
+    vec3 mean = fetch(N, pc.levels - 1u);
+    vec3 sum = vec3(0.0);
+    float weight = 0.0;
+    for (uint i = 0u; i < pc.samples; i++) {
+        float xi = (float(i) + 0.5) / float(pc.samples), phi = 2.0 * PI * radical_inverse(i);
+        // cos^2 theta_h from q = 1 - xi, without cancellation for smooth surfaces
+        float q = 1.0 - xi;
+        float c2 = q / (q + a2 * xi);
+        float ch = sqrt(c2), sh = sqrt(max(1.0 - c2, 0.0));
+        vec3 h = T * (sh * cos(phi)) + B * (sh * sin(phi)) + N * ch;
+        vec3 l = 2.0 * ch * h - N;
+        float nl = dot(N, l);
+        if (nl <= 0.0)
+            continue;
+        // pdf(l) = D(h) (n.h) / (4 v.h) = D / 4 with n = v
+        float d = (c2 * (a2 - 1.0) + 1.0);
+        float D = a2 / (PI * d * d);
+        float omega_s = 4.0 / (float(pc.samples) * D);
+        float lod = min(0.5 * log2(omega_s / omega_p) + pc.lod_bias, pc.max_lod);
+        sum += (fetch_lod(l, lod) - mean) * nl;
+        weight += nl;
+    }
+    result[pc.out_offset + t.y * n + t.x] = vec4(weight > 0.0 ? mean + sum / weight : fetch(N, 0u), 0.0);
+}
