@@ -17,6 +17,7 @@
 
 #include "bvh.h"
 #include "family.h"
+#include "json.h"
 #include "log.h"
 #include "mesh.h"
 #include "parallel.h"
@@ -105,15 +106,6 @@ static enum sb_result raycaster(struct probes_state *st, struct sb_vk *vk)
     if (!st->rc && !(res = sb_bvh_build(&st->mesh, &st->bvh)))
         res = sb_raycaster_create(vk, &st->bvh, &st->rc);
     return res;
-}
-
-/* A path that needs no escaping in JSON (else the settings leave it out). */
-static bool json_safe(const char *s)
-{
-    for (; *s; s++)
-        if (*s == '"' || *s == '\\' || (unsigned char)*s < 0x20)
-            return false;
-    return true;
 }
 
 /* The grid over the world's bounds (or the scene's), centred on them. */
@@ -329,7 +321,7 @@ static enum sb_result bake_visibility(struct probes_state *st, const struct sb_s
              "\"world_hash\":\"%s\",\"world_path\":\"%s\"}",
              layout->ray_count, layout->grid[0], layout->grid[1], layout->grid[2], (double)layout->spacing_m[0],
              layout->explicit_count, mesh->triangle_count, inside, pushed, inside - pushed, deringed, lowest,
-             st->mesh_hash, json_safe(st->path) ? st->path : "");
+             st->mesh_hash, sb_json_safe(st->path) ? st->path : "");
     sb_info("sky_visibility: %u probes over %u triangles; %u inside geometry, %u pushed out; %u deringed", count,
             mesh->triangle_count, inside, pushed, deringed);
 done:

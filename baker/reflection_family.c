@@ -16,6 +16,7 @@
 #include "dfg.h"
 #include "exr.h"
 #include "family.h"
+#include "json.h"
 #include "log.h"
 #include "mesh.h"
 #include "probes.h"
@@ -31,6 +32,7 @@ struct reflection_state {
     bool has_world;
     struct sb_mesh mesh;
     char mesh_hash[SB_HASH_HEX_SIZE];
+    char path[640]; /* the world's file, absolute */
     struct sb_bvh bvh;
     struct sb_raycaster *rc;
     struct sb_atmosphere_baker *atmosphere;
@@ -49,7 +51,7 @@ static enum sb_result reflection_create(struct sb_vk *vk, const struct sb_scene 
     *out = st;
     if (!wants_cubes(scene) || !scene->has_world)
         return SB_OK;
-    enum sb_result res = sb_mesh_load_world(&scene->world, scene->directory, &st->mesh, NULL, 0);
+    enum sb_result res = sb_mesh_load_world(&scene->world, scene->directory, &st->mesh, st->path, sizeof(st->path));
     if (res)
         return res;
     st->has_world = true;
@@ -196,12 +198,10 @@ static enum sb_result bake_cubes(struct reflection_state *st, struct sb_vk *vk, 
     a->gpu_ms = gpu_ms;
     snprintf(a->settings_json, sizeof(a->settings_json),
              "{\"face_size\":%u,\"levels\":%u,\"cubes\":%u,\"samples\":%u,\"ambient_rays\":%u,"
-             "\"roughness\":\"level / (levels - 1) = r (2 - r)\",\"prefilter\":\"GGX importance sampling, "
-             "Hammersley, filtered (Colbert and Krivanek), n = v = r\",\"capture\":\"BVH ray casts; surfaces "
-             "Lambertian, lit by the sun (shadow ray) and the sky (one bounce)\",\"sun_disk\":\"left out: analytic "
-             "at runtime\",\"layout\":\"OpenEXR cube (+x,-x,+y,-y,+z,-z)\",\"most_back_faces\":%.4f,"
-             "\"world_hash\":\"%s\"}",
-             n, levels, cubes, p->samples, p->ambient_rays, worst_back, st->has_world ? st->mesh_hash : "");
+             "\"roughness\":\"l/(levels-1)=r(2-r)\",\"sun_disk\":\"analytic at runtime\",\"most_back_faces\":%.4f,"
+             "\"world_hash\":\"%s\",\"world_path\":\"%s\"}",
+             n, levels, cubes, p->samples, p->ambient_rays, worst_back, st->has_world ? st->mesh_hash : "",
+             st->has_world && sb_json_safe(st->path) ? st->path : "");
 done:
     if (res)
         sb_image_finish(image);

@@ -169,3 +169,11 @@ enum sb_result sb_json_only_keys(const cJSON *obj, const char *source, const cha
     }
     return res;
 }
+
+bool sb_json_safe(const char *s)
+{
+    for (; *s; s++)
+        if (*s == '"' || *s == '\\' || (unsigned char)*s < 0x20)
+            return false;
+    return true;
+}

@@ -57,6 +57,8 @@ static void usage(FILE *f)
                "                          against, else the built-in data/worlds/test.json)\n"
                "  --no-probes             light the world with the sky alone, ignoring the pack's\n"
                "                          sky-visibility probes\n"
+               "  --no-reflections        the sky model's ambient specular, ignoring the pack's\n"
+               "                          reflection probes\n"
                "  --tonemap agx|aces|gt   tone mapper (default agx)\n"
                "  --exposure EV           exposure compensation (default 0)\n"
                "  --no-bloom              no bloom\n"
@@ -186,6 +188,8 @@ static int parse_options(int argc, char **argv, struct options *o)
             o->hdr = true;
         else if (!strcmp(a, "--no-probes"))
             o->params.no_probes = true;
+        else if (!strcmp(a, "--no-reflections"))
+            o->params.no_reflections = true;
         else if (!strcmp(a, "--bench"))
             o->bench = true;
         else if (!strcmp(a, "--device") && next)
@@ -318,36 +322,40 @@ static void settings_string(const char *json, const char *key, char *out, size_t
 }
 
 /*
- * The world to draw: --world, else the world the pack's probes were baked
- * against (its scene's world, read from where the baker read it), else the
- * built-in one. Probes light only the world they were baked for: another
- * world (or the same file changed since) is drawn with the sky alone.
+ * The world to draw: --world, else the world the pack's probes (or its
+ * reflection cubes) were baked against (its scene's world, read from where
+ * the baker read it), else the built-in one. Probes and cubes light only
+ * the world they were baked for: another world (or the same file changed
+ * since) is drawn without them, with a warning.
  */
 static enum sb_result load_world(const struct options *o, const struct sb_pack *pack, struct sb_world *world,
-                                 bool *no_probes)
+                                 struct sb_renderer_params *params)
 {
-    enum sb_result res;
-    const struct sb_artifact *a = &pack->artifacts[SB_PRODUCT_SKY_VISIBILITY];
-    bool probes = pack->present[SB_PRODUCT_SKY_VISIBILITY];
-    char baked_hash[64] = "", baked_path[1024] = "";
-    if (probes) {
-        settings_string(a->settings_json, "world_hash", baked_hash, sizeof(baked_hash));
-        settings_string(a->settings_json, "world_path", baked_path, sizeof(baked_path));
+    static const enum sb_product_id baked_against[] = {SB_PRODUCT_SKY_VISIBILITY, SB_PRODUCT_REFLECTION_CUBES};
+    char hash[2][64] = {"", ""}, baked_path[1024] = "";
+    for (int i = 0; i < 2; i++) {
+        const struct sb_artifact *a = &pack->artifacts[baked_against[i]];
+        if (!pack->present[baked_against[i]])
+            continue;
+        settings_string(a->settings_json, "world_hash", hash[i], sizeof(hash[i]));
+        if (!baked_path[0])
+            settings_string(a->settings_json, "world_path", baked_path, sizeof(baked_path));
     }
+    enum sb_result res;
     if (o->world) {
         res = sb_world_load(o->world, NULL, world);
-    } else if (probes && baked_path[0]) {
-        struct sb_world_params *params = malloc(sizeof(*params));
-        if (!params)
+    } else if (baked_path[0]) {
+        struct sb_world_params *wp = malloc(sizeof(*wp));
+        if (!wp)
             return SB_ERR_NOMEM;
-        *params = pack->scene->world;
-        snprintf(params->file, sizeof(params->file), "%s", baked_path);
+        *wp = pack->scene->world;
+        snprintf(wp->file, sizeof(wp->file), "%s", baked_path);
         struct sb_mesh mesh = {0};
-        res = sb_mesh_load_world(params, "", &mesh, NULL, 0);
+        res = sb_mesh_load_world(wp, "", &mesh, NULL, 0);
         if (!res)
             res = sb_world_from_mesh(&mesh, world);
         sb_mesh_finish(&mesh);
-        free(params);
+        free(wp);
         if (res)
             sb_error("%s: the world its probes were baked against cannot be read; name one with --world", o->pack);
     } else {
@@ -356,10 +364,17 @@ static enum sb_result load_world(const struct options *o, const struct sb_pack *
     }
     if (res)
         return res;
-    if (probes && !o->params.no_probes && strcmp(baked_hash, world->mesh_hash) != 0) {
+    if (pack->present[SB_PRODUCT_SKY_VISIBILITY] && !params->no_probes && strcmp(hash[0], world->mesh_hash) != 0) {
         sb_warn("%s: its probes were baked against another world (%s, not this one's %s): lit by the sky alone",
-                o->pack, baked_hash[0] ? baked_hash : "unrecorded", world->mesh_hash);
-        *no_probes = true;
+                o->pack, hash[0][0] ? hash[0] : "unrecorded", world->mesh_hash);
+        params->no_probes = true;
+    }
+    /* Cubes baked with no world (the sky alone) suit any. */
+    if (pack->present[SB_PRODUCT_REFLECTION_CUBES] && !params->no_reflections && hash[1][0] &&
+        strcmp(hash[1], world->mesh_hash) != 0) {
+        sb_warn("%s: its reflection cubes were captured in another world (%s, not this one's %s): not used", o->pack,
+                hash[1], world->mesh_hash);
+        params->no_reflections = true;
     }
     return SB_OK;
 }
@@ -373,7 +388,7 @@ static int run(const struct options *o)
     }
     struct sb_world world;
     struct sb_renderer_params params = o->params;
-    if (load_world(o, &pack, &world, &params.no_probes)) {
+    if (load_world(o, &pack, &world, &params)) {
         sb_pack_close(&pack);
         return EXIT_USAGE;
     }

@@ -68,8 +68,9 @@ struct sb_renderer {
 
     struct sb_buffer atmosphere, transmittance, multiscattering, irradiance_ground;
     struct sb_buffer frame, vertices, exposure;
-    struct sb_buffer probes, probe_light; /* sb_probes_gpu and its probes; the sky's and probes' SH */
-    uint32_t probe_count;                 /* grid probes lit by the probes pass (0: none) */
+    struct sb_buffer probes, probe_light;           /* sb_probes_gpu and its probes; the sky's and probes' SH */
+    struct sb_buffer reflections, reflection_cubes; /* sb_reflections_gpu, its probes and the DFG; the cubes */
+    uint32_t probe_count;                           /* grid probes lit by the probes pass (0: none) */
     struct sb_buffer read_ldr, read_hdr, read_sky_view;
 
     struct sb_texture sky_view, aerial, aerial_t, shadow, hdr, depth, bloom, ldr;
@@ -132,6 +133,8 @@ static const VkDescriptorType binding_types[SB_VIEW_BINDING_COUNT] = {
     [SB_VIEW_BINDING_LDR] = VK_DESCRIPTOR_TYPE_STORAGE_IMAGE,
     [SB_VIEW_BINDING_PROBES] = VK_DESCRIPTOR_TYPE_STORAGE_BUFFER,
     [SB_VIEW_BINDING_PROBE_LIGHT] = VK_DESCRIPTOR_TYPE_STORAGE_BUFFER,
+    [SB_VIEW_BINDING_REFLECTIONS] = VK_DESCRIPTOR_TYPE_STORAGE_BUFFER,
+    [SB_VIEW_BINDING_REFLECTION_CUBES] = VK_DESCRIPTOR_TYPE_STORAGE_BUFFER,
 };
 
 /* Write every binding of `set`; the bloom step's source and target vary per set. */
@@ -150,6 +153,8 @@ static void write_set(struct sb_renderer *r, VkDescriptorSet set, VkImageView bl
         [SB_VIEW_BINDING_EXPOSURE] = &r->exposure,
         [SB_VIEW_BINDING_PROBES] = &r->probes,
         [SB_VIEW_BINDING_PROBE_LIGHT] = &r->probe_light,
+        [SB_VIEW_BINDING_REFLECTIONS] = &r->reflections,
+        [SB_VIEW_BINDING_REFLECTION_CUBES] = &r->reflection_cubes,
     };
     const VkImageView view_of[SB_VIEW_BINDING_COUNT] = {
         [SB_VIEW_BINDING_SKY_VIEW] = r->sky_view.view,
@@ -409,6 +414,78 @@ static enum sb_result upload_probes(struct sb_renderer *r, const struct sb_pack 
     return SB_OK;
 }
 
+/*
+ * The pack's reflection probes (reflections.glsl), or none: the cubes
+ * reordered from the pack's level-major image to one chain a cube, the
+ * probes' positions and boxes, and the DFG LUT when the pack has it (else
+ * the shader's analytic fit). The sky-only cube's irradiance on an upward
+ * surface, for relighting under another sun.
+ */
+static enum sb_result upload_reflections(struct sb_renderer *r, const struct sb_pack *pack)
+{
+    const struct sb_image *cubes = &pack->images[SB_PRODUCT_REFLECTION_CUBES];
+    const struct sb_image *records = &pack->images[SB_PRODUCT_REFLECTION_PROBES];
+    bool use = pack->present[SB_PRODUCT_REFLECTION_CUBES] && pack->present[SB_PRODUCT_REFLECTION_PROBES] &&
+               !r->params.no_reflections && records->width == cubes->depth && cubes->levels <= 16;
+    bool dfg = use && pack->present[SB_PRODUCT_DFG];
+    uint32_t count = use ? cubes->depth : 0, n = use ? cubes->width : 1, levels = use ? cubes->levels : 1;
+    uint64_t chain = 0;
+    for (uint32_t l = 0; l < levels; l++)
+        chain += 6ull * sb_image_level_size(n, l) * sb_image_level_size(n, l);
+    size_t header_vec4s = (sizeof(struct sb_reflections_gpu) + 15) / 16;
+    size_t vec4s = header_vec4s + 3 * (size_t)count + (dfg ? (size_t)SB_DFG_SIZE * SB_DFG_SIZE : 0);
+    enum sb_result res = upload(r->vk, NULL, vec4s * 16, "reflection probes", &r->reflections);
+    if (!res)
+        res = upload(r->vk, NULL, (use ? chain * count : 1) * 16, "reflection cubes", &r->reflection_cubes);
+    if (res || !use)
+        return res;
+    struct sb_reflections_gpu *g = r->reflections.mapped;
+    g->info[0] = n;
+    g->info[1] = levels;
+    g->info[2] = count;
+    g->info[3] = dfg;
+    double el = pack->scene->view.sun_elevation_deg * M_PI / 180, az = pack->scene->view.sun_azimuth_deg * M_PI / 180;
+    double sun[3];
+    sb_direction(az, el, sun);
+    for (int k = 0; k < 3; k++)
+        g->baked_sun[k] = (float)sun[k];
+    /* E(up) = sum_k E_k Y_k(+y): Y_0 and Y_1 (y) and Y_6 (3 z^2 - 1 = -1) and Y_8 (x^2 - y^2 = -1) */
+    const float *sky = records->data + 9;
+    for (int c = 0; c < 3; c++)
+        g->baked_sky_up[c] = (float)(0.28209479177387814 * sky[c] + 0.4886025119029199 * sky[3 + c] -
+                                     0.31539156525252005 * sky[18 + c] - 0.5462742152960396 * sky[24 + c]);
+    uint64_t at = 0;
+    for (uint32_t l = 0; l < levels; l++) {
+        g->level_offsets[l / 4][l % 4] = (uint32_t)at;
+        at += 6ull * sb_image_level_size(n, l) * sb_image_level_size(n, l);
+    }
+    g->level_offsets[3][3] = (uint32_t)chain;
+    float *data = (float *)r->reflections.mapped + 4 * header_vec4s;
+    for (uint32_t i = 0; i < count; i++)
+        for (int k = 0; k < 9; k++) /* position, box min, box max: the record's first nine channels */
+            data[12 * i + 4 * (k / 3) + k % 3] = records->data[(size_t)i * records->channel_count + k];
+    if (dfg) {
+        const struct sb_image *lut = &pack->images[SB_PRODUCT_DFG];
+        float *d = data + 12 * (size_t)count;
+        for (size_t t = 0; t < (size_t)SB_DFG_SIZE * SB_DFG_SIZE; t++) {
+            d[4 * t] = lut->data[2 * t];
+            d[4 * t + 1] = lut->data[2 * t + 1];
+        }
+    }
+    float *texels = r->reflection_cubes.mapped;
+    for (uint32_t l = 0; l < levels; l++) {
+        uint32_t m = sb_image_level_size(n, l);
+        const float *src = cubes->data + sb_image_level_offset(cubes, l);
+        for (uint32_t i = 0; i < count; i++)
+            for (size_t t = 0; t < 6ull * m * m; t++) {
+                float *o = texels + 4 * (i * chain + g->level_offsets[l / 4][l % 4] + t);
+                memcpy(o, src + 3 * ((size_t)i * 6 * m * m + t), 3 * sizeof(float));
+            }
+    }
+    sb_info("reflections: %u cubes of %u^2, %u levels%s", count, n, levels, dfg ? ", the DFG LUT" : "");
+    return SB_OK;
+}
+
 static enum sb_result create_texture(struct sb_renderer *r, struct sb_texture *t, uint32_t w, uint32_t h,
                                      uint32_t depth, uint32_t layers, uint32_t mips, VkFormat format,
                                      VkImageUsageFlags usage, const char *name)
@@ -557,6 +634,8 @@ enum sb_result sb_renderer_create(struct sb_vk *vk, const struct sb_pack *pack, 
     if (!res)
         res = upload_probes(r, pack, world);
     if (!res)
+        res = upload_reflections(r, pack);
+    if (!res)
         res = upload(vk, NULL, sizeof(struct sb_frame_gpu), "frame constants", &r->frame);
     if (!res)
         res = upload(vk, NULL, SB_HISTOGRAM_BINS * sizeof(uint32_t) + sizeof(struct sb_exposure_gpu), "exposure",
@@ -639,9 +718,10 @@ void sb_renderer_destroy(struct sb_renderer **pr)
                                      &r->hdr,      &r->depth,  &r->bloom,    &r->ldr};
     for (size_t i = 0; i < sizeof(textures) / sizeof(textures[0]); i++)
         sb_texture_destroy(vk, textures[i]);
-    struct sb_buffer *buffers[] = {&r->atmosphere, &r->transmittance, &r->multiscattering, &r->irradiance_ground,
-                                   &r->frame,      &r->vertices,      &r->exposure,        &r->read_ldr,
-                                   &r->read_hdr,   &r->read_sky_view, &r->probes,          &r->probe_light};
+    struct sb_buffer *buffers[] = {&r->atmosphere,  &r->transmittance,   &r->multiscattering, &r->irradiance_ground,
+                                   &r->frame,       &r->vertices,        &r->exposure,        &r->read_ldr,
+                                   &r->read_hdr,    &r->read_sky_view,   &r->probes,          &r->probe_light,
+                                   &r->reflections, &r->reflection_cubes};
     for (size_t i = 0; i < sizeof(buffers) / sizeof(buffers[0]); i++)
         sb_buffer_destroy(vk, buffers[i]);
     free(r);
@@ -718,6 +798,7 @@ static void fill_frame(struct sb_renderer *r, const struct sb_view *v, struct sb
     f->size[0] = r->width;
     f->size[1] = r->height;
     f->size[2] = r->bloom_levels;
+    f->size[3] = (uint32_t)r->params.debug;
 }
 
 static void barrier(VkCommandBuffer cmd)

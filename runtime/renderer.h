@@ -28,6 +28,8 @@ struct sb_renderer_params {
     double exposure_compensation_ev; /* added to the metered exposure; 0: none */
     double bloom_strength;           /* 0: 0.15; negative: no bloom */
     bool no_probes;                  /* light the world with the sky alone even if the pack has probes */
+    bool no_reflections;             /* leave the pack's reflection probes unread (the sky model's specular) */
+    int debug;                       /* SB_DEBUG_* (config.h): the scene pass writes one term; 0: the frame */
 };
 
 /* What one frame looks at. Angles in radians; lengths in metres. */

@@ -157,7 +157,15 @@ struct sb_bake_push {
 #define SB_VIEW_BINDING_LDR 19           /* image2D rgba8: the display-referred frame */
 #define SB_VIEW_BINDING_PROBES 20        /* struct sb_probes_gpu, then 3 vec4 a probe (probes.glsl) */
 #define SB_VIEW_BINDING_PROBE_LIGHT 21   /* the sky's SH, then each probe's irradiance SH (probes.glsl) */
-#define SB_VIEW_BINDING_COUNT 22
+#define SB_VIEW_BINDING_REFLECTIONS 22   /* struct sb_reflections_gpu, then its probes and the DFG LUT */
+#define SB_VIEW_BINDING_REFLECTION_CUBES 23 /* the reflection cubes' texels, vec4 (reflections.glsl) */
+#define SB_VIEW_BINDING_COUNT 24
+
+/* What the scene pass writes (sb_frame_gpu.size.w): the lit frame, or for
+ * tests one term of it, in the pack's radiance units times the frame's
+ * scale, without aerial perspective. */
+#define SB_DEBUG_NONE 0
+#define SB_DEBUG_ENV_SPECULAR 1 /* the ambient specular alone */
 
 #define SB_SKY_VIEW_WIDTH 192 /* azimuth from the sun, 0 to pi */
 #define SB_SKY_VIEW_HEIGHT 108 /* zenith angle, the horizon between rows 53 and 54 */
@@ -198,7 +206,19 @@ struct sb_frame_gpu {
     SB_VEC4(adaptation);       /* x: speed to brighter (1/s), y: to darker (1/s), z: dt (s), w: 1 to snap */
     SB_VEC4(post);             /* x: bloom threshold (exposed), y: bloom strength, z: exposure
                                   compensation (EV), w: tone mapper (SB_TONEMAP_*) */
-    SB_UVEC4(size);            /* xy: frame size; z: bloom levels; w: unused */
+    SB_UVEC4(size);            /* xy: frame size; z: bloom levels; w: SB_DEBUG_* */
+};
+
+/* The reflection probes skyview reads (reflections.glsl): a pack's
+ * reflection_cubes in SB_VIEW_BINDING_REFLECTION_CUBES (cube by cube, each
+ * its chain level by level, faces as OpenEXR lays them, one vec4 a texel)
+ * and, after this header, 3 vec4 a cube (position, box min, box max; the
+ * first is the sky-only probe) and the DFG LUT (SB_DFG_SIZE^2 vec4: x, y). */
+struct sb_reflections_gpu {
+    SB_UVEC4(info);        /* x: face size; y: levels; z: cubes (0: none); w: 1 when the DFG LUT follows */
+    SB_VEC4(baked_sun);    /* xyz: the sun the cubes were captured under; w: unused */
+    SB_VEC4(baked_sky_up); /* rgb: the sky-only cube's irradiance on an upward surface; w: unused */
+    SB_UVEC4(level_offsets[4]); /* each level's first texel in a cube's chain; [3].w: a cube's texels */
 };
 
 /* The sky-visibility probes skyview lights the world with (probes.glsl):

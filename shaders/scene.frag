@@ -10,12 +10,20 @@
  *   without (or outside their grid), irradiance_ground's sky irradiance on an
  *   upward surface and the ground's bounce for downward ones, blended by
  *   (1 +- n.up) / 2; Karis's analytic environment BRDF for the specular part;
+ * - reflections: with the pack's reflection probes (reflections.glsl), the
+ *   ambient specular is their prefiltered radiance, parallax-corrected and
+ *   blended, times the DFG LUT's split sum x + f0 (y - x) and Filament's
+ *   energy compensation 1 + f0 (1 / y - 1); under another sun than the
+ *   cubes were captured under, scaled by the sky's irradiance now over
+ *   then (the sun's own specular is the analytic term above, never in the
+ *   cubes);
  * - aerial perspective: the volume inside its range, else the same
  *   integral per fragment (cameras above the atmosphere, far geometry). */
 #extension GL_GOOGLE_include_directive : require
 #include "config.h"
 #include "view.glsl"
 #include "probes.glsl"
+#include "reflections.glsl"
 
 layout(set = 0, binding = SB_VIEW_BINDING_SHADOW) uniform sampler2DArrayShadow shadow_map;
 layout(set = 0, binding = SB_VIEW_BINDING_AERIAL) uniform sampler3D aerial_inscatter;
@@ -154,7 +162,24 @@ void main()
     vec4 rr = roughness * c0 + c1;
     float a004 = min(rr.x * rr.x, exp2(-9.28 * n_dot_v)) * rr.x + rr.y;
     vec2 env_ab = vec2(-1.04, 1.04) * a004 + rr.zw;
-    color += diffuse_color / PI * e_n + (f0 * env_ab.x + env_ab.y) * l_env;
+    vec3 specular = (f0 * env_ab.x + env_ab.y) * l_env;
+    if (reflections.info.z > 0u) {
+        vec3 world_p = in_offset + frame.camera_m.xyz;
+        vec3 env = reflection_radiance(world_p, refl, roughness);
+        vec2 dfg = reflections.info.w != 0u ? reflection_dfg(n_dot_v, roughness) : vec2(env_ab.y, env_ab.x + env_ab.y);
+        vec3 energy = 1.0 + f0 * (1.0 / max(dfg.y, 1e-3) - 1.0);
+        if (dot(reflections.baked_sun.xyz, l) < 0.99996) { /* another sun: by the sky's light now over then */
+            float then = dot(reflections.baked_sky_up.rgb, vec3(0.2126, 0.7152, 0.0722));
+            float now = dot(e_sky, vec3(0.2126, 0.7152, 0.0722));
+            env *= then > 0.0 ? clamp(now / then, 0.0, 16.0) : 1.0;
+        }
+        specular = env * (dfg.x + f0 * (dfg.y - dfg.x)) * energy;
+    }
+    if (frame.size.w == SB_DEBUG_ENV_SPECULAR) {
+        out_color = vec4(fp16_safe(specular * frame.aerial.y), 1.0);
+        return;
+    }
+    color += diffuse_color / PI * e_n + specular;
 
     vec3 inscatter, transmittance;
     aerial_perspective(in_offset, inscatter, transmittance);
