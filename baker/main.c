@@ -41,6 +41,7 @@ static void usage(FILE *f)
                "       skybake info PACK [--json]\n"
                "       skybake verify PACK [--json]\n"
                "       skybake diff A B [--tol REL] [--floor F] [--json]\n"
+               "       skybake preview PACK OUT.png\n"
                "       skybake --version | --help\n"
                "\n"
                "Bakes what SCENE (JSON, see docs/scene.md) needs into the pack OUT_DIR:\n"
@@ -48,7 +49,9 @@ static void usage(FILE *f)
                "cloud volumes (baked when the scene lists them, as earth-clouds.json does),\n"
                "probe files for the sky-visibility probes and their bounce over the scene's\n"
                "world (a mesh assimp reads, or a skybake world file: ifc-house.json,\n"
-               "outdoor.json), and the reflections' DFG LUT (EXR) when listed.\n"
+               "outdoor.json), and the reflections when listed: the DFG LUT (EXR), the\n"
+               "reflection probes' prefiltered cubes (tiled mip-mapped cube EXRs) and their\n"
+               "records with irradiance SH (reflections.json; docs/reflections.md).\n"
                "The pack is replaced atomically;\n"
                "a failed bake leaves the previous pack as it was. Baking into a pack\n"
                "reuses every artifact whose bake key (its parameters, settings, kernels\n"
@@ -99,6 +102,10 @@ static void usage(FILE *f)
                "(default 1e-3); --tol REL (default 0). Exit 0 identical, 1 within\n"
                "tolerance, 5 different, 6 an artifact missing from one pack (the worst\n"
                "artifact decides), 2 usage or a pack that does not verify.\n"
+               "\n"
+               "preview: a contact sheet of PACK's reflection cubes as a PNG: a block a\n"
+               "cube, a row a mip (sharp to rough), the six faces as stored (+x -x +y -y\n"
+               "+z -z), one exposure for the sheet. Exit 2 if the pack has no cubes.\n"
                "\n"
                "exit codes: 0 ok, 1 bake failed, 2 usage or scene error, 3 no Vulkan device,\n"
                "            4 validation messages\n");
@@ -426,7 +433,10 @@ static bool pack_args(int argc, char **argv, const char *command, const char **d
         }
     }
     if (n < count) {
-        fprintf(stderr, "skybake: %s needs %s\n", command, count == 1 ? "a PACK" : "two packs, A and B");
+        fprintf(stderr, "skybake: %s needs %s\n", command,
+                count == 1                ? "a PACK"
+                : !strcmp(command, "diff") ? "two packs, A and B"
+                                           : "a PACK and an OUT.png");
         return false;
     }
     return true;
@@ -456,6 +466,27 @@ static int cmd_verify(int argc, char **argv)
     if (!pack_args(argc, argv, "verify", &dir, 1, &json, NULL, NULL))
         return EXIT_USAGE;
     return sb_pack_verify_print(dir, json) ? EXIT_BAKE_FAILED : 0;
+}
+
+static int cmd_preview(int argc, char **argv)
+{
+    const char *args[2];
+    bool json = false;
+    if (!pack_args(argc, argv, "preview", args, 2, &json, NULL, NULL))
+        return EXIT_USAGE;
+    struct sb_pack pack;
+    enum sb_result res = sb_pack_open(args[0], &pack);
+    if (res) {
+        sb_error("%s: not a valid pack (%s)", args[0], sb_result_name(res));
+        return EXIT_USAGE;
+    }
+    res = sb_pack_contact_sheet(&pack, args[1]);
+    sb_pack_close(&pack);
+    if (res)
+        return res == SB_ERR_USAGE ? EXIT_USAGE : EXIT_BAKE_FAILED;
+    if (!json)
+        printf("wrote %s\n", args[1]);
+    return 0;
 }
 
 static int cmd_diff(int argc, char **argv)
@@ -534,6 +565,8 @@ int main(int argc, char **argv)
         return cmd_verify(argc - 2, argv + 2);
     if (!strcmp(argv[1], "diff"))
         return cmd_diff(argc - 2, argv + 2);
+    if (!strcmp(argv[1], "preview"))
+        return cmd_preview(argc - 2, argv + 2);
     if (!strcmp(argv[1], "sky-error"))
         return cmd_sky_error(argc - 2, argv + 2);
     fprintf(stderr, "skybake: unknown command '%s'\n", argv[1]);

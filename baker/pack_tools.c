@@ -9,6 +9,7 @@
 
 #include "json.h"
 #include "log.h"
+#include "pngfile.h"
 #include "scene.h"
 
 static long long file_bytes(const char *dir, const char *file)
@@ -288,4 +289,57 @@ void sb_pack_diff_print(const struct sb_pack *a, const char *dir_a, const struct
         sb_json_emit(stdout, root);
     else
         printf("outcome: %s\n", sb_diff_outcome_name(worst));
+}
+
+#define SHEET_FACE 48
+#define SHEET_GAP 2
+
+static uint8_t srgb8(double linear)
+{
+    double v = linear <= 0.0031308 ? 12.92 * linear : 1.055 * pow(linear, 1 / 2.4) - 0.055;
+    return (uint8_t)lrint(fmin(fmax(v, 0.0), 1.0) * 255.0);
+}
+
+enum sb_result sb_pack_contact_sheet(const struct sb_pack *pack, const char *png_path)
+{
+    if (!pack->present[SB_PRODUCT_REFLECTION_CUBES]) {
+        sb_error("%s: the pack has no reflection_cubes to draw", png_path);
+        return SB_ERR_USAGE;
+    }
+    const struct sb_image *cubes = &pack->images[SB_PRODUCT_REFLECTION_CUBES];
+    uint32_t n = cubes->width, levels = cubes->levels ? cubes->levels : 1, count = cubes->depth;
+    uint32_t cell = SHEET_FACE + SHEET_GAP;
+    uint32_t width = 6 * cell + SHEET_GAP, height = count * (levels * cell + 3 * SHEET_GAP) + SHEET_GAP;
+    double log_sum = 0;
+    for (size_t t = 0; t < (size_t)6 * n * n; t++) {
+        const float *c = cubes->data + 3 * t;
+        log_sum += log(fmax(0.2126 * c[0] + 0.7152 * c[1] + 0.0722 * c[2], 1e-9));
+    }
+    double exposure = 0.18 / exp(log_sum / (6.0 * n * n));
+    uint8_t *rgba = malloc((size_t)width * height * 4);
+    if (!rgba)
+        return SB_ERR_NOMEM;
+    for (size_t i = 0; i < (size_t)width * height; i++) { /* a dark grey ground */
+        rgba[4 * i] = rgba[4 * i + 1] = rgba[4 * i + 2] = 32;
+        rgba[4 * i + 3] = 255;
+    }
+    for (uint32_t i = 0; i < count; i++)
+        for (uint32_t l = 0; l < levels; l++) {
+            uint32_t m = sb_image_level_size(n, l);
+            const float *level = cubes->data + sb_image_level_offset(cubes, l) + (size_t)i * 6 * m * m * 3;
+            uint32_t y0 = SHEET_GAP + i * (levels * cell + 3 * SHEET_GAP) + l * cell;
+            for (uint32_t f = 0; f < 6; f++)
+                for (uint32_t y = 0; y < SHEET_FACE; y++)
+                    for (uint32_t x = 0; x < SHEET_FACE; x++) {
+                        const float *c = level + 3 * (((size_t)f * m + y * m / SHEET_FACE) * m + x * m / SHEET_FACE);
+                        uint8_t *o = rgba + 4 * ((size_t)(y0 + y) * width + SHEET_GAP + f * cell + x);
+                        for (int k = 0; k < 3; k++) {
+                            double v = c[k] * exposure;
+                            o[k] = srgb8(v / (1 + v));
+                        }
+                    }
+        }
+    enum sb_result res = sb_png_write(png_path, width, height, rgba);
+    free(rgba);
+    return res;
 }

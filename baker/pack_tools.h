@@ -13,6 +13,16 @@
 
 #include "pack.h"
 
+/*
+ * A contact sheet of the pack's reflection cubes as an 8-bit sRGB PNG: a
+ * block a cube (the sky-only probe's first), a row a mip (sharp to rough),
+ * each row the six faces as the file stores them (+x, -x, +y, -y, +z, -z),
+ * every face drawn 48 x 48 (nearest texel) with 2-pixel gaps; one exposure
+ * for the sheet (the first cube's level 0 mean luminance to 0.18),
+ * x / (1 + x) per channel. SB_ERR_USAGE when the pack has no cubes.
+ */
+enum sb_result sb_pack_contact_sheet(const struct sb_pack *pack, const char *png_path);
+
 /* Print the open pack read from `dir` as a table, or as one JSON object, on stdout. */
 void sb_pack_info_print(const struct sb_pack *pack, const char *dir, bool json);
 

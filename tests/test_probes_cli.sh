@@ -139,6 +139,10 @@ if command -v exrheader >/dev/null; then
     check "mip-mapped" grep -q "mip-map" "$tmp/out"
     check "two parts: the sky's probe and the scene's" grep -q "part 1:" "$tmp/out"
 fi
+check "a contact sheet of the cubes" expect_exit 0 "$skybake" preview "$tmp/r" "$tmp/sheet.png"
+check "is a PNG" sh -c "head -c 8 '$tmp/sheet.png' | od -An -c | grep -q 'P   N   G'"
+check "preview of a pack without cubes is refused" expect_exit 2 "$skybake" preview "$tmp/p" "$tmp/none.png"
+check "and writes nothing" test ! -e "$tmp/none.png"
 refl '[{"position_m":[0,0.5,-18],"box_m":[[-12,0,-40],[12,10,-8]]}]' >"$tmp/r_inside.json"
 check "a probe inside the metal box is refused" expect_exit 1 "$skybake" bake "$tmp/r_inside.json" -o "$tmp/r_inside"
 check "naming it" grep -q "reflections.probes\[0\].*inside geometry" "$tmp/err"
