@@ -326,6 +326,8 @@ enum sb_result sb_bench_run(struct sb_vk *vk, const struct sb_atmosphere_params 
         res = bench_clouds(vk, params, repeat, times, report);
     if (!res && params->probes)
         res = sb_bench_probes(vk, params, report);
+    if (!res && params->reflection)
+        res = sb_bench_reflection(vk, atmosphere, params, report);
     if (!res)
         mark_pareto(report->rows, report->row_count);
     sb_image_finish(&image);
@@ -456,6 +458,7 @@ void sb_bench_print(const struct sb_bench_report *report, const struct sb_vk *vk
     }
     if (!report->cloud_row_count) {
         sb_bench_probes_print(report);
+        sb_bench_reflection_print(report);
         return;
     }
     printf("\ncloud noise (the GPU against the CPU reference on one core, every value compared)\n");
@@ -474,6 +477,7 @@ void sb_bench_print(const struct sb_bench_report *report, const struct sb_vk *vk
     }
     printf("  %-14s %-12s %11.4f %11s %14.1f %9.1f\n", "all", "", gpu, "", ref, ref / fmax(gpu, 1e-9));
     sb_bench_probes_print(report);
+    sb_bench_reflection_print(report);
 }
 
 static enum sb_result write_text(const char *dir, const char *name, const char *text)
@@ -653,6 +657,11 @@ enum sb_result sb_bench_write(const struct sb_bench_report *report, const struct
         char path[4200];
         snprintf(path, sizeof(path), "%s/bench_probes.csv", dir);
         res = sb_bench_probes_csv(report, path);
+    }
+    if (!res && report->reflection_row_count) {
+        char path[4200];
+        snprintf(path, sizeof(path), "%s/bench_reflection.csv", dir);
+        res = sb_bench_reflection_csv(report, path);
     }
     if (!res) {
         cJSON *root = report_json(report, vk);

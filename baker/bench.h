@@ -21,6 +21,7 @@
 #include "accuracy.h"
 #include "atmosphere.h"
 #include "context.h"
+#include "mesh.h"
 #include "scene.h"
 
 /* The sweeps: one per product, and one of transmittance's resolution
@@ -70,10 +71,25 @@ struct sb_bench_probe_row {
     double bounce_ms; /* sky_bounce at the same probes, the defaults (median of the repeats) */
 };
 
+/* reflection_cubes' prefilter (bench_reflection.c): one setting's GPU time
+ * and its error against the fp64 reference per mip. */
+#define SB_BENCH_MAX_MIPS 12
+struct sb_bench_reflection_row {
+    char label[48];
+    const char *anchor;     /* the published setting this row reproduces, or NULL */
+    bool is_default, pareto;
+    uint32_t samples_first, samples_last; /* a texel's at mip 1 and at the last */
+    double gpu_ms, gpu_ms_min;
+    double rms[SB_BENCH_MAX_MIPS], max[SB_BENCH_MAX_MIPS]; /* relative, per mip (0: the source) */
+    double worst_rms, worst_max;                            /* over mips 1.. */
+};
+
 struct sb_bench_params {
     bool sweeps[SB_BENCH_SWEEP_COUNT]; /* which to run */
     bool clouds[SB_PRODUCT_COUNT];     /* which cloud products to time */
     bool probes;                       /* sky_visibility */
+    bool reflection;                   /* reflection_cubes' prefilter */
+    uint32_t reflection_face;          /* its cube's face size (0: 256, 64 with quick) */
     struct sb_cloud_params cloud_params;
     int repeat; /* bakes per setting; the median is reported */
     bool quick; /* only the settings marked quick (meson's benchmark) */
@@ -88,8 +104,21 @@ struct sb_bench_report {
     struct sb_bench_cloud_row cloud_rows[SB_PRODUCT_COUNT - SB_ATMOSPHERE_PRODUCT_COUNT];
     int probe_row_count;
     struct sb_bench_probe_row probe_rows[2];
+    int reflection_row_count;
+    struct sb_bench_reflection_row reflection_rows[16];
+    uint32_t reflection_face, reflection_levels;
+    double reflection_capture_ms, reflection_reference_s;
 };
 
+/* bench_probes.c: also the terrain (rolling hills over 2 km, (n - 1)^2 x 2
+ * triangles) and the median of n values (sorted in place) the benches share. */
+enum sb_result sb_bench_terrain(uint32_t n, struct sb_mesh *mesh);
+double sb_bench_median(double *v, int n);
+/* bench_reflection.c */
+enum sb_result sb_bench_reflection(struct sb_vk *vk, const struct sb_atmosphere_params *atmosphere,
+                                   const struct sb_bench_params *params, struct sb_bench_report *report);
+void sb_bench_reflection_print(const struct sb_bench_report *report);
+enum sb_result sb_bench_reflection_csv(const struct sb_bench_report *report, const char *path);
 /* bench_probes.c */
 enum sb_result sb_bench_probes(struct sb_vk *vk, const struct sb_bench_params *params, struct sb_bench_report *report);
 void sb_bench_probes_print(const struct sb_bench_report *report);

@@ -31,8 +31,7 @@ static double now_s(void)
     return ts.tv_sec + ts.tv_nsec * 1e-9;
 }
 
-/* Rolling hills over 2 km, (n - 1)^2 x 2 triangles. */
-static enum sb_result terrain(uint32_t n, struct sb_mesh *mesh)
+enum sb_result sb_bench_terrain(uint32_t n, struct sb_mesh *mesh)
 {
     uint32_t material;
     double albedo[3] = {0.2, 0.25, 0.15};
@@ -54,8 +53,7 @@ static enum sb_result terrain(uint32_t n, struct sb_mesh *mesh)
     return res;
 }
 
-/* The median of n values (sorted in place: a handful). */
-static double median_of(double *v, int n)
+double sb_bench_median(double *v, int n)
 {
     for (int a = 1; a < n; a++)
         for (int b = a; b > 0 && v[b] < v[b - 1]; b--) {
@@ -122,8 +120,8 @@ static enum sb_result bench_one(struct sb_vk *vk, const char *name, struct sb_me
         }
     }
     if (!res) {
-        row->gpu_ms = median_of(times, repeat);
-        row->bounce_ms = median_of(bounce_times, repeat);
+        row->gpu_ms = sb_bench_median(times, repeat);
+        row->bounce_ms = sb_bench_median(bounce_times, repeat);
         row->bounce_rays = bounce.ray_count;
         row->bounce_secondary = bounce.secondary;
     }
@@ -196,7 +194,7 @@ enum sb_result sb_bench_probes(struct sb_vk *vk, const struct sb_bench_params *p
     } else {
         sb_warn("bench: %s is missing (Debian's assimp-testmodels): no IFC house row", BENCH_IFC_HOUSE);
     }
-    if (!res && !(res = terrain(params->quick ? 201 : 709, &mesh)))
+    if (!res && !(res = sb_bench_terrain(params->quick ? 201 : 709, &mesh)))
         res = bench_one(vk, params->quick ? "terrain-80k" : "terrain-1M", &mesh, rays, repeat,
                         &report->probe_rows[report->probe_row_count++]);
     sb_mesh_finish(&mesh);

@@ -76,9 +76,12 @@ static void usage(FILE *f)
                "SCENE's sizes), timed against its CPU reference on one core; and\n"
                "sky_visibility: 4096 probes' rays per second on the device against Embree's\n"
                "on every core, over the IFC house and a terrain of a million triangles,\n"
-               "and sky_bounce's GPU time at the same probes (rays / 8 x rays / 32; 64 x 8 with --quick)\n"
+               "and sky_bounce's GPU time at the same probes (rays / 8 x rays / 32; 64 x 8 with --quick);\n"
+               "reflection (or reflection_cubes): the prefilter's GPU time against its error per\n"
+               "mip for sample counts and Karis's and Filament's settings, on a 256^2 cube (64^2\n"
+               "with --quick, --face N to choose) captured above the terrain\n"
                "(default: all). -o DIR writes bench.csv, bench.json, bench.svg (gnuplot),\n"
-               "bench_clouds.csv, bench_probes.csv.\n"
+               "bench_clouds.csv, bench_probes.csv, bench_reflection.csv.\n"
                "--repeat N bakes each setting N times (default 3) and reports the median;\n"
                "--quick runs a short sweep (the meson benchmark).\n"
                "\n"
@@ -245,6 +248,10 @@ static int cmd_bench(int argc, char **argv)
                 params.probes = any = true;
                 continue;
             }
+            if (!strcmp(argv[i], "reflection") || (known && id == SB_PRODUCT_REFLECTION_CUBES)) {
+                params.reflection = any = true;
+                continue;
+            }
             if (!sb_bench_sweep_from_name(argv[i], &sweep)) {
                 fprintf(stderr, "skybake: bench: unknown product '%s'\n", argv[i]);
                 return EXIT_USAGE;
@@ -260,6 +267,14 @@ static int cmd_bench(int argc, char **argv)
             params.repeat = (int)n;
         } else if (!strcmp(a, "--quick")) {
             params.quick = true;
+        } else if (!strcmp(a, "--face") && i + 1 < argc) {
+            char *end;
+            long n = strtol(argv[++i], &end, 10);
+            if (*end || n < 16 || n > 1024 || (n & (n - 1))) {
+                fprintf(stderr, "skybake: bench: --face takes a power of two in [16, 1024]\n");
+                return EXIT_USAGE;
+            }
+            params.reflection_face = (uint32_t)n;
         } else if (a[0] == '-' && a[1]) {
             fprintf(stderr, "skybake: unknown or incomplete option '%s'\n", a);
             usage(stderr);
@@ -277,6 +292,7 @@ static int cmd_bench(int argc, char **argv)
         for (int p = 0; p < SB_PRODUCT_COUNT; p++)
             params.clouds[p] = sb_product_format((enum sb_product_id)p)->family == SB_FAMILY_CLOUDS;
         params.probes = true;
+        params.reflection = true;
     }
     struct sb_scene scene = {0};
     if (scene_path && sb_scene_load(scene_path, &scene))

@@ -85,9 +85,10 @@ done:
     return res;
 }
 
-enum sb_result sb_reflection_prefilter(struct sb_vk *vk, const float *level0, uint32_t n, uint32_t samples, float *out,
-                                       double *gpu_ms)
+enum sb_result sb_reflection_prefilter(struct sb_vk *vk, const float *level0, uint32_t n,
+                                       const struct sb_prefilter_params *params, float *out, double *gpu_ms)
 {
+    uint32_t samples = params->samples;
     uint32_t levels = sb_cube_levels(n);
     if (levels > SB_PREFILTER_MAX_LEVELS || !samples) {
         sb_error("reflection prefilter: %u levels (at most %d) or no samples", levels, SB_PREFILTER_MAX_LEVELS);
@@ -114,12 +115,18 @@ enum sb_result sb_reflection_prefilter(struct sb_vk *vk, const float *level0, ui
     const struct sb_buffer *bindings[SB_PREFILTER_BINDING_COUNT] = {
         [SB_PREFILTER_BINDING_SOURCE] = &source, [SB_PREFILTER_BINDING_OUT] = &result};
     sb_pipeline_bind(vk, &pipeline, bindings);
-    /* No bias on Colbert and Krivanek's lod (their +1 blurs: 2 to 4 times
-     * the error against the reference), and no source level of faces
-     * under 4 texels (a rough lobe read from 1 x 1 faces is six flat
+    /* skybake's: no bias on Colbert and Krivanek's lod (their +1 blurs: 2
+     * to 4 times the error against the reference), and no source level of
+     * faces under 4 texels (a rough lobe read from 1 x 1 faces is six flat
      * patches). */
     struct sb_prefilter_push pc = {
-        .face_size = n, .levels = levels, .lod_bias = 0.0f, .max_lod = levels > 3 ? (float)(levels - 3) : 0.0f};
+        .face_size = n,
+        .levels = levels,
+        .lod_bias = params->lod_bias,
+        .max_lod = params->unfiltered ? 0.0f
+                   : levels > 3       ? (float)(levels - 3)
+                                      : 0.0f,
+    };
     for (uint32_t l = 0; l < levels; l++)
         pc.source_offsets[l / 4][l % 4] = (uint32_t)sb_cube_level_offset(n, l);
     double total = 0;
@@ -127,7 +134,7 @@ enum sb_result sb_reflection_prefilter(struct sb_vk *vk, const float *level0, ui
         uint32_t m = n >> l;
         double ms = 0;
         pc.level = l;
-        pc.samples = sb_reflection_level_samples(samples, l);
+        pc.samples = params->constant_samples ? samples : sb_reflection_level_samples(samples, l);
         pc.roughness = (float)sb_reflection_level_roughness(l, levels);
         pc.out_offset = (uint32_t)sb_cube_level_offset(n, l);
         res = sb_dispatch(vk, &pipeline, &pc, (m + SB_WORKGROUP_X - 1) / SB_WORKGROUP_X,

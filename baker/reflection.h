@@ -49,12 +49,20 @@ struct sb_capture_params {
 enum sb_result sb_reflection_capture(struct sb_vk *vk, const struct sb_capture_inputs *in,
                                      const struct sb_capture_params *params, float *out, double *gpu_ms);
 
-/* The prefiltered chain of one cube from its level 0 (rgba texels, 6 n^2),
- * `samples` GGX samples a texel at each level above 0 (level 0 is the
- * source itself, a mirror). out: every level, rgba texels, level by level
- * (sb_cube_level_offset). */
-enum sb_result sb_reflection_prefilter(struct sb_vk *vk, const float *level0, uint32_t face_size, uint32_t samples,
-                                       float *out, double *gpu_ms);
+/* How a cube is prefiltered: skybake's way (zero but `samples`), or the
+ * published ones the bench compares with. */
+struct sb_prefilter_params {
+    uint32_t samples;      /* GGX samples a texel at mip 1 */
+    bool constant_samples; /* the same count at every mip (else doubling per mip, sb_reflection_level_samples) */
+    float lod_bias;        /* added to the filtered lookup's lod (Colbert and Krivanek's, Filament's: 1) */
+    bool unfiltered;       /* every sample reads level 0 (Karis 2013) */
+};
+
+/* The prefiltered chain of one cube from its level 0 (rgba texels, 6 n^2);
+ * level 0 is the source itself, a mirror. out: every level, rgba texels,
+ * level by level (sb_cube_level_offset); *gpu_ms the dispatches' time. */
+enum sb_result sb_reflection_prefilter(struct sb_vk *vk, const float *level0, uint32_t face_size,
+                                       const struct sb_prefilter_params *params, float *out, double *gpu_ms);
 
 /* The order-2 SH of a cube's level 0 (rgba texels) by exact texel solid
  * angles; the irradiance's (cosine-convolved) when `irradiance`. */

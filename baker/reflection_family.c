@@ -181,7 +181,8 @@ static enum sb_result bake_cubes(struct reflection_state *st, struct sb_vk *vk, 
             res = SB_ERR_OUT_OF_RANGE;
             break;
         }
-        if ((res = sb_reflection_prefilter(vk, level0, n, p->samples, filtered, &ms)))
+        const struct sb_prefilter_params pp = {.samples = p->samples};
+        if ((res = sb_reflection_prefilter(vk, level0, n, &pp, filtered, &ms)))
             break;
         gpu_ms += ms;
         for (uint32_t l = 0; l < levels; l++) {

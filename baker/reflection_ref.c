@@ -34,6 +34,9 @@ void sb_reflection_reference(const float *level0, uint32_t n, const double nd[3]
         return;
     }
     double a2 = r * r * r * r;
+    /* Past tan theta_h = 100 alpha, D is below 1e-8 of its peak: what lies
+     * there weighs under 2e-4 of the lobe even over a whole hemisphere. */
+    double t2 = 1e4 * a2, nl_min = fmax(2.0 / (1.0 + t2) - 1.0, 0.0);
     double sum[3] = {0, 0, 0}, weight = 0;
     uint32_t m = n * (uint32_t)sub;
     double step = 2.0 / m;
@@ -45,7 +48,7 @@ void sb_reflection_reference(const float *level0, uint32_t n, const double nd[3]
                 sb_cube_direction(f, u, v, l);
                 double len = sqrt(l[0] * l[0] + l[1] * l[1] + l[2] * l[2]);
                 double nl = (nd[0] * l[0] + nd[1] * l[1] + nd[2] * l[2]) / len;
-                if (nl <= 0)
+                if (nl <= nl_min)
                     continue;
                 /* n.h with h = normalize(n + l): cos^2 = (1 + n.l) / 2 */
                 double c2 = 0.5 * (1 + nl), d = c2 * (a2 - 1) + 1;

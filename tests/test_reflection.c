@@ -110,7 +110,8 @@ static void seam_jumps(const float *chain, uint32_t l, double *across, double *i
 static float *prefilter(struct sb_vk *vk, const float *level0, uint32_t samples)
 {
     float *chain = calloc(sb_cube_level_offset(N, LEVELS) * 4, sizeof(float));
-    CHECK(sb_reflection_prefilter(vk, level0, N, samples, chain, NULL) == SB_OK, "prefilter");
+    const struct sb_prefilter_params params = {.samples = samples};
+    CHECK(sb_reflection_prefilter(vk, level0, N, &params, chain, NULL) == SB_OK, "prefilter");
     return chain;
 }
 
