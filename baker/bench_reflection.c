@@ -161,6 +161,7 @@ enum sb_result sb_bench_reflection(struct sb_vk *vk, const struct sb_atmosphere_
         res = capture(vk, atmosphere, n, level0, &report->reflection_capture_ms);
     if (res)
         goto done;
+    struct sb_reflection_kernels kernels = {0};
     pick_texels(n, levels, texels);
     double t0 = now_s();
     struct ref_job job = {.level0 = level0, .n = n, .levels = levels, .texels = texels};
@@ -194,7 +195,8 @@ enum sb_result sb_bench_reflection(struct sb_vk *vk, const struct sb_atmosphere_
         const struct sb_prefilter_params pp = {.samples = settings[s].samples,
                                                .constant_samples = settings[s].constant,
                                                .lod_bias = settings[s].bias,
-                                               .unfiltered = settings[s].unfiltered};
+                                               .unfiltered = settings[s].unfiltered,
+                                               .kernels = &kernels};
         for (int k = 0; k < repeat && !res; k++)
             res = sb_reflection_prefilter(vk, level0, n, &pp, chain, &times[k]);
         if (res)
@@ -216,6 +218,7 @@ enum sb_result sb_bench_reflection(struct sb_vk *vk, const struct sb_atmosphere_
         sb_info("reflection_cubes %-10s %10.3f ms  worst mip rms %.3g max %.3g", row->label, row->gpu_ms,
                 row->worst_rms, row->worst_max);
     }
+    sb_reflection_kernels_destroy(vk, &kernels);
     /* The Pareto front: no other row both faster and more accurate. */
     for (int i = 0; i < report->reflection_row_count; i++) {
         struct sb_bench_reflection_row *a = &report->reflection_rows[i];

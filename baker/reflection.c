@@ -26,6 +26,21 @@ uint32_t sb_reflection_level_samples(uint32_t samples, uint32_t level)
     return s < SB_REFLECTION_MAX_SAMPLES ? (uint32_t)s : SB_REFLECTION_MAX_SAMPLES;
 }
 
+void sb_reflection_kernels_destroy(struct sb_vk *vk, struct sb_reflection_kernels *k)
+{
+    sb_pipeline_destroy(vk, &k->capture);
+    sb_pipeline_destroy(vk, &k->prefilter);
+}
+
+/* The cached pipeline (made on first use) or, without a cache, `temp`. */
+static enum sb_result pipeline_for(struct sb_vk *vk, struct sb_pipeline *cached, const struct sb_pipeline_params *pp,
+                                   struct sb_pipeline *temp, struct sb_pipeline **use)
+{
+    struct sb_pipeline *p = cached ? cached : temp;
+    *use = p;
+    return p->pipeline ? SB_OK : sb_pipeline_create(vk, pp, p);
+}
+
 enum sb_result sb_reflection_capture(struct sb_vk *vk, const struct sb_capture_inputs *in,
                                      const struct sb_capture_params *p, float *out, double *gpu_ms)
 {
@@ -39,7 +54,7 @@ enum sb_result sb_reflection_capture(struct sb_vk *vk, const struct sb_capture_i
         .tmin_m = 1e-4f,
     };
     struct sb_buffer result = {0}, albedo = {0}, sky = {0}, dummy = {0};
-    struct sb_pipeline pipeline = {0};
+    struct sb_pipeline temp = {0}, *pipeline = NULL;
     const struct sb_pipeline_params pp = {
         .spirv = sb_spv_reflection_capture,
         .spirv_size = sizeof(sb_spv_reflection_capture),
@@ -52,7 +67,8 @@ enum sb_result sb_reflection_capture(struct sb_vk *vk, const struct sb_capture_i
     if ((res = sb_buffer_create(vk, (VkDeviceSize)6 * n * n * 4 * sizeof(float), "reflection capture", &result)) ||
         (res = sb_buffer_create(vk, (VkDeviceSize)materials * 4 * sizeof(float), "albedo", &albedo)) ||
         (res = sb_buffer_create(vk, SB_PROBE_SH * 4 * sizeof(float), "sky sh", &sky)) ||
-        (res = sb_buffer_create(vk, 64, "no world", &dummy)) || (res = sb_pipeline_create(vk, &pp, &pipeline)))
+        (res = sb_buffer_create(vk, 64, "no world", &dummy)) ||
+        (res = pipeline_for(vk, in->kernels ? &in->kernels->capture : NULL, &pp, &temp, &pipeline)))
         goto done;
     float *a = albedo.mapped;
     for (uint32_t m = 0; in->rc && m < in->mesh->material_count; m++)
@@ -69,15 +85,15 @@ enum sb_result sb_reflection_capture(struct sb_vk *vk, const struct sb_capture_i
         [SB_CAPTURE_BINDING_SKY_SH] = &sky,
     };
     sb_atmosphere_bind_inputs(in->atmosphere, bindings);
-    sb_pipeline_bind(vk, &pipeline, bindings);
+    sb_pipeline_bind(vk, pipeline, bindings);
     double ms = 0;
-    if (!(res = sb_dispatch(vk, &pipeline, &pc, (n + SB_WORKGROUP_X - 1) / SB_WORKGROUP_X,
+    if (!(res = sb_dispatch(vk, pipeline, &pc, (n + SB_WORKGROUP_X - 1) / SB_WORKGROUP_X,
                             (6 * n + SB_WORKGROUP_Y - 1) / SB_WORKGROUP_Y, 1, &ms)))
         res = sb_buffer_read(vk, &result, out);
     if (gpu_ms)
         *gpu_ms = ms;
 done:
-    sb_pipeline_destroy(vk, &pipeline);
+    sb_pipeline_destroy(vk, &temp);
     sb_buffer_destroy(vk, &result);
     sb_buffer_destroy(vk, &albedo);
     sb_buffer_destroy(vk, &sky);
@@ -96,7 +112,7 @@ enum sb_result sb_reflection_prefilter(struct sb_vk *vk, const float *level0, ui
     }
     uint64_t texels = sb_cube_level_offset(n, levels);
     struct sb_buffer source = {0}, result = {0};
-    struct sb_pipeline pipeline = {0};
+    struct sb_pipeline temp = {0}, *pipeline = NULL;
     const struct sb_pipeline_params pp = {
         .spirv = sb_spv_reflection_prefilter,
         .spirv_size = sizeof(sb_spv_reflection_prefilter),
@@ -107,14 +123,22 @@ enum sb_result sb_reflection_prefilter(struct sb_vk *vk, const float *level0, ui
     enum sb_result res;
     if ((res = sb_buffer_create(vk, texels * 4 * sizeof(float), "prefilter source", &source)) ||
         (res = sb_buffer_create(vk, texels * 4 * sizeof(float), "prefiltered", &result)) ||
-        (res = sb_pipeline_create(vk, &pp, &pipeline)))
+        (res = pipeline_for(vk, params->kernels ? &params->kernels->prefilter : NULL, &pp, &temp, &pipeline)))
         goto done;
-    float *chain = source.mapped;
+    /* Built in host memory: a device's mapped memory may be uncached, and
+     * each level reads the one before (seconds on an H100 otherwise). */
+    float *chain = malloc(texels * 4 * sizeof(float));
+    if (!chain) {
+        res = SB_ERR_NOMEM;
+        goto done;
+    }
     memcpy(chain, level0, (size_t)6 * n * n * 4 * sizeof(float));
     sb_cube_build_mips(chain, n, levels);
+    memcpy(source.mapped, chain, texels * 4 * sizeof(float));
+    free(chain);
     const struct sb_buffer *bindings[SB_PREFILTER_BINDING_COUNT] = {
         [SB_PREFILTER_BINDING_SOURCE] = &source, [SB_PREFILTER_BINDING_OUT] = &result};
-    sb_pipeline_bind(vk, &pipeline, bindings);
+    sb_pipeline_bind(vk, pipeline, bindings);
     /* skybake's: no bias on Colbert and Krivanek's lod (their +1 blurs: 2
      * to 4 times the error against the reference), and no source level of
      * faces under 4 texels (a rough lobe read from 1 x 1 faces is six flat
@@ -135,10 +159,17 @@ enum sb_result sb_reflection_prefilter(struct sb_vk *vk, const float *level0, ui
         double ms = 0;
         pc.level = l;
         pc.samples = params->constant_samples ? samples : sb_reflection_level_samples(samples, l);
+        /* About 16 samples an invocation: the wide levels' few samples
+         * would otherwise leave most of a workgroup idle. */
+        pc.threads_per_texel = 1;
+        while (pc.threads_per_texel < SB_PREFILTER_THREADS && pc.threads_per_texel * 16 < pc.samples)
+            pc.threads_per_texel *= 2;
+        uint64_t texels_per_group = SB_PREFILTER_THREADS / pc.threads_per_texel;
+        uint64_t groups = (6ull * m * m + texels_per_group - 1) / texels_per_group;
+        pc.groups_x = groups < 65535 ? (uint32_t)groups : 65535;
         pc.roughness = (float)sb_reflection_level_roughness(l, levels);
         pc.out_offset = (uint32_t)sb_cube_level_offset(n, l);
-        res = sb_dispatch(vk, &pipeline, &pc, (m + SB_WORKGROUP_X - 1) / SB_WORKGROUP_X,
-                          (6 * m + SB_WORKGROUP_Y - 1) / SB_WORKGROUP_Y, 1, &ms);
+        res = sb_dispatch(vk, pipeline, &pc, pc.groups_x, (uint32_t)((groups + pc.groups_x - 1) / pc.groups_x), 1, &ms);
         total += ms;
     }
     if (!res)
@@ -148,7 +179,7 @@ enum sb_result sb_reflection_prefilter(struct sb_vk *vk, const float *level0, ui
     if (gpu_ms)
         *gpu_ms = total;
 done:
-    sb_pipeline_destroy(vk, &pipeline);
+    sb_pipeline_destroy(vk, &temp);
     sb_buffer_destroy(vk, &source);
     sb_buffer_destroy(vk, &result);
     return res;

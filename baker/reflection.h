@@ -27,12 +27,20 @@ double sb_reflection_level_roughness(uint32_t level, uint32_t levels);
 #define SB_REFLECTION_MAX_SAMPLES 16384
 uint32_t sb_reflection_level_samples(uint32_t samples, uint32_t level);
 
+/* The two kernels' pipelines, kept across the probes of a bake (creating
+ * them takes seconds on some drivers); zero-initialise, destroy once. */
+struct sb_reflection_kernels {
+    struct sb_pipeline capture, prefilter;
+};
+void sb_reflection_kernels_destroy(struct sb_vk *vk, struct sb_reflection_kernels *kernels);
+
 /* What a capture reads: the atmosphere's LUTs (a baker that has them) and
  * the world (rc NULL: the sky alone). */
 struct sb_capture_inputs {
     struct sb_atmosphere_baker *atmosphere;
     struct sb_raycaster *rc;
     const struct sb_mesh *mesh;
+    struct sb_reflection_kernels *kernels; /* may be NULL: made for the call */
 };
 
 struct sb_capture_params {
@@ -56,6 +64,7 @@ struct sb_prefilter_params {
     bool constant_samples; /* the same count at every mip (else doubling per mip, sb_reflection_level_samples) */
     float lod_bias;        /* added to the filtered lookup's lod (Colbert and Krivanek's, Filament's: 1) */
     bool unfiltered;       /* every sample reads level 0 (Karis 2013) */
+    struct sb_reflection_kernels *kernels; /* may be NULL: made for the call */
 };
 
 /* The prefiltered chain of one cube from its level 0 (rgba texels, 6 n^2);

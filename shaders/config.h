@@ -389,8 +389,10 @@ struct sb_capture_push {
     float tmin_m;
 };
 
-/* GGX prefiltering (reflection_prefilter.comp): one invocation a texel of
- * level `level`, reading the source cube's box-filtered mip chain. */
+/* GGX prefiltering (reflection_prefilter.comp): threads_per_texel
+ * invocations a texel of level `level`, SB_PREFILTER_THREADS a workgroup,
+ * reading the source cube's box-filtered mip chain. */
+#define SB_PREFILTER_THREADS 64
 #define SB_PREFILTER_BINDING_SOURCE 0 /* the source's levels, vec4 a texel */
 #define SB_PREFILTER_BINDING_OUT 1    /* the output's levels, vec4 a texel */
 #define SB_PREFILTER_BINDING_COUNT 2
@@ -405,6 +407,9 @@ struct sb_prefilter_push {
     SB_UINT out_offset;  /* the level's first texel in the output */
     float lod_bias;      /* added to filtered importance sampling's lod */
     float max_lod;       /* samples read no coarser source level than this */
+    SB_UINT threads_per_texel; /* a power of two up to SB_PREFILTER_THREADS */
+    SB_UINT groups_x;          /* workgroups along x; the workgroup's index is y groups_x + x */
+    SB_UINT pad0, pad1;
     SB_UVEC4(source_offsets[SB_PREFILTER_MAX_LEVELS / 4]); /* each source level's first texel */
 };
 

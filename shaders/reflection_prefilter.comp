@@ -5,14 +5,17 @@
 // D(h) (n.h) at alpha = roughness^2, divided by the sum of n.l, each
 // sample read from the source's box-filtered mip chain at the level whose
 // texels match its share of the lobe (Colbert and Krivanek 2007's filtered
-// importance sampling: lod = 0.5 log2(omega_s / omega_p) + 1). The same
+// importance sampling: lod = 0.5 log2(omega_s / omega_p) + 1).
+// threads_per_texel invocations a texel (about 16 samples each), each
+// taking every threads_per_texel-th sample, their sums added in a fixed
+// tree order (the same result whatever the scheduling). The same
 // set for every texel in a frame that turns smoothly with n: no noise
 // pattern changes across a face's edge, and the source is read across
 // edges by direction, so the result has no seams.
 #extension GL_GOOGLE_include_directive : require
 #include "config.h"
 
-layout(local_size_x = SB_WORKGROUP_X, local_size_y = SB_WORKGROUP_Y) in;
+layout(local_size_x = SB_PREFILTER_THREADS) in;
 layout(std430, binding = SB_PREFILTER_BINDING_SOURCE) readonly buffer Source { vec4 source[]; };
 layout(std430, binding = SB_PREFILTER_BINDING_OUT) writeonly buffer Out { vec4 result[]; };
 layout(push_constant) uniform Push { sb_prefilter_push pc; };
@@ -59,12 +62,18 @@ float radical_inverse(uint i)
     return float(bitfieldReverse(i)) * 2.3283064365386963e-10;
 }
 
+shared vec4 partial[SB_PREFILTER_THREADS];
+
 void main()
 {
-    uvec2 t = gl_GlobalInvocationID.xy;
+    // threads_per_texel invocations a texel (a power of two), the
+    // workgroup's texels one after another in the level's row order.
+    uint lane = gl_LocalInvocationID.x, tpt = pc.threads_per_texel;
+    uint sub = lane % tpt;
+    uint texel = (gl_WorkGroupID.y * pc.groups_x + gl_WorkGroupID.x) * (SB_PREFILTER_THREADS / tpt) + lane / tpt;
     uint n = max(pc.face_size >> pc.level, 1u);
-    if (t.x >= n || t.y >= 6u * n)
-        return;
+    bool valid = texel < 6u * n * n; // the rest only take part in the barriers
+    uvec2 t = uvec2(texel % n, min(texel / n, 6u * n - 1u));
     uint face = t.y / n;
     vec2 uv = (vec2(t.x, t.y - face * n) + 0.5) / float(n) * 2.0 - 1.0;
     vec3 N = normalize(cube_direction(face, uv));
@@ -79,7 +88,7 @@ void main()
     vec3 mean = fetch(N, pc.levels - 1u);
     vec3 sum = vec3(0.0);
     float weight = 0.0;
-    for (uint i = 0u; i < pc.samples; i++) {
+    for (uint i = sub; i < pc.samples && valid; i += tpt) {
         float xi = (float(i) + 0.5) / float(pc.samples), phi = 2.0 * PI * radical_inverse(i);
         // cos^2 theta_h from q = 1 - xi, without cancellation for smooth surfaces
         float q = 1.0 - xi;
@@ -98,5 +107,15 @@ void main()
         sum += (fetch_lod(l, lod) - mean) * nl;
         weight += nl;
     }
-    result[pc.out_offset + t.y * n + t.x] = vec4(weight > 0.0 ? mean + sum / weight : fetch(N, 0u), 0.0);
+    partial[lane] = vec4(sum, weight);
+    barrier();
+    for (uint stride = tpt / 2u; stride > 0u; stride /= 2u) {
+        if (sub < stride)
+            partial[lane] += partial[lane + stride];
+        barrier();
+    }
+    if (sub == 0u && valid) {
+        vec4 total = partial[lane];
+        result[pc.out_offset + t.y * n + t.x] = vec4(total.w > 0.0 ? mean + total.rgb / total.w : fetch(N, 0u), 0.0);
+    }
 }
