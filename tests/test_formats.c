@@ -289,6 +289,27 @@ static void test_scenes(void)
     got = sb_scene_parse(with_nul, sizeof(with_nul) - 1, "nul", &nested);
     CHECK(got == SB_ERR_JSON_SYNTAX, "a NUL byte in the text: got %s", sb_result_name(got));
 
+    /* A million reflection probes: refused by their count, naming the field;
+     * 64, the cap, accepted. */
+    static const int counts[] = {64, 65, 1000000};
+    for (size_t c = 0; c < sizeof(counts) / sizeof(counts[0]); c++) {
+        int count = counts[c];
+        const char probe[] = "{\"position_m\":[0,1,0],\"box_m\":[[-1,0,-1],[1,2,1]]},";
+        size_t cap = 200 + (size_t)count * (sizeof(probe) - 1);
+        char *json = malloc(cap);
+        size_t len = (size_t)snprintf(json, cap, EARTH "\"reflections\":{\"probes\":[");
+        for (int i = 0; i < count; i++) {
+            memcpy(json + len, probe, sizeof(probe) - 1);
+            len += sizeof(probe) - 1;
+        }
+        len += (size_t)snprintf(json + len - 1, cap - len + 1, "]}}") - 1;
+        struct sb_scene many;
+        got = sb_scene_parse(json, len, "many", &many);
+        CHECK(got == (count == 64 ? SB_OK : SB_ERR_OUT_OF_RANGE), "%d reflection probes: got %s", count,
+              sb_result_name(got));
+        free(json);
+    }
+
     /* Overrides apply and normalisation is stable. */
     struct sb_scene a, b;
     const char *ja = "{\"atmosphere\":{\"preset\":\"earth\",\"mie_g\":0.76}}";
@@ -764,10 +785,10 @@ static void test_pack_reader(void)
         {"format version 3 listing sky_bounce", edit_version_3, NULL, SB_ERR_UNKNOWN_PRODUCT, false},
         {"format version 4 listing dfg", edit_version_4, NULL, SB_ERR_UNKNOWN_PRODUCT, false},
         {"format version 5 listing reflection_cubes", edit_version_5, NULL, SB_ERR_UNKNOWN_PRODUCT, false},
-        {"cube file truncated, vouched for", NULL,
-         "head -c 4000 reflection_cubes.exr > t && mv t reflection_cubes.exr", SB_ERR_EXR, true},
-        {"cube file replaced by the DFG's EXR, vouched for", NULL, "cp dfg.exr reflection_cubes.exr",
-         SB_ERR_BAD_IMAGE, true},
+        {"cube file truncated, vouched for", NULL, "head -c 4000 reflection_cubes.exr > t && mv t reflection_cubes.exr",
+         SB_ERR_EXR, true},
+        {"cube file replaced by the DFG's EXR, vouched for", NULL, "cp dfg.exr reflection_cubes.exr", SB_ERR_BAD_IMAGE,
+         true},
         {"reflection probes truncated, vouched for", NULL,
          "head -c 200 reflection_probes.sbprobes > t && mv t reflection_probes.sbprobes", SB_ERR_BAD_IMAGE, true},
         {"truncated bounce file, vouched for", NULL, "head -c 300 sky_bounce.sbprobes > t && mv t sky_bounce.sbprobes",
