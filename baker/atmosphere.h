@@ -67,8 +67,9 @@ enum sb_result sb_atmosphere_bake(struct sb_atmosphere_baker *baker, enum sb_pro
 
 /* The buffers a kernel including atmosphere.glsl reads at bindings 0 to
  * 3 (config.h, SB_BINDING_*): the parameters and the LUTs this baker has
- * baked or adopted (a placeholder for those it has not), for kernels of
- * other families (the reflection capture). bindings[] must have room for 4. */
+ * baked or adopted (a 16-byte unused buffer in the slot of each it has
+ * not), for kernels of other families (the reflection capture).
+ * bindings[] must have room for 4. */
 void sb_atmosphere_bind_inputs(struct sb_atmosphere_baker *baker, const struct sb_buffer **bindings);
 
 /*

@@ -47,6 +47,20 @@ double sb_cube_solid_angle(double u0, double v0, double u1, double v1)
     return corner_area(u1, v1) - corner_area(u0, v1) - corner_area(u1, v0) + corner_area(u0, v0);
 }
 
+void sb_cube_bilinear(const float *face, uint32_t n, uint32_t stride, double u, double v, double out[3])
+{
+    double px = fmin(fmax((u * 0.5 + 0.5) * n - 0.5, 0.0), n - 1.0);
+    double py = fmin(fmax((v * 0.5 + 0.5) * n - 0.5, 0.0), n - 1.0);
+    uint32_t x0 = (uint32_t)px, y0 = (uint32_t)py;
+    uint32_t x1 = x0 + 1 < n ? x0 + 1 : n - 1, y1 = y0 + 1 < n ? y0 + 1 : n - 1;
+    double fx = px - x0, fy = py - y0;
+    for (int c = 0; c < 3; c++) {
+        double a = face[stride * ((size_t)y0 * n + x0) + c], b = face[stride * ((size_t)y0 * n + x1) + c];
+        double d = face[stride * ((size_t)y1 * n + x0) + c], e = face[stride * ((size_t)y1 * n + x1) + c];
+        out[c] = (a + (b - a) * fx) * (1 - fy) + (d + (e - d) * fx) * fy;
+    }
+}
+
 uint64_t sb_cube_level_offset(uint32_t face_size, uint32_t level)
 {
     uint64_t n = 0;

@@ -21,6 +21,11 @@ int sb_cube_face(const double d[3], double *u, double *v);
 /* The solid angle of the rectangle [u0, u1] x [v0, v1] of a face. */
 double sb_cube_solid_angle(double u0, double v0, double u1, double v1);
 
+/* One face of n x n texels, `stride` floats apart (rgb first), read at
+ * (u, v) bilinearly between texel centres and clamped at the face's edges:
+ * how the device reads a cube (reflection_prefilter.comp, reflections.glsl). */
+void sb_cube_bilinear(const float *face, uint32_t n, uint32_t stride, double u, double v, double out[3]);
+
 /* Texels before level `level` in one cube's chain (6 faces a level). */
 uint64_t sb_cube_level_offset(uint32_t face_size, uint32_t level);
 

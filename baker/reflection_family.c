@@ -59,6 +59,8 @@ static enum sb_result reflection_create(struct sb_vk *vk, const struct sb_scene 
     if (!st)
         return SB_ERR_NOMEM;
     *out = st;
+    if (wants_cubes(scene) && !scene->has_world && scene->reflections.probe_count)
+        sb_warn("reflections.probes: the scene has no world, so every cube sees the sky alone");
     if (!wants_cubes(scene) || !scene->has_world)
         return SB_OK;
     enum sb_result res = sb_mesh_load_world(&scene->world, scene->directory, &st->mesh, st->path, sizeof(st->path));

@@ -10,27 +10,12 @@
 #include "cube.h"
 #include "reflection.h"
 
-static void bilinear(const float *level0, uint32_t n, int face, double u, double v, double out[3])
-{
-    double px = fmin(fmax((u * 0.5 + 0.5) * n - 0.5, 0.0), n - 1.0);
-    double py = fmin(fmax((v * 0.5 + 0.5) * n - 0.5, 0.0), n - 1.0);
-    uint32_t x0 = (uint32_t)px, y0 = (uint32_t)py;
-    uint32_t x1 = x0 + 1 < n ? x0 + 1 : n - 1, y1 = y0 + 1 < n ? y0 + 1 : n - 1;
-    double fx = px - x0, fy = py - y0;
-    const float *base = level0 + 4 * (size_t)face * n * n;
-    for (int c = 0; c < 3; c++) {
-        double a = base[4 * ((size_t)y0 * n + x0) + c], b = base[4 * ((size_t)y0 * n + x1) + c];
-        double d = base[4 * ((size_t)y1 * n + x0) + c], e = base[4 * ((size_t)y1 * n + x1) + c];
-        out[c] = (a + (b - a) * fx) * (1 - fy) + (d + (e - d) * fx) * fy;
-    }
-}
-
 void sb_reflection_reference(const float *level0, uint32_t n, const double nd[3], double r, int sub, double out[3])
 {
     if (r <= 0) {
         double u, v;
         int face = sb_cube_face(nd, &u, &v);
-        bilinear(level0, n, face, u, v, out);
+        sb_cube_bilinear(level0 + 4 * (size_t)face * n * n, n, 4, u, v, out);
         return;
     }
     double a2 = r * r * r * r;
@@ -54,7 +39,7 @@ void sb_reflection_reference(const float *level0, uint32_t n, const double nd[3]
                 double c2 = 0.5 * (1 + nl), d = c2 * (a2 - 1) + 1;
                 double w = a2 / (M_PI * d * d) * nl * sb_cube_solid_angle(u0, v0, u0 + step, v0 + step);
                 double L[3];
-                bilinear(level0, n, f, u, v, L);
+                sb_cube_bilinear(level0 + 4 * (size_t)f * n * n, n, 4, u, v, L);
                 for (int c = 0; c < 3; c++)
                     sum[c] += w * L[c];
                 weight += w;

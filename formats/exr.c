@@ -6,6 +6,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "exr_internal.h"
 #include "log.h"
 
 #define EXR_DEFAULT_MAX_PIXELS (64ull << 20)
@@ -14,14 +15,14 @@
  * system's reason (e.g. "File too large"), which the codes do not. */
 static _Thread_local char last_message[256];
 
-static void silent_errors(exr_const_context_t ctxt, exr_result_t code, const char *msg)
+void sb_exr_error_handler(exr_const_context_t ctxt, exr_result_t code, const char *msg)
 {
     (void)ctxt;
     snprintf(last_message, sizeof(last_message), "%s", msg ? msg : "");
     sb_debug("openexr: %s (%d)", msg, (int)code);
 }
 
-static enum sb_result exr_fail(const char *path, const char *what, exr_result_t rv)
+enum sb_result sb_exr_fail(const char *path, const char *what, exr_result_t rv)
 {
     sb_error("%s: %s: %s%s%s", path, what, exr_get_default_error_message(rv), last_message[0] ? ": " : "",
              last_message);
@@ -29,11 +30,33 @@ static enum sb_result exr_fail(const char *path, const char *what, exr_result_t 
     return rv == EXR_ERR_FILE_ACCESS || rv == EXR_ERR_WRITE_IO ? SB_ERR_IO : SB_ERR_EXR;
 }
 
+static _Thread_local exr_result_t (*library_compress)(exr_encode_pipeline_t *);
+
+static exr_result_t compress_or_keep(exr_encode_pipeline_t *encode)
+{
+    exr_result_t rv = library_compress(encode);
+    if (rv == EXR_ERR_SUCCESS && encode->compressed_bytes >= encode->packed_bytes) {
+        if (encode->compressed_alloc_size < encode->packed_bytes)
+            return EXR_ERR_OUT_OF_MEMORY;
+        memcpy(encode->compressed_buffer, encode->packed_buffer, encode->packed_bytes);
+        encode->compressed_bytes = encode->packed_bytes;
+    }
+    return rv;
+}
+
+void sb_exr_keep_raw_when_larger(exr_encode_pipeline_t *encoder)
+{
+    if (encoder->compress_fn && encoder->compress_fn != compress_or_keep) {
+        library_compress = encoder->compress_fn;
+        encoder->compress_fn = compress_or_keep;
+    }
+}
+
 enum sb_result sb_exr_write(const char *path, const struct sb_image *image, const struct sb_attribute *attributes,
                             int attribute_count)
 {
     exr_context_initializer_t init = EXR_DEFAULT_CONTEXT_INITIALIZER;
-    init.error_handler_fn = silent_errors;
+    init.error_handler_fn = sb_exr_error_handler;
     exr_context_t ctxt = NULL;
     exr_encode_pipeline_t encoder;
     bool encoder_live = false;
@@ -50,39 +73,31 @@ enum sb_result sb_exr_write(const char *path, const struct sb_image *image, cons
         sb_error("%s: cannot create EXR file: %s", path, exr_get_default_error_message(rv));
         return SB_ERR_IO;
     }
-#define EXR_TRY(call, what)                                                                                            \
-    do {                                                                                                               \
-        rv = (call);                                                                                                   \
-        if (rv != EXR_ERR_SUCCESS) {                                                                                   \
-            res = exr_fail(path, what, rv);                                                                            \
-            goto cleanup;                                                                                              \
-        }                                                                                                              \
-    } while (0)
 
-    EXR_TRY(exr_add_part(ctxt, "main", EXR_STORAGE_SCANLINE, &part), "adding the part");
-    EXR_TRY(exr_initialize_required_attr_simple(ctxt, part, (int32_t)image->width, (int32_t)image->height,
-                                                EXR_COMPRESSION_ZIP),
-            "setting the header");
+    SB_EXR_TRY(exr_add_part(ctxt, "main", EXR_STORAGE_SCANLINE, &part), "adding the part");
+    SB_EXR_TRY(exr_initialize_required_attr_simple(ctxt, part, (int32_t)image->width, (int32_t)image->height,
+                                                   EXR_COMPRESSION_ZIP),
+               "setting the header");
     for (uint32_t c = 0; c < image->channel_count; c++)
-        EXR_TRY(exr_add_channel(ctxt, part, image->channel_names[c], EXR_PIXEL_FLOAT, EXR_PERCEPTUALLY_LINEAR, 1, 1),
-                "adding a channel");
+        SB_EXR_TRY(exr_add_channel(ctxt, part, image->channel_names[c], EXR_PIXEL_FLOAT, EXR_PERCEPTUALLY_LINEAR, 1, 1),
+                   "adding a channel");
     for (int a = 0; a < attribute_count; a++)
-        EXR_TRY(exr_attr_set_string(ctxt, part, attributes[a].name, attributes[a].value), "setting an attribute");
-    EXR_TRY(exr_write_header(ctxt), "writing the header");
+        SB_EXR_TRY(exr_attr_set_string(ctxt, part, attributes[a].name, attributes[a].value), "setting an attribute");
+    SB_EXR_TRY(exr_write_header(ctxt), "writing the header");
 
     int32_t lines_per_chunk = 1, chunks = 0;
-    EXR_TRY(exr_get_scanlines_per_chunk(ctxt, part, &lines_per_chunk), "querying chunks");
-    EXR_TRY(exr_get_chunk_count(ctxt, part, &chunks), "querying chunks");
+    SB_EXR_TRY(exr_get_scanlines_per_chunk(ctxt, part, &lines_per_chunk), "querying chunks");
+    SB_EXR_TRY(exr_get_chunk_count(ctxt, part, &chunks), "querying chunks");
     size_t pixel_stride = (size_t)image->channel_count * sizeof(float);
     for (int32_t chunk = 0; chunk < chunks; chunk++) {
         int32_t y = chunk * lines_per_chunk;
         exr_chunk_info_t cinfo;
-        EXR_TRY(exr_write_scanline_chunk_info(ctxt, part, y, &cinfo), "preparing a chunk");
+        SB_EXR_TRY(exr_write_scanline_chunk_info(ctxt, part, y, &cinfo), "preparing a chunk");
         if (!encoder_live) {
-            EXR_TRY(exr_encoding_initialize(ctxt, part, &cinfo, &encoder), "starting the encoder");
+            SB_EXR_TRY(exr_encoding_initialize(ctxt, part, &cinfo, &encoder), "starting the encoder");
             encoder_live = true;
         } else {
-            EXR_TRY(exr_encoding_update(ctxt, part, &cinfo, &encoder), "updating the encoder");
+            SB_EXR_TRY(exr_encoding_update(ctxt, part, &cinfo, &encoder), "updating the encoder");
         }
         for (int16_t ch = 0; ch < encoder.channel_count; ch++) {
             exr_coding_channel_info_t *info = &encoder.channels[ch];
@@ -94,15 +109,18 @@ enum sb_result sb_exr_write(const char *path, const struct sb_image *image, cons
                 res = SB_ERR_EXR;
                 goto cleanup;
             }
-            info->encode_from_ptr = (const uint8_t *)(image->data + ((size_t)y * image->width) * image->channel_count + src);
+            info->encode_from_ptr =
+                (const uint8_t *)(image->data + ((size_t)y * image->width) * image->channel_count + src);
             info->user_pixel_stride = (int32_t)pixel_stride;
             info->user_line_stride = (int32_t)(pixel_stride * image->width);
             info->user_bytes_per_element = 4;
             info->user_data_type = EXR_PIXEL_FLOAT;
         }
-        if (chunk == 0)
-            EXR_TRY(exr_encoding_choose_default_routines(ctxt, part, &encoder), "choosing the encoder");
-        EXR_TRY(exr_encoding_run(ctxt, part, &encoder), "encoding");
+        if (chunk == 0) {
+            SB_EXR_TRY(exr_encoding_choose_default_routines(ctxt, part, &encoder), "choosing the encoder");
+            sb_exr_keep_raw_when_larger(&encoder);
+        }
+        SB_EXR_TRY(exr_encoding_run(ctxt, part, &encoder), "encoding");
     }
 
 cleanup:
@@ -120,7 +138,7 @@ enum sb_result sb_exr_read(const char *path, const char *channel_order, uint64_t
                            struct sb_attribute *attributes, int *attribute_count)
 {
     exr_context_initializer_t init = EXR_DEFAULT_CONTEXT_INITIALIZER;
-    init.error_handler_fn = silent_errors;
+    init.error_handler_fn = sb_exr_error_handler;
     exr_context_t ctxt = NULL;
     exr_decode_pipeline_t decoder;
     bool decoder_live = false;
@@ -140,16 +158,16 @@ enum sb_result sb_exr_read(const char *path, const char *channel_order, uint64_t
         return rv == EXR_ERR_FILE_ACCESS || rv == EXR_ERR_WRITE_IO ? SB_ERR_IO : SB_ERR_EXR;
     }
     int parts = 0;
-    EXR_TRY(exr_get_count(ctxt, &parts), "counting parts");
+    SB_EXR_TRY(exr_get_count(ctxt, &parts), "counting parts");
     exr_storage_t storage;
-    EXR_TRY(exr_get_storage(ctxt, 0, &storage), "reading the storage type");
+    SB_EXR_TRY(exr_get_storage(ctxt, 0, &storage), "reading the storage type");
     if (parts != 1 || storage != EXR_STORAGE_SCANLINE) {
         sb_error("%s: expected one scanline part, found %d part(s)", path, parts);
         res = SB_ERR_BAD_IMAGE;
         goto cleanup;
     }
     exr_attr_box2i_t window;
-    EXR_TRY(exr_get_data_window(ctxt, 0, &window), "reading the data window");
+    SB_EXR_TRY(exr_get_data_window(ctxt, 0, &window), "reading the data window");
     int64_t width = (int64_t)window.max.x - window.min.x + 1, height = (int64_t)window.max.y - window.min.y + 1;
     if (width <= 0 || height <= 0 || (uint64_t)(width * height) > max_pixels) {
         sb_error("%s: data window %lldx%lld is empty or larger than %llu pixels", path, (long long)width,
@@ -158,7 +176,7 @@ enum sb_result sb_exr_read(const char *path, const char *channel_order, uint64_t
         goto cleanup;
     }
     const exr_attr_chlist_t *chlist = NULL;
-    EXR_TRY(exr_get_channels(ctxt, 0, &chlist), "reading the channel list");
+    SB_EXR_TRY(exr_get_channels(ctxt, 0, &chlist), "reading the channel list");
     int file_channels = chlist->num_channels;
     if (file_channels <= 0 || file_channels > SB_IMAGE_MAX_CHANNELS) {
         sb_error("%s: %d channels; skybake images have 1 to %d", path, file_channels, SB_IMAGE_MAX_CHANNELS);
@@ -210,18 +228,18 @@ enum sb_result sb_exr_read(const char *path, const char *channel_order, uint64_t
         snprintf(image->channel_names[map[c]], SB_CHANNEL_NAME_MAX, "%s", chlist->entries[c].name.str);
 
     int32_t lines_per_chunk = 1, chunks = 0;
-    EXR_TRY(exr_get_scanlines_per_chunk(ctxt, 0, &lines_per_chunk), "querying chunks");
-    EXR_TRY(exr_get_chunk_count(ctxt, 0, &chunks), "querying chunks");
+    SB_EXR_TRY(exr_get_scanlines_per_chunk(ctxt, 0, &lines_per_chunk), "querying chunks");
+    SB_EXR_TRY(exr_get_chunk_count(ctxt, 0, &chunks), "querying chunks");
     size_t pixel_stride = (size_t)count * sizeof(float);
     for (int32_t chunk = 0; chunk < chunks; chunk++) {
         int32_t y = window.min.y + chunk * lines_per_chunk;
         exr_chunk_info_t cinfo;
-        EXR_TRY(exr_read_scanline_chunk_info(ctxt, 0, y, &cinfo), "reading a chunk");
+        SB_EXR_TRY(exr_read_scanline_chunk_info(ctxt, 0, y, &cinfo), "reading a chunk");
         if (!decoder_live) {
-            EXR_TRY(exr_decoding_initialize(ctxt, 0, &cinfo, &decoder), "starting the decoder");
+            SB_EXR_TRY(exr_decoding_initialize(ctxt, 0, &cinfo, &decoder), "starting the decoder");
             decoder_live = true;
         } else {
-            EXR_TRY(exr_decoding_update(ctxt, 0, &cinfo, &decoder), "updating the decoder");
+            SB_EXR_TRY(exr_decoding_update(ctxt, 0, &cinfo, &decoder), "updating the decoder");
         }
         int64_t row = (int64_t)cinfo.start_y - window.min.y;
         if (row < 0 || row + cinfo.height > height || cinfo.width != width) {
@@ -246,13 +264,13 @@ enum sb_result sb_exr_read(const char *path, const char *channel_order, uint64_t
             info->user_data_type = EXR_PIXEL_FLOAT;
         }
         if (chunk == 0)
-            EXR_TRY(exr_decoding_choose_default_routines(ctxt, 0, &decoder), "choosing the decoder");
-        EXR_TRY(exr_decoding_run(ctxt, 0, &decoder), "decoding");
+            SB_EXR_TRY(exr_decoding_choose_default_routines(ctxt, 0, &decoder), "choosing the decoder");
+        SB_EXR_TRY(exr_decoding_run(ctxt, 0, &decoder), "decoding");
     }
 
     if (attributes && attribute_count) {
         int32_t n = 0;
-        EXR_TRY(exr_get_attribute_count(ctxt, 0, &n), "counting attributes");
+        SB_EXR_TRY(exr_get_attribute_count(ctxt, 0, &n), "counting attributes");
         for (int32_t i = 0; i < n && *attribute_count < SB_FILE_MAX_ATTRIBUTES; i++) {
             const exr_attribute_t *attr = NULL;
             if (exr_get_attribute_by_index(ctxt, 0, EXR_ATTR_LIST_FILE_ORDER, i, &attr) != EXR_ERR_SUCCESS)

@@ -8,36 +8,10 @@
 #include <string.h>
 
 #include "exr.h"
+#include "exr_internal.h"
 #include "log.h"
 
 #define CUBE_TILE 64
-
-/* OpenEXR's message for the last error of this thread (see exr.c). */
-static _Thread_local char last_message[256];
-
-static void quiet(exr_const_context_t ctxt, exr_result_t code, const char *msg)
-{
-    (void)ctxt;
-    snprintf(last_message, sizeof(last_message), "%s", msg ? msg : "");
-    sb_debug("openexr: %s (%d)", msg, (int)code);
-}
-
-static enum sb_result fail(const char *path, const char *what, exr_result_t rv)
-{
-    sb_error("%s: %s: %s%s%s", path, what, exr_get_default_error_message(rv), last_message[0] ? ": " : "",
-             last_message);
-    last_message[0] = '\0';
-    return rv == EXR_ERR_FILE_ACCESS || rv == EXR_ERR_WRITE_IO ? SB_ERR_IO : SB_ERR_EXR;
-}
-
-#define TRY(call, what)                                                                                                \
-    do {                                                                                                               \
-        exr_result_t rv_ = (call);                                                                                     \
-        if (rv_ != EXR_ERR_SUCCESS) {                                                                                  \
-            res = fail(path, what, rv_);                                                                               \
-            goto cleanup;                                                                                              \
-        }                                                                                                              \
-    } while (0)
 
 uint32_t sb_cube_levels(uint32_t face_size)
 {
@@ -123,26 +97,6 @@ static exr_result_t tile_counts(exr_const_context_t ctxt, int part, int level, i
     return rv;
 }
 
-/*
- * OpenEXR 3.1's core library stores a tile's ZIP stream even where it is
- * larger than the tile, which its own reader then refuses ("invalid packed
- * size"); the file format says the smaller is stored. This compressor runs
- * the library's and keeps the tile raw when that is no smaller.
- */
-static _Thread_local exr_result_t (*library_compress)(exr_encode_pipeline_t *);
-
-static exr_result_t compress_or_keep(exr_encode_pipeline_t *encode)
-{
-    exr_result_t rv = library_compress(encode);
-    if (rv == EXR_ERR_SUCCESS && encode->compressed_bytes >= encode->packed_bytes) {
-        if (encode->compressed_alloc_size < encode->packed_bytes)
-            return EXR_ERR_OUT_OF_MEMORY;
-        memcpy(encode->compressed_buffer, encode->packed_buffer, encode->packed_bytes);
-        encode->compressed_bytes = encode->packed_bytes;
-    }
-    return rv;
-}
-
 static bool is_cube_image(const struct sb_image *image)
 {
     uint32_t n = image->width;
@@ -158,7 +112,7 @@ enum sb_result sb_exr_cube_write(const char *path, const struct sb_image *image,
         return SB_ERR_BAD_IMAGE;
     }
     exr_context_initializer_t init = EXR_DEFAULT_CONTEXT_INITIALIZER;
-    init.error_handler_fn = quiet;
+    init.error_handler_fn = sb_exr_error_handler;
     exr_context_t ctxt = NULL;
     exr_encode_pipeline_t encoder;
     bool encoder_live = false;
@@ -179,24 +133,26 @@ enum sb_result sb_exr_cube_write(const char *path, const struct sb_image *image,
         char name[32];
         int part = 0;
         snprintf(name, sizeof(name), "cube.%u", cube);
-        TRY(exr_add_part(ctxt, name, EXR_STORAGE_TILED, &part), "adding a part");
-        TRY(exr_initialize_required_attr_simple(ctxt, part, (int32_t)image->width, (int32_t)image->height,
-                                                EXR_COMPRESSION_ZIP),
-            "setting the header");
-        TRY(exr_set_tile_descriptor(ctxt, part, tile_x, tile_y, EXR_TILE_MIPMAP_LEVELS, EXR_TILE_ROUND_DOWN),
-            "setting the tiles");
-        TRY(exr_attr_set_envmap(ctxt, part, "envmap", EXR_ENVMAP_CUBE), "setting envmap");
+        SB_EXR_TRY(exr_add_part(ctxt, name, EXR_STORAGE_TILED, &part), "adding a part");
+        SB_EXR_TRY(exr_initialize_required_attr_simple(ctxt, part, (int32_t)image->width, (int32_t)image->height,
+                                                       EXR_COMPRESSION_ZIP),
+                   "setting the header");
+        SB_EXR_TRY(exr_set_tile_descriptor(ctxt, part, tile_x, tile_y, EXR_TILE_MIPMAP_LEVELS, EXR_TILE_ROUND_DOWN),
+                   "setting the tiles");
+        SB_EXR_TRY(exr_attr_set_envmap(ctxt, part, "envmap", EXR_ENVMAP_CUBE), "setting envmap");
         for (uint32_t c = 0; c < image->channel_count; c++)
-            TRY(exr_add_channel(ctxt, part, image->channel_names[c], EXR_PIXEL_FLOAT, EXR_PERCEPTUALLY_LINEAR, 1, 1),
+            SB_EXR_TRY(
+                exr_add_channel(ctxt, part, image->channel_names[c], EXR_PIXEL_FLOAT, EXR_PERCEPTUALLY_LINEAR, 1, 1),
                 "adding a channel");
         for (int a = 0; a < attribute_count; a++)
-            TRY(exr_attr_set_string(ctxt, part, attributes[a].name, attributes[a].value), "setting an attribute");
+            SB_EXR_TRY(exr_attr_set_string(ctxt, part, attributes[a].name, attributes[a].value),
+                       "setting an attribute");
     }
-    TRY(exr_write_header(ctxt), "writing the header");
+    SB_EXR_TRY(exr_write_header(ctxt), "writing the header");
     for (uint32_t cube = 0; cube < image->depth; cube++) {
         int part = (int)cube;
         int32_t levels_x = 0, levels_y = 0;
-        TRY(exr_get_tile_levels(ctxt, part, &levels_x, &levels_y), "querying levels");
+        SB_EXR_TRY(exr_get_tile_levels(ctxt, part, &levels_x, &levels_y), "querying levels");
         if ((uint32_t)levels_x != image->levels + CUBE_TAIL_LEVELS) {
             sb_error("%s: OpenEXR makes %d levels of a %u cube, skybake %u", path, levels_x, image->width,
                      image->levels + CUBE_TAIL_LEVELS);
@@ -211,17 +167,17 @@ enum sb_result sb_exr_cube_write(const char *path, const struct sb_image *image,
             float *base = level < image->levels ? level_base(image, cube, level, &width)
                                                 : tail + (level > image->levels ? 3 * image->channel_count : 0);
             int32_t tiles_x = 0, tiles_y = 0, tw = 0, th = 0;
-            TRY(tile_counts(ctxt, part, (int)level, &tiles_x, &tiles_y, &tw, &th), "querying tiles");
+            SB_EXR_TRY(tile_counts(ctxt, part, (int)level, &tiles_x, &tiles_y, &tw, &th), "querying tiles");
             for (int32_t ty = 0; ty < tiles_y; ty++)
                 for (int32_t tx = 0; tx < tiles_x; tx++) {
                     exr_chunk_info_t cinfo;
-                    TRY(exr_write_tile_chunk_info(ctxt, part, tx, ty, (int)level, (int)level, &cinfo),
-                        "preparing a tile");
+                    SB_EXR_TRY(exr_write_tile_chunk_info(ctxt, part, tx, ty, (int)level, (int)level, &cinfo),
+                               "preparing a tile");
                     bool first = !encoder_live;
                     if (encoder_live)
-                        TRY(exr_encoding_update(ctxt, part, &cinfo, &encoder), "updating the encoder");
+                        SB_EXR_TRY(exr_encoding_update(ctxt, part, &cinfo, &encoder), "updating the encoder");
                     else {
-                        TRY(exr_encoding_initialize(ctxt, part, &cinfo, &encoder), "starting the encoder");
+                        SB_EXR_TRY(exr_encoding_initialize(ctxt, part, &cinfo, &encoder), "starting the encoder");
                         encoder_live = true;
                     }
                     if (!point_channels(encoder.channels, encoder.channel_count, image, base, width, tx * tw, ty * th,
@@ -230,13 +186,10 @@ enum sb_result sb_exr_cube_write(const char *path, const struct sb_image *image,
                         goto cleanup;
                     }
                     if (first) {
-                        TRY(exr_encoding_choose_default_routines(ctxt, part, &encoder), "choosing the encoder");
-                        if (encoder.compress_fn && encoder.compress_fn != compress_or_keep) {
-                            library_compress = encoder.compress_fn;
-                            encoder.compress_fn = compress_or_keep;
-                        }
+                        SB_EXR_TRY(exr_encoding_choose_default_routines(ctxt, part, &encoder), "choosing the encoder");
+                        sb_exr_keep_raw_when_larger(&encoder);
                     }
-                    TRY(exr_encoding_run(ctxt, part, &encoder), "encoding");
+                    SB_EXR_TRY(exr_encoding_run(ctxt, part, &encoder), "encoding");
                 }
         }
         /* A coder belongs to its part. */
@@ -261,7 +214,7 @@ static enum sb_result check_part(exr_context_t ctxt, const char *path, int part,
 {
     enum sb_result res = SB_OK;
     exr_storage_t storage;
-    TRY(exr_get_storage(ctxt, part, &storage), "reading the storage type");
+    SB_EXR_TRY(exr_get_storage(ctxt, part, &storage), "reading the storage type");
     if (storage != EXR_STORAGE_TILED) {
         sb_error("%s: part %d: not a tiled image", path, part);
         return SB_ERR_BAD_IMAGE;
@@ -269,7 +222,7 @@ static enum sb_result check_part(exr_context_t ctxt, const char *path, int part,
     uint32_t tw = 0, th = 0;
     exr_tile_level_mode_t mode;
     exr_tile_round_mode_t round;
-    TRY(exr_get_tile_descriptor(ctxt, part, &tw, &th, &mode, &round), "reading the tiles");
+    SB_EXR_TRY(exr_get_tile_descriptor(ctxt, part, &tw, &th, &mode, &round), "reading the tiles");
     if (mode != EXR_TILE_MIPMAP_LEVELS || round != EXR_TILE_ROUND_DOWN || !tw || !th || tw > 4096 || th > 4096) {
         sb_error("%s: part %d: not mip-mapped with level sizes rounded down (tiles %ux%u)", path, part, tw, th);
         return SB_ERR_BAD_IMAGE;
@@ -280,7 +233,7 @@ static enum sb_result check_part(exr_context_t ctxt, const char *path, int part,
         return SB_ERR_BAD_IMAGE;
     }
     exr_attr_box2i_t window;
-    TRY(exr_get_data_window(ctxt, part, &window), "reading the data window");
+    SB_EXR_TRY(exr_get_data_window(ctxt, part, &window), "reading the data window");
     if (window.min.x != 0 || window.min.y != 0 || (int64_t)window.max.x + 1 != face_size ||
         (int64_t)window.max.y + 1 != 6 * (int64_t)face_size) {
         sb_error("%s: part %d: data window (%d %d) - (%d %d), expected (0 0) - (%u %u)", path, part, window.min.x,
@@ -288,14 +241,14 @@ static enum sb_result check_part(exr_context_t ctxt, const char *path, int part,
         return SB_ERR_BAD_IMAGE;
     }
     int32_t levels_x = 0, levels_y = 0;
-    TRY(exr_get_tile_levels(ctxt, part, &levels_x, &levels_y), "reading the levels");
+    SB_EXR_TRY(exr_get_tile_levels(ctxt, part, &levels_x, &levels_y), "reading the levels");
     if ((uint32_t)levels_x != sb_cube_levels(face_size) + CUBE_TAIL_LEVELS) {
         sb_error("%s: part %d: %d levels, expected %u", path, part, levels_x,
                  sb_cube_levels(face_size) + CUBE_TAIL_LEVELS);
         return SB_ERR_BAD_IMAGE;
     }
     const exr_attr_chlist_t *chlist = NULL;
-    TRY(exr_get_channels(ctxt, part, &chlist), "reading the channel list");
+    SB_EXR_TRY(exr_get_channels(ctxt, part, &chlist), "reading the channel list");
     if (chlist->num_channels != (int)channels->channel_count) {
         sb_error("%s: part %d: %d channels, expected %u", path, part, chlist->num_channels, channels->channel_count);
         return SB_ERR_BAD_IMAGE;
@@ -322,7 +275,7 @@ enum sb_result sb_exr_cube_read(const char *path, const char *channel_order, uin
         return SB_ERR_BAD_IMAGE;
     }
     exr_context_initializer_t init = EXR_DEFAULT_CONTEXT_INITIALIZER;
-    init.error_handler_fn = quiet;
+    init.error_handler_fn = sb_exr_error_handler;
     exr_context_t ctxt = NULL;
     exr_decode_pipeline_t decoder;
     bool decoder_live = false;
@@ -337,7 +290,7 @@ enum sb_result sb_exr_cube_read(const char *path, const char *channel_order, uin
         return rv == EXR_ERR_FILE_ACCESS ? SB_ERR_IO : SB_ERR_EXR;
     }
     int parts = 0;
-    TRY(exr_get_count(ctxt, &parts), "counting parts");
+    SB_EXR_TRY(exr_get_count(ctxt, &parts), "counting parts");
     if (parts != (int)cube_count) {
         sb_error("%s: %d parts, expected %u cubes", path, parts, cube_count);
         res = SB_ERR_BAD_IMAGE;
@@ -354,7 +307,7 @@ enum sb_result sb_exr_cube_read(const char *path, const char *channel_order, uin
         float tail[4 * SB_IMAGE_MAX_CHANNELS];
         for (uint32_t level = 0; level < image->levels + CUBE_TAIL_LEVELS; level++) {
             int32_t tiles_x = 0, tiles_y = 0, tw = 0, th = 0;
-            TRY(tile_counts(ctxt, part, (int)level, &tiles_x, &tiles_y, &tw, &th), "counting tiles");
+            SB_EXR_TRY(tile_counts(ctxt, part, (int)level, &tiles_x, &tiles_y, &tw, &th), "counting tiles");
             uint32_t width = 1;
             float *base = level < image->levels ? level_base(image, (uint32_t)part, level, &width)
                                                 : tail + (level > image->levels ? 3 * image->channel_count : 0);
@@ -364,7 +317,8 @@ enum sb_result sb_exr_cube_read(const char *path, const char *channel_order, uin
             for (int32_t ty = 0; ty < tiles_y; ty++)
                 for (int32_t tx = 0; tx < tiles_x; tx++) {
                     exr_chunk_info_t cinfo;
-                    TRY(exr_read_tile_chunk_info(ctxt, part, tx, ty, (int)level, (int)level, &cinfo), "reading a tile");
+                    SB_EXR_TRY(exr_read_tile_chunk_info(ctxt, part, tx, ty, (int)level, (int)level, &cinfo),
+                               "reading a tile");
                     int32_t x0 = tx * tw, y0 = ty * th;
                     if (x0 + (int32_t)cinfo.width > w || y0 + (int32_t)cinfo.height > h) {
                         sb_error("%s: part %d: tile (%d, %d) of level %u lies outside it", path, part, tx, ty, level);
@@ -373,9 +327,9 @@ enum sb_result sb_exr_cube_read(const char *path, const char *channel_order, uin
                     }
                     bool first = !decoder_live;
                     if (decoder_live)
-                        TRY(exr_decoding_update(ctxt, part, &cinfo, &decoder), "updating the decoder");
+                        SB_EXR_TRY(exr_decoding_update(ctxt, part, &cinfo, &decoder), "updating the decoder");
                     else {
-                        TRY(exr_decoding_initialize(ctxt, part, &cinfo, &decoder), "starting the decoder");
+                        SB_EXR_TRY(exr_decoding_initialize(ctxt, part, &cinfo, &decoder), "starting the decoder");
                         decoder_live = true;
                     }
                     if (!point_channels(decoder.channels, decoder.channel_count, image, base, width, x0, y0, true)) {
@@ -383,8 +337,8 @@ enum sb_result sb_exr_cube_read(const char *path, const char *channel_order, uin
                         goto cleanup;
                     }
                     if (first)
-                        TRY(exr_decoding_choose_default_routines(ctxt, part, &decoder), "choosing the decoder");
-                    TRY(exr_decoding_run(ctxt, part, &decoder), "decoding");
+                        SB_EXR_TRY(exr_decoding_choose_default_routines(ctxt, part, &decoder), "choosing the decoder");
+                    SB_EXR_TRY(exr_decoding_run(ctxt, part, &decoder), "decoding");
                 }
         }
         exr_decoding_destroy(ctxt, &decoder);

@@ -622,10 +622,12 @@ static enum sb_result read_artifact_entry(const cJSON *entry, int index, struct 
     uint32_t shape[3] = {format->width, format->height, format->depth};
     if (scene)
         sb_product_shape(scene, id, shape);
-    /* A probe product's count follows from the world's geometry, which this
-     * tier does not read: the manifest says it, the file must agree. */
-    if (format->storage == SB_STORAGE_PROBES && ((res = manifest_u32(entry, "width", &shape[0], source, where)) ||
-                                                 !shape[0] || shape[0] > SB_PROBES_MAX_COUNT)) {
+    /* A probe grid's count follows from the world's geometry, which this
+     * tier does not read: the manifest says it, the file must agree. (The
+     * reflection probes' count is the scene's, checked like any shape.) */
+    if (format->storage == SB_STORAGE_PROBES && !shape[0] &&
+        ((res = manifest_u32(entry, "width", &shape[0], source, where)) || !shape[0] ||
+         shape[0] > SB_PROBES_MAX_COUNT)) {
         sb_error("%s: %swidth: %s needs 1 to %u probes", source, where, name, SB_PROBES_MAX_COUNT);
         return res ? res : SB_ERR_OUT_OF_RANGE;
     }

@@ -426,7 +426,7 @@ static enum sb_result upload_reflections(struct sb_renderer *r, const struct sb_
     const struct sb_image *cubes = &pack->images[SB_PRODUCT_REFLECTION_CUBES];
     const struct sb_image *records = &pack->images[SB_PRODUCT_REFLECTION_PROBES];
     bool use = pack->present[SB_PRODUCT_REFLECTION_CUBES] && pack->present[SB_PRODUCT_REFLECTION_PROBES] &&
-               !r->params.no_reflections && records->width == cubes->depth && cubes->levels <= 16;
+               !r->params.no_reflections && records->width == cubes->depth && cubes->levels < 16; /* [3].w: the chain */
     bool dfg = use && pack->present[SB_PRODUCT_DFG];
     uint32_t count = use ? cubes->depth : 0, n = use ? cubes->width : 1, levels = use ? cubes->levels : 1;
     uint64_t chain = 0;
@@ -449,11 +449,14 @@ static enum sb_result upload_reflections(struct sb_renderer *r, const struct sb_
     sb_direction(az, el, sun);
     for (int k = 0; k < 3; k++)
         g->baked_sun[k] = (float)sun[k];
-    /* E(up) = sum_k E_k Y_k(+y): Y_0 and Y_1 (y) and Y_6 (3 z^2 - 1 = -1) and Y_8 (x^2 - y^2 = -1) */
-    const float *sky = records->data + 9;
-    for (int c = 0; c < 3; c++)
-        g->baked_sky_up[c] = (float)(0.28209479177387814 * sky[c] + 0.4886025119029199 * sky[3 + c] -
-                                     0.31539156525252005 * sky[18 + c] - 0.5462742152960396 * sky[24 + c]);
+    /* The sky-only cube's irradiance SH (its record's channels 9 on, k then rgb) at +y. */
+    const double up[3] = {0, 1, 0};
+    for (int c = 0; c < 3; c++) {
+        double coefficients[SB_PROBE_SH];
+        for (int k = 0; k < SB_PROBE_SH; k++)
+            coefficients[k] = records->data[9 + 3 * k + c];
+        g->baked_sky_up[c] = (float)sb_sh9_eval(coefficients, up);
+    }
     uint64_t at = 0;
     for (uint32_t l = 0; l < levels; l++) {
         g->level_offsets[l / 4][l % 4] = (uint32_t)at;

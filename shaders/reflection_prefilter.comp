@@ -34,17 +34,9 @@ uint source_offset(uint level)
 vec3 fetch(vec3 d, uint level)
 {
     uint n = max(pc.face_size >> level, 1u);
-    vec2 uv;
-    uint face = cube_face(d, uv);
-    vec2 p = clamp((uv * 0.5 + 0.5) * float(n) - 0.5, vec2(0.0), vec2(float(n) - 1.0));
-    uvec2 i0 = uvec2(p);
-    uvec2 i1 = min(i0 + 1u, uvec2(n - 1u));
-    vec2 f = p - vec2(i0);
-    uint base = source_offset(level) + face * n * n;
-    vec3 a = source[base + i0.y * n + i0.x].rgb, b = source[base + i0.y * n + i1.x].rgb;
-    vec3 c = source[base + i1.y * n + i0.x].rgb, e = source[base + i1.y * n + i1.x].rgb;
-    vec3 top = a + (b - a) * f.x, bottom = c + (e - c) * f.x;
-    return top + (bottom - top) * f.y; // exact where the texels are equal, unlike mix
+    vec3 rgb;
+    CUBE_BILINEAR(source, source_offset(level), n, d, rgb);
+    return rgb;
 }
 
 vec3 fetch_lod(vec3 d, float lod)

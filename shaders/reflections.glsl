@@ -26,17 +26,9 @@ uint reflection_level_offset(uint level)
 vec3 reflection_fetch(uint cube, vec3 d, uint level)
 {
     uint n = max(reflections.info.x >> level, 1u);
-    vec2 uv;
-    uint face = cube_face(d, uv);
-    vec2 p = clamp((uv * 0.5 + 0.5) * float(n) - 0.5, vec2(0.0), vec2(float(n) - 1.0));
-    uvec2 i0 = uvec2(p);
-    uvec2 i1 = min(i0 + 1u, uvec2(n - 1u));
-    vec2 f = p - vec2(i0);
-    uint base = cube * reflections.level_offsets[3].w + reflection_level_offset(level) + face * n * n;
-    vec3 a = cube_texels[base + i0.y * n + i0.x].rgb, b = cube_texels[base + i0.y * n + i1.x].rgb;
-    vec3 c = cube_texels[base + i1.y * n + i0.x].rgb, e = cube_texels[base + i1.y * n + i1.x].rgb;
-    vec3 top = a + (b - a) * f.x, bottom = c + (e - c) * f.x;
-    return top + (bottom - top) * f.y;
+    vec3 rgb;
+    CUBE_BILINEAR(cube_texels, cube * reflections.level_offsets[3].w + reflection_level_offset(level), n, d, rgb);
+    return rgb;
 }
 
 /* Radiance prefiltered for perceptual roughness r along d: the mip

@@ -26,6 +26,48 @@ static void quiet(void *user, enum sb_log_level level, const char *msg)
     (void)msg;
 }
 
+/* How many prefixes of the file at `path` (every length below `fine`, then
+ * every `step`th) `read` accepts; the file is left as the longest prefix
+ * tried, for the caller to remove. */
+static int truncations_accepted(const char *path, long fine, long step, bool (*read)(const char *path))
+{
+    FILE *f = fopen(path, "rb");
+    fseek(f, 0, SEEK_END);
+    long size = ftell(f);
+    rewind(f);
+    unsigned char *bytes = malloc(size);
+    CHECK(fread(bytes, 1, size, f) == (size_t)size, "read %s back", path);
+    fclose(f);
+    int accepted = 0;
+    for (long cut = 0; cut < size; cut += cut < fine ? 1 : step) {
+        f = fopen(path, "wb");
+        fwrite(bytes, 1, cut, f);
+        fclose(f);
+        accepted += read(path);
+    }
+    free(bytes);
+    return accepted;
+}
+
+static bool read_rgb(const char *path)
+{
+    struct sb_image t;
+    bool ok = sb_exr_read(path, "r,g,b", 0, &t, NULL, NULL) == SB_OK;
+    if (ok)
+        sb_image_finish(&t);
+    return ok;
+}
+
+/* As a pack reads test_exr_cube's file: 3 cubes of 32 a face. */
+static bool read_cube(const char *path)
+{
+    struct sb_image t;
+    bool ok = sb_exr_cube_read(path, "R,G,B", 32, 3, &t) == SB_OK;
+    if (ok)
+        sb_image_finish(&t);
+    return ok;
+}
+
 static void test_exr_round_trip(void)
 {
     struct sb_image img, back;
@@ -57,26 +99,8 @@ static void test_exr_round_trip(void)
     CHECK(sb_exr_read(path, "r,g", 0, &reordered, NULL, NULL) == SB_ERR_BAD_IMAGE, "channel count mismatch");
     CHECK(sb_exr_read(path, NULL, 10, &reordered, NULL, NULL) == SB_ERR_BAD_IMAGE, "size cap");
     /* Every truncated prefix is refused cleanly. */
-    FILE *f = fopen(path, "rb");
-    fseek(f, 0, SEEK_END);
-    long size = ftell(f);
-    rewind(f);
-    unsigned char *bytes = malloc(size);
-    CHECK(fread(bytes, 1, size, f) == (size_t)size, "read back");
-    fclose(f);
-    int accepted = 0;
-    for (long cut = 0; cut < size; cut += (cut < 512 ? 1 : 97)) {
-        f = fopen(path, "wb");
-        fwrite(bytes, 1, cut, f);
-        fclose(f);
-        struct sb_image t;
-        if (sb_exr_read(path, "r,g,b", 0, &t, NULL, NULL) == SB_OK) {
-            accepted++;
-            sb_image_finish(&t);
-        }
-    }
+    int accepted = truncations_accepted(path, 512, 97, read_rgb);
     CHECK(accepted == 0, "%d truncated files were accepted", accepted);
-    free(bytes);
     unlink(path);
     /* The hash sees every value and the shape. */
     img.data[5] = nextafterf(img.data[5], INFINITY);
@@ -139,28 +163,10 @@ static void test_exr_cube(void)
     CHECK(sb_exr_cube_read(path2, "R,G,B", n, 1, &back) == SB_ERR_BAD_IMAGE, "scanline refused");
     unlink(path2);
     sb_image_finish(&plain);
-    /* Every truncated prefix, and flipped bytes past the header, are refused
-     * or read as what the file says (never a crash). */
-    FILE *f = fopen(path, "rb");
-    fseek(f, 0, SEEK_END);
-    long size = ftell(f);
-    rewind(f);
-    unsigned char *bytes = malloc(size);
-    CHECK(fread(bytes, 1, size, f) == (size_t)size, "read back");
-    fclose(f);
-    int accepted = 0;
-    for (long cut = 0; cut < size; cut += (cut < 1024 ? 7 : 331)) {
-        f = fopen(path, "wb");
-        fwrite(bytes, 1, cut, f);
-        fclose(f);
-        struct sb_image t;
-        if (sb_exr_cube_read(path, "R,G,B", n, cubes, &t) == SB_OK) {
-            accepted++;
-            sb_image_finish(&t);
-        }
-    }
+    /* Every truncated prefix is refused cleanly (a byte at a time through
+     * the header, then every 331st). */
+    int accepted = truncations_accepted(path, 1024, 331, read_cube);
     CHECK(accepted == 0, "%d truncated cube files were accepted", accepted);
-    free(bytes);
     unlink(path);
     sb_image_finish(&img);
 }

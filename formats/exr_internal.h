@@ -1,0 +1,41 @@
+/*
+ * What skybake's two EXR writers and readers share (exr.c: scanline
+ * images; exr_cube.c: tiled mip-mapped cube maps): OpenEXR's errors
+ * reported as skybake's, and a compressor that keeps a chunk raw where
+ * ZIP does not shrink it. Internal to formats/.
+ */
+#ifndef SB_EXR_INTERNAL_H
+#define SB_EXR_INTERNAL_H
+
+#include <openexr.h>
+
+#include "result.h"
+
+/* For exr_context_initializer_t.error_handler_fn: keeps OpenEXR's message
+ * for the thread's next sb_exr_fail instead of printing it. */
+void sb_exr_error_handler(exr_const_context_t ctxt, exr_result_t code, const char *msg);
+
+/* Log "path: what: OpenEXR's reason" and map the code (SB_ERR_IO for file
+ * access and writes, else SB_ERR_EXR). */
+enum sb_result sb_exr_fail(const char *path, const char *what, exr_result_t rv);
+
+/* Run `call`; on failure set `res` from sb_exr_fail and go to `cleanup`. */
+#define SB_EXR_TRY(call, what)                                                                                         \
+    do {                                                                                                               \
+        exr_result_t rv_ = (call);                                                                                     \
+        if (rv_ != EXR_ERR_SUCCESS) {                                                                                  \
+            res = sb_exr_fail(path, what, rv_);                                                                        \
+            goto cleanup;                                                                                              \
+        }                                                                                                              \
+    } while (0)
+
+/*
+ * After exr_encoding_choose_default_routines: wrap the encoder's
+ * compressor so that a chunk whose compressed size is not smaller than its
+ * raw size is stored raw. OpenEXR 3.1's ZIP keeps a stream exactly as long
+ * as the raw bytes, which its reader (and every reader) then takes as raw:
+ * corrupt pixels (OpenEXR issue 2306, fixed in 3.4.7).
+ */
+void sb_exr_keep_raw_when_larger(exr_encode_pipeline_t *encoder);
+
+#endif
