@@ -1,5 +1,6 @@
-#include "renderer.h"
+#include "renderer_internal.h"
 
+#include <assert.h>
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
@@ -29,67 +30,13 @@
 
 #define NEAR_M 0.1
 #define AERIAL_FAR_KM 32.0
-#define HDR_FORMAT VK_FORMAT_R16G16B16A16_SFLOAT
-#define DEPTH_FORMAT VK_FORMAT_D32_SFLOAT
-#define BLOOM_SETS (2 * SB_BLOOM_MAX_LEVELS)
 
-static const char *const pass_names[SB_PASS_COUNT] = {
-    [SB_PASS_SKY_VIEW] = "sky-view", [SB_PASS_PROBES] = "probes", [SB_PASS_AERIAL_PERSPECTIVE] = "aerial perspective",
-    [SB_PASS_SHADOWS] = "shadows",   [SB_PASS_SCENE] = "scene",   [SB_PASS_SKY] = "sky",
-    [SB_PASS_EXPOSURE] = "exposure", [SB_PASS_BLOOM] = "bloom",   [SB_PASS_TONEMAP] = "tonemap",
-};
+static const struct sb_pass_class *const pass_classes[SB_PASS_COUNT];
 
 const char *sb_pass_name(enum sb_pass pass)
 {
-    return pass < SB_PASS_COUNT ? pass_names[pass] : "?";
+    return pass < SB_PASS_COUNT ? pass_classes[pass]->name : "?";
 }
-
-enum compute_kernel {
-    KERNEL_SKY_VIEW,
-    KERNEL_AERIAL,
-    KERNEL_SKY,
-    KERNEL_HISTOGRAM,
-    KERNEL_EXPOSURE,
-    KERNEL_BLOOM_DOWN,
-    KERNEL_BLOOM_UP,
-    KERNEL_TONEMAP,
-    KERNEL_PROBE_SKY,
-    KERNEL_PROBE_LIGHT,
-    KERNEL_COUNT,
-};
-
-struct sb_renderer {
-    struct sb_vk *vk;
-    struct sb_renderer_params params;
-    uint32_t width, height, bloom_levels;
-    uint32_t vertex_count, caster_first_vertex;
-    double radiance_scale; /* what stored radiance is multiplied by (fp16 headroom) */
-    double ground_radius_km;
-
-    struct sb_buffer atmosphere, transmittance, multiscattering, irradiance_ground;
-    struct sb_buffer frame, vertices, exposure;
-    struct sb_buffer probes, probe_light;           /* sb_probes_gpu and its probes; the sky's and probes' SH */
-    struct sb_buffer reflections, reflection_cubes; /* sb_reflections_gpu, its probes and the DFG; the cubes */
-    uint32_t probe_count;                           /* grid probes lit by the probes pass (0: none) */
-    struct sb_buffer read_ldr, read_hdr, read_sky_view;
-
-    struct sb_texture sky_view, aerial, aerial_t, shadow, hdr, depth, bloom, ldr;
-    VkSampler linear, nearest, shadow_compare;
-
-    VkDescriptorSetLayout set_layout;
-    VkPipelineLayout layout;
-    VkDescriptorPool pool;
-    VkDescriptorSet set;                    /* everything, bloom bindings at level 0 */
-    VkDescriptorSet bloom_sets[BLOOM_SETS]; /* down steps 0..L-1, then up steps */
-    VkPipeline kernels[KERNEL_COUNT];
-    VkPipeline shadow_pipeline, scene_pipeline;
-
-    VkQueryPool queries;
-    VkCommandBuffer cmd;
-    VkFence fence;
-    struct sb_mat4 view_proj; /* of the last frame, camera-relative */
-    double camera_m[3];
-};
 
 static const struct {
     const uint32_t *words;
@@ -137,40 +84,65 @@ static const VkDescriptorType binding_types[SB_VIEW_BINDING_COUNT] = {
     [SB_VIEW_BINDING_REFLECTION_CUBES] = VK_DESCRIPTOR_TYPE_STORAGE_BUFFER,
 };
 
+void sb_renderer_bind_buffer(struct sb_renderer *r, uint32_t binding, const struct sb_buffer *buffer)
+{
+    assert(binding < SB_VIEW_BINDING_COUNT && binding_types[binding] == VK_DESCRIPTOR_TYPE_STORAGE_BUFFER);
+    r->bound_buffer[binding] = buffer;
+}
+
+void sb_renderer_bind_view(struct sb_renderer *r, uint32_t binding, VkImageView view)
+{
+    assert(binding < SB_VIEW_BINDING_COUNT && binding_types[binding] != VK_DESCRIPTOR_TYPE_STORAGE_BUFFER);
+    r->bound_view[binding] = view;
+}
+
+/* The renderer's own resources; the bloom step's bindings vary per set. */
+static void bind_own(struct sb_renderer *r)
+{
+    const struct {
+        uint32_t binding;
+        const struct sb_buffer *buffer;
+    } buffers[] = {
+        {SB_BINDING_ATMOSPHERE, &r->atmosphere},
+        {SB_BINDING_TRANSMITTANCE, &r->transmittance},
+        {SB_BINDING_MULTISCATTERING, &r->multiscattering},
+        {SB_BINDING_IRRADIANCE_GROUND, &r->irradiance_ground},
+        {SB_VIEW_BINDING_FRAME, &r->frame},
+        {SB_VIEW_BINDING_VERTICES, &r->vertices},
+        {SB_VIEW_BINDING_EXPOSURE, &r->exposure},
+        {SB_VIEW_BINDING_PROBES, &r->probes},
+        {SB_VIEW_BINDING_PROBE_LIGHT, &r->probe_light},
+        {SB_VIEW_BINDING_REFLECTIONS, &r->reflections},
+        {SB_VIEW_BINDING_REFLECTION_CUBES, &r->reflection_cubes},
+    };
+    for (size_t i = 0; i < sizeof(buffers) / sizeof(buffers[0]); i++)
+        sb_renderer_bind_buffer(r, buffers[i].binding, buffers[i].buffer);
+    const struct {
+        uint32_t binding;
+        VkImageView view;
+    } views[] = {
+        {SB_VIEW_BINDING_SKY_VIEW, r->sky_view.view},
+        {SB_VIEW_BINDING_SKY_VIEW_OUT, r->sky_view.view},
+        {SB_VIEW_BINDING_AERIAL, r->aerial.view},
+        {SB_VIEW_BINDING_AERIAL_T, r->aerial_t.view},
+        {SB_VIEW_BINDING_AERIAL_OUT, r->aerial.view},
+        {SB_VIEW_BINDING_AERIAL_T_OUT, r->aerial_t.view},
+        {SB_VIEW_BINDING_SHADOW, r->shadow.view},
+        {SB_VIEW_BINDING_HDR, r->hdr.view},
+        {SB_VIEW_BINDING_DEPTH, r->depth.view},
+        {SB_VIEW_BINDING_BLOOM, r->bloom.subview_count ? r->bloom.subviews[0] : r->bloom.view},
+        {SB_VIEW_BINDING_LDR, r->ldr.view},
+    };
+    for (size_t i = 0; i < sizeof(views) / sizeof(views[0]); i++)
+        sb_renderer_bind_view(r, views[i].binding, views[i].view);
+}
+
 /* Write every binding of `set`; the bloom step's source and target vary per set. */
 static void write_set(struct sb_renderer *r, VkDescriptorSet set, VkImageView bloom_src, VkImageView bloom_dst)
 {
     VkDescriptorBufferInfo buffers[SB_VIEW_BINDING_COUNT] = {0};
     VkDescriptorImageInfo images[SB_VIEW_BINDING_COUNT] = {0};
     VkWriteDescriptorSet writes[SB_VIEW_BINDING_COUNT];
-    const struct sb_buffer *buffer_of[SB_VIEW_BINDING_COUNT] = {
-        [SB_BINDING_ATMOSPHERE] = &r->atmosphere,
-        [SB_BINDING_TRANSMITTANCE] = &r->transmittance,
-        [SB_BINDING_MULTISCATTERING] = &r->multiscattering,
-        [SB_BINDING_IRRADIANCE_GROUND] = &r->irradiance_ground,
-        [SB_VIEW_BINDING_FRAME] = &r->frame,
-        [SB_VIEW_BINDING_VERTICES] = &r->vertices,
-        [SB_VIEW_BINDING_EXPOSURE] = &r->exposure,
-        [SB_VIEW_BINDING_PROBES] = &r->probes,
-        [SB_VIEW_BINDING_PROBE_LIGHT] = &r->probe_light,
-        [SB_VIEW_BINDING_REFLECTIONS] = &r->reflections,
-        [SB_VIEW_BINDING_REFLECTION_CUBES] = &r->reflection_cubes,
-    };
-    const VkImageView view_of[SB_VIEW_BINDING_COUNT] = {
-        [SB_VIEW_BINDING_SKY_VIEW] = r->sky_view.view,
-        [SB_VIEW_BINDING_SKY_VIEW_OUT] = r->sky_view.view,
-        [SB_VIEW_BINDING_AERIAL] = r->aerial.view,
-        [SB_VIEW_BINDING_AERIAL_T] = r->aerial_t.view,
-        [SB_VIEW_BINDING_AERIAL_OUT] = r->aerial.view,
-        [SB_VIEW_BINDING_AERIAL_T_OUT] = r->aerial_t.view,
-        [SB_VIEW_BINDING_SHADOW] = r->shadow.view,
-        [SB_VIEW_BINDING_HDR] = r->hdr.view,
-        [SB_VIEW_BINDING_DEPTH] = r->depth.view,
-        [SB_VIEW_BINDING_BLOOM_SRC] = bloom_src,
-        [SB_VIEW_BINDING_BLOOM_DST] = bloom_dst,
-        [SB_VIEW_BINDING_BLOOM] = r->bloom.subview_count ? r->bloom.subviews[0] : r->bloom.view,
-        [SB_VIEW_BINDING_LDR] = r->ldr.view,
-    };
     for (uint32_t b = 0; b < SB_VIEW_BINDING_COUNT; b++) {
         writes[b] = (VkWriteDescriptorSet){
             .sType = VK_STRUCTURE_TYPE_WRITE_DESCRIPTOR_SET,
@@ -180,14 +152,19 @@ static void write_set(struct sb_renderer *r, VkDescriptorSet set, VkImageView bl
             .descriptorType = binding_types[b],
         };
         if (binding_types[b] == VK_DESCRIPTOR_TYPE_STORAGE_BUFFER) {
-            buffers[b] = (VkDescriptorBufferInfo){.buffer = buffer_of[b]->buffer, .range = VK_WHOLE_SIZE};
+            assert(r->bound_buffer[b]);
+            buffers[b] = (VkDescriptorBufferInfo){.buffer = r->bound_buffer[b]->buffer, .range = VK_WHOLE_SIZE};
             writes[b].pBufferInfo = &buffers[b];
         } else {
+            VkImageView view = b == SB_VIEW_BINDING_BLOOM_SRC   ? bloom_src
+                               : b == SB_VIEW_BINDING_BLOOM_DST ? bloom_dst
+                                                                : r->bound_view[b];
+            assert(view);
             images[b] = (VkDescriptorImageInfo){
                 .sampler = b == SB_VIEW_BINDING_SHADOW  ? r->shadow_compare
                            : b == SB_VIEW_BINDING_DEPTH ? r->nearest /* depth formats need not filter */
                                                         : r->linear,
-                .imageView = view_of[b],
+                .imageView = view,
                 .imageLayout = b == SB_VIEW_BINDING_SHADOW || b == SB_VIEW_BINDING_DEPTH
                                    ? VK_IMAGE_LAYOUT_DEPTH_STENCIL_READ_ONLY_OPTIMAL
                                    : VK_IMAGE_LAYOUT_GENERAL,
@@ -198,21 +175,19 @@ static void write_set(struct sb_renderer *r, VkDescriptorSet set, VkImageView bl
     vkUpdateDescriptorSets(r->vk->device, SB_VIEW_BINDING_COUNT, writes, 0, NULL);
 }
 
-static enum sb_result create_descriptors(struct sb_renderer *r)
+/* The layout every pass's pipelines share: config.h's bindings and sb_view_push. */
+static enum sb_result create_layout(struct sb_renderer *r)
 {
     enum sb_result res = SB_OK;
     struct sb_vk *vk = r->vk;
     VkDescriptorSetLayoutBinding bindings[SB_VIEW_BINDING_COUNT];
-    uint32_t counts[16] = {0};
-    for (uint32_t b = 0; b < SB_VIEW_BINDING_COUNT; b++) {
+    for (uint32_t b = 0; b < SB_VIEW_BINDING_COUNT; b++)
         bindings[b] = (VkDescriptorSetLayoutBinding){
             .binding = b,
             .descriptorType = binding_types[b],
             .descriptorCount = 1,
             .stageFlags = VK_SHADER_STAGE_ALL,
         };
-        counts[binding_types[b]]++;
-    }
     VkDescriptorSetLayoutCreateInfo set_info = {
         .sType = VK_STRUCTURE_TYPE_DESCRIPTOR_SET_LAYOUT_CREATE_INFO,
         .bindingCount = SB_VIEW_BINDING_COUNT,
@@ -228,8 +203,20 @@ static enum sb_result create_descriptors(struct sb_renderer *r)
         .pPushConstantRanges = &range,
     };
     VK(vkCreatePipelineLayout(vk->device, &layout_info, NULL, &r->layout));
+cleanup:
+    return res;
+}
 
-    const uint32_t set_count = 1 + BLOOM_SETS;
+/* The main set and the bloom steps' sets, every binding written. */
+static enum sb_result create_sets(struct sb_renderer *r)
+{
+    enum sb_result res = SB_OK;
+    struct sb_vk *vk = r->vk;
+    uint32_t counts[16] = {0};
+    for (uint32_t b = 0; b < SB_VIEW_BINDING_COUNT; b++)
+        counts[binding_types[b]]++;
+    bind_own(r);
+    const uint32_t set_count = 1 + SB_BLOOM_SETS;
     VkDescriptorPoolSize sizes[4];
     uint32_t n = 0;
     const VkDescriptorType types[] = {VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER,
@@ -243,10 +230,10 @@ static enum sb_result create_descriptors(struct sb_renderer *r)
         .pPoolSizes = sizes,
     };
     VK(vkCreateDescriptorPool(vk->device, &pool_info, NULL, &r->pool));
-    VkDescriptorSetLayout layouts[1 + BLOOM_SETS];
+    VkDescriptorSetLayout layouts[1 + SB_BLOOM_SETS];
     for (uint32_t i = 0; i < set_count; i++)
         layouts[i] = r->set_layout;
-    VkDescriptorSet sets[1 + BLOOM_SETS];
+    VkDescriptorSet sets[1 + SB_BLOOM_SETS];
     VkDescriptorSetAllocateInfo alloc = {
         .sType = VK_STRUCTURE_TYPE_DESCRIPTOR_SET_ALLOCATE_INFO,
         .descriptorPool = r->pool,
@@ -279,6 +266,18 @@ static enum sb_result upload(struct sb_vk *vk, const void *data, size_t bytes, c
     if (!res && data)
         memcpy(b->mapped, data, bytes);
     return res;
+}
+
+enum sb_result sb_renderer_upload(struct sb_renderer *r, const void *data, size_t bytes, const char *name,
+                                  struct sb_buffer *buffer)
+{
+    return upload(r->vk, data, bytes, name, buffer);
+}
+
+enum sb_result sb_renderer_kernel(struct sb_renderer *r, const uint32_t *spirv, size_t spirv_size, const char *name,
+                                  VkPipeline *pipeline)
+{
+    return sb_compute_pipeline_create(r->vk, r->layout, spirv, spirv_size, name, pipeline);
 }
 
 static enum sb_result upload_atmosphere(struct sb_renderer *r, const struct sb_pack *pack)
@@ -512,26 +511,26 @@ static enum sb_result create_images(struct sb_renderer *r)
     const VkImageUsageFlags copy = VK_IMAGE_USAGE_TRANSFER_SRC_BIT;
     uint32_t s = r->params.shadow_size;
     uint32_t bw = r->width / 2 ? r->width / 2 : 1, bh = r->height / 2 ? r->height / 2 : 1;
-    enum sb_result res = create_texture(r, &r->sky_view, SB_SKY_VIEW_WIDTH, SB_SKY_VIEW_HEIGHT, 1, 1, 1, HDR_FORMAT,
+    enum sb_result res = create_texture(r, &r->sky_view, SB_SKY_VIEW_WIDTH, SB_SKY_VIEW_HEIGHT, 1, 1, 1, SB_HDR_FORMAT,
                                         storage_sampled | copy, "sky-view LUT");
     if (!res)
-        res = create_texture(r, &r->aerial, SB_AERIAL_SIZE, SB_AERIAL_SIZE, SB_AERIAL_SIZE, 1, 1, HDR_FORMAT,
+        res = create_texture(r, &r->aerial, SB_AERIAL_SIZE, SB_AERIAL_SIZE, SB_AERIAL_SIZE, 1, 1, SB_HDR_FORMAT,
                              storage_sampled, "aerial perspective in-scattering");
     if (!res)
-        res = create_texture(r, &r->aerial_t, SB_AERIAL_SIZE, SB_AERIAL_SIZE, SB_AERIAL_SIZE, 1, 1, HDR_FORMAT,
+        res = create_texture(r, &r->aerial_t, SB_AERIAL_SIZE, SB_AERIAL_SIZE, SB_AERIAL_SIZE, 1, 1, SB_HDR_FORMAT,
                              storage_sampled, "aerial perspective transmittance");
     if (!res)
         res =
-            create_texture(r, &r->shadow, s, s, 1, SB_CASCADES, 1, DEPTH_FORMAT,
+            create_texture(r, &r->shadow, s, s, 1, SB_CASCADES, 1, SB_DEPTH_FORMAT,
                            VK_IMAGE_USAGE_DEPTH_STENCIL_ATTACHMENT_BIT | VK_IMAGE_USAGE_SAMPLED_BIT, "shadow cascades");
     if (!res)
-        res = create_texture(r, &r->hdr, r->width, r->height, 1, 1, 1, HDR_FORMAT,
+        res = create_texture(r, &r->hdr, r->width, r->height, 1, 1, 1, SB_HDR_FORMAT,
                              storage_sampled | copy | VK_IMAGE_USAGE_COLOR_ATTACHMENT_BIT, "HDR frame");
     if (!res)
-        res = create_texture(r, &r->depth, r->width, r->height, 1, 1, 1, DEPTH_FORMAT,
+        res = create_texture(r, &r->depth, r->width, r->height, 1, 1, 1, SB_DEPTH_FORMAT,
                              VK_IMAGE_USAGE_DEPTH_STENCIL_ATTACHMENT_BIT | VK_IMAGE_USAGE_SAMPLED_BIT, "scene depth");
     if (!res)
-        res = create_texture(r, &r->bloom, bw, bh, 1, 1, r->bloom_levels > 1 ? r->bloom_levels : 2, HDR_FORMAT,
+        res = create_texture(r, &r->bloom, bw, bh, 1, 1, r->bloom_levels > 1 ? r->bloom_levels : 2, SB_HDR_FORMAT,
                              storage_sampled, "bloom chain");
     if (!res)
         res = create_texture(r, &r->ldr, r->width, r->height, 1, 1, 1, VK_FORMAT_R8G8B8A8_UNORM,
@@ -573,7 +572,7 @@ static enum sb_result create_pipelines(struct sb_renderer *r)
         .layout = r->layout,
         .vertex_spirv = sb_spv_shadow_vert,
         .vertex_size = sizeof(sb_spv_shadow_vert),
-        .depth_format = DEPTH_FORMAT,
+        .depth_format = SB_DEPTH_FORMAT,
         .depth_compare = VK_COMPARE_OP_LESS,
         .depth_clamp = true, /* casters behind the near plane still cast ("pancaking") */
         .depth_bias_constant = 1.0f,
@@ -587,8 +586,8 @@ static enum sb_result create_pipelines(struct sb_renderer *r)
         .vertex_size = sizeof(sb_spv_scene_vert),
         .fragment_spirv = sb_spv_scene_frag,
         .fragment_size = sizeof(sb_spv_scene_frag),
-        .color_format = HDR_FORMAT,
-        .depth_format = DEPTH_FORMAT,
+        .color_format = SB_HDR_FORMAT,
+        .depth_format = SB_DEPTH_FORMAT,
         .depth_compare = VK_COMPARE_OP_GREATER, /* reverse Z */
         .name = "scene",
     };
@@ -653,9 +652,16 @@ enum sb_result sb_renderer_create(struct sb_vk *vk, const struct sb_pack *pack, 
     if (!res)
         res = create_images(r);
     if (!res)
-        res = create_descriptors(r);
+        res = create_layout(r);
     if (!res)
         res = create_pipelines(r);
+    r->scene = pack->scene;
+    for (int p = 0; p < SB_PASS_COUNT && !res; p++)
+        if (pass_classes[p]->create)
+            res = pass_classes[p]->create(r);
+    r->scene = NULL;
+    if (!res)
+        res = create_sets(r);
     if (res)
         goto cleanup;
 
@@ -698,6 +704,9 @@ void sb_renderer_destroy(struct sb_renderer **pr)
         vkFreeCommandBuffers(d, vk->command_pool, 1, &r->cmd);
     if (r->queries)
         vkDestroyQueryPool(d, r->queries, NULL);
+    for (int p = SB_PASS_COUNT; p-- > 0;)
+        if (pass_classes[p]->destroy)
+            pass_classes[p]->destroy(r);
     for (int k = 0; k < KERNEL_COUNT; k++)
         if (r->kernels[k])
             vkDestroyPipeline(d, r->kernels[k], NULL);
@@ -804,7 +813,7 @@ static void fill_frame(struct sb_renderer *r, const struct sb_view *v, struct sb
     f->size[3] = (uint32_t)r->params.debug;
 }
 
-static void barrier(VkCommandBuffer cmd)
+void sb_renderer_barrier(VkCommandBuffer cmd)
 {
     VkMemoryBarrier b = {
         .sType = VK_STRUCTURE_TYPE_MEMORY_BARRIER,
@@ -815,27 +824,29 @@ static void barrier(VkCommandBuffer cmd)
                          0, NULL);
 }
 
-static void pass_begin(struct sb_renderer *r, enum sb_pass pass)
+static void dispatch_on(struct sb_renderer *r, VkPipeline pipeline, VkDescriptorSet set,
+                        const struct sb_view_push *push, const uint32_t size[3], const uint32_t group[3])
 {
-    if (r->queries)
-        vkCmdWriteTimestamp(r->cmd, VK_PIPELINE_STAGE_TOP_OF_PIPE_BIT, r->queries, 2 * pass);
+    struct sb_view_push none = {0};
+    vkCmdBindPipeline(r->cmd, VK_PIPELINE_BIND_POINT_COMPUTE, pipeline);
+    vkCmdBindDescriptorSets(r->cmd, VK_PIPELINE_BIND_POINT_COMPUTE, r->layout, 0, 1, &set, 0, NULL);
+    vkCmdPushConstants(r->cmd, r->layout, VK_SHADER_STAGE_ALL, 0, sizeof(none), push ? push : &none);
+    vkCmdDispatch(r->cmd, (size[0] + group[0] - 1) / group[0], (size[1] + group[1] - 1) / group[1],
+                  (size[2] + group[2] - 1) / group[2]);
 }
 
-static void pass_end(struct sb_renderer *r, enum sb_pass pass)
+void sb_renderer_dispatch(struct sb_renderer *r, VkPipeline pipeline, const struct sb_view_push *push,
+                          const uint32_t size[3], const uint32_t group[3])
 {
-    if (r->queries)
-        vkCmdWriteTimestamp(r->cmd, VK_PIPELINE_STAGE_BOTTOM_OF_PIPE_BIT, r->queries, 2 * pass + 1);
-    barrier(r->cmd);
+    dispatch_on(r, pipeline, r->set, push, size, group);
 }
 
+/* A 2D dispatch of one of the renderer's kernels. */
 static void dispatch(struct sb_renderer *r, enum compute_kernel k, VkDescriptorSet set, const struct sb_view_push *push,
                      uint32_t width, uint32_t height, uint32_t group_x, uint32_t group_y)
 {
-    struct sb_view_push none = {0};
-    vkCmdBindPipeline(r->cmd, VK_PIPELINE_BIND_POINT_COMPUTE, r->kernels[k]);
-    vkCmdBindDescriptorSets(r->cmd, VK_PIPELINE_BIND_POINT_COMPUTE, r->layout, 0, 1, &set, 0, NULL);
-    vkCmdPushConstants(r->cmd, r->layout, VK_SHADER_STAGE_ALL, 0, sizeof(none), push ? push : &none);
-    vkCmdDispatch(r->cmd, (width + group_x - 1) / group_x, (height + group_y - 1) / group_y, 1);
+    dispatch_on(r, r->kernels[k], set, push, (const uint32_t[3]){width, height, 1},
+                (const uint32_t[3]){group_x, group_y, 1});
 }
 
 static void set_viewport(VkCommandBuffer cmd, uint32_t w, uint32_t h)
@@ -932,15 +943,68 @@ static void record_bloom(struct sb_renderer *r)
         struct sb_view_push push = {.level = i, .first_level = i == 0};
         dispatch(r, KERNEL_BLOOM_DOWN, r->bloom_sets[i], &push, w >> i ? w >> i : 1, h >> i ? h >> i : 1,
                  SB_WORKGROUP_X, SB_WORKGROUP_Y);
-        barrier(r->cmd);
+        sb_renderer_barrier(r->cmd);
     }
     for (uint32_t i = r->bloom_levels - 1; i-- > 0;) {
         struct sb_view_push push = {.level = i};
         dispatch(r, KERNEL_BLOOM_UP, r->bloom_sets[SB_BLOOM_MAX_LEVELS + i], &push, w >> i ? w >> i : 1,
                  h >> i ? h >> i : 1, SB_WORKGROUP_X, SB_WORKGROUP_Y);
-        barrier(r->cmd);
+        sb_renderer_barrier(r->cmd);
     }
 }
+
+static void record_sky_view(struct sb_renderer *r)
+{
+    dispatch(r, KERNEL_SKY_VIEW, r->set, NULL, SB_SKY_VIEW_WIDTH, SB_SKY_VIEW_HEIGHT, SB_WORKGROUP_X, SB_WORKGROUP_Y);
+}
+
+static void record_probes(struct sb_renderer *r)
+{
+    if (!r->probe_count)
+        return;
+    dispatch(r, KERNEL_PROBE_SKY, r->set, NULL, 1, 1, 1, 1);
+    sb_renderer_barrier(r->cmd);
+    dispatch(r, KERNEL_PROBE_LIGHT, r->set, NULL, r->probe_count, 1, SB_PROBE_THREADS, 1);
+}
+
+static void record_aerial(struct sb_renderer *r)
+{
+    dispatch(r, KERNEL_AERIAL, r->set, NULL, SB_AERIAL_SIZE, SB_AERIAL_SIZE, SB_WORKGROUP_X, SB_WORKGROUP_Y);
+}
+
+static void record_sky(struct sb_renderer *r)
+{
+    dispatch(r, KERNEL_SKY, r->set, NULL, r->width, r->height, SB_WORKGROUP_X, SB_WORKGROUP_Y);
+}
+
+static void record_exposure(struct sb_renderer *r)
+{
+    dispatch(r, KERNEL_HISTOGRAM, r->set, NULL, r->width, r->height, 16, 16);
+    sb_renderer_barrier(r->cmd);
+    dispatch(r, KERNEL_EXPOSURE, r->set, NULL, 1, 1, 1, 1);
+}
+
+static void record_tonemap(struct sb_renderer *r)
+{
+    dispatch(r, KERNEL_TONEMAP, r->set, NULL, r->width, r->height, SB_WORKGROUP_X, SB_WORKGROUP_Y);
+}
+
+static const struct sb_pass_class pass_sky_view = {.name = "sky-view", .record = record_sky_view};
+static const struct sb_pass_class pass_probes = {.name = "probes", .record = record_probes};
+static const struct sb_pass_class pass_aerial = {.name = "aerial perspective", .record = record_aerial};
+static const struct sb_pass_class pass_shadows = {.name = "shadows", .record = record_shadows};
+static const struct sb_pass_class pass_scene = {.name = "scene", .record = record_scene};
+static const struct sb_pass_class pass_sky = {.name = "sky", .record = record_sky};
+static const struct sb_pass_class pass_exposure = {.name = "exposure", .record = record_exposure};
+static const struct sb_pass_class pass_bloom = {.name = "bloom", .record = record_bloom};
+static const struct sb_pass_class pass_tonemap = {.name = "tonemap", .record = record_tonemap};
+
+/* A frame's passes, in order (enum sb_pass). */
+static const struct sb_pass_class *const pass_classes[SB_PASS_COUNT] = {
+    [SB_PASS_SKY_VIEW] = &pass_sky_view, [SB_PASS_PROBES] = &pass_probes, [SB_PASS_AERIAL_PERSPECTIVE] = &pass_aerial,
+    [SB_PASS_SHADOWS] = &pass_shadows,   [SB_PASS_SCENE] = &pass_scene,   [SB_PASS_SKY] = &pass_sky,
+    [SB_PASS_EXPOSURE] = &pass_exposure, [SB_PASS_BLOOM] = &pass_bloom,   [SB_PASS_TONEMAP] = &pass_tonemap,
+};
 
 /* Copies leave the general layout for the transfer-optimal one and come back. */
 static void copy_image(struct sb_renderer *r, const struct sb_texture *t, const struct sb_buffer *b)
@@ -960,6 +1024,7 @@ enum sb_result sb_renderer_render(struct sb_renderer *r, const struct sb_view *v
     enum sb_result res = SB_OK;
     struct sb_vk *vk = r->vk;
     fill_frame(r, view, r->frame.mapped);
+    r->view = view;
 
     VK(vkResetCommandBuffer(r->cmd, 0));
     VkCommandBufferBeginInfo begin = {
@@ -970,47 +1035,14 @@ enum sb_result sb_renderer_render(struct sb_renderer *r, const struct sb_view *v
     if (r->queries)
         vkCmdResetQueryPool(r->cmd, r->queries, 0, 2 * SB_PASS_COUNT);
 
-    pass_begin(r, SB_PASS_SKY_VIEW);
-    dispatch(r, KERNEL_SKY_VIEW, r->set, NULL, SB_SKY_VIEW_WIDTH, SB_SKY_VIEW_HEIGHT, SB_WORKGROUP_X, SB_WORKGROUP_Y);
-    pass_end(r, SB_PASS_SKY_VIEW);
-
-    pass_begin(r, SB_PASS_PROBES);
-    if (r->probe_count) {
-        dispatch(r, KERNEL_PROBE_SKY, r->set, NULL, 1, 1, 1, 1);
-        barrier(r->cmd);
-        dispatch(r, KERNEL_PROBE_LIGHT, r->set, NULL, r->probe_count, 1, SB_PROBE_THREADS, 1);
+    for (int p = 0; p < SB_PASS_COUNT; p++) {
+        if (r->queries)
+            vkCmdWriteTimestamp(r->cmd, VK_PIPELINE_STAGE_TOP_OF_PIPE_BIT, r->queries, 2 * p);
+        pass_classes[p]->record(r);
+        if (r->queries)
+            vkCmdWriteTimestamp(r->cmd, VK_PIPELINE_STAGE_BOTTOM_OF_PIPE_BIT, r->queries, 2 * p + 1);
+        sb_renderer_barrier(r->cmd);
     }
-    pass_end(r, SB_PASS_PROBES);
-
-    pass_begin(r, SB_PASS_AERIAL_PERSPECTIVE);
-    dispatch(r, KERNEL_AERIAL, r->set, NULL, SB_AERIAL_SIZE, SB_AERIAL_SIZE, SB_WORKGROUP_X, SB_WORKGROUP_Y);
-    pass_end(r, SB_PASS_AERIAL_PERSPECTIVE);
-
-    pass_begin(r, SB_PASS_SHADOWS);
-    record_shadows(r);
-    pass_end(r, SB_PASS_SHADOWS);
-
-    pass_begin(r, SB_PASS_SCENE);
-    record_scene(r);
-    pass_end(r, SB_PASS_SCENE);
-
-    pass_begin(r, SB_PASS_SKY);
-    dispatch(r, KERNEL_SKY, r->set, NULL, r->width, r->height, SB_WORKGROUP_X, SB_WORKGROUP_Y);
-    pass_end(r, SB_PASS_SKY);
-
-    pass_begin(r, SB_PASS_EXPOSURE);
-    dispatch(r, KERNEL_HISTOGRAM, r->set, NULL, r->width, r->height, 16, 16);
-    barrier(r->cmd);
-    dispatch(r, KERNEL_EXPOSURE, r->set, NULL, 1, 1, 1, 1);
-    pass_end(r, SB_PASS_EXPOSURE);
-
-    pass_begin(r, SB_PASS_BLOOM);
-    record_bloom(r);
-    pass_end(r, SB_PASS_BLOOM);
-
-    pass_begin(r, SB_PASS_TONEMAP);
-    dispatch(r, KERNEL_TONEMAP, r->set, NULL, r->width, r->height, SB_WORKGROUP_X, SB_WORKGROUP_Y);
-    pass_end(r, SB_PASS_TONEMAP);
 
     if (readback) {
         copy_image(r, &r->ldr, &r->read_ldr);
@@ -1033,6 +1065,8 @@ enum sb_result sb_renderer_render(struct sb_renderer *r, const struct sb_view *v
     };
     VK(vkQueueSubmit(vk->queue, 1, &submit, r->fence));
     VK(vkWaitForFences(vk->device, 1, &r->fence, VK_TRUE, UINT64_MAX));
+    r->view = NULL;
+    r->frame_index++;
 
     if (timings) {
         memset(timings, 0, sizeof(*timings));

@@ -1,0 +1,112 @@
+/*
+ * Inside skyview's renderer: the state its passes share, and the interface a
+ * pass implements. A frame records the passes of sb_pass_classes in order;
+ * adding a pass is a file that defines its class, an entry in enum sb_pass
+ * (renderer.h) and one in that table (renderer.c).
+ *
+ * Every pass sees one descriptor set layout, the bindings of config.h's
+ * SB_VIEW_BINDING_*: the renderer binds its own resources, and a pass binds
+ * the ones it owns in its create hook (sb_renderer_bind_*), before the sets
+ * are written. Every binding must be bound by then, so a pass that has
+ * nothing to do in a frame still binds (small) resources.
+ */
+#ifndef SB_RUNTIME_RENDERER_INTERNAL_H
+#define SB_RUNTIME_RENDERER_INTERNAL_H
+
+#include "compute.h"
+#include "config.h"
+#include "renderer.h"
+#include "texture.h"
+#include "transform.h"
+
+#define SB_HDR_FORMAT VK_FORMAT_R16G16B16A16_SFLOAT
+#define SB_DEPTH_FORMAT VK_FORMAT_D32_SFLOAT
+#define SB_BLOOM_SETS (2 * SB_BLOOM_MAX_LEVELS)
+
+enum compute_kernel {
+    KERNEL_SKY_VIEW,
+    KERNEL_AERIAL,
+    KERNEL_SKY,
+    KERNEL_HISTOGRAM,
+    KERNEL_EXPOSURE,
+    KERNEL_BLOOM_DOWN,
+    KERNEL_BLOOM_UP,
+    KERNEL_TONEMAP,
+    KERNEL_PROBE_SKY,
+    KERNEL_PROBE_LIGHT,
+    KERNEL_COUNT,
+};
+
+struct sb_renderer {
+    struct sb_vk *vk;
+    struct sb_renderer_params params;
+    const struct sb_scene *scene; /* the pack's, during sb_renderer_create only */
+    uint32_t width, height, bloom_levels;
+    uint32_t vertex_count, caster_first_vertex;
+    double radiance_scale; /* what stored radiance is multiplied by (fp16 headroom) */
+    double ground_radius_km;
+
+    struct sb_buffer atmosphere, transmittance, multiscattering, irradiance_ground;
+    struct sb_buffer frame, vertices, exposure;
+    struct sb_buffer probes, probe_light;           /* sb_probes_gpu and its probes; the sky's and probes' SH */
+    struct sb_buffer reflections, reflection_cubes; /* sb_reflections_gpu, its probes and the DFG; the cubes */
+    uint32_t probe_count;                           /* grid probes lit by the probes pass (0: none) */
+    struct sb_buffer read_ldr, read_hdr, read_sky_view;
+
+    struct sb_texture sky_view, aerial, aerial_t, shadow, hdr, depth, bloom, ldr;
+    VkSampler linear, nearest, shadow_compare;
+
+    /* What each binding of the sets points at (sb_renderer_bind_*). */
+    const struct sb_buffer *bound_buffer[SB_VIEW_BINDING_COUNT];
+    VkImageView bound_view[SB_VIEW_BINDING_COUNT];
+
+    VkDescriptorSetLayout set_layout;
+    VkPipelineLayout layout;
+    VkDescriptorPool pool;
+    VkDescriptorSet set;                       /* everything, bloom bindings at level 0 */
+    VkDescriptorSet bloom_sets[SB_BLOOM_SETS]; /* down steps 0..L-1, then up steps */
+    VkPipeline kernels[KERNEL_COUNT];
+    VkPipeline shadow_pipeline, scene_pipeline;
+
+    VkQueryPool queries;
+    VkCommandBuffer cmd;
+    VkFence fence;
+    const struct sb_view *view; /* the frame being recorded */
+    uint64_t frame_index;       /* frames rendered before this one */
+    struct sb_mat4 view_proj;   /* of the last frame, camera-relative */
+    double camera_m[3];
+};
+
+/* A pass: hooks called in sb_pass_classes' order. `create` (may be NULL)
+ * makes what the pass owns and binds it; `destroy` (may be NULL) frees it
+ * and accepts a partly created pass; `record` adds the pass's commands to
+ * r->cmd (its timestamps and the barrier after it are the renderer's). */
+struct sb_pass_class {
+    const char *name; /* in timing tables */
+    enum sb_result (*create)(struct sb_renderer *r);
+    void (*destroy)(struct sb_renderer *r);
+    void (*record)(struct sb_renderer *r);
+};
+
+/* Point a binding at a buffer or an image view (kept by pointer or handle:
+ * they must outlive the renderer's sets). */
+void sb_renderer_bind_buffer(struct sb_renderer *r, uint32_t binding, const struct sb_buffer *buffer);
+void sb_renderer_bind_view(struct sb_renderer *r, uint32_t binding, VkImageView view);
+
+/* A host-visible storage buffer of `bytes`, filled from `data` unless NULL (then zeroed). */
+enum sb_result sb_renderer_upload(struct sb_renderer *r, const void *data, size_t bytes, const char *name,
+                                  struct sb_buffer *buffer);
+
+/* A compute pipeline on the renderer's layout. */
+enum sb_result sb_renderer_kernel(struct sb_renderer *r, const uint32_t *spirv, size_t spirv_size, const char *name,
+                                  VkPipeline *pipeline);
+
+/* Record a dispatch of `pipeline` on the main set covering width x height x
+ * depth invocations in groups of group_x x group_y x group_z. */
+void sb_renderer_dispatch(struct sb_renderer *r, VkPipeline pipeline, const struct sb_view_push *push,
+                          const uint32_t size[3], const uint32_t group[3]);
+
+/* A full memory barrier: every earlier command's writes before every later command. */
+void sb_renderer_barrier(VkCommandBuffer cmd);
+
+#endif
