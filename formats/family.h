@@ -61,4 +61,8 @@ enum sb_result sb_reflections_section_parse(const struct cJSON *section, struct 
 struct cJSON *sb_reflections_section_json(const struct sb_scene *scene);
 void sb_reflections_product_shape(const struct sb_scene *scene, enum sb_product_id id, uint32_t shape[3]);
 
+/* The fog's section (scene_fog.c), skyview's alone. */
+enum sb_result sb_fog_section_parse(const struct cJSON *section, struct sb_scene *scene, const char *source);
+struct cJSON *sb_fog_section_json(const struct sb_scene *scene);
+
 #endif

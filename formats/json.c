@@ -177,3 +177,25 @@ bool sb_json_safe(const char *s)
             return false;
     return true;
 }
+
+enum sb_result sb_json_box(const cJSON *item, const char *source, const char *path, double lo, double hi,
+                           double box[2][3])
+{
+    if (!cJSON_IsArray(item) || cJSON_GetArraySize(item) != 2) {
+        sb_error("%s: %s: expected [[min x, y, z], [max x, y, z]]", source, path);
+        return SB_ERR_WRONG_TYPE;
+    }
+    enum sb_result res = SB_OK;
+    char corner[160];
+    for (int c = 0; c < 2 && !res; c++) {
+        snprintf(corner, sizeof(corner), "%s[%d]", path, c);
+        res = sb_json_vec3(cJSON_GetArrayItem(item, c), source, corner, lo, hi, box[c]);
+    }
+    for (int k = 0; k < 3 && !res; k++)
+        if (!(box[1][k] - box[0][k] >= 0.01)) {
+            sb_error("%s: %s: %g m along %c; a box is at least 0.01 m on every side (max corner above min)", source,
+                     path, box[1][k] - box[0][k], "xyz"[k]);
+            res = SB_ERR_OUT_OF_RANGE;
+        }
+    return res;
+}

@@ -47,4 +47,9 @@ enum sb_result sb_json_number(const cJSON *item, const char *source, const char 
 enum sb_result sb_json_vec3(const cJSON *item, const char *source, const char *path, double lo, double hi,
                             double out[3]);
 
+/* A box [[min x, y, z], [max x, y, z]], every coordinate in [lo, hi] and
+ * every side at least 0.01 (max above min); `path` names the box. */
+enum sb_result sb_json_box(const cJSON *item, const char *source, const char *path, double lo, double hi,
+                           double box[2][3]);
+
 #endif

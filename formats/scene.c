@@ -347,7 +347,8 @@ static enum sb_result parse_view(const cJSON *obj, struct sb_scene *scene, const
     for (const cJSON *item = obj->child; item && !res; item = item->next)
         if (strcmp(item->string, "altitude_km") && strcmp(item->string, "sun_elevation_deg") &&
             strcmp(item->string, "sun_azimuth_deg")) {
-            sb_error("%s: view.%s: unknown key (altitude_km, sun_elevation_deg, sun_azimuth_deg)", source, item->string);
+            sb_error("%s: view.%s: unknown key (altitude_km, sun_elevation_deg, sun_azimuth_deg)", source,
+                     item->string);
             res = SB_ERR_UNKNOWN_KEY;
         }
     if (!res)
@@ -358,6 +359,25 @@ static enum sb_result parse_view(const cJSON *obj, struct sb_scene *scene, const
         res = view_number(obj, "sun_azimuth_deg", -360.0, 360.0, source, &scene->view.sun_azimuth_deg);
     scene->has_view = true;
     return res;
+}
+
+/* Sections that belong to no product family: what the bakes place
+ * (the world) and what only skyview reads (the fog), in normalised order. */
+static const struct other_section {
+    const char *key;
+    enum sb_result (*parse)(const cJSON *section, struct sb_scene *scene, const char *source);
+    cJSON *(*json)(const struct sb_scene *scene);
+} other_sections[] = {
+    {"world", sb_world_section_parse, sb_world_section_json},
+    {"fog", sb_fog_section_parse, sb_fog_section_json},
+};
+
+static const struct other_section *other_section(const char *key)
+{
+    for (size_t i = 0; i < sizeof(other_sections) / sizeof(other_sections[0]); i++)
+        if (!strcmp(other_sections[i].key, key))
+            return &other_sections[i];
+    return NULL;
 }
 
 /* The family whose scene section `key` is, or NULL. */
@@ -416,8 +436,8 @@ static enum sb_result parse_root(const cJSON *root, struct sb_scene *scene, cons
         } else if (strcmp(item->string, "view") == 0) {
             if ((res = parse_view(item, scene, source)))
                 return res;
-        } else if (strcmp(item->string, "world") == 0) {
-            if ((res = sb_world_section_parse(item, scene, source)))
+        } else if (other_section(item->string)) {
+            if ((res = other_section(item->string)->parse(item, scene, source)))
                 return res;
         } else if (strcmp(item->string, "tolerance") == 0) {
             if ((res = parse_tolerance(item, scene, source)))
@@ -523,9 +543,11 @@ char *sb_scene_normalized_json(const struct sb_scene *scene)
         if (section)
             cJSON_AddItemToObject(root, family->section, section);
     }
-    cJSON *world = sb_world_section_json(scene);
-    if (world)
-        cJSON_AddItemToObject(root, "world", world);
+    for (size_t i = 0; i < sizeof(other_sections) / sizeof(other_sections[0]); i++) {
+        cJSON *section = other_sections[i].json(scene);
+        if (section)
+            cJSON_AddItemToObject(root, other_sections[i].key, section);
+    }
     cJSON *tolerance = NULL;
     for (int p = 0; p < SB_PRODUCT_COUNT; p++) {
         if (scene->tolerance[p] <= 0)

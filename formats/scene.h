@@ -122,6 +122,28 @@ struct sb_reflection_params {
 
 void sb_reflection_params_default(struct sb_reflection_params *params);
 
+/* The scene's "fog" (docs/fog.md): media near the ground that skyview
+ * renders; the bakes do not read it. World y in metres; defaults in brackets. */
+#define SB_FOG_MAX_VOLUMES 16
+struct sb_fog_params {
+    double extinction_per_m;  /* the height fog's extinction at base_altitude_m, [0, 10] [0.01]; 0: none */
+    double base_altitude_m;   /* [0] */
+    double falloff_height_m;  /* the density falls by e every this much higher, grows likewise lower, [1, 1e4] [50] */
+    double albedo[3];         /* single-scattering albedo, [0, 1] [0.9] */
+    double anisotropy;        /* Henyey-Greenstein g, [-0.95, 0.95] [0.6] */
+    double noise_amount;      /* how much the baked cloud_detail noise thins the fog, [0, 1] [0; 0.6 with "noise"] */
+    double noise_scale_m;     /* the noise's tile, [0.1, 1e4] [40] */
+    double noise_wind_m_s[3]; /* how fast the noise drifts [2, 0, 0] */
+    int volume_count;
+    struct {
+        double box_m[2][3];      /* min, max corners */
+        double extinction_per_m; /* added inside the box, [0, 10] */
+        double edge_m;           /* the density ramps up over this far inside the faces, [0, 1e3] [1] */
+    } volumes[SB_FOG_MAX_VOLUMES];
+};
+
+void sb_fog_params_default(struct sb_fog_params *params);
+
 struct sb_scene {
     char name[64];
     char preset[32];
@@ -144,6 +166,8 @@ struct sb_scene {
     struct sb_probe_params probes;
     bool has_reflections;
     struct sb_reflection_params reflections;
+    bool has_fog;
+    struct sb_fog_params fog;
 };
 
 /* Tolerances a scene may ask for: [SB_TOLERANCE_MIN, SB_TOLERANCE_MAX]. */

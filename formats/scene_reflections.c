@@ -64,21 +64,12 @@ static enum sb_result parse_probe(const cJSON *e, int i, struct sb_reflection_pa
     snprintf(path, sizeof(path), "%s.position_m", where);
     if ((res = sb_json_vec3(position, source, path, -1e4, 1e4, p->probes[i].position_m)))
         return res;
-    if (!cJSON_IsArray(box) || cJSON_GetArraySize(box) != 2) {
-        sb_error("%s: %s.box_m: expected [[min x, y, z], [max x, y, z]]", source, where);
-        return SB_ERR_WRONG_TYPE;
-    }
-    for (int c = 0; c < 2 && !res; c++) {
-        snprintf(path, sizeof(path), "%s.box_m[%d]", where, c);
-        res = sb_json_vec3(cJSON_GetArrayItem(box, c), source, path, -1e4, 1e4, p->probes[i].box_m[c]);
-    }
+    snprintf(path, sizeof(path), "%s.box_m", where);
+    if ((res = sb_json_box(box, source, path, -1e4, 1e4, p->probes[i].box_m)))
+        return res;
     for (int k = 0; k < 3 && !res; k++) {
         double lo = p->probes[i].box_m[0][k], hi = p->probes[i].box_m[1][k], at = p->probes[i].position_m[k];
-        if (!(hi - lo >= 0.01)) {
-            sb_error("%s: %s.box_m: %g m along %c; a box is at least 0.01 m on every side (max corner above min)",
-                     source, where, hi - lo, "xyz"[k]);
-            res = SB_ERR_OUT_OF_RANGE;
-        } else if (at < lo || at > hi) {
+        if (at < lo || at > hi) {
             sb_error("%s: %s.position_m: %c = %g lies outside the probe's box [%g, %g]", source, where, "xyz"[k], at,
                      lo, hi);
             res = SB_ERR_OUT_OF_RANGE;

@@ -59,6 +59,11 @@ static void usage(FILE *f)
                "                          sky-visibility probes\n"
                "  --no-reflections        the sky model's ambient specular, ignoring the pack's\n"
                "                          reflection probes\n"
+               "  --no-fog                leave out the scene's fog\n"
+               "  --fog-tile PX           a froxel's width and height in pixels (default 8)\n"
+               "  --fog-slices N          froxel slices, 2 to 256 (default 64)\n"
+               "  --fog-far M             where the froxel volume ends, metres (default 256);\n"
+               "                          the height fog goes on beyond it in closed form\n"
                "  --tonemap agx|aces|gt   tone mapper (default agx)\n"
                "  --exposure EV           exposure compensation (default 0)\n"
                "  --no-bloom              no bloom\n"
@@ -190,7 +195,18 @@ static int parse_options(int argc, char **argv, struct options *o)
             o->params.no_probes = true;
         else if (!strcmp(a, "--no-reflections"))
             o->params.no_reflections = true;
-        else if (!strcmp(a, "--bench"))
+        else if (!strcmp(a, "--no-fog"))
+            o->params.no_fog = true;
+        else if (!strcmp(a, "--fog-tile") && next) {
+            ok = parse_number(argv[++i], 1, 64, &v) && v == floor(v);
+            o->params.fog_tile_px = (uint32_t)v;
+        } else if (!strcmp(a, "--fog-slices") && next) {
+            ok = parse_number(argv[++i], 2, 256, &v) && v == floor(v);
+            o->params.fog_slices = (uint32_t)v;
+        } else if (!strcmp(a, "--fog-far") && next) {
+            ok = parse_number(argv[++i], 1, 1e5, &v);
+            o->params.fog_far_m = v;
+        } else if (!strcmp(a, "--bench"))
             o->bench = true;
         else if (!strcmp(a, "--device") && next)
             o->device = argv[++i];
@@ -424,6 +440,8 @@ static int run(const struct options *o)
     for (int i = 0; i < total && !res; i++) {
         struct sb_view view = o->view;
         view.snap_exposure = i == 0;
+        view.dt_s = 1.0 / 60.0;
+        view.time_s = i * view.dt_s;
         int measured = o->bench ? i - o->warmup : i;
         bool write = !o->bench || i == total - 1;
         res = sb_renderer_render(r, &view, write, measured >= 0 ? &timings[measured] : NULL);

@@ -11,6 +11,7 @@
 #include "compute.h"
 #include "exposure.spv.h"
 #include "histogram.spv.h"
+#include "image.h"
 #include "log.h"
 #include "physics.h"
 #include "pipeline.h"
@@ -82,7 +83,14 @@ static const VkDescriptorType binding_types[SB_VIEW_BINDING_COUNT] = {
     [SB_VIEW_BINDING_PROBE_LIGHT] = VK_DESCRIPTOR_TYPE_STORAGE_BUFFER,
     [SB_VIEW_BINDING_REFLECTIONS] = VK_DESCRIPTOR_TYPE_STORAGE_BUFFER,
     [SB_VIEW_BINDING_REFLECTION_CUBES] = VK_DESCRIPTOR_TYPE_STORAGE_BUFFER,
+    [SB_VIEW_BINDING_FOG] = VK_DESCRIPTOR_TYPE_STORAGE_BUFFER,
+    [SB_VIEW_BINDING_FROXEL_LIGHT_OUT] = VK_DESCRIPTOR_TYPE_STORAGE_IMAGE,
+    [SB_VIEW_BINDING_FROXEL_HISTORY] = VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER,
+    [SB_VIEW_BINDING_FROXEL_OUT] = VK_DESCRIPTOR_TYPE_STORAGE_IMAGE,
+    [SB_VIEW_BINDING_FROXEL] = VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER,
+    [SB_VIEW_BINDING_FOG_NOISE] = VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER,
 };
+_Static_assert(SB_VIEW_BINDING_COUNT == 30, "every binding has a type above");
 
 void sb_renderer_bind_buffer(struct sb_renderer *r, uint32_t binding, const struct sb_buffer *buffer)
 {
@@ -90,10 +98,11 @@ void sb_renderer_bind_buffer(struct sb_renderer *r, uint32_t binding, const stru
     r->bound_buffer[binding] = buffer;
 }
 
-void sb_renderer_bind_view(struct sb_renderer *r, uint32_t binding, VkImageView view)
+void sb_renderer_bind_view(struct sb_renderer *r, uint32_t binding, VkImageView view, VkSampler sampler)
 {
     assert(binding < SB_VIEW_BINDING_COUNT && binding_types[binding] != VK_DESCRIPTOR_TYPE_STORAGE_BUFFER);
     r->bound_view[binding] = view;
+    r->bound_sampler[binding] = sampler;
 }
 
 /* The renderer's own resources; the bloom step's bindings vary per set. */
@@ -134,7 +143,7 @@ static void bind_own(struct sb_renderer *r)
         {SB_VIEW_BINDING_LDR, r->ldr.view},
     };
     for (size_t i = 0; i < sizeof(views) / sizeof(views[0]); i++)
-        sb_renderer_bind_view(r, views[i].binding, views[i].view);
+        sb_renderer_bind_view(r, views[i].binding, views[i].view, NULL);
 }
 
 /* Write every binding of `set`; the bloom step's source and target vary per set. */
@@ -161,9 +170,10 @@ static void write_set(struct sb_renderer *r, VkDescriptorSet set, VkImageView bl
                                                                 : r->bound_view[b];
             assert(view);
             images[b] = (VkDescriptorImageInfo){
-                .sampler = b == SB_VIEW_BINDING_SHADOW  ? r->shadow_compare
-                           : b == SB_VIEW_BINDING_DEPTH ? r->nearest /* depth formats need not filter */
-                                                        : r->linear,
+                .sampler = r->bound_sampler[b]           ? r->bound_sampler[b]
+                           : b == SB_VIEW_BINDING_SHADOW ? r->shadow_compare
+                           : b == SB_VIEW_BINDING_DEPTH  ? r->nearest /* depth formats need not filter */
+                                                         : r->linear,
                 .imageView = view,
                 .imageLayout = b == SB_VIEW_BINDING_SHADOW || b == SB_VIEW_BINDING_DEPTH
                                    ? VK_IMAGE_LAYOUT_DEPTH_STENCIL_READ_ONLY_OPTIMAL
@@ -655,11 +665,11 @@ enum sb_result sb_renderer_create(struct sb_vk *vk, const struct sb_pack *pack, 
         res = create_layout(r);
     if (!res)
         res = create_pipelines(r);
-    r->scene = pack->scene;
+    r->pack = pack;
     for (int p = 0; p < SB_PASS_COUNT && !res; p++)
-        if (pass_classes[p]->create)
+        if (assert(pass_classes[p]), pass_classes[p]->create)
             res = pass_classes[p]->create(r);
-    r->scene = NULL;
+    r->pack = NULL;
     if (!res)
         res = create_sets(r);
     if (res)
@@ -1001,9 +1011,17 @@ static const struct sb_pass_class pass_tonemap = {.name = "tonemap", .record = r
 
 /* A frame's passes, in order (enum sb_pass). */
 static const struct sb_pass_class *const pass_classes[SB_PASS_COUNT] = {
-    [SB_PASS_SKY_VIEW] = &pass_sky_view, [SB_PASS_PROBES] = &pass_probes, [SB_PASS_AERIAL_PERSPECTIVE] = &pass_aerial,
-    [SB_PASS_SHADOWS] = &pass_shadows,   [SB_PASS_SCENE] = &pass_scene,   [SB_PASS_SKY] = &pass_sky,
-    [SB_PASS_EXPOSURE] = &pass_exposure, [SB_PASS_BLOOM] = &pass_bloom,   [SB_PASS_TONEMAP] = &pass_tonemap,
+    [SB_PASS_SKY_VIEW] = &pass_sky_view,
+    [SB_PASS_PROBES] = &pass_probes,
+    [SB_PASS_AERIAL_PERSPECTIVE] = &pass_aerial,
+    [SB_PASS_SHADOWS] = &pass_shadows,
+    [SB_PASS_FOG] = &sb_pass_fog, /* fog.c */
+    [SB_PASS_SCENE] = &pass_scene,
+    [SB_PASS_SKY] = &pass_sky,
+    [SB_PASS_FOG_APPLY] = &sb_pass_fog_apply, /* fog.c */
+    [SB_PASS_EXPOSURE] = &pass_exposure,
+    [SB_PASS_BLOOM] = &pass_bloom,
+    [SB_PASS_TONEMAP] = &pass_tonemap,
 };
 
 /* Copies leave the general layout for the transfer-optimal one and come back. */
@@ -1098,24 +1116,11 @@ const uint8_t *sb_renderer_ldr(const struct sb_renderer *r)
     return r->read_ldr.mapped;
 }
 
-static float half_to_float(uint16_t h)
-{
-    uint32_t sign = (uint32_t)(h >> 15) << 31, exp = (h >> 10) & 31, mant = h & 1023;
-    float v;
-    if (exp == 0)
-        v = ldexpf((float)mant, -24);
-    else if (exp == 31)
-        v = mant ? NAN : INFINITY;
-    else
-        v = ldexpf((float)(mant | 1024), (int)exp - 25);
-    return sign ? -v : v;
-}
-
 static void halves_to_rgb(const uint16_t *src, size_t pixels, double scale, float *rgb)
 {
     for (size_t i = 0; i < pixels; i++)
         for (int c = 0; c < 3; c++)
-            rgb[i * 3 + c] = (float)(half_to_float(src[i * 4 + c]) / scale);
+            rgb[i * 3 + c] = (float)(sb_half_to_float(src[i * 4 + c]) / scale);
 }
 
 void sb_renderer_hdr(const struct sb_renderer *r, float *rgb)

@@ -29,6 +29,10 @@ struct sb_renderer_params {
     double bloom_strength;           /* 0: 0.15; negative: no bloom */
     bool no_probes;                  /* light the world with the sky alone even if the pack has probes */
     bool no_reflections;             /* leave the pack's reflection probes unread (the sky model's specular) */
+    bool no_fog;                     /* leave out the scene's fog */
+    uint32_t fog_tile_px;            /* a froxel's width and height in pixels; 0: 8 */
+    uint32_t fog_slices;             /* froxel slices, [2, 256]; 0: 64 */
+    double fog_far_m;                /* where the froxel volume ends (then the height fog in closed form); 0: 256 */
     int debug;                       /* SB_DEBUG_* (config.h): the scene pass writes one term; 0: the frame */
 };
 
@@ -40,7 +44,8 @@ struct sb_view {
     double sun_azimuth;   /* same convention as yaw */
     double sun_elevation; /* above the horizon; negative below */
     double dt_s;          /* time since the previous frame, for exposure adaptation; 0: 1/60 s */
-    bool snap_exposure;   /* take the metered exposure at once (a first frame, a cut) */
+    bool snap_exposure;   /* a cut: take the metered exposure at once, drop the fog's history */
+    double time_s;        /* what the fog's noise drifts with (s) */
 };
 
 enum sb_pass {
@@ -48,15 +53,18 @@ enum sb_pass {
     SB_PASS_PROBES,
     SB_PASS_AERIAL_PERSPECTIVE,
     SB_PASS_SHADOWS,
+    SB_PASS_FOG,
     SB_PASS_SCENE,
     SB_PASS_SKY,
+    SB_PASS_FOG_APPLY,
     SB_PASS_EXPOSURE,
     SB_PASS_BLOOM,
     SB_PASS_TONEMAP,
     SB_PASS_COUNT,
 };
 
-/* "sky-view", "probes", "aerial perspective", "shadows", "scene", "sky", "exposure", "bloom", "tonemap". */
+/* "sky-view", "probes", "aerial perspective", "shadows", "fog", "scene", "sky", "fog apply", "exposure",
+ * "bloom", "tonemap". */
 const char *sb_pass_name(enum sb_pass pass);
 
 struct sb_frame_timings {

@@ -19,6 +19,8 @@
 #include "texture.h"
 #include "transform.h"
 
+struct sb_fog;
+
 #define SB_HDR_FORMAT VK_FORMAT_R16G16B16A16_SFLOAT
 #define SB_DEPTH_FORMAT VK_FORMAT_D32_SFLOAT
 #define SB_BLOOM_SETS (2 * SB_BLOOM_MAX_LEVELS)
@@ -40,7 +42,7 @@ enum compute_kernel {
 struct sb_renderer {
     struct sb_vk *vk;
     struct sb_renderer_params params;
-    const struct sb_scene *scene; /* the pack's, during sb_renderer_create only */
+    const struct sb_pack *pack; /* during sb_renderer_create only */
     uint32_t width, height, bloom_levels;
     uint32_t vertex_count, caster_first_vertex;
     double radiance_scale; /* what stored radiance is multiplied by (fp16 headroom) */
@@ -59,6 +61,7 @@ struct sb_renderer {
     /* What each binding of the sets points at (sb_renderer_bind_*). */
     const struct sb_buffer *bound_buffer[SB_VIEW_BINDING_COUNT];
     VkImageView bound_view[SB_VIEW_BINDING_COUNT];
+    VkSampler bound_sampler[SB_VIEW_BINDING_COUNT]; /* NULL: the renderer's choice */
 
     VkDescriptorSetLayout set_layout;
     VkPipelineLayout layout;
@@ -67,6 +70,8 @@ struct sb_renderer {
     VkDescriptorSet bloom_sets[SB_BLOOM_SETS]; /* down steps 0..L-1, then up steps */
     VkPipeline kernels[KERNEL_COUNT];
     VkPipeline shadow_pipeline, scene_pipeline;
+
+    struct sb_fog *fog; /* fog.c */
 
     VkQueryPool queries;
     VkCommandBuffer cmd;
@@ -88,10 +93,14 @@ struct sb_pass_class {
     void (*record)(struct sb_renderer *r);
 };
 
-/* Point a binding at a buffer or an image view (kept by pointer or handle:
- * they must outlive the renderer's sets). */
+extern const struct sb_pass_class sb_pass_fog;       /* fog.c: the froxel volume */
+extern const struct sb_pass_class sb_pass_fog_apply; /* fog.c: the volume applied to the frame */
+
+/* Point a binding at a buffer, or at an image view with a sampler (NULL:
+ * linear filtering clamped to the edge). They are kept by pointer or handle
+ * and must outlive the renderer's sets. */
 void sb_renderer_bind_buffer(struct sb_renderer *r, uint32_t binding, const struct sb_buffer *buffer);
-void sb_renderer_bind_view(struct sb_renderer *r, uint32_t binding, VkImageView view);
+void sb_renderer_bind_view(struct sb_renderer *r, uint32_t binding, VkImageView view, VkSampler sampler);
 
 /* A host-visible storage buffer of `bytes`, filled from `data` unless NULL (then zeroed). */
 enum sb_result sb_renderer_upload(struct sb_renderer *r, const void *data, size_t bytes, const char *name,

@@ -24,8 +24,8 @@
 #include "view.glsl"
 #include "probes.glsl"
 #include "reflections.glsl"
+#include "shadows.glsl"
 
-layout(set = 0, binding = SB_VIEW_BINDING_SHADOW) uniform sampler2DArrayShadow shadow_map;
 layout(set = 0, binding = SB_VIEW_BINDING_AERIAL) uniform sampler3D aerial_inscatter;
 layout(set = 0, binding = SB_VIEW_BINDING_AERIAL_T) uniform sampler3D aerial_transmittance;
 
@@ -34,41 +34,6 @@ layout(location = 1) in vec3 in_normal;
 layout(location = 2) in vec3 in_albedo;
 layout(location = 3) in vec2 in_metallic_roughness;
 layout(location = 0) out vec4 out_color;
-
-float cascade_visibility(int c, vec3 offset, vec3 n)
-{
-    vec3 p = offset + n * (frame.cascade_texel[c] * frame.shadow.y);
-    vec4 clip = frame.shadow_view_proj[c] * vec4(p, 1.0);
-    vec3 s = clip.xyz / clip.w;
-    vec2 uv = s.xy * 0.5 + 0.5;
-    if (any(lessThan(uv, vec2(0.0))) || any(greaterThan(uv, vec2(1.0))) || s.z > 1.0)
-        return 1.0;
-    float texel = 1.0 / frame.shadow.z;
-    float sum = 0.0;
-    for (int j = -1; j <= 1; j++)
-        for (int i = -1; i <= 1; i++)
-            sum += texture(shadow_map, vec4(uv + vec2(i, j) * texel, float(c), s.z));
-    return sum / 9.0;
-}
-
-float sun_visibility(vec3 offset, vec3 n)
-{
-    if (frame.shadow.w == 0.0)
-        return 1.0;
-    float depth = dot(offset, frame.camera_forward.xyz);
-    int c = 0;
-    while (c < SB_CASCADES && depth > frame.cascade_ends[c])
-        c++;
-    if (c == SB_CASCADES)
-        return 1.0;
-    float visibility = cascade_visibility(c, offset, n);
-    float begin = c == 0 ? 0.0 : frame.cascade_ends[c - 1];
-    float band = frame.shadow.x * (frame.cascade_ends[c] - begin);
-    float f = band > 0.0 ? (depth - (frame.cascade_ends[c] - band)) / band : 0.0;
-    if (f > 0.0) /* toward the next cascade, or out of the shadows past the last */
-        visibility = mix(visibility, c + 1 < SB_CASCADES ? cascade_visibility(c + 1, offset, n) : 1.0, f);
-    return visibility;
-}
 
 /* In-scattered radiance (rgb, scaled like the frame) and transmittance from
  * the camera to a point `offset` metres away. */
@@ -143,7 +108,7 @@ void main()
     vec3 brdf = diffuse_color / PI + D * V * F;
 
     vec3 e_sun = atm.solar_irradiance.rgb * sun_transmittance(h, mu_s);
-    vec3 color = brdf * e_sun * (n_dot_l * sun_visibility(in_offset, n));
+    vec3 color = brdf * e_sun * (n_dot_l * sun_visibility(in_offset, n, true));
 
     /* The world is low enough to read the ground row of irradiance_ground. */
     vec3 e_sky = ground_sky_irradiance_sample(mu_s);

@@ -270,6 +270,27 @@ static void test_scenes(void)
          SB_ERR_WRONG_TYPE},
         {EARTH "\"reflections\":{\"probes\":{}}}", SB_ERR_WRONG_TYPE},
         {EARTH "\"tolerance\":{\"reflection_cubes\":1e-2}}", SB_ERR_OUT_OF_RANGE},
+        /* Fog. */
+        {EARTH "\"fog\":{}}", SB_OK},
+        {EARTH "\"fog\":{\"extinction_per_m\":0.02,\"base_altitude_m\":-5,\"falloff_height_m\":30,"
+               "\"albedo\":[0.9,0.8,0.7],\"anisotropy\":-0.3,\"noise\":{\"amount\":1,\"scale_m\":20,"
+               "\"wind_m_s\":[1,0,-2]},\"volumes\":[{\"box_m\":[[-5,0,-5],[5,3,5]],\"extinction_per_m\":0.5}]}}",
+         SB_OK},
+        {EARTH "\"fog\":{\"extinction_per_m\":-0.01}}", SB_ERR_OUT_OF_RANGE},
+        {EARTH "\"fog\":{\"extinction_per_m\":11}}", SB_ERR_OUT_OF_RANGE},
+        {EARTH "\"fog\":{\"extinction_per_m\":NaN}}", SB_ERR_JSON_SYNTAX},
+        {EARTH "\"fog\":{\"extinction_per_m\":\"thick\"}}", SB_ERR_WRONG_TYPE},
+        {EARTH "\"fog\":{\"falloff_height_m\":0}}", SB_ERR_OUT_OF_RANGE},
+        {EARTH "\"fog\":{\"albedo\":[0.9,1.2,0.9]}}", SB_ERR_OUT_OF_RANGE},
+        {EARTH "\"fog\":{\"anisotropy\":1}}", SB_ERR_OUT_OF_RANGE},
+        {EARTH "\"fog\":{\"noise\":{\"amount\":1.5}}}", SB_ERR_OUT_OF_RANGE},
+        {EARTH "\"fog\":{\"noise\":{\"scale_m\":0}}}", SB_ERR_OUT_OF_RANGE},
+        {EARTH "\"fog\":{\"noise\":{\"speed\":1}}}", SB_ERR_UNKNOWN_KEY},
+        {EARTH "\"fog\":{\"density\":1}}", SB_ERR_UNKNOWN_KEY},
+        {EARTH "\"fog\":{\"volumes\":[{\"box_m\":[[-5,0,-5],[5,3,5]]}]}}", SB_ERR_MISSING_FIELD},
+        {EARTH "\"fog\":{\"volumes\":[{\"box_m\":[[5,0,5],[-5,3,-5]],\"extinction_per_m\":1}]}}", SB_ERR_OUT_OF_RANGE},
+        {EARTH "\"fog\":{\"volumes\":[{\"box_m\":[[-5,0,-5],[5,3,5]],\"extinction_per_m\":-1}]}}", SB_ERR_OUT_OF_RANGE},
+        {EARTH "\"fog\":{\"volumes\":{}}}", SB_ERR_WRONG_TYPE},
         {EARTH "\"view\":{\"sun_azimuth_deg\":400}}", SB_ERR_OUT_OF_RANGE},
         {EARTH "\"view\":{\"sun_azimuth_deg\":40}}", SB_OK},
     };

@@ -2,6 +2,7 @@
 
 #include <string.h>
 
+#include "compute.h"
 #include "log.h"
 
 static bool is_depth(VkFormat f)
@@ -93,6 +94,34 @@ void sb_texture_barrier(VkCommandBuffer cmd, const struct sb_texture *t, VkImage
     };
     vkCmdPipelineBarrier(cmd, VK_PIPELINE_STAGE_ALL_COMMANDS_BIT, VK_PIPELINE_STAGE_ALL_COMMANDS_BIT, 0, 0, NULL, 0,
                          NULL, 1, &b);
+}
+
+enum sb_result sb_texture_upload(struct sb_vk *vk, const struct sb_texture *t, const void *data, size_t bytes,
+                                 size_t texel_bytes)
+{
+    if (bytes != (size_t)t->width * t->height * t->depth * t->layers * texel_bytes || !bytes) {
+        sb_error("texture upload: %zu bytes for %u x %u x %u x %u texels of %zu bytes", bytes, t->width, t->height,
+                 t->depth, t->layers, texel_bytes);
+        return SB_ERR_USAGE;
+    }
+    struct sb_buffer staging;
+    enum sb_result res = sb_buffer_create(vk, bytes, "texture upload", &staging);
+    if (res)
+        return res;
+    memcpy(staging.mapped, data, bytes);
+    VkCommandBuffer cmd;
+    if (!(res = sb_vk_begin_once(vk, &cmd))) {
+        VkBufferImageCopy region = {
+            .imageSubresource = {t->aspect, 0, 0, t->layers},
+            .imageExtent = {t->width, t->height, t->depth},
+        };
+        sb_texture_barrier(cmd, t, VK_IMAGE_LAYOUT_GENERAL, VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL);
+        vkCmdCopyBufferToImage(cmd, staging.buffer, t->image, VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL, 1, &region);
+        sb_texture_barrier(cmd, t, VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL, VK_IMAGE_LAYOUT_GENERAL);
+        res = sb_vk_end_once(vk, cmd);
+    }
+    sb_buffer_destroy(vk, &staging);
+    return res;
 }
 
 void sb_texture_destroy(struct sb_vk *vk, struct sb_texture *t)

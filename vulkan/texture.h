@@ -44,6 +44,13 @@ enum sb_result sb_texture_create(struct sb_vk *vk, const struct sb_texture_param
  * earlier command's writes and before every later command (a full barrier:
  * skyview's passes depend on each other in sequence anyway). */
 void sb_texture_barrier(VkCommandBuffer cmd, const struct sb_texture *t, VkImageLayout from, VkImageLayout to);
+/* Fill mip level 0 of every layer of a colour texture, in the general
+ * layout, from `bytes` of tightly packed texels (layer by layer, then slice
+ * by slice, row by row), through a staging buffer; waits for the copy.
+ * Call it outside other recording. SB_ERR_USAGE when `bytes` is not the
+ * level's size in `texel_bytes` a texel. */
+enum sb_result sb_texture_upload(struct sb_vk *vk, const struct sb_texture *texture, const void *data, size_t bytes,
+                                 size_t texel_bytes);
 /* Free a texture; accepts a zeroed one. */
 void sb_texture_destroy(struct sb_vk *vk, struct sb_texture *texture);
 

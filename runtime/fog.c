@@ -1,0 +1,272 @@
+/*
+ * Froxel fog (docs/fog.md): the scene's "fog" in a camera-aligned volume of
+ * froxels, lit each frame and blended with the last frame's (fog_inject),
+ * integrated front to back (fog_integrate), then applied to the frame
+ * (fog_apply). Two passes of the renderer's table: "fog", after the
+ * shadows, and "fog apply", after the sky.
+ */
+#include <math.h>
+#include <stdint.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "image.h"
+#include "log.h"
+#include "renderer_internal.h"
+#include "scene.h"
+
+#include "fog_apply.spv.h"
+#include "fog_inject.spv.h"
+#include "fog_integrate.spv.h"
+
+#define FROXEL_FORMAT VK_FORMAT_R16G16B16A16_SFLOAT
+#define SLICE_SCALE_M 1.0         /* c in distance(w) = c ((1 + far / c)^w - 1) */
+#define HISTORY_WEIGHT 0.9        /* the last frame's share in a froxel (10 frames to settle) */
+#define SUN_CHANGE_COS 0.99999391 /* cos 0.2 degrees: more sun motion than this drops the history */
+
+_Static_assert(SB_FOG_VOLUMES == SB_FOG_MAX_VOLUMES, "config.h and scene.h agree on the fog's boxes");
+
+struct sb_fog {
+    bool enabled;
+    struct sb_fog_params medium;
+    uint32_t grid[3];
+    double far_m;
+    struct sb_buffer params;
+    struct sb_texture light, history, integrated, noise;
+    VkSampler repeat;
+    VkPipeline inject, integrate, apply;
+    /* The last frame, for reprojection. */
+    bool has_history;
+    struct sb_mat4 view_proj;
+    double camera_m[3], sun[3];
+};
+
+static enum sb_result volume(struct sb_renderer *r, struct sb_texture *t, const uint32_t size[3],
+                             VkImageUsageFlags usage, const char *name)
+{
+    struct sb_texture_params p = {
+        .width = size[0],
+        .height = size[1],
+        .depth = size[2],
+        .format = FROXEL_FORMAT,
+        .usage = usage,
+        .name = name,
+    };
+    return sb_texture_create(r->vk, &p, t);
+}
+
+/* The pack's cloud_detail as an rgba16f volume (its half values exactly),
+ * or one of 1 (no modulation) where the fog asks for none or the pack has none. */
+static enum sb_result upload_noise(struct sb_renderer *r, struct sb_fog *f)
+{
+    const struct sb_image *detail = &r->pack->images[SB_PRODUCT_CLOUD_DETAIL];
+    bool use = f->enabled && f->medium.noise_amount > 0.0;
+    if (use && !r->pack->present[SB_PRODUCT_CLOUD_DETAIL]) {
+        sb_warn("fog.noise: the pack has no cloud_detail to modulate the fog with; the fog is not modulated");
+        f->medium.noise_amount = 0.0;
+        use = false;
+    }
+    uint32_t size[3] = {1, 1, 2}; /* a depth of 2 keeps the image 3D */
+    if (use)
+        for (int k = 0; k < 3; k++)
+            size[k] = k == 0 ? detail->width : k == 1 ? detail->height : detail->depth;
+    size_t texels = (size_t)size[0] * size[1] * size[2];
+    uint16_t *data = malloc(texels * 4 * sizeof(uint16_t));
+    if (!data)
+        return SB_ERR_NOMEM;
+    for (size_t i = 0; i < texels; i++)
+        for (int c = 0; c < 4; c++) {
+            float v = use && c < (int)detail->channel_count ? detail->data[i * detail->channel_count + c] : 1.0f;
+            data[4 * i + c] = sb_half_from_float(v);
+        }
+    enum sb_result res =
+        volume(r, &f->noise, size, VK_IMAGE_USAGE_SAMPLED_BIT | VK_IMAGE_USAGE_TRANSFER_DST_BIT, "fog noise");
+    if (!res)
+        res = sb_texture_upload(r->vk, &f->noise, data, texels * 4 * sizeof(uint16_t), 4 * sizeof(uint16_t));
+    free(data);
+    return res;
+}
+
+static enum sb_result fog_create(struct sb_renderer *r)
+{
+    struct sb_fog *f = calloc(1, sizeof(*f));
+    if (!f)
+        return SB_ERR_NOMEM;
+    r->fog = f;
+    const struct sb_scene *scene = r->pack->scene;
+    f->medium = scene->fog;
+    f->enabled =
+        scene->has_fog && !r->params.no_fog && (f->medium.extinction_per_m > 0.0 || f->medium.volume_count > 0);
+    uint32_t tile = r->params.fog_tile_px ? r->params.fog_tile_px : 8;
+    f->grid[0] = f->enabled ? (r->width + tile - 1) / tile : 1;
+    f->grid[1] = f->enabled ? (r->height + tile - 1) / tile : 1;
+    f->grid[2] = f->enabled ? (r->params.fog_slices ? r->params.fog_slices : 64) : 2;
+    f->far_m = r->params.fog_far_m > 0.0 ? r->params.fog_far_m : 256.0;
+
+    const VkImageUsageFlags storage_sampled = VK_IMAGE_USAGE_STORAGE_BIT | VK_IMAGE_USAGE_SAMPLED_BIT;
+    enum sb_result res = sb_renderer_upload(r, NULL, sizeof(struct sb_fog_gpu), "fog parameters", &f->params);
+    if (!res)
+        res = volume(r, &f->light, f->grid, storage_sampled | VK_IMAGE_USAGE_TRANSFER_SRC_BIT, "froxel light");
+    if (!res)
+        res = volume(r, &f->history, f->grid, VK_IMAGE_USAGE_SAMPLED_BIT | VK_IMAGE_USAGE_TRANSFER_DST_BIT,
+                     "froxel history");
+    if (!res)
+        res = volume(r, &f->integrated, f->grid, storage_sampled, "froxels integrated");
+    if (!res)
+        res = upload_noise(r, f);
+    if (res)
+        return res;
+    VkSamplerCreateInfo info = {
+        .sType = VK_STRUCTURE_TYPE_SAMPLER_CREATE_INFO,
+        .magFilter = VK_FILTER_LINEAR,
+        .minFilter = VK_FILTER_LINEAR,
+        .mipmapMode = VK_SAMPLER_MIPMAP_MODE_NEAREST,
+        .addressModeU = VK_SAMPLER_ADDRESS_MODE_REPEAT,
+        .addressModeV = VK_SAMPLER_ADDRESS_MODE_REPEAT,
+        .addressModeW = VK_SAMPLER_ADDRESS_MODE_REPEAT,
+        .maxLod = VK_LOD_CLAMP_NONE,
+    };
+    VK(vkCreateSampler(r->vk->device, &info, NULL, &f->repeat));
+    res = sb_renderer_kernel(r, sb_spv_fog_inject, sizeof(sb_spv_fog_inject), "fog inject", &f->inject);
+    if (!res)
+        res = sb_renderer_kernel(r, sb_spv_fog_integrate, sizeof(sb_spv_fog_integrate), "fog integrate", &f->integrate);
+    if (!res)
+        res = sb_renderer_kernel(r, sb_spv_fog_apply, sizeof(sb_spv_fog_apply), "fog apply", &f->apply);
+    if (res)
+        return res;
+    sb_renderer_bind_buffer(r, SB_VIEW_BINDING_FOG, &f->params);
+    sb_renderer_bind_view(r, SB_VIEW_BINDING_FROXEL_LIGHT_OUT, f->light.view, NULL);
+    sb_renderer_bind_view(r, SB_VIEW_BINDING_FROXEL_HISTORY, f->history.view, NULL);
+    sb_renderer_bind_view(r, SB_VIEW_BINDING_FROXEL_OUT, f->integrated.view, NULL);
+    sb_renderer_bind_view(r, SB_VIEW_BINDING_FROXEL, f->integrated.view, NULL);
+    sb_renderer_bind_view(r, SB_VIEW_BINDING_FOG_NOISE, f->noise.view, f->repeat);
+    if (f->enabled)
+        sb_info("fog: %u x %u x %u froxels to %g m%s, %d boxes", f->grid[0], f->grid[1], f->grid[2], f->far_m,
+                f->medium.noise_amount > 0.0 ? ", noise" : "", f->medium.volume_count);
+cleanup:
+    return res;
+}
+
+static void fog_destroy(struct sb_renderer *r)
+{
+    struct sb_fog *f = r->fog;
+    if (!f)
+        return;
+    VkDevice d = r->vk->device;
+    VkPipeline pipelines[] = {f->inject, f->integrate, f->apply};
+    for (size_t i = 0; i < sizeof(pipelines) / sizeof(pipelines[0]); i++)
+        if (pipelines[i])
+            vkDestroyPipeline(d, pipelines[i], NULL);
+    if (f->repeat)
+        vkDestroySampler(d, f->repeat, NULL);
+    struct sb_texture *textures[] = {&f->light, &f->history, &f->integrated, &f->noise};
+    for (size_t i = 0; i < sizeof(textures) / sizeof(textures[0]); i++)
+        sb_texture_destroy(r->vk, textures[i]);
+    sb_buffer_destroy(r->vk, &f->params);
+    free(f);
+    r->fog = NULL;
+}
+
+/* The radical inverse of i in `base`: Halton's sequence, for the jitter. */
+static double halton(uint64_t i, unsigned base)
+{
+    double f = 1.0, x = 0.0;
+    for (; i > 0; i /= base) {
+        f /= base;
+        x += f * (double)(i % base);
+    }
+    return x;
+}
+
+static void fill_params(struct sb_renderer *r, struct sb_fog *f, struct sb_fog_gpu *g)
+{
+    const struct sb_view *v = r->view;
+    const struct sb_fog_params *m = &f->medium;
+    double sun[3];
+    sb_direction(v->sun_azimuth, v->sun_elevation, sun);
+    bool keep = f->has_history && !v->snap_exposure &&
+                sun[0] * f->sun[0] + sun[1] * f->sun[1] + sun[2] * f->sun[2] > SUN_CHANGE_COS;
+    memset(g, 0, sizeof(*g));
+    sb_mat4_store(&f->view_proj, g->previous_view_proj);
+    g->grid[0] = f->grid[0];
+    g->grid[1] = f->grid[1];
+    g->grid[2] = f->grid[2];
+    g->grid[3] = (uint32_t)m->volume_count;
+    g->slices[0] = (float)f->far_m;
+    g->slices[1] = (float)SLICE_SCALE_M;
+    g->slices[2] = (float)log2(1.0 + f->far_m / SLICE_SCALE_M);
+    g->slices[3] = keep ? (float)HISTORY_WEIGHT : 0.0f;
+    g->medium[0] = (float)m->extinction_per_m;
+    g->medium[1] = (float)m->base_altitude_m;
+    g->medium[2] = (float)(1.0 / m->falloff_height_m);
+    g->medium[3] = (float)m->anisotropy;
+    for (int k = 0; k < 3; k++) {
+        g->albedo[k] = (float)m->albedo[k];
+        /* The drift wrapped to the noise's tile, so fp32 keeps it exact over hours. */
+        double drift = -m->noise_wind_m_s[k] * v->time_s;
+        g->noise[k] = (float)(drift - m->noise_scale_m * floor(drift / m->noise_scale_m));
+        g->camera_motion_m[k] = (float)(v->camera_m[k] - f->camera_m[k]);
+    }
+    g->albedo[3] = (float)m->noise_amount;
+    g->noise[3] = (float)(1.0 / m->noise_scale_m);
+    /* Halton (2, 3, 5), a new point each frame; the first frame samples centres. */
+    uint64_t i = r->frame_index;
+    g->jitter[0] = i ? (float)halton(i, 2) : 0.5f;
+    g->jitter[1] = i ? (float)halton(i, 3) : 0.5f;
+    g->jitter[2] = i ? (float)halton(i, 5) : 0.5f;
+    g->jitter[3] = m->extinction_per_m > 0.0 ? 1.0f : 0.0f;
+    for (int b = 0; b < m->volume_count; b++) {
+        for (int k = 0; k < 3; k++) {
+            g->volume_min[b][k] = (float)m->volumes[b].box_m[0][k];
+            g->volume_max[b][k] = (float)m->volumes[b].box_m[1][k];
+        }
+        g->volume_min[b][3] = (float)m->volumes[b].extinction_per_m;
+        g->volume_max[b][3] = (float)m->volumes[b].edge_m;
+    }
+    f->view_proj = r->view_proj;
+    memcpy(f->camera_m, v->camera_m, sizeof(f->camera_m));
+    memcpy(f->sun, sun, sizeof(f->sun));
+    f->has_history = true;
+}
+
+static void fog_record(struct sb_renderer *r)
+{
+    struct sb_fog *f = r->fog;
+    if (!f->enabled)
+        return;
+    fill_params(r, f, f->params.mapped);
+    sb_renderer_dispatch(r, f->inject, NULL, f->grid, (const uint32_t[3]){SB_FOG_GROUP, SB_FOG_GROUP, SB_FOG_GROUP});
+    sb_renderer_barrier(r->cmd);
+    /* This frame's light is the next frame's history. */
+    VkImageCopy region = {
+        .srcSubresource = {VK_IMAGE_ASPECT_COLOR_BIT, 0, 0, 1},
+        .dstSubresource = {VK_IMAGE_ASPECT_COLOR_BIT, 0, 0, 1},
+        .extent = {f->grid[0], f->grid[1], f->grid[2]},
+    };
+    sb_texture_barrier(r->cmd, &f->light, VK_IMAGE_LAYOUT_GENERAL, VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL);
+    sb_texture_barrier(r->cmd, &f->history, VK_IMAGE_LAYOUT_GENERAL, VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL);
+    vkCmdCopyImage(r->cmd, f->light.image, VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL, f->history.image,
+                   VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL, 1, &region);
+    sb_texture_barrier(r->cmd, &f->light, VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL, VK_IMAGE_LAYOUT_GENERAL);
+    sb_texture_barrier(r->cmd, &f->history, VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL, VK_IMAGE_LAYOUT_GENERAL);
+    sb_renderer_dispatch(r, f->integrate, NULL, (const uint32_t[3]){f->grid[0], f->grid[1], 1},
+                         (const uint32_t[3]){SB_WORKGROUP_X, SB_WORKGROUP_Y, 1});
+}
+
+static void fog_apply_record(struct sb_renderer *r)
+{
+    struct sb_fog *f = r->fog;
+    if (!f->enabled)
+        return;
+    sb_renderer_dispatch(r, f->apply, NULL, (const uint32_t[3]){r->width, r->height, 1},
+                         (const uint32_t[3]){SB_WORKGROUP_X, SB_WORKGROUP_Y, 1});
+}
+
+const struct sb_pass_class sb_pass_fog = {
+    .name = "fog",
+    .create = fog_create,
+    .destroy = fog_destroy,
+    .record = fog_record,
+};
+
+const struct sb_pass_class sb_pass_fog_apply = {.name = "fog apply", .record = fog_apply_record};

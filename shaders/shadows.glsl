@@ -1,0 +1,52 @@
+/*
+ * The sun's visibility through skyview's cascaded shadow maps, for a point
+ * `offset` metres from the camera: the cascade by view depth, a normal offset
+ * of frame.shadow.y texels along n (0 for points in the air), the depth
+ * compare filtered bilinearly by the sampler (zero gradients: compute
+ * shaders have none, and the maps have one level), then 3 x 3 taps with pcf (the
+ * scene) or one (the fog, whose jitter and history filter it), and a blend
+ * band toward the next cascade. 1 beyond the last cascade.
+ */
+#ifndef SB_SHADOWS_GLSL
+#define SB_SHADOWS_GLSL
+
+layout(set = 0, binding = SB_VIEW_BINDING_SHADOW) uniform sampler2DArrayShadow shadow_map;
+
+float cascade_visibility(int c, vec3 offset, vec3 n, bool pcf)
+{
+    vec3 p = offset + n * (frame.cascade_texel[c] * frame.shadow.y);
+    vec4 clip = frame.shadow_view_proj[c] * vec4(p, 1.0);
+    vec3 s = clip.xyz / clip.w;
+    vec2 uv = s.xy * 0.5 + 0.5;
+    if (any(lessThan(uv, vec2(0.0))) || any(greaterThan(uv, vec2(1.0))) || s.z > 1.0)
+        return 1.0;
+    if (!pcf)
+        return textureGrad(shadow_map, vec4(uv, float(c), s.z), vec2(0.0), vec2(0.0));
+    float texel = 1.0 / frame.shadow.z;
+    float sum = 0.0;
+    for (int j = -1; j <= 1; j++)
+        for (int i = -1; i <= 1; i++)
+            sum += textureGrad(shadow_map, vec4(uv + vec2(i, j) * texel, float(c), s.z), vec2(0.0), vec2(0.0));
+    return sum / 9.0;
+}
+
+float sun_visibility(vec3 offset, vec3 n, bool pcf)
+{
+    if (frame.shadow.w == 0.0)
+        return 1.0;
+    float depth = dot(offset, frame.camera_forward.xyz);
+    int c = 0;
+    while (c < SB_CASCADES && depth > frame.cascade_ends[c])
+        c++;
+    if (c == SB_CASCADES)
+        return 1.0;
+    float visibility = cascade_visibility(c, offset, n, pcf);
+    float begin = c == 0 ? 0.0 : frame.cascade_ends[c - 1];
+    float band = frame.shadow.x * (frame.cascade_ends[c] - begin);
+    float f = band > 0.0 ? (depth - (frame.cascade_ends[c] - band)) / band : 0.0;
+    if (f > 0.0) /* toward the next cascade, or out of the shadows past the last */
+        visibility = mix(visibility, c + 1 < SB_CASCADES ? cascade_visibility(c + 1, offset, n, pcf) : 1.0, f);
+    return visibility;
+}
+
+#endif
