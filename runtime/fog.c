@@ -33,7 +33,6 @@ struct sb_fog {
     double far_m;
     struct sb_buffer params;
     struct sb_texture light, history, integrated, noise;
-    VkSampler repeat;
     VkPipeline inject, integrate, apply;
     /* The last frame, for reprojection. */
     bool has_history;
@@ -114,20 +113,8 @@ static enum sb_result fog_create(struct sb_renderer *r)
         res = volume(r, &f->integrated, f->grid, storage_sampled, "froxels integrated");
     if (!res)
         res = upload_noise(r, f);
-    if (res)
-        return res;
-    VkSamplerCreateInfo info = {
-        .sType = VK_STRUCTURE_TYPE_SAMPLER_CREATE_INFO,
-        .magFilter = VK_FILTER_LINEAR,
-        .minFilter = VK_FILTER_LINEAR,
-        .mipmapMode = VK_SAMPLER_MIPMAP_MODE_NEAREST,
-        .addressModeU = VK_SAMPLER_ADDRESS_MODE_REPEAT,
-        .addressModeV = VK_SAMPLER_ADDRESS_MODE_REPEAT,
-        .addressModeW = VK_SAMPLER_ADDRESS_MODE_REPEAT,
-        .maxLod = VK_LOD_CLAMP_NONE,
-    };
-    VK(vkCreateSampler(r->vk->device, &info, NULL, &f->repeat));
-    res = sb_renderer_kernel(r, sb_spv_fog_inject, sizeof(sb_spv_fog_inject), "fog inject", &f->inject);
+    if (!res)
+        res = sb_renderer_kernel(r, sb_spv_fog_inject, sizeof(sb_spv_fog_inject), "fog inject", &f->inject);
     if (!res)
         res = sb_renderer_kernel(r, sb_spv_fog_integrate, sizeof(sb_spv_fog_integrate), "fog integrate", &f->integrate);
     if (!res)
@@ -139,12 +126,11 @@ static enum sb_result fog_create(struct sb_renderer *r)
     sb_renderer_bind_view(r, SB_VIEW_BINDING_FROXEL_HISTORY, f->history.view, NULL);
     sb_renderer_bind_view(r, SB_VIEW_BINDING_FROXEL_OUT, f->integrated.view, NULL);
     sb_renderer_bind_view(r, SB_VIEW_BINDING_FROXEL, f->integrated.view, NULL);
-    sb_renderer_bind_view(r, SB_VIEW_BINDING_FOG_NOISE, f->noise.view, f->repeat);
+    sb_renderer_bind_view(r, SB_VIEW_BINDING_FOG_NOISE, f->noise.view, r->repeat);
     if (f->enabled)
         sb_info("fog: %u x %u x %u froxels to %g m%s, %d boxes", f->grid[0], f->grid[1], f->grid[2], f->far_m,
                 f->medium.noise_amount > 0.0 ? ", noise" : "", f->medium.volume_count);
-cleanup:
-    return res;
+    return SB_OK;
 }
 
 static void fog_destroy(struct sb_renderer *r)
@@ -157,8 +143,6 @@ static void fog_destroy(struct sb_renderer *r)
     for (size_t i = 0; i < sizeof(pipelines) / sizeof(pipelines[0]); i++)
         if (pipelines[i])
             vkDestroyPipeline(d, pipelines[i], NULL);
-    if (f->repeat)
-        vkDestroySampler(d, f->repeat, NULL);
     struct sb_texture *textures[] = {&f->light, &f->history, &f->integrated, &f->noise};
     for (size_t i = 0; i < sizeof(textures) / sizeof(textures[0]); i++)
         sb_texture_destroy(r->vk, textures[i]);

@@ -566,6 +566,9 @@ static enum sb_result create_images(struct sb_renderer *r)
     info.compareEnable = VK_TRUE;
     info.compareOp = VK_COMPARE_OP_LESS_OR_EQUAL;
     VK(vkCreateSampler(vk->device, &info, NULL, &r->shadow_compare));
+    info.compareEnable = VK_FALSE;
+    info.addressModeU = info.addressModeV = info.addressModeW = VK_SAMPLER_ADDRESS_MODE_REPEAT;
+    VK(vkCreateSampler(vk->device, &info, NULL, &r->repeat));
 cleanup:
     return res;
 }
@@ -736,6 +739,8 @@ void sb_renderer_destroy(struct sb_renderer **pr)
         vkDestroySampler(d, r->nearest, NULL);
     if (r->shadow_compare)
         vkDestroySampler(d, r->shadow_compare, NULL);
+    if (r->repeat)
+        vkDestroySampler(d, r->repeat, NULL);
     struct sb_texture *textures[] = {&r->sky_view, &r->aerial, &r->aerial_t, &r->shadow,
                                      &r->hdr,      &r->depth,  &r->bloom,    &r->ldr};
     for (size_t i = 0; i < sizeof(textures) / sizeof(textures[0]); i++)

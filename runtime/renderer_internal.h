@@ -56,7 +56,7 @@ struct sb_renderer {
     struct sb_buffer read_ldr, read_hdr, read_sky_view;
 
     struct sb_texture sky_view, aerial, aerial_t, shadow, hdr, depth, bloom, ldr;
-    VkSampler linear, nearest, shadow_compare;
+    VkSampler linear, nearest, shadow_compare, repeat; /* repeat: linear, wrapping (tileable noise) */
 
     /* What each binding of the sets points at (sb_renderer_bind_*). */
     const struct sb_buffer *bound_buffer[SB_VIEW_BINDING_COUNT];

@@ -3,7 +3,7 @@
  * (docs/fog.md). Lengths in metres, world y up; radiance scaled like the
  * frame (frame.aerial.y).
  * - Medium: exponential height fog, extinction sigma_0 e^(-(y - base) / H)
- *   (the exponent held above -20 below the base), thinned by the baked noise
+ *   (the exponent at most 20: far below the base the fog stops thickening), thinned by the baked noise
  *   as mix(1, noise, amount), plus boxes whose extinction ramps up over their
  *   edge. Extinction is grey; scattering is albedo times it.
  * - Light: the sun through the atmosphere's transmittance LUT at the
@@ -82,7 +82,7 @@ void fog_light(vec3 offset, vec3 p, out vec3 sun, out vec3 ambient)
     vec3 up = planet / r;
     float h = max(r - ground_radius(), 0.0);
     float mu_s = dot(up, frame.sun_direction.xyz);
-    float tau_sun = fog.medium.z > 0.0 ? height_fog_extinction(p.y) / (fog.medium.z * max(mu_s, 1e-4)) : 1e30;
+    float tau_sun = height_fog_extinction(p.y) / (fog.medium.z * max(mu_s, 1e-4)); /* H >= 1 m: z > 0 */
     sun = atm.solar_irradiance.rgb * sun_transmittance(h, mu_s) * (exp(-tau_sun) * frame.aerial.y);
     vec3 e_up = ground_sky_irradiance_sample(mu_s);
     vec3 e_down = atm.ground_albedo.rgb * ground_irradiance_sample(mu_s);

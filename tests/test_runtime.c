@@ -829,7 +829,6 @@ static void test_fog(const char *dir)
     double worst_s = 0, worst_t = 0;
     for (int i = 0; i < 4 && S && T; i++) {
         double dist = fog_walls[i][0], a = fog_walls[i][1] * DEG;
-        double d[3] = {sin(a), 0.0, -cos(a)};
         int px = (int)floor(FOG_W / 2.0 + tan(a) / tan(25.0 * DEG) * (FOG_H / 2.0)), py = FOG_H / 2;
         /* The pixel's ray, which ends on the wall's face at z = -dist cos a. */
         double ndc_x = ((px + 0.5) / FOG_W * 2 - 1) * tan(25.0 * DEG) * FOG_W / FOG_H;
@@ -844,7 +843,6 @@ static void test_fog(const char *dir)
             worst_s = fmax(worst_s, fabs(s[c] - s_ref) / s_ref);
         }
         worst_t = fmax(worst_t, fabs(t[0] - t_ref));
-        (void)d;
     }
     /* fp16 volumes (5e-4), trilinear reads between slices of an
      * exponential (1e-3 at 200 m), the irradiance LUT's interpolation
@@ -869,8 +867,6 @@ static void test_fog(const char *dir)
         double x_at = j == 0 ? 2.0 : 16.0;
         double target[3] = {x_at, 5.0, -32.0};
         double px[2];
-        struct sb_renderer_params rp = {.width = FOG_W, .height = FOG_H};
-        (void)rp;
         double dx = target[0] - v.camera_m[0], dy = target[1] - v.camera_m[1], dz = target[2] - v.camera_m[2];
         double n = sqrt(dx * dx + dy * dy + dz * dz);
         double ray[3] = {dx / n, dy / n, dz / n};
