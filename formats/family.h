@@ -65,4 +65,8 @@ void sb_reflections_product_shape(const struct sb_scene *scene, enum sb_product_
 enum sb_result sb_fog_section_parse(const struct cJSON *section, struct sb_scene *scene, const char *source);
 struct cJSON *sb_fog_section_json(const struct sb_scene *scene);
 
+/* The cloud layer's section (scene_cloud_layer.c), skyview's alone. */
+enum sb_result sb_cloud_layer_section_parse(const struct cJSON *section, struct sb_scene *scene, const char *source);
+struct cJSON *sb_cloud_layer_section_json(const struct sb_scene *scene);
+
 #endif

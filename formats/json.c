@@ -199,3 +199,21 @@ enum sb_result sb_json_box(const cJSON *item, const char *source, const char *pa
         }
     return res;
 }
+
+enum sb_result sb_json_member_number(const cJSON *obj, const char *where, const char *key, double lo, double hi,
+                                     const char *source, double *out)
+{
+    const cJSON *item = cJSON_GetObjectItemCaseSensitive(obj, key);
+    char path[128];
+    snprintf(path, sizeof(path), "%s.%s", where, key);
+    return item ? sb_json_number(item, source, path, lo, hi, out) : SB_OK;
+}
+
+enum sb_result sb_json_member_vec3(const cJSON *obj, const char *where, const char *key, double lo, double hi,
+                                   const char *source, double out[3])
+{
+    const cJSON *item = cJSON_GetObjectItemCaseSensitive(obj, key);
+    char path[128];
+    snprintf(path, sizeof(path), "%s.%s", where, key);
+    return item ? sb_json_vec3(item, source, path, lo, hi, out) : SB_OK;
+}

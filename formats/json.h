@@ -47,6 +47,14 @@ enum sb_result sb_json_number(const cJSON *item, const char *source, const char 
 enum sb_result sb_json_vec3(const cJSON *item, const char *source, const char *path, double lo, double hi,
                             double out[3]);
 
+/* The member `key` of object `obj`, if there, as sb_json_number or
+ * sb_json_vec3 would read it, named "where.key" in messages; SB_OK and
+ * *out untouched when it is absent (a default stands). */
+enum sb_result sb_json_member_number(const cJSON *obj, const char *where, const char *key, double lo, double hi,
+                                     const char *source, double *out);
+enum sb_result sb_json_member_vec3(const cJSON *obj, const char *where, const char *key, double lo, double hi,
+                                   const char *source, double out[3]);
+
 /* A box [[min x, y, z], [max x, y, z]], every coordinate in [lo, hi] and
  * every side at least 0.01 (max above min); `path` names the box. */
 enum sb_result sb_json_box(const cJSON *item, const char *source, const char *path, double lo, double hi,

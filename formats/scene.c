@@ -362,7 +362,7 @@ static enum sb_result parse_view(const cJSON *obj, struct sb_scene *scene, const
 }
 
 /* Sections that belong to no product family: what the bakes place
- * (the world) and what only skyview reads (the fog), in normalised order. */
+ * (the world) and what only skyview reads (the fog, the cloud layer), in normalised order. */
 static const struct other_section {
     const char *key;
     enum sb_result (*parse)(const cJSON *section, struct sb_scene *scene, const char *source);
@@ -370,6 +370,7 @@ static const struct other_section {
 } other_sections[] = {
     {"world", sb_world_section_parse, sb_world_section_json},
     {"fog", sb_fog_section_parse, sb_fog_section_json},
+    {"cloud_layer", sb_cloud_layer_section_parse, sb_cloud_layer_section_json},
 };
 
 static const struct other_section *other_section(const char *key)
@@ -405,6 +406,7 @@ static enum sb_result parse_root(const cJSON *root, struct sb_scene *scene, cons
     sb_cloud_params_default(&scene->clouds);
     sb_probe_params_default(&scene->probes);
     sb_reflection_params_default(&scene->reflections);
+    sb_cloud_layer_params_default(&scene->cloud_layer);
     for (const cJSON *item = root->child; item; item = item->next) {
         if (strcmp(item->string, "version") == 0) {
             if (!cJSON_IsNumber(item)) {

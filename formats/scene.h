@@ -144,6 +144,30 @@ struct sb_fog_params {
 
 void sb_fog_params_default(struct sb_fog_params *params);
 
+/* The scene's "cloud_layer" (docs/clouds.md, "In skyview"): the volumetric
+ * cloud layer skyview renders from the baked noise; the bakes do not read
+ * it. Altitudes above the ground, lengths in metres; defaults in brackets. */
+struct sb_cloud_layer_params {
+    double base_altitude_m;      /* the layer's base, [0, 3e4] [1500] */
+    double top_altitude_m;       /* its top, at least 100 m above the base, [100, 3e4] [4000] */
+    double coverage;             /* 0: clear; 0.5: the weather map's coverage as baked; 1: overcast [0.4] */
+    double extinction_per_m;     /* at density 1, [0, 1] [0.08] */
+    double albedo[3];            /* single-scattering albedo, [0, 1] [0.99] */
+    double weather_scale_m;      /* the weather map's tile, [100, 1e7] [40000] */
+    double shape_scale_m;        /* cloud_shape's tile, on all three axes, [10, 1e6] [8000] */
+    double detail_scale_m;       /* cloud_detail's tile, [1, 1e5] [700] */
+    double erosion;              /* how much the detail noise erodes the shape's edges, [0, 1] [0.4] */
+    double curl_scale_m;         /* cloud_curl's tile, [1, 1e6] [5000] */
+    double curl_m;               /* how far the curl moves the detail noise, [0, 1e4] [200] */
+    double wind_m_s[3];          /* the layer's drift [10, 0, 0] */
+    double phase_forward_g;      /* the two Henyey-Greenstein lobes' g, [-0.95, 0.95] [0.8] */
+    double phase_backward_g;     /* [-0.95, 0.95] [-0.3] */
+    double phase_forward_weight; /* the forward lobe's share, [0, 1] [0.7] */
+    uint32_t scattering_octaves; /* multiple-scattering octaves (Wrenninge; Hillaire 2016), [1, 8] [4] */
+};
+
+void sb_cloud_layer_params_default(struct sb_cloud_layer_params *params);
+
 struct sb_scene {
     char name[64];
     char preset[32];
@@ -168,6 +192,8 @@ struct sb_scene {
     struct sb_reflection_params reflections;
     bool has_fog;
     struct sb_fog_params fog;
+    bool has_cloud_layer; /* a "cloud_layer" was given (skyview draws the defaults' layer otherwise) */
+    struct sb_cloud_layer_params cloud_layer;
 };
 
 /* Tolerances a scene may ask for: [SB_TOLERANCE_MIN, SB_TOLERANCE_MAX]. */

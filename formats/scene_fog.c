@@ -27,36 +27,17 @@ void sb_fog_params_default(struct sb_fog_params *p)
     };
 }
 
-/* A number at `key` of `obj`, if there, in [lo, hi]. */
-static enum sb_result number(const cJSON *obj, const char *where, const char *key, double lo, double hi,
-                             const char *source, double *out)
-{
-    const cJSON *item = cJSON_GetObjectItemCaseSensitive(obj, key);
-    char path[96];
-    snprintf(path, sizeof(path), "%s.%s", where, key);
-    return item ? sb_json_number(item, source, path, lo, hi, out) : SB_OK;
-}
-
-static enum sb_result vec3(const cJSON *obj, const char *where, const char *key, double lo, double hi,
-                           const char *source, double out[3])
-{
-    const cJSON *item = cJSON_GetObjectItemCaseSensitive(obj, key);
-    char path[96];
-    snprintf(path, sizeof(path), "%s.%s", where, key);
-    return item ? sb_json_vec3(item, source, path, lo, hi, out) : SB_OK;
-}
-
 static enum sb_result parse_noise(const cJSON *obj, struct sb_fog_params *p, const char *source)
 {
     static const char *const keys[] = {"amount", "scale_m", "wind_m_s", NULL};
     enum sb_result res = sb_json_only_keys(obj, source, "fog.noise", keys);
     p->noise_amount = 0.6;
     if (!res)
-        res = number(obj, "fog.noise", "amount", 0.0, 1.0, source, &p->noise_amount);
+        res = sb_json_member_number(obj, "fog.noise", "amount", 0.0, 1.0, source, &p->noise_amount);
     if (!res)
-        res = number(obj, "fog.noise", "scale_m", 0.1, 1e4, source, &p->noise_scale_m);
+        res = sb_json_member_number(obj, "fog.noise", "scale_m", 0.1, 1e4, source, &p->noise_scale_m);
     if (!res)
-        res = vec3(obj, "fog.noise", "wind_m_s", -200.0, 200.0, source, p->noise_wind_m_s);
+        res = sb_json_member_vec3(obj, "fog.noise", "wind_m_s", -200.0, 200.0, source, p->noise_wind_m_s);
     return res;
 }
 
@@ -78,9 +59,9 @@ static enum sb_result parse_volume(const cJSON *e, int i, struct sb_fog_params *
         return res;
     p->volumes[i].edge_m = 1.0;
     if (!res)
-        res = number(e, where, "extinction_per_m", 0.0, 10.0, source, &p->volumes[i].extinction_per_m);
+        res = sb_json_member_number(e, where, "extinction_per_m", 0.0, 10.0, source, &p->volumes[i].extinction_per_m);
     if (!res)
-        res = number(e, where, "edge_m", 0.0, 1e3, source, &p->volumes[i].edge_m);
+        res = sb_json_member_number(e, where, "edge_m", 0.0, 1e3, source, &p->volumes[i].edge_m);
     return res;
 }
 
@@ -93,15 +74,15 @@ enum sb_result sb_fog_section_parse(const cJSON *obj, struct sb_scene *scene, co
     scene->has_fog = true;
     enum sb_result res = sb_json_only_keys(obj, source, "fog", keys);
     if (!res)
-        res = number(obj, "fog", "extinction_per_m", 0.0, 10.0, source, &p->extinction_per_m);
+        res = sb_json_member_number(obj, "fog", "extinction_per_m", 0.0, 10.0, source, &p->extinction_per_m);
     if (!res)
-        res = number(obj, "fog", "base_altitude_m", -1e4, 1e5, source, &p->base_altitude_m);
+        res = sb_json_member_number(obj, "fog", "base_altitude_m", -1e4, 1e5, source, &p->base_altitude_m);
     if (!res)
-        res = number(obj, "fog", "falloff_height_m", 1.0, 1e4, source, &p->falloff_height_m);
+        res = sb_json_member_number(obj, "fog", "falloff_height_m", 1.0, 1e4, source, &p->falloff_height_m);
     if (!res)
-        res = vec3(obj, "fog", "albedo", 0.0, 1.0, source, p->albedo);
+        res = sb_json_member_vec3(obj, "fog", "albedo", 0.0, 1.0, source, p->albedo);
     if (!res)
-        res = number(obj, "fog", "anisotropy", -0.95, 0.95, source, &p->anisotropy);
+        res = sb_json_member_number(obj, "fog", "anisotropy", -0.95, 0.95, source, &p->anisotropy);
     const cJSON *noise = cJSON_GetObjectItemCaseSensitive(obj, "noise");
     if (!res && noise)
         res = parse_noise(noise, p, source);

@@ -55,35 +55,17 @@ static enum sb_result volume(struct sb_renderer *r, struct sb_texture *t, const 
 }
 
 /* The pack's cloud_detail as an rgba16f volume (its half values exactly),
- * or one of 1 (no modulation) where the fog asks for none or the pack has none. */
+ * or one texel of 1 (no modulation) where the fog asks for none or the pack has none. */
 static enum sb_result upload_noise(struct sb_renderer *r, struct sb_fog *f)
 {
-    const struct sb_image *detail = &r->pack->images[SB_PRODUCT_CLOUD_DETAIL];
     bool use = f->enabled && f->medium.noise_amount > 0.0;
     if (use && !r->pack->present[SB_PRODUCT_CLOUD_DETAIL]) {
         sb_warn("fog.noise: the pack has no cloud_detail to modulate the fog with; the fog is not modulated");
         f->medium.noise_amount = 0.0;
         use = false;
     }
-    uint32_t size[3] = {1, 1, 2}; /* a depth of 2 keeps the image 3D */
-    if (use)
-        for (int k = 0; k < 3; k++)
-            size[k] = k == 0 ? detail->width : k == 1 ? detail->height : detail->depth;
-    size_t texels = (size_t)size[0] * size[1] * size[2];
-    uint16_t *data = malloc(texels * 4 * sizeof(uint16_t));
-    if (!data)
-        return SB_ERR_NOMEM;
-    for (size_t i = 0; i < texels; i++)
-        for (int c = 0; c < 4; c++) {
-            float v = use && c < (int)detail->channel_count ? detail->data[i * detail->channel_count + c] : 1.0f;
-            data[4 * i + c] = sb_half_from_float(v);
-        }
-    enum sb_result res =
-        volume(r, &f->noise, size, VK_IMAGE_USAGE_SAMPLED_BIT | VK_IMAGE_USAGE_TRANSFER_DST_BIT, "fog noise");
-    if (!res)
-        res = sb_texture_upload(r->vk, &f->noise, data, texels * 4 * sizeof(uint16_t), 4 * sizeof(uint16_t));
-    free(data);
-    return res;
+    return sb_renderer_upload_image(r, use ? &r->pack->images[SB_PRODUCT_CLOUD_DETAIL] : NULL, true, 1.0f, "fog noise",
+                                    &f->noise);
 }
 
 static enum sb_result fog_create(struct sb_renderer *r)
@@ -221,18 +203,7 @@ static void fog_record(struct sb_renderer *r)
     fill_params(r, f, f->params.mapped);
     sb_renderer_dispatch(r, f->inject, NULL, f->grid, (const uint32_t[3]){SB_FOG_GROUP, SB_FOG_GROUP, SB_FOG_GROUP});
     sb_renderer_barrier(r->cmd);
-    /* This frame's light is the next frame's history. */
-    VkImageCopy region = {
-        .srcSubresource = {VK_IMAGE_ASPECT_COLOR_BIT, 0, 0, 1},
-        .dstSubresource = {VK_IMAGE_ASPECT_COLOR_BIT, 0, 0, 1},
-        .extent = {f->grid[0], f->grid[1], f->grid[2]},
-    };
-    sb_texture_barrier(r->cmd, &f->light, VK_IMAGE_LAYOUT_GENERAL, VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL);
-    sb_texture_barrier(r->cmd, &f->history, VK_IMAGE_LAYOUT_GENERAL, VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL);
-    vkCmdCopyImage(r->cmd, f->light.image, VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL, f->history.image,
-                   VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL, 1, &region);
-    sb_texture_barrier(r->cmd, &f->light, VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL, VK_IMAGE_LAYOUT_GENERAL);
-    sb_texture_barrier(r->cmd, &f->history, VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL, VK_IMAGE_LAYOUT_GENERAL);
+    sb_renderer_copy_texture(r, &f->light, &f->history); /* this frame's light is the next frame's history */
     sb_renderer_dispatch(r, f->integrate, NULL, (const uint32_t[3]){f->grid[0], f->grid[1], 1},
                          (const uint32_t[3]){SB_WORKGROUP_X, SB_WORKGROUP_Y, 1});
 }

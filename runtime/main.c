@@ -13,6 +13,7 @@
 #include <string.h>
 #include <sys/stat.h>
 
+#include "config.h"
 #include "context.h"
 #include "default_world.h"
 #include "exr.h"
@@ -64,6 +65,14 @@ static void usage(FILE *f)
                "  --fog-slices N          froxel slices, 2 to 256 (default 64)\n"
                "  --fog-far M             where the froxel volume ends, metres (default 256);\n"
                "                          the height fog goes on beyond it in closed form\n"
+               "  --no-clouds             leave out the cloud layer (drawn when the pack has the\n"
+               "                          cloud noise; the scene's cloud_layer shapes it)\n"
+               "  --cloud-scale N         trace the clouds at one pixel in N x N a frame, the rest\n"
+               "                          reprojected: 1, 2 or 4 (default 2)\n"
+               "  --cloud-steps N         view march steps at most, 8 to 1024 (default 128)\n"
+               "  --cloud-light-steps N   steps toward the sun, 1 to 16 (default 6)\n"
+               "  --cloud-shadow-size N   texels per side of the clouds' shadow map over 16 km,\n"
+               "                          16 to 4096 (default 512)\n"
                "  --tonemap agx|aces|gt   tone mapper (default agx)\n"
                "  --exposure EV           exposure compensation (default 0)\n"
                "  --no-bloom              no bloom\n"
@@ -206,6 +215,20 @@ static int parse_options(int argc, char **argv, struct options *o)
         } else if (!strcmp(a, "--fog-far") && next) {
             ok = parse_number(argv[++i], 1, 1e5, &v);
             o->params.fog_far_m = v;
+        } else if (!strcmp(a, "--no-clouds"))
+            o->params.no_clouds = true;
+        else if (!strcmp(a, "--cloud-scale") && next) {
+            ok = parse_number(argv[++i], 1, 4, &v) && (v == 1 || v == 2 || v == 4);
+            o->params.cloud_scale = (uint32_t)v;
+        } else if (!strcmp(a, "--cloud-steps") && next) {
+            ok = parse_number(argv[++i], 8, 1024, &v) && v == floor(v);
+            o->params.cloud_steps = (uint32_t)v;
+        } else if (!strcmp(a, "--cloud-light-steps") && next) {
+            ok = parse_number(argv[++i], 1, SB_CLOUD_MAX_LIGHT_STEPS, &v) && v == floor(v);
+            o->params.cloud_light_steps = (uint32_t)v;
+        } else if (!strcmp(a, "--cloud-shadow-size") && next) {
+            ok = parse_number(argv[++i], 16, 4096, &v) && v == floor(v);
+            o->params.cloud_shadow_size = (uint32_t)v;
         } else if (!strcmp(a, "--bench"))
             o->bench = true;
         else if (!strcmp(a, "--device") && next)

@@ -89,8 +89,21 @@ static const VkDescriptorType binding_types[SB_VIEW_BINDING_COUNT] = {
     [SB_VIEW_BINDING_FROXEL_OUT] = VK_DESCRIPTOR_TYPE_STORAGE_IMAGE,
     [SB_VIEW_BINDING_FROXEL] = VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER,
     [SB_VIEW_BINDING_FOG_NOISE] = VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER,
+    [SB_VIEW_BINDING_CLOUDS] = VK_DESCRIPTOR_TYPE_STORAGE_BUFFER,
+    [SB_VIEW_BINDING_CLOUD_SHAPE] = VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER,
+    [SB_VIEW_BINDING_CLOUD_DETAIL] = VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER,
+    [SB_VIEW_BINDING_CLOUD_CURL] = VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER,
+    [SB_VIEW_BINDING_CLOUD_WEATHER] = VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER,
+    [SB_VIEW_BINDING_CLOUD_SHADOW] = VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER,
+    [SB_VIEW_BINDING_CLOUD_SHADOW_OUT] = VK_DESCRIPTOR_TYPE_STORAGE_IMAGE,
+    [SB_VIEW_BINDING_CLOUD_TRACE] = VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER,
+    [SB_VIEW_BINDING_CLOUD_TRACE_OUT] = VK_DESCRIPTOR_TYPE_STORAGE_IMAGE,
+    [SB_VIEW_BINDING_CLOUD_DEPTH] = VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER,
+    [SB_VIEW_BINDING_CLOUD_DEPTH_OUT] = VK_DESCRIPTOR_TYPE_STORAGE_IMAGE,
+    [SB_VIEW_BINDING_CLOUD_HISTORY] = VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER,
+    [SB_VIEW_BINDING_CLOUD_OUT] = VK_DESCRIPTOR_TYPE_STORAGE_IMAGE,
 };
-_Static_assert(SB_VIEW_BINDING_COUNT == 30, "every binding has a type above");
+_Static_assert(SB_VIEW_BINDING_COUNT == 43, "every binding has a type above");
 
 void sb_renderer_bind_buffer(struct sb_renderer *r, uint32_t binding, const struct sb_buffer *buffer)
 {
@@ -288,6 +301,39 @@ enum sb_result sb_renderer_kernel(struct sb_renderer *r, const uint32_t *spirv, 
                                   VkPipeline *pipeline)
 {
     return sb_compute_pipeline_create(r->vk, r->layout, spirv, spirv_size, name, pipeline);
+}
+
+enum sb_result sb_renderer_upload_image(struct sb_renderer *r, const struct sb_image *image, bool volume, float fill,
+                                        const char *name, struct sb_texture *texture)
+{
+    uint32_t size[3] = {1, 1, volume ? 2 : 1}; /* a depth of 2 keeps a stand-in 3D */
+    if (image) {
+        size[0] = image->width;
+        size[1] = image->height;
+        size[2] = image->depth ? image->depth : 1;
+    }
+    size_t texels = (size_t)size[0] * size[1] * size[2];
+    uint16_t *data = malloc(texels * 4 * sizeof(uint16_t));
+    if (!data)
+        return SB_ERR_NOMEM;
+    for (size_t i = 0; i < texels; i++)
+        for (uint32_t c = 0; c < 4; c++) {
+            float v = image && c < image->channel_count ? image->data[i * image->channel_count + c] : fill;
+            data[4 * i + c] = sb_half_from_float(v);
+        }
+    struct sb_texture_params p = {
+        .width = size[0],
+        .height = size[1],
+        .depth = size[2],
+        .format = VK_FORMAT_R16G16B16A16_SFLOAT,
+        .usage = VK_IMAGE_USAGE_SAMPLED_BIT | VK_IMAGE_USAGE_TRANSFER_DST_BIT,
+        .name = name,
+    };
+    enum sb_result res = sb_texture_create(r->vk, &p, texture);
+    if (!res)
+        res = sb_texture_upload(r->vk, texture, data, texels * 4 * sizeof(uint16_t), 4 * sizeof(uint16_t));
+    free(data);
+    return res;
 }
 
 static enum sb_result upload_atmosphere(struct sb_renderer *r, const struct sb_pack *pack)
@@ -839,6 +885,21 @@ void sb_renderer_barrier(VkCommandBuffer cmd)
                          0, NULL);
 }
 
+void sb_renderer_copy_texture(struct sb_renderer *r, const struct sb_texture *src, const struct sb_texture *dst)
+{
+    VkImageCopy region = {
+        .srcSubresource = {VK_IMAGE_ASPECT_COLOR_BIT, 0, 0, 1},
+        .dstSubresource = {VK_IMAGE_ASPECT_COLOR_BIT, 0, 0, 1},
+        .extent = {src->width, src->height, src->depth ? src->depth : 1},
+    };
+    sb_texture_barrier(r->cmd, src, VK_IMAGE_LAYOUT_GENERAL, VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL);
+    sb_texture_barrier(r->cmd, dst, VK_IMAGE_LAYOUT_GENERAL, VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL);
+    vkCmdCopyImage(r->cmd, src->image, VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL, dst->image,
+                   VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL, 1, &region);
+    sb_texture_barrier(r->cmd, src, VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL, VK_IMAGE_LAYOUT_GENERAL);
+    sb_texture_barrier(r->cmd, dst, VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL, VK_IMAGE_LAYOUT_GENERAL);
+}
+
 static void dispatch_on(struct sb_renderer *r, VkPipeline pipeline, VkDescriptorSet set,
                         const struct sb_view_push *push, const uint32_t size[3], const uint32_t group[3])
 {
@@ -1020,9 +1081,11 @@ static const struct sb_pass_class *const pass_classes[SB_PASS_COUNT] = {
     [SB_PASS_PROBES] = &pass_probes,
     [SB_PASS_AERIAL_PERSPECTIVE] = &pass_aerial,
     [SB_PASS_SHADOWS] = &pass_shadows,
-    [SB_PASS_FOG] = &sb_pass_fog, /* fog.c */
+    [SB_PASS_CLOUD_SHADOW] = &sb_pass_cloud_shadow, /* clouds.c */
+    [SB_PASS_FOG] = &sb_pass_fog,                   /* fog.c */
     [SB_PASS_SCENE] = &pass_scene,
     [SB_PASS_SKY] = &pass_sky,
+    [SB_PASS_CLOUDS] = &sb_pass_clouds,       /* clouds.c */
     [SB_PASS_FOG_APPLY] = &sb_pass_fog_apply, /* fog.c */
     [SB_PASS_EXPOSURE] = &pass_exposure,
     [SB_PASS_BLOOM] = &pass_bloom,

@@ -33,6 +33,11 @@ struct sb_renderer_params {
     uint32_t fog_tile_px;            /* a froxel's width and height in pixels; 0: 8 */
     uint32_t fog_slices;             /* froxel slices, [2, 256]; 0: 64 */
     double fog_far_m;                /* where the froxel volume ends (then the height fog in closed form); 0: 256 */
+    bool no_clouds;                  /* leave out the cloud layer */
+    uint32_t cloud_scale;            /* clouds traced at one pixel in scale x scale a frame: 1, 2 or 4; 0: 2 */
+    uint32_t cloud_steps;            /* view march steps at most, [8, 1024]; 0: 128 */
+    uint32_t cloud_light_steps;      /* light march steps toward the sun, [1, SB_CLOUD_MAX_LIGHT_STEPS]; 0: 6 */
+    uint32_t cloud_shadow_size;      /* texels per side of the clouds' shadow map, [16, 4096]; 0: 512 */
     int debug;                       /* SB_DEBUG_* (config.h): the scene pass writes one term; 0: the frame */
 };
 
@@ -44,8 +49,8 @@ struct sb_view {
     double sun_azimuth;   /* same convention as yaw */
     double sun_elevation; /* above the horizon; negative below */
     double dt_s;          /* time since the previous frame, for exposure adaptation; 0: 1/60 s */
-    bool snap_exposure;   /* a cut: take the metered exposure at once, drop the fog's history */
-    double time_s;        /* what the fog's noise drifts with (s) */
+    bool snap_exposure;   /* a cut: take the metered exposure at once, drop the fog's and clouds' history */
+    double time_s;        /* what the fog's noise and the clouds drift with (s) */
 };
 
 enum sb_pass {
@@ -53,9 +58,11 @@ enum sb_pass {
     SB_PASS_PROBES,
     SB_PASS_AERIAL_PERSPECTIVE,
     SB_PASS_SHADOWS,
+    SB_PASS_CLOUD_SHADOW,
     SB_PASS_FOG,
     SB_PASS_SCENE,
     SB_PASS_SKY,
+    SB_PASS_CLOUDS,
     SB_PASS_FOG_APPLY,
     SB_PASS_EXPOSURE,
     SB_PASS_BLOOM,
@@ -63,8 +70,8 @@ enum sb_pass {
     SB_PASS_COUNT,
 };
 
-/* "sky-view", "probes", "aerial perspective", "shadows", "fog", "scene", "sky", "fog apply", "exposure",
- * "bloom", "tonemap". */
+/* "sky-view", "probes", "aerial perspective", "shadows", "cloud shadow", "fog", "scene", "sky", "clouds",
+ * "fog apply", "exposure", "bloom", "tonemap". */
 const char *sb_pass_name(enum sb_pass pass);
 
 struct sb_frame_timings {

@@ -19,7 +19,9 @@
 #include "texture.h"
 #include "transform.h"
 
+struct sb_clouds;
 struct sb_fog;
+struct sb_image;
 
 #define SB_HDR_FORMAT VK_FORMAT_R16G16B16A16_SFLOAT
 #define SB_DEPTH_FORMAT VK_FORMAT_D32_SFLOAT
@@ -71,7 +73,8 @@ struct sb_renderer {
     VkPipeline kernels[KERNEL_COUNT];
     VkPipeline shadow_pipeline, scene_pipeline;
 
-    struct sb_fog *fog; /* fog.c */
+    struct sb_fog *fog;       /* fog.c */
+    struct sb_clouds *clouds; /* clouds.c */
 
     VkQueryPool queries;
     VkCommandBuffer cmd;
@@ -93,8 +96,10 @@ struct sb_pass_class {
     void (*record)(struct sb_renderer *r);
 };
 
-extern const struct sb_pass_class sb_pass_fog;       /* fog.c: the froxel volume */
-extern const struct sb_pass_class sb_pass_fog_apply; /* fog.c: the volume applied to the frame */
+extern const struct sb_pass_class sb_pass_fog;          /* fog.c: the froxel volume */
+extern const struct sb_pass_class sb_pass_fog_apply;    /* fog.c: the volume applied to the frame */
+extern const struct sb_pass_class sb_pass_cloud_shadow; /* clouds.c: the clouds' shadow map */
+extern const struct sb_pass_class sb_pass_clouds;       /* clouds.c: traced, resolved, composited */
 
 /* Point a binding at a buffer, or at an image view with a sampler (NULL:
  * linear filtering clamped to the edge). They are kept by pointer or handle
@@ -106,6 +111,12 @@ void sb_renderer_bind_view(struct sb_renderer *r, uint32_t binding, VkImageView 
 enum sb_result sb_renderer_upload(struct sb_renderer *r, const void *data, size_t bytes, const char *name,
                                   struct sb_buffer *buffer);
 
+/* A sampled RGBA16F texture of `image`'s values as halves (its channels,
+ * then `fill`), 3D where the image has depth, else 2D; without an image
+ * (NULL), one texel of `fill`, 3D when `volume`. */
+enum sb_result sb_renderer_upload_image(struct sb_renderer *r, const struct sb_image *image, bool volume, float fill,
+                                        const char *name, struct sb_texture *texture);
+
 /* A compute pipeline on the renderer's layout. */
 enum sb_result sb_renderer_kernel(struct sb_renderer *r, const uint32_t *spirv, size_t spirv_size, const char *name,
                                   VkPipeline *pipeline);
@@ -114,6 +125,10 @@ enum sb_result sb_renderer_kernel(struct sb_renderer *r, const uint32_t *spirv, 
  * depth invocations in groups of group_x x group_y x group_z. */
 void sb_renderer_dispatch(struct sb_renderer *r, VkPipeline pipeline, const struct sb_view_push *push,
                           const uint32_t size[3], const uint32_t group[3]);
+
+/* Record a copy of the whole of `src` into `dst` (same size and format),
+ * both in the general layout before and after. */
+void sb_renderer_copy_texture(struct sb_renderer *r, const struct sb_texture *src, const struct sb_texture *dst);
 
 /* A full memory barrier: every earlier command's writes before every later command. */
 void sb_renderer_barrier(VkCommandBuffer cmd);

@@ -4,7 +4,8 @@
  * slice, scaled toward nothing at the camera), then beyond the volume's far
  * end the height fog in closed form, its optical depth
  * sigma(y_far) (1 - e^(-t mu / H)) H / mu along the pixel's ray, lit like
- * the volume's last slice but without the cascades, noise or boxes.
+ * the volume's last slice but without the cascades, noise or boxes (the
+ * clouds' shadow included).
  * colour = colour * T + S. */
 #extension GL_GOOGLE_include_directive : require
 #include "config.h"
@@ -12,6 +13,7 @@
 #define SB_FOG_PROBES
 #include "probes.glsl"
 #include "fog.glsl"
+#include "cloud_layer.glsl"
 
 layout(local_size_x = SB_WORKGROUP_X, local_size_y = SB_WORKGROUP_Y) in;
 layout(set = 0, binding = SB_VIEW_BINDING_DEPTH) uniform sampler2D scene_depth;
@@ -47,7 +49,9 @@ void main()
                                   : sigma * (distance - far);
         vec3 sun, ambient;
         fog_light(d * far, p_far, sun, ambient);
-        vec3 source = fog.albedo.rgb * (sun * phase_hg(fog.medium.w, dot(d, frame.sun_direction.xyz)) + ambient);
+        float clouds_t = cloud_sun_transmittance(p_far);
+        vec3 source =
+            fog.albedo.rgb * (sun * (phase_hg(fog.medium.w, dot(d, frame.sun_direction.xyz)) * clouds_t) + ambient);
         inscatter += transmittance * source * (1.0 - exp(-tau));
         transmittance *= exp(-tau);
     }
@@ -57,7 +61,7 @@ void main()
         colour = inscatter;
     else if (frame.size.w == SB_DEBUG_FOG_TRANSMITTANCE)
         colour = vec3(transmittance);
-    else
+    else if (frame.size.w == SB_DEBUG_NONE || frame.size.w == SB_DEBUG_ENV_SPECULAR)
         colour = colour * transmittance + inscatter;
     imageStore(hdr, pixel, vec4(fp16_safe(colour), 1.0));
 }

@@ -12,6 +12,7 @@
 #include "probes.glsl"
 #include "fog.glsl"
 #include "shadows.glsl"
+#include "cloud_layer.glsl"
 
 layout(local_size_x = SB_FOG_GROUP, local_size_y = SB_FOG_GROUP, local_size_z = SB_FOG_GROUP) in;
 layout(set = 0, binding = SB_VIEW_BINDING_FROXEL_LIGHT_OUT, rgba16f) uniform writeonly image3D light_out;
@@ -28,7 +29,7 @@ vec4 froxel_light(vec3 cell)
     vec3 sun, ambient;
     fog_light(offset, p, sun, ambient);
     float nu = dot(d, frame.sun_direction.xyz);
-    vec3 light = sun * (phase_hg(fog.medium.w, nu) * sun_visibility(offset, vec3(0.0), false)) + ambient;
+    vec3 light = sun * (phase_hg(fog.medium.w, nu) * sun_visibility(offset, vec3(0.0), false) * cloud_sun_transmittance(p)) + ambient;
     return min(vec4(fog.albedo.rgb * sigma * light, sigma), vec4(65000.0));
 }
 

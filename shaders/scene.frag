@@ -2,7 +2,7 @@
 /* The world lit by the sun and the sky, seen through the air:
  * - the sun: E_sun times the baked transmittance toward it, through the
  *   cascaded shadow maps (normal offset, 3x3 comparison PCF, a blend band
- *   between cascades);
+ *   between cascades) and the clouds' shadow map (cloud_layer.glsl);
  * - the BRDF: GGX distribution, height-correlated Smith visibility, Schlick
  *   Fresnel, Lambert diffuse (Karis 2013; Filament);
  * - the sky: with probes (probes.glsl), the irradiance they interpolate, the
@@ -25,59 +25,14 @@
 #include "probes.glsl"
 #include "reflections.glsl"
 #include "shadows.glsl"
-
-layout(set = 0, binding = SB_VIEW_BINDING_AERIAL) uniform sampler3D aerial_inscatter;
-layout(set = 0, binding = SB_VIEW_BINDING_AERIAL_T) uniform sampler3D aerial_transmittance;
+#include "aerial.glsl"
+#include "cloud_layer.glsl"
 
 layout(location = 0) in vec3 in_offset;
 layout(location = 1) in vec3 in_normal;
 layout(location = 2) in vec3 in_albedo;
 layout(location = 3) in vec2 in_metallic_roughness;
 layout(location = 0) out vec4 out_color;
-
-/* In-scattered radiance (rgb, scaled like the frame) and transmittance from
- * the camera to a point `offset` metres away. */
-void aerial_perspective(vec3 offset, out vec3 inscatter, out vec3 transmittance)
-{
-    float d_km = length(offset) * 1e-3;
-    float far_km = frame.aerial.x;
-    bool inside = frame.camera_km.w < atmosphere_thickness();
-    if (inside && d_km <= far_km) {
-        vec2 uv = gl_FragCoord.xy / vec2(frame.size.xy);
-        float w = sqrt(d_km / far_km);
-        const float w0 = 0.5 / float(SB_AERIAL_SIZE);
-        vec3 uvw = vec3(uv, max(w, w0));
-        inscatter = textureLod(aerial_inscatter, uvw, 0.0).rgb;
-        transmittance = textureLod(aerial_transmittance, uvw, 0.0).rgb;
-        if (w < w0) { /* before the first slice, linear in distance */
-            float f = (w / w0) * (w / w0);
-            inscatter *= f;
-            transmittance = mix(vec3(1.0), transmittance, f);
-        }
-        return;
-    }
-    vec3 d = normalize(offset);
-    vec3 p = frame.camera_km.xyz;
-    float entry = atmosphere_entry(p, d);
-    inscatter = vec3(0.0);
-    transmittance = vec3(1.0);
-    if (entry < 0.0 || entry >= d_km)
-        return;
-    vec3 p0 = p + d * entry;
-    float r0 = length(p0);
-    float h0 = max(r0 - ground_radius(), 0.0);
-    float mu = dot(p0, d) / r0, mu_s = dot(p0, frame.sun_direction.xyz) / r0;
-    float nu = dot(d, frame.sun_direction.xyz);
-    float ts[SB_RAY_MAX_BREAKS];
-    int n = ray_breakpoints(h0, mu, mu_s, nu, d_km - entry, ts);
-    RayIntegrals ri = ray_integrals_begin();
-    for (int s = 0; s + 1 < n; s++)
-        integrate_segment(ri, h0, mu, mu_s, nu, ts[s], ts[s + 1], true);
-    vec3 L = atm.solar_irradiance.rgb * (ri.sun_rayleigh * phase_rayleigh(nu) + ri.sun_mie * phase_mie(nu)) +
-             ri.ms_rayleigh + ri.ms_mie;
-    inscatter = L * frame.aerial.y;
-    transmittance = ri.transmittance;
-}
 
 void main()
 {
@@ -108,7 +63,12 @@ void main()
     vec3 brdf = diffuse_color / PI + D * V * F;
 
     vec3 e_sun = atm.solar_irradiance.rgb * sun_transmittance(h, mu_s);
-    vec3 color = brdf * e_sun * (n_dot_l * sun_visibility(in_offset, n, true));
+    float clouds_t = cloud_sun_transmittance(in_offset + frame.camera_m.xyz);
+    if (frame.size.w == SB_DEBUG_CLOUD_SHADOW) {
+        out_color = vec4(vec3(clouds_t * frame.aerial.y), 1.0); /* read back divided by the scale */
+        return;
+    }
+    vec3 color = brdf * e_sun * (n_dot_l * sun_visibility(in_offset, n, true) * clouds_t);
 
     /* The world is low enough to read the ground row of irradiance_ground. */
     vec3 e_sky = ground_sky_irradiance_sample(mu_s);
@@ -147,6 +107,6 @@ void main()
     color += diffuse_color / PI * e_n + specular;
 
     vec3 inscatter, transmittance;
-    aerial_perspective(in_offset, inscatter, transmittance);
+    aerial_perspective(gl_FragCoord.xy / vec2(frame.size.xy), in_offset, inscatter, transmittance);
     out_color = vec4(fp16_safe(color * frame.aerial.y * transmittance + inscatter), 1.0);
 }

@@ -291,6 +291,32 @@ static void test_scenes(void)
         {EARTH "\"fog\":{\"volumes\":[{\"box_m\":[[5,0,5],[-5,3,-5]],\"extinction_per_m\":1}]}}", SB_ERR_OUT_OF_RANGE},
         {EARTH "\"fog\":{\"volumes\":[{\"box_m\":[[-5,0,-5],[5,3,5]],\"extinction_per_m\":-1}]}}", SB_ERR_OUT_OF_RANGE},
         {EARTH "\"fog\":{\"volumes\":{}}}", SB_ERR_WRONG_TYPE},
+        /* The cloud layer. */
+        {EARTH "\"cloud_layer\":{}}", SB_OK},
+        {EARTH "\"cloud_layer\":{\"base_altitude_m\":800,\"top_altitude_m\":2500,\"coverage\":1,"
+               "\"extinction_per_m\":0.1,\"albedo\":[1,1,1],\"weather_scale_m\":2e4,\"shape_scale_m\":5e3,"
+               "\"detail_scale_m\":500,\"erosion\":0.5,\"curl_scale_m\":3e3,\"curl_m\":100,"
+               "\"wind_m_s\":[5,0,-3],\"phase\":{\"forward_g\":0.85,\"backward_g\":-0.2,\"forward_weight\":0.6},"
+               "\"scattering_octaves\":8}}",
+         SB_OK},
+        {EARTH "\"cloud_layer\":{\"extinction_per_m\":-0.01}}", SB_ERR_OUT_OF_RANGE},
+        {EARTH "\"cloud_layer\":{\"extinction_per_m\":NaN}}", SB_ERR_JSON_SYNTAX},
+        {EARTH "\"cloud_layer\":{\"coverage\":1.01}}", SB_ERR_OUT_OF_RANGE},
+        {EARTH "\"cloud_layer\":{\"coverage\":-0.1}}", SB_ERR_OUT_OF_RANGE},
+        {EARTH "\"cloud_layer\":{\"base_altitude_m\":3000,\"top_altitude_m\":2000}}", SB_ERR_OUT_OF_RANGE},
+        {EARTH "\"cloud_layer\":{\"base_altitude_m\":2000,\"top_altitude_m\":2050}}", SB_ERR_OUT_OF_RANGE},
+        {EARTH "\"cloud_layer\":{\"base_altitude_m\":-1}}", SB_ERR_OUT_OF_RANGE},
+        {EARTH "\"cloud_layer\":{\"top_altitude_m\":1e6}}", SB_ERR_OUT_OF_RANGE},
+        {EARTH "\"cloud_layer\":{\"albedo\":[0.9,1.2,0.9]}}", SB_ERR_OUT_OF_RANGE},
+        {EARTH "\"cloud_layer\":{\"weather_scale_m\":0}}", SB_ERR_OUT_OF_RANGE},
+        {EARTH "\"cloud_layer\":{\"erosion\":2}}", SB_ERR_OUT_OF_RANGE},
+        {EARTH "\"cloud_layer\":{\"wind_m_s\":[1,2]}}", SB_ERR_WRONG_TYPE},
+        {EARTH "\"cloud_layer\":{\"phase\":{\"forward_g\":1}}}", SB_ERR_OUT_OF_RANGE},
+        {EARTH "\"cloud_layer\":{\"phase\":{\"g\":0.5}}}", SB_ERR_UNKNOWN_KEY},
+        {EARTH "\"cloud_layer\":{\"scattering_octaves\":2.5}}", SB_ERR_OUT_OF_RANGE},
+        {EARTH "\"cloud_layer\":{\"scattering_octaves\":0}}", SB_ERR_OUT_OF_RANGE},
+        {EARTH "\"cloud_layer\":{\"density\":1}}", SB_ERR_UNKNOWN_KEY},
+        {EARTH "\"cloud_layer\":[]}", SB_ERR_WRONG_TYPE},
         {EARTH "\"view\":{\"sun_azimuth_deg\":400}}", SB_ERR_OUT_OF_RANGE},
         {EARTH "\"view\":{\"sun_azimuth_deg\":40}}", SB_OK},
     };

@@ -23,6 +23,7 @@ check "bad --size is a usage error" expect_exit 2 "$skyview" "$tmp/pack" -o "$tm
 check "bad --tonemap is a usage error" expect_exit 2 "$skyview" "$tmp/pack" -o "$tmp/f" --tonemap reinhard
 
 check "one frame" expect_exit 0 "$skyview" "$tmp/pack" -o "$tmp/f" $small --hdr
+check "a pack without the cloud noise has no clouds, and says so" grep -q "clouds: the pack has no cloud_shape.*no clouds" "$tmp/err"
 check "frame_0000.png is a PNG" test "$(head -c 8 "$tmp/f/frame_0000.png" | od -An -tx1 | tr -d ' ')" = 89504e470d0a1a0a
 check "frame_0000.exr is an EXR" test "$(head -c 4 "$tmp/f/frame_0000.exr" | od -An -tx1 | tr -d ' ')" = 762f3101
 # The default world is built in: the same frame from another directory as
@@ -63,6 +64,31 @@ check "so the pack's world was the test world" cmp -s "$tmp/p0/frame_0000.png" "
 printf '{"version":1,"boxes":[{"center_m":[0,1,-10],"size_m":[1,1,1]}]}' >"$tmp/other.json"
 check "another world" expect_exit 0 "$skyview" "$tmp/probes" -o "$tmp/p3" $small --world "$tmp/other.json"
 check "is lit by the sky alone, with a warning" grep -q "baked against another world.*lit by the sky alone" "$tmp/err"
+
+# The cloud noise added to a copy of the pack: skyview draws the clouds
+# (with validation on), every bad cloud option is a usage error, and
+# --no-clouds gives the pack's frame without them.
+cat >"$tmp/clouds.json" <<EOF
+{"version":1,"name":"view","atmosphere":{"preset":"earth"},
+ "products":["irradiance_ground","cloud_shape","cloud_detail","cloud_curl","weather"],
+ "clouds":{"cloud_shape":{"size":64,"worley_cells":[2,4,8]},"weather":{"size":64},"cloud_curl":{"size":32}},
+ "cloud_layer":{"coverage":0.6}}
+EOF
+cp -r "$tmp/pack" "$tmp/clouds"
+check "bake the cloud noise into a copy of the pack" expect_exit 0 "$skybake" bake "$tmp/clouds.json" -o "$tmp/clouds" -q
+check "a frame with clouds" expect_exit 0 "$skyview" "$tmp/clouds" -o "$tmp/c1" $small --frames 2 --cloud-shadow-size 64
+check "the clouds are drawn" grep -q "clouds: 1500 to 4000 m, coverage 0.6" "$tmp/err"
+check "--no-clouds" expect_exit 0 "$skyview" "$tmp/clouds" -o "$tmp/c0" $small --frames 2 --no-clouds
+check "the clouds change the frame" sh -c "! cmp -s '$tmp/c1/frame_0001.png' '$tmp/c0/frame_0001.png'"
+check "lavapipe's settings" expect_exit 0 "$skyview" "$tmp/clouds" -o "$tmp/c2" $small --cloud-scale 4 --cloud-steps 48 \
+    --cloud-light-steps 3 --cloud-shadow-size 128
+for bad in "--cloud-scale 3" "--cloud-steps 4" "--cloud-light-steps 17" "--cloud-shadow-size 8"; do
+    check "$bad is a usage error" expect_exit 2 "$skyview" "$tmp/clouds" -o "$tmp/x" $bad
+done
+check "bench has the cloud passes" expect_exit 0 "$skyview" "$tmp/clouds" -o "$tmp/cb" $small --bench --frames 2 --warmup 1
+for pass in "cloud shadow" clouds; do
+    check "bench table has $pass" grep -q "^$pass " "$tmp/out"
+done
 
 # Packs that must be refused, with what is wrong named.
 cp -r "$tmp/pack" "$tmp/edited"
