@@ -32,6 +32,7 @@ skyview_abs=$(cd "$(dirname "$skyview")" && pwd)/$(basename "$skyview")
 check "from another directory" sh -c "cd / && '$skyview_abs' '$tmp/pack' -o '$tmp/elsewhere' $small >/dev/null 2>&1"
 check "with the world file named" expect_exit 0 "$skyview" "$tmp/pack" -o "$tmp/named" $small --world "$root/data/worlds/test.json"
 check "the built-in world is data/worlds/test.json" cmp -s "$tmp/elsewhere/frame_0000.png" "$tmp/named/frame_0000.png"
+check "data/worlds/colonnade.json (docs/fog.md's shafts) loads" expect_exit 0 "$skyview" "$tmp/pack" -o "$tmp/named" $small --world "$root/data/worlds/colonnade.json"
 check "three frames, each tone mapper" expect_exit 0 "$skyview" "$tmp/pack" -o "$tmp/g" $small --frames 3 --tonemap gt
 check "frame_0002.png" test -s "$tmp/g/frame_0002.png"
 check "aces" expect_exit 0 "$skyview" "$tmp/pack" -o "$tmp/g" $small --tonemap aces --no-bloom
