@@ -16,6 +16,7 @@
 #include "compute.h"
 #include "config.h"
 #include "renderer.h"
+#include "shadows.h"
 #include "texture.h"
 #include "transform.h"
 
@@ -47,7 +48,10 @@ struct sb_renderer {
     const struct sb_pack *pack; /* during sb_renderer_create only */
     uint32_t width, height, bloom_levels;
     uint32_t vertex_count, caster_first_vertex;
-    double radiance_scale; /* what stored radiance is multiplied by (fp16 headroom) */
+    struct sb_caster_box *caster_boxes; /* shadows.h */
+    unsigned caster_box_count;
+    int32_t cascade_clear[SB_CASCADES][4]; /* this frame's texels to clear and draw in each cascade */
+    double radiance_scale;                 /* what stored radiance is multiplied by (fp16 headroom) */
     double ground_radius_km;
 
     struct sb_buffer atmosphere, transmittance, multiscattering, irradiance_ground;

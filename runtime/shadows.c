@@ -1,6 +1,7 @@
 #include "shadows.h"
 
 #include <math.h>
+#include <stdlib.h>
 
 void sb_cascades_compute(const struct sb_cascade_params *p, const double camera_m[3], const double forward[3],
                          const double sun[3], struct sb_cascades *out)
@@ -58,4 +59,65 @@ void sb_cascades_compute(const struct sb_cascade_params *p, const double camera_
         out->view_proj[i] = sb_mat4_mul(&ortho, &view);
         begin = end;
     }
+}
+
+unsigned sb_caster_boxes(const struct sb_vertex_gpu *vertices, uint32_t first, uint32_t end, struct sb_caster_box **out,
+                         bool *failed)
+{
+    *out = NULL;
+    *failed = false;
+    uint32_t triangles = end > first ? (end - first) / 3 : 0;
+    unsigned count = (triangles + SB_CASTER_RUN - 1) / SB_CASTER_RUN;
+    if (!count)
+        return 0;
+    struct sb_caster_box *boxes = malloc(count * sizeof(*boxes));
+    if (!boxes) {
+        *failed = true;
+        return 0;
+    }
+    for (unsigned b = 0; b < count; b++) {
+        uint32_t v0 = first + 3 * SB_CASTER_RUN * b, v1 = v0 + 3 * SB_CASTER_RUN;
+        if (v1 > first + 3 * triangles)
+            v1 = first + 3 * triangles;
+        for (int k = 0; k < 3; k++) {
+            boxes[b].min[k] = HUGE_VAL;
+            boxes[b].max[k] = -HUGE_VAL;
+        }
+        for (uint32_t v = v0; v < v1; v++)
+            for (int k = 0; k < 3; k++) {
+                boxes[b].min[k] = fmin(boxes[b].min[k], vertices[v].position[k]);
+                boxes[b].max[k] = fmax(boxes[b].max[k], vertices[v].position[k]);
+            }
+    }
+    *out = boxes;
+    return count;
+}
+
+void sb_cascade_caster_rect(const struct sb_mat4 *view_proj, const double camera_m[3],
+                            const struct sb_caster_box *boxes, unsigned count, unsigned map_size, int32_t rect[4])
+{
+    /* In texel units, x = (ndc + 1) size / 2; a texel i is drawn when its
+     * centre i + 0.5 is covered, so [floor(lo), ceil(hi)) holds them all,
+     * and one more texel each side absorbs the fp32 rounding of the GPU's
+     * transform. */
+    double lo[2] = {HUGE_VAL, HUGE_VAL}, hi[2] = {-HUGE_VAL, -HUGE_VAL};
+    for (unsigned b = 0; b < count; b++)
+        for (int corner = 0; corner < 8; corner++) {
+            double p[3], ndc[3];
+            for (int k = 0; k < 3; k++)
+                p[k] = ((corner >> k) & 1 ? boxes[b].max[k] : boxes[b].min[k]) - camera_m[k];
+            sb_mat4_project(view_proj, p, ndc);
+            for (int k = 0; k < 2; k++) {
+                double x = (ndc[k] + 1.0) * 0.5 * map_size;
+                lo[k] = fmin(lo[k], x);
+                hi[k] = fmax(hi[k], x);
+            }
+        }
+    for (int k = 0; k < 2; k++) {
+        double a = fmax(floor(lo[k]) - 1.0, 0.0), b = fmin(ceil(hi[k]) + 1.0, (double)map_size);
+        rect[k] = (int32_t)(a < b ? a : 0.0);
+        rect[k + 2] = (int32_t)(a < b ? b : 0.0);
+    }
+    if (rect[0] >= rect[2] || rect[1] >= rect[3])
+        rect[0] = rect[1] = rect[2] = rect[3] = 0;
 }

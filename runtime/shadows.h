@@ -8,6 +8,9 @@
 #ifndef SB_RUNTIME_SHADOWS_H
 #define SB_RUNTIME_SHADOWS_H
 
+#include <stdbool.h>
+#include <stdint.h>
+
 #include "config.h"
 #include "transform.h"
 
@@ -35,5 +38,35 @@ struct sb_cascades {
  */
 void sb_cascades_compute(const struct sb_cascade_params *params, const double camera_m[3], const double forward[3],
                          const double sun[3], struct sb_cascades *out);
+
+/*
+ * Only the part of a cascade where casters project is cleared and drawn:
+ * clearing 4 x 2048^2 depth texels took the H100 1.2 ms (it has 8 ROPs), a
+ * frame of a few hundred triangles rarely covers a tenth of them, and the
+ * rest would hold the clear value. The casters are kept as boxes around runs
+ * of SB_CASTER_RUN triangles (in the world's order, so a run is mostly one
+ * object), projected each frame.
+ */
+#define SB_CASTER_RUN 32
+
+struct sb_caster_box {
+    double min[3], max[3]; /* world, m */
+};
+
+/* The boxes of vertices[first, end) (a triangle list; the world's casters).
+ * Returns how many, or 0 with *out NULL on no casters or no memory (*out is
+ * NULL then; failed set when it was the memory). */
+unsigned sb_caster_boxes(const struct sb_vertex_gpu *vertices, uint32_t first, uint32_t end, struct sb_caster_box **out,
+                         bool *failed);
+
+/*
+ * The texels of a map_size^2 cascade that casters can cover, as the box
+ * [rect[0], rect[2]) x [rect[1], rect[3]) of texel indices, from the boxes'
+ * corners through view_proj (camera-relative, so camera_m is subtracted):
+ * every texel whose centre a projected caster covers is inside. Empty
+ * (rect[0] >= rect[2]) when no box reaches the map.
+ */
+void sb_cascade_caster_rect(const struct sb_mat4 *view_proj, const double camera_m[3],
+                            const struct sb_caster_box *boxes, unsigned count, unsigned map_size, int32_t rect[4]);
 
 #endif

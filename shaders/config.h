@@ -221,6 +221,8 @@ struct sb_frame_gpu {
     SB_VEC4(sun_direction);    /* unit vector toward the sun, world; w: sun's angular radius (rad) */
     SB_VEC4(cascade_ends);     /* view depth (m) where each cascade ends */
     SB_VEC4(cascade_texel);    /* a shadow texel's width (m) in each cascade */
+    SB_VEC4(cascade_rect[SB_CASCADES]); /* uv box (min xy, max xy) outside which a cascade has no caster:
+                                           lookups there see the sun without reading the map */
     SB_VEC4(shadow);           /* x: blend band (fraction of a cascade), y: normal offset (texels),
                                   z: shadow map size (texels), w: 1 to use shadows */
     SB_VEC4(aerial);           /* x: the volume's far distance (km); y: radiance scale (what the frame's

@@ -5,7 +5,9 @@
  * compare filtered bilinearly by the sampler (zero gradients: compute
  * shaders have none, and the maps have one level), then 3 x 3 taps with pcf (the
  * scene) or one (the fog, whose jitter and history filter it), and a blend
- * band toward the next cascade. 1 beyond the last cascade.
+ * band toward the next cascade. 1 beyond the last cascade, and outside the
+ * box of a cascade's casters, where the map was neither cleared nor drawn
+ * (frame.cascade_rect; runtime/shadows.h).
  */
 #ifndef SB_SHADOWS_GLSL
 #define SB_SHADOWS_GLSL
@@ -18,7 +20,8 @@ float cascade_visibility(int c, vec3 offset, vec3 n, bool pcf)
     vec4 clip = frame.shadow_view_proj[c] * vec4(p, 1.0);
     vec3 s = clip.xyz / clip.w;
     vec2 uv = s.xy * 0.5 + 0.5;
-    if (any(lessThan(uv, vec2(0.0))) || any(greaterThan(uv, vec2(1.0))) || s.z > 1.0)
+    vec4 rect = frame.cascade_rect[c];
+    if (any(lessThan(uv, max(rect.xy, vec2(0.0)))) || any(greaterThan(uv, min(rect.zw, vec2(1.0)))) || s.z > 1.0)
         return 1.0;
     if (!pcf)
         return textureGrad(shadow_map, vec4(uv, float(c), s.z), vec2(0.0), vec2(0.0));

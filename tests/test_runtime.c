@@ -20,6 +20,7 @@
 #include "parallel.h"
 #include "renderer.h"
 #include "scene.h"
+#include "shadows.h"
 #include "transform.h"
 #include "world.h"
 
@@ -193,6 +194,73 @@ static void test_shadows(struct sb_renderer *r)
     }
     CHECK(checked == 2, "two pillars checked");
     free(rgb);
+}
+
+/* Each cascade is cleared and drawn only where the casters project
+ * (runtime/shadows.h): the texel box holds every caster vertex's texel with
+ * a margin, is smaller than the map where the casters are few, and the
+ * frames are the same, bit for bit, as with whole maps. */
+static void test_shadow_boxes(struct sb_renderer *r, const struct sb_renderer_params *rp)
+{
+    struct sb_caster_box *boxes;
+    bool failed;
+    unsigned count = sb_caster_boxes(world.vertices, world.caster_first_vertex, world.vertex_count, &boxes, &failed);
+    CHECK(count > 0 && !failed, "the test world's casters have boxes");
+    struct sb_view views[3] = {base_view(), base_view(), base_view()};
+    views[1].camera_m[1] = 40.0;
+    views[1].pitch = -40.0 * DEG;
+    views[2].sun_elevation = 4.0 * DEG;
+    views[2].sun_azimuth = 10.0 * DEG;
+    int64_t cleared = 0, whole = 0;
+    for (int i = 0; i < 3; i++) {
+        double forward[3], sun[3];
+        sb_direction(views[i].yaw, views[i].pitch, forward);
+        sb_direction(views[i].sun_azimuth, views[i].sun_elevation, sun);
+        struct sb_cascade_params cp = {.near_m = 0.1,
+                                       .distance_m = 250.0,
+                                       .lambda = 0.75,
+                                       .fov_y = views[i].fov_y,
+                                       .aspect = (double)W / H,
+                                       .map_size = 1024,
+                                       .caster_margin_m = 200.0};
+        struct sb_cascades cascades;
+        sb_cascades_compute(&cp, views[i].camera_m, forward, sun, &cascades);
+        for (int c = 0; c < SB_CASCADES; c++) {
+            int32_t rect[4];
+            sb_cascade_caster_rect(&cascades.view_proj[c], views[i].camera_m, boxes, count, cp.map_size, rect);
+            cleared += (int64_t)(rect[2] - rect[0]) * (rect[3] - rect[1]);
+            whole += (int64_t)cp.map_size * cp.map_size;
+            int outside = 0;
+            for (uint32_t v = world.caster_first_vertex; v < world.vertex_count; v++) {
+                double p[3], ndc[3];
+                for (int k = 0; k < 3; k++)
+                    p[k] = world.vertices[v].position[k] - views[i].camera_m[k];
+                sb_mat4_project(&cascades.view_proj[c], p, ndc);
+                double x = (ndc[0] + 1.0) * 0.5 * cp.map_size, y = (ndc[1] + 1.0) * 0.5 * cp.map_size;
+                bool on_map = x >= 0.0 && x < cp.map_size && y >= 0.0 && y < cp.map_size;
+                outside += on_map && (x < rect[0] + 1.0 || x > rect[2] - 1.0 || y < rect[1] + 1.0 || y > rect[3] - 1.0);
+            }
+            CHECK(outside == 0, "view %d, cascade %d: %d caster vertices outside the texel box [%d, %d) x [%d, %d)", i,
+                  c, outside, rect[0], rect[2], rect[1], rect[3]);
+        }
+    }
+    free(boxes);
+    CHECK(cleared < whole / 2, "the casters' boxes cover %.1f%% of the cascades (under half)", 100.0 * cleared / whole);
+    printf("shadows: the casters' boxes cover %.1f%% of the cascades' texels\n", 100.0 * cleared / whole);
+
+    struct sb_renderer_params whole_rp = *rp;
+    whole_rp.whole_shadow_maps = true;
+    struct sb_renderer *w = NULL;
+    CHECK(sb_renderer_create(vk, &pack, &world, &whole_rp, &w) == SB_OK, "renderer with whole shadow maps");
+    for (int i = 0; i < 3 && w; i++) {
+        if (!render(r, &views[i]) || !render(w, &views[i]))
+            break;
+        float *a = frame_rgb(r), *b = frame_rgb(w);
+        CHECK(!memcmp(a, b, sizeof(float) * 3 * W * H), "view %d: the frame is the same as with whole shadow maps", i);
+        free(a);
+        free(b);
+    }
+    sb_renderer_destroy(&w);
 }
 
 static int compare_doubles(const void *a, const void *b)
@@ -981,6 +1049,7 @@ int main(int argc, char **argv)
     if (r) {
         test_sky_colours(r);
         test_shadows(r);
+        test_shadow_boxes(r, &rp);
         test_exposure(r);
         /* Against a reference that reads the sun's transmittance from the
          * baked LUT as the runtime does, so the LUT's own error (reported)
