@@ -11,6 +11,7 @@
 #include "irradiance_sky.spv.h"
 #include "log.h"
 #include "multiscattering.spv.h"
+#include "multiscattering_hillaire.spv.h"
 #include "physics.h"
 #include "transmittance_gl0.spv.h"
 #include "transmittance_gl1.spv.h"
@@ -74,7 +75,15 @@ static const struct spirv scattering_shaders[SB_ATMOSPHERE_PRODUCT_COUNT] = {
     [SB_PRODUCT_IRRADIANCE_GROUND] = SPIRV(irradiance_ground),
     [SB_PRODUCT_IRRADIANCE_SKY] = SPIRV(irradiance_sky),
 };
+/* skybake bench's anchor: Hillaire 2020's multiple-scattering LUT (config.h). */
+static const struct spirv hillaire_multiscattering = SPIRV(multiscattering_hillaire);
 #undef SPIRV
+
+/* A scattering product's setting of the published methods (bench anchors). */
+static bool is_anchor(enum sb_product_id id, const struct sb_atmosphere_settings *s)
+{
+    return id != SB_PRODUCT_TRANSMITTANCE && s->quadrature != SB_QUADRATURE_GAUSS_LEGENDRE;
+}
 
 const struct sb_atmosphere_product *sb_atmosphere_product(enum sb_product_id id)
 {
@@ -104,12 +113,29 @@ static struct sb_atmosphere_settings resolve_settings(enum sb_product_id id,
         s.directions_mu = in.directions_mu;
     if (in.directions_phi)
         s.directions_phi = in.directions_phi;
+    if (in.quadrature) {
+        s.quadrature = in.quadrature;
+        s.samples = in.samples;
+    }
     return s;
 }
 
 static enum sb_result check_settings(enum sb_product_id id, const struct sb_atmosphere_settings *s)
 {
     const char *name = sb_product_name(id);
+    if (is_anchor(id, s)) {
+        if (id != SB_PRODUCT_MULTISCATTERING || s->quadrature != SB_QUADRATURE_UNIFORM_0_3 ||
+            s->directions_mu * s->directions_phi < 1 ||
+            s->directions_mu * s->directions_phi > SB_ANCHOR_MAX_DIRECTIONS || s->samples < 1 ||
+            s->samples > SB_UNIFORM_MAX_STEPS) {
+            sb_error("%s: the uniform rules are Hillaire 2020's multiscattering only: 1 to %d directions, 1 to %d "
+                     "steps (got %ux%u, %u)",
+                     name, SB_ANCHOR_MAX_DIRECTIONS, SB_UNIFORM_MAX_STEPS, s->directions_mu, s->directions_phi,
+                     s->samples);
+            return SB_ERR_USAGE;
+        }
+        return SB_OK;
+    }
     if (id != SB_PRODUCT_TRANSMITTANCE) {
         if (s->directions_mu < 1 || s->directions_mu > SB_MAX_DIRECTIONS_MU || s->directions_phi < 1 ||
             s->directions_phi > SB_MAX_DIRECTIONS_PHI) {
@@ -151,6 +177,8 @@ static uint64_t sphere_directions(const struct sb_atmosphere_settings *s, bool c
 uint64_t sb_atmosphere_settings_cost(enum sb_product_id id, const struct sb_atmosphere_settings *settings)
 {
     struct sb_atmosphere_settings s = resolve_settings(id, settings);
+    if (is_anchor(id, &s))
+        return (uint64_t)s.directions_mu * s.directions_phi;
     if (id != SB_PRODUCT_TRANSMITTANCE)
         return sphere_directions(&s, id != SB_PRODUCT_MULTISCATTERING);
     if (s.quadrature == SB_QUADRATURE_GAUSS_LEGENDRE)
@@ -162,6 +190,10 @@ void sb_atmosphere_settings_label(enum sb_product_id id, const struct sb_atmosph
                                   size_t size)
 {
     struct sb_atmosphere_settings s = resolve_settings(id, settings);
+    if (is_anchor(id, &s)) {
+        snprintf(out, size, "hillaire%ux%u-%u", s.directions_mu, s.directions_phi, s.samples);
+        return;
+    }
     if (id != SB_PRODUCT_TRANSMITTANCE) {
         snprintf(out, size, "%ux%u", s.directions_mu, s.directions_phi);
         return;
@@ -236,7 +268,7 @@ void sb_atmosphere_baker_destroy(struct sb_atmosphere_baker **pb)
  */
 static enum sb_result run(struct sb_atmosphere_baker *b, const uint32_t *spirv, size_t spirv_size, const char *name,
                           struct sb_buffer *output, uint32_t width, uint32_t height, uint64_t directions,
-                          const struct sb_atmosphere_settings *s, double *gpu_ms)
+                          bool group_per_texel, const struct sb_atmosphere_settings *s, double *gpu_ms)
 {
     uint32_t directions_mu = s->directions_mu, directions_phi = s->directions_phi;
     struct sb_bake_push push = {
@@ -282,8 +314,9 @@ static enum sb_result run(struct sb_atmosphere_baker *b, const uint32_t *spirv, 
         if (bindings[i] == output) /* a product is never its own input */
             bindings[i] = &b->dummy;
     sb_pipeline_bind(b->vk, &pipeline, bindings);
-    uint32_t groups_x = workgroup_per_texel ? width : (width + SB_WORKGROUP_X - 1) / SB_WORKGROUP_X;
-    uint32_t groups_y = workgroup_per_texel ? height : (height + SB_WORKGROUP_Y - 1) / SB_WORKGROUP_Y;
+    group_per_texel = group_per_texel || workgroup_per_texel;
+    uint32_t groups_x = group_per_texel ? width : (width + SB_WORKGROUP_X - 1) / SB_WORKGROUP_X;
+    uint32_t groups_y = group_per_texel ? height : (height + SB_WORKGROUP_Y - 1) / SB_WORKGROUP_Y;
     double total_ms = 0;
     for (uint32_t step = 0; step < push.step_count && !res; step += SB_SPHERE_STEPS_PER_PASS) {
         push.step_begin = step;
@@ -347,19 +380,20 @@ enum sb_result sb_atmosphere_bake(struct sb_atmosphere_baker *b, enum sb_product
     if ((res = sb_buffer_create(b->vk, bytes, sb_product_name(id), &b->outputs[id])))
         goto cleanup;
 
+    bool anchor = is_anchor(id, &s);
     const struct spirv *shader =
         id == SB_PRODUCT_TRANSMITTANCE
             ? &transmittance_shaders[s.quadrature == SB_QUADRATURE_GAUSS_LEGENDRE ? s.samples : 0]
-            : &scattering_shaders[id];
+            : (anchor ? &hillaire_multiscattering : &scattering_shaders[id]);
     bool cap = id == SB_PRODUCT_IRRADIANCE_GROUND || (id == SB_PRODUCT_IRRADIANCE_SKY && b->sky_cap);
-    uint64_t directions = prod->workgroup_per_texel ? sphere_directions(&s, cap) : 0;
-    if ((res = run(b, shader->words, shader->size, sb_product_name(id), &b->outputs[id], width, height, directions, &s,
-                   gpu_ms)))
+    uint64_t directions = prod->workgroup_per_texel && !anchor ? sphere_directions(&s, cap) : 0;
+    if ((res = run(b, shader->words, shader->size, sb_product_name(id), &b->outputs[id], width, height, directions,
+                   anchor, &s, gpu_ms)))
         goto cleanup;
     memcpy(image->data, b->outputs[id].mapped, bytes);
-    /* A resolution other than the format's is a measurement: later bakes
-     * must not read it. */
-    if (width != format->width || height != format->height)
+    /* A resolution other than the format's, or an anchor, is a measurement:
+     * later bakes must not read it. */
+    if (anchor || width != format->width || height != format->height)
         sb_buffer_destroy(b->vk, &b->outputs[id]);
     else
         res = make_lookup(b, id, image);
@@ -433,7 +467,7 @@ enum sb_result sb_atmosphere_run_kernel(struct sb_atmosphere_baker *b, const uin
     uint32_t width = record_count < per_row ? record_count : per_row;
     uint32_t height = (record_count + per_row - 1) / per_row;
     struct sb_atmosphere_settings s = {.directions_mu = record_count, .directions_phi = record_floats};
-    res = run(b, spirv, spirv_size, "kernel", &io, width, height, 0, &s, NULL);
+    res = run(b, spirv, spirv_size, "kernel", &io, width, height, 0, false, &s, NULL);
     if (!res)
         memcpy(records, io.mapped, bytes);
     sb_buffer_destroy(b->vk, &io);

@@ -19,6 +19,7 @@
 
 #define HILLAIRE "Hillaire 2020 (40-step march, offset 0.3)"
 #define BRUNETON "Bruneton 2017 (500-step trapezoid)"
+#define HILLAIRE_MS "Hillaire 2020 (64 directions, 20-step march, LUT sun)"
 
 struct sweep_entry {
     struct sb_atmosphere_settings settings;
@@ -70,9 +71,22 @@ static const struct sweep_entry resolution_sweep[] = {
     {                                                                                                                  \
         .directions_mu = m, .directions_phi = p                                                                        \
     }
+#define HILLAIRE_DIRS(n, steps)                                                                                        \
+    {                                                                                                                  \
+        .quadrature = SB_QUADRATURE_UNIFORM_0_3, .samples = steps, .directions_mu = n, .directions_phi = n             \
+    }
 static const struct sweep_entry multiscattering_sweep[] = {
-    {DIRS(2, 2), NULL, true},    {DIRS(4, 4), NULL, true},    {DIRS(6, 6), NULL, false},   {DIRS(8, 8), NULL, true},
-    {DIRS(12, 12), NULL, false}, {DIRS(16, 12), NULL, false}, {DIRS(24, 16), NULL, false}, {DIRS(32, 24), NULL, false},
+    {HILLAIRE_DIRS(8, 20), HILLAIRE_MS, true},
+    {HILLAIRE_DIRS(8, 80), NULL, false},
+    {HILLAIRE_DIRS(8, 320), NULL, false},
+    {DIRS(2, 2), NULL, true},
+    {DIRS(4, 4), NULL, true},
+    {DIRS(6, 6), NULL, false},
+    {DIRS(8, 8), NULL, true},
+    {DIRS(12, 12), NULL, false},
+    {DIRS(16, 12), NULL, false},
+    {DIRS(24, 16), NULL, false},
+    {DIRS(32, 24), NULL, false},
 };
 static const struct sweep_entry irradiance_ground_sweep[] = {
     {DIRS(4, 4), NULL, true},    {DIRS(6, 6), NULL, true},    {DIRS(8, 8), NULL, true},
@@ -86,6 +100,7 @@ static const struct sweep_entry irradiance_sky_sweep[] = {
 #undef UNI
 #undef RES
 #undef DIRS
+#undef HILLAIRE_DIRS
 
 static const struct {
     const char *name;

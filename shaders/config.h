@@ -131,6 +131,11 @@ struct sb_bake_push {
 #define SB_TRANSMITTANCE_MAX_PIECES 21
 #define SB_GL_MAX_SUBDIVISIONS 16
 #define SB_UNIFORM_MAX_STEPS 4096
+/* skybake bench's anchor for multiple scattering: Hillaire 2020's LUT
+ * (multiscattering_hillaire.comp), selected by quadrature
+ * SB_QUADRATURE_UNIFORM_0_3 on that product: directions_mu x directions_phi
+ * directions (at most a workgroup's), `samples` steps a ray. Never in a pack. */
+#define SB_ANCHOR_MAX_DIRECTIONS 64
 
 /* ---- skyview ------------------------------------------------------------------ */
 /*

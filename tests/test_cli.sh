@@ -247,6 +247,8 @@ check "bench has Hillaire's row" grep -q "uniform0.3-40,.*Hillaire" "$tmp/bench/
 check "bench has Bruneton's row" grep -q "trapezoid-500,.*Bruneton" "$tmp/bench/bench.csv"
 check "bench marks a Pareto front" grep -Eq '"pareto":[[:space:]]*true' "$tmp/bench/bench.json"
 check "bench table names the default" grep -q '^.\*gl8x1' "$tmp/out"
+check "bench of multiscattering, quick" expect_exit 0 "$skybake" bench --product multiscattering --quick --repeat 1 -q -o "$tmp/benchm"
+check "bench has Hillaire's multiple-scattering row" grep -q "hillaire8x8-20,.*Hillaire 2020" "$tmp/benchm/bench.csv"
 check "bench refuses an unknown product" expect_exit 2 "$skybake" bench --product sky
 check "bench of the cloud noise" expect_exit 0 "$skybake" bench --product cloud_detail --product cloud_curl --repeat 1 -q -o "$tmp/benchc"
 check "bench_clouds.csv: two products, every value equal to the reference" \
