@@ -159,15 +159,11 @@ static void clouds_destroy(struct sb_renderer *r)
     struct sb_clouds *c = r->clouds;
     if (!c)
         return;
-    VkDevice d = r->vk->device;
-    VkPipeline pipelines[] = {c->shadow_kernel, c->trace_kernel, c->resolve_kernel};
-    for (size_t i = 0; i < sizeof(pipelines) / sizeof(pipelines[0]); i++)
-        if (pipelines[i])
-            vkDestroyPipeline(d, pipelines[i], NULL);
-    struct sb_texture *textures[] = {&c->shape, &c->detail, &c->curl, &c->weather, &c->shadow,
-                                     &c->trace, &c->depth,  &c->out,  &c->history};
-    for (size_t i = 0; i < sizeof(textures) / sizeof(textures[0]); i++)
-        sb_texture_destroy(r->vk, textures[i]);
+    const VkPipeline pipelines[] = {c->shadow_kernel, c->trace_kernel, c->resolve_kernel};
+    struct sb_texture *const textures[] = {&c->shape, &c->detail, &c->curl, &c->weather, &c->shadow,
+                                           &c->trace, &c->depth,  &c->out,  &c->history};
+    sb_renderer_release(r, pipelines, sizeof(pipelines) / sizeof(pipelines[0]), textures,
+                        sizeof(textures) / sizeof(textures[0]));
     sb_buffer_destroy(r->vk, &c->params);
     free(c);
     r->clouds = NULL;

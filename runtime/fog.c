@@ -120,14 +120,10 @@ static void fog_destroy(struct sb_renderer *r)
     struct sb_fog *f = r->fog;
     if (!f)
         return;
-    VkDevice d = r->vk->device;
-    VkPipeline pipelines[] = {f->inject, f->integrate, f->apply};
-    for (size_t i = 0; i < sizeof(pipelines) / sizeof(pipelines[0]); i++)
-        if (pipelines[i])
-            vkDestroyPipeline(d, pipelines[i], NULL);
-    struct sb_texture *textures[] = {&f->light, &f->history, &f->integrated, &f->noise};
-    for (size_t i = 0; i < sizeof(textures) / sizeof(textures[0]); i++)
-        sb_texture_destroy(r->vk, textures[i]);
+    const VkPipeline pipelines[] = {f->inject, f->integrate, f->apply};
+    struct sb_texture *const textures[] = {&f->light, &f->history, &f->integrated, &f->noise};
+    sb_renderer_release(r, pipelines, sizeof(pipelines) / sizeof(pipelines[0]), textures,
+                        sizeof(textures) / sizeof(textures[0]));
     sb_buffer_destroy(r->vk, &f->params);
     free(f);
     r->fog = NULL;

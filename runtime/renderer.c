@@ -779,13 +779,9 @@ void sb_renderer_destroy(struct sb_renderer **pr)
     for (int p = SB_PASS_COUNT; p-- > 0;)
         if (pass_classes[p]->destroy)
             pass_classes[p]->destroy(r);
-    for (int k = 0; k < KERNEL_COUNT; k++)
-        if (r->kernels[k])
-            vkDestroyPipeline(d, r->kernels[k], NULL);
-    if (r->shadow_pipeline)
-        vkDestroyPipeline(d, r->shadow_pipeline, NULL);
-    if (r->scene_pipeline)
-        vkDestroyPipeline(d, r->scene_pipeline, NULL);
+    const VkPipeline raster[] = {r->shadow_pipeline, r->scene_pipeline};
+    sb_renderer_release(r, r->kernels, KERNEL_COUNT, NULL, 0);
+    sb_renderer_release(r, raster, 2, NULL, 0);
     if (r->pool)
         vkDestroyDescriptorPool(d, r->pool, NULL);
     if (r->layout)
@@ -800,10 +796,9 @@ void sb_renderer_destroy(struct sb_renderer **pr)
         vkDestroySampler(d, r->shadow_compare, NULL);
     if (r->repeat)
         vkDestroySampler(d, r->repeat, NULL);
-    struct sb_texture *textures[] = {&r->sky_view, &r->aerial, &r->aerial_t, &r->shadow,
-                                     &r->hdr,      &r->depth,  &r->bloom,    &r->ldr};
-    for (size_t i = 0; i < sizeof(textures) / sizeof(textures[0]); i++)
-        sb_texture_destroy(vk, textures[i]);
+    struct sb_texture *const textures[] = {&r->sky_view, &r->aerial, &r->aerial_t, &r->shadow,
+                                           &r->hdr,      &r->depth,  &r->bloom,    &r->ldr};
+    sb_renderer_release(r, NULL, 0, textures, sizeof(textures) / sizeof(textures[0]));
     struct sb_buffer *buffers[] = {&r->atmosphere,  &r->transmittance,   &r->multiscattering, &r->irradiance_ground,
                                    &r->frame,       &r->vertices,        &r->exposure,        &r->read_ldr,
                                    &r->read_hdr,    &r->read_sky_view,   &r->probes,          &r->probe_light,
@@ -919,6 +914,16 @@ void sb_renderer_barrier(VkCommandBuffer cmd)
     };
     vkCmdPipelineBarrier(cmd, VK_PIPELINE_STAGE_ALL_COMMANDS_BIT, VK_PIPELINE_STAGE_ALL_COMMANDS_BIT, 0, 1, &b, 0, NULL,
                          0, NULL);
+}
+
+void sb_renderer_release(struct sb_renderer *r, const VkPipeline *pipelines, size_t pipeline_count,
+                         struct sb_texture *const *textures, size_t texture_count)
+{
+    for (size_t i = 0; i < pipeline_count; i++)
+        if (pipelines[i])
+            vkDestroyPipeline(r->vk->device, pipelines[i], NULL);
+    for (size_t i = 0; i < texture_count; i++)
+        sb_texture_destroy(r->vk, textures[i]);
 }
 
 void sb_renderer_copy_texture(struct sb_renderer *r, const struct sb_texture *src, const struct sb_texture *dst)

@@ -134,6 +134,11 @@ void sb_renderer_dispatch(struct sb_renderer *r, VkPipeline pipeline, const stru
  * both in the general layout before and after. */
 void sb_renderer_copy_texture(struct sb_renderer *r, const struct sb_texture *src, const struct sb_texture *dst);
 
+/* Destroy what a pass made: its pipelines (VK_NULL_HANDLE ones skipped) and
+ * textures (zeroed ones accepted). */
+void sb_renderer_release(struct sb_renderer *r, const VkPipeline *pipelines, size_t pipeline_count,
+                         struct sb_texture *const *textures, size_t texture_count);
+
 /* A full memory barrier: every earlier command's writes before every later command. */
 void sb_renderer_barrier(VkCommandBuffer cmd);
 

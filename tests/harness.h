@@ -5,6 +5,7 @@
 #ifndef SB_TEST_HARNESS_H
 #define SB_TEST_HARNESS_H
 
+#include <stdbool.h>
 #include <stdio.h>
 #include <stdlib.h>
 
@@ -28,6 +29,23 @@ static inline int test_finish(const char *name)
 {
     printf("%s: %d checks, %d failed\n", name, test_checks, test_failures);
     return test_failures ? 1 : 0;
+}
+
+/* A new directory $TMPDIR/name-XXXXXX (/tmp without TMPDIR) in dir[size];
+ * false when it could not be made. */
+static inline bool test_temp_dir(const char *name, char *dir, size_t size)
+{
+    const char *tmp = getenv("TMPDIR");
+    int n = snprintf(dir, size, "%s/%s-XXXXXX", tmp && *tmp ? tmp : "/tmp", name);
+    return n > 0 && (size_t)n < size && mkdtemp(dir) != NULL;
+}
+
+/* Remove a directory test_temp_dir made, with all it holds. */
+static inline bool test_remove_dir(const char *dir)
+{
+    char cmd[4200];
+    int n = snprintf(cmd, sizeof(cmd), "rm -rf '%s'", dir);
+    return n > 0 && (size_t)n < sizeof(cmd) && system(cmd) == 0;
 }
 
 #endif

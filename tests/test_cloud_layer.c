@@ -362,10 +362,8 @@ int main(void)
         return TEST_SKIP;
     if (res)
         return test_finish("cloud layer");
-    const char *tmp = getenv("TMPDIR");
     char dir[256];
-    snprintf(dir, sizeof(dir), "%s/skyview-clouds-XXXXXX", tmp && *tmp ? tmp : "/tmp");
-    CHECK(mkdtemp(dir) != NULL, "temporary directory");
+    CHECK(test_temp_dir("skyview-clouds", dir, sizeof(dir)), "temporary directory");
     char pack_dir[300], world_path[300];
     snprintf(pack_dir, sizeof(pack_dir), "%s/pack", dir);
     snprintf(world_path, sizeof(world_path), "%s/ground.json", dir);
@@ -407,8 +405,6 @@ int main(void)
     sb_vk_destroy(&vk);
     sb_world_finish(&world);
     sb_pack_close(&pack);
-    char cmd[400];
-    snprintf(cmd, sizeof(cmd), "rm -rf '%s'", dir);
-    CHECK(system(cmd) == 0, "clean up");
+    CHECK(test_remove_dir(dir), "clean up");
     return test_finish("cloud layer");
 }

@@ -769,9 +769,7 @@ static void edit_artifact_number(cJSON *r)
 
 static void test_pack_reader(void)
 {
-    const char *tmp = getenv("TMPDIR");
-    snprintf(pack_root, sizeof(pack_root), "%s/skybake-pack-test-%s", tmp && *tmp ? tmp : "/tmp", "XXXXXX");
-    CHECK(mkdtemp(pack_root) != NULL, "temporary directory");
+    CHECK(test_temp_dir("skybake-pack-test", pack_root, sizeof(pack_root)), "temporary directory");
     char good[256], bad[256];
     snprintf(good, sizeof(good), "%s/good", pack_root);
     snprintf(bad, sizeof(bad), "%s/bad", pack_root);
@@ -950,9 +948,7 @@ static void test_pack_reader(void)
     CHECK(refused == prefixes, "%u of %u truncated volumes refused with hash-mismatch", refused, prefixes);
     free(pack);
 
-    char cmd[512];
-    snprintf(cmd, sizeof(cmd), "rm -rf '%s'", pack_root);
-    run(cmd);
+    CHECK(test_remove_dir(pack_root), "clean up %s", pack_root);
 }
 
 /* The codes are a closed set: each has its own name and a description. */
@@ -983,8 +979,8 @@ static void restamp(uint8_t *b, size_t size)
 
 static void test_probes(void)
 {
-    char dir[] = "/tmp/skybake-probes-XXXXXX", path[256];
-    CHECK(mkdtemp(dir) != NULL, "temporary directory");
+    char dir[256], path[300];
+    CHECK(test_temp_dir("skybake-probes", dir, sizeof(dir)), "temporary directory");
     snprintf(path, sizeof(path), "%s/p.sbprobes", dir);
     struct sb_image img = {0}, back;
     const uint32_t n = 2 * 1 * 2 + 1, ch = SB_SKY_VISIBILITY_CHANNEL_COUNT;

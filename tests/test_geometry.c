@@ -530,8 +530,8 @@ static void write_file(const char *path, const char *text)
 
 static void test_hostile(void)
 {
-    char dir[] = "/tmp/skybake-geometry-XXXXXX", path[256];
-    CHECK(mkdtemp(dir) != NULL, "temporary directory");
+    char dir[256], path[300];
+    CHECK(test_temp_dir("skybake-geometry", dir, sizeof(dir)), "temporary directory");
     struct {
         const char *name, *text;
         enum sb_result want;

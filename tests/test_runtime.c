@@ -1027,10 +1027,8 @@ int main(int argc, char **argv)
         return test_finish("runtime");
 
     /* A pack of what skyview reads (irradiance_sky is not needed). */
-    const char *tmp = getenv("TMPDIR");
     char dir[256];
-    snprintf(dir, sizeof(dir), "%s/skyview-test-XXXXXX", tmp && *tmp ? tmp : "/tmp");
-    CHECK(mkdtemp(dir) != NULL, "temporary directory");
+    CHECK(test_temp_dir("skyview-test", dir, sizeof(dir)), "temporary directory");
     char pack_dir[300];
     snprintf(pack_dir, sizeof(pack_dir), "%s/pack", dir);
     struct sb_scene scene = {.name = "runtime test", .preset = "earth"};
@@ -1070,8 +1068,6 @@ int main(int argc, char **argv)
     sb_vk_destroy(&vk);
     sb_world_finish(&world);
     sb_pack_close(&pack);
-    char cmd[400];
-    snprintf(cmd, sizeof(cmd), "rm -rf '%s'", dir);
-    CHECK(system(cmd) == 0, "clean up");
+    CHECK(test_remove_dir(dir), "clean up");
     return test_finish("runtime");
 }
