@@ -13,6 +13,7 @@
 #include "multiscattering.spv.h"
 #include "multiscattering_hillaire.spv.h"
 #include "physics.h"
+#include "sun_columns.spv.h"
 #include "transmittance_gl0.spv.h"
 #include "transmittance_gl1.spv.h"
 #include "transmittance_gl2.spv.h"
@@ -77,6 +78,8 @@ static const struct spirv scattering_shaders[SB_ATMOSPHERE_PRODUCT_COUNT] = {
 };
 /* skybake bench's anchor: Hillaire 2020's multiple-scattering LUT (config.h). */
 static const struct spirv hillaire_multiscattering = SPIRV(multiscattering_hillaire);
+/* The scattering bakes' sun table (atmosphere.glsl). */
+static const struct spirv sun_columns_shader = SPIRV(sun_columns);
 #undef SPIRV
 
 /* A scattering product's setting of the published methods (bench anchors). */
@@ -212,7 +215,8 @@ struct sb_atmosphere_baker {
     struct sb_vk *vk;
     struct sb_buffer params;
     struct sb_buffer dummy;
-    struct sb_buffer scratch; /* sphere.glsl's sums between passes */
+    struct sb_buffer scratch;     /* sphere.glsl's sums between passes */
+    struct sb_buffer sun_columns; /* the scattering bakes' sun table */
     struct sb_buffer outputs[SB_ATMOSPHERE_PRODUCT_COUNT];
     struct sb_buffer lookups[SB_ATMOSPHERE_PRODUCT_COUNT]; /* the form later bakes read (config.h) */
     bool sky_cap; /* irradiance_sky integrates Mie's peak on a cap (sphere.glsl) */
@@ -253,6 +257,7 @@ void sb_atmosphere_baker_destroy(struct sb_atmosphere_baker **pb)
     sb_buffer_destroy(b->vk, &b->params);
     sb_buffer_destroy(b->vk, &b->dummy);
     sb_buffer_destroy(b->vk, &b->scratch);
+    sb_buffer_destroy(b->vk, &b->sun_columns);
     free(b);
     *pb = NULL;
 }
@@ -308,6 +313,7 @@ static enum sb_result run(struct sb_atmosphere_baker *b, const uint32_t *spirv, 
     const struct sb_buffer *bindings[SB_BINDING_COUNT] = {
         [SB_BINDING_OUTPUT] = output,
         [SB_BINDING_SCRATCH] = workgroup_per_texel ? &b->scratch : &b->dummy,
+        [SB_BINDING_SUN_COLUMNS] = b->sun_columns.buffer && output != &b->sun_columns ? &b->sun_columns : &b->dummy,
     };
     sb_atmosphere_bind_inputs(b, bindings);
     for (int i = SB_BINDING_TRANSMITTANCE; i <= SB_BINDING_IRRADIANCE_GROUND; i++)
@@ -336,6 +342,24 @@ static enum sb_result run(struct sb_atmosphere_baker *b, const uint32_t *spirv, 
     if (gpu_ms)
         *gpu_ms = total_ms;
     sb_pipeline_destroy(b->vk, &pipeline);
+    return res;
+}
+
+/* The scattering bakes' sun table (atmosphere.glsl), built before the first
+ * of them reads it; *gpu_ms adds its time. */
+static enum sb_result build_sun_columns(struct sb_atmosphere_baker *b, double *gpu_ms)
+{
+    enum sb_result res = SB_OK;
+    if (!b->sun_columns.buffer &&
+        (res = sb_buffer_create(b->vk, SB_SUN_COLUMNS_FLOATS * sizeof(float), "sun columns", &b->sun_columns)))
+        return res;
+    const struct sb_atmosphere_settings none = {0};
+    double ms = 0;
+    res = run(b, sun_columns_shader.words, sun_columns_shader.size, "sun columns", &b->sun_columns,
+              SB_SUN_COLUMNS_X + 2, 2 * (SB_SUN_COLUMNS_U + 2), 0, false, &none, &ms);
+    if (res)
+        sb_buffer_destroy(b->vk, &b->sun_columns);
+    *gpu_ms += ms;
     return res;
 }
 
@@ -387,8 +411,17 @@ enum sb_result sb_atmosphere_bake(struct sb_atmosphere_baker *b, enum sb_product
             : (anchor ? &hillaire_multiscattering : &scattering_shaders[id]);
     bool cap = id == SB_PRODUCT_IRRADIANCE_GROUND || (id == SB_PRODUCT_IRRADIANCE_SKY && b->sky_cap);
     uint64_t directions = prod->workgroup_per_texel && !anchor ? sphere_directions(&s, cap) : 0;
-    if ((res = run(b, shader->words, shader->size, sb_product_name(id), &b->outputs[id], width, height, directions,
-                   anchor, &s, gpu_ms)))
+    /* The sun table is built afresh by every multiscattering bake, the
+     * first of the scattering products, so that its time counts there. */
+    double table_ms = 0, product_ms = 0;
+    if (directions && (id == SB_PRODUCT_MULTISCATTERING || !b->sun_columns.buffer) &&
+        (res = build_sun_columns(b, &table_ms)))
+        goto cleanup;
+    res = run(b, shader->words, shader->size, sb_product_name(id), &b->outputs[id], width, height, directions, anchor,
+              &s, &product_ms);
+    if (gpu_ms)
+        *gpu_ms = table_ms + product_ms;
+    if (res)
         goto cleanup;
     memcpy(image->data, b->outputs[id].mapped, bytes);
     /* A resolution other than the format's, or an anchor, is a measurement:
@@ -429,6 +462,10 @@ void sb_atmosphere_code_hash(enum sb_product_id id, char out[SB_HASH_HEX_SIZE])
     int count = id == SB_PRODUCT_TRANSMITTANCE ? SB_GL_MAX_ORDER + 1 : 1;
     for (int i = 0; i < count; i++) {
         sb_hash_bytes(shaders[i].words, shaders[i].size, text + n);
+        n += SB_HASH_HEX_SIZE - 1;
+    }
+    if (id != SB_PRODUCT_TRANSMITTANCE) { /* they read the sun table */
+        sb_hash_bytes(sun_columns_shader.words, sun_columns_shader.size, text + n);
         n += SB_HASH_HEX_SIZE - 1;
     }
     snprintf(text + n, sizeof(text) - n, " recipe %d cap %a %a %d", SB_ATMOSPHERE_RECIPE, (double)SB_CAP_MIN_G,
@@ -497,14 +534,16 @@ void sb_atmosphere_settings_json(enum sb_product_id id, const struct sb_atmosphe
                                     "tangent altitude and the sun's mirror"
                                   : "the horizon, two ground depths, the ozone corners, 25 scale heights of "
                                     "tangent altitude, the sun's mirror and the sun";
-    snprintf(out, size,
-             "{\"directions_mu\":%u,\"directions_phi\":%u,"
-             "\"zenith\":\"gauss-legendre per piece, cut at %s\","
-             "\"azimuth\":\"midpoint over [0, pi]%s\","
-             "\"ray_segments\":\"altitude levels, geometric from half the smallest scale height, the shadow "
-             "boundary and the sun grazing the ozone corners\",\"segment_quadrature\":\"gauss-legendre-%d\","
-             "\"sun_transmittance\":\"integrated, at most 40 samples\"%s}",
-             s->directions_mu, s->directions_phi, zenith_cuts,
-             id == SB_PRODUCT_MULTISCATTERING ? "" : ", crowded toward the sun", SB_RAY_GL_ORDER,
-             id == SB_PRODUCT_MULTISCATTERING ? "" : ",\"lut_lookup\":\"catmull-rom of the logarithm\"");
+    snprintf(
+        out, size,
+        "{\"directions_mu\":%u,\"directions_phi\":%u,"
+        "\"zenith\":\"gauss-legendre per piece, cut at %s\","
+        "\"azimuth\":\"midpoint over [0, pi]%s\","
+        "\"ray_segments\":\"altitude levels, geometric from half the smallest scale height, the shadow "
+        "boundary and the sun grazing the ozone corners\",\"segment_quadrature\":\"gauss-legendre-%d\","
+        "\"sun_transmittance\":\"the sun table: Catmull-Rom of Rayleigh and Mie airmasses on %dx%d nodes a region, "
+        "ozone integrated\"%s}",
+        s->directions_mu, s->directions_phi, zenith_cuts,
+        id == SB_PRODUCT_MULTISCATTERING ? "" : ", crowded toward the sun", SB_RAY_GL_ORDER, SB_SUN_COLUMNS_X,
+        SB_SUN_COLUMNS_U, id == SB_PRODUCT_MULTISCATTERING ? "" : ",\"lut_lookup\":\"catmull-rom of the logarithm\"");
 }

@@ -397,22 +397,6 @@ vec3 transmittance_lut_sample(float h, float mu)
     return v;
 }
 
-/* Transmittance toward the sun from altitude h; zero when the planet hides it.
- * The bakes integrate it: bilinear lookups of the 256x64 LUT are off by up to
- * ~1e-2 (more near the horizon), which they cannot afford. The runtime
- * defines SB_SUN_TRANSMITTANCE_LUT and reads the baked LUT, which is what a
- * pack is for. */
-vec3 sun_transmittance(float h, float mu_s)
-{
-    if (ray_hits_ground(h, mu_s))
-        return vec3(0.0);
-#ifdef SB_SUN_TRANSMITTANCE_LUT
-    return transmittance_lut_sample(h, mu_s);
-#else
-    return transmittance_to_top(h, mu_s);
-#endif
-}
-
 /* ---- Multiple-scattering LUT and irradiance LUTs -------------------------------- */
 /*
  * Both use Bruneton's sub-texel mapping: texel i of n sits at x = i / (n - 1),
@@ -525,6 +509,179 @@ const float GL4_S[16] = float[16](
     0.3762362349997362, 0.3260725774312730, -0.0557608572049417, 0.0134710011890763,
     0.3343838439483776, 0.7079060120674879, 0.3260725774312732, -0.0283813898622823,
     0.3549651445090452, 0.6268902294837367, 0.7053535150325437, 0.1739274225687269);
+
+/* ---- The sun's optical depth in the scattering bakes ---------------------------- */
+/*
+ * The scattering bakes need the transmittance toward the sun at every node
+ * of every ray: integrating it there (40 density samples) was most of their
+ * time, and bilinear lookups of the 256x64 LUT are off by up to ~1e-2 near
+ * the horizon, which they cannot afford. So they read a table built for
+ * them (sun_columns.comp), parameterised by the line the sun's ray lies on
+ * rather than by (h, mu), and good to about 1e-5 in optical depth wherever
+ * the sun's light counts (docs/accuracy.md):
+ *
+ * tau = beta_R N_R + beta_M,ext N_M + beta_O N_O, with N the columns of the
+ * three constituents' densities from the point to the top. A line of closest
+ * radius rc = R + hc to the planet's centre, walked from an origin at
+ * altitude hb where its distance to the closest point is sb, is a path of
+ * path_altitude: the closest point itself (hb = hc, sb = 0) when the line
+ * passes above the ground (hc >= 0, the upper region), else the point where
+ * it leaves the ground (hb = 0, sb = g = sqrt(R^2 - rc^2), the lower
+ * region). The table holds N_R / rho_R and N_M / rho_M at nodes t along each
+ * path, normalised by the densities at the node, which leaves smooth
+ * "airmasses" that Catmull-Rom reads to fourth order:
+ * - across paths: x = sqrt(hc / thickness) (upper), x = sqrt(g / R) (lower),
+ *   so that the grazing paths, where the columns change fastest, are
+ *   crowded, and both are even functions of x (the ghost row at x < 0 is the
+ *   mirror of x > 0);
+ * - along a path: u = asinh(t / sigma) / asinh(t_end / sigma), sigma four
+ *   of the smallest scale height, from the origin (u = 0) to the top (1).
+ * A ray that sets off toward the closest point (mu < 0 on an upper line)
+ * has N = 2 N(closest point) - N(its mirror image). Ozone, whose tent kinks,
+ * is integrated exactly instead: Gauss-Legendre 4 on the path's pieces
+ * between the tent's corners, where it is a linear function of the
+ * altitude. Lines that miss the atmosphere are never looked up.
+ */
+#ifndef SB_SUN_TRANSMITTANCE_LUT
+layout(std430, set = 0, binding = SB_BINDING_SUN_COLUMNS) readonly buffer SunColumnsBuffer {
+    vec2 sun_columns[];
+};
+
+float sun_columns_sigma()
+{
+    return 4.0 * min(atm.rayleigh_scattering.w, atm.mie_scattering.w);
+}
+
+/* A line's path as an origin (hb, rb = R + hb, sb) and its length to the top. */
+struct SunPath {
+    float hb, rb, sb, t_end;
+};
+
+/* Upper region: the line whose closest point is at altitude hc >= 0; lower
+ * region: the line leaving the ground at distance g from its closest point. */
+SunPath sun_path(bool lower, float hc_or_g)
+{
+    SunPath p;
+    p.hb = lower ? 0.0 : hc_or_g;
+    p.rb = ground_radius() + p.hb;
+    p.sb = lower ? hc_or_g : 0.0;
+    p.t_end = path_distance_to_level(p.hb, p.sb, atmosphere_thickness());
+    return p;
+}
+
+/* The table's unit coordinate along a path, and its inverse. */
+float sun_columns_u(float t, float t_end)
+{
+    float sigma = sun_columns_sigma();
+    return t_end > 0.0 ? asinh(t / sigma) / asinh(t_end / sigma) : 0.0;
+}
+
+float sun_columns_t(float u, float t_end)
+{
+    float sigma = sun_columns_sigma();
+    return sigma * sinh(u * asinh(t_end / sigma));
+}
+
+/* Index of node (i, j) of region `lower`, ghosts at -1 and X or U. */
+int sun_columns_index(bool lower, int i, int j)
+{
+    return ((lower ? SB_SUN_COLUMNS_X + 2 : 0) + i + 1) * (SB_SUN_COLUMNS_U + 2) + j + 1;
+}
+
+/* Catmull-Rom of the table at unit coordinates (x, u) of a region. */
+vec2 sun_columns_sample(bool lower, float x, float u)
+{
+    float fx = clamp(x, 0.0, 1.0) * float(SB_SUN_COLUMNS_X - 1);
+    float fu = clamp(u, 0.0, 1.0) * float(SB_SUN_COLUMNS_U - 1);
+    int i0 = min(int(fx), SB_SUN_COLUMNS_X - 2), j0 = min(int(fu), SB_SUN_COLUMNS_U - 2);
+    float wx[4], wu[4];
+    catmull_rom(fx - float(i0), wx);
+    catmull_rom(fu - float(j0), wu);
+    vec2 sum = vec2(0.0);
+    for (int a = 0; a < 4; a++) {
+        vec2 row = vec2(0.0);
+        for (int b = 0; b < 4; b++)
+            row += wu[b] * sun_columns[sun_columns_index(lower, i0 - 1 + a, j0 - 1 + b)];
+        sum += wx[a] * row;
+    }
+    return sum;
+}
+
+/* Rayleigh and Mie densities relative to the ground's. */
+vec2 sun_columns_density(float h)
+{
+    return exp(-h / vec2(atm.rayleigh_scattering.w, atm.mie_scattering.w));
+}
+
+/* The ozone column of a path from t0 to its top: Gauss-Legendre 4 on the
+ * pieces between the tent's corners, where the density is linear in the
+ * altitude. */
+float sun_ozone_column(SunPath p, float t0)
+{
+    float centre = atm.ozone_absorption.w, half_width = atm.ground_albedo.w;
+    float sum = 0.0, a = t0;
+    for (int k = -1; k <= 2; k++) {
+        float level = centre + float(k) * half_width, b = p.t_end;
+        if (k < 2 && level < atmosphere_thickness())
+            b = level > p.hb ? min(path_distance_to_level(p.hb, p.sb, level), p.t_end) : a;
+        if (b <= a)
+            continue;
+        float half_len = 0.5 * (b - a), mid = 0.5 * (a + b), piece = 0.0;
+        for (int i = 0; i < 4; i++)
+            piece += GL4_W[i] * ozone_density(path_altitude(p.hb, p.rb, p.sb, mid + half_len * GL4_X[i]));
+        sum += piece * half_len;
+        a = b;
+    }
+    return sum;
+}
+
+/* Optical depth toward the sun from altitude h along cosine mu, for a ray
+ * that does not hit the ground, from the table. */
+vec3 sun_optical_depth(float h, float mu)
+{
+    float R = ground_radius(), r = R + h, s = r * mu;
+    float sin_v = sqrt(max(1.0 - mu * mu, 0.0));
+    /* hc = r sin - R without cancelling; a ray setting off downward that
+     * rounding puts under the ground grazes it */
+    float hc = (h * (2.0 * R + h) - s * s) / (r * sin_v + R);
+    vec2 n;
+    float ozone;
+    if (hc >= 0.0 || s < 0.0) {
+        hc = max(hc, 0.0);
+        SunPath p = sun_path(false, hc);
+        float x = sqrt(hc / atmosphere_thickness()), t = abs(s);
+        n = sun_columns_sample(false, x, sun_columns_u(t, p.t_end)) * sun_columns_density(h);
+        ozone = sun_ozone_column(p, t);
+        if (s < 0.0) {
+            n = 2.0 * sun_columns_sample(false, x, 0.0) * sun_columns_density(hc) - n;
+            ozone = 2.0 * sun_ozone_column(p, 0.0) - ozone;
+        }
+    } else {
+        float g = sqrt(-hc * (2.0 * R + hc)); /* sqrt(R^2 - rc^2) */
+        SunPath p = sun_path(true, g);
+        float t = h * (2.0 * R + h) / (s + g); /* s - g without cancelling */
+        n = sun_columns_sample(true, sqrt(g / R), sun_columns_u(t, p.t_end)) * sun_columns_density(h);
+        ozone = sun_ozone_column(p, t);
+    }
+    return atm.rayleigh_scattering.rgb * max(n.x, 0.0) + atm.mie_extinction.rgb * max(n.y, 0.0)
+         + atm.ozone_absorption.rgb * max(ozone, 0.0);
+}
+
+#endif /* !SB_SUN_TRANSMITTANCE_LUT */
+
+/* Transmittance toward the sun from altitude h; zero when the planet hides
+ * it. The runtime defines SB_SUN_TRANSMITTANCE_LUT and reads the baked LUT,
+ * which is what a pack is for; the bakes read their own table (above). */
+vec3 sun_transmittance(float h, float mu_s)
+{
+    if (ray_hits_ground(h, mu_s))
+        return vec3(0.0);
+#ifdef SB_SUN_TRANSMITTANCE_LUT
+    return transmittance_lut_sample(h, mu_s);
+#else
+    return exp(-sun_optical_depth(h, mu_s));
+#endif
+}
 
 float level_at(int i)
 {

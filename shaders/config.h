@@ -47,7 +47,7 @@
 #define SB_CAP_MIN_G 0.85
 #define SB_SPHERE_CAP_PIECES 6
 
-/* Every atmosphere bake pipeline has the same descriptor set layout: six
+/* Every atmosphere bake pipeline has the same descriptor set layout: seven
  * storage buffers. Inputs a product does not read are bound to a dummy.
  * Transmittance is bound as baked; multiscattering and irradiance_ground
  * in their lookup form (physics.h): ln(max(psi, 1e-30)) per texel and
@@ -59,7 +59,15 @@
 #define SB_BINDING_IRRADIANCE_GROUND 3
 #define SB_BINDING_OUTPUT 4
 #define SB_BINDING_SCRATCH 5 /* sphere.glsl's partial sums between passes */
-#define SB_BINDING_COUNT 6
+#define SB_BINDING_SUN_COLUMNS 6 /* the scattering bakes' sun table (sun_columns.comp) */
+#define SB_BINDING_COUNT 7
+
+/* The sun table of the scattering bakes (atmosphere.glsl, "The sun's optical
+ * depth"): two regions of SB_SUN_COLUMNS_X x SB_SUN_COLUMNS_U nodes, each
+ * with a ghost node on every side, of two floats (Rayleigh, Mie). */
+#define SB_SUN_COLUMNS_X 128
+#define SB_SUN_COLUMNS_U 64
+#define SB_SUN_COLUMNS_FLOATS (2 * (SB_SUN_COLUMNS_X + 2) * (SB_SUN_COLUMNS_U + 2) * 2)
 
 /* Product sizes and channel counts of format version 1. */
 #define SB_TRANSMITTANCE_WIDTH 256

@@ -3,7 +3,8 @@
  * Evaluates the shared GLSL model at given points so tests can hold each
  * function against the fp64 reference (see sb_atmosphere_run_kernel).
  * One record of SB_PROBE_FLOATS floats per invocation, read then overwritten:
- *   in:  [0] h, [1] mu, [2] x_mu, [3] x_r, [4..5] a multiscattering texel, [6..7] an irradiance texel
+ *   in:  [0] h, [1] mu, [2] x_mu, [3] x_r, [4..5] a multiscattering texel, [6..7] an irradiance texel,
+ *        [16] h, [17] mu of a ray toward the sun
  *   out: [0..2]  transmittance_to_top(h, mu) (the exact quadrature)
  *        [3..5]  transmittance_lut_sample(h, mu)
  *        [6..7]  transmittance_unit_coords(h, mu)
@@ -11,12 +12,13 @@
  *        [10..11] transmittance_unit_coords(h', mu')
  *        [12..13] subtexel_coords(subtexel_geometry(ms texel, 32x32))
  *        [14..15] subtexel_coords(subtexel_geometry(irradiance texel, 64x16))
+ *        [16..18] sun_transmittance(h, mu) of [16..17], from the bakes' sun table
  */
 #extension GL_GOOGLE_include_directive : require
 #include "config.h"
 #include "atmosphere.glsl"
 
-#define SB_PROBE_FLOATS 16
+#define SB_PROBE_FLOATS 20
 
 layout(local_size_x = SB_WORKGROUP_X, local_size_y = SB_WORKGROUP_Y) in;
 layout(std430, set = 0, binding = SB_BINDING_OUTPUT) buffer Records { float records[]; };
@@ -32,6 +34,8 @@ void main()
     vec2 x = vec2(records[base + 2u], records[base + 3u]);
     uvec2 ms_texel = uvec2(records[base + 4u], records[base + 5u]);
     uvec2 irr_texel = uvec2(records[base + 6u], records[base + 7u]);
+
+    vec3 sun = sun_transmittance(records[base + 16u], records[base + 17u]);
 
     float out_[SB_PROBE_FLOATS];
     vec3 exact = transmittance_to_top(h, mu);
@@ -53,6 +57,7 @@ void main()
     out_[10] = back.x; out_[11] = back.y;
     out_[12] = ms_back.x; out_[13] = ms_back.y;
     out_[14] = irr_back.x; out_[15] = irr_back.y;
+    out_[16] = sun.r; out_[17] = sun.g; out_[18] = sun.b; out_[19] = 0.0;
     for (uint i = 0u; i < SB_PROBE_FLOATS; i++)
         records[base + i] = out_[i];
 }
