@@ -268,7 +268,8 @@ void sb_atmosphere_baker_destroy(struct sb_atmosphere_baker **pb)
  * runs SB_WORKGROUP_X x SB_WORKGROUP_Y texels a workgroup in one dispatch,
  * or, for sphere.glsl's integrals over at most `directions` directions
  * (else 0), one workgroup per texel in passes of
- * SB_SPHERE_STEPS_PER_PASS directions per invocation, the partial sums kept
+ * SB_SPHERE_STEPS_PER_PASS directions per invocation on a CPU device (one
+ * pass on a GPU), the partial sums kept
  * in the scratch buffer; *gpu_ms sums the passes.
  */
 static enum sb_result run(struct sb_atmosphere_baker *b, const uint32_t *spirv, size_t spirv_size, const char *name,
@@ -324,11 +325,13 @@ static enum sb_result run(struct sb_atmosphere_baker *b, const uint32_t *spirv, 
     uint32_t groups_x = group_per_texel ? width : (width + SB_WORKGROUP_X - 1) / SB_WORKGROUP_X;
     uint32_t groups_y = group_per_texel ? height : (height + SB_WORKGROUP_Y - 1) / SB_WORKGROUP_Y;
     double total_ms = 0;
-    for (uint32_t step = 0; step < push.step_count && !res; step += SB_SPHERE_STEPS_PER_PASS) {
+    /* Passes exist for llvmpipe's loop limiter; a GPU takes all the steps
+     * in one dispatch (the sums are the same: sphere.glsl). */
+    uint32_t per_pass =
+        b->vk->properties.deviceType == VK_PHYSICAL_DEVICE_TYPE_CPU ? SB_SPHERE_STEPS_PER_PASS : push.step_count;
+    for (uint32_t step = 0; step < push.step_count && !res; step += per_pass) {
         push.step_begin = step;
-        push.step_end = workgroup_per_texel && push.step_count - step > SB_SPHERE_STEPS_PER_PASS
-                            ? step + SB_SPHERE_STEPS_PER_PASS
-                            : push.step_count;
+        push.step_end = workgroup_per_texel && push.step_count - step > per_pass ? step + per_pass : push.step_count;
         double ms = 0;
         res = sb_dispatch(b->vk, &pipeline, &push, groups_x, groups_y, 1, &ms);
         total_ms += ms;

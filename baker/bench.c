@@ -16,6 +16,7 @@
 
 #include "json.h"
 #include "log.h"
+#include "warm_up.spv.h"
 
 #define HILLAIRE "Hillaire 2020 (40-step march, offset 0.3)"
 #define BRUNETON "Bruneton 2017 (500-step trapezoid)"
@@ -260,6 +261,51 @@ static enum sb_result bench_clouds(struct sb_vk *vk, const struct sb_bench_param
     return res;
 }
 
+/*
+ * A GPU idles at its lowest clocks between bakes (an H100 at 345 of 1980
+ * MHz), and a bake of a few milliseconds ends before they rise, so its time
+ * says more about the clock governor than about the kernel. Before timing a
+ * setting, keep the GPU busy for SB_BENCH_WARM_UP_MS (docs/accuracy.md).
+ * Nothing to do on a CPU device.
+ */
+#define SB_BENCH_WARM_UP_MS 200.0
+
+static enum sb_result warm_up(struct sb_vk *vk)
+{
+    if (vk->properties.deviceType == VK_PHYSICAL_DEVICE_TYPE_CPU || !vk->has_timestamps)
+        return SB_OK;
+    enum { GROUPS = 4096 };
+    struct sb_buffer out = {0};
+    struct sb_pipeline pipeline = {0};
+    struct sb_pipeline_params pp = {
+        .spirv = sb_spv_warm_up,
+        .spirv_size = sizeof(sb_spv_warm_up),
+        .binding_count = 1,
+        .push_size = sizeof(uint32_t),
+        .name = "warm up",
+    };
+    enum sb_result res = sb_buffer_create(vk, GROUPS * 64 * sizeof(float), "warm up", &out);
+    if (!res)
+        res = sb_pipeline_create(vk, &pp, &pipeline);
+    if (!res) {
+        const struct sb_buffer *bindings[1] = {&out};
+        sb_pipeline_bind(vk, &pipeline, bindings);
+    }
+    /* Dispatches of about 10 ms, their length scaled from the last one. */
+    uint32_t rounds = 1024;
+    double busy = 0;
+    for (int n = 0; !res && busy < SB_BENCH_WARM_UP_MS && n < 256; n++) {
+        double ms = 0;
+        res = sb_dispatch(vk, &pipeline, &rounds, GROUPS, 1, 1, &ms);
+        busy += ms;
+        double scale = ms > 0 ? 10.0 / ms : 16.0;
+        rounds = (uint32_t)fmin(fmax(rounds * fmin(scale, 16.0), 1.0), 1e7);
+    }
+    sb_pipeline_destroy(vk, &pipeline);
+    sb_buffer_destroy(vk, &out);
+    return res;
+}
+
 enum sb_result sb_bench_run(struct sb_vk *vk, const struct sb_atmosphere_params *atmosphere,
                             const struct sb_bench_params *params, struct sb_bench_report *report)
 {
@@ -309,7 +355,8 @@ enum sb_result sb_bench_run(struct sb_vk *vk, const struct sb_atmosphere_params 
             row->anchor = entry->anchor;
             row->cost = sb_atmosphere_settings_cost(id, &entry->settings);
             sb_atmosphere_settings_label(id, &entry->settings, row->label, sizeof(row->label));
-            /* one untimed bake first when timing repeats: pipeline caches and GPU clocks settle */
+            /* one untimed bake first when timing repeats: pipeline caches settle */
+            res = warm_up(vk);
             for (int k = repeat >= 3 ? -1 : 0; k < repeat && !res; k++) {
                 double ms;
                 sb_image_finish(&image);
@@ -452,8 +499,11 @@ void sb_bench_print(const struct sb_bench_report *report, const struct sb_vk *vk
         sb_json_emit(stdout, report_json(report, vk));
         return;
     }
-    printf("skybake bench on %s (%s); GPU time is the median of the repeats\n", vk->properties.deviceName,
+    printf("skybake bench on %s (%s); GPU time is the median of the repeats", vk->properties.deviceName,
            vk->driver_name);
+    if (vk->properties.deviceType != VK_PHYSICAL_DEVICE_TYPE_CPU)
+        printf(", each setting after %.0f ms of warm-up", SB_BENCH_WARM_UP_MS);
+    printf("\n");
     printf("P: on the Pareto front; *: skybake's default\n");
     for (int w = 0; w < SB_BENCH_SWEEP_COUNT; w++) {
         if (!report->probe[w][0])
