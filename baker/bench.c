@@ -187,12 +187,6 @@ static double now_s(void)
     return ts.tv_sec + ts.tv_nsec * 1e-9;
 }
 
-static int compare_doubles(const void *a, const void *b)
-{
-    double x = *(const double *)a, y = *(const double *)b;
-    return x < y ? -1 : x > y;
-}
-
 /* Rows on the Pareto front of their sweep: no other row is as fast or faster
  * and strictly more accurate, or strictly faster and as accurate. */
 static void mark_pareto(struct sb_bench_row *rows, int count)
@@ -224,6 +218,7 @@ static enum sb_result bench_clouds(struct sb_vk *vk, const struct sb_bench_param
         struct sb_bench_cloud_row *row = &report->cloud_rows[report->cloud_row_count++];
         row->product = id;
         struct sb_image image = {0};
+        res = sb_bench_warm_up(vk);
         /* one untimed bake first when timing repeats, as for the atmosphere */
         for (int k = repeat >= 3 ? -1 : 0; k < repeat && !res; k++) {
             double ms;
@@ -232,8 +227,7 @@ static enum sb_result bench_clouds(struct sb_vk *vk, const struct sb_bench_param
         }
         if (res)
             break;
-        qsort(times, (size_t)repeat, sizeof(double), compare_doubles);
-        row->gpu_ms = times[repeat / 2];
+        row->gpu_ms = sb_bench_median(times, repeat); /* sorts them */
         row->gpu_ms_min = times[0];
         row->shape[0] = image.width;
         row->shape[1] = image.height;
@@ -261,16 +255,7 @@ static enum sb_result bench_clouds(struct sb_vk *vk, const struct sb_bench_param
     return res;
 }
 
-/*
- * A GPU idles at its lowest clocks between bakes (an H100 at 345 of 1980
- * MHz), and a bake of a few milliseconds ends before they rise, so its time
- * says more about the clock governor than about the kernel. Before timing a
- * setting, keep the GPU busy for SB_BENCH_WARM_UP_MS (docs/accuracy.md).
- * Nothing to do on a CPU device.
- */
-#define SB_BENCH_WARM_UP_MS 200.0
-
-static enum sb_result warm_up(struct sb_vk *vk)
+enum sb_result sb_bench_warm_up(struct sb_vk *vk)
 {
     if (vk->properties.deviceType == VK_PHYSICAL_DEVICE_TYPE_CPU || !vk->has_timestamps)
         return SB_OK;
@@ -355,8 +340,8 @@ enum sb_result sb_bench_run(struct sb_vk *vk, const struct sb_atmosphere_params 
             row->anchor = entry->anchor;
             row->cost = sb_atmosphere_settings_cost(id, &entry->settings);
             sb_atmosphere_settings_label(id, &entry->settings, row->label, sizeof(row->label));
+            res = sb_bench_warm_up(vk);
             /* one untimed bake first when timing repeats: pipeline caches settle */
-            res = warm_up(vk);
             for (int k = repeat >= 3 ? -1 : 0; k < repeat && !res; k++) {
                 double ms;
                 sb_image_finish(&image);
@@ -369,8 +354,7 @@ enum sb_result sb_bench_run(struct sb_vk *vk, const struct sb_atmosphere_params 
             if (at_format.width == format->width && at_format.height == format->height)
                 at_format.width = at_format.height = 0;
             row->is_default = same_settings(id, &at_format, &product->defaults);
-            qsort(times, (size_t)repeat, sizeof(double), compare_doubles);
-            row->gpu_ms = times[repeat / 2];
+            row->gpu_ms = sb_bench_median(times, repeat); /* sorts them */
             row->gpu_ms_min = times[0];
             sb_accuracy_measure(ref, &image, false, &row->error);
             sb_accuracy_measure(ref, &image, true, &row->error_half);

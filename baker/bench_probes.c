@@ -109,6 +109,7 @@ static enum sb_result bench_one(struct sb_vk *vk, const char *name, struct sb_me
         res = SB_ERR_NOMEM;
         goto done;
     }
+    res = sb_bench_warm_up(vk);
     for (int k = repeat >= 3 ? -1 : 0; k < repeat && !res; k++) {
         double ms, bms = 0;
         res = sb_sky_visibility_bake(rc, positions, count, &params, out, &ms);

@@ -85,6 +85,8 @@ static void usage(FILE *f)
                "(default: all). -o DIR writes bench.csv, bench.json, bench.svg (gnuplot),\n"
                "bench_clouds.csv, bench_probes.csv, bench_reflection.csv.\n"
                "--repeat N bakes each setting N times (default 3) and reports the median;\n"
+               "on a GPU each setting is timed after 200 ms of warm-up, so that its clocks\n"
+               "are up (docs/accuracy.md, \"GPU clocks\");\n"
                "--quick runs a short sweep (the meson benchmark).\n"
                "\n"
                "sky-error: the sky as the runtime computes it from a default bake, against\n"
@@ -452,7 +454,7 @@ static bool pack_args(int argc, char **argv, const char *command, const char **d
     }
     if (n < count) {
         fprintf(stderr, "skybake: %s needs %s\n", command,
-                count == 1                ? "a PACK"
+                count == 1                 ? "a PACK"
                 : !strcmp(command, "diff") ? "two packs, A and B"
                                            : "a PACK and an OUT.png");
         return false;

@@ -874,12 +874,13 @@ static void fill_frame(struct sb_renderer *r, const struct sb_view *v, struct sb
             clear[k] = box[k] - 5 > 0 ? box[k] - 5 : 0;
             clear[k + 2] = box[k + 2] + 5 < size ? box[k + 2] + 5 : size;
         }
-        if (box[0] >= box[2]) /* no casters: nothing to draw, every lookup lit */
+        if (box[0] >= box[2]) { /* no casters: nothing to draw, every lookup lit */
             clear[0] = clear[1] = clear[2] = clear[3] = 0;
-        store4(f->cascade_rect[c], (box[0] - 2.0) / size, (box[1] - 2.0) / size, (box[2] + 2.0) / size,
-               (box[3] + 2.0) / size);
-        if (box[0] >= box[2])
             store4(f->cascade_rect[c], 2.0, 2.0, -1.0, -1.0);
+        } else {
+            store4(f->cascade_rect[c], (box[0] - 2.0) / size, (box[1] - 2.0) / size, (box[2] + 2.0) / size,
+                   (box[3] + 2.0) / size);
+        }
     }
 
     const double R = r->ground_radius_km;

@@ -67,7 +67,10 @@ unsigned sb_caster_boxes(const struct sb_vertex_gpu *vertices, uint32_t first, u
     *out = NULL;
     *failed = false;
     uint32_t triangles = end > first ? (end - first) / 3 : 0;
-    unsigned count = (triangles + SB_CASTER_RUN - 1) / SB_CASTER_RUN;
+    uint32_t run = SB_CASTER_RUN;
+    if (triangles > (uint32_t)SB_CASTER_RUN * SB_CASTER_MAX_BOXES)
+        run = (triangles + SB_CASTER_MAX_BOXES - 1) / SB_CASTER_MAX_BOXES;
+    unsigned count = (triangles + run - 1) / run;
     if (!count)
         return 0;
     struct sb_caster_box *boxes = malloc(count * sizeof(*boxes));
@@ -76,7 +79,7 @@ unsigned sb_caster_boxes(const struct sb_vertex_gpu *vertices, uint32_t first, u
         return 0;
     }
     for (unsigned b = 0; b < count; b++) {
-        uint32_t v0 = first + 3 * SB_CASTER_RUN * b, v1 = v0 + 3 * SB_CASTER_RUN;
+        uint32_t v0 = first + 3 * run * b, v1 = v0 + 3 * run;
         if (v1 > first + 3 * triangles)
             v1 = first + 3 * triangles;
         for (int k = 0; k < 3; k++) {

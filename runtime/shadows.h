@@ -45,9 +45,12 @@ void sb_cascades_compute(const struct sb_cascade_params *params, const double ca
  * frame of a few hundred triangles rarely covers a tenth of them, and the
  * rest would hold the clear value. The casters are kept as boxes around runs
  * of SB_CASTER_RUN triangles (in the world's order, so a run is mostly one
- * object), projected each frame.
+ * object), projected each frame; in a world of more than SB_CASTER_MAX_BOXES
+ * runs the runs grow, so that the frame's 4 x 8 corners a box stay a bounded
+ * cost (a million triangles would otherwise be a million projections).
  */
 #define SB_CASTER_RUN 32
+#define SB_CASTER_MAX_BOXES 1024
 
 struct sb_caster_box {
     double min[3], max[3]; /* world, m */

@@ -31,8 +31,9 @@ static inline int test_finish(const char *name)
     return test_failures ? 1 : 0;
 }
 
-/* A new directory $TMPDIR/name-XXXXXX (/tmp without TMPDIR) in dir[size];
- * false when it could not be made. */
+/* A new directory under $TMPDIR (/tmp without TMPDIR), named `name`, a dash
+ * and six characters mkdtemp picks, in dir[size]; false when it could not
+ * be made. */
 static inline bool test_temp_dir(const char *name, char *dir, size_t size)
 {
     const char *tmp = getenv("TMPDIR");

@@ -196,6 +196,46 @@ static void test_shadows(struct sb_renderer *r)
     free(rgb);
 }
 
+/* A world of many triangles gets at most SB_CASTER_MAX_BOXES boxes, and
+ * every caster vertex lies in the box of its triangle's run: triangle t is
+ * placed at x = t, so the boxes are disjoint in x and in order. */
+static void test_caster_boxes_bounded(void)
+{
+    const uint32_t triangles = 100003, first = 6;
+    struct sb_vertex_gpu *v = calloc((size_t)(first + 3 * triangles), sizeof(*v));
+    CHECK(v != NULL, "memory");
+    if (!v)
+        return;
+    uint32_t state = 12345;
+    for (uint32_t i = first; i < first + 3 * triangles; i++) {
+        state = state * 1664525u + 1013904223u;
+        v[i].position[0] = (float)((i - first) / 3);
+        v[i].position[1] = (float)(state >> 8) / 16777216.0f * 50.0f;
+        v[i].position[2] = (float)(i % 7) - 3.0f;
+    }
+    struct sb_caster_box *boxes;
+    bool failed;
+    unsigned count = sb_caster_boxes(v, first, first + 3 * triangles, &boxes, &failed);
+    CHECK(!failed && count > 0 && count <= SB_CASTER_MAX_BOXES, "%u boxes for %u triangles (at most %d)", count,
+          triangles, SB_CASTER_MAX_BOXES);
+    int outside = 0;
+    for (uint32_t i = first; i < first + 3 * triangles && count; i++) {
+        unsigned lo = 0, hi = count - 1; /* the last box whose min x <= x */
+        while (lo < hi) {
+            unsigned mid = (lo + hi + 1) / 2;
+            if (boxes[mid].min[0] <= v[i].position[0])
+                lo = mid;
+            else
+                hi = mid - 1;
+        }
+        for (int k = 0; k < 3; k++)
+            outside += v[i].position[k] < boxes[lo].min[k] || v[i].position[k] > boxes[lo].max[k];
+    }
+    CHECK(outside == 0, "%d vertex coordinates outside their run's box", outside);
+    free(boxes);
+    free(v);
+}
+
 /* Each cascade is cleared and drawn only where the casters project
  * (runtime/shadows.h): the texel box holds every caster vertex's texel with
  * a margin, is smaller than the map where the casters are few, and the
@@ -1048,6 +1088,7 @@ int main(int argc, char **argv)
         test_sky_colours(r);
         test_shadows(r);
         test_shadow_boxes(r, &rp);
+        test_caster_boxes_bounded();
         test_exposure(r);
         /* Against a reference that reads the sun's transmittance from the
          * baked LUT as the runtime does, so the LUT's own error (reported)
