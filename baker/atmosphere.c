@@ -226,6 +226,12 @@ enum sb_result sb_atmosphere_baker_create(struct sb_vk *vk, const struct sb_atmo
                                           struct sb_atmosphere_baker **out)
 {
     *out = NULL;
+    uint32_t shared = vk->properties.limits.maxComputeSharedMemorySize;
+    if (shared < SB_SPHERE_SHARED_BYTES) {
+        sb_error("%s offers %u bytes of workgroup memory; the scattering bakes need %u", vk->properties.deviceName,
+                 shared, (unsigned)SB_SPHERE_SHARED_BYTES);
+        return SB_ERR_DEVICE_LIMIT;
+    }
     struct sb_atmosphere_baker *b = calloc(1, sizeof(*b));
     if (!b)
         return SB_ERR_NOMEM;

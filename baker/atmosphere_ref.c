@@ -273,6 +273,12 @@ static void lut_log_cubic(const struct sb_image *lut, double x_u, double x_v, ui
     }
 }
 
+void sb_ref_multiscattering_lookup(const struct sb_atmosphere_params *p, const struct sb_image *lut, double h,
+                                   double mu_s, double out[3])
+{
+    lut_log_cubic(lut, mu_s * 0.5 + 0.5, h / (p->top_radius_km - p->ground_radius_km), 0, out);
+}
+
 /* ---- Scattering along a ray ------------------------------------------------- */
 
 struct ray_sums {

@@ -50,6 +50,11 @@ void sb_ref_transmittance_coords(const struct sb_atmosphere_params *p, double r,
 void sb_ref_transmittance_lookup(const struct sb_atmosphere_params *p, const struct sb_image *lut, double r, double mu,
                                  double out[3]);
 
+/* The shaders' lookup of a multiscattering LUT at altitude h (km) with sun
+ * cosine mu_s: Catmull-Rom of its logarithm, the edges repeated. */
+void sb_ref_multiscattering_lookup(const struct sb_atmosphere_params *p, const struct sb_image *lut, double h,
+                                   double mu_s, double out[3]);
+
 /* Hillaire's psi_ms at altitude h (km) with sun cosine mu_s (see multiscattering.comp). */
 void sb_ref_multiscattering(const struct sb_atmosphere_params *p, double h, double mu_s, const struct sb_ref_quality *q,
                             double out[3]);

@@ -39,6 +39,13 @@
 #define SB_MAX_DIRECTIONS_MU 64
 #define SB_MAX_DIRECTIONS_PHI 256
 #define SB_SPHERE_MAX_PIECES 10
+/* Workgroup memory of the largest sphere bake (irradiance_sky: the
+ * quadrature's nodes, the partial sums and the multiscattering LUT's copy),
+ * in bytes: more than the 16 KiB every device offers, less than the 32 KiB
+ * of llvmpipe and every desktop GPU; the baker checks the device's limit. */
+#define SB_SPHERE_SHARED_BYTES                                                                             \
+    (4 * (2 * SB_MAX_DIRECTIONS_MU + 2 * SB_MAX_DIRECTIONS_PHI + SB_SPHERE_THREADS * SB_SPHERE_MAX_SUMS) \
+     + 16 * SB_MULTISCATTERING_LOOKUP_TEXELS)
 /* Mie single scattering's cap around its peak (sphere.glsl): over the whole
  * sphere, for |g| >= SB_CAP_MIN_G, radius SB_CAP_THETA (radians), the
  * window falling to 0 at twice that; up to three rings' pieces times two
@@ -75,6 +82,9 @@
 #define SB_TRANSMITTANCE_CHANNELS 3
 #define SB_MULTISCATTERING_SIZE 32
 #define SB_MULTISCATTERING_CHANNELS 3
+/* The multiscattering LUT's lookup form (physics.h): its texels with a ghost
+ * texel on every side, four floats each. */
+#define SB_MULTISCATTERING_LOOKUP_TEXELS ((SB_MULTISCATTERING_SIZE + 2) * (SB_MULTISCATTERING_SIZE + 2))
 #define SB_IRRADIANCE_WIDTH 64
 #define SB_IRRADIANCE_HEIGHT 16
 #define SB_IRRADIANCE_GROUND_CHANNELS 6 /* direct.rgb, sky.rgb */

@@ -53,7 +53,7 @@ size_t sb_lookup_float_count(enum sb_product_id id)
 {
     switch (id) {
     case SB_PRODUCT_MULTISCATTERING:
-        return (size_t)SB_MULTISCATTERING_SIZE * SB_MULTISCATTERING_SIZE * 3;
+        return (size_t)SB_MULTISCATTERING_LOOKUP_TEXELS * 4;
     case SB_PRODUCT_IRRADIANCE_GROUND:
         return (size_t)2 * SB_IRRADIANCE_WIDTH * 3;
     default:
@@ -69,9 +69,15 @@ static float log_floor(double v)
 void sb_lookup_fill(enum sb_product_id id, const struct sb_image *image, float *dst)
 {
     if (id == SB_PRODUCT_MULTISCATTERING) {
-        size_t n = (size_t)image->width * image->height * 3;
-        for (size_t i = 0; i < n; i++)
-            dst[i] = log_floor(image->data[i]);
+        int n = SB_MULTISCATTERING_SIZE;
+        for (int j = -1; j <= n; j++)
+            for (int i = -1; i <= n; i++) {
+                int sj = j < 0 ? 0 : (j < n ? j : n - 1), si = i < 0 ? 0 : (i < n ? i : n - 1);
+                float *texel = dst + ((size_t)(j + 1) * (n + 2) + (size_t)(i + 1)) * 4;
+                for (int c = 0; c < 3; c++)
+                    texel[c] = log_floor(image->data[((size_t)sj * n + si) * 3 + c]);
+                texel[3] = 0.0f;
+            }
     } else if (id == SB_PRODUCT_IRRADIANCE_GROUND) {
         /* Row 0 of the image is the ground, h = 0. */
         for (uint32_t x = 0; x < image->width; x++) {

@@ -29,7 +29,10 @@ int sb_atmosphere_levels(const struct sb_atmosphere_params *params, double level
 
 /*
  * The lookup form of a baked product (config.h), which shaders read:
- * - multiscattering: ln(max(psi, 1e-30)) per texel and channel;
+ * - multiscattering: ln(max(psi, 1e-30)) per texel and channel, padded to
+ *   four floats a texel (the fourth 0), with a ghost texel on every side
+ *   repeating the edge (SB_MULTISCATTERING_LOOKUP_TEXELS texels, rows of
+ *   SB_MULTISCATTERING_SIZE + 2 from mu_s = -1 and h = 0);
  * - irradiance_ground: two rows of SB_IRRADIANCE_WIDTH x 3 floats taken from
  *   the ground row (h = 0), ln(max(direct + sky, 1e-30)) then
  *   ln(max(sky, 1e-30));

@@ -158,7 +158,9 @@ SpherePieces sphere_pieces(float h, bool whole_sphere, float mu_s, bool peaked)
 }
 
 /* Gauss-Legendre nodes and weights, ascending: n_mu on [-1, 1] and, with
- * `cap`, n_phi on [0, 1]; every invocation of the workgroup must call it. */
+ * `cap`, n_phi on [0, 1], and the workgroup's copy of the multiscattering
+ * LUT where the shader asked for one (atmosphere.glsl); every invocation of
+ * the workgroup must call it. */
 void sphere_init(uint n_mu, uint n_phi, bool cap)
 {
     uint i = gl_LocalInvocationIndex;
@@ -168,6 +170,10 @@ void sphere_init(uint n_mu, uint n_phi, bool cap)
         sphere_node[i] = x;
         sphere_weight[i] = w;
     }
+#ifdef SB_MULTISCATTERING_SHARED
+    for (uint k = i; k < uint(SB_MULTISCATTERING_LOOKUP_TEXELS); k += SB_SPHERE_THREADS)
+        multiscattering_shared[k] = multiscattering_log[k];
+#endif
     for (uint k = i; cap && k < n_phi; k += SB_SPHERE_THREADS) {
         float x, w;
         gauss_legendre(int(k), int(n_phi), 0.0, 1.0, x, w);

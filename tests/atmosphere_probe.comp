@@ -4,7 +4,7 @@
  * function against the fp64 reference (see sb_atmosphere_run_kernel).
  * One record of SB_PROBE_FLOATS floats per invocation, read then overwritten:
  *   in:  [0] h, [1] mu, [2] x_mu, [3] x_r, [4..5] a multiscattering texel, [6..7] an irradiance texel,
- *        [16] h, [17] mu of a ray toward the sun
+ *        [16] h, [17] mu of a ray toward the sun, [20] h, [21] mu_s of a multiscattering lookup
  *   out: [0..2]  transmittance_to_top(h, mu) (the exact quadrature)
  *        [3..5]  transmittance_lut_sample(h, mu)
  *        [6..7]  transmittance_unit_coords(h, mu)
@@ -13,12 +13,13 @@
  *        [12..13] subtexel_coords(subtexel_geometry(ms texel, 32x32))
  *        [14..15] subtexel_coords(subtexel_geometry(irradiance texel, 64x16))
  *        [16..18] sun_transmittance(h, mu) of [16..17], from the bakes' sun table
+ *        [20..22] multiscattering_lut_sample(h, mu_s) of [20..21]
  */
 #extension GL_GOOGLE_include_directive : require
 #include "config.h"
 #include "atmosphere.glsl"
 
-#define SB_PROBE_FLOATS 20
+#define SB_PROBE_FLOATS 24
 
 layout(local_size_x = SB_WORKGROUP_X, local_size_y = SB_WORKGROUP_Y) in;
 layout(std430, set = 0, binding = SB_BINDING_OUTPUT) buffer Records { float records[]; };
@@ -36,6 +37,7 @@ void main()
     uvec2 irr_texel = uvec2(records[base + 6u], records[base + 7u]);
 
     vec3 sun = sun_transmittance(records[base + 16u], records[base + 17u]);
+    vec3 psi = multiscattering_lut_sample(records[base + 20u], records[base + 21u]);
 
     float out_[SB_PROBE_FLOATS];
     vec3 exact = transmittance_to_top(h, mu);
@@ -58,6 +60,7 @@ void main()
     out_[12] = ms_back.x; out_[13] = ms_back.y;
     out_[14] = irr_back.x; out_[15] = irr_back.y;
     out_[16] = sun.r; out_[17] = sun.g; out_[18] = sun.b; out_[19] = 0.0;
+    out_[20] = psi.r; out_[21] = psi.g; out_[22] = psi.b; out_[23] = 0.0;
     for (uint i = 0u; i < SB_PROBE_FLOATS; i++)
         records[base + i] = out_[i];
 }

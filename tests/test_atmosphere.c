@@ -75,7 +75,7 @@ static void test_transmittance(void)
 
 /* ---- the GLSL model's functions, one by one ------------------------------------ */
 
-#define PROBE_FLOATS 20
+#define PROBE_FLOATS 24
 #define PROBE_RECORDS 1024
 
 static double rel_err(double gpu, double ref)
@@ -131,6 +131,18 @@ static void sun_ray(int k, float *h, float *mu)
     *mu = (float)(m < mu_h + 1e-6 ? fabs(m) : m);
 }
 
+/* The k-th point of a multiscattering lookup: the LUT's edges (h = 0 and
+ * the top, mu_s = -1 and 1) one time in four each, else anywhere. */
+static void lookup_point(int k, float *h, float *mu_s)
+{
+    double v[2];
+    for (int i = 0; i < 2; i++)
+        v[i] = fmod((k + 1) * (i ? 0.7548776662466927 : 0.5698402909980532), 1.0);
+    double thickness = earth.top_radius_km - earth.ground_radius_km;
+    *h = (float)(k % 4 == 0 ? (k % 8 ? thickness : 0.0) : thickness * v[0]);
+    *mu_s = (float)(k % 4 == 1 ? (k % 8 == 1 ? -1.0 : 1.0) : -1 + 2 * v[1]);
+}
+
 static void test_probe(struct sb_atmosphere_baker *baker)
 {
     static const double grid[] = {0, 0.5 / 256, 0.5 / 64, 0.1, 0.25, 0.5, 0.75, 0.9, 1 - 0.5 / 64, 1 - 0.5 / 256, 1};
@@ -149,6 +161,7 @@ static void test_probe(struct sb_atmosphere_baker *baker)
         in[6] = (float)(k % SB_IRRADIANCE_WIDTH);
         in[7] = (float)(k / SB_IRRADIANCE_WIDTH);
         sun_ray(k, &in[16], &in[17]);
+        lookup_point(k, &in[20], &in[21]);
     }
     float *inputs = malloc((size_t)PROBE_RECORDS * PROBE_FLOATS * sizeof(float));
     memcpy(inputs, rec, (size_t)PROBE_RECORDS * PROBE_FLOATS * sizeof(float));
@@ -157,8 +170,8 @@ static void test_probe(struct sb_atmosphere_baker *baker)
     CHECK(res == SB_OK, "probe kernel: %s", sb_result_name(res));
 
     double exact_worst = -1, lut_worst = 0, coords_worst = 0, trip_worst = 0, geo_h = 0, geo_mu = 0, sub_worst = 0;
-    double sun_worst = -1, sun_tau = 0;
-    int exact_at = 0, lut_at = 0, sun_at = 0;
+    double sun_worst = -1, sun_tau = 0, psi_worst = -1;
+    int exact_at = 0, lut_at = 0, sun_at = 0, psi_at = 0;
     for (int k = 0; !res && k < PROBE_RECORDS; k++) {
         const float *in = inputs + k * PROBE_FLOATS, *out = rec + k * PROBE_FLOATS;
         double h = in[0], mu = in[1], r = earth.ground_radius_km + h, ref[3];
@@ -203,6 +216,26 @@ static void test_probe(struct sb_atmosphere_baker *baker)
                 sun_tau = fabs(log(out[16 + c] / sun_ref[c]));
             }
         }
+        /* The multiscattering lookup against the same lookup in fp64 from
+         * the same LUT: the sums of fp32 logarithms (|ln psi| < 70, down to
+         * the floor) leave 1e-5; the coordinates' roundings, a few ulp of
+         * 31 texels, count where ln psi is steep (at night it falls to the
+         * floor within a texel), so the bound adds what 4 ulp of either
+         * input change. */
+        const struct sb_image *ms_lut = &luts[SB_PRODUCT_MULTISCATTERING];
+        double psi[3], psi_h[3], psi_mu[3];
+        float ph = in[20], pmu = in[21];
+        sb_ref_multiscattering_lookup(&earth, ms_lut, ph, pmu, psi);
+        sb_ref_multiscattering_lookup(&earth, ms_lut, ph + 4 * (nextafterf(ph, 1e9f) - ph), pmu, psi_h);
+        sb_ref_multiscattering_lookup(&earth, ms_lut, ph, pmu - 4 * (pmu - nextafterf(pmu, -2.0f)), psi_mu);
+        for (int c = 0; c < 3; c++) {
+            double excess =
+                rel_err(out[20 + c], psi[c]) - 1e-5 - rel_err(psi_h[c], psi[c]) - rel_err(psi_mu[c], psi[c]);
+            if (psi[c] > 1e-20 && excess > psi_worst) {
+                psi_worst = excess;
+                psi_at = k;
+            }
+        }
         double rr, rmu;
         sb_ref_transmittance_geometry(&earth, in[2], in[3], &rr, &rmu);
         geo_h = fmax(geo_h, fabs(out[8] - (rr - earth.ground_radius_km)));
@@ -227,6 +260,10 @@ static void test_probe(struct sb_atmosphere_baker *baker)
            "optical depth)\n",
            sun_worst, PROBE_RECORDS, inputs[sun_at * PROBE_FLOATS + 16], inputs[sun_at * PROBE_FLOATS + 17], sun_tau);
     CHECK(sun_worst <= 0, "sun table: %.3g beyond its bound", sun_worst);
+    printf("multiscattering lookup: worst error minus (1e-5 + 4-ulp sensitivity) %.3g over %d points (h %.4g mu_s "
+           "%.6g)\n",
+           psi_worst, PROBE_RECORDS, inputs[psi_at * PROBE_FLOATS + 20], inputs[psi_at * PROBE_FLOATS + 21]);
+    CHECK(psi_worst <= 0, "multiscattering lookup: %.3g beyond its bound", psi_worst);
     /*
      * Mappings. fp32 budget: coordinates come from distances of up to 2300 km
      * (ulp 2.4e-4 km) over spans of >= 1034 km, a few roundings each: 2e-6
