@@ -621,17 +621,24 @@ vec2 sun_columns_density(float h)
     return exp(-h / vec2(atm.rayleigh_scattering.w, atm.mie_scattering.w));
 }
 
+/* Distance along a path to where it reaches altitude `level`, within [0, t_end]. */
+float sun_path_distance(SunPath p, float level)
+{
+    if (level <= p.hb)
+        return 0.0;
+    return level < atmosphere_thickness() ? min(path_distance_to_level(p.hb, p.sb, level), p.t_end) : p.t_end;
+}
+
 /* The ozone column of a path from t0 to its top: Gauss-Legendre 4 on the
- * pieces between the tent's corners, where the density is linear in the
- * altitude. */
+ * two halves of the tent, where the density is linear in the altitude. The
+ * path climbs all the way, so the rest of it, below the tent's lower corner
+ * and above its upper one, holds no ozone. */
 float sun_ozone_column(SunPath p, float t0)
 {
     float centre = atm.ozone_absorption.w, half_width = atm.ground_albedo.w;
-    float sum = 0.0, a = t0;
-    for (int k = -1; k <= 2; k++) {
-        float level = centre + float(k) * half_width, b = p.t_end;
-        if (k < 2 && level < atmosphere_thickness())
-            b = level > p.hb ? min(path_distance_to_level(p.hb, p.sb, level), p.t_end) : a;
+    float sum = 0.0, a = max(t0, sun_path_distance(p, centre - half_width));
+    for (int k = 0; k < 2; k++) {
+        float b = sun_path_distance(p, centre + float(k) * half_width);
         if (b <= a)
             continue;
         float half_len = 0.5 * (b - a), mid = 0.5 * (a + b), piece = 0.0;
