@@ -33,19 +33,30 @@ void main()
     sphere_begin();
     uint count = sphere_direction_count(pieces, pc.directions_mu, pc.directions_phi);
     uint total = count + sphere_cap_direction_count(cap, pc.directions_mu, pc.directions_phi);
+    /* One integrate_ray for both grids, so that the invocations integrating
+     * the cap's directions and those on the zenith grid run it together. */
     for (uint d = sphere_first_direction(); d < sphere_end_direction(total); d += SB_SPHERE_THREADS) {
-        if (d >= count) { /* Mie single scattering's peak */
+        bool on_cap = d >= count; /* Mie single scattering's peak */
+        SphereDirection s;
+        float nu;
+        if (on_cap) {
             CapDirection cd = sphere_cap_direction(cap, d - count, pc.directions_mu, pc.directions_phi);
-            if (cd.phase_weight > 0.0) {
-                RayIntegrals ri = integrate_ray(h, cd.mu, mu_s, cd.nu, cd.toward_ground, false);
-                sphere_add3(3u, cd.phase_weight * sun * ri.sun_mie);
-            }
+            if (cd.phase_weight <= 0.0)
+                continue;
+            s.mu = cd.mu;
+            s.weight = cd.phase_weight;
+            s.toward_ground = cd.toward_ground;
+            nu = cd.nu;
+        } else {
+            s = sphere_direction(pieces, d, pc.directions_mu, pc.directions_phi);
+            float sin_v = sqrt(max(1.0 - s.mu * s.mu, 0.0));
+            nu = clamp(sin_v * sin_s * s.cos_phi + s.mu * mu_s, -1.0, 1.0);
+        }
+        RayIntegrals ri = integrate_ray(h, s.mu, mu_s, nu, s.toward_ground, !on_cap);
+        if (on_cap) {
+            sphere_add3(3u, s.weight * sun * ri.sun_mie);
             continue;
         }
-        SphereDirection s = sphere_direction(pieces, d, pc.directions_mu, pc.directions_phi);
-        float sin_v = sqrt(max(1.0 - s.mu * s.mu, 0.0));
-        float nu = clamp(sin_v * sin_s * s.cos_phi + s.mu * mu_s, -1.0, 1.0);
-        RayIntegrals ri = integrate_ray(h, s.mu, mu_s, nu, s.toward_ground, true);
         sphere_add3(0u, s.weight * (sun * ri.sun_rayleigh * phase_rayleigh(nu) + ri.ms_rayleigh));
         float mie = phase_mie(nu) * (1.0 - sphere_cap_window(true, nu));
         sphere_add3(3u, s.weight * (sun * ri.sun_mie * mie + ri.ms_mie));
