@@ -659,24 +659,18 @@ vec3 sun_optical_depth(float h, float mu)
     /* hc = r sin - R without cancelling; a ray setting off downward that
      * rounding puts under the ground grazes it */
     float hc = (h * (2.0 * R + h) - s * s) / (r * sin_v + R);
-    vec2 n;
-    float ozone;
-    if (hc >= 0.0 || s < 0.0) {
-        hc = max(hc, 0.0);
-        SunPath p = sun_path(false, hc);
-        float x = sqrt(hc / atmosphere_thickness()), t = abs(s);
-        n = sun_columns_sample(false, x, sun_columns_u(t, p.t_end)) * sun_columns_density(h);
-        ozone = sun_ozone_column(p, t);
-        if (s < 0.0) {
-            n = 2.0 * sun_columns_sample(false, x, 0.0) * sun_columns_density(hc) - n;
-            ozone = 2.0 * sun_ozone_column(p, 0.0) - ozone;
-        }
-    } else {
-        float g = sqrt(-hc * (2.0 * R + hc)); /* sqrt(R^2 - rc^2) */
-        SunPath p = sun_path(true, g);
-        float t = h * (2.0 * R + h) / (s + g); /* s - g without cancelling */
-        n = sun_columns_sample(true, sqrt(g / R), sun_columns_u(t, p.t_end)) * sun_columns_density(h);
-        ozone = sun_ozone_column(p, t);
+    /* One lookup for both regions, so that rays of either run it together. */
+    bool lower = hc < 0.0 && s >= 0.0;
+    float g = lower ? sqrt(-hc * (2.0 * R + hc)) : 0.0; /* sqrt(R^2 - rc^2) */
+    hc = max(hc, 0.0);
+    SunPath p = sun_path(lower, lower ? g : hc);
+    float x = lower ? sqrt(g / R) : sqrt(hc / atmosphere_thickness());
+    float t = lower ? h * (2.0 * R + h) / (s + g) : abs(s); /* lower: s - g without cancelling */
+    vec2 n = sun_columns_sample(lower, x, sun_columns_u(t, p.t_end)) * sun_columns_density(h);
+    float ozone = sun_ozone_column(p, t);
+    if (s < 0.0) {
+        n = 2.0 * sun_columns_sample(false, x, 0.0) * sun_columns_density(hc) - n;
+        ozone = 2.0 * sun_ozone_column(p, 0.0) - ozone;
     }
     return atm.rayleigh_scattering.rgb * max(n.x, 0.0) + atm.mie_extinction.rgb * max(n.y, 0.0)
          + atm.ozone_absorption.rgb * max(ozone, 0.0);
