@@ -9,7 +9,6 @@
  * scattering read from its LUT. One workgroup per texel (sphere.glsl). */
 #extension GL_GOOGLE_include_directive : require
 #include "config.h"
-#define SB_MULTISCATTERING_SHARED
 #include "atmosphere.glsl"
 #include "sphere.glsl"
 

@@ -12,7 +12,6 @@
  * (sphere.glsl). */
 #extension GL_GOOGLE_include_directive : require
 #include "config.h"
-#define SB_MULTISCATTERING_SHARED
 #include "atmosphere.glsl"
 #include "sphere.glsl"
 
