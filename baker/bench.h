@@ -62,8 +62,8 @@ struct sb_bench_cloud_row {
 struct sb_bench_probe_row {
     char scene[32];
     uint32_t triangles, probes, rays_per_probe;
-    double bvh_ms;                  /* the BVH's build on one thread */
-    double gpu_ms, gpu_rays_per_s;  /* the bake (median of the repeats) */
+    double bvh_ms;                 /* the BVH's build on one thread */
+    double gpu_ms, gpu_rays_per_s; /* the bake (median of the repeats) */
     double embree_s, embree_rays_per_s;
     int embree_threads;
     uint64_t rays, hits_differ; /* rays whose hit or miss differ, summed over probes */
@@ -76,12 +76,12 @@ struct sb_bench_probe_row {
 #define SB_BENCH_MAX_MIPS 12
 struct sb_bench_reflection_row {
     char label[48];
-    const char *anchor;     /* the published setting this row reproduces, or NULL */
+    const char *anchor; /* the published setting this row reproduces, or NULL */
     bool is_default, pareto;
     uint32_t samples_first, samples_last; /* a texel's at mip 1 and at the last */
     double gpu_ms, gpu_ms_min;
     double rms[SB_BENCH_MAX_MIPS], max[SB_BENCH_MAX_MIPS]; /* relative, per mip (0: the source) */
-    double worst_rms, worst_max;                            /* over mips 1.. */
+    double worst_rms, worst_max;                           /* over mips 1.. */
 };
 
 struct sb_bench_params {
@@ -122,9 +122,11 @@ struct sb_bench_report {
 enum sb_result sb_bench_warm_up(struct sb_vk *vk);
 
 /* bench_probes.c: also the terrain (rolling hills over 2 km, (n - 1)^2 x 2
- * triangles) and the median of n values (sorted in place) the benches share. */
+ * triangles), the median of n values (sorted in place) and the monotonic
+ * clock in seconds that the benches share. */
 enum sb_result sb_bench_terrain(uint32_t n, struct sb_mesh *mesh);
 double sb_bench_median(double *v, int n);
+double sb_bench_now_s(void);
 /* bench_reflection.c */
 enum sb_result sb_bench_reflection(struct sb_vk *vk, const struct sb_atmosphere_params *atmosphere,
                                    const struct sb_bench_params *params, struct sb_bench_report *report);

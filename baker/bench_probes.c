@@ -24,7 +24,7 @@
 
 #define BENCH_IFC_HOUSE "/usr/share/assimp/models/IFC/AC14-FZK-Haus.ifc"
 
-static double now_s(void)
+double sb_bench_now_s(void)
 {
     struct timespec ts;
     clock_gettime(CLOCK_MONOTONIC, &ts);
@@ -75,9 +75,9 @@ static enum sb_result bench_one(struct sb_vk *vk, const char *name, struct sb_me
     struct sb_raycaster *rc = NULL;
     struct sb_embree e = {0};
     float *positions = NULL, *out = NULL, *rays = NULL, *hits = NULL;
-    double t0 = now_s();
+    double t0 = sb_bench_now_s();
     enum sb_result res = sb_bvh_build(mesh, &bvh);
-    row->bvh_ms = (now_s() - t0) * 1e3;
+    row->bvh_ms = (sb_bench_now_s() - t0) * 1e3;
     if (res || (res = sb_raycaster_create(vk, &bvh, &rc)))
         goto done;
     /* 16^3 probes over the bounds, from 2 m above its bottom */

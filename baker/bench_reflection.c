@@ -14,7 +14,6 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
-#include <time.h>
 
 #include "bench.h"
 #include "bvh.h"
@@ -95,13 +94,6 @@ static void measure(const float *chain, uint32_t n, const struct ref_texel *texe
         }
 }
 
-static double now_s(void)
-{
-    struct timespec ts;
-    clock_gettime(CLOCK_MONOTONIC, &ts);
-    return ts.tv_sec + ts.tv_nsec * 1e-9;
-}
-
 /* The cube: the sky-only capture for the light surfaces see, then the
  * world's from 20 m above the terrain's middle, the sun 30 degrees up. */
 static enum sb_result capture(struct sb_vk *vk, const struct sb_atmosphere_params *atmosphere, uint32_t n,
@@ -163,10 +155,10 @@ enum sb_result sb_bench_reflection(struct sb_vk *vk, const struct sb_atmosphere_
         goto done;
     struct sb_reflection_kernels kernels = {0};
     pick_texels(n, levels, texels);
-    double t0 = now_s();
+    double t0 = sb_bench_now_s();
     struct ref_job job = {.level0 = level0, .n = n, .levels = levels, .texels = texels};
     sb_parallel_for((int)count, reference_one, &job);
-    report->reflection_reference_s = now_s() - t0;
+    report->reflection_reference_s = sb_bench_now_s() - t0;
     sb_info("reflection_cubes: the fp64 reference at %u texels of %u levels took %.1f s", count, levels - 1,
             report->reflection_reference_s);
 
