@@ -8,6 +8,7 @@
 #include <string.h>
 
 #include "irradiance_ground.spv.h"
+#include "irradiance_ground_bruneton.spv.h"
 #include "irradiance_ground_shared.spv.h"
 #include "irradiance_sky.spv.h"
 #include "irradiance_sky_shared.spv.h"
@@ -90,8 +91,12 @@ static const struct spirv scattering_shaders[2][SB_ATMOSPHERE_PRODUCT_COUNT] = {
         [SB_PRODUCT_IRRADIANCE_SKY] = SPIRV(irradiance_sky_shared),
     },
 };
-/* skybake bench's anchor: Hillaire 2020's multiple-scattering LUT (config.h). */
-static const struct spirv hillaire_multiscattering = SPIRV(multiscattering_hillaire);
+/* skybake bench's anchors: Hillaire 2020's multiple-scattering LUT and
+ * Bruneton 2017's ground irradiance (config.h), by product. */
+static const struct spirv anchor_shaders[SB_ATMOSPHERE_PRODUCT_COUNT] = {
+    [SB_PRODUCT_MULTISCATTERING] = SPIRV(multiscattering_hillaire),
+    [SB_PRODUCT_IRRADIANCE_GROUND] = SPIRV(irradiance_ground_bruneton),
+};
 /* The scattering bakes' sun table (atmosphere.glsl). */
 static const struct spirv sun_columns_shader = SPIRV(sun_columns);
 #undef SPIRV
@@ -141,14 +146,19 @@ static enum sb_result check_settings(enum sb_product_id id, const struct sb_atmo
 {
     const char *name = sb_product_name(id);
     if (is_anchor(id, s)) {
-        if (id != SB_PRODUCT_MULTISCATTERING || s->quadrature != SB_QUADRATURE_UNIFORM_0_3 ||
-            s->directions_mu * s->directions_phi < 1 ||
-            s->directions_mu * s->directions_phi > SB_ANCHOR_MAX_DIRECTIONS || s->samples < 1 ||
-            s->samples > SB_UNIFORM_MAX_STEPS) {
-            sb_error("%s: the uniform rules are Hillaire 2020's multiscattering only: 1 to %d directions, 1 to %d "
-                     "steps (got %ux%u, %u)",
-                     name, SB_ANCHOR_MAX_DIRECTIONS, SB_UNIFORM_MAX_STEPS, s->directions_mu, s->directions_phi,
-                     s->samples);
+        uint64_t directions = (uint64_t)s->directions_mu * s->directions_phi;
+        bool hillaire = id == SB_PRODUCT_MULTISCATTERING && s->quadrature == SB_QUADRATURE_UNIFORM_0_3 &&
+                        directions >= 1 && directions <= SB_ANCHOR_MAX_DIRECTIONS && s->samples >= 1 &&
+                        s->samples <= SB_UNIFORM_MAX_STEPS;
+        bool bruneton = id == SB_PRODUCT_IRRADIANCE_GROUND && s->quadrature == SB_QUADRATURE_TRAPEZOID &&
+                        directions >= 1 && directions <= SB_BRUNETON_MAX_DIRECTIONS && s->samples >= 1 &&
+                        s->samples <= SB_BRUNETON_MAX_STEPS;
+        if (!hillaire && !bruneton) {
+            sb_error("%s: the published rules are Hillaire 2020's multiscattering (uniform, 1 to %d directions, 1 to "
+                     "%d steps) and Bruneton 2017's irradiance_ground (trapezoid, 1 to %d directions, 1 to %d steps); "
+                     "got quadrature %u, %ux%u, %u",
+                     name, SB_ANCHOR_MAX_DIRECTIONS, SB_UNIFORM_MAX_STEPS, SB_BRUNETON_MAX_DIRECTIONS,
+                     SB_BRUNETON_MAX_STEPS, s->quadrature, s->directions_mu, s->directions_phi, s->samples);
             return SB_ERR_USAGE;
         }
         return SB_OK;
@@ -208,7 +218,8 @@ void sb_atmosphere_settings_label(enum sb_product_id id, const struct sb_atmosph
 {
     struct sb_atmosphere_settings s = resolve_settings(id, settings);
     if (is_anchor(id, &s)) {
-        snprintf(out, size, "hillaire%ux%u-%u", s.directions_mu, s.directions_phi, s.samples);
+        snprintf(out, size, "%s%ux%u-%u", id == SB_PRODUCT_MULTISCATTERING ? "hillaire" : "bruneton", s.directions_mu,
+                 s.directions_phi, s.samples);
         return;
     }
     if (id != SB_PRODUCT_TRANSMITTANCE) {
@@ -431,7 +442,7 @@ enum sb_result sb_atmosphere_bake(struct sb_atmosphere_baker *b, enum sb_product
     const struct spirv *shader =
         id == SB_PRODUCT_TRANSMITTANCE
             ? &transmittance_shaders[s.quadrature == SB_QUADRATURE_GAUSS_LEGENDRE ? s.samples : 0]
-            : (anchor ? &hillaire_multiscattering
+            : (anchor ? &anchor_shaders[id]
                       : &scattering_shaders[b->vk->properties.deviceType == VK_PHYSICAL_DEVICE_TYPE_CPU][id]);
     bool cap = id == SB_PRODUCT_IRRADIANCE_GROUND || (id == SB_PRODUCT_IRRADIANCE_SKY && b->sky_cap);
     uint64_t directions = prod->workgroup_per_texel && !anchor ? sphere_directions(&s, cap) : 0;

@@ -20,6 +20,7 @@
 #define HILLAIRE "Hillaire 2020 (40-step march, offset 0.3)"
 #define BRUNETON "Bruneton 2017 (500-step trapezoid)"
 #define HILLAIRE_MS "Hillaire 2020 (64 directions, 20-step march, LUT sun)"
+#define BRUNETON_E "Bruneton 2017 (16 x 64 directions, 50-step trapezoid, LUT transmittance)"
 
 struct sweep_entry {
     struct sb_atmosphere_settings settings;
@@ -88,9 +89,21 @@ static const struct sweep_entry multiscattering_sweep[] = {
     {DIRS(24, 16), NULL, false},
     {DIRS(32, 24), NULL, false},
 };
+#define BRUNETON_DIRS(theta, phi, steps)                                                                               \
+    {                                                                                                                  \
+        .quadrature = SB_QUADRATURE_TRAPEZOID, .samples = steps, .directions_mu = theta, .directions_phi = phi         \
+    }
 static const struct sweep_entry irradiance_ground_sweep[] = {
-    {DIRS(4, 4), NULL, true},    {DIRS(6, 6), NULL, true},    {DIRS(8, 8), NULL, true},
-    {DIRS(12, 12), NULL, false}, {DIRS(16, 16), NULL, false}, {DIRS(24, 24), NULL, false},
+    {BRUNETON_DIRS(16, 64, 50), BRUNETON_E, true},
+    {BRUNETON_DIRS(8, 32, 50), NULL, false},
+    {BRUNETON_DIRS(32, 128, 50), NULL, false},
+    {BRUNETON_DIRS(16, 64, 200), NULL, false},
+    {DIRS(4, 4), NULL, true},
+    {DIRS(6, 6), NULL, true},
+    {DIRS(8, 8), NULL, true},
+    {DIRS(12, 12), NULL, false},
+    {DIRS(16, 16), NULL, false},
+    {DIRS(24, 24), NULL, false},
 };
 static const struct sweep_entry irradiance_sky_sweep[] = {
     {DIRS(4, 4), NULL, true},    {DIRS(8, 8), NULL, true},    {DIRS(12, 12), NULL, false},
@@ -101,6 +114,7 @@ static const struct sweep_entry irradiance_sky_sweep[] = {
 #undef RES
 #undef DIRS
 #undef HILLAIRE_DIRS
+#undef BRUNETON_DIRS
 
 static const struct {
     const char *name;

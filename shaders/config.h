@@ -154,6 +154,13 @@ struct sb_bake_push {
  * SB_QUADRATURE_UNIFORM_0_3 on that product: directions_mu x directions_phi
  * directions (at most a workgroup's), `samples` steps a ray. Never in a pack. */
 #define SB_ANCHOR_MAX_DIRECTIONS 64
+/* skybake bench's anchor for ground irradiance: Bruneton 2017's quadrature
+ * (irradiance_ground_bruneton.comp), selected by SB_QUADRATURE_TRAPEZOID on
+ * that product: directions_mu zenith angles by directions_phi azimuths over
+ * the upper hemisphere, `samples` trapezoid intervals a ray. The bounds keep
+ * an invocation's loops far below llvmpipe's 65535 iterations. */
+#define SB_BRUNETON_MAX_DIRECTIONS 8192
+#define SB_BRUNETON_MAX_STEPS 200
 
 /* ---- skyview ------------------------------------------------------------------ */
 /*

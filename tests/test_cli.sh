@@ -249,6 +249,8 @@ check "bench marks a Pareto front" grep -Eq '"pareto":[[:space:]]*true' "$tmp/be
 check "bench table names the default" grep -q '^.\*gl8x1' "$tmp/out"
 check "bench of multiscattering, quick" expect_exit 0 "$skybake" bench --product multiscattering --quick --repeat 1 -q -o "$tmp/benchm"
 check "bench has Hillaire's multiple-scattering row" grep -q "hillaire8x8-20,.*Hillaire 2020" "$tmp/benchm/bench.csv"
+check "bench of irradiance_ground, quick" expect_exit 0 "$skybake" bench --product irradiance_ground --quick --repeat 1 -q -o "$tmp/benche"
+check "bench has Bruneton's irradiance row" grep -q "bruneton16x64-50,.*Bruneton 2017" "$tmp/benche/bench.csv"
 check "bench refuses an unknown product" expect_exit 2 "$skybake" bench --product sky
 check "bench of the cloud noise" expect_exit 0 "$skybake" bench --product cloud_detail --product cloud_curl --repeat 1 -q -o "$tmp/benchc"
 check "bench_clouds.csv: two products, every value equal to the reference" \
