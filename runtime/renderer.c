@@ -24,6 +24,7 @@
 #include "shadow_vert.spv.h"
 #include "shadows.h"
 #include "sky.spv.h"
+#include "sky_from_space.spv.h"
 #include "sky_view.spv.h"
 #include "texture.h"
 #include "tonemap.spv.h"
@@ -52,6 +53,7 @@ static const struct {
     [KERNEL_SKY_VIEW] = {sb_spv_sky_view, sizeof(sb_spv_sky_view), "sky-view"},
     [KERNEL_AERIAL] = {sb_spv_aerial_perspective, sizeof(sb_spv_aerial_perspective), "aerial perspective"},
     [KERNEL_SKY] = {sb_spv_sky, sizeof(sb_spv_sky), "sky"},
+    [KERNEL_SKY_FROM_SPACE] = {sb_spv_sky_from_space, sizeof(sb_spv_sky_from_space), "sky from space"},
     [KERNEL_HISTOGRAM] = {sb_spv_histogram, sizeof(sb_spv_histogram), "histogram"},
     [KERNEL_EXPOSURE] = {sb_spv_exposure, sizeof(sb_spv_exposure), "exposure"},
     [KERNEL_BLOOM_DOWN] = {sb_spv_bloom_down, sizeof(sb_spv_bloom_down), "bloom down"},
@@ -357,6 +359,7 @@ static enum sb_result upload_atmosphere(struct sb_renderer *r, const struct sb_p
     double sun_max = fmax(atm->solar_irradiance[0], fmax(atm->solar_irradiance[1], atm->solar_irradiance[2]));
     r->radiance_scale = sun_max > 0.0 ? 1.0 / sun_max : 1.0;
     r->ground_radius_km = atm->ground_radius_km;
+    r->thickness_km = gpu.radii[3];
 
     const struct sb_image *t = &pack->images[SB_PRODUCT_TRANSMITTANCE];
     enum sb_result res = upload(r->vk, &gpu, sizeof(gpu), "atmosphere parameters", &r->atmosphere);
@@ -889,6 +892,8 @@ static void fill_frame(struct sb_renderer *r, const struct sb_view *v, struct sb
     const double sun_radius = 0.2666 * M_PI / 180.0; /* the sun's mean angular radius */
     store4(f->camera_m, v->camera_m[0], v->camera_m[1], v->camera_m[2], 0.0);
     store4(f->camera_km, km[0], km[1], km[2], altitude);
+    /* the shaders' test, on the same fp32 values */
+    r->camera_in_atmosphere = (float)altitude < r->thickness_km;
     store4(f->camera_forward, forward[0], forward[1], forward[2], cos(sun_radius));
     store4(f->sun_direction, sun[0], sun[1], sun[2], sun_radius);
     store4(f->shadow, 0.1, 1.5, r->params.shadow_size, 1.0);
@@ -1097,7 +1102,8 @@ static void record_aerial(struct sb_renderer *r)
 
 static void record_sky(struct sb_renderer *r)
 {
-    dispatch(r, KERNEL_SKY, r->set, NULL, r->width, r->height, SB_WORKGROUP_X, SB_WORKGROUP_Y);
+    dispatch(r, r->camera_in_atmosphere ? KERNEL_SKY : KERNEL_SKY_FROM_SPACE, r->set, NULL, r->width, r->height,
+             SB_WORKGROUP_X, SB_WORKGROUP_Y);
 }
 
 static void record_exposure(struct sb_renderer *r)

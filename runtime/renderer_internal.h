@@ -31,7 +31,8 @@ struct sb_image;
 enum compute_kernel {
     KERNEL_SKY_VIEW,
     KERNEL_AERIAL,
-    KERNEL_SKY,
+    KERNEL_SKY,            /* the camera inside the atmosphere */
+    KERNEL_SKY_FROM_SPACE, /* above it */
     KERNEL_HISTOGRAM,
     KERNEL_EXPOSURE,
     KERNEL_BLOOM_DOWN,
@@ -53,6 +54,8 @@ struct sb_renderer {
     int32_t cascade_clear[SB_CASCADES][4]; /* this frame's texels to clear and draw in each cascade */
     double radiance_scale;                 /* what stored radiance is multiplied by (fp16 headroom) */
     double ground_radius_km;
+    float thickness_km;        /* the atmosphere's, as the shaders hold it */
+    bool camera_in_atmosphere; /* this frame's: which sky kernel runs */
 
     struct sb_buffer atmosphere, transmittance, multiscattering, irradiance_ground;
     struct sb_buffer frame, vertices, exposure;

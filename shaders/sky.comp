@@ -3,7 +3,10 @@
  * inside the atmosphere, the same integral per pixel from the top of the
  * atmosphere above it (the LUT's rows cannot hold a planet seen from space),
  * the planet's ground below the horizon, and the sun's disk where the planet
- * does not hide it, seen through the transmittance toward it. */
+ * does not hide it, seen through the transmittance toward it. Built twice:
+ * for a camera inside the atmosphere, and with SB_SKY_FROM_SPACE for one
+ * above it; the renderer dispatches the one the frame needs, since llvmpipe
+ * runs an untaken branch's code too (a quarter of the pass's time there). */
 #extension GL_GOOGLE_include_directive : require
 #include "config.h"
 #include "view.glsl"
@@ -29,14 +32,17 @@ void main()
 
     vec3 L = vec3(0.0);
     vec3 sun_t = vec3(0.0); /* transmittance toward the sun along the view, 0 when the planet hides it */
-    if (frame.camera_km.w < atmosphere_thickness()) {
+#ifndef SB_SKY_FROM_SPACE
+    {
         vec3 up = normalize(p);
         float h = clamp(frame.camera_km.w, 0.0, atmosphere_thickness()); /* as the LUT was made */
         float mu = clamp(dot(up, d), -1.0, 1.0);
         L = textureLod(sky_view, sky_view_uv_toward(d), 0.0).rgb;
         if (!ray_hits_ground(h, mu))
             sun_t = transmittance_lut_sample(h, mu);
-    } else {
+    }
+#else
+    {
         float entry = atmosphere_entry(p, d);
         if (entry >= 0.0) {
             vec3 p0 = p + d * entry;
@@ -51,6 +57,7 @@ void main()
             sun_t = vec3(1.0);
         }
     }
+#endif
     L += sun_disk(nu) * sun_t * frame.aerial.y;
     imageStore(hdr, pixel, vec4(fp16_safe(L), 1.0));
 }
