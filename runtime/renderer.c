@@ -19,6 +19,7 @@
 #include "probe_sky.spv.h"
 #include "scene.h"
 #include "scene_frag.spv.h"
+#include "scene_frag_volume.spv.h"
 #include "scene_vert.spv.h"
 #include "sh.h"
 #include "shadow_vert.spv.h"
@@ -660,6 +661,11 @@ static enum sb_result create_pipelines(struct sb_renderer *r)
     };
     if (!res)
         res = sb_graphics_pipeline_create(r->vk, &scene, &r->scene_pipeline);
+    scene.fragment_spirv = sb_spv_scene_frag_volume;
+    scene.fragment_size = sizeof(sb_spv_scene_frag_volume);
+    scene.name = "scene (aerial volume only)";
+    if (!res)
+        res = sb_graphics_pipeline_create(r->vk, &scene, &r->scene_volume_pipeline);
     return res;
 }
 
@@ -696,6 +702,15 @@ enum sb_result sb_renderer_create(struct sb_vk *vk, const struct sb_pack *pack, 
             r->bloom_levels++;
     r->vertex_count = world->vertex_count;
     r->caster_first_vertex = world->caster_first_vertex;
+    for (int i = 0; i < 3; i++) {
+        r->world_min_m[i] = world->vertex_count ? INFINITY : 0.0;
+        r->world_max_m[i] = world->vertex_count ? -INFINITY : 0.0;
+    }
+    for (uint32_t v = 0; v < world->vertex_count; v++)
+        for (int i = 0; i < 3; i++) {
+            r->world_min_m[i] = fmin(r->world_min_m[i], world->vertices[v].position[i]);
+            r->world_max_m[i] = fmax(r->world_max_m[i], world->vertices[v].position[i]);
+        }
     bool failed;
     r->caster_box_count =
         sb_caster_boxes(world->vertices, world->caster_first_vertex, world->vertex_count, &r->caster_boxes, &failed);
@@ -782,9 +797,9 @@ void sb_renderer_destroy(struct sb_renderer **pr)
     for (int p = SB_PASS_COUNT; p-- > 0;)
         if (pass_classes[p]->destroy)
             pass_classes[p]->destroy(r);
-    const VkPipeline raster[] = {r->shadow_pipeline, r->scene_pipeline};
+    const VkPipeline raster[] = {r->shadow_pipeline, r->scene_pipeline, r->scene_volume_pipeline};
     sb_renderer_release(r, r->kernels, KERNEL_COUNT, NULL, 0);
-    sb_renderer_release(r, raster, 2, NULL, 0);
+    sb_renderer_release(r, raster, 3, NULL, 0);
     if (r->pool)
         vkDestroyDescriptorPool(d, r->pool, NULL);
     if (r->layout)
@@ -894,6 +909,15 @@ static void fill_frame(struct sb_renderer *r, const struct sb_view *v, struct sb
     store4(f->camera_km, km[0], km[1], km[2], altitude);
     /* the shaders' test, on the same fp32 values */
     r->camera_in_atmosphere = (float)altitude < r->thickness_km;
+    /* Every fragment lies in the world's box: when its farthest corner is
+     * inside the aerial-perspective volume's range (1% to spare for fp32),
+     * no fragment needs the ray's integral (aerial.glsl). */
+    double reach2 = 0.0;
+    for (int i = 0; i < 3; i++) {
+        double d = fmax(fabs(r->world_min_m[i] - v->camera_m[i]), fabs(r->world_max_m[i] - v->camera_m[i]));
+        reach2 += d * d;
+    }
+    r->aerial_volume_only = r->camera_in_atmosphere && sqrt(reach2) <= 0.99e3 * AERIAL_FAR_KM;
     store4(f->camera_forward, forward[0], forward[1], forward[2], cos(sun_radius));
     store4(f->sun_direction, sun[0], sun[1], sun[2], sun_radius);
     store4(f->shadow, 0.1, 1.5, r->params.shadow_size, 1.0);
@@ -1052,7 +1076,8 @@ static void record_scene(struct sb_renderer *r)
     };
     vkCmdBeginRendering(r->cmd, &info);
     set_viewport(r->cmd, r->width, r->height);
-    vkCmdBindPipeline(r->cmd, VK_PIPELINE_BIND_POINT_GRAPHICS, r->scene_pipeline);
+    vkCmdBindPipeline(r->cmd, VK_PIPELINE_BIND_POINT_GRAPHICS,
+                      r->aerial_volume_only ? r->scene_volume_pipeline : r->scene_pipeline);
     vkCmdBindDescriptorSets(r->cmd, VK_PIPELINE_BIND_POINT_GRAPHICS, r->layout, 0, 1, &r->set, 0, NULL);
     struct sb_view_push push = {0};
     vkCmdPushConstants(r->cmd, r->layout, VK_SHADER_STAGE_ALL, 0, sizeof(push), &push);

@@ -54,8 +54,10 @@ struct sb_renderer {
     int32_t cascade_clear[SB_CASCADES][4]; /* this frame's texels to clear and draw in each cascade */
     double radiance_scale;                 /* what stored radiance is multiplied by (fp16 headroom) */
     double ground_radius_km;
-    float thickness_km;        /* the atmosphere's, as the shaders hold it */
-    bool camera_in_atmosphere; /* this frame's: which sky kernel runs */
+    float thickness_km;                    /* the atmosphere's, as the shaders hold it */
+    bool camera_in_atmosphere;             /* this frame's: which sky kernel runs */
+    double world_min_m[3], world_max_m[3]; /* the world's box */
+    bool aerial_volume_only;               /* this frame's: which scene pipeline draws */
 
     struct sb_buffer atmosphere, transmittance, multiscattering, irradiance_ground;
     struct sb_buffer frame, vertices, exposure;
@@ -79,6 +81,7 @@ struct sb_renderer {
     VkDescriptorSet bloom_sets[SB_BLOOM_SETS]; /* down steps 0..L-1, then up steps */
     VkPipeline kernels[KERNEL_COUNT];
     VkPipeline shadow_pipeline, scene_pipeline;
+    VkPipeline scene_volume_pipeline; /* aerial perspective from its volume alone (aerial.glsl) */
 
     struct sb_fog *fog;       /* fog.c */
     struct sb_clouds *clouds; /* clouds.c */

@@ -2,7 +2,10 @@
  * Aerial perspective between the camera and a point (Hillaire 2020, section
  * 5.4): the aerial-perspective volume inside its range, else the same
  * integral along the ray (cameras above the atmosphere, far points). For
- * the scene and the clouds.
+ * the scene and the clouds. A shader that defines SB_AERIAL_VOLUME_ONLY
+ * leaves the ray's integral out: its caller must know that the camera is in
+ * the atmosphere and every point within the volume's range (llvmpipe runs
+ * the integral's code for every fragment even when none takes it).
  */
 #ifndef SB_AERIAL_GLSL
 #define SB_AERIAL_GLSL
@@ -17,8 +20,10 @@ void aerial_perspective(vec2 uv, vec3 offset, out vec3 inscatter, out vec3 trans
 {
     float d_km = length(offset) * 1e-3;
     float far_km = frame.aerial.x;
-    bool inside = frame.camera_km.w < atmosphere_thickness();
-    if (inside && d_km <= far_km) {
+#ifndef SB_AERIAL_VOLUME_ONLY
+    if (frame.camera_km.w < atmosphere_thickness() && d_km <= far_km)
+#endif
+    {
         float w = sqrt(d_km / far_km);
         const float w0 = 0.5 / float(SB_AERIAL_SIZE);
         vec3 uvw = vec3(uv, max(w, w0));
@@ -31,6 +36,7 @@ void aerial_perspective(vec2 uv, vec3 offset, out vec3 inscatter, out vec3 trans
         }
         return;
     }
+#ifndef SB_AERIAL_VOLUME_ONLY
     vec3 d = normalize(offset);
     vec3 p = frame.camera_km.xyz;
     float entry = atmosphere_entry(p, d);
@@ -52,6 +58,7 @@ void aerial_perspective(vec2 uv, vec3 offset, out vec3 inscatter, out vec3 trans
              ri.ms_rayleigh + ri.ms_mie;
     inscatter = L * frame.aerial.y;
     transmittance = ri.transmittance;
+#endif
 }
 
 #endif
