@@ -507,6 +507,7 @@ static enum sb_result upload_reflections(struct sb_renderer *r, const struct sb_
     g->info[0] = n;
     g->info[1] = levels;
     g->info[2] = count;
+    r->reflection_count = count;
     g->info[3] = dfg;
     double el = pack->scene->view.sun_elevation_deg * M_PI / 180, az = pack->scene->view.sun_azimuth_deg * M_PI / 180;
     double sun[3];
@@ -648,8 +649,17 @@ static enum sb_result create_pipelines(struct sb_renderer *r)
         .name = "shadow cascades",
     };
     res = sb_graphics_pipeline_create(r->vk, &shadow, &r->shadow_pipeline);
+    /* scene.frag's specialization: what the pack holds */
+    const VkBool32 has[2] = {r->probe_count > 0, r->reflection_count > 0};
+    const VkSpecializationMapEntry entries[2] = {
+        {.constantID = 0, .offset = 0, .size = sizeof(VkBool32)},
+        {.constantID = 1, .offset = sizeof(VkBool32), .size = sizeof(VkBool32)},
+    };
+    const VkSpecializationInfo specialization = {
+        .mapEntryCount = 2, .pMapEntries = entries, .dataSize = sizeof(has), .pData = has};
     struct sb_graphics_pipeline_params scene = {
         .layout = r->layout,
+        .fragment_specialization = &specialization,
         .vertex_spirv = sb_spv_scene_vert,
         .vertex_size = sizeof(sb_spv_scene_vert),
         .fragment_spirv = sb_spv_scene_frag,

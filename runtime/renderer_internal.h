@@ -64,6 +64,7 @@ struct sb_renderer {
     struct sb_buffer probes, probe_light;           /* sb_probes_gpu and its probes; the sky's and probes' SH */
     struct sb_buffer reflections, reflection_cubes; /* sb_reflections_gpu, its probes and the DFG; the cubes */
     uint32_t probe_count;                           /* grid probes lit by the probes pass (0: none) */
+    uint32_t reflection_count;                      /* reflection probes the scene reads (0: none) */
     struct sb_buffer read_ldr, read_hdr, read_sky_view;
 
     struct sb_texture sky_view, aerial, aerial_t, shadow, hdr, depth, bloom, ldr;

@@ -63,6 +63,7 @@ enum sb_result sb_graphics_pipeline_create(struct sb_vk *vk, const struct sb_gra
             .stage = VK_SHADER_STAGE_FRAGMENT_BIT,
             .module = modules[1],
             .pName = "main",
+            .pSpecializationInfo = p->fragment_specialization,
         },
     };
     VkPipelineVertexInputStateCreateInfo vertex_input = {

@@ -29,6 +29,7 @@ struct sb_graphics_pipeline_params {
     bool depth_clamp;          /* clamp instead of clipping at near and far (needs vk->depth_clamp) */
     float depth_bias_constant; /* 0 and 0: no bias */
     float depth_bias_slope;
+    const VkSpecializationInfo *fragment_specialization; /* NULL: the fragment shader's defaults */
     const char *name;
 };
 
