@@ -22,7 +22,7 @@ static const struct {
     [SB_ERR_VALIDATION] = {"validation", "the Vulkan validation layers reported a message"},
     [SB_ERR_NUMERIC] = {"numeric", "NaN, Inf or a value outside the product's range"},
     [SB_ERR_USAGE] = {"usage", "bad command line"},
-    [SB_ERR_DEVICE_LIMIT] = {"device-limit", "a kernel exceeds a limit of the device"},
+    [SB_ERR_DEVICE_LIMIT] = {"device-limit", "the device ended a kernel early"},
     [SB_ERR_VERSION] = {"version", "a pack of a format this build does not read: rebake needed"},
     [SB_ERR_HASH_MISMATCH] = {"hash-mismatch", "content that differs from the hash recorded for it"},
     [SB_ERR_UNSAFE_PATH] = {"unsafe-path", "a path that leaves the pack or goes through a symbolic link"},

@@ -28,10 +28,11 @@ layout(std430, set = 0, binding = SB_BINDING_TRANSMITTANCE) readonly buffer Tran
 layout(std430, set = 0, binding = SB_BINDING_MULTISCATTERING) readonly buffer MultiscatteringBuffer {
     vec4 multiscattering_log[];
 };
-/* The sphere bakes (sphere.glsl) read the multiscattering LUT from a copy in
- * workgroup memory, which sphere_init fills: llvmpipe loads it much faster
- * than a storage buffer (irradiance_sky's bake 10.7 -> 8.3 s). A shader
- * defines SB_MULTISCATTERING_SHARED before including this file to get it. */
+/* A sphere bake (sphere.glsl) built with SB_MULTISCATTERING_SHARED defined
+ * before this file reads the multiscattering LUT from a copy in workgroup
+ * memory, which sphere_init fills: llvmpipe loads it much faster than a
+ * storage buffer (irradiance_sky's bake 10.7 -> 8.3 s), a GPU holds fewer
+ * workgroups for it (baker/atmosphere.c chooses by device). */
 #ifdef SB_MULTISCATTERING_SHARED
 shared vec4 multiscattering_shared[SB_MULTISCATTERING_LOOKUP_TEXELS];
 #define SB_MULTISCATTERING_LOG(k) multiscattering_shared[k].rgb

@@ -39,10 +39,11 @@
 #define SB_MAX_DIRECTIONS_MU 64
 #define SB_MAX_DIRECTIONS_PHI 256
 #define SB_SPHERE_MAX_PIECES 10
-/* Workgroup memory of the largest sphere bake (irradiance_sky: the
- * quadrature's nodes, the partial sums and the multiscattering LUT's copy),
- * in bytes: more than the 16 KiB every device offers, less than the 32 KiB
- * of llvmpipe and every desktop GPU; the baker checks the device's limit. */
+/* Workgroup memory of the largest sphere bake with the multiscattering LUT's
+ * copy (irradiance_sky: the quadrature's nodes, the partial sums and the
+ * copy), in bytes: more than the 16 KiB every device offers, less than
+ * llvmpipe's 32 KiB; the baker takes the copy only where the device's limit
+ * allows it. */
 #define SB_SPHERE_SHARED_BYTES                                                                             \
     (4 * (2 * SB_MAX_DIRECTIONS_MU + 2 * SB_MAX_DIRECTIONS_PHI + SB_SPHERE_THREADS * SB_SPHERE_MAX_SUMS) \
      + 16 * SB_MULTISCATTERING_LOOKUP_TEXELS)
