@@ -650,7 +650,8 @@ static enum sb_result create_pipelines(struct sb_renderer *r)
     };
     res = sb_graphics_pipeline_create(r->vk, &shadow, &r->shadow_pipeline);
     /* scene.frag's specialization: what the pack holds */
-    const VkBool32 has[2] = {r->probe_count > 0, r->reflection_count > 0};
+    bool generic = r->params.generic_shaders;
+    const VkBool32 has[2] = {generic || r->probe_count > 0, generic || r->reflection_count > 0};
     const VkSpecializationMapEntry entries[2] = {
         {.constantID = 0, .offset = 0, .size = sizeof(VkBool32)},
         {.constantID = 1, .offset = sizeof(VkBool32), .size = sizeof(VkBool32)},
@@ -927,7 +928,8 @@ static void fill_frame(struct sb_renderer *r, const struct sb_view *v, struct sb
         double d = fmax(fabs(r->world_min_m[i] - v->camera_m[i]), fabs(r->world_max_m[i] - v->camera_m[i]));
         reach2 += d * d;
     }
-    r->aerial_volume_only = r->camera_in_atmosphere && sqrt(reach2) <= 0.99e3 * AERIAL_FAR_KM;
+    r->aerial_volume_only =
+        !r->params.generic_shaders && r->camera_in_atmosphere && sqrt(reach2) <= 0.99e3 * AERIAL_FAR_KM;
     store4(f->camera_forward, forward[0], forward[1], forward[2], cos(sun_radius));
     store4(f->sun_direction, sun[0], sun[1], sun[2], sun_radius);
     store4(f->shadow, 0.1, 1.5, r->params.shadow_size, 1.0);

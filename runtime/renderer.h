@@ -41,6 +41,9 @@ struct sb_renderer_params {
     int debug;                       /* SB_DEBUG_* (config.h): the scene pass writes one term; 0: the frame */
     bool whole_shadow_maps;          /* clear and draw every cascade whole, not only where casters
                                         project (runtime/shadows.h); the same frame, slower */
+    bool generic_shaders;            /* never the scene's shaders specialised to the pack (no probes, no
+                                        reflection probes) and the frame (aerial perspective from its
+                                        volume alone); the same frame, slower on llvmpipe */
 };
 
 /* What one frame looks at. Angles in radians; lengths in metres. */

@@ -303,6 +303,31 @@ static void test_shadow_boxes(struct sb_renderer *r, const struct sb_renderer_pa
     sb_renderer_destroy(&w);
 }
 
+/* The shaders specialised to the pack and the frame (the scene's fragments
+ * without the probes' and reflection probes' code the test pack does not
+ * need, aerial perspective from its volume alone) give the generic
+ * shaders' frames bit for bit. */
+static void test_specialised_shaders(struct sb_renderer *r, const struct sb_renderer_params *rp)
+{
+    struct sb_renderer_params generic_rp = *rp;
+    generic_rp.generic_shaders = true;
+    struct sb_renderer *g = NULL;
+    CHECK(sb_renderer_create(vk, &pack, &world, &generic_rp, &g) == SB_OK, "renderer with generic shaders");
+    struct sb_view views[2] = {base_view(), base_view()};
+    views[1].camera_m[1] = 40.0;
+    views[1].pitch = -40.0 * DEG;
+    views[1].sun_elevation = 4.0 * DEG;
+    for (int i = 0; i < 2 && g; i++) {
+        if (!render(r, &views[i]) || !render(g, &views[i]))
+            break;
+        float *a = frame_rgb(r), *b = frame_rgb(g);
+        CHECK(!memcmp(a, b, sizeof(float) * 3 * W * H), "view %d: the frame is the same as with generic shaders", i);
+        free(a);
+        free(b);
+    }
+    sb_renderer_destroy(&g);
+}
+
 static int compare_doubles(const void *a, const void *b)
 {
     double x = *(const double *)a, y = *(const double *)b;
@@ -1088,6 +1113,7 @@ int main(int argc, char **argv)
         test_sky_colours(r);
         test_shadows(r);
         test_shadow_boxes(r, &rp);
+        test_specialised_shaders(r, &rp);
         test_caster_boxes_bounded();
         test_exposure(r);
         /* Against a reference that reads the sun's transmittance from the
