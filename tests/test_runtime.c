@@ -240,6 +240,24 @@ static void test_caster_boxes_bounded(void)
  * (runtime/shadows.h): the texel box holds every caster vertex's texel with
  * a margin, is smaller than the map where the casters are few, and the
  * frames are the same, bit for bit, as with whole maps. */
+/* The frames of `n` views drawn by r and by a renderer made with `other`
+ * (a setting that must not change them, named by `what`), equal bit for bit. */
+static void check_same_frames(struct sb_renderer *r, const struct sb_renderer_params *other,
+                              const struct sb_view *views, int n, const char *what)
+{
+    struct sb_renderer *o = NULL;
+    CHECK(sb_renderer_create(vk, &pack, &world, other, &o) == SB_OK, "renderer with %s", what);
+    for (int i = 0; i < n && o; i++) {
+        if (!render(r, &views[i]) || !render(o, &views[i]))
+            break;
+        float *a = frame_rgb(r), *b = frame_rgb(o);
+        CHECK(!memcmp(a, b, sizeof(float) * 3 * W * H), "view %d: the frame is the same as with %s", i, what);
+        free(a);
+        free(b);
+    }
+    sb_renderer_destroy(&o);
+}
+
 static void test_shadow_boxes(struct sb_renderer *r, const struct sb_renderer_params *rp)
 {
     struct sb_caster_box *boxes;
@@ -290,17 +308,7 @@ static void test_shadow_boxes(struct sb_renderer *r, const struct sb_renderer_pa
 
     struct sb_renderer_params whole_rp = *rp;
     whole_rp.whole_shadow_maps = true;
-    struct sb_renderer *w = NULL;
-    CHECK(sb_renderer_create(vk, &pack, &world, &whole_rp, &w) == SB_OK, "renderer with whole shadow maps");
-    for (int i = 0; i < 3 && w; i++) {
-        if (!render(r, &views[i]) || !render(w, &views[i]))
-            break;
-        float *a = frame_rgb(r), *b = frame_rgb(w);
-        CHECK(!memcmp(a, b, sizeof(float) * 3 * W * H), "view %d: the frame is the same as with whole shadow maps", i);
-        free(a);
-        free(b);
-    }
-    sb_renderer_destroy(&w);
+    check_same_frames(r, &whole_rp, views, 3, "whole shadow maps");
 }
 
 /* The shaders specialised to the pack and the frame (the scene's fragments
@@ -311,21 +319,11 @@ static void test_specialised_shaders(struct sb_renderer *r, const struct sb_rend
 {
     struct sb_renderer_params generic_rp = *rp;
     generic_rp.generic_shaders = true;
-    struct sb_renderer *g = NULL;
-    CHECK(sb_renderer_create(vk, &pack, &world, &generic_rp, &g) == SB_OK, "renderer with generic shaders");
     struct sb_view views[2] = {base_view(), base_view()};
     views[1].camera_m[1] = 40.0;
     views[1].pitch = -40.0 * DEG;
     views[1].sun_elevation = 4.0 * DEG;
-    for (int i = 0; i < 2 && g; i++) {
-        if (!render(r, &views[i]) || !render(g, &views[i]))
-            break;
-        float *a = frame_rgb(r), *b = frame_rgb(g);
-        CHECK(!memcmp(a, b, sizeof(float) * 3 * W * H), "view %d: the frame is the same as with generic shaders", i);
-        free(a);
-        free(b);
-    }
-    sb_renderer_destroy(&g);
+    check_same_frames(r, &generic_rp, views, 2, "generic shaders");
 }
 
 static int compare_doubles(const void *a, const void *b)
