@@ -17,6 +17,7 @@
 
 #include "fog_apply.spv.h"
 #include "fog_inject.spv.h"
+#include "fog_inject_traced.spv.h"
 #include "fog_integrate.spv.h"
 
 #define FROXEL_FORMAT VK_FORMAT_R16G16B16A16_SFLOAT
@@ -96,7 +97,10 @@ static enum sb_result fog_create(struct sb_renderer *r)
     if (!res)
         res = upload_noise(r, f);
     if (!res)
-        res = sb_renderer_kernel(r, sb_spv_fog_inject, sizeof(sb_spv_fog_inject), "fog inject", &f->inject);
+        res = r->scene_traced
+                  ? sb_renderer_kernel(r, sb_spv_fog_inject_traced, sizeof(sb_spv_fog_inject_traced),
+                                       "fog inject (shadow rays)", &f->inject)
+                  : sb_renderer_kernel(r, sb_spv_fog_inject, sizeof(sb_spv_fog_inject), "fog inject", &f->inject);
     if (!res)
         res = sb_renderer_kernel(r, sb_spv_fog_integrate, sizeof(sb_spv_fog_integrate), "fog integrate", &f->integrate);
     if (!res)

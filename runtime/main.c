@@ -77,6 +77,11 @@ static void usage(FILE *f)
                "  --exposure EV           exposure compensation (default 0)\n"
                "  --no-bloom              no bloom\n"
                "  --shadow-size N         texels per side of each of the 4 cascades (default 2048)\n"
+               "  --scene auto|raster|traced\n"
+               "                          how the world is drawn: rasterised with cascaded shadow\n"
+               "                          maps, or one ray a pixel with shadow rays (exact, hard\n"
+               "                          shadows); auto: traced on a GPU, rasterised on a CPU\n"
+               "                          device (default)\n"
                "  --hdr                   also write the linear HDR frames, frame_0000.exr, ...\n"
                "  --bench                 time the passes: warm-up frames, then --frames frames;\n"
                "                          prints a table and writes OUT_DIR/bench.json\n"
@@ -190,6 +195,14 @@ static int parse_options(int argc, char **argv, struct options *o)
                                 : !strcmp(t, "gt")   ? SB_TONEMAP_GT
                                                      : -1;
             ok = o->params.tonemap >= 0;
+        } else if (!strcmp(a, "--scene") && next) {
+            const char *t = argv[++i];
+            int m = !strcmp(t, "auto")     ? SB_SCENE_AUTO
+                    : !strcmp(t, "raster") ? SB_SCENE_RASTER
+                    : !strcmp(t, "traced") ? SB_SCENE_TRACED
+                                           : -1;
+            ok = m >= 0;
+            o->params.scene = m >= 0 ? (enum sb_scene_method)m : SB_SCENE_AUTO;
         } else if (!strcmp(a, "--exposure") && next) {
             ok = parse_number(argv[++i], -20, 20, &v);
             o->params.exposure_compensation_ev = v;

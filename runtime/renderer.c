@@ -110,8 +110,11 @@ static const VkDescriptorType binding_types[SB_VIEW_BINDING_COUNT] = {
     [SB_VIEW_BINDING_CLOUD_DEPTH_OUT] = VK_DESCRIPTOR_TYPE_STORAGE_IMAGE,
     [SB_VIEW_BINDING_CLOUD_HISTORY] = VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER,
     [SB_VIEW_BINDING_CLOUD_OUT] = VK_DESCRIPTOR_TYPE_STORAGE_IMAGE,
+    [SB_VIEW_BINDING_BVH_NODES] = VK_DESCRIPTOR_TYPE_STORAGE_BUFFER,
+    [SB_VIEW_BINDING_BVH_TRIANGLES] = VK_DESCRIPTOR_TYPE_STORAGE_BUFFER,
+    [SB_VIEW_BINDING_DEPTH_OUT] = VK_DESCRIPTOR_TYPE_STORAGE_IMAGE,
 };
-_Static_assert(SB_VIEW_BINDING_COUNT == 43, "every binding has a type above");
+_Static_assert(SB_VIEW_BINDING_COUNT == 46, "every binding has a type above");
 
 void sb_renderer_bind_buffer(struct sb_renderer *r, uint32_t binding, const struct sb_buffer *buffer)
 {
@@ -144,6 +147,8 @@ static void bind_own(struct sb_renderer *r)
         {SB_VIEW_BINDING_PROBE_LIGHT, &r->probe_light},
         {SB_VIEW_BINDING_REFLECTIONS, &r->reflections},
         {SB_VIEW_BINDING_REFLECTION_CUBES, &r->reflection_cubes},
+        {SB_VIEW_BINDING_BVH_NODES, &r->bvh_nodes},
+        {SB_VIEW_BINDING_BVH_TRIANGLES, &r->bvh_triangles},
     };
     for (size_t i = 0; i < sizeof(buffers) / sizeof(buffers[0]); i++)
         sb_renderer_bind_buffer(r, buffers[i].binding, buffers[i].buffer);
@@ -160,6 +165,7 @@ static void bind_own(struct sb_renderer *r)
         {SB_VIEW_BINDING_SHADOW, r->shadow.view},
         {SB_VIEW_BINDING_HDR, r->hdr.view},
         {SB_VIEW_BINDING_DEPTH, r->depth.view},
+        {SB_VIEW_BINDING_DEPTH_OUT, r->scene_traced ? r->depth.view : r->depth_stand_in.view},
         {SB_VIEW_BINDING_BLOOM, r->bloom.subview_count ? r->bloom.subviews[0] : r->bloom.view},
         {SB_VIEW_BINDING_LDR, r->ldr.view},
     };
@@ -196,7 +202,7 @@ static void write_set(struct sb_renderer *r, VkDescriptorSet set, VkImageView bl
                            : b == SB_VIEW_BINDING_DEPTH  ? r->nearest /* depth formats need not filter */
                                                          : r->linear,
                 .imageView = view,
-                .imageLayout = b == SB_VIEW_BINDING_SHADOW || b == SB_VIEW_BINDING_DEPTH
+                .imageLayout = b == SB_VIEW_BINDING_SHADOW || (b == SB_VIEW_BINDING_DEPTH && !r->scene_traced)
                                    ? VK_IMAGE_LAYOUT_DEPTH_STENCIL_READ_ONLY_OPTIMAL
                                    : VK_IMAGE_LAYOUT_GENERAL,
             };
@@ -575,7 +581,7 @@ static enum sb_result create_images(struct sb_renderer *r)
 {
     const VkImageUsageFlags storage_sampled = VK_IMAGE_USAGE_STORAGE_BIT | VK_IMAGE_USAGE_SAMPLED_BIT;
     const VkImageUsageFlags copy = VK_IMAGE_USAGE_TRANSFER_SRC_BIT;
-    uint32_t s = r->params.shadow_size;
+    uint32_t s = r->scene_traced ? 1 : r->params.shadow_size; /* traced: never drawn nor read */
     uint32_t bw = r->width / 2 ? r->width / 2 : 1, bh = r->height / 2 ? r->height / 2 : 1;
     enum sb_result res = create_texture(r, &r->sky_view, SB_SKY_VIEW_WIDTH, SB_SKY_VIEW_HEIGHT, 1, 1, 1, SB_HDR_FORMAT,
                                         storage_sampled | copy, "sky-view LUT");
@@ -592,9 +598,16 @@ static enum sb_result create_images(struct sb_renderer *r)
     if (!res)
         res = create_texture(r, &r->hdr, r->width, r->height, 1, 1, 1, SB_HDR_FORMAT,
                              storage_sampled | copy | VK_IMAGE_USAGE_COLOR_ATTACHMENT_BIT, "HDR frame");
-    if (!res)
+    /* the traced scene writes its depth from a kernel, which a depth format cannot take */
+    if (!res && r->scene_traced)
+        res = create_texture(r, &r->depth, r->width, r->height, 1, 1, 1, VK_FORMAT_R32_SFLOAT, storage_sampled,
+                             "scene depth (traced)");
+    if (!res && !r->scene_traced)
         res = create_texture(r, &r->depth, r->width, r->height, 1, 1, 1, SB_DEPTH_FORMAT,
                              VK_IMAGE_USAGE_DEPTH_STENCIL_ATTACHMENT_BIT | VK_IMAGE_USAGE_SAMPLED_BIT, "scene depth");
+    if (!res && !r->scene_traced)
+        res = create_texture(r, &r->depth_stand_in, 1, 1, 1, 1, 1, VK_FORMAT_R32_SFLOAT, VK_IMAGE_USAGE_STORAGE_BIT,
+                             "traced depth stand-in");
     if (!res)
         res = create_texture(r, &r->bloom, bw, bh, 1, 1, r->bloom_levels > 1 ? r->bloom_levels : 2, SB_HDR_FORMAT,
                              storage_sampled, "bloom chain");
@@ -713,6 +726,7 @@ enum sb_result sb_renderer_create(struct sb_vk *vk, const struct sb_pack *pack, 
             r->bloom_levels++;
     r->vertex_count = world->vertex_count;
     r->caster_first_vertex = world->caster_first_vertex;
+    r->scene_traced = sb_scene_trace_wanted(&r->params, vk, world->vertex_count);
     for (int i = 0; i < 3; i++) {
         r->world_min_m[i] = world->vertex_count ? INFINITY : 0.0;
         r->world_max_m[i] = world->vertex_count ? -INFINITY : 0.0;
@@ -755,6 +769,8 @@ enum sb_result sb_renderer_create(struct sb_vk *vk, const struct sb_pack *pack, 
         res = create_layout(r);
     if (!res)
         res = create_pipelines(r);
+    if (!res)
+        res = sb_scene_trace_create(r, world);
     r->pack = pack;
     for (int p = 0; p < SB_PASS_COUNT && !res; p++)
         if (assert(pass_classes[p]), pass_classes[p]->create)
@@ -808,6 +824,7 @@ void sb_renderer_destroy(struct sb_renderer **pr)
     for (int p = SB_PASS_COUNT; p-- > 0;)
         if (pass_classes[p]->destroy)
             pass_classes[p]->destroy(r);
+    sb_scene_trace_destroy(r);
     const VkPipeline raster[] = {r->shadow_pipeline, r->scene_pipeline, r->scene_volume_pipeline};
     sb_renderer_release(r, r->kernels, KERNEL_COUNT, NULL, 0);
     sb_renderer_release(r, raster, 3, NULL, 0);
@@ -825,8 +842,8 @@ void sb_renderer_destroy(struct sb_renderer **pr)
         vkDestroySampler(d, r->shadow_compare, NULL);
     if (r->repeat)
         vkDestroySampler(d, r->repeat, NULL);
-    struct sb_texture *const textures[] = {&r->sky_view, &r->aerial, &r->aerial_t, &r->shadow,
-                                           &r->hdr,      &r->depth,  &r->bloom,    &r->ldr};
+    struct sb_texture *const textures[] = {&r->sky_view, &r->aerial, &r->aerial_t, &r->shadow,        &r->hdr,
+                                           &r->depth,    &r->bloom,  &r->ldr,      &r->depth_stand_in};
     sb_renderer_release(r, NULL, 0, textures, sizeof(textures) / sizeof(textures[0]));
     struct sb_buffer *buffers[] = {&r->atmosphere,  &r->transmittance,   &r->multiscattering, &r->irradiance_ground,
                                    &r->frame,       &r->vertices,        &r->exposure,        &r->read_ldr,
@@ -916,7 +933,7 @@ static void fill_frame(struct sb_renderer *r, const struct sb_view *v, struct sb
     double km[3] = {v->camera_m[0] * 1e-3, R + v->camera_m[1] * 1e-3, v->camera_m[2] * 1e-3};
     double altitude = sqrt(km[0] * km[0] + km[1] * km[1] + km[2] * km[2]) - R;
     const double sun_radius = 0.2666 * M_PI / 180.0; /* the sun's mean angular radius */
-    store4(f->camera_m, v->camera_m[0], v->camera_m[1], v->camera_m[2], 0.0);
+    store4(f->camera_m, v->camera_m[0], v->camera_m[1], v->camera_m[2], NEAR_M);
     store4(f->camera_km, km[0], km[1], km[2], altitude);
     /* the shaders' test, on the same fp32 values */
     r->camera_in_atmosphere = (float)altitude < r->thickness_km;
@@ -1025,6 +1042,8 @@ static void set_viewport(VkCommandBuffer cmd, uint32_t w, uint32_t h)
 
 static void record_shadows(struct sb_renderer *r)
 {
+    if (r->scene_traced) /* shadow rays instead */
+        return;
     uint32_t s = r->params.shadow_size;
     sb_texture_barrier(r->cmd, &r->shadow, VK_IMAGE_LAYOUT_UNDEFINED, DEPTH_WRITE); /* cleared anyway */
     vkCmdBindPipeline(r->cmd, VK_PIPELINE_BIND_POINT_GRAPHICS, r->shadow_pipeline);
@@ -1061,6 +1080,10 @@ static void record_shadows(struct sb_renderer *r)
 
 static void record_scene(struct sb_renderer *r)
 {
+    if (r->scene_traced) {
+        sb_scene_trace_record(r);
+        return;
+    }
     sb_texture_barrier(r->cmd, &r->hdr, VK_IMAGE_LAYOUT_UNDEFINED, VK_IMAGE_LAYOUT_COLOR_ATTACHMENT_OPTIMAL);
     sb_texture_barrier(r->cmd, &r->depth, VK_IMAGE_LAYOUT_UNDEFINED, DEPTH_WRITE);
     VkRenderingAttachmentInfo color = {
@@ -1310,4 +1333,14 @@ bool sb_renderer_project(const struct sb_renderer *r, const double world_m[3], d
     pixel[0] = (ndc[0] * 0.5 + 0.5) * r->width;
     pixel[1] = (ndc[1] * 0.5 + 0.5) * r->height;
     return true;
+}
+
+void sb_renderer_pixel_ray(const struct sb_renderer *r, const double pixel[2], double direction[3])
+{
+    struct sb_mat4 inv = sb_mat4_inverse(&r->view_proj);
+    double ndc[3] = {pixel[0] / r->width * 2.0 - 1.0, pixel[1] / r->height * 2.0 - 1.0, 0.5}, p[3];
+    sb_mat4_project(&inv, ndc, p);
+    double len = sqrt(p[0] * p[0] + p[1] * p[1] + p[2] * p[2]);
+    for (int i = 0; i < 3; i++)
+        direction[i] = p[i] / len;
 }

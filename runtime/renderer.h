@@ -20,6 +20,13 @@
 #include "pack.h"
 #include "world.h"
 
+/* How the scene pass finds the world's points (runtime/scene_trace.c). */
+enum sb_scene_method {
+    SB_SCENE_AUTO,   /* traced on a GPU, rasterised on a CPU device (llvmpipe) */
+    SB_SCENE_RASTER, /* rasterised, shadows from cascaded shadow maps */
+    SB_SCENE_TRACED, /* a ray a pixel through the world's BVH, shadows from shadow rays */
+};
+
 struct sb_renderer_params {
     uint32_t width, height;          /* 0: 1280 x 720 */
     uint32_t shadow_size;            /* texels per side of each cascade; 0: 2048 */
@@ -44,6 +51,7 @@ struct sb_renderer_params {
     bool generic_shaders;            /* never the scene's shaders specialised to the pack (no probes, no
                                         reflection probes) and the frame (aerial perspective from its
                                         volume alone); the same frame, slower on llvmpipe */
+    enum sb_scene_method scene;      /* how the scene pass finds the world's points */
 };
 
 /* What one frame looks at. Angles in radians; lengths in metres. */
@@ -120,5 +128,10 @@ void sb_renderer_exposure(const struct sb_renderer *renderer, float state[4]);
 /* Where a world point lands in the last frame's image (pixels, x right, y
  * down); false when it is behind the camera. */
 bool sb_renderer_project(const struct sb_renderer *renderer, const double world_m[3], double pixel[2]);
+
+/* The unit direction of the last frame's view ray through `pixel` (x
+ * right, y down; a pixel's centre is at its index plus one half), from the
+ * camera; the reverse of sb_renderer_project. */
+void sb_renderer_pixel_ray(const struct sb_renderer *renderer, const double pixel[2], double direction[3]);
 
 #endif

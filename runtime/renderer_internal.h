@@ -58,6 +58,7 @@ struct sb_renderer {
     bool camera_in_atmosphere;             /* this frame's: which sky kernel runs */
     double world_min_m[3], world_max_m[3]; /* the world's box */
     bool aerial_volume_only;               /* this frame's: which scene pipeline draws */
+    bool scene_traced;                     /* the scene pass traces (scene_trace.c): no cascades to draw */
 
     struct sb_buffer atmosphere, transmittance, multiscattering, irradiance_ground;
     struct sb_buffer frame, vertices, exposure;
@@ -82,7 +83,10 @@ struct sb_renderer {
     VkDescriptorSet bloom_sets[SB_BLOOM_SETS]; /* down steps 0..L-1, then up steps */
     VkPipeline kernels[KERNEL_COUNT];
     VkPipeline shadow_pipeline, scene_pipeline;
-    VkPipeline scene_volume_pipeline; /* aerial perspective from its volume alone (aerial.glsl) */
+    VkPipeline scene_volume_pipeline;          /* aerial perspective from its volume alone (aerial.glsl) */
+    VkPipeline scene_trace[2];                 /* traced: generic, aerial perspective from its volume alone */
+    struct sb_buffer bvh_nodes, bvh_triangles; /* the world's BVH when traced, else stand-ins */
+    struct sb_texture depth_stand_in;          /* the depth output's binding when rasterised */
 
     struct sb_fog *fog;       /* fog.c */
     struct sb_clouds *clouds; /* clouds.c */
@@ -106,6 +110,13 @@ struct sb_pass_class {
     void (*destroy)(struct sb_renderer *r);
     void (*record)(struct sb_renderer *r);
 };
+
+/* scene_trace.c: whether to trace the scene; the BVH and kernels (stand-ins
+ * when not traced), bound; a frame's traced scene pass. */
+bool sb_scene_trace_wanted(const struct sb_renderer_params *params, const struct sb_vk *vk, uint32_t vertex_count);
+enum sb_result sb_scene_trace_create(struct sb_renderer *r, const struct sb_world *world);
+void sb_scene_trace_destroy(struct sb_renderer *r);
+void sb_scene_trace_record(struct sb_renderer *r);
 
 extern const struct sb_pass_class sb_pass_fog;          /* fog.c: the froxel volume */
 extern const struct sb_pass_class sb_pass_fog_apply;    /* fog.c: the volume applied to the frame */

@@ -78,3 +78,29 @@ void sb_world_finish(struct sb_world *w)
     free(w->vertices);
     memset(w, 0, sizeof(*w));
 }
+
+enum sb_result sb_world_mesh(const struct sb_world *world, bool casters_only, struct sb_mesh *mesh)
+{
+    memset(mesh, 0, sizeof(*mesh));
+    uint32_t first = casters_only ? world->caster_first_vertex : 0;
+    uint32_t n = (world->vertex_count - first) / 3;
+    mesh->positions = malloc((size_t)n * 9 * sizeof(float) + 1);
+    mesh->indices = malloc((size_t)n * 3 * sizeof(uint32_t) + 1);
+    mesh->materials = malloc((size_t)n * sizeof(uint32_t) + 1);
+    mesh->material_list = calloc(2, sizeof(*mesh->material_list));
+    if (!mesh->positions || !mesh->indices || !mesh->materials || !mesh->material_list) {
+        sb_mesh_finish(mesh);
+        return SB_ERR_NOMEM;
+    }
+    for (uint32_t v = 0; v < 3 * n; v++) {
+        memcpy(&mesh->positions[3 * (size_t)v], world->vertices[first + v].position, 3 * sizeof(float));
+        mesh->indices[v] = v;
+    }
+    for (uint32_t t = 0; t < n; t++)
+        mesh->materials[t] = first + 3 * t >= world->caster_first_vertex;
+    mesh->material_list[1].casts_shadows = true;
+    mesh->vertex_count = 3 * n;
+    mesh->triangle_count = n;
+    mesh->material_count = 2;
+    return SB_OK;
+}

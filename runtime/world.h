@@ -8,6 +8,7 @@
 #ifndef SB_RUNTIME_WORLD_H
 #define SB_RUNTIME_WORLD_H
 
+#include <stdbool.h>
 #include <stddef.h>
 #include <stdint.h>
 
@@ -35,6 +36,12 @@ enum sb_result sb_world_load(const char *path, const struct sb_mesh_load_params 
 
 /* A world file's text; source names it in messages. */
 enum sb_result sb_world_parse(const char *json, size_t size, const char *source, struct sb_world *world);
+
+/* The world's triangles as a mesh (for a BVH, or Embree): triangle t is
+ * vertices 3t to 3t + 2 of all of them, or of those from
+ * caster_first_vertex on with casters_only; material 1 (casting shadows)
+ * or 0 (receiving only). */
+enum sb_result sb_world_mesh(const struct sb_world *world, bool casters_only, struct sb_mesh *mesh);
 
 /* Free the triangles; accepts a zeroed world. */
 void sb_world_finish(struct sb_world *world);

@@ -4,7 +4,8 @@
 // that includes this declares the node and triangle buffers as
 //   bvh_nodes[]: two vec4s a node (min, first; max, count),
 //   bvh_triangles[]: three vec4s a triangle (v0, triangle; e1, material; e2, -),
-// and then includes this file.
+// and then includes this file. With BVH_ANY_HIT_MATERIAL_0_PASSES defined,
+// an any-hit trace goes through the triangles of material 0.
 
 struct BvhHit {
     float t;
@@ -26,9 +27,13 @@ bool bvh_hit_box(uint node, vec3 o, vec3 inv_d, float tmin, float tmax, out floa
     return t0 <= t1;
 }
 
-bool bvh_hit_triangle(uint i, vec3 o, vec3 d, float tmin, float tmax, inout BvhHit hit)
+bool bvh_hit_triangle(uint i, vec3 o, vec3 d, float tmin, float tmax, bool any_hit, inout BvhHit hit)
 {
     vec4 v0 = bvh_triangles[3 * i], e1 = bvh_triangles[3 * i + 1], e2 = bvh_triangles[3 * i + 2];
+#ifdef BVH_ANY_HIT_MATERIAL_0_PASSES
+    if (any_hit && floatBitsToUint(e1.w) == 0u)
+        return false;
+#endif
     vec3 p = cross(d, e2.xyz);
     float det = dot(e1.xyz, p);
     if (det == 0.0)
@@ -78,7 +83,7 @@ BvhHit bvh_trace(vec3 o, vec3 d, float tmin, float tmax, bool any_hit)
         uint count = floatBitsToUint(bvh_nodes[2 * node + 1].w);
         if (count != 0u) {
             for (uint i = first; i < first + count; i++) {
-                if (bvh_hit_triangle(i, o, d, tmin, hit.t, hit) && any_hit)
+                if (bvh_hit_triangle(i, o, d, tmin, hit.t, any_hit, hit) && any_hit)
                     return hit;
             }
         } else {

@@ -209,7 +209,12 @@ struct sb_bake_push {
 #define SB_VIEW_BINDING_CLOUD_DEPTH_OUT 40  /* image2D r32f: the same, written */
 #define SB_VIEW_BINDING_CLOUD_HISTORY 41    /* sampler2D: the last frame's clouds at full resolution */
 #define SB_VIEW_BINDING_CLOUD_OUT 42        /* image2D rgba16f: this frame's, written */
-#define SB_VIEW_BINDING_COUNT 43
+#define SB_VIEW_BINDING_BVH_NODES 43        /* the world's BVH (geometry/bvh.h) when traced: its nodes */
+#define SB_VIEW_BINDING_BVH_TRIANGLES 44    /* its triangles; material 1: casts shadows, 0: does not */
+#define SB_VIEW_BINDING_DEPTH_OUT 45        /* image2D r32f: the traced scene's depth, written */
+#define SB_VIEW_BINDING_COUNT 46
+/* A shadow ray's reach: past any two points of a world (4 x SB_MESH_MAX_EXTENT_M, geometry/mesh.h). */
+#define SB_TRACE_FAR_M 4.0e4
 
 /* What the scene pass writes (sb_frame_gpu.size.w): the lit frame, or for
  * tests one term of it, in the pack's radiance units times the frame's
@@ -221,6 +226,7 @@ struct sb_bake_push {
 #define SB_DEBUG_CLOUDS 4             /* the clouds' in-scattering alone (rgb), before aerial perspective */
 #define SB_DEBUG_CLOUD_TRANSMITTANCE 5 /* the clouds' transmittance (grey) */
 #define SB_DEBUG_CLOUD_SHADOW 6       /* the scene: the clouds' transmittance toward the sun (grey) */
+#define SB_DEBUG_SUN_VISIBILITY 7     /* the scene: the sun's visibility, its shadows (grey) */
 
 #define SB_SKY_VIEW_WIDTH 192 /* azimuth from the sun, 0 to pi */
 #define SB_SKY_VIEW_HEIGHT 108 /* zenith angle, the horizon between rows 53 and 54 */
@@ -246,7 +252,7 @@ struct sb_frame_gpu {
     SB_MAT4(view_proj);        /* camera-relative world (m) to clip, reverse Z, infinite far */
     SB_MAT4(inv_view_proj);
     SB_MAT4(shadow_view_proj[SB_CASCADES]); /* camera-relative world (m) to each cascade's clip */
-    SB_VEC4(camera_m);         /* the camera in the world (m); w: unused */
+    SB_VEC4(camera_m);         /* the camera in the world (m); w: the near plane's distance (m) */
     SB_VEC4(camera_km);        /* planet-centred camera (km); w: its altitude (km) */
     SB_VEC4(camera_forward);   /* unit view direction, world; w: cos of the sun's angular radius */
     SB_VEC4(sun_direction);    /* unit vector toward the sun, world; w: sun's angular radius (rad) */

@@ -73,6 +73,8 @@ vec4 scene_shade(vec3 offset, vec3 n, vec3 albedo, vec2 metallic_roughness, vec2
     float clouds_t = cloud_sun_transmittance(offset + frame.camera_m.xyz);
     if (frame.size.w == SB_DEBUG_CLOUD_SHADOW)
         return vec4(vec3(clouds_t * frame.aerial.y), 1.0); /* read back divided by the scale */
+    if (frame.size.w == SB_DEBUG_SUN_VISIBILITY)
+        return vec4(vec3(visibility * frame.aerial.y), 1.0);
     vec3 color = brdf * e_sun * (n_dot_l * visibility * clouds_t);
 
     /* The world is low enough to read the ground row of irradiance_ground. */

@@ -8,9 +8,35 @@
  * band toward the next cascade. 1 beyond the last cascade, and outside the
  * box of a cascade's casters, where the map was neither cleared nor drawn
  * (frame.cascade_rect; runtime/shadows.h).
+ *
+ * With SB_TRACED_SHADOWS (the traced scene, runtime/scene_trace.c), a
+ * shadow ray instead: from the point, lifted off its surface along n,
+ * toward the sun's centre through the world's BVH, any caster ending it.
+ * Exact and hard (no penumbra, no filtering), at every distance.
  */
 #ifndef SB_SHADOWS_GLSL
 #define SB_SHADOWS_GLSL
+
+#ifdef SB_TRACED_SHADOWS
+layout(std430, set = 0, binding = SB_VIEW_BINDING_BVH_NODES) readonly buffer BvhNodes { vec4 bvh_nodes[]; };
+layout(std430, set = 0, binding = SB_VIEW_BINDING_BVH_TRIANGLES) readonly buffer BvhTriangles { vec4 bvh_triangles[]; };
+#define BVH_ANY_HIT_MATERIAL_0_PASSES /* receivers only (a ground) cast no shadow, as in the maps */
+#include "bvh.glsl"
+
+/* `pcf` is the raster's: a ray needs no filter. */
+float sun_visibility(vec3 offset, vec3 n, bool pcf)
+{
+    if (frame.shadow.w == 0.0)
+        return 1.0;
+    vec3 l = frame.sun_direction.xyz;
+    vec3 p = offset + frame.camera_m.xyz;
+    /* Off the surface by a few of fp32's steps at p (the hit point is good
+     * to about one), to the side the sun is on. */
+    float lift = 1e-3 + 4e-6 * max(abs(p.x), max(abs(p.y), abs(p.z)));
+    vec3 o = p + n * (dot(n, l) < 0.0 ? -lift : lift);
+    return bvh_trace(o, l, 0.0, SB_TRACE_FAR_M, true).triangle == SB_BVH_MISS ? 1.0 : 0.0;
+}
+#else
 
 layout(set = 0, binding = SB_VIEW_BINDING_SHADOW) uniform sampler2DArrayShadow shadow_map;
 
@@ -51,5 +77,6 @@ float sun_visibility(vec3 offset, vec3 n, bool pcf)
         visibility = mix(visibility, c + 1 < SB_CASCADES ? cascade_visibility(c + 1, offset, n, pcf) : 1.0, f);
     return visibility;
 }
+#endif /* SB_TRACED_SHADOWS */
 
 #endif

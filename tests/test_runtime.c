@@ -13,6 +13,7 @@
 #include "atmosphere_ref.h"
 #include "bake.h"
 #include "cube.h"
+#include "embree_ref.h"
 #include "harness_vk.h"
 #include "json.h"
 #include "log.h"
@@ -324,6 +325,167 @@ static void test_specialised_shaders(struct sb_renderer *r, const struct sb_rend
     views[1].pitch = -40.0 * DEG;
     views[1].sun_elevation = 4.0 * DEG;
     check_same_frames(r, &generic_rp, views, 2, "generic shaders");
+}
+
+/*
+ * The traced scene (runtime/scene_trace.c) against Embree and against the
+ * raster scene, on views with shadows near and far:
+ * - its shadows (the sun's visibility, SB_DEBUG_SUN_VISIBILITY) against
+ *   Embree's: a primary ray a pixel through its centre, then a shadow ray
+ *   toward the sun among the casters. They may differ only next to an
+ *   edge of the reference's picture (a triangle's or a shadow's), where a
+ *   ray grazes one and fp32 decides, never inside a region;
+ * - its frame against the raster frame where both see the same surface
+ *   with the same visibility (inside a triangle's region, the cascades'
+ *   filtered visibility exactly the ray's 0 or 1) and where both see the
+ *   sky: equal to within the two paths' own roundings, each value stored
+ *   in fp16 (2^-11 relative) once, so 2^-10 relative, plus fp32's share of
+ *   a surface point placed by interpolation or by a ray (1e-5).
+ */
+static bool pixel_edge(const uint32_t *ids, const uint8_t *lit, int x, int y)
+{
+    for (int j = -1; j <= 1; j++)
+        for (int i = -1; i <= 1; i++) {
+            int u = x + i, v = y + j;
+            if (u < 0 || v < 0 || u >= W || v >= H)
+                continue;
+            if (ids[v * W + u] != ids[y * W + x] || lit[v * W + u] != lit[y * W + x])
+                return true;
+        }
+    return false;
+}
+
+static void test_traced_scene(const struct sb_renderer_params *rp)
+{
+    struct sb_mesh all = {0}, casters = {0};
+    struct sb_embree e_all = {0}, e_casters = {0};
+    bool ok = sb_world_mesh(&world, false, &all) == SB_OK && sb_world_mesh(&world, true, &casters) == SB_OK;
+    ok = ok && sb_embree_create(&all, &e_all) && sb_embree_create(&casters, &e_casters);
+    CHECK(ok, "the world in Embree");
+    struct sb_renderer *rr[4] = {NULL}; /* raster, traced; each also writing the sun's visibility */
+    for (int k = 0; k < 4 && ok; k++) {
+        struct sb_renderer_params p = *rp;
+        p.scene = k & 1 ? SB_SCENE_TRACED : SB_SCENE_RASTER;
+        p.debug = k >= 2 ? SB_DEBUG_SUN_VISIBILITY : SB_DEBUG_NONE;
+        ok = sb_renderer_create(vk, &pack, &world, &p, &rr[k]) == SB_OK;
+        CHECK(ok, "renderer %d for the traced scene", k);
+    }
+    struct sb_view views[3] = {base_view(), base_view(), base_view()};
+    views[1].camera_m[1] = 40.0; /* from above: pillars' shadows in several cascades */
+    views[1].pitch = -40.0 * DEG;
+    views[2].sun_elevation = 4.0 * DEG; /* long shadows, reaching past the cascades */
+    views[2].sun_azimuth = 10.0 * DEG;
+    float *rays = malloc(sizeof(float) * 8 * W * H), *hits = malloc(sizeof(float) * 4 * W * H);
+    float *shadow_hits = malloc(sizeof(float) * 4 * W * H);
+    uint32_t *ids = malloc(sizeof(uint32_t) * W * H);
+    uint8_t *lit = malloc(W * H);
+    ok = ok && rays && hits && shadow_hits && ids && lit;
+    for (int vi = 0; vi < 3 && ok; vi++) {
+        const struct sb_view *v = &views[vi];
+        float *f[4] = {NULL};
+        for (int k = 0; k < 4; k++) {
+            ok = ok && render(rr[k], v);
+            f[k] = ok ? frame_rgb(rr[k]) : NULL;
+        }
+        if (!ok)
+            break;
+        double sun[3], forward[3];
+        sb_direction(v->sun_azimuth, v->sun_elevation, sun);
+        sb_direction(v->yaw, v->pitch, forward);
+        for (int y = 0; y < H; y++)
+            for (int x = 0; x < W; x++) {
+                double d[3], px[2] = {x + 0.5, y + 0.5};
+                sb_renderer_pixel_ray(rr[1], px, d);
+                float *ray = rays + 8 * (y * W + x);
+                for (int i = 0; i < 3; i++) {
+                    ray[i] = (float)v->camera_m[i];
+                    ray[4 + i] = (float)d[i];
+                }
+                ray[3] =
+                    (float)(0.1 / (d[0] * forward[0] + d[1] * forward[1] + d[2] * forward[2])); /* the near plane */
+                ray[7] = 1e30f;
+            }
+        sb_embree_cast(&e_all, rays, W * H, hits);
+        for (int i = 0; i < W * H; i++) {
+            uint32_t t;
+            memcpy(&t, &hits[4 * i + 1], sizeof(t));
+            ids[i] = t == SB_BVH_MISS ? SB_BVH_MISS : t & ~SB_BVH_BACK_FACE;
+            float *ray = rays + 8 * i;
+            if (ids[i] == SB_BVH_MISS) {
+                ray[3] = ray[7] = 0.0f; /* no shadow ray */
+                continue;
+            }
+            const float *n = world.vertices[3 * ids[i]].normal;
+            double n_l = n[0] * sun[0] + n[1] * sun[1] + n[2] * sun[2];
+            double p[3], big = 0.0;
+            for (int k = 0; k < 3; k++) {
+                p[k] = ray[k] + (double)ray[4 + k] * hits[4 * i];
+                big = fmax(big, fabs(p[k]));
+            }
+            double lift = (1e-3 + 4e-6 * big) * (n_l < 0.0 ? -1.0 : 1.0);
+            for (int k = 0; k < 3; k++) {
+                ray[k] = (float)(p[k] + n[k] * lift);
+                ray[4 + k] = (float)sun[k];
+            }
+            ray[3] = 0.0f;
+            ray[7] = n_l > 0.0 ? (float)SB_TRACE_FAR_M : 0.0f;
+        }
+        sb_embree_cast(&e_casters, rays, W * H, shadow_hits);
+        for (int i = 0; i < W * H; i++) {
+            uint32_t t;
+            memcpy(&t, &shadow_hits[4 * i + 1], sizeof(t));
+            lit[i] = ids[i] != SB_BVH_MISS && rays[8 * i + 7] > 0.0f && t == SB_BVH_MISS;
+        }
+        int inside_wrong = 0, edge_wrong = 0, surfaces = 0, compared = 0, differ = 0;
+        double worst = 0.0;
+        for (int y = 0; y < H; y++)
+            for (int x = 0; x < W; x++) {
+                int i = y * W + x;
+                bool edge = pixel_edge(ids, lit, x, y);
+                if (ids[i] != SB_BVH_MISS) {
+                    surfaces++;
+                    bool traced_lit = f[3][3 * i + 1] > 0.5f;
+                    if (traced_lit != (bool)lit[i]) {
+                        edge_wrong += edge;
+                        inside_wrong += !edge;
+                        if (!edge && inside_wrong <= 3)
+                            printf("view %d, pixel %d,%d: traced visibility %g, Embree's %d\n", vi, x, y,
+                                   f[3][3 * i + 1], lit[i]);
+                    }
+                }
+                if (edge || (ids[i] != SB_BVH_MISS && f[2][3 * i + 1] != (float)lit[i]))
+                    continue;
+                compared++;
+                for (int c = 0; c < 3; c++) {
+                    double a = f[0][3 * i + c], b = f[1][3 * i + c];
+                    double rel = fabs(a - b) / fmax(fmax(fabs(a), fabs(b)), 1e-30);
+                    worst = fmax(worst, rel);
+                    differ += rel > ldexp(1.0, -10) + 1e-5;
+                }
+            }
+        CHECK(inside_wrong == 0, "view %d: the traced shadows are Embree's inside every region (%d pixels differ)", vi,
+              inside_wrong);
+        CHECK(compared > W * H / 2, "view %d: %d pixels compared with the raster frame (over half)", vi, compared);
+        CHECK(differ == 0,
+              "view %d: the traced frame is the raster frame within 2^-10 + 1e-5 (%d values over; worst %.3g)", vi,
+              differ, worst);
+        printf("traced scene, view %d: shadows differ from Embree's at %d of %d surface pixels, at edges; "
+               "%d pixels equal to the raster frame's within %.3g\n",
+               vi, edge_wrong, surfaces, compared, worst);
+        for (int k = 0; k < 4; k++)
+            free(f[k]);
+    }
+    free(rays);
+    free(hits);
+    free(shadow_hits);
+    free(ids);
+    free(lit);
+    for (int k = 0; k < 4; k++)
+        sb_renderer_destroy(&rr[k]);
+    sb_embree_destroy(&e_all);
+    sb_embree_destroy(&e_casters);
+    sb_mesh_finish(&all);
+    sb_mesh_finish(&casters);
 }
 
 static int compare_doubles(const void *a, const void *b)
@@ -1112,6 +1274,7 @@ int main(int argc, char **argv)
         test_shadows(r);
         test_shadow_boxes(r, &rp);
         test_specialised_shaders(r, &rp);
+        test_traced_scene(&rp);
         test_caster_boxes_bounded();
         test_exposure(r);
         /* Against a reference that reads the sun's transmittance from the
