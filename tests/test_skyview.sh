@@ -21,6 +21,7 @@ check "no arguments is a usage error" expect_exit 2 "$skyview"
 check "no -o is a usage error" expect_exit 2 "$skyview" "$tmp/pack"
 check "bad --size is a usage error" expect_exit 2 "$skyview" "$tmp/pack" -o "$tmp/f" --size 64by36
 check "bad --tonemap is a usage error" expect_exit 2 "$skyview" "$tmp/pack" -o "$tmp/f" --tonemap reinhard
+check "bad --scene is a usage error" expect_exit 2 "$skyview" "$tmp/pack" -o "$tmp/f" --scene rays
 
 check "one frame" expect_exit 0 "$skyview" "$tmp/pack" -o "$tmp/f" $small --hdr
 check "a pack without the cloud noise has no clouds, and says so" grep -q "clouds: the pack has no cloud_shape.*no clouds" "$tmp/err"
@@ -37,6 +38,13 @@ check "three frames, each tone mapper" expect_exit 0 "$skyview" "$tmp/pack" -o "
 check "frame_0002.png" test -s "$tmp/g/frame_0002.png"
 check "aces" expect_exit 0 "$skyview" "$tmp/pack" -o "$tmp/g" $small --tonemap aces --no-bloom
 check "camera above the atmosphere" expect_exit 0 "$skyview" "$tmp/pack" -o "$tmp/g" $small --camera 0,1000000,0,0,-60,60
+# The traced scene (test_runtime checks its pixels); here the command line.
+check "the scene traced" expect_exit 0 "$skyview" "$tmp/pack" -o "$tmp/t" $small --scene traced --world "$root/data/worlds/colonnade.json"
+check "traced, camera above the atmosphere" expect_exit 0 "$skyview" "$tmp/pack" -o "$tmp/t" $small --scene traced --camera 0,1000000,0,0,-60,60
+check "the scene rasterised" expect_exit 0 "$skyview" "$tmp/pack" -o "$tmp/r" $small --scene raster
+if grep -q "on llvmpipe" "$tmp/err"; then
+    check "--scene auto rasterises on a CPU device" cmp -s "$tmp/elsewhere/frame_0000.png" "$tmp/r/frame_0000.png"
+fi
 
 check "bench" expect_exit 0 "$skyview" "$tmp/pack" -o "$tmp/b" $small --bench --frames 3 --warmup 1
 for pass in sky-view probes "aerial perspective" shadows scene sky exposure bloom tonemap total; do
