@@ -19,9 +19,7 @@ void main()
     uvec2 column = gl_GlobalInvocationID.xy;
     if (column.x >= SB_AERIAL_SIZE || column.y >= SB_AERIAL_SIZE)
         return;
-    vec2 ndc = (vec2(column) + 0.5) / float(SB_AERIAL_SIZE) * 2.0 - 1.0;
-    vec4 far_point = frame.inv_view_proj * vec4(ndc, 0.5, 1.0);
-    vec3 d = normalize(far_point.xyz / far_point.w);
+    vec3 d = view_ray((vec2(column) + 0.5) / float(SB_AERIAL_SIZE));
     vec3 p = frame.camera_km.xyz;
     float r = length(p);
     float h = max(r - ground_radius(), 0.0);

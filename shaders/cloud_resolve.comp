@@ -78,8 +78,7 @@ void main()
     if (any(greaterThanEqual(uvec2(pixel), frame.size.xy)))
         return;
     vec2 uv = (vec2(pixel) + 0.5) / vec2(frame.size.xy);
-    vec4 point = frame.inv_view_proj * vec4(uv * 2.0 - 1.0, 0.5, 1.0);
-    vec4 value = resolve(pixel, uv, normalize(point.xyz / point.w));
+    vec4 value = resolve(pixel, uv, view_ray(uv));
     imageStore(clouds_out, pixel, value);
     vec3 colour = imageLoad(hdr, pixel).rgb;
     if (frame.size.w == SB_DEBUG_CLOUDS)

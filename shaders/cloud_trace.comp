@@ -31,8 +31,7 @@ void main()
     uint s = clouds.trace.z;
     ivec2 pixel = min(ivec2(id * s + uvec2(clouds.trace.w % s, clouds.trace.w / s)), ivec2(frame.size.xy) - 1);
     vec2 uv = (vec2(pixel) + 0.5) / vec2(frame.size.xy);
-    vec4 point = frame.inv_view_proj * vec4(uv * 2.0 - 1.0, 0.5, 1.0);
-    vec3 d = normalize(point.xyz / point.w);
+    vec3 d = view_ray(uv);
     float depth = texelFetch(scene_depth, pixel, 0).r;
     float scene_m = 1e30;
     if (depth > 0.0) {

@@ -37,9 +37,7 @@ float froxel_w(float d)
 /* The view ray through froxel column xy (continuous: cell centres at + 0.5). */
 vec3 froxel_ray(vec2 xy)
 {
-    vec2 ndc = xy / vec2(fog.grid.xy) * 2.0 - 1.0;
-    vec4 p = frame.inv_view_proj * vec4(ndc, 0.5, 1.0);
-    return normalize(p.xyz / p.w);
+    return view_ray(xy / vec2(fog.grid.xy));
 }
 
 /* The height fog's extinction at world height y. */

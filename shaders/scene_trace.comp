@@ -24,8 +24,7 @@ void main()
     if (any(greaterThanEqual(uvec2(pixel), frame.size.xy)))
         return;
     vec2 uv = (vec2(pixel) + 0.5) / vec2(frame.size.xy);
-    vec4 point = frame.inv_view_proj * vec4(uv * 2.0 - 1.0, 0.5, 1.0);
-    vec3 d = normalize(point.xyz / point.w);
+    vec3 d = view_ray(uv);
     /* from the near plane on, as the rasteriser clips */
     float t_near = frame.camera_m.w / max(dot(d, frame.camera_forward.xyz), 1e-6);
     BvhHit hit = bvh_trace(frame.camera_m.xyz, d, t_near, 1e30, false);

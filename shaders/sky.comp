@@ -23,9 +23,7 @@ void main()
         return;
     if (texelFetch(scene_depth, pixel, 0).r != 0.0)
         return;
-    vec2 ndc = (vec2(pixel) + 0.5) / vec2(frame.size.xy) * 2.0 - 1.0;
-    vec4 point = frame.inv_view_proj * vec4(ndc, 0.5, 1.0);
-    vec3 d = normalize(point.xyz / point.w);
+    vec3 d = view_ray((vec2(pixel) + 0.5) / vec2(frame.size.xy));
     vec3 p = frame.camera_km.xyz;
     vec3 l = frame.sun_direction.xyz;
     float nu = clamp(dot(d, l), -1.0, 1.0);

@@ -18,6 +18,14 @@ layout(push_constant) uniform ViewPush {
     sb_view_push pc;
 };
 
+/* The unit view ray from the camera through uv of the frame (0 to 1, x
+ * right, y down; a pixel's centre is at (pixel + 0.5) / size). */
+vec3 view_ray(vec2 uv)
+{
+    vec4 point = frame.inv_view_proj * vec4(uv * 2.0 - 1.0, 0.5, 1.0);
+    return normalize(point.xyz / point.w);
+}
+
 /* Planet-centred position (km) of a camera-relative world offset (m). */
 vec3 planet_position(vec3 offset_m)
 {
