@@ -29,10 +29,13 @@ float sun_visibility(vec3 offset, vec3 n, bool pcf)
     if (frame.shadow.w == 0.0)
         return 1.0;
     vec3 l = frame.sun_direction.xyz;
-    vec3 p = offset + frame.camera_m.xyz;
-    /* Off the surface by a few of fp32's steps at p (the hit point is good
-     * to about one), to the side the sun is on. */
-    float lift = 1e-3 + 4e-6 * max(abs(p.x), max(abs(p.y), abs(p.z)));
+    vec3 c = abs(frame.camera_m.xyz), p = offset + frame.camera_m.xyz;
+    /* Off the surface, to the side the sun is on, by 1 mm and 4e-6 of the
+     * scale of the point's rounding: it was found from the camera at
+     * `offset` (a ray's t) and placed in the world (fp32 steps of |p| <=
+     * |camera| + |offset|), so the lift stays a fixed fraction of a pixel's
+     * footprint however far the camera is. */
+    float lift = 1e-3 + 4e-6 * (max(c.x, max(c.y, c.z)) + length(offset));
     vec3 o = p + n * (dot(n, l) < 0.0 ? -lift : lift);
     return bvh_trace(o, l, 0.0, SB_TRACE_FAR_M, true).triangle == SB_BVH_MISS ? 1.0 : 0.0;
 }

@@ -370,17 +370,21 @@ static void test_traced_scene(const struct sb_renderer_params *rp)
         ok = sb_renderer_create(vk, &pack, &world, &p, &rr[k]) == SB_OK;
         CHECK(ok, "renderer %d for the traced scene", k);
     }
-    struct sb_view views[3] = {base_view(), base_view(), base_view()};
+    struct sb_view views[4] = {base_view(), base_view(), base_view(), base_view()};
     views[1].camera_m[1] = 40.0; /* from above: pillars' shadows in several cascades */
     views[1].pitch = -40.0 * DEG;
     views[2].sun_elevation = 4.0 * DEG; /* long shadows, reaching past the cascades */
     views[2].sun_azimuth = 10.0 * DEG;
+    views[3].camera_m[1] = 8000.0; /* from 10 km through a telephoto: fp32 far from the camera */
+    views[3].camera_m[2] = 6000.0;
+    views[3].pitch = -atan2(8000.0, 6040.0);
+    views[3].fov_y = 1.0 * DEG;
     float *rays = malloc(sizeof(float) * 8 * W * H), *hits = malloc(sizeof(float) * 4 * W * H);
     float *shadow_hits = malloc(sizeof(float) * 4 * W * H);
     uint32_t *ids = malloc(sizeof(uint32_t) * W * H);
     uint8_t *lit = malloc(W * H);
     ok = ok && rays && hits && shadow_hits && ids && lit;
-    for (int vi = 0; vi < 3 && ok; vi++) {
+    for (int vi = 0; vi < 4 && ok; vi++) {
         const struct sb_view *v = &views[vi];
         float *f[4] = {NULL};
         for (int k = 0; k < 4; k++) {
@@ -417,12 +421,12 @@ static void test_traced_scene(const struct sb_renderer_params *rp)
             }
             const float *n = world.vertices[3 * ids[i]].normal;
             double n_l = n[0] * sun[0] + n[1] * sun[1] + n[2] * sun[2];
-            double p[3], big = 0.0;
+            double p[3], camera = 0.0; /* shadows.glsl's lift off the surface */
             for (int k = 0; k < 3; k++) {
                 p[k] = ray[k] + (double)ray[4 + k] * hits[4 * i];
-                big = fmax(big, fabs(p[k]));
+                camera = fmax(camera, fabs(v->camera_m[k]));
             }
-            double lift = (1e-3 + 4e-6 * big) * (n_l < 0.0 ? -1.0 : 1.0);
+            double lift = (1e-3 + 4e-6 * (camera + hits[4 * i])) * (n_l < 0.0 ? -1.0 : 1.0);
             for (int k = 0; k < 3; k++) {
                 ray[k] = (float)(p[k] + n[k] * lift);
                 ray[4 + k] = (float)sun[k];
