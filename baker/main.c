@@ -163,17 +163,11 @@ static bool common_option(int argc, char **argv, int *i, struct sb_vk_params *vk
     return true;
 }
 
-static bool validate_from_env(void)
-{
-    const char *env = getenv("SKYBAKE_VALIDATE");
-    return env && *env && strcmp(env, "0") != 0;
-}
-
 static int cmd_bake(int argc, char **argv)
 {
     const char *scene_path = NULL, *out_dir = NULL;
     struct sb_bake_options options = {0};
-    struct sb_vk_params params = {.validate = validate_from_env()};
+    struct sb_vk_params params = sb_vk_params_from_env();
     bool json = false;
     for (int i = 0; i < argc; i++) {
         const char *a = argv[i];
@@ -232,7 +226,7 @@ static int cmd_bake(int argc, char **argv)
 static int cmd_bench(int argc, char **argv)
 {
     const char *scene_path = NULL, *out_dir = NULL;
-    struct sb_vk_params vk_params = {.validate = validate_from_env()};
+    struct sb_vk_params vk_params = sb_vk_params_from_env();
     struct sb_bench_params params = {.repeat = 3};
     bool json = false, any = false;
     for (int i = 0; i < argc; i++) {
@@ -347,7 +341,7 @@ static int cmd_sky_error(int argc, char **argv)
 {
     const char *scenes[16];
     int scene_count = 0;
-    struct sb_vk_params vk_params = {.validate = validate_from_env()};
+    struct sb_vk_params vk_params = sb_vk_params_from_env();
     struct sb_sky_error_params params = {.seed = 1};
     bool json = false;
     for (int i = 0; i < argc; i++) {

@@ -123,11 +123,12 @@ static bool parse_number(const char *s, double lo, double hi, double *out)
 }
 
 struct options {
-    const char *pack, *out_dir, *device, *world;
+    const char *pack, *out_dir, *world;
+    struct sb_vk_params vk; /* the environment's, then --device and --validate */
     struct sb_renderer_params params;
     struct sb_view view;
     int frames, warmup;
-    bool validate, hdr, bench;
+    bool hdr, bench;
 };
 
 static int parse_options(int argc, char **argv, struct options *o)
@@ -143,8 +144,8 @@ static int parse_options(int argc, char **argv, struct options *o)
         .sun_azimuth = 150.0 * DEG,
         .sun_elevation = 30.0 * DEG,
     };
-    const char *env = getenv("SKYBAKE_VALIDATE");
-    o->validate = env && *env && strcmp(env, "0") != 0;
+    o->vk = sb_vk_params_from_env();
+    o->vk.graphics = true;
     for (int i = 0; i < argc; i++) {
         const char *a = argv[i];
         const char *next = i + 1 < argc ? argv[i + 1] : NULL;
@@ -245,9 +246,9 @@ static int parse_options(int argc, char **argv, struct options *o)
         } else if (!strcmp(a, "--bench"))
             o->bench = true;
         else if (!strcmp(a, "--device") && next)
-            o->device = argv[++i];
+            o->vk.device = argv[++i];
         else if (!strcmp(a, "--validate"))
-            o->validate = true;
+            o->vk.validate = true;
         else if (!strcmp(a, "-q") || !strcmp(a, "--quiet"))
             sb_log_set_level(SB_LOG_WARN);
         else if (!strcmp(a, "-v") || !strcmp(a, "--verbose"))
@@ -455,8 +456,7 @@ static int run(const struct options *o)
     struct sb_vk *vk = NULL;
     struct sb_renderer *r = NULL;
     struct sb_frame_timings *timings = NULL;
-    struct sb_vk_params vp = {.device = o->device, .validate = o->validate, .graphics = true};
-    enum sb_result res = sb_vk_create(&vp, &vk);
+    enum sb_result res = sb_vk_create(&o->vk, &vk);
     if (res) {
         code = res == SB_ERR_NO_DEVICE ? EXIT_NO_DEVICE : EXIT_RENDER_FAILED;
         goto done;

@@ -131,6 +131,35 @@ static enum sb_result pick_device(struct sb_vk *vk, const char *want)
     return SB_OK;
 }
 
+static bool has_device_extension(VkPhysicalDevice device, const char *name)
+{
+    uint32_t n = 0;
+    vkEnumerateDeviceExtensionProperties(device, NULL, &n, NULL);
+    VkExtensionProperties *ext = calloc(n ? n : 1, sizeof(*ext));
+    if (!ext)
+        return false;
+    vkEnumerateDeviceExtensionProperties(device, NULL, &n, ext);
+    bool found = false;
+    for (uint32_t i = 0; i < n && !found; i++)
+        found = strcmp(ext[i].extensionName, name) == 0;
+    free(ext);
+    return found;
+}
+
+static bool env_flag(const char *name)
+{
+    const char *env = getenv(name);
+    return env && *env && strcmp(env, "0") != 0;
+}
+
+struct sb_vk_params sb_vk_params_from_env(void)
+{
+    return (struct sb_vk_params){
+        .validate = env_flag("SKYBAKE_VALIDATE"),
+        .statistics = env_flag("SKYBAKE_PIPELINE_STATS"),
+    };
+}
+
 enum sb_result sb_vk_create(const struct sb_vk_params *params, struct sb_vk **out)
 {
     enum sb_result res = SB_OK;
@@ -260,9 +289,22 @@ enum sb_result sb_vk_create(const struct sb_vk_params *params, struct sb_vk **ou
         vk->depth_clamp = have.features.depthClamp;
         vk->graphics = true;
     }
+    VkPhysicalDevicePipelineExecutablePropertiesFeaturesKHR executable_features = {
+        .sType = VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_PIPELINE_EXECUTABLE_PROPERTIES_FEATURES_KHR,
+        .pNext = &features12,
+        .pipelineExecutableInfo = VK_TRUE,
+    };
+    const char *device_extensions[] = {VK_KHR_PIPELINE_EXECUTABLE_PROPERTIES_EXTENSION_NAME};
+    vk->statistics = params->statistics &&
+                     has_device_extension(vk->physical_device, VK_KHR_PIPELINE_EXECUTABLE_PROPERTIES_EXTENSION_NAME);
+    if (params->statistics && !vk->statistics)
+        sb_warn("%s does not report pipeline statistics (no %s)", vk->properties.deviceName,
+                VK_KHR_PIPELINE_EXECUTABLE_PROPERTIES_EXTENSION_NAME);
     VkDeviceCreateInfo device_info = {
         .sType = VK_STRUCTURE_TYPE_DEVICE_CREATE_INFO,
-        .pNext = &features12,
+        .pNext = vk->statistics ? (void *)&executable_features : (void *)&features12,
+        .enabledExtensionCount = vk->statistics ? 1 : 0,
+        .ppEnabledExtensionNames = device_extensions,
         .pEnabledFeatures = &features,
         .queueCreateInfoCount = 1,
         .pQueueCreateInfos = &queue_info,

@@ -24,7 +24,15 @@ struct sb_vk_params {
     /* Also rasterise: the queue must do graphics, and the device must offer
      * Vulkan 1.3 or dynamic rendering (skyview); else SB_ERR_NO_DEVICE. */
     bool graphics;
+    /* Log each compute pipeline's statistics as the driver reports them
+     * (VK_KHR_pipeline_executable_properties: registers, spills, workgroup
+     * memory), where the device offers the extension; ignored elsewhere. */
+    bool statistics;
 };
+
+/* The parameters the environment asks for: SKYBAKE_VALIDATE and
+ * SKYBAKE_PIPELINE_STATS (set and not "0"). */
+struct sb_vk_params sb_vk_params_from_env(void);
 
 struct sb_vk {
     VkInstance instance;
@@ -41,6 +49,7 @@ struct sb_vk {
     bool graphics;    /* created with sb_vk_params.graphics */
     bool depth_clamp; /* the depthClamp feature is enabled */
     bool has_timestamps;
+    bool statistics; /* pipelines capture their statistics (sb_vk_params.statistics) */
     double timestamp_period_ns;
     unsigned validation_messages;
     PFN_vkSetDebugUtilsObjectNameEXT set_object_name;

@@ -1,5 +1,7 @@
 #include "pipeline.h"
 
+#include <stdio.h>
+
 #include "log.h"
 
 static enum sb_result shader_module(struct sb_vk *vk, const uint32_t *spirv, size_t size, VkShaderModule *module)
@@ -13,6 +15,54 @@ static enum sb_result shader_module(struct sb_vk *vk, const uint32_t *spirv, siz
     VK(vkCreateShaderModule(vk->device, &info, NULL, module));
 cleanup:
     return res;
+}
+
+/* Log what the driver says of the pipeline's code, one line per executable:
+ * "NAME (EXECUTABLE): Register Count 64, ..." as it names them. */
+static void log_statistics(struct sb_vk *vk, VkPipeline pipeline, const char *name)
+{
+    PFN_vkGetPipelineExecutablePropertiesKHR get_properties =
+        (PFN_vkGetPipelineExecutablePropertiesKHR)vkGetDeviceProcAddr(vk->device, "vkGetPipelineExecutablePropertiesKHR");
+    PFN_vkGetPipelineExecutableStatisticsKHR get_statistics =
+        (PFN_vkGetPipelineExecutableStatisticsKHR)vkGetDeviceProcAddr(vk->device, "vkGetPipelineExecutableStatisticsKHR");
+    if (!get_properties || !get_statistics)
+        return;
+    VkPipelineInfoKHR info = {.sType = VK_STRUCTURE_TYPE_PIPELINE_INFO_KHR, .pipeline = pipeline};
+    VkPipelineExecutablePropertiesKHR executables[4];
+    uint32_t n = 4;
+    for (uint32_t i = 0; i < n; i++)
+        executables[i] = (VkPipelineExecutablePropertiesKHR){.sType = VK_STRUCTURE_TYPE_PIPELINE_EXECUTABLE_PROPERTIES_KHR};
+    if (get_properties(vk->device, &info, &n, executables) < 0)
+        return;
+    for (uint32_t e = 0; e < n; e++) {
+        VkPipelineExecutableInfoKHR which = {
+            .sType = VK_STRUCTURE_TYPE_PIPELINE_EXECUTABLE_INFO_KHR,
+            .pipeline = pipeline,
+            .executableIndex = e,
+        };
+        VkPipelineExecutableStatisticKHR stats[32];
+        uint32_t count = 32;
+        for (uint32_t i = 0; i < count; i++)
+            stats[i] = (VkPipelineExecutableStatisticKHR){.sType = VK_STRUCTURE_TYPE_PIPELINE_EXECUTABLE_STATISTIC_KHR};
+        if (get_statistics(vk->device, &which, &count, stats) < 0)
+            continue;
+        char line[1024];
+        int len = snprintf(line, sizeof(line), "%s (%s):", name, executables[e].name);
+        for (uint32_t i = 0; i < count && len > 0 && (size_t)len < sizeof(line); i++) {
+            const VkPipelineExecutableStatisticKHR *st = &stats[i];
+            const char *sep = i ? "," : "";
+            size_t room = sizeof(line) - (size_t)len;
+            if (st->format == VK_PIPELINE_EXECUTABLE_STATISTIC_FORMAT_BOOL32_KHR)
+                len += snprintf(line + len, room, "%s %s %s", sep, st->name, st->value.b32 ? "yes" : "no");
+            else if (st->format == VK_PIPELINE_EXECUTABLE_STATISTIC_FORMAT_INT64_KHR)
+                len += snprintf(line + len, room, "%s %s %lld", sep, st->name, (long long)st->value.i64);
+            else if (st->format == VK_PIPELINE_EXECUTABLE_STATISTIC_FORMAT_UINT64_KHR)
+                len += snprintf(line + len, room, "%s %s %llu", sep, st->name, (unsigned long long)st->value.u64);
+            else
+                len += snprintf(line + len, room, "%s %s %g", sep, st->name, st->value.f64);
+        }
+        sb_info("%s", line);
+    }
 }
 
 enum sb_result sb_compute_pipeline_create(struct sb_vk *vk, VkPipelineLayout layout, const uint32_t *spirv,
@@ -33,9 +83,12 @@ enum sb_result sb_compute_pipeline_create(struct sb_vk *vk, VkPipelineLayout lay
                 .pName = "main",
             },
         .layout = layout,
+        .flags = vk->statistics ? VK_PIPELINE_CREATE_CAPTURE_STATISTICS_BIT_KHR : 0,
     };
     VK(vkCreateComputePipelines(vk->device, VK_NULL_HANDLE, 1, &info, NULL, pipeline));
     sb_vk_name(vk, VK_OBJECT_TYPE_PIPELINE, (uint64_t)*pipeline, name);
+    if (vk->statistics)
+        log_statistics(vk, *pipeline, name);
 cleanup:
     vkDestroyShaderModule(vk->device, module, NULL);
     return res;
