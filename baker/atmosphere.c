@@ -7,13 +7,14 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "irradiance_ground.spv.h"
+#include "irradiance_ground_gpu.spv.h"
 #include "irradiance_ground_bruneton.spv.h"
 #include "irradiance_ground_shared.spv.h"
-#include "irradiance_sky.spv.h"
+#include "irradiance_sky_gpu.spv.h"
 #include "irradiance_sky_shared.spv.h"
 #include "log.h"
 #include "multiscattering.spv.h"
+#include "multiscattering_gpu.spv.h"
 #include "multiscattering_hillaire.spv.h"
 #include "physics.h"
 #include "sun_columns.spv.h"
@@ -62,11 +63,16 @@ static const struct sb_atmosphere_product products[SB_ATMOSPHERE_PRODUCT_COUNT] 
 struct spirv {
     const uint32_t *words;
     size_t size;
+    uint32_t threads; /* a sphere.glsl kernel's workgroup size */
 };
 
 #define SPIRV(name)                                                                                                    \
     {                                                                                                                  \
-        sb_spv_##name, sizeof(sb_spv_##name)                                                                           \
+        sb_spv_##name, sizeof(sb_spv_##name), SB_SPHERE_THREADS_CPU                                                    \
+    }
+#define SPIRV_GPU(name)                                                                                                \
+    {                                                                                                                  \
+        sb_spv_##name, sizeof(sb_spv_##name), SB_SPHERE_THREADS_GPU                                                    \
     }
 /* Transmittance: one shader per Gauss-Legendre order, 0 for the uniform rules (config.h). */
 static const struct spirv transmittance_shaders[SB_GL_MAX_ORDER + 1] = {
@@ -74,23 +80,26 @@ static const struct spirv transmittance_shaders[SB_GL_MAX_ORDER + 1] = {
     SPIRV(transmittance_gl3), SPIRV(transmittance_gl4), SPIRV(transmittance_gl5),
     SPIRV(transmittance_gl6), SPIRV(transmittance_gl7), SPIRV(transmittance_gl8),
 };
-/* The scattering products [0], and [1] with the irradiance bakes reading the
- * multiscattering LUT from workgroup memory (atmosphere.glsl), which a CPU
- * device runs when it offers that memory (workgroup_copy). Both compute the
- * same sums. On the H100, workgroup memory took irradiance_sky from 6.1 to
- * 8.5 ms (irradiance_ground 1.13 -> 1.05 ms); on llvmpipe, from 10.7 to
- * 8.2 s (1.46 -> 1.25 s). */
+/* The scattering products as a GPU runs them [SB_ATMOSPHERE_KERNELS_GPU],
+ * SB_SPHERE_THREADS_GPU invocations a texel (config.h), and as a CPU device
+ * does [SB_ATMOSPHERE_KERNELS_CPU], with the irradiance bakes reading the
+ * multiscattering LUT from workgroup memory (atmosphere.glsl). Both compute
+ * the same sums in another order. On the H100, workgroup memory took
+ * irradiance_sky from 6.1 to 8.5 ms (irradiance_ground 1.13 -> 1.05 ms); on
+ * llvmpipe, from 10.7 to 8.2 s (1.46 -> 1.25 s). */
 static const struct spirv scattering_shaders[2][SB_ATMOSPHERE_PRODUCT_COUNT] = {
-    {
-        [SB_PRODUCT_MULTISCATTERING] = SPIRV(multiscattering),
-        [SB_PRODUCT_IRRADIANCE_GROUND] = SPIRV(irradiance_ground),
-        [SB_PRODUCT_IRRADIANCE_SKY] = SPIRV(irradiance_sky),
-    },
-    {
-        [SB_PRODUCT_MULTISCATTERING] = SPIRV(multiscattering),
-        [SB_PRODUCT_IRRADIANCE_GROUND] = SPIRV(irradiance_ground_shared),
-        [SB_PRODUCT_IRRADIANCE_SKY] = SPIRV(irradiance_sky_shared),
-    },
+    [SB_ATMOSPHERE_KERNELS_GPU] =
+        {
+            [SB_PRODUCT_MULTISCATTERING] = SPIRV_GPU(multiscattering_gpu),
+            [SB_PRODUCT_IRRADIANCE_GROUND] = SPIRV_GPU(irradiance_ground_gpu),
+            [SB_PRODUCT_IRRADIANCE_SKY] = SPIRV_GPU(irradiance_sky_gpu),
+        },
+    [SB_ATMOSPHERE_KERNELS_CPU] =
+        {
+            [SB_PRODUCT_MULTISCATTERING] = SPIRV(multiscattering),
+            [SB_PRODUCT_IRRADIANCE_GROUND] = SPIRV(irradiance_ground_shared),
+            [SB_PRODUCT_IRRADIANCE_SKY] = SPIRV(irradiance_sky_shared),
+        },
 };
 /* skybake bench's anchors: Hillaire 2020's multiple-scattering LUT and
  * Bruneton 2017's ground irradiance (config.h), by product. */
@@ -102,11 +111,14 @@ static const struct spirv anchor_shaders[SB_ATMOSPHERE_PRODUCT_COUNT] = {
 static const struct spirv sun_columns_shader = SPIRV(sun_columns);
 #undef SPIRV
 
-/* Whether the scattering bakes take scattering_shaders[1] on this device. */
-static bool workgroup_copy(const struct sb_vk *vk)
+/* The kernels a device runs: a CPU device's where it offers their
+ * workgroup memory. */
+static enum sb_atmosphere_kernels device_kernels(const struct sb_vk *vk)
 {
     return vk->properties.deviceType == VK_PHYSICAL_DEVICE_TYPE_CPU &&
-           vk->properties.limits.maxComputeSharedMemorySize >= SB_SPHERE_SHARED_BYTES;
+                   vk->properties.limits.maxComputeSharedMemorySize >= SB_SPHERE_SHARED_BYTES
+               ? SB_ATMOSPHERE_KERNELS_CPU
+               : SB_ATMOSPHERE_KERNELS_GPU;
 }
 
 /* A scattering product's setting of the published methods (bench anchors). */
@@ -253,6 +265,7 @@ struct sb_atmosphere_baker {
     struct sb_buffer outputs[SB_ATMOSPHERE_PRODUCT_COUNT];
     struct sb_buffer lookups[SB_ATMOSPHERE_PRODUCT_COUNT]; /* the form later bakes read (config.h) */
     bool sky_cap; /* irradiance_sky integrates Mie's peak on a cap (sphere.glsl) */
+    enum sb_atmosphere_kernels kernels;
 };
 
 enum sb_result sb_atmosphere_baker_create(struct sb_vk *vk, const struct sb_atmosphere_params *params,
@@ -264,6 +277,7 @@ enum sb_result sb_atmosphere_baker_create(struct sb_vk *vk, const struct sb_atmo
         return SB_ERR_NOMEM;
     b->vk = vk;
     b->sky_cap = fabs(params->mie_g) >= SB_CAP_MIN_G;
+    b->kernels = device_kernels(vk);
     struct sb_atmosphere_gpu gpu;
     sb_atmosphere_gpu_pack(params, &gpu);
     enum sb_result res = sb_buffer_create(vk, sizeof(gpu), "atmosphere parameters", &b->params);
@@ -275,6 +289,15 @@ enum sb_result sb_atmosphere_baker_create(struct sb_vk *vk, const struct sb_atmo
     }
     memcpy(b->params.mapped, &gpu, sizeof(gpu));
     *out = b;
+    return SB_OK;
+}
+
+enum sb_result sb_atmosphere_baker_set_kernels(struct sb_atmosphere_baker *b, enum sb_atmosphere_kernels kernels)
+{
+    if (kernels == SB_ATMOSPHERE_KERNELS_CPU &&
+        b->vk->properties.limits.maxComputeSharedMemorySize < SB_SPHERE_SHARED_BYTES)
+        return SB_ERR_DEVICE_LIMIT;
+    b->kernels = kernels;
     return SB_OK;
 }
 
@@ -305,7 +328,7 @@ void sb_atmosphere_baker_destroy(struct sb_atmosphere_baker **pb)
  * pass on a GPU), the partial sums kept
  * in the scratch buffer; *gpu_ms sums the passes.
  */
-static enum sb_result run(struct sb_atmosphere_baker *b, const uint32_t *spirv, size_t spirv_size, const char *name,
+static enum sb_result run(struct sb_atmosphere_baker *b, const struct spirv *kernel, const char *name,
                           struct sb_buffer *output, uint32_t width, uint32_t height, uint64_t directions,
                           bool group_per_texel, const struct sb_atmosphere_settings *s, double *gpu_ms)
 {
@@ -323,8 +346,8 @@ static enum sb_result run(struct sb_atmosphere_baker *b, const uint32_t *spirv, 
     enum sb_result res = SB_OK;
     bool workgroup_per_texel = directions > 0;
     if (workgroup_per_texel) {
-        push.step_count = (uint32_t)((directions + SB_SPHERE_THREADS - 1) / SB_SPHERE_THREADS);
-        size_t bytes = 16 + (size_t)width * height * SB_SPHERE_THREADS * SB_SPHERE_MAX_SUMS * sizeof(float);
+        push.step_count = (uint32_t)((directions + kernel->threads - 1) / kernel->threads);
+        size_t bytes = 16 + (size_t)width * height * kernel->threads * SB_SPHERE_MAX_SUMS * sizeof(float);
         if (b->scratch.size < bytes) {
             sb_buffer_destroy(b->vk, &b->scratch);
             if ((res = sb_buffer_create(b->vk, bytes, "sphere scratch", &b->scratch)))
@@ -336,8 +359,8 @@ static enum sb_result run(struct sb_atmosphere_baker *b, const uint32_t *spirv, 
 
     struct sb_pipeline pipeline = {0};
     struct sb_pipeline_params pp = {
-        .spirv = spirv,
-        .spirv_size = spirv_size,
+        .spirv = kernel->words,
+        .spirv_size = kernel->size,
         .binding_count = SB_BINDING_COUNT,
         .push_size = sizeof(struct sb_bake_push),
         .name = name,
@@ -391,7 +414,7 @@ static enum sb_result build_sun_columns(struct sb_atmosphere_baker *b, double *g
         return res;
     const struct sb_atmosphere_settings none = {0};
     double ms = 0;
-    res = run(b, sun_columns_shader.words, sun_columns_shader.size, "sun columns", &b->sun_columns,
+    res = run(b, &sun_columns_shader, "sun columns", &b->sun_columns,
               SB_SUN_COLUMNS_X + 2, 2 * (SB_SUN_COLUMNS_U + 2), 0, false, &none, &ms);
     if (res)
         sb_buffer_destroy(b->vk, &b->sun_columns);
@@ -444,7 +467,7 @@ enum sb_result sb_atmosphere_bake(struct sb_atmosphere_baker *b, enum sb_product
     const struct spirv *shader =
         id == SB_PRODUCT_TRANSMITTANCE
             ? &transmittance_shaders[s.quadrature == SB_QUADRATURE_GAUSS_LEGENDRE ? s.samples : 0]
-            : (anchor ? &anchor_shaders[id] : &scattering_shaders[workgroup_copy(b->vk)][id]);
+            : (anchor ? &anchor_shaders[id] : &scattering_shaders[b->kernels][id]);
     bool cap = id == SB_PRODUCT_IRRADIANCE_GROUND || (id == SB_PRODUCT_IRRADIANCE_SKY && b->sky_cap);
     uint64_t directions = prod->workgroup_per_texel && !anchor ? sphere_directions(&s, cap) : 0;
     /* The sun table is built afresh by every multiscattering bake, the
@@ -453,7 +476,7 @@ enum sb_result sb_atmosphere_bake(struct sb_atmosphere_baker *b, enum sb_product
     if (directions && (id == SB_PRODUCT_MULTISCATTERING || !b->sun_columns.buffer) &&
         (res = build_sun_columns(b, &table_ms)))
         goto cleanup;
-    res = run(b, shader->words, shader->size, sb_product_name(id), &b->outputs[id], width, height, directions, anchor,
+    res = run(b, shader, sb_product_name(id), &b->outputs[id], width, height, directions, anchor,
               &s, &product_ms);
     if (gpu_ms)
         *gpu_ms = table_ms + product_ms;
@@ -501,8 +524,8 @@ void sb_atmosphere_code_hash(enum sb_product_id id, char out[SB_HASH_HEX_SIZE])
         for (int i = 0; i <= SB_GL_MAX_ORDER; i++)
             shaders[count++] = &transmittance_shaders[i];
     else
-        for (int cpu = 0; cpu < 2; cpu++)
-            shaders[count++] = &scattering_shaders[cpu][id];
+        for (int k = 0; k < 2; k++)
+            shaders[count++] = &scattering_shaders[k][id];
     for (int i = 0; i < count; i++) {
         sb_hash_bytes(shaders[i]->words, shaders[i]->size, text + n);
         n += SB_HASH_HEX_SIZE - 1;
@@ -547,7 +570,8 @@ enum sb_result sb_atmosphere_run_kernel(struct sb_atmosphere_baker *b, const uin
     uint32_t width = record_count < per_row ? record_count : per_row;
     uint32_t height = (record_count + per_row - 1) / per_row;
     struct sb_atmosphere_settings s = {.directions_mu = record_count, .directions_phi = record_floats};
-    res = run(b, spirv, spirv_size, "kernel", &io, width, height, 0, false, &s, NULL);
+    const struct spirv kernel = {spirv, spirv_size, 0};
+    res = run(b, &kernel, "kernel", &io, width, height, 0, false, &s, NULL);
     if (!res)
         memcpy(records, io.mapped, bytes);
     sb_buffer_destroy(b->vk, &io);

@@ -55,6 +55,19 @@ enum sb_result sb_atmosphere_baker_create(struct sb_vk *vk, const struct sb_atmo
                                           struct sb_atmosphere_baker **baker);
 void sb_atmosphere_baker_destroy(struct sb_atmosphere_baker **baker);
 
+/* The scattering bakes' kernels as laid out for either kind of device
+ * (config.h, SB_SPHERE_THREADS_*): the same sums in another order. */
+enum sb_atmosphere_kernels {
+    SB_ATMOSPHERE_KERNELS_GPU,
+    SB_ATMOSPHERE_KERNELS_CPU, /* narrower; the irradiance bakes copy the multiscattering LUT to workgroup memory */
+};
+
+/* Bake with the other kind's kernels from now on (tests compare the two on
+ * one device); a baker starts with its device's. A CPU device's kernels
+ * need SB_SPHERE_SHARED_BYTES of workgroup memory: SB_ERR_DEVICE_LIMIT
+ * where the device has less. */
+enum sb_result sb_atmosphere_baker_set_kernels(struct sb_atmosphere_baker *baker, enum sb_atmosphere_kernels kernels);
+
 /*
  * Bake one product into `image` (initialised here; the caller finishes it).
  * Its dependencies must have been baked by this baker first. `settings` may

@@ -27,8 +27,22 @@
 #define SB_WORKGROUP_Y 8
 
 /* Scattering bakes (sphere.glsl) run one workgroup of SB_SPHERE_THREADS per
- * texel; each invocation sums at most SB_SPHERE_MAX_SUMS values. */
-#define SB_SPHERE_THREADS 64
+ * texel; each invocation sums at most SB_SPHERE_MAX_SUMS values. A GPU runs
+ * the kernels built with SB_SPHERE_GPU defined, SB_SPHERE_THREADS_GPU wide: at 64 an H100 holds six of
+ * these workgroups an SM (159 to 168 registers an invocation), and the
+ * 1024 texels of the multiscattering LUT take two uneven waves; at 128 the
+ * default multiscattering bake took 2.70 ms instead of 3.43, irradiance_ground
+ * 0.66 instead of 1.13 and irradiance_sky 4.71 instead of 6.02 (256: 2.55,
+ * 0.59, 4.60, but the cheap settings twice as slow). llvmpipe is faster at 64
+ * (the default bake 9.3 s, 15.7 at 128). The sums' order, and so the last
+ * bits, differ between the two. */
+#define SB_SPHERE_THREADS_CPU 64
+#define SB_SPHERE_THREADS_GPU 128
+#ifdef SB_SPHERE_GPU
+#define SB_SPHERE_THREADS SB_SPHERE_THREADS_GPU
+#else
+#define SB_SPHERE_THREADS SB_SPHERE_THREADS_CPU
+#endif
 #define SB_SPHERE_MAX_SUMS 9
 /* Directions per invocation in one dispatch (sphere.glsl): the passes keep
  * every invocation far below llvmpipe's 65535 loop iterations. */
@@ -45,7 +59,7 @@
  * llvmpipe's 32 KiB; the baker takes the copy only where the device's limit
  * allows it. */
 #define SB_SPHERE_SHARED_BYTES                                                                             \
-    (4 * (2 * SB_MAX_DIRECTIONS_MU + 2 * SB_MAX_DIRECTIONS_PHI + SB_SPHERE_THREADS * SB_SPHERE_MAX_SUMS) \
+    (4 * (2 * SB_MAX_DIRECTIONS_MU + 2 * SB_MAX_DIRECTIONS_PHI + SB_SPHERE_THREADS_CPU * SB_SPHERE_MAX_SUMS) \
      + 16 * SB_MULTISCATTERING_LOOKUP_TEXELS)
 /* Mie single scattering's cap around its peak (sphere.glsl): over the whole
  * sphere, for |g| >= SB_CAP_MIN_G, radius SB_CAP_THETA (radians), the

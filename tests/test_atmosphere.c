@@ -566,6 +566,52 @@ static void test_many_directions(struct sb_atmosphere_baker *baker)
     sb_image_finish(&many);
 }
 
+/*
+ * The kernels laid out for a GPU (wider workgroups, the multiscattering LUT
+ * read from its buffer) and for a CPU device (narrower, the LUT copied to
+ * workgroup memory) must compute the same sums: both bake each scattering
+ * product on this device, at a sixteenth of its texels, and agree to
+ * within fp32's rounding of ~1e3 positive terms summed in another order
+ * (a few 1e-7; the bound leaves a factor 10 to 30). One direction missed
+ * or weighted twice moves a texel by more than 1e-4. irradiance_sky first:
+ * a bake at another resolution is a measurement and drops the product's
+ * lookup, which the products before it in the bake order read.
+ */
+static void test_kernel_layouts(struct sb_atmosphere_baker *baker)
+{
+    static const enum sb_product_id ids[] = {SB_PRODUCT_IRRADIANCE_SKY, SB_PRODUCT_IRRADIANCE_GROUND,
+                                             SB_PRODUCT_MULTISCATTERING};
+    for (int i = 0; i < 3; i++) {
+        const struct sb_product_format *format = sb_product_format(ids[i]);
+        struct sb_atmosphere_settings s = sb_atmosphere_product(ids[i])->defaults;
+        s.width = format->width / 4;
+        s.height = format->height / 4;
+        struct sb_image cpu = {0}, gpu = {0};
+        if (sb_atmosphere_baker_set_kernels(baker, SB_ATMOSPHERE_KERNELS_CPU) == SB_ERR_DEVICE_LIMIT) {
+            printf("kernel layouts: this device lacks the CPU layout's workgroup memory; not compared\n");
+            return;
+        }
+        enum sb_result rc = sb_atmosphere_bake(baker, ids[i], &s, &cpu, NULL, NULL);
+        sb_atmosphere_baker_set_kernels(baker, SB_ATMOSPHERE_KERNELS_GPU);
+        enum sb_result rg = sb_atmosphere_bake(baker, ids[i], &s, &gpu, NULL, NULL);
+        CHECK(rc == SB_OK && rg == SB_OK, "%s in both layouts: %s, %s", sb_product_name(ids[i]),
+              sb_result_name(rc), sb_result_name(rg));
+        if (rc == SB_OK && rg == SB_OK) {
+            double worst = 0, peak = 0;
+            size_t n = sb_image_float_count(&cpu);
+            for (size_t k = 0; k < n; k++)
+                peak = fmax(peak, fabs(cpu.data[k]));
+            for (size_t k = 0; k < n; k++)
+                worst = fmax(worst, fabs(gpu.data[k] - cpu.data[k]) / fmax(fabs(cpu.data[k]), 1e-6 * peak));
+            printf("%s, GPU against CPU kernel layout: max rel difference %.3g over %zu values\n",
+                   sb_product_name(ids[i]), worst, n);
+            CHECK(worst <= 1e-5, "%s: the two kernel layouts differ by %.3g", sb_product_name(ids[i]), worst);
+        }
+        sb_image_finish(&cpu);
+        sb_image_finish(&gpu);
+    }
+}
+
 int main(void)
 {
     sb_atmosphere_preset_earth(&earth);
@@ -604,6 +650,7 @@ int main(void)
         test_sampled(SB_PRODUCT_IRRADIANCE_GROUND, ig_x, 13, ig_y, 4, 1e-3, 1e-3);
         test_sampled(SB_PRODUCT_IRRADIANCE_SKY, ig_x, 13, ig_y, 4, 1e-3, 1e-3);
         test_many_directions(baker);
+        test_kernel_layouts(baker); /* last: it drops the products' lookups */
     }
     sb_atmosphere_baker_destroy(&baker);
     for (int p = 0; p < SB_PRODUCT_COUNT; p++)
