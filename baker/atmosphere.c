@@ -7,8 +7,8 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "irradiance_ground_gpu.spv.h"
 #include "irradiance_ground_bruneton.spv.h"
+#include "irradiance_ground_gpu.spv.h"
 #include "irradiance_ground_shared.spv.h"
 #include "irradiance_sky_gpu.spv.h"
 #include "irradiance_sky_shared.spv.h"
@@ -414,8 +414,8 @@ static enum sb_result build_sun_columns(struct sb_atmosphere_baker *b, double *g
         return res;
     const struct sb_atmosphere_settings none = {0};
     double ms = 0;
-    res = run(b, &sun_columns_shader, "sun columns", &b->sun_columns,
-              SB_SUN_COLUMNS_X + 2, 2 * (SB_SUN_COLUMNS_U + 2), 0, false, &none, &ms);
+    res = run(b, &sun_columns_shader, "sun columns", &b->sun_columns, SB_SUN_COLUMNS_X + 2, 2 * (SB_SUN_COLUMNS_U + 2),
+              0, false, &none, &ms);
     if (res)
         sb_buffer_destroy(b->vk, &b->sun_columns);
     *gpu_ms += ms;
@@ -476,8 +476,7 @@ enum sb_result sb_atmosphere_bake(struct sb_atmosphere_baker *b, enum sb_product
     if (directions && (id == SB_PRODUCT_MULTISCATTERING || !b->sun_columns.buffer) &&
         (res = build_sun_columns(b, &table_ms)))
         goto cleanup;
-    res = run(b, shader, sb_product_name(id), &b->outputs[id], width, height, directions, anchor,
-              &s, &product_ms);
+    res = run(b, shader, sb_product_name(id), &b->outputs[id], width, height, directions, anchor, &s, &product_ms);
     if (gpu_ms)
         *gpu_ms = table_ms + product_ms;
     if (res)

@@ -594,8 +594,8 @@ static void test_kernel_layouts(struct sb_atmosphere_baker *baker)
         enum sb_result rc = sb_atmosphere_bake(baker, ids[i], &s, &cpu, NULL, NULL);
         sb_atmosphere_baker_set_kernels(baker, SB_ATMOSPHERE_KERNELS_GPU);
         enum sb_result rg = sb_atmosphere_bake(baker, ids[i], &s, &gpu, NULL, NULL);
-        CHECK(rc == SB_OK && rg == SB_OK, "%s in both layouts: %s, %s", sb_product_name(ids[i]),
-              sb_result_name(rc), sb_result_name(rg));
+        CHECK(rc == SB_OK && rg == SB_OK, "%s in both layouts: %s, %s", sb_product_name(ids[i]), sb_result_name(rc),
+              sb_result_name(rg));
         if (rc == SB_OK && rg == SB_OK) {
             double worst = 0, peak = 0;
             size_t n = sb_image_float_count(&cpu);

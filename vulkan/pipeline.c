@@ -22,16 +22,19 @@ cleanup:
 static void log_statistics(struct sb_vk *vk, VkPipeline pipeline, const char *name)
 {
     PFN_vkGetPipelineExecutablePropertiesKHR get_properties =
-        (PFN_vkGetPipelineExecutablePropertiesKHR)vkGetDeviceProcAddr(vk->device, "vkGetPipelineExecutablePropertiesKHR");
+        (PFN_vkGetPipelineExecutablePropertiesKHR)vkGetDeviceProcAddr(vk->device,
+                                                                      "vkGetPipelineExecutablePropertiesKHR");
     PFN_vkGetPipelineExecutableStatisticsKHR get_statistics =
-        (PFN_vkGetPipelineExecutableStatisticsKHR)vkGetDeviceProcAddr(vk->device, "vkGetPipelineExecutableStatisticsKHR");
+        (PFN_vkGetPipelineExecutableStatisticsKHR)vkGetDeviceProcAddr(vk->device,
+                                                                      "vkGetPipelineExecutableStatisticsKHR");
     if (!get_properties || !get_statistics)
         return;
     VkPipelineInfoKHR info = {.sType = VK_STRUCTURE_TYPE_PIPELINE_INFO_KHR, .pipeline = pipeline};
     VkPipelineExecutablePropertiesKHR executables[4];
     uint32_t n = 4;
     for (uint32_t i = 0; i < n; i++)
-        executables[i] = (VkPipelineExecutablePropertiesKHR){.sType = VK_STRUCTURE_TYPE_PIPELINE_EXECUTABLE_PROPERTIES_KHR};
+        executables[i] =
+            (VkPipelineExecutablePropertiesKHR){.sType = VK_STRUCTURE_TYPE_PIPELINE_EXECUTABLE_PROPERTIES_KHR};
     if (get_properties(vk->device, &info, &n, executables) < 0)
         return;
     for (uint32_t e = 0; e < n; e++) {
