@@ -115,6 +115,10 @@ static void usage(FILE *f)
                "cube, a row a mip (sharp to rough), the six faces as stored (+x -x +y -y\n"
                "+z -z), one exposure for the sheet. Exit 2 if the pack has no cubes.\n"
                "\n"
+               "environment: SKYBAKE_VALIDATE=1 as --validate; SKYBAKE_PIPELINE_STATS=1 logs\n"
+               "each compute kernel's registers and memory as the driver reports them (on\n"
+               "NVIDIA; not with -q).\n"
+               "\n"
                "exit codes: 0 ok, 1 bake failed, 2 usage or scene error, 3 no Vulkan device,\n"
                "            4 validation messages\n");
 }

@@ -25,7 +25,7 @@ enum sb_result {
     SB_ERR_VALIDATION,      /* the validation layers reported a message */
     SB_ERR_NUMERIC,         /* a product holds NaN, Inf or a value outside its range */
     SB_ERR_USAGE,           /* bad command line */
-    SB_ERR_DEVICE_LIMIT,    /* the device ended a kernel early (llvmpipe's loop limit) */
+    SB_ERR_DEVICE_LIMIT,    /* a kernel needs more than the device offers, or it ended it early */
     SB_ERR_VERSION,         /* a pack of a format version this build does not read: rebake needed */
     SB_ERR_HASH_MISMATCH,   /* an artifact's content differs from the hash its manifest records */
     SB_ERR_UNSAFE_PATH,     /* a path that leaves the pack or goes through a symbolic link */

@@ -92,6 +92,10 @@ static void usage(FILE *f)
                "  -q, --quiet             warnings and errors only\n"
                "  -v, --verbose           debug messages\n"
                "\n"
+               "environment: SKYBAKE_VALIDATE=1 as --validate; SKYBAKE_PIPELINE_STATS=1 logs\n"
+               "each compute kernel's registers and memory as the driver reports them (on\n"
+               "NVIDIA; not with -q).\n"
+               "\n"
                "exit codes: 0 ok, 1 rendering failed, 2 usage, pack or world error,\n"
                "            3 no Vulkan device, 4 validation messages\n");
 }

@@ -28,14 +28,14 @@
 
 /* Scattering bakes (sphere.glsl) run one workgroup of SB_SPHERE_THREADS per
  * texel; each invocation sums at most SB_SPHERE_MAX_SUMS values. A GPU runs
- * the kernels built with SB_SPHERE_GPU defined, SB_SPHERE_THREADS_GPU wide: at 64 an H100 holds six of
- * these workgroups an SM (159 to 168 registers an invocation), and the
- * 1024 texels of the multiscattering LUT take two uneven waves; at 128 the
- * default multiscattering bake took 2.70 ms instead of 3.43, irradiance_ground
- * 0.66 instead of 1.13 and irradiance_sky 4.71 instead of 6.02 (256: 2.55,
- * 0.59, 4.60, but the cheap settings twice as slow). llvmpipe is faster at 64
- * (the default bake 9.3 s, 15.7 at 128). The sums' order, and so the last
- * bits, differ between the two. */
+ * the kernels built with SB_SPHERE_GPU defined, SB_SPHERE_THREADS_GPU wide:
+ * at 64 an H100 holds six of these workgroups an SM (159 to 168 registers
+ * an invocation), and the 1024 texels of the multiscattering LUT take two
+ * uneven waves; at 128 the default multiscattering bake took 2.70 ms
+ * instead of 3.43, irradiance_ground 0.66 instead of 1.13 and irradiance_sky
+ * 4.71 instead of 6.02 (256: 2.55, 0.59, 4.60, but the cheap settings twice
+ * as slow). llvmpipe is faster at 64 (the default bake 9.3 s, 15.7 at 128).
+ * The sums' order, and so the last bits, differ between the two. */
 #define SB_SPHERE_THREADS_CPU 64
 #define SB_SPHERE_THREADS_GPU 128
 #ifdef SB_SPHERE_GPU
