@@ -7,6 +7,7 @@
 #include <string.h>
 
 #include "atmosphere.h"
+#include "atmosphere_probe.h"
 #include "atmosphere_probe.spv.h"
 #include "atmosphere_ref.h"
 #include "context.h"
@@ -75,13 +76,7 @@ static void test_transmittance(void)
 
 /* ---- the GLSL model's functions, one by one ------------------------------------ */
 
-#define PROBE_FLOATS 24
 #define PROBE_RECORDS 1024
-
-static double rel_err(double gpu, double ref)
-{
-    return fabs(gpu / ref - 1.0);
-}
 
 /*
  * Points where the functions of atmosphere.glsl are evaluated on the device:
@@ -109,26 +104,6 @@ static int probe_directions(double (*dirs)[2], int max)
         }
     }
     return n;
-}
-
-/* The k-th ray toward the sun on which the bakes' sun table is checked:
- * altitudes crowded toward the ground, cosines over the whole range and,
- * for every other ray, within 0.2 of the horizon, crowded toward it. */
-static void sun_ray(int k, float *h, float *mu)
-{
-    uint64_t state = 0x9e3779b97f4a7c15ull * (uint64_t)(k + 1);
-    double v[3];
-    for (int i = 0; i < 3; i++) {
-        state ^= state >> 31;
-        state *= 0xbf58476d1ce4e5b9ull;
-        state ^= state >> 29;
-        v[i] = (double)(state >> 11) / 9007199254740992.0;
-    }
-    double R = earth.ground_radius_km, hh = (earth.top_radius_km - R) * v[0] * v[0];
-    double mu_h = -sqrt(hh * (2 * R + hh)) / (R + hh);
-    double m = k % 2 ? mu_h + 0.2 * v[1] * v[1] * v[1] * (v[2] < 0.5 ? -1 : 1) : -1 + 2 * v[1];
-    *h = (float)hh;
-    *mu = (float)(m < mu_h + 1e-6 ? fabs(m) : m);
 }
 
 /* The k-th point of a multiscattering lookup: the LUT's edges (h = 0 and
@@ -160,7 +135,7 @@ static void test_probe(struct sb_atmosphere_baker *baker)
         in[5] = (float)(k / SB_MULTISCATTERING_SIZE);
         in[6] = (float)(k % SB_IRRADIANCE_WIDTH);
         in[7] = (float)(k / SB_IRRADIANCE_WIDTH);
-        sun_ray(k, &in[16], &in[17]);
+        sun_table_ray(&earth, k, &in[PROBE_SUN], &in[PROBE_SUN + 1]);
         lookup_point(k, &in[20], &in[21]);
     }
     float *inputs = malloc((size_t)PROBE_RECORDS * PROBE_FLOATS * sizeof(float));
@@ -170,8 +145,9 @@ static void test_probe(struct sb_atmosphere_baker *baker)
     CHECK(res == SB_OK, "probe kernel: %s", sb_result_name(res));
 
     double exact_worst = -1, lut_worst = 0, coords_worst = 0, trip_worst = 0, geo_h = 0, geo_mu = 0, sub_worst = 0;
-    double sun_worst = -1, sun_tau = 0, psi_worst = -1;
-    int exact_at = 0, lut_at = 0, sun_at = 0, psi_at = 0;
+    double psi_worst = -1;
+    int exact_at = 0, lut_at = 0, psi_at = 0;
+    struct sun_table_worst sun = {0};
     for (int k = 0; !res && k < PROBE_RECORDS; k++) {
         const float *in = inputs + k * PROBE_FLOATS, *out = rec + k * PROBE_FLOATS;
         double h = in[0], mu = in[1], r = earth.ground_radius_km + h, ref[3];
@@ -202,20 +178,8 @@ static void test_probe(struct sb_atmosphere_baker *baker)
             coords_worst = fmax(coords_worst, fmax(fabs(out[6] - xm), fabs(out[7] - xr)));
         }
         /* The sun table against fp64: its interpolation is good to ~1e-5
-         * in optical depth (docs/accuracy.md); the bound is 2e-5 of T plus
-         * the 4-ulp sensitivity, wherever T > 0.05 (tau < 3; beyond, the
-         * sun's light no longer counts). */
-        double sh = in[16], smu = in[17], sun_ref[3], sun_next[3], sulp = nextafterf((float)smu, 2.0f) - (float)smu;
-        sb_ref_transmittance(&earth, earth.ground_radius_km + sh, smu, 8, sun_ref);
-        sb_ref_transmittance(&earth, earth.ground_radius_km + sh, smu + 4 * sulp, 8, sun_next);
-        for (int c = 0; c < 3; c++) {
-            double excess = rel_err(out[16 + c], sun_ref[c]) - 2e-5 - rel_err(sun_next[c], sun_ref[c]);
-            if (sun_ref[c] > 0.05 && excess > sun_worst) {
-                sun_worst = excess;
-                sun_at = k;
-                sun_tau = fabs(log(out[16 + c] / sun_ref[c]));
-            }
-        }
+         * in optical depth on the earth (docs/accuracy.md), the bound 2e-5. */
+        sun_table_record(&earth, in[PROBE_SUN], in[PROBE_SUN + 1], out + PROBE_SUN, 2e-5, &sun);
         /* The multiscattering lookup against the same lookup in fp64 from
          * the same LUT: the sums of fp32 logarithms (|ln psi| < 70, down to
          * the floor) leave 1e-5; the coordinates' roundings, a few ulp of
@@ -256,10 +220,10 @@ static void test_probe(struct sb_atmosphere_baker *baker)
         "transmittance mapping: coords %.3g, geometry h %.3g km mu %.3g, round trip %.3g; sub-texel round trip %.3g\n",
         coords_worst, geo_h, geo_mu, trip_worst, sub_worst);
     CHECK(exact_worst <= 0, "transmittance_to_top: %.3g beyond its bound", exact_worst);
-    printf("sun table: worst error minus (2e-5 + 4-ulp sensitivity) %.3g over %d rays (h %.4g mu %.6g: %.3g in "
+    printf("sun table: worst error minus (2e-5 + 4-ulp sensitivity) %.3g over %d values (h %.4g mu %.6g: %.3g in "
            "optical depth)\n",
-           sun_worst, PROBE_RECORDS, inputs[sun_at * PROBE_FLOATS + 16], inputs[sun_at * PROBE_FLOATS + 17], sun_tau);
-    CHECK(sun_worst <= 0, "sun table: %.3g beyond its bound", sun_worst);
+           sun.excess, sun.count, sun.h, sun.mu, sun.tau);
+    CHECK(sun.count > PROBE_RECORDS && sun.excess <= 0, "sun table: %.3g beyond its bound", sun.excess);
     printf("multiscattering lookup: worst error minus (1e-5 + 4-ulp sensitivity) %.3g over %d points (h %.4g mu_s "
            "%.6g)\n",
            psi_worst, PROBE_RECORDS, inputs[psi_at * PROBE_FLOATS + 20], inputs[psi_at * PROBE_FLOATS + 21]);
