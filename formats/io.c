@@ -2,7 +2,10 @@
 
 #include <errno.h>
 #include <fcntl.h>
+#include <stdint.h>
+#include <stdlib.h>
 #include <string.h>
+#include <sys/stat.h>
 #include <unistd.h>
 
 #include "log.h"
@@ -61,5 +64,62 @@ enum sb_result sb_write_file(const char *path, const void *data, size_t size, co
         unlink(path);
         return SB_ERR_IO;
     }
+    return SB_OK;
+}
+
+enum sb_result sb_read_file(int dir, const char *path, const char *source, size_t max_bytes, bool follow_symlinks,
+                            char **data, size_t *size)
+{
+    *data = NULL;
+    *size = 0;
+    int fd = openat(dir, path, O_RDONLY | O_CLOEXEC | (follow_symlinks ? 0 : O_NOFOLLOW));
+    if (fd < 0) {
+        if (errno == ELOOP) {
+            sb_error("%s: is a symbolic link; refused", source);
+            return SB_ERR_UNSAFE_PATH;
+        }
+        sb_error("%s: cannot open: %s", source, strerror(errno));
+        return SB_ERR_IO;
+    }
+    struct stat st;
+    if (fstat(fd, &st) != 0 || !S_ISREG(st.st_mode)) {
+        sb_error("%s: not a regular file", source);
+        close(fd);
+        return SB_ERR_IO;
+    }
+    if ((uint64_t)st.st_size > max_bytes) {
+        sb_error("%s: larger than %zu bytes; refused", source, max_bytes);
+        close(fd);
+        return SB_ERR_OUT_OF_RANGE;
+    }
+    /* Read up to one byte past the cap: the file may have grown since fstat. */
+    char *buf = malloc(max_bytes + 1);
+    if (!buf) {
+        close(fd);
+        return SB_ERR_NOMEM;
+    }
+    size_t n = 0;
+    for (;;) {
+        ssize_t got = read(fd, buf + n, max_bytes + 1 - n);
+        if (got < 0 && errno == EINTR)
+            continue;
+        if (got < 0) {
+            sb_error("%s: cannot read: %s", source, strerror(errno));
+            free(buf);
+            close(fd);
+            return SB_ERR_IO;
+        }
+        if (got == 0 || (n += (size_t)got) > max_bytes)
+            break;
+    }
+    close(fd);
+    if (n > max_bytes) {
+        sb_error("%s: larger than %zu bytes; refused", source, max_bytes);
+        free(buf);
+        return SB_ERR_OUT_OF_RANGE;
+    }
+    buf[n] = '\0';
+    *data = buf;
+    *size = n;
     return SB_OK;
 }

@@ -25,6 +25,14 @@ bool sb_read_all(int fd, void *data, size_t size);
  * cannot write the <what>: reason", remove the file and return SB_ERR_IO. */
 enum sb_result sb_write_file(const char *path, const void *data, size_t size, const char *what);
 
+/* The whole of `path` (relative to the directory fd `dir`, or AT_FDCWD),
+ * at most max_bytes, into a malloc'd buffer (*data, NUL-terminated, *size
+ * bytes without the NUL; free it); errors name `source`. A symbolic link is
+ * refused unless follow_symlinks (SB_ERR_UNSAFE_PATH), a larger file too
+ * (SB_ERR_OUT_OF_RANGE). */
+enum sb_result sb_read_file(int dir, const char *path, const char *source, size_t max_bytes, bool follow_symlinks,
+                            char **data, size_t *size);
+
 #ifdef __cplusplus
 }
 #endif

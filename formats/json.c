@@ -1,15 +1,12 @@
 #include "json.h"
 
-#include <errno.h>
-#include <fcntl.h>
 #include <math.h>
 #include <stdint.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
-#include <sys/stat.h>
-#include <unistd.h>
 
+#include "io.h"
 #include "log.h"
 
 enum sb_result sb_json_parse(const char *text, size_t size, const char *source, cJSON **root)
@@ -48,53 +45,12 @@ enum sb_result sb_json_load(int dir, const char *path, const char *source, size_
                             cJSON **root)
 {
     *root = NULL;
-    int fd = openat(dir, path, O_RDONLY | O_CLOEXEC | (follow_symlinks ? 0 : O_NOFOLLOW));
-    if (fd < 0) {
-        if (errno == ELOOP) {
-            sb_error("%s: is a symbolic link; refused", source);
-            return SB_ERR_UNSAFE_PATH;
-        }
-        sb_error("%s: cannot open: %s", source, strerror(errno));
-        return SB_ERR_IO;
-    }
-    struct stat st;
-    if (fstat(fd, &st) != 0 || !S_ISREG(st.st_mode)) {
-        sb_error("%s: not a regular file", source);
-        close(fd);
-        return SB_ERR_IO;
-    }
-    if ((uint64_t)st.st_size > max_bytes) {
-        sb_error("%s: larger than %zu bytes; refused", source, max_bytes);
-        close(fd);
-        return SB_ERR_OUT_OF_RANGE;
-    }
-    char *buf = malloc(max_bytes + 1);
-    if (!buf) {
-        close(fd);
-        return SB_ERR_NOMEM;
-    }
-    size_t n = 0;
-    for (;;) {
-        ssize_t got = read(fd, buf + n, max_bytes + 1 - n);
-        if (got < 0 && errno == EINTR)
-            continue;
-        if (got < 0) {
-            sb_error("%s: cannot read: %s", source, strerror(errno));
-            free(buf);
-            close(fd);
-            return SB_ERR_IO;
-        }
-        if (got == 0 || (n += (size_t)got) > max_bytes)
-            break;
-    }
-    close(fd);
-    enum sb_result res;
-    if (n > max_bytes) {
-        sb_error("%s: larger than %zu bytes; refused", source, max_bytes);
-        res = SB_ERR_OUT_OF_RANGE;
-    } else {
-        res = sb_json_parse(buf, n, source, root);
-    }
+    char *buf;
+    size_t n;
+    enum sb_result res = sb_read_file(dir, path, source, max_bytes, follow_symlinks, &buf, &n);
+    if (res)
+        return res;
+    res = sb_json_parse(buf, n, source, root);
     free(buf);
     return res;
 }

@@ -13,6 +13,7 @@
 #include "harness.h"
 #include "image.h"
 #include "log.h"
+#include "lut3d.h"
 #include "pack.h"
 #include "probes.h"
 #include "scene.h"
@@ -1080,6 +1081,121 @@ static void test_probes(void)
     sb_image_finish(&img);
 }
 
+/* The last error logged, for checking what a refusal says. */
+static char last_error[512];
+
+static void keep_error(void *user, enum sb_log_level level, const char *msg)
+{
+    (void)user;
+    if (level == SB_LOG_ERROR)
+        snprintf(last_error, sizeof(last_error), "%s", msg);
+}
+
+/* .cube files: a small one with every keyword, read entry by entry; an
+ * identity of the usual 33^3 exact; every prefix of a file refused (but
+ * the whole); hostile files refused with the line and the reason. */
+static void test_lut3d(void)
+{
+    static const char small[] = "# a comment\r\nTITLE \"two by two\"\r\n\r\nDOMAIN_MIN 0 0 0\r\nDOMAIN_MAX 1 2 4\r\n"
+                                "LUT_3D_SIZE 2\r\n"
+                                "0 0 0\r\n1 0 0\r\n0 1 0\r\n1 1 0\r\n0 0 1\r\n1 0 1\r\n0 1 1\r\n  1 1 1  \r\n";
+    struct sb_lut3d lut;
+    enum sb_result res = sb_lut3d_parse(small, strlen(small), "small.cube", &lut);
+    CHECK(res == SB_OK, "small.cube: %s", sb_result_name(res));
+    if (!res) {
+        CHECK(lut.size == 2 && !strcmp(lut.title, "two by two"), "size %u title '%s'", lut.size, lut.title);
+        CHECK(lut.domain_max[1] == 2.0f && lut.domain_max[2] == 4.0f, "domain");
+        bool order = true; /* red fastest */
+        for (int b = 0; b < 2; b++)
+            for (int g = 0; g < 2; g++)
+                for (int r = 0; r < 2; r++) {
+                    const float *e = lut.rgb + ((b * 2 + g) * 2 + r) * 3;
+                    order = order && e[0] == (float)r && e[1] == (float)g && e[2] == (float)b;
+                }
+        CHECK(order, "entries in red-fastest order");
+        sb_lut3d_finish(&lut);
+    }
+    size_t last = strlen(small) - 5; /* the last entry's final digit */
+    int accepted = 0;
+    for (size_t n = 0; n < last; n++)
+        if (sb_lut3d_parse(small, n, "prefix.cube", &lut) == SB_OK) {
+            accepted++;
+            sb_lut3d_finish(&lut);
+        }
+    CHECK(accepted == 0, "%d prefixes of a .cube accepted", accepted);
+
+    char *text = malloc(33 * 33 * 33 * 40 + 64);
+    size_t len = (size_t)sprintf(text, "LUT_3D_SIZE 33\n");
+    for (int i = 0; i < 33 * 33 * 33; i++)
+        len +=
+            (size_t)sprintf(text + len, "%.9g %.9g %.9g\n", (i % 33) / 32.0, (i / 33 % 33) / 32.0, (i / 1089) / 32.0);
+    res = sb_lut3d_parse(text, len, "identity.cube", &lut);
+    CHECK(res == SB_OK && lut.size == 33, "identity.cube: %s", sb_result_name(res));
+    bool exact = !res;
+    for (int i = 0; exact && i < 33 * 33 * 33; i++)
+        exact = lut.rgb[3 * i] == (i % 33) / 32.0f && lut.rgb[3 * i + 2] == (i / 1089) / 32.0f;
+    CHECK(exact, "identity.cube's entries exact");
+    sb_lut3d_finish(&lut);
+    free(text);
+
+    static const struct {
+        const char *text, *says;
+        enum sb_result result;
+    } bad[] = {
+        {"", "no LUT_3D_SIZE", SB_ERR_MISSING_FIELD},
+        {"0 0 0\n", ":1: an entry before LUT_3D_SIZE", SB_ERR_MISSING_FIELD},
+        {"LUT_3D_SIZE 1\n0 0 0\n", ":1: LUT_3D_SIZE must be", SB_ERR_OUT_OF_RANGE},
+        {"LUT_3D_SIZE 2.5\n", ":1: LUT_3D_SIZE must be", SB_ERR_OUT_OF_RANGE},
+        {"LUT_3D_SIZE 4096\n", ":1: LUT_3D_SIZE must be", SB_ERR_TOO_LARGE},
+        {"LUT_3D_SIZE 2\nLUT_3D_SIZE 2\n", ":2: LUT_3D_SIZE given twice", SB_ERR_DUPLICATE_KEY},
+        {"LUT_1D_SIZE 1024\n", ":1: a 1D LUT", SB_ERR_BAD_IMAGE},
+        {"LUT_3D_SIZE 2\nGAMMA 2.2\n", ":2: unknown keyword 'GAMMA'", SB_ERR_UNKNOWN_KEY},
+        {"TITLE unquoted\nLUT_3D_SIZE 2\n", ":1: TITLE needs one quoted string", SB_ERR_OUT_OF_RANGE},
+        {"DOMAIN_MIN 0 0\nLUT_3D_SIZE 2\n", ":1: DOMAIN_MIN needs three numbers", SB_ERR_OUT_OF_RANGE},
+        {"DOMAIN_MIN 1 0 0\nDOMAIN_MAX 1 1 1\nLUT_3D_SIZE 2\n0 0 0\n0 0 0\n0 0 0\n0 0 0\n0 0 0\n0 0 0\n0 0 0\n0 0 0\n",
+         "not below its maximum", SB_ERR_OUT_OF_RANGE},
+        {"DOMAIN_MIN 0 0 0\nLUT_3D_INPUT_RANGE 0 1\n", ":2: LUT_3D_INPUT_RANGE with", SB_ERR_DUPLICATE_KEY},
+        {"LUT_3D_SIZE 2\n", "0 entries; LUT_3D_SIZE 2 needs 8", SB_ERR_OUT_OF_RANGE},
+        {"LUT_3D_SIZE 2\n0 0 0\n", "1 entries; LUT_3D_SIZE 2 needs 8", SB_ERR_OUT_OF_RANGE},
+        {"LUT_3D_SIZE 2\n0 0 nan\n", ":2: an entry must be three numbers within", SB_ERR_OUT_OF_RANGE},
+        {"LUT_3D_SIZE 2\n0 0 1e999\n", ":2: an entry must be three numbers within", SB_ERR_OUT_OF_RANGE},
+        {"LUT_3D_SIZE 2\n0 0 6e80\n", ":2: an entry must be three numbers within", SB_ERR_OUT_OF_RANGE},
+        {"LUT_3D_SIZE 2\n0 0 0 0\n", ":2: an entry must be three numbers within", SB_ERR_OUT_OF_RANGE},
+        {"LUT_3D_SIZE 2\n0 0\n0\n", ":2: an entry must be three numbers within", SB_ERR_OUT_OF_RANGE},
+        {"LUT_3D_SIZE 2\n0 0 0x\n", ":2: an entry must be three numbers within", SB_ERR_OUT_OF_RANGE},
+        {"LUT_3D_SIZE 2\n0 0 0\nTITLE \"late\"\n", ":3: a keyword after the table's first entry", SB_ERR_OUT_OF_RANGE},
+    };
+    sb_log_set_sink(keep_error, NULL);
+    for (size_t i = 0; i < sizeof(bad) / sizeof(bad[0]); i++) {
+        last_error[0] = '\0';
+        res = sb_lut3d_parse(bad[i].text, strlen(bad[i].text), "bad.cube", &lut);
+        CHECK(res == bad[i].result && strstr(last_error, "bad.cube") && strstr(last_error, bad[i].says) && !lut.rgb &&
+                  !lut.size,
+              "bad .cube %zu: %s, '%s' (wanted %s, '%s')", i, sb_result_name(res), last_error,
+              sb_result_name(bad[i].result), bad[i].says);
+    }
+    /* A NUL byte, a line past the cap, more entries than the size makes */
+    static const char nul[] = "LUT_3D_SIZE 2\n\0";
+    res = sb_lut3d_parse(nul, sizeof(nul) - 1, "bad.cube", &lut);
+    CHECK(res == SB_ERR_BAD_IMAGE && strstr(last_error, "NUL"), "a NUL byte: %s", sb_result_name(res));
+    char longline[400] = "LUT_3D_SIZE 2\n0 0 ";
+    memset(longline + strlen(longline), '0', 300);
+    res = sb_lut3d_parse(longline, strlen(longline), "bad.cube", &lut);
+    CHECK(res == SB_ERR_OUT_OF_RANGE && strstr(last_error, ":2: a line of"), "a long line: %s", sb_result_name(res));
+    char more[256] = "LUT_3D_SIZE 2\n";
+    for (int i = 0; i < 9; i++)
+        strcat(more, "0.5 0.5 0.5\n");
+    res = sb_lut3d_parse(more, strlen(more), "bad.cube", &lut);
+    CHECK(res == SB_ERR_OUT_OF_RANGE && strstr(last_error, ":10: more than the 8 entries"), "nine entries: %s",
+          sb_result_name(res));
+    CHECK(sb_lut3d_load("/nonexistent/x.cube", &lut) == SB_ERR_IO && strstr(last_error, "/nonexistent/x.cube"),
+          "a missing file");
+    if (!getenv("SKYBAKE_TEST_VERBOSE"))
+        sb_log_set_sink(quiet, NULL);
+    else
+        sb_log_set_sink(NULL, NULL);
+}
+
 int main(void)
 {
     if (!getenv("SKYBAKE_TEST_VERBOSE"))
@@ -1092,5 +1208,6 @@ int main(void)
     test_scenes();
     test_pack_reader();
     test_probes();
+    test_lut3d();
     return test_finish("formats");
 }
