@@ -18,6 +18,7 @@
 #include "default_world.h"
 #include "exr.h"
 #include "log.h"
+#include "lut3d.h"
 #include "mesh.h"
 #include "pack.h"
 #include "pngfile.h"
@@ -74,6 +75,9 @@ static void usage(FILE *f)
                "  --cloud-shadow-size N   texels per side of the clouds' shadow map over 16 km,\n"
                "                          16 to 4096 (default 512)\n"
                "  --tonemap agx|aces|gt   tone mapper (default agx)\n"
+               "  --grade FILE.cube       grade the tone-mapped sRGB frame through a 3D LUT (.cube,\n"
+               "                          trilinear, each 8-bit code in and out; a neutral LUT\n"
+               "                          leaves the frame unchanged)\n"
                "  --exposure EV           exposure compensation (default 0)\n"
                "  --no-bloom              no bloom\n"
                "  --shadow-size N         texels per side of each of the 4 cascades (default 2048)\n"
@@ -128,6 +132,7 @@ static bool parse_number(const char *s, double lo, double hi, double *out)
 
 struct options {
     const char *pack, *out_dir, *world;
+    const char *grade;      /* a .cube file, or NULL */
     struct sb_vk_params vk; /* the environment's, then --device and --validate */
     struct sb_renderer_params params;
     struct sb_view view;
@@ -191,7 +196,9 @@ static int parse_options(int argc, char **argv, struct options *o)
                     ok = ok && c[5] > 1.0 && c[5] < 170.0;
                 }
             }
-        } else if (!strcmp(a, "--world") && next)
+        } else if (!strcmp(a, "--grade") && next)
+            o->grade = argv[++i];
+        else if (!strcmp(a, "--world") && next)
             o->world = argv[++i];
         else if (!strcmp(a, "--tonemap") && next) {
             const char *t = argv[++i];
@@ -445,12 +452,21 @@ static int run(const struct options *o)
     }
     struct sb_world world;
     struct sb_renderer_params params = o->params;
+    struct sb_lut3d grade = {0};
+    if (o->grade && sb_lut3d_load(o->grade, &grade)) {
+        sb_error("%s: refused; nothing was rendered", o->grade);
+        sb_pack_close(&pack);
+        return EXIT_USAGE;
+    }
+    params.grade = o->grade ? &grade : NULL;
     if (load_world(o, &pack, &world, &params)) {
+        sb_lut3d_finish(&grade);
         sb_pack_close(&pack);
         return EXIT_USAGE;
     }
     if (mkdir(o->out_dir, 0777) != 0 && errno != EEXIST) {
         sb_error("%s: cannot create the output directory: %s", o->out_dir, strerror(errno));
+        sb_lut3d_finish(&grade);
         sb_world_finish(&world);
         sb_pack_close(&pack);
         return EXIT_RENDER_FAILED;
@@ -506,6 +522,7 @@ done:
     sb_vk_destroy(&vk);
     free(timings);
     sb_world_finish(&world);
+    sb_lut3d_finish(&grade);
     sb_pack_close(&pack);
     if (!code && messages) {
         sb_error("%u validation message(s)", messages);

@@ -27,6 +27,8 @@ enum sb_scene_method {
     SB_SCENE_TRACED, /* a ray a pixel through the world's BVH, shadows from shadow rays */
 };
 
+struct sb_lut3d;
+
 struct sb_renderer_params {
     uint32_t width, height;          /* 0: 1280 x 720 */
     uint32_t shadow_size;            /* texels per side of each cascade; 0: 2048 */
@@ -52,6 +54,8 @@ struct sb_renderer_params {
                                         reflection probes) and the frame (aerial perspective from its
                                         volume alone); the same frame, slower on llvmpipe */
     enum sb_scene_method scene;      /* how the scene pass finds the world's points */
+    const struct sb_lut3d *grade;    /* a .cube LUT for the display-referred frame (grade.c), read during
+                                        sb_renderer_create only; NULL: no grading */
 };
 
 /* What one frame looks at. Angles in radians; lengths in metres. */
@@ -80,11 +84,12 @@ enum sb_pass {
     SB_PASS_EXPOSURE,
     SB_PASS_BLOOM,
     SB_PASS_TONEMAP,
+    SB_PASS_GRADE,
     SB_PASS_COUNT,
 };
 
 /* "sky-view", "probes", "aerial perspective", "shadows", "cloud shadow", "fog", "scene", "sky", "clouds",
- * "fog apply", "exposure", "bloom", "tonemap". */
+ * "fog apply", "exposure", "bloom", "tonemap", "grade". */
 const char *sb_pass_name(enum sb_pass pass);
 
 struct sb_frame_timings {

@@ -22,6 +22,7 @@
 
 struct sb_clouds;
 struct sb_fog;
+struct sb_grade;
 struct sb_image;
 
 #define SB_HDR_FORMAT VK_FORMAT_R16G16B16A16_SFLOAT
@@ -90,6 +91,7 @@ struct sb_renderer {
 
     struct sb_fog *fog;       /* fog.c */
     struct sb_clouds *clouds; /* clouds.c */
+    struct sb_grade *grade;   /* grade.c */
 
     VkQueryPool queries;
     VkCommandBuffer cmd;
@@ -122,6 +124,7 @@ extern const struct sb_pass_class sb_pass_fog;          /* fog.c: the froxel vol
 extern const struct sb_pass_class sb_pass_fog_apply;    /* fog.c: the volume applied to the frame */
 extern const struct sb_pass_class sb_pass_cloud_shadow; /* clouds.c: the clouds' shadow map */
 extern const struct sb_pass_class sb_pass_clouds;       /* clouds.c: traced, resolved, composited */
+extern const struct sb_pass_class sb_pass_grade;        /* grade.c: the LUT on the display-referred frame */
 
 /* Point a binding at a buffer, or at an image view with a sampler (NULL:
  * linear filtering clamped to the edge). They are kept by pointer or handle

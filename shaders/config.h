@@ -226,7 +226,8 @@ struct sb_bake_push {
 #define SB_VIEW_BINDING_BVH_NODES 43        /* the world's BVH (geometry/bvh.h) when traced: its nodes */
 #define SB_VIEW_BINDING_BVH_TRIANGLES 44    /* its triangles; material 1: casts shadows, 0: does not */
 #define SB_VIEW_BINDING_DEPTH_OUT 45        /* image2D r32f: the traced scene's depth, written */
-#define SB_VIEW_BINDING_COUNT 46
+#define SB_VIEW_BINDING_GRADE_LUT 46        /* the grading LUT (grade.comp): domain, size, entries */
+#define SB_VIEW_BINDING_COUNT 47
 /* A shadow ray's reach: past any two points of a world (4 x SB_MESH_MAX_EXTENT_M, geometry/mesh.h). */
 #define SB_TRACE_FAR_M 4.0e4
 

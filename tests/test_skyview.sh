@@ -46,8 +46,19 @@ if grep -q "on llvmpipe" "$tmp/err"; then
     check "--scene auto rasterises on a CPU device" cmp -s "$tmp/elsewhere/frame_0000.png" "$tmp/r/frame_0000.png"
 fi
 
+# Grading through a .cube LUT (test_runtime checks the codes): a neutral
+# one leaves the frame as it was; a hostile one is refused, named.
+awk 'BEGIN { print "TITLE \"neutral\""; print "LUT_3D_SIZE 33";
+    for (b = 0; b < 33; b++) for (g = 0; g < 33; g++) for (r = 0; r < 33; r++) printf "%.6f %.6f %.6f\n", r / 32, g / 32, b / 32 }' >"$tmp/neutral.cube"
+check "a neutral grading LUT" expect_exit 0 "$skyview" "$tmp/pack" -o "$tmp/n" $small --grade "$tmp/neutral.cube"
+check "leaves the frame unchanged" cmp -s "$tmp/elsewhere/frame_0000.png" "$tmp/n/frame_0000.png"
+printf 'LUT_3D_SIZE 2\n0 0 0\n1 1 1\n' >"$tmp/short.cube"
+check "a .cube short of entries is refused" expect_exit 2 "$skyview" "$tmp/pack" -o "$tmp/n" $small --grade "$tmp/short.cube"
+check "naming the file and the count" grep -q "short.cube: 2 entries; LUT_3D_SIZE 2 needs 8" "$tmp/err"
+check "a missing .cube is refused" expect_exit 2 "$skyview" "$tmp/pack" -o "$tmp/n" $small --grade "$tmp/none.cube"
+
 check "bench" expect_exit 0 "$skyview" "$tmp/pack" -o "$tmp/b" $small --bench --frames 3 --warmup 1
-for pass in sky-view probes "aerial perspective" shadows scene sky exposure bloom tonemap total; do
+for pass in sky-view probes "aerial perspective" shadows scene sky exposure bloom tonemap grade total; do
     check "bench table has $pass" grep -q "^$pass " "$tmp/out"
     check "bench.json has $pass" grep -q "\"pass\":[[:space:]]*\"$pass\"" "$tmp/b/bench.json"
 done
