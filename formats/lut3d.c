@@ -164,7 +164,9 @@ enum sb_result sb_lut3d_parse(const char *text, size_t size, const char *source,
         char line[LUT_MAX_LINE];
         memcpy(line, start, len);
         line[len] = '\0';
-        bool data = (*line >= '0' && *line <= '9') || *line == '-' || *line == '+' || *line == '.';
+        char *after;
+        strtod(line, &after); /* a line that opens with a number (nan and inf too) is an entry */
+        bool data = after != line;
         if (!data) {
             if (entries) {
                 lut_error(&c, "%s", "a keyword after the table's first entry");

@@ -1163,6 +1163,8 @@ static void test_lut3d(void)
         {"LUT_3D_SIZE 2\n0 0 0 0\n", ":2: an entry must be three numbers within", SB_ERR_OUT_OF_RANGE},
         {"LUT_3D_SIZE 2\n0 0\n0\n", ":2: an entry must be three numbers within", SB_ERR_OUT_OF_RANGE},
         {"LUT_3D_SIZE 2\n0 0 0x\n", ":2: an entry must be three numbers within", SB_ERR_OUT_OF_RANGE},
+        {"LUT_3D_SIZE 2\n0 0 0\ninf 0 0\n", ":3: an entry must be three numbers within", SB_ERR_OUT_OF_RANGE},
+        {"LUT_3D_SIZE 2\nnan 0 0\n", ":2: an entry must be three numbers within", SB_ERR_OUT_OF_RANGE},
         {"LUT_3D_SIZE 2\n0 0 0\nTITLE \"late\"\n", ":3: a keyword after the table's first entry", SB_ERR_OUT_OF_RANGE},
     };
     sb_log_set_sink(keep_error, NULL);
