@@ -75,9 +75,26 @@ static void usage(FILE *f)
                "  --cloud-shadow-size N   texels per side of the clouds' shadow map over 16 km,\n"
                "                          16 to 4096 (default 512)\n"
                "  --tonemap agx|aces|gt   tone mapper (default agx)\n"
-               "  --grade FILE.cube       grade the tone-mapped sRGB frame through a 3D LUT (.cube,\n"
-               "                          trilinear, each 8-bit code in and out; a neutral LUT\n"
-               "                          leaves the frame unchanged)\n"
+               "  --grade FILE.cube       grade through a 3D LUT (.cube, trilinear): by default the\n"
+               "                          tone-mapped sRGB frame, each 8-bit code in and out (a\n"
+               "                          neutral LUT leaves the frame unchanged)\n"
+               "  --grade-space srgb|acescct\n"
+               "                          the LUT's input: the sRGB frame (default), or the exposed\n"
+               "                          scene-linear frame in ACEScct, before the tone curve\n"
+               "  --white-balance K[,TINT]\n"
+               "                          render light of colour temperature K (1000 to 15000)\n"
+               "                          white; TINT moves that light off the Planckian locus,\n"
+               "                          in Duv/1000, positive toward magenta (default 6504,0:\n"
+               "                          none; D65 is 6504 K)\n"
+               "  --saturation S          about the luminance, before the tone curve: 0 grey, 1 none\n"
+               "                          (default), up to 4\n"
+               "  --contrast C            before the tone curve, each channel 0.18 (c / 0.18)^C:\n"
+               "                          1 none (default), 0.25 to 4\n"
+               "  --no-purkinje           no Purkinje shift (by default dim light, below 5 cd/m^2,\n"
+               "                          shifts toward blue as the eye's rods see it)\n"
+               "  --sun-lux LUX           the sun's illuminance above the atmosphere, which makes\n"
+               "                          the pack's radiance absolute for the Purkinje shift\n"
+               "                          (default 128000, the earth's)\n"
                "  --exposure EV           exposure compensation (default 0)\n"
                "  --no-bloom              no bloom\n"
                "  --shadow-size N         texels per side of each of the 4 cascades (default 2048)\n"
@@ -155,6 +172,13 @@ static int parse_options(int argc, char **argv, struct options *o)
     };
     o->vk = sb_vk_params_from_env();
     o->vk.graphics = true;
+    o->params.grading = (struct sb_grading){
+        .enabled = true,
+        .white_balance_k = SB_GRADING_NEUTRAL_K,
+        .saturation = 1.0,
+        .contrast = 1.0,
+    };
+    o->params.purkinje = true;
     for (int i = 0; i < argc; i++) {
         const char *a = argv[i];
         const char *next = i + 1 < argc ? argv[i + 1] : NULL;
@@ -198,7 +222,27 @@ static int parse_options(int argc, char **argv, struct options *o)
             }
         } else if (!strcmp(a, "--grade") && next)
             o->grade = argv[++i];
-        else if (!strcmp(a, "--world") && next)
+        else if (!strcmp(a, "--grade-space") && next) {
+            const char *t = argv[++i];
+            ok = !strcmp(t, "srgb") || !strcmp(t, "acescct");
+            o->params.grade_log = !strcmp(t, "acescct");
+        } else if (!strcmp(a, "--white-balance") && next) {
+            ok = parse_doubles(argv[++i], c, 1, 2, &n) && c[0] >= 1000.0 && c[0] <= 15000.0 &&
+                 (n < 2 || fabs(c[1]) <= 50.0);
+            o->params.grading.white_balance_k = c[0];
+            o->params.grading.tint = n == 2 ? c[1] : 0.0;
+        } else if (!strcmp(a, "--saturation") && next) {
+            ok = parse_number(argv[++i], 0, 4, &v);
+            o->params.grading.saturation = v;
+        } else if (!strcmp(a, "--contrast") && next) {
+            ok = parse_number(argv[++i], 0.25, 4, &v);
+            o->params.grading.contrast = v;
+        } else if (!strcmp(a, "--no-purkinje"))
+            o->params.purkinje = false;
+        else if (!strcmp(a, "--sun-lux") && next) {
+            ok = parse_number(argv[++i], 1e-3, 1e7, &v);
+            o->params.sun_illuminance_lux = v;
+        } else if (!strcmp(a, "--world") && next)
             o->world = argv[++i];
         else if (!strcmp(a, "--tonemap") && next) {
             const char *t = argv[++i];

@@ -114,8 +114,10 @@ static const VkDescriptorType binding_types[SB_VIEW_BINDING_COUNT] = {
     [SB_VIEW_BINDING_BVH_TRIANGLES] = VK_DESCRIPTOR_TYPE_STORAGE_BUFFER,
     [SB_VIEW_BINDING_DEPTH_OUT] = VK_DESCRIPTOR_TYPE_STORAGE_IMAGE,
     [SB_VIEW_BINDING_GRADE_LUT] = VK_DESCRIPTOR_TYPE_STORAGE_BUFFER,
+    [SB_VIEW_BINDING_GRADING] = VK_DESCRIPTOR_TYPE_STORAGE_BUFFER,
+    [SB_VIEW_BINDING_PURKINJE] = VK_DESCRIPTOR_TYPE_STORAGE_BUFFER,
 };
-_Static_assert(SB_VIEW_BINDING_COUNT == 47, "every binding has a type above");
+_Static_assert(SB_VIEW_BINDING_COUNT == 49, "every binding has a type above");
 
 void sb_renderer_bind_buffer(struct sb_renderer *r, uint32_t binding, const struct sb_buffer *buffer)
 {
@@ -1201,7 +1203,9 @@ static const struct sb_pass_class *const pass_classes[SB_PASS_COUNT] = {
     [SB_PASS_SKY] = &pass_sky,
     [SB_PASS_CLOUDS] = &sb_pass_clouds,       /* clouds.c */
     [SB_PASS_FOG_APPLY] = &sb_pass_fog_apply, /* fog.c */
+    [SB_PASS_PURKINJE] = &sb_pass_purkinje,   /* purkinje.c */
     [SB_PASS_EXPOSURE] = &pass_exposure,
+    [SB_PASS_GRADE_LINEAR] = &sb_pass_grade_linear, /* grade.c */
     [SB_PASS_BLOOM] = &pass_bloom,
     [SB_PASS_TONEMAP] = &pass_tonemap,
     [SB_PASS_GRADE] = &sb_pass_grade, /* grade.c */

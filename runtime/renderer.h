@@ -29,6 +29,19 @@ enum sb_scene_method {
 
 struct sb_lut3d;
 
+/* Scene-linear grading (runtime/grade.c): on the exposed frame (mid grey at
+ * 0.18), before bloom and the tone curve. */
+#define SB_GRADING_NEUTRAL_K 6504.0 /* D65's correlated colour temperature */
+struct sb_grading {
+    bool enabled;           /* false: none (as every setting neutral) */
+    double white_balance_k; /* the colour temperature (K) of the light to render white, 1000 to 15000:
+                               lower makes the frame cooler; SB_GRADING_NEUTRAL_K: none */
+    double tint;            /* that light's offset from the locus, in Duv / 1000; positive: more magenta
+                               (the frame turns greener); 0: none */
+    double saturation;      /* about the luminance: 0 grey, 1 none */
+    double contrast;        /* each channel 0.18 (c / 0.18)^contrast; 1: none */
+};
+
 struct sb_renderer_params {
     uint32_t width, height;          /* 0: 1280 x 720 */
     uint32_t shadow_size;            /* texels per side of each cascade; 0: 2048 */
@@ -54,9 +67,27 @@ struct sb_renderer_params {
                                         reflection probes) and the frame (aerial perspective from its
                                         volume alone); the same frame, slower on llvmpipe */
     enum sb_scene_method scene;      /* how the scene pass finds the world's points */
-    const struct sb_lut3d *grade;    /* a .cube LUT for the display-referred frame (grade.c), read during
-                                        sb_renderer_create only; NULL: no grading */
+    const struct sb_lut3d *grade;    /* a .cube LUT (grade.c), read during sb_renderer_create only; NULL:
+                                        none. It grades the display-referred 8-bit frame, or with
+                                        grade_log the scene-linear one in ACEScct before the tone curve */
+    bool grade_log;                  /* the LUT's input is ACEScct, not the sRGB-encoded frame */
+    struct sb_grading grading;       /* scene-linear grading; zeroed: none */
+    bool purkinje;                   /* the Purkinje shift in dim light (purkinje.c) */
+    double sun_illuminance_lux;      /* the sun's illuminance above the atmosphere, what makes the pack's
+                                        radiance absolute for the Purkinje shift; 0: 128000 (the earth's) */
 };
+
+/* The grading's colour matrix (rows, linear Rec.709): white balance, then
+ * saturation; the chromaticity (CIE 1931 xy) it renders white for a colour
+ * temperature and tint; whether a grading changes nothing. */
+void sb_grading_matrix(const struct sb_grading *grading, double m[3][3]);
+void sb_grading_white(double kelvin, double tint, double xy[2]);
+bool sb_grading_is_neutral(const struct sb_grading *grading);
+/* The Planckian locus (CIE 1931 xy; Krystek's approximation, 1000 to 15000 K). */
+void sb_planckian_xy(double kelvin, double xy[2]);
+/* Linear Rec.709 to CIE XYZ, and to ACES AP1 (D65 to D60 by Bradford); rows. */
+void sb_rec709_to_xyz(double m[3][3]);
+void sb_rec709_to_ap1(double m[3][3]);
 
 /* What one frame looks at. Angles in radians; lengths in metres. */
 struct sb_view {
@@ -81,7 +112,9 @@ enum sb_pass {
     SB_PASS_SKY,
     SB_PASS_CLOUDS,
     SB_PASS_FOG_APPLY,
+    SB_PASS_PURKINJE,
     SB_PASS_EXPOSURE,
+    SB_PASS_GRADE_LINEAR,
     SB_PASS_BLOOM,
     SB_PASS_TONEMAP,
     SB_PASS_GRADE,
@@ -89,7 +122,7 @@ enum sb_pass {
 };
 
 /* "sky-view", "probes", "aerial perspective", "shadows", "cloud shadow", "fog", "scene", "sky", "clouds",
- * "fog apply", "exposure", "bloom", "tonemap", "grade". */
+ * "fog apply", "purkinje", "exposure", "grade linear", "bloom", "tonemap", "grade". */
 const char *sb_pass_name(enum sb_pass pass);
 
 struct sb_frame_timings {

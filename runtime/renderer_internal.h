@@ -23,6 +23,7 @@
 struct sb_clouds;
 struct sb_fog;
 struct sb_grade;
+struct sb_purkinje;
 struct sb_image;
 
 #define SB_HDR_FORMAT VK_FORMAT_R16G16B16A16_SFLOAT
@@ -89,9 +90,10 @@ struct sb_renderer {
     struct sb_buffer bvh_nodes, bvh_triangles; /* the world's BVH when traced, else stand-ins */
     struct sb_texture depth_stand_in;          /* the depth output's binding when rasterised */
 
-    struct sb_fog *fog;       /* fog.c */
-    struct sb_clouds *clouds; /* clouds.c */
-    struct sb_grade *grade;   /* grade.c */
+    struct sb_fog *fog;           /* fog.c */
+    struct sb_clouds *clouds;     /* clouds.c */
+    struct sb_grade *grade;       /* grade.c */
+    struct sb_purkinje *purkinje; /* purkinje.c */
 
     VkQueryPool queries;
     VkCommandBuffer cmd;
@@ -124,6 +126,8 @@ extern const struct sb_pass_class sb_pass_fog;          /* fog.c: the froxel vol
 extern const struct sb_pass_class sb_pass_fog_apply;    /* fog.c: the volume applied to the frame */
 extern const struct sb_pass_class sb_pass_cloud_shadow; /* clouds.c: the clouds' shadow map */
 extern const struct sb_pass_class sb_pass_clouds;       /* clouds.c: traced, resolved, composited */
+extern const struct sb_pass_class sb_pass_purkinje;     /* purkinje.c: the rods' shift in dim light */
+extern const struct sb_pass_class sb_pass_grade_linear; /* grade.c: scene-linear grading (and its resources) */
 extern const struct sb_pass_class sb_pass_grade;        /* grade.c: the LUT on the display-referred frame */
 
 /* Point a binding at a buffer, or at an image view with a sampler (NULL:

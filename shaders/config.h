@@ -227,7 +227,9 @@ struct sb_bake_push {
 #define SB_VIEW_BINDING_BVH_TRIANGLES 44    /* its triangles; material 1: casts shadows, 0: does not */
 #define SB_VIEW_BINDING_DEPTH_OUT 45        /* image2D r32f: the traced scene's depth, written */
 #define SB_VIEW_BINDING_GRADE_LUT 46        /* the grading LUT (grade.comp): domain, size, entries */
-#define SB_VIEW_BINDING_COUNT 47
+#define SB_VIEW_BINDING_GRADING 47          /* struct sb_grading_gpu (grade_linear.comp) */
+#define SB_VIEW_BINDING_PURKINJE 48         /* struct sb_purkinje_gpu (purkinje.comp) */
+#define SB_VIEW_BINDING_COUNT 49
 /* A shadow ray's reach: past any two points of a world (4 x SB_MESH_MAX_EXTENT_M, geometry/mesh.h). */
 #define SB_TRACE_FAR_M 4.0e4
 
@@ -374,6 +376,24 @@ struct sb_probes_gpu {
 struct sb_exposure_gpu {
     SB_VEC4(state); /* x: adapted log2 luminance; y: exposure (multiplier); z: metered log2 luminance
                        of this frame; w: pixels in the metering window */
+};
+
+/* Scene-linear grading (runtime/grade.c, grade_linear.comp), on the
+ * exposed frame before bloom and the tone curve: c = matrix * c (white
+ * balance, then saturation), then each channel pivot * (c / pivot)^contrast,
+ * then, with a LUT in ACEScct, the LUT. */
+struct sb_grading_gpu {
+    SB_VEC4(matrix[3]);   /* rows of the 3x3 colour matrix, linear Rec.709 */
+    SB_VEC4(tone);        /* x: contrast (an exponent), y: pivot (exposed), zw: unused */
+    SB_VEC4(to_ap1[3]);   /* rows: linear Rec.709 (D65) to ACES AP1 (D60), Bradford */
+    SB_VEC4(from_ap1[3]); /* rows: its inverse */
+};
+
+/* The Purkinje shift (runtime/purkinje.c, purkinje.comp). */
+struct sb_purkinje_gpu {
+    SB_VEC4(scale); /* x: cd/m^2 per unit of stored radiance, y: its inverse,
+                       z: photopic luminance (cd/m^2, no shift at or above),
+                       w: scotopic luminance (the whole shift at or below) */
 };
 
 /* Push constants of skyview's passes. */

@@ -17,7 +17,6 @@
 #include "harness_vk.h"
 #include "json.h"
 #include "log.h"
-#include "lut3d.h"
 #include "pack.h"
 #include "parallel.h"
 #include "renderer.h"
@@ -258,90 +257,6 @@ static void check_same_frames(struct sb_renderer *r, const struct sb_renderer_pa
         free(b);
     }
     sb_renderer_destroy(&o);
-}
-
-/* A LUT of n^3 entries, each f(node) for the node's (r, g, b) in [0, 1]. */
-static bool make_lut(uint32_t n, void (*f)(const float in[3], float out[3]), struct sb_lut3d *lut)
-{
-    *lut = (struct sb_lut3d){.size = n, .domain_max = {1, 1, 1}};
-    lut->rgb = malloc((size_t)n * n * n * 3 * sizeof(float));
-    for (uint32_t i = 0; lut->rgb && i < n * n * n; i++) {
-        const float in[3] = {(float)(i % n) / (float)(n - 1), (float)(i / n % n) / (float)(n - 1),
-                             (float)(i / (n * n)) / (float)(n - 1)};
-        f(in, lut->rgb + 3 * i);
-    }
-    return lut->rgb != NULL;
-}
-
-static void lut_neutral(const float in[3], float out[3])
-{
-    memcpy(out, in, 3 * sizeof(float));
-}
-
-static void lut_invert(const float in[3], float out[3])
-{
-    for (int c = 0; c < 3; c++)
-        out[c] = 1.0f - in[c];
-}
-
-static void lut_swap(const float in[3], float out[3])
-{
-    out[0] = in[2];
-    out[1] = in[1];
-    out[2] = in[0];
-}
-
-/*
- * Grading (runtime/grade.c) against the ungraded frame, code by code. LUTs
- * linear in their input are reproduced exactly by trilinear interpolation,
- * so: the neutral 33^3 LUT leaves every byte as it was; 1 - v at 17^3 turns
- * each colour code q into 255 - q; swapping red and blue at 2^3 swaps the
- * codes. The frame has enough distinct codes for that to mean something.
- */
-static void test_grade(struct sb_renderer *r, const struct sb_renderer_params *rp)
-{
-    struct sb_view v = base_view();
-    if (!render(r, &v))
-        return;
-    size_t bytes = (size_t)W * H * 4;
-    uint8_t *ref = malloc(bytes);
-    memcpy(ref, sb_renderer_ldr(r), bytes);
-    bool seen[256] = {false};
-    int distinct = 0;
-    for (size_t i = 0; i < bytes; i++)
-        if (i % 4 != 3 && !seen[ref[i]]) {
-            seen[ref[i]] = true;
-            distinct++;
-        }
-    CHECK(distinct >= 64, "the ungraded frame has %d distinct codes", distinct);
-    static const struct {
-        uint32_t size;
-        void (*f)(const float in[3], float out[3]);
-        const char *name;
-    } luts[] = {{33, lut_neutral, "neutral"}, {17, lut_invert, "inverting"}, {2, lut_swap, "red-blue swapping"}};
-    for (size_t k = 0; k < sizeof(luts) / sizeof(luts[0]); k++) {
-        struct sb_lut3d lut;
-        struct sb_renderer *g = NULL;
-        struct sb_renderer_params p = *rp;
-        p.grade = &lut;
-        bool ok = make_lut(luts[k].size, luts[k].f, &lut) && sb_renderer_create(vk, &pack, &world, &p, &g) == SB_OK;
-        CHECK(ok, "a renderer grading through the %s LUT", luts[k].name);
-        if (ok && render(g, &v)) {
-            const uint8_t *got = sb_renderer_ldr(g);
-            size_t wrong = 0;
-            for (size_t i = 0; i < bytes; i += 4)
-                for (int c = 0; c < 4; c++) {
-                    uint8_t q = ref[i + (k == 2 && c != 1 && c != 3 ? 2 - c : c)];
-                    uint8_t want = k == 1 && c != 3 ? (uint8_t)(255 - q) : q;
-                    wrong += got[i + c] != want;
-                }
-            CHECK(wrong == 0, "the %s LUT: %zu of %zu bytes are not what it maps the ungraded frame's to", luts[k].name,
-                  wrong, bytes);
-        }
-        sb_renderer_destroy(&g);
-        sb_lut3d_finish(&lut);
-    }
-    free(ref);
 }
 
 static void test_shadow_boxes(struct sb_renderer *r, const struct sb_renderer_params *rp)
@@ -1363,7 +1278,6 @@ int main(int argc, char **argv)
         test_shadows(r);
         test_shadow_boxes(r, &rp);
         test_specialised_shaders(r, &rp);
-        test_grade(r, &rp);
         test_traced_scene(&rp);
         test_caster_boxes_bounded();
         test_exposure(r);

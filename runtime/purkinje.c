@@ -1,0 +1,77 @@
+/*
+ * The Purkinje shift (shaders/purkinje.comp): one pass of the renderer's
+ * table, "purkinje", on the lit frame before exposure, so that the meter
+ * and every later pass see what the eye would. It needs the frame's
+ * radiance in cd/m^2: the pack's is relative to its solar irradiance, and
+ * the sun's illuminance above the atmosphere (params.sun_illuminance_lux)
+ * makes it absolute. Off, it records nothing.
+ */
+#include <stdlib.h>
+
+#include "renderer_internal.h"
+#include "scene.h"
+
+#include "purkinje.spv.h"
+
+/* CIE 191:2010's mesopic range: the cones alone at and above 5 cd/m^2, the
+ * rods alone at and below 0.005 cd/m^2. */
+#define PHOTOPIC_CD_M2 5.0
+#define SCOTOPIC_CD_M2 0.005
+#define EARTH_SUN_LUX 128000.0
+
+struct sb_purkinje {
+    bool enabled;
+    struct sb_buffer params; /* sb_purkinje_gpu */
+    VkPipeline kernel;
+};
+
+static enum sb_result purkinje_create(struct sb_renderer *r)
+{
+    struct sb_purkinje *p = calloc(1, sizeof(*p));
+    if (!p)
+        return SB_ERR_NOMEM;
+    r->purkinje = p;
+    const double *sun = r->pack->scene->atmosphere.solar_irradiance;
+    double sun_y = 0.2126 * sun[0] + 0.7152 * sun[1] + 0.0722 * sun[2];
+    double lux = r->params.sun_illuminance_lux > 0.0 ? r->params.sun_illuminance_lux : EARTH_SUN_LUX;
+    p->enabled = r->params.purkinje && sun_y > 0.0;
+    enum sb_result res = sb_renderer_upload(r, NULL, sizeof(struct sb_purkinje_gpu), "Purkinje shift", &p->params);
+    if (res)
+        return res;
+    struct sb_purkinje_gpu *gpu = p->params.mapped;
+    double scale = p->enabled ? lux / (sun_y * r->radiance_scale) : 1.0;
+    gpu->scale[0] = (float)scale;
+    gpu->scale[1] = (float)(1.0 / scale);
+    gpu->scale[2] = (float)PHOTOPIC_CD_M2;
+    gpu->scale[3] = (float)SCOTOPIC_CD_M2;
+    sb_renderer_bind_buffer(r, SB_VIEW_BINDING_PURKINJE, &p->params);
+    if (p->enabled)
+        res = sb_renderer_kernel(r, sb_spv_purkinje, sizeof(sb_spv_purkinje), "purkinje", &p->kernel);
+    return res;
+}
+
+static void purkinje_destroy(struct sb_renderer *r)
+{
+    struct sb_purkinje *p = r->purkinje;
+    if (!p)
+        return;
+    sb_renderer_release(r, &p->kernel, 1, NULL, 0);
+    sb_buffer_destroy(r->vk, &p->params);
+    free(p);
+    r->purkinje = NULL;
+}
+
+static void purkinje_record(struct sb_renderer *r)
+{
+    if (!r->purkinje->enabled)
+        return;
+    sb_renderer_dispatch(r, r->purkinje->kernel, NULL, (const uint32_t[3]){r->width, r->height, 1},
+                         (const uint32_t[3]){SB_WORKGROUP_X, SB_WORKGROUP_Y, 1});
+}
+
+const struct sb_pass_class sb_pass_purkinje = {
+    .name = "purkinje",
+    .create = purkinje_create,
+    .destroy = purkinje_destroy,
+    .record = purkinje_record,
+};
