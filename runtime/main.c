@@ -90,6 +90,9 @@ static void usage(FILE *f)
                "                          (default), up to 4\n"
                "  --contrast C            before the tone curve, each channel 0.18 (c / 0.18)^C:\n"
                "                          1 none (default), 0.25 to 4\n"
+               "  --local-contrast C      local tone mapping: the large-scale contrast about the\n"
+               "                          frame's mean (bilateral grid, detail kept), 0.25 to 1;\n"
+               "                          1: none (default 0.7)\n"
                "  --no-purkinje           no Purkinje shift (by default dim light, below 5 cd/m^2,\n"
                "                          shifts toward blue as the eye's rods see it)\n"
                "  --sun-lux LUX           the sun's illuminance above the atmosphere, which makes\n"
@@ -179,6 +182,7 @@ static int parse_options(int argc, char **argv, struct options *o)
         .contrast = 1.0,
     };
     o->params.purkinje = true;
+    o->params.local_contrast = 0.7;
     for (int i = 0; i < argc; i++) {
         const char *a = argv[i];
         const char *next = i + 1 < argc ? argv[i + 1] : NULL;
@@ -237,6 +241,9 @@ static int parse_options(int argc, char **argv, struct options *o)
         } else if (!strcmp(a, "--contrast") && next) {
             ok = parse_number(argv[++i], 0.25, 4, &v);
             o->params.grading.contrast = v;
+        } else if (!strcmp(a, "--local-contrast") && next) {
+            ok = parse_number(argv[++i], 0.25, 1, &v);
+            o->params.local_contrast = v;
         } else if (!strcmp(a, "--no-purkinje"))
             o->params.purkinje = false;
         else if (!strcmp(a, "--sun-lux") && next) {

@@ -116,8 +116,10 @@ static const VkDescriptorType binding_types[SB_VIEW_BINDING_COUNT] = {
     [SB_VIEW_BINDING_GRADE_LUT] = VK_DESCRIPTOR_TYPE_STORAGE_BUFFER,
     [SB_VIEW_BINDING_GRADING] = VK_DESCRIPTOR_TYPE_STORAGE_BUFFER,
     [SB_VIEW_BINDING_PURKINJE] = VK_DESCRIPTOR_TYPE_STORAGE_BUFFER,
+    [SB_VIEW_BINDING_LOCAL_TONEMAP] = VK_DESCRIPTOR_TYPE_STORAGE_BUFFER,
+    [SB_VIEW_BINDING_LOCAL_TONEMAP_GRID] = VK_DESCRIPTOR_TYPE_STORAGE_BUFFER,
 };
-_Static_assert(SB_VIEW_BINDING_COUNT == 49, "every binding has a type above");
+_Static_assert(SB_VIEW_BINDING_COUNT == 51, "every binding has a type above");
 
 void sb_renderer_bind_buffer(struct sb_renderer *r, uint32_t binding, const struct sb_buffer *buffer)
 {
@@ -600,7 +602,8 @@ static enum sb_result create_images(struct sb_renderer *r)
                            VK_IMAGE_USAGE_DEPTH_STENCIL_ATTACHMENT_BIT | VK_IMAGE_USAGE_SAMPLED_BIT, "shadow cascades");
     if (!res)
         res = create_texture(r, &r->hdr, r->width, r->height, 1, 1, 1, SB_HDR_FORMAT,
-                             storage_sampled | copy | VK_IMAGE_USAGE_COLOR_ATTACHMENT_BIT, "HDR frame");
+                             storage_sampled | copy | VK_IMAGE_USAGE_TRANSFER_DST_BIT | VK_IMAGE_USAGE_COLOR_ATTACHMENT_BIT,
+                             "HDR frame");
     /* the traced scene writes its depth from a kernel, which a depth format cannot take */
     if (!res && r->scene_traced)
         res = create_texture(r, &r->depth, r->width, r->height, 1, 1, 1, VK_FORMAT_R32_SFLOAT, storage_sampled,
@@ -764,6 +767,17 @@ enum sb_result sb_renderer_create(struct sb_vk *vk, const struct sb_pack *pack, 
     if (!res)
         res = upload(vk, NULL, (size_t)r->width * r->height * 8, "HDR readback", &r->read_hdr);
     if (!res)
+        res = upload(vk, NULL, (size_t)r->width * r->height * 8, "post-processed HDR readback", &r->read_post);
+    if (!res && params->post_input) {
+        res = upload(vk, NULL, (size_t)r->width * r->height * 8, "post-processing input", &r->post_input);
+        uint16_t *dst = res ? NULL : r->post_input.mapped;
+        for (size_t i = 0; dst && i < (size_t)r->width * r->height; i++)
+            for (int c = 0; c < 4; c++) {
+                float v = c < 3 ? params->post_input[3 * i + c] : 1.0f;
+                dst[4 * i + c] = sb_half_from_float(isfinite(v) ? (float)(v * r->radiance_scale) : 0.0f);
+            }
+    }
+    if (!res)
         res = upload(vk, NULL, (size_t)SB_SKY_VIEW_WIDTH * SB_SKY_VIEW_HEIGHT * 8, "sky-view readback",
                      &r->read_sky_view);
     if (!res)
@@ -848,10 +862,10 @@ void sb_renderer_destroy(struct sb_renderer **pr)
     struct sb_texture *const textures[] = {&r->sky_view, &r->aerial, &r->aerial_t, &r->shadow,        &r->hdr,
                                            &r->depth,    &r->bloom,  &r->ldr,      &r->depth_stand_in};
     sb_renderer_release(r, NULL, 0, textures, sizeof(textures) / sizeof(textures[0]));
-    struct sb_buffer *buffers[] = {&r->atmosphere,  &r->transmittance,   &r->multiscattering, &r->irradiance_ground,
-                                   &r->frame,       &r->vertices,        &r->exposure,        &r->read_ldr,
-                                   &r->read_hdr,    &r->read_sky_view,   &r->probes,          &r->probe_light,
-                                   &r->reflections, &r->reflection_cubes};
+    struct sb_buffer *buffers[] = {&r->atmosphere,  &r->transmittance,    &r->multiscattering, &r->irradiance_ground,
+                                   &r->frame,       &r->vertices,         &r->exposure,        &r->read_ldr,
+                                   &r->read_hdr,    &r->read_sky_view,    &r->probes,          &r->probe_light,
+                                   &r->reflections, &r->reflection_cubes, &r->read_post,       &r->post_input};
     for (size_t i = 0; i < sizeof(buffers) / sizeof(buffers[0]); i++)
         sb_buffer_destroy(vk, buffers[i]);
     free(r);
@@ -1205,7 +1219,8 @@ static const struct sb_pass_class *const pass_classes[SB_PASS_COUNT] = {
     [SB_PASS_FOG_APPLY] = &sb_pass_fog_apply, /* fog.c */
     [SB_PASS_PURKINJE] = &sb_pass_purkinje,   /* purkinje.c */
     [SB_PASS_EXPOSURE] = &pass_exposure,
-    [SB_PASS_GRADE_LINEAR] = &sb_pass_grade_linear, /* grade.c */
+    [SB_PASS_LOCAL_TONEMAP] = &sb_pass_local_tonemap, /* local_tonemap.c */
+    [SB_PASS_GRADE_LINEAR] = &sb_pass_grade_linear,   /* grade.c */
     [SB_PASS_BLOOM] = &pass_bloom,
     [SB_PASS_TONEMAP] = &pass_tonemap,
     [SB_PASS_GRADE] = &sb_pass_grade, /* grade.c */
@@ -1221,6 +1236,20 @@ static void copy_image(struct sb_renderer *r, const struct sb_texture *t, const 
     sb_texture_barrier(r->cmd, t, VK_IMAGE_LAYOUT_GENERAL, VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL);
     vkCmdCopyImageToBuffer(r->cmd, t->image, VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL, b->buffer, 1, &region);
     sb_texture_barrier(r->cmd, t, VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL, VK_IMAGE_LAYOUT_GENERAL);
+}
+
+/* The lit frame replaced by params.post_input's (its halves, uploaded once). */
+static void copy_input(struct sb_renderer *r)
+{
+    VkBufferImageCopy region = {
+        .imageSubresource = {VK_IMAGE_ASPECT_COLOR_BIT, 0, 0, 1},
+        .imageExtent = {r->width, r->height, 1},
+    };
+    sb_texture_barrier(r->cmd, &r->hdr, VK_IMAGE_LAYOUT_GENERAL, VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL);
+    vkCmdCopyBufferToImage(r->cmd, r->post_input.buffer, r->hdr.image, VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL, 1,
+                           &region);
+    sb_texture_barrier(r->cmd, &r->hdr, VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL, VK_IMAGE_LAYOUT_GENERAL);
+    sb_renderer_barrier(r->cmd);
 }
 
 enum sb_result sb_renderer_render(struct sb_renderer *r, const struct sb_view *view, bool readback,
@@ -1247,11 +1276,17 @@ enum sb_result sb_renderer_render(struct sb_renderer *r, const struct sb_view *v
         if (r->queries)
             vkCmdWriteTimestamp(r->cmd, VK_PIPELINE_STAGE_BOTTOM_OF_PIPE_BIT, r->queries, 2 * p + 1);
         sb_renderer_barrier(r->cmd);
+        if (p == SB_PASS_LAST_LIT) { /* the lit frame is whole: post-processing takes it from here */
+            if (r->params.post_input)
+                copy_input(r);
+            if (readback)
+                copy_image(r, &r->hdr, &r->read_hdr);
+        }
     }
 
     if (readback) {
         copy_image(r, &r->ldr, &r->read_ldr);
-        copy_image(r, &r->hdr, &r->read_hdr);
+        copy_image(r, &r->hdr, &r->read_post);
         copy_image(r, &r->sky_view, &r->read_sky_view);
     }
     VkMemoryBarrier to_host = {
@@ -1313,6 +1348,11 @@ static void halves_to_rgb(const uint16_t *src, size_t pixels, double scale, floa
 void sb_renderer_hdr(const struct sb_renderer *r, float *rgb)
 {
     halves_to_rgb(r->read_hdr.mapped, (size_t)r->width * r->height, r->radiance_scale, rgb);
+}
+
+void sb_renderer_post_hdr(const struct sb_renderer *r, float *rgb)
+{
+    halves_to_rgb(r->read_post.mapped, (size_t)r->width * r->height, r->radiance_scale, rgb);
 }
 
 void sb_renderer_sky_view(const struct sb_renderer *r, float *rgb)

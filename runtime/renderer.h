@@ -73,8 +73,13 @@ struct sb_renderer_params {
     bool grade_log;                  /* the LUT's input is ACEScct, not the sRGB-encoded frame */
     struct sb_grading grading;       /* scene-linear grading; zeroed: none */
     bool purkinje;                   /* the Purkinje shift in dim light (purkinje.c) */
+    double local_contrast;           /* local tone mapping (local_tonemap.c): the base layer's contrast about
+                                        the frame's pivot, (0, 1]; 0 or 1: none */
     double sun_illuminance_lux;      /* the sun's illuminance above the atmosphere, what makes the pack's
                                         radiance absolute for the Purkinje shift; 0: 128000 (the earth's) */
+    const float *post_input;         /* width x height x 3 floats in the pack's units, or NULL: every frame
+                                        post-processes this image instead of the lit one (read during
+                                        sb_renderer_create only; non-finite values read as 0) */
 };
 
 /* The grading's colour matrix (rows, linear Rec.709): white balance, then
@@ -112,8 +117,10 @@ enum sb_pass {
     SB_PASS_SKY,
     SB_PASS_CLOUDS,
     SB_PASS_FOG_APPLY,
+    SB_PASS_LAST_LIT = SB_PASS_FOG_APPLY, /* the last pass that lights the frame; post-processing follows */
     SB_PASS_PURKINJE,
     SB_PASS_EXPOSURE,
+    SB_PASS_LOCAL_TONEMAP,
     SB_PASS_GRADE_LINEAR,
     SB_PASS_BLOOM,
     SB_PASS_TONEMAP,
@@ -122,7 +129,7 @@ enum sb_pass {
 };
 
 /* "sky-view", "probes", "aerial perspective", "shadows", "cloud shadow", "fog", "scene", "sky", "clouds",
- * "fog apply", "purkinje", "exposure", "grade linear", "bloom", "tonemap", "grade". */
+ * "fog apply", "purkinje", "exposure", "local tonemap", "grade linear", "bloom", "tonemap", "grade". */
 const char *sb_pass_name(enum sb_pass pass);
 
 struct sb_frame_timings {
@@ -151,11 +158,15 @@ enum sb_result sb_renderer_render(struct sb_renderer *renderer, const struct sb_
 /* The last frame rendered with readback, top row first:
  * - ldr: width * height * 4 bytes, sRGB-encoded RGBA;
  * - hdr: width * height * 3 floats, linear radiance in the pack's units
- *   (those of its solar irradiance), before exposure;
+ *   (those of its solar irradiance), before exposure and post-processing;
+ * - post_hdr: the same after the passes that post-process it in place (the
+ *   Purkinje shift, local tone mapping, scene-linear grading): what bloom
+ *   and the tone curve take, divided by the exposure again;
  * - sky_view: SB_SKY_VIEW_WIDTH * SB_SKY_VIEW_HEIGHT * 3 floats, likewise. */
 void sb_renderer_size(const struct sb_renderer *renderer, uint32_t *width, uint32_t *height);
 const uint8_t *sb_renderer_ldr(const struct sb_renderer *renderer);
 void sb_renderer_hdr(const struct sb_renderer *renderer, float *rgb);
+void sb_renderer_post_hdr(const struct sb_renderer *renderer, float *rgb);
 void sb_renderer_sky_view(const struct sb_renderer *renderer, float *rgb);
 
 /* The exposure state after the last frame: adapted log2 luminance, the

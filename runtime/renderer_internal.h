@@ -23,6 +23,7 @@
 struct sb_clouds;
 struct sb_fog;
 struct sb_grade;
+struct sb_local_tonemap;
 struct sb_purkinje;
 struct sb_image;
 
@@ -69,6 +70,8 @@ struct sb_renderer {
     uint32_t probe_count;                           /* grid probes lit by the probes pass (0: none) */
     uint32_t reflection_count;                      /* reflection probes the scene reads (0: none) */
     struct sb_buffer read_ldr, read_hdr, read_sky_view;
+    struct sb_buffer read_post;  /* the HDR frame after post-processing */
+    struct sb_buffer post_input; /* params.post_input as halves, or none */
 
     struct sb_texture sky_view, aerial, aerial_t, shadow, hdr, depth, bloom, ldr;
     VkSampler linear, nearest, shadow_compare, repeat; /* repeat: linear, wrapping (tileable noise) */
@@ -90,10 +93,11 @@ struct sb_renderer {
     struct sb_buffer bvh_nodes, bvh_triangles; /* the world's BVH when traced, else stand-ins */
     struct sb_texture depth_stand_in;          /* the depth output's binding when rasterised */
 
-    struct sb_fog *fog;           /* fog.c */
-    struct sb_clouds *clouds;     /* clouds.c */
-    struct sb_grade *grade;       /* grade.c */
-    struct sb_purkinje *purkinje; /* purkinje.c */
+    struct sb_fog *fog;                     /* fog.c */
+    struct sb_clouds *clouds;               /* clouds.c */
+    struct sb_grade *grade;                 /* grade.c */
+    struct sb_purkinje *purkinje;           /* purkinje.c */
+    struct sb_local_tonemap *local_tonemap; /* local_tonemap.c */
 
     VkQueryPool queries;
     VkCommandBuffer cmd;
@@ -122,13 +126,14 @@ enum sb_result sb_scene_trace_create(struct sb_renderer *r, const struct sb_worl
 void sb_scene_trace_destroy(struct sb_renderer *r);
 void sb_scene_trace_record(struct sb_renderer *r);
 
-extern const struct sb_pass_class sb_pass_fog;          /* fog.c: the froxel volume */
-extern const struct sb_pass_class sb_pass_fog_apply;    /* fog.c: the volume applied to the frame */
-extern const struct sb_pass_class sb_pass_cloud_shadow; /* clouds.c: the clouds' shadow map */
-extern const struct sb_pass_class sb_pass_clouds;       /* clouds.c: traced, resolved, composited */
-extern const struct sb_pass_class sb_pass_purkinje;     /* purkinje.c: the rods' shift in dim light */
-extern const struct sb_pass_class sb_pass_grade_linear; /* grade.c: scene-linear grading (and its resources) */
-extern const struct sb_pass_class sb_pass_grade;        /* grade.c: the LUT on the display-referred frame */
+extern const struct sb_pass_class sb_pass_fog;           /* fog.c: the froxel volume */
+extern const struct sb_pass_class sb_pass_fog_apply;     /* fog.c: the volume applied to the frame */
+extern const struct sb_pass_class sb_pass_cloud_shadow;  /* clouds.c: the clouds' shadow map */
+extern const struct sb_pass_class sb_pass_clouds;        /* clouds.c: traced, resolved, composited */
+extern const struct sb_pass_class sb_pass_purkinje;      /* purkinje.c: the rods' shift in dim light */
+extern const struct sb_pass_class sb_pass_local_tonemap; /* local_tonemap.c: base and detail on a bilateral grid */
+extern const struct sb_pass_class sb_pass_grade_linear;  /* grade.c: scene-linear grading (and its resources) */
+extern const struct sb_pass_class sb_pass_grade;         /* grade.c: the LUT on the display-referred frame */
 
 /* Point a binding at a buffer, or at an image view with a sampler (NULL:
  * linear filtering clamped to the edge). They are kept by pointer or handle

@@ -229,7 +229,9 @@ struct sb_bake_push {
 #define SB_VIEW_BINDING_GRADE_LUT 46        /* the grading LUT (grade.comp): domain, size, entries */
 #define SB_VIEW_BINDING_GRADING 47          /* struct sb_grading_gpu (grade_linear.comp) */
 #define SB_VIEW_BINDING_PURKINJE 48         /* struct sb_purkinje_gpu (purkinje.comp) */
-#define SB_VIEW_BINDING_COUNT 49
+#define SB_VIEW_BINDING_LOCAL_TONEMAP 49    /* struct sb_local_tonemap_gpu (local_tonemap.glsl) */
+#define SB_VIEW_BINDING_LOCAL_TONEMAP_GRID 50 /* its bilateral grid (local_tonemap.glsl) */
+#define SB_VIEW_BINDING_COUNT 51
 /* A shadow ray's reach: past any two points of a world (4 x SB_MESH_MAX_EXTENT_M, geometry/mesh.h). */
 #define SB_TRACE_FAR_M 4.0e4
 
@@ -394,6 +396,24 @@ struct sb_purkinje_gpu {
     SB_VEC4(scale); /* x: cd/m^2 per unit of stored radiance, y: its inverse,
                        z: photopic luminance (cd/m^2, no shift at or above),
                        w: scotopic luminance (the whole shift at or below) */
+};
+
+/* Local tone mapping (runtime/local_tonemap.c, local_tonemap.glsl): a
+ * bilateral grid of the exposed frame's log2 luminance, SB_LTM_GRID_X
+ * cells across (square, whole pixels), SB_LTM_BINS bins from SB_LTM_MIN_EV
+ * to SB_LTM_MAX_EV; sums in fixed point, 1 / SB_LTM_Q EV, offset by
+ * SB_LTM_BIAS so that they are never negative. */
+#define SB_LTM_GRID_X 32
+#define SB_LTM_BINS 32
+#define SB_LTM_MIN_EV -15.0
+#define SB_LTM_MAX_EV 9.0
+#define SB_LTM_Q 64
+#define SB_LTM_BIAS 1024
+struct sb_local_tonemap_gpu {
+    SB_UVEC4(grid);  /* xyz: cells; w: a cell's side in pixels */
+    SB_VEC4(params); /* x: the base layer's contrast (1: none); yzw: unused */
+    SB_UVEC4(pivot); /* this frame's: x: the sum of the cells' biased mean log2 luminance, y: the cells with
+                        pixels (their mean of means is the pivot); zw: unused */
 };
 
 /* Push constants of skyview's passes. */

@@ -45,7 +45,8 @@ static struct sb_view view_at(double sun_elevation_deg)
     };
 }
 
-/* One frame read back: 8-bit sRGB, HDR in the pack's units, the exposure state. */
+/* One frame read back: 8-bit sRGB, the post-processed HDR frame in the pack's
+ * units, the exposure state. */
 struct frame {
     uint8_t ldr[PIXELS * 4];
     float hdr[PIXELS * 3];
@@ -63,7 +64,7 @@ static bool render(const struct sb_renderer_params *p, const struct sb_view *v, 
     CHECK(res == SB_OK, "%s: %s", what, sb_result_name(res));
     if (!res) {
         memcpy(f->ldr, sb_renderer_ldr(r), sizeof(f->ldr));
-        sb_renderer_hdr(r, f->hdr);
+        sb_renderer_post_hdr(r, f->hdr);
         sb_renderer_exposure(r, f->exposure);
     }
     sb_renderer_destroy(&r);
@@ -416,6 +417,83 @@ done:
     free(on);
 }
 
+/* ---- Local tone mapping ----------------------------------------------------------------- */
+
+static double mean_log2_luminance(const float *hdr, int y0, int y1)
+{
+    double sum = 0.0;
+    for (int y = y0; y < y1; y++)
+        for (int x = 0; x < W; x++) {
+            const float *p = hdr + 3 * (y * W + x);
+            sum += log2(0.2126 * p[0] + 0.7152 * p[1] + 0.0722 * p[2]);
+        }
+    return sum / ((double)(y1 - y0) * W);
+}
+
+/* The mean of |log2 Y| between horizontal neighbours: a checker's amplitude. */
+static double mean_step(const float *hdr, int y0, int y1)
+{
+    double sum = 0.0;
+    for (int y = y0; y < y1; y++)
+        for (int x = 0; x + 1 < W; x++) {
+            const float *p = hdr + 3 * (y * W + x), *q = p + 3;
+            sum += fabs(log2((0.2126 * p[0] + 0.7152 * p[1] + 0.0722 * p[2]) /
+                             (0.2126 * q[0] + 0.7152 * q[1] + 0.0722 * q[2])));
+        }
+    return sum / ((double)(y1 - y0) * (W - 1));
+}
+
+/*
+ * Local tone mapping (runtime/local_tonemap.c) on images given to the post
+ * chain (params.post_input):
+ * - a frame of one colour, at three levels, is left bit for bit as it was
+ *   (the base layer is an exact 0 there);
+ * - a frame whose upper half is 4 EV brighter than its lower, each half a
+ *   checker of +-0.25 EV: at contrast 0.5 the halves' interiors end 2 EV
+ *   apart, each moved 1 EV toward the pivot, the checker kept.
+ */
+static void test_local_tonemap(void)
+{
+    struct sb_view v = view_at(30.0);
+    struct frame *off = malloc(sizeof(*off)), *on = malloc(sizeof(*on));
+    float *input = malloc(sizeof(float) * PIXELS * 3);
+    struct sb_renderer_params p = base_params, q = base_params;
+    p.post_input = q.post_input = input;
+    q.local_contrast = 0.5;
+    static const float levels[] = {1e-4f, 0.05f, 3.0f};
+    for (int k = 0; k < 3; k++) {
+        for (int i = 0; i < PIXELS * 3; i++)
+            input[i] = levels[k] * (i % 3 == 2 ? 1.5f : 1.0f);
+        if (render(&p, &v, off, "a constant frame") && render(&q, &v, on, "locally tone mapped"))
+            CHECK(!memcmp(on->hdr, off->hdr, sizeof(on->hdr)) && !memcmp(on->ldr, off->ldr, sizeof(on->ldr)),
+                  "local tone mapping changes a frame of one colour (%g)", levels[k]);
+    }
+
+    for (int y = 0; y < H; y++)
+        for (int x = 0; x < W; x++)
+            for (int c = 0; c < 3; c++)
+                input[3 * (y * W + x) + c] =
+                    (float)(0.01 * (y < H / 2 ? 16.0 : 1.0) * exp2((x + y) % 2 ? 0.25 : -0.25));
+    if (render(&p, &v, off, "two halves") && render(&q, &v, on, "two halves, locally tone mapped")) {
+        /* interiors: 3 cells (5 pixels each) from the edge between the halves */
+        int top = H / 2 - 15, bottom = H / 2 + 15;
+        double in_top = mean_log2_luminance(off->hdr, 0, top), in_bottom = mean_log2_luminance(off->hdr, bottom, H);
+        double out_top = mean_log2_luminance(on->hdr, 0, top), out_bottom = mean_log2_luminance(on->hdr, bottom, H);
+        double step_in = mean_step(off->hdr, 0, top), step_out = mean_step(on->hdr, 0, top);
+        printf("local tone mapping: halves %.3f EV apart -> %.3f (top %+.3f EV, bottom %+.3f); checker %.3f -> %.3f "
+               "EV\n",
+               in_top - in_bottom, out_top - out_bottom, out_top - in_top, out_bottom - in_bottom, step_in, step_out);
+        CHECK(fabs((out_top - out_bottom) - 0.5 * (in_top - in_bottom)) < 0.1,
+              "halves %.3f EV apart end %.3f EV apart, not half", in_top - in_bottom, out_top - out_bottom);
+        CHECK(fabs(out_top - in_top + 1.0) < 0.1 && fabs(out_bottom - in_bottom - 1.0) < 0.1,
+              "the halves move %+.3f and %+.3f EV, not -1 and +1", out_top - in_top, out_bottom - in_bottom);
+        CHECK(fabs(step_out / step_in - 1.0) < 0.1, "the checker's steps go from %.3f to %.3f EV", step_in, step_out);
+    }
+    free(input);
+    free(off);
+    free(on);
+}
+
 /* ---- The Purkinje shift ---------------------------------------------------------------- */
 
 #define SUN_LUX 128000.0
@@ -524,6 +602,7 @@ int main(int argc, char **argv)
         test_linear_grading();
         test_display_lut();
         test_log_lut();
+        test_local_tonemap();
         test_purkinje();
     }
     CHECK(sb_vk_validation_messages(vk) == 0, "%u validation messages", sb_vk_validation_messages(vk));

@@ -64,18 +64,20 @@ check "leave the frame unchanged" cmp -s "$tmp/elsewhere/frame_0000.png" "$tmp/n
 check "graded" expect_exit 0 "$skyview" "$tmp/pack" -o "$tmp/n" $small --white-balance 3200,5 --saturation 1.2 \
     --contrast 1.1 --grade "$tmp/neutral.cube" --grade-space acescct
 check "grading changes the frame" sh -c "! cmp -s '$tmp/elsewhere/frame_0000.png' '$tmp/n/frame_0000.png'"
+check "without local tone mapping" expect_exit 0 "$skyview" "$tmp/pack" -o "$tmp/n" $small --local-contrast 1
+check "local tone mapping changes the frame" sh -c "! cmp -s '$tmp/elsewhere/frame_0000.png' '$tmp/n/frame_0000.png'"
 check "daylight without the Purkinje shift" expect_exit 0 "$skyview" "$tmp/pack" -o "$tmp/n" $small --no-purkinje
 check "is the same frame" cmp -s "$tmp/elsewhere/frame_0000.png" "$tmp/n/frame_0000.png"
 check "dusk with the Purkinje shift" expect_exit 0 "$skyview" "$tmp/pack" -o "$tmp/n" $small --sun-elevation -8
 check "dusk without it" expect_exit 0 "$skyview" "$tmp/pack" -o "$tmp/n0" $small --sun-elevation -8 --no-purkinje
 check "the shift changes dusk" sh -c "! cmp -s '$tmp/n/frame_0000.png' '$tmp/n0/frame_0000.png'"
 for bad in "--white-balance 900" "--white-balance 5000,60" "--saturation -1" "--contrast 0" "--grade-space log" \
-    "--sun-lux 0"; do
+    "--sun-lux 0" "--local-contrast 0.1" "--local-contrast 1.5"; do
     check "$bad is a usage error" expect_exit 2 "$skyview" "$tmp/pack" -o "$tmp/x" $bad
 done
 
 check "bench" expect_exit 0 "$skyview" "$tmp/pack" -o "$tmp/b" $small --bench --frames 3 --warmup 1 --contrast 1.1
-for pass in sky-view probes "aerial perspective" shadows scene sky purkinje exposure "grade linear" bloom tonemap grade \
+for pass in sky-view probes "aerial perspective" shadows scene sky purkinje exposure "local tonemap" "grade linear" bloom tonemap grade \
     total; do
     check "bench table has $pass" grep -q "^$pass " "$tmp/out"
     check "bench.json has $pass" grep -q "\"pass\":[[:space:]]*\"$pass\"" "$tmp/b/bench.json"
