@@ -15,7 +15,7 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "bake.h"
+#include "harness_view.h"
 #include "harness_vk.h"
 #include "log.h"
 #include "lut3d.h"
@@ -146,7 +146,8 @@ static void test_colour_science(void)
 {
     /* The Planckian locus in CIE 1960 uv, which Krystek's approximation
      * follows to about 1e-4: illuminant A (a Planckian radiator at 2856 K)
-     * and the locus at 4000 K and 6500 K (CIE 15's tables). */
+     * and the locus at 4000 K and 6500 K as tables of it give them to five
+     * places, which adds up to 3e-5 (measured 5.4e-5 to 1.2e-4 off). */
     static const struct {
         double k, x, y;
     } locus[] = {{2856, 0.44757, 0.40745}, {4000, 0.38052, 0.37674}, {6500, 0.31352, 0.32363}};
@@ -207,7 +208,8 @@ static void test_colour_science(void)
     double off_row = 0.0;
     for (int j = 0; j < 3; j++)
         off_row = fmax(off_row, fmax(fabs(m[0][j] - m[1][j]), fabs(m[2][j] - m[1][j])));
-    CHECK(off_row < 1e-3, "saturation 0: rows differ by %.2g", off_row);
+    /* the same row times the same white balance, so exactly */
+    CHECK(off_row == 0.0, "saturation 0: rows differ by %.2g", off_row);
     struct sb_grading neutral = {true, SB_GRADING_NEUTRAL_K, 0.0, 1.0, 1.0};
     CHECK(sb_grading_is_neutral(&neutral) && !sb_grading_is_neutral(&grey), "neutral is neutral, grey is not");
 }
@@ -480,14 +482,18 @@ static void test_local_tonemap(void)
         double in_top = mean_log2_luminance(off->hdr, 0, top), in_bottom = mean_log2_luminance(off->hdr, bottom, H);
         double out_top = mean_log2_luminance(on->hdr, 0, top), out_bottom = mean_log2_luminance(on->hdr, bottom, H);
         double step_in = mean_step(off->hdr, 0, top), step_out = mean_step(on->hdr, 0, top);
-        printf("local tone mapping: halves %.3f EV apart -> %.3f (top %+.3f EV, bottom %+.3f); checker %.3f -> %.3f "
+        printf("local tone mapping: halves %.3f EV apart -> %.3f (top %+.3f EV, bottom %+.3f); checker %.4f -> %.4f "
                "EV\n",
                in_top - in_bottom, out_top - out_bottom, out_top - in_top, out_bottom - in_bottom, step_in, step_out);
-        CHECK(fabs((out_top - out_bottom) - 0.5 * (in_top - in_bottom)) < 0.1,
+        /* The base is each half's mean within the fixed point's 1/64 EV and
+         * the halves' rounding (measured 0.010 EV at most): 0.03. The
+         * checker's phases, 0.5 EV apart, read the base at their own bins,
+         * which the [1 2 1] blur makes nearly alike (measured 0.1%): 2%. */
+        CHECK(fabs((out_top - out_bottom) - 0.5 * (in_top - in_bottom)) < 0.03,
               "halves %.3f EV apart end %.3f EV apart, not half", in_top - in_bottom, out_top - out_bottom);
-        CHECK(fabs(out_top - in_top + 1.0) < 0.1 && fabs(out_bottom - in_bottom - 1.0) < 0.1,
+        CHECK(fabs(out_top - in_top + 1.0) < 0.03 && fabs(out_bottom - in_bottom - 1.0) < 0.03,
               "the halves move %+.3f and %+.3f EV, not -1 and +1", out_top - in_top, out_bottom - in_bottom);
-        CHECK(fabs(step_out / step_in - 1.0) < 0.1, "the checker's steps go from %.3f to %.3f EV", step_in, step_out);
+        CHECK(fabs(step_out / step_in - 1.0) < 0.02, "the checker's steps go from %.3f to %.3f EV", step_in, step_out);
     }
     free(input);
     free(off);
@@ -587,14 +593,7 @@ int main(int argc, char **argv)
 
     char dir[256];
     CHECK(test_temp_dir("skyview-post", dir, sizeof(dir)), "temporary directory");
-    char pack_dir[300];
-    snprintf(pack_dir, sizeof(pack_dir), "%s/pack", dir);
-    struct sb_scene scene = {.name = "post test", .preset = "earth"};
-    sb_atmosphere_preset_earth(&scene.atmosphere);
-    scene.wants[SB_PRODUCT_IRRADIANCE_GROUND] = true;
-    struct sb_bake_report report;
-    CHECK(sb_bake_scene(vk, &scene, pack_dir, NULL, &report) == SB_OK, "bake");
-    CHECK(sb_pack_open(pack_dir, &pack) == SB_OK, "the pack opens");
+    test_view_pack(vk, dir, "post test", &pack);
     CHECK(sb_world_load(world_path, NULL, &world) == SB_OK, "the world loads");
     if (pack.scene && world.vertices) {
         const double *sun = pack.scene->atmosphere.solar_irradiance;

@@ -14,6 +14,7 @@
 #include "bake.h"
 #include "cube.h"
 #include "embree_ref.h"
+#include "harness_view.h"
 #include "harness_vk.h"
 #include "json.h"
 #include "log.h"
@@ -1255,17 +1256,9 @@ int main(int argc, char **argv)
     if (res)
         return test_finish("runtime");
 
-    /* A pack of what skyview reads (irradiance_sky is not needed). */
     char dir[256];
     CHECK(test_temp_dir("skyview-test", dir, sizeof(dir)), "temporary directory");
-    char pack_dir[300];
-    snprintf(pack_dir, sizeof(pack_dir), "%s/pack", dir);
-    struct sb_scene scene = {.name = "runtime test", .preset = "earth"};
-    sb_atmosphere_preset_earth(&scene.atmosphere);
-    scene.wants[SB_PRODUCT_IRRADIANCE_GROUND] = true;
-    struct sb_bake_report report;
-    CHECK(sb_bake_scene(vk, &scene, pack_dir, NULL, &report) == SB_OK, "bake");
-    CHECK(sb_pack_open(pack_dir, &pack) == SB_OK, "the pack opens");
+    test_view_pack(vk, dir, "runtime test", &pack);
     CHECK(sb_world_load(world_path, NULL, &world) == SB_OK, "the world loads");
     read_pillars(world_path);
 
