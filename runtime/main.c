@@ -331,6 +331,10 @@ static int parse_options(int argc, char **argv, struct options *o)
             return EXIT_USAGE;
         }
     }
+    if (o->params.grade_log && !o->grade) {
+        fprintf(stderr, "skyview: --grade-space acescct applies a LUT: it needs --grade FILE.cube\n");
+        return EXIT_USAGE;
+    }
     if (!o->pack || !o->out_dir) {
         fprintf(stderr, "skyview: needs a PACK and -o OUT_DIR\n");
         usage(stderr);

@@ -71,6 +71,9 @@ check "is the same frame" cmp -s "$tmp/elsewhere/frame_0000.png" "$tmp/n/frame_0
 check "dusk with the Purkinje shift" expect_exit 0 "$skyview" "$tmp/pack" -o "$tmp/n" $small --sun-elevation -8
 check "dusk without it" expect_exit 0 "$skyview" "$tmp/pack" -o "$tmp/n0" $small --sun-elevation -8 --no-purkinje
 check "the shift changes dusk" sh -c "! cmp -s '$tmp/n/frame_0000.png' '$tmp/n0/frame_0000.png'"
+check "--grade-space acescct without --grade is a usage error" expect_exit 2 "$skyview" "$tmp/pack" -o "$tmp/x" \
+    --grade-space acescct
+check "saying so" grep -q "needs --grade" "$tmp/err"
 for bad in "--white-balance 900" "--white-balance 5000,60" "--saturation -1" "--contrast 0" "--grade-space log" \
     "--sun-lux 0" "--local-contrast 0.1" "--local-contrast 1.5"; do
     check "$bad is a usage error" expect_exit 2 "$skyview" "$tmp/pack" -o "$tmp/x" $bad
