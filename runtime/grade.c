@@ -215,6 +215,7 @@ static enum sb_result grade_create(struct sb_renderer *r)
     bool log_lut = lut && r->params.grade_log;
     g->display = lut && !log_lut;
     g->linear = log_lut || !sb_grading_is_neutral(&r->params.grading);
+    r->post_in_place |= g->linear;
     size_t entries = lut ? (size_t)lut->size * lut->size * lut->size * 3 : 0;
     size_t bytes = 8 * sizeof(float) + (entries ? entries : 3) * sizeof(float);
     enum sb_result res = sb_renderer_upload(r, NULL, bytes, "grading LUT", &g->lut);
@@ -232,14 +233,12 @@ static enum sb_result grade_create(struct sb_renderer *r)
         memcpy(dst + 8, lut->rgb, entries * sizeof(float));
     }
     struct sb_grading_gpu *gpu = g->grading.mapped;
-    struct sb_grading neutral = {.white_balance_k = SB_GRADING_NEUTRAL_K, .saturation = 1.0, .contrast = 1.0};
-    const struct sb_grading *grading = sb_grading_is_neutral(&r->params.grading) ? &neutral : &r->params.grading;
-    mat3 m, inv;
-    sb_grading_matrix(grading, m);
-    if (grading == &neutral) /* exactly */
-        memcpy(m, (const mat3){{1, 0, 0}, {0, 1, 0}, {0, 0, 1}}, sizeof(m));
+    bool neutral = sb_grading_is_neutral(&r->params.grading);
+    mat3 m = {{1, 0, 0}, {0, 1, 0}, {0, 0, 1}}, inv; /* neutral: exactly the identity */
+    if (!neutral)
+        sb_grading_matrix(&r->params.grading, m);
     store_rows(m, gpu->matrix);
-    gpu->tone[0] = (float)grading->contrast;
+    gpu->tone[0] = neutral ? 1.0f : (float)r->params.grading.contrast;
     gpu->tone[1] = 0.18f;
     sb_rec709_to_ap1(m);
     invert3(m, inv);

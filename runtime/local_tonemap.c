@@ -8,8 +8,8 @@
  * SB_LTM_BINS bins of 0.75 EV and blurred, is the base; the base's distance
  * from the frame's pivot (the mean of the cells' mean log2 luminance) is
  * scaled by params.local_contrast and the detail kept. A sunset's sky and its
- * shadowed foreground, 8 EV apart, end 4.8 EV apart at 0.6, their texture
- * as it was. Contrast 1 records nothing.
+ * shadowed foreground, 8 EV apart, end 5.6 EV apart at 0.7 (the CLI's
+ * default), their texture as it was. Contrast 1 records nothing.
  */
 #include <stddef.h>
 #include <stdlib.h>
@@ -35,6 +35,7 @@ static enum sb_result local_tonemap_create(struct sb_renderer *r)
     r->local_tonemap = t;
     double contrast = r->params.local_contrast;
     t->enabled = contrast > 0.0 && contrast != 1.0;
+    r->post_in_place |= t->enabled;
     uint32_t side = (r->width + SB_LTM_GRID_X - 1) / SB_LTM_GRID_X;
     uint32_t gx = (r->width + side - 1) / side, gy = (r->height + side - 1) / side;
     size_t cells = (size_t)gx * gy * SB_LTM_BINS;

@@ -32,9 +32,11 @@ static enum sb_result purkinje_create(struct sb_renderer *r)
         return SB_ERR_NOMEM;
     r->purkinje = p;
     const double *sun = r->pack->scene->atmosphere.solar_irradiance;
-    double sun_y = 0.2126 * sun[0] + 0.7152 * sun[1] + 0.0722 * sun[2];
+    static const double weights[3] = {SB_LUMINANCE_RGB};
+    double sun_y = weights[0] * sun[0] + weights[1] * sun[1] + weights[2] * sun[2];
     double lux = r->params.sun_illuminance_lux > 0.0 ? r->params.sun_illuminance_lux : EARTH_SUN_LUX;
     p->enabled = r->params.purkinje && sun_y > 0.0;
+    r->post_in_place |= p->enabled;
     enum sb_result res = sb_renderer_upload(r, NULL, sizeof(struct sb_purkinje_gpu), "Purkinje shift", &p->params);
     if (res)
         return res;

@@ -602,7 +602,8 @@ static enum sb_result create_images(struct sb_renderer *r)
                            VK_IMAGE_USAGE_DEPTH_STENCIL_ATTACHMENT_BIT | VK_IMAGE_USAGE_SAMPLED_BIT, "shadow cascades");
     if (!res)
         res = create_texture(r, &r->hdr, r->width, r->height, 1, 1, 1, SB_HDR_FORMAT,
-                             storage_sampled | copy | VK_IMAGE_USAGE_TRANSFER_DST_BIT | VK_IMAGE_USAGE_COLOR_ATTACHMENT_BIT,
+                             storage_sampled | copy | VK_IMAGE_USAGE_TRANSFER_DST_BIT |
+                                 VK_IMAGE_USAGE_COLOR_ATTACHMENT_BIT,
                              "HDR frame");
     /* the traced scene writes its depth from a kernel, which a depth format cannot take */
     if (!res && r->scene_traced)
@@ -766,15 +767,14 @@ enum sb_result sb_renderer_create(struct sb_vk *vk, const struct sb_pack *pack, 
         res = upload(vk, NULL, (size_t)r->width * r->height * 4, "LDR readback", &r->read_ldr);
     if (!res)
         res = upload(vk, NULL, (size_t)r->width * r->height * 8, "HDR readback", &r->read_hdr);
-    if (!res)
-        res = upload(vk, NULL, (size_t)r->width * r->height * 8, "post-processed HDR readback", &r->read_post);
     if (!res && params->post_input) {
         res = upload(vk, NULL, (size_t)r->width * r->height * 8, "post-processing input", &r->post_input);
         uint16_t *dst = res ? NULL : r->post_input.mapped;
         for (size_t i = 0; dst && i < (size_t)r->width * r->height; i++)
             for (int c = 0; c < 4; c++) {
                 float v = c < 3 ? params->post_input[3 * i + c] : 1.0f;
-                dst[4 * i + c] = sb_half_from_float(isfinite(v) ? (float)(v * r->radiance_scale) : 0.0f);
+                double stored = isfinite(v) ? v * r->radiance_scale : 0.0; /* within a half's range */
+                dst[4 * i + c] = sb_half_from_float((float)fmin(fmax(stored, -65504.0), 65504.0));
             }
     }
     if (!res)
@@ -793,6 +793,8 @@ enum sb_result sb_renderer_create(struct sb_vk *vk, const struct sb_pack *pack, 
         if (assert(pass_classes[p]), pass_classes[p]->create)
             res = pass_classes[p]->create(r);
     r->pack = NULL;
+    if (!res && r->post_in_place)
+        res = upload(vk, NULL, (size_t)r->width * r->height * 8, "post-processed HDR readback", &r->read_post);
     if (!res)
         res = create_sets(r);
     if (res)
@@ -1286,7 +1288,8 @@ enum sb_result sb_renderer_render(struct sb_renderer *r, const struct sb_view *v
 
     if (readback) {
         copy_image(r, &r->ldr, &r->read_ldr);
-        copy_image(r, &r->hdr, &r->read_post);
+        if (r->post_in_place)
+            copy_image(r, &r->hdr, &r->read_post);
         copy_image(r, &r->sky_view, &r->read_sky_view);
     }
     VkMemoryBarrier to_host = {
@@ -1352,7 +1355,8 @@ void sb_renderer_hdr(const struct sb_renderer *r, float *rgb)
 
 void sb_renderer_post_hdr(const struct sb_renderer *r, float *rgb)
 {
-    halves_to_rgb(r->read_post.mapped, (size_t)r->width * r->height, r->radiance_scale, rgb);
+    const struct sb_buffer *b = r->post_in_place ? &r->read_post : &r->read_hdr;
+    halves_to_rgb(b->mapped, (size_t)r->width * r->height, r->radiance_scale, rgb);
 }
 
 void sb_renderer_sky_view(const struct sb_renderer *r, float *rgb)

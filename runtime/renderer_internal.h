@@ -70,7 +70,9 @@ struct sb_renderer {
     uint32_t probe_count;                           /* grid probes lit by the probes pass (0: none) */
     uint32_t reflection_count;                      /* reflection probes the scene reads (0: none) */
     struct sb_buffer read_ldr, read_hdr, read_sky_view;
-    struct sb_buffer read_post;  /* the HDR frame after post-processing */
+    struct sb_buffer read_post;  /* the HDR frame after post-processing, when post_in_place */
+    bool post_in_place;          /* a pass after SB_PASS_LAST_LIT changes the HDR frame in place: each such
+                                    pass sets it in its create hook when it will run */
     struct sb_buffer post_input; /* params.post_input as halves, or none */
 
     struct sb_texture sky_view, aerial, aerial_t, shadow, hdr, depth, bloom, ldr;

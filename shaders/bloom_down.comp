@@ -23,7 +23,7 @@ layout(set = 0, binding = SB_VIEW_BINDING_BLOOM_DST, rgba16f) uniform writeonly 
 
 float luma(vec3 c)
 {
-    return dot(c, vec3(0.2126, 0.7152, 0.0722));
+    return dot(c, vec3(SB_LUMINANCE_RGB));
 }
 
 vec3 prepare(vec3 c)

@@ -380,6 +380,10 @@ struct sb_exposure_gpu {
                        of this frame; w: pixels in the metering window */
 };
 
+/* Rec.709's luminance weights (linear R, G, B), for C ({SB_LUMINANCE_RGB})
+ * and GLSL (vec3(SB_LUMINANCE_RGB)) alike. */
+#define SB_LUMINANCE_RGB 0.2126, 0.7152, 0.0722
+
 /* Scene-linear grading (runtime/grade.c, grade_linear.comp), on the
  * exposed frame before bloom and the tone curve: c = matrix * c (white
  * balance, then saturation), then each channel pivot * (c / pivot)^contrast,

@@ -25,7 +25,7 @@ void main()
     ivec2 pixel = ivec2(gl_GlobalInvocationID.xy);
     if (all(lessThan(uvec2(pixel), frame.size.xy))) {
         /* Radiance as stored, back in the scene's units. */
-        float lum = dot(imageLoad(hdr, pixel).rgb, vec3(0.2126, 0.7152, 0.0722)) / frame.aerial.y;
+        float lum = dot(imageLoad(hdr, pixel).rgb, vec3(SB_LUMINANCE_RGB)) / frame.aerial.y;
         uint bin = 0u;
         if (lum > 0.0) {
             float x = (log2(lum) - frame.exposure.x) / frame.exposure.y;

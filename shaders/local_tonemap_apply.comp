@@ -31,7 +31,7 @@ void main()
     if (any(greaterThanEqual(uvec2(pixel), frame.size.xy)))
         return;
     vec4 h = imageLoad(hdr, pixel);
-    float lum = dot(h.rgb * (exposure.state.y / frame.aerial.y), vec3(0.2126, 0.7152, 0.0722));
+    float lum = dot(h.rgb * (exposure.state.y / frame.aerial.y), vec3(SB_LUMINANCE_RGB));
     if (!(lum > 0.0))
         return;
     float l = ltm_log_luminance(lum);

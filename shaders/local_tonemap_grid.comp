@@ -37,7 +37,7 @@ void main()
             if (any(greaterThanEqual(p, frame.size.xy)))
                 continue;
             vec3 c = imageLoad(hdr, ivec2(p)).rgb * to_exposed;
-            float lum = dot(c, vec3(0.2126, 0.7152, 0.0722));
+            float lum = dot(c, vec3(SB_LUMINANCE_RGB));
             if (!(lum > 0.0))
                 continue;
             float l = ltm_log_luminance(lum);

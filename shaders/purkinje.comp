@@ -32,7 +32,7 @@ void main()
         return;
     vec4 h = imageLoad(hdr, pixel);
     vec3 c = max(h.rgb, vec3(0.0)) * purkinje.scale.x; /* cd/m^2 */
-    float y = dot(c, vec3(0.2126, 0.7152, 0.0722));
+    float y = dot(c, vec3(SB_LUMINANCE_RGB));
     float photopic = purkinje.scale.z, scotopic = purkinje.scale.w;
     if (!(y < photopic))
         return;

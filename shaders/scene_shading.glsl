@@ -103,8 +103,8 @@ vec4 scene_shade(vec3 offset, vec3 n, vec3 albedo, vec2 metallic_roughness, vec2
         vec2 dfg = reflections.info.w != 0u ? reflection_dfg(n_dot_v, roughness) : vec2(env_ab.y, env_ab.x + env_ab.y);
         vec3 energy = 1.0 + f0 * (1.0 / max(dfg.y, 1e-3) - 1.0);
         if (dot(reflections.baked_sun.xyz, l) < 0.99996) { /* another sun: by the sky's light now over then */
-            float then = dot(reflections.baked_sky_up.rgb, vec3(0.2126, 0.7152, 0.0722));
-            float now = dot(e_sky, vec3(0.2126, 0.7152, 0.0722));
+            float then = dot(reflections.baked_sky_up.rgb, vec3(SB_LUMINANCE_RGB));
+            float now = dot(e_sky, vec3(SB_LUMINANCE_RGB));
             env *= then > 0.0 ? clamp(now / then, 0.0, 16.0) : 1.0;
         }
         specular = env * (dfg.x + f0 * (dfg.y - dfg.x)) * energy;
