@@ -161,7 +161,8 @@ enum sb_result sb_renderer_render(struct sb_renderer *renderer, const struct sb_
  *   (those of its solar irradiance), before exposure and post-processing;
  * - post_hdr: the same after the passes that post-process it in place (the
  *   Purkinje shift, local tone mapping, scene-linear grading): what bloom
- *   and the tone curve take, divided by the exposure again;
+ *   and the tone curve take, divided by the exposure again (hdr itself when
+ *   none of them runs);
  * - sky_view: SB_SKY_VIEW_WIDTH * SB_SKY_VIEW_HEIGHT * 3 floats, likewise. */
 void sb_renderer_size(const struct sb_renderer *renderer, uint32_t *width, uint32_t *height);
 const uint8_t *sb_renderer_ldr(const struct sb_renderer *renderer);
