@@ -25,6 +25,14 @@ __attribute__((format(printf, 2, 3)))
 #endif
 void sb_log(enum sb_log_level level, const char *fmt, ...);
 
+/*
+ * Progress of long work: "what: done/total" rewritten in place on stderr,
+ * first shown once a second has passed since the call with done 0, ended by
+ * a newline with done == total. Silent when stderr is not a terminal, while
+ * a sink is installed, or with the level below SB_LOG_INFO (quiet, --json).
+ */
+void sb_progress(const char *what, unsigned done, unsigned total);
+
 #define sb_error(...) sb_log(SB_LOG_ERROR, __VA_ARGS__)
 #define sb_warn(...) sb_log(SB_LOG_WARN, __VA_ARGS__)
 #define sb_info(...) sb_log(SB_LOG_INFO, __VA_ARGS__)

@@ -23,7 +23,6 @@
 
 #define CLOUD_FORMAT VK_FORMAT_R16G16B16A16_SFLOAT
 #define HISTORY_WEIGHT 0.8         /* the last frame's share where a pixel is traced again */
-#define SUN_CHANGE_COS 0.99999391  /* cos 0.2 degrees: more sun motion than this drops the history */
 #define SHADOW_WIDTH_M 16000.0     /* the shadow map's square, about the camera */
 #define SHADOW_STEPS 32            /* pieces of a shadow texel's crossing of the layer */
 #define GOLDEN 0.61803398874989485 /* the jitter's step from frame to frame */
@@ -191,8 +190,9 @@ static void fill_params(struct sb_renderer *r, struct sb_clouds *c, struct sb_cl
     const struct sb_cloud_layer_params *m = &c->layer;
     double sun[3];
     sb_direction(v->sun_azimuth, v->sun_elevation, sun);
-    bool keep = c->has_history && !v->snap_exposure &&
-                sun[0] * c->sun[0] + sun[1] * c->sun[1] + sun[2] * c->sun[2] > SUN_CHANGE_COS;
+    bool keep =
+        c->has_history && !v->snap_exposure &&
+        sun[0] * c->sun[0] + sun[1] * c->sun[1] + sun[2] * c->sun[2] > cos(SB_SUN_HISTORY_LIMIT_DEG * M_PI / 180.0);
     memset(g, 0, sizeof(*g));
     sb_mat4_store(&c->view_proj, g->previous_view_proj);
     double thickness = m->top_altitude_m - m->base_altitude_m;

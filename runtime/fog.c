@@ -21,9 +21,8 @@
 #include "fog_integrate.spv.h"
 
 #define FROXEL_FORMAT VK_FORMAT_R16G16B16A16_SFLOAT
-#define SLICE_SCALE_M 1.0         /* c in distance(w) = c ((1 + far / c)^w - 1) */
-#define HISTORY_WEIGHT 0.9        /* the last frame's share in a froxel (10 frames to settle) */
-#define SUN_CHANGE_COS 0.99999391 /* cos 0.2 degrees: more sun motion than this drops the history */
+#define SLICE_SCALE_M 1.0  /* c in distance(w) = c ((1 + far / c)^w - 1) */
+#define HISTORY_WEIGHT 0.9 /* the last frame's share in a froxel (10 frames to settle) */
 
 _Static_assert(SB_FOG_VOLUMES == SB_FOG_MAX_VOLUMES, "config.h and scene.h agree on the fog's boxes");
 
@@ -150,8 +149,9 @@ static void fill_params(struct sb_renderer *r, struct sb_fog *f, struct sb_fog_g
     const struct sb_fog_params *m = &f->medium;
     double sun[3];
     sb_direction(v->sun_azimuth, v->sun_elevation, sun);
-    bool keep = f->has_history && !v->snap_exposure &&
-                sun[0] * f->sun[0] + sun[1] * f->sun[1] + sun[2] * f->sun[2] > SUN_CHANGE_COS;
+    bool keep =
+        f->has_history && !v->snap_exposure &&
+        sun[0] * f->sun[0] + sun[1] * f->sun[1] + sun[2] * f->sun[2] > cos(SB_SUN_HISTORY_LIMIT_DEG * M_PI / 180.0);
     memset(g, 0, sizeof(*g));
     sb_mat4_store(&f->view_proj, g->previous_view_proj);
     g->grid[0] = f->grid[0];

@@ -14,9 +14,11 @@
 #include <sys/stat.h>
 
 #include "config.h"
+#include "contact_sheet.h"
 #include "context.h"
 #include "default_world.h"
 #include "exr.h"
+#include "io.h"
 #include "log.h"
 #include "lut3d.h"
 #include "mesh.h"
@@ -25,6 +27,9 @@
 #include "renderer.h"
 #include "scene.h"
 #include "skybake_version.h"
+#include "sun_path.h"
+#include "transform.h"
+#include "video.h"
 #include "world.h"
 
 enum {
@@ -107,6 +112,33 @@ static void usage(FILE *f)
                "                          shadows); auto: traced on a GPU, rasterised on a CPU\n"
                "                          device (default)\n"
                "  --hdr                   also write the linear HDR frames, frame_0000.exr, ...\n"
+               "\n"
+               "time of day (the sun from a place and a date, or from keys; -z is north):\n"
+               "  --time-of-day H | FROM-TO\n"
+               "                          the sun at local time H (hours), or a sweep from FROM to\n"
+               "                          TO (0 to 48) over --frames frames (default: enough that\n"
+               "                          the sun moves at most 0.2 degrees a frame, which keeps\n"
+               "                          the fog's and clouds' history), exposure adapting and\n"
+               "                          the clouds drifting between frames as in playback;\n"
+               "                          writes OUT_DIR/day.mp4 (ffmpeg) or frame_0000.png, ...,\n"
+               "                          and OUT_DIR/sequence.json (each frame's hour, sun and\n"
+               "                          exposure)\n"
+               "  --location LAT,LON      degrees, north and east positive (default 45,0)\n"
+               "  --date YYYY-MM-DD       1800 to 2100 (default 2026-06-21, the June solstice)\n"
+               "  --utc-offset H          hours are clock time H ahead of UTC (default: the\n"
+               "                          longitude's mean solar time, LON / 15)\n"
+               "  --sun-keys H:EL:AZ,...  the sun from keys instead (hours, degrees): a monotone\n"
+               "                          cubic through them, azimuth the short way round\n"
+               "  --fps N                 playback rate: the time between frames for exposure\n"
+               "                          and drift, and the video's rate (default 30)\n"
+               "  --encoder auto|ffmpeg|png\n"
+               "                          a sweep's frames as an H.264 MP4 through ffmpeg, or as\n"
+               "                          numbered PNGs; auto: ffmpeg when installed (default)\n"
+               "  --contact-sheet STEP    instead of the sweep, OUT_DIR/contact_sheet.png: the day\n"
+               "                          at every multiple of STEP hours from FROM to TO, each\n"
+               "                          frame settled (8 frames at its hour), labelled with\n"
+               "                          its time and sun (--size is a frame's; default 480x270)\n"
+               "\n"
                "  --bench                 time the passes: warm-up frames, then --frames frames;\n"
                "                          prints a table and writes OUT_DIR/bench.json\n"
                "  --warmup N              warm-up frames for --bench (default 5)\n"
@@ -158,7 +190,106 @@ struct options {
     struct sb_view view;
     int frames, warmup;
     bool hdr, bench;
+    /* Time of day: the sun from sun_path at day_from (one hour), or swept to day_to. */
+    bool time_of_day, sweep;
+    double day_from, day_to;
+    struct sb_sun_path sun_path;
+    double fps;
+    enum { ENCODER_AUTO, ENCODER_FFMPEG, ENCODER_PNG } encoder;
+    double sheet_step_h; /* > 0: a contact sheet instead of the sweep */
+    const char *set[16]; /* options given that only go with some others, for the checks after parsing */
+    int set_count;
 };
+
+/* Remember that option `a` was given, for check_combinations. */
+static void note_option(struct options *o, const char *a)
+{
+    if (o->set_count < (int)(sizeof(o->set) / sizeof(o->set[0])))
+        o->set[o->set_count++] = a;
+}
+
+static bool given(const struct options *o, const char *name)
+{
+    for (int i = 0; i < o->set_count; i++)
+        if (!strcmp(o->set[i], name))
+            return true;
+    return false;
+}
+
+/* The sweep's frames when --frames is not given: enough that the sun moves
+ * less than the renderer's history limit between two (sampled each minute). */
+static int sweep_frames(const struct options *o)
+{
+    double fastest = 0.0, previous[3] = {0.0, 0.0, 0.0};
+    for (double h = o->day_from; h <= o->day_to + 1e-9; h += 1.0 / 60.0) {
+        double e, a, d[3];
+        sb_sun_path_at(&o->sun_path, h, &e, &a);
+        sb_direction(a, e, d);
+        if (h > o->day_from) {
+            double cosine = d[0] * previous[0] + d[1] * previous[1] + d[2] * previous[2];
+            fastest = fmax(fastest, acos(fmin(1.0, cosine)) * 60.0); /* radians an hour */
+        }
+        memcpy(previous, d, sizeof(d));
+    }
+    double steps = ceil((o->day_to - o->day_from) * fastest / (0.95 * SB_SUN_HISTORY_LIMIT_DEG * DEG));
+    return (int)fmin(100000.0, fmax(2.0, steps + 1.0));
+}
+
+/* Options that go only with others, and the defaults that depend on them. */
+static int check_combinations(struct options *o)
+{
+    static const char *const need_time[] = {"--location", "--date",    "--utc-offset",   "--sun-keys",
+                                            "--fps",      "--encoder", "--contact-sheet"};
+    for (size_t i = 0; i < sizeof(need_time) / sizeof(need_time[0]); i++)
+        if (!o->time_of_day && given(o, need_time[i])) {
+            fprintf(stderr, "skyview: %s goes with --time-of-day\n", need_time[i]);
+            return EXIT_USAGE;
+        }
+    if (o->time_of_day) {
+        static const char *const fixed_sun[] = {"--sun-elevation", "--sun-azimuth"};
+        for (int i = 0; i < 2; i++)
+            if (given(o, fixed_sun[i])) {
+                fprintf(stderr, "skyview: %s and --time-of-day both set the sun: give one\n", fixed_sun[i]);
+                return EXIT_USAGE;
+            }
+        static const char *const place[] = {"--location", "--date", "--utc-offset"};
+        for (int i = 0; i < 3; i++)
+            if (o->sun_path.key_count && given(o, place[i])) {
+                fprintf(stderr, "skyview: %s places the sun by the date, --sun-keys by keys: give one\n", place[i]);
+                return EXIT_USAGE;
+            }
+        if (o->bench) {
+            fprintf(stderr, "skyview: --bench times frames of one sun: it does not go with --time-of-day\n");
+            return EXIT_USAGE;
+        }
+        if ((given(o, "--encoder") || given(o, "--contact-sheet")) && !o->sweep) {
+            fprintf(stderr, "skyview: %s needs a sweep, --time-of-day FROM-TO\n",
+                    given(o, "--encoder") ? "--encoder" : "--contact-sheet");
+            return EXIT_USAGE;
+        }
+        if (o->sheet_step_h > 0.0 && given(o, "--encoder")) {
+            fprintf(stderr, "skyview: --contact-sheet writes one PNG: --encoder does not go with it\n");
+            return EXIT_USAGE;
+        }
+        if (o->sheet_step_h > 0.0 && ceil(o->day_from / o->sheet_step_h - 1e-9) * o->sheet_step_h > o->day_to + 1e-9) {
+            fprintf(stderr, "skyview: --contact-sheet %g: no multiple of %g hours from %g to %g\n", o->sheet_step_h,
+                    o->sheet_step_h, o->day_from, o->day_to);
+            return EXIT_USAGE;
+        }
+        if (o->sheet_step_h > 0.0 && o->frames >= 0) {
+            fprintf(stderr, "skyview: --contact-sheet renders one frame an hour it shows: --frames does not go "
+                            "with it\n");
+            return EXIT_USAGE;
+        }
+        if (o->sweep && o->frames == 1) {
+            fprintf(stderr, "skyview: a sweep, --time-of-day FROM-TO, needs --frames 2 or more\n");
+            return EXIT_USAGE;
+        }
+    }
+    if (o->frames < 0)
+        o->frames = o->bench ? 30 : o->sweep ? sweep_frames(o) : 1;
+    return 0;
+}
 
 static int parse_options(int argc, char **argv, struct options *o)
 {
@@ -183,6 +314,8 @@ static int parse_options(int argc, char **argv, struct options *o)
     };
     o->params.purkinje = true;
     o->params.local_contrast = 0.7;
+    o->sun_path.latitude_deg = 45.0;
+    o->fps = 30.0;
     for (int i = 0; i < argc; i++) {
         const char *a = argv[i];
         const char *next = i + 1 < argc ? argv[i + 1] : NULL;
@@ -206,9 +339,62 @@ static int parse_options(int argc, char **argv, struct options *o)
         } else if (!strcmp(a, "--sun-elevation") && next) {
             ok = parse_number(argv[++i], -90, 90, &v);
             o->view.sun_elevation = v * DEG;
+            note_option(o, a);
         } else if (!strcmp(a, "--sun-azimuth") && next) {
             ok = parse_number(argv[++i], -360, 360, &v);
             o->view.sun_azimuth = v * DEG;
+            note_option(o, a);
+        } else if (!strcmp(a, "--time-of-day") && next) {
+            const char *t = argv[++i];
+            char *dash = strchr(t, '-');
+            o->time_of_day = true;
+            if (dash) {
+                char from[64];
+                snprintf(from, sizeof(from), "%.*s", (int)(dash - t), t);
+                ok = (size_t)(dash - t) < sizeof(from) && parse_number(from, 0, 48, &o->day_from) &&
+                     parse_number(dash + 1, 0, 48, &o->day_to) && o->day_to > o->day_from;
+                o->sweep = true;
+            } else {
+                ok = parse_number(t, 0, 48, &o->day_from);
+                o->day_to = o->day_from;
+            }
+        } else if (!strcmp(a, "--location") && next) {
+            ok = parse_doubles(argv[++i], c, 2, 2, &n) && fabs(c[0]) <= 90.0 && fabs(c[1]) <= 180.0;
+            o->sun_path.latitude_deg = c[0];
+            o->sun_path.longitude_deg = c[1];
+            note_option(o, a);
+        } else if (!strcmp(a, "--date") && next) {
+            char why[256];
+            struct sb_sun_path *p = &o->sun_path;
+            if (!sb_parse_date(argv[++i], &p->year, &p->month, &p->day, why, sizeof(why))) {
+                fprintf(stderr, "skyview: --date: %s\n", why);
+                return EXIT_USAGE;
+            }
+            note_option(o, a);
+        } else if (!strcmp(a, "--utc-offset") && next) {
+            ok = parse_number(argv[++i], -14, 14, &v);
+            o->sun_path.has_utc_offset = true;
+            o->sun_path.utc_offset_h = v;
+            note_option(o, a);
+        } else if (!strcmp(a, "--sun-keys") && next) {
+            char why[256];
+            if (!sb_sun_path_parse_keys(argv[++i], &o->sun_path, why, sizeof(why))) {
+                fprintf(stderr, "skyview: --sun-keys: %s\n", why);
+                return EXIT_USAGE;
+            }
+            note_option(o, a);
+        } else if (!strcmp(a, "--fps") && next) {
+            ok = parse_number(argv[++i], 1, 240, &v);
+            o->fps = v;
+            note_option(o, a);
+        } else if (!strcmp(a, "--encoder") && next) {
+            const char *t = argv[++i];
+            ok = !strcmp(t, "auto") || !strcmp(t, "ffmpeg") || !strcmp(t, "png");
+            o->encoder = !strcmp(t, "ffmpeg") ? ENCODER_FFMPEG : !strcmp(t, "png") ? ENCODER_PNG : ENCODER_AUTO;
+            note_option(o, a);
+        } else if (!strcmp(a, "--contact-sheet") && next) {
+            ok = parse_number(argv[++i], 1.0 / 60.0, 24, &o->sheet_step_h);
+            note_option(o, a);
         } else if (!strcmp(a, "--camera") && next) {
             ok = parse_doubles(argv[++i], c, 3, 6, &n) && fabs(c[0]) <= 1e7 && fabs(c[2]) <= 1e7 && c[1] > 0.0 &&
                  c[1] <= 1e8;
@@ -340,9 +526,7 @@ static int parse_options(int argc, char **argv, struct options *o)
         usage(stderr);
         return EXIT_USAGE;
     }
-    if (o->frames < 0)
-        o->frames = o->bench ? 30 : 1;
-    return 0;
+    return check_combinations(o);
 }
 
 static int compare_doubles(const void *a, const void *b)
@@ -355,6 +539,26 @@ static double median(double *v, int n)
 {
     qsort(v, (size_t)n, sizeof(double), compare_doubles);
     return n % 2 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
+}
+
+/* Write `root` formatted to `path` (then free it); SB_ERR_IO naming the path. */
+static enum sb_result write_json(const char *path, cJSON *root)
+{
+    char *text = cJSON_Print(root);
+    cJSON_Delete(root);
+    if (!text)
+        return SB_ERR_NOMEM;
+    size_t n = strlen(text);
+    char *with_newline = realloc(text, n + 2);
+    if (!with_newline) {
+        free(text);
+        return SB_ERR_NOMEM;
+    }
+    with_newline[n] = '\n';
+    with_newline[n + 1] = '\0';
+    enum sb_result res = sb_write_file(path, with_newline, n + 1, "JSON");
+    free(with_newline);
+    return res;
 }
 
 /* The bench table on stdout and the same numbers as JSON in OUT_DIR/bench.json. */
@@ -393,39 +597,162 @@ static enum sb_result report_bench(const struct options *o, const struct sb_vk *
     free(v);
     char path[4200];
     snprintf(path, sizeof(path), "%s/bench.json", o->out_dir);
-    char *text = cJSON_Print(root);
-    cJSON_Delete(root);
-    FILE *f = text ? fopen(path, "w") : NULL;
-    enum sb_result res = SB_OK;
-    if (!f || fputs(text, f) < 0 || fputc('\n', f) < 0) {
-        sb_error("%s: cannot write: %s", path, strerror(errno));
-        res = SB_ERR_IO;
-    }
-    if (f && fclose(f) != 0 && !res) {
-        sb_error("%s: cannot write: %s", path, strerror(errno));
-        res = SB_ERR_IO;
-    }
-    free(text);
-    return res;
+    return write_json(path, root);
 }
 
-static enum sb_result write_frame(const struct options *o, struct sb_renderer *r, int index)
+/* The frame's HDR image as OUT_DIR/frame_NNNN.exr. */
+static enum sb_result write_hdr(const struct options *o, struct sb_renderer *r, int index)
 {
     uint32_t w, h;
     sb_renderer_size(r, &w, &h);
-    char path[4200];
-    snprintf(path, sizeof(path), "%s/frame_%04d.png", o->out_dir, index);
-    enum sb_result res = sb_png_write(path, w, h, sb_renderer_ldr(r));
-    if (res || !o->hdr)
-        return res;
     struct sb_image image = {0};
-    if ((res = sb_image_init(&image, w, h, 3)))
+    enum sb_result res = sb_image_init(&image, w, h, 3);
+    if (res)
         return res;
     sb_image_set_channel_names(&image, "R,G,B");
     sb_renderer_hdr(r, image.data);
+    char path[4200];
     snprintf(path, sizeof(path), "%s/frame_%04d.exr", o->out_dir, index);
     res = sb_exr_write(path, &image, NULL, 0);
     sb_image_finish(&image);
+    return res;
+}
+
+/* The frame as OUT_DIR/frame_NNNN.png, or into the video; with --hdr, its EXR too. */
+static enum sb_result write_frame(const struct options *o, struct sb_renderer *r, int index, struct sb_video *video)
+{
+    uint32_t w, h;
+    sb_renderer_size(r, &w, &h);
+    enum sb_result res;
+    if (video)
+        res = sb_video_write(video, sb_renderer_ldr(r));
+    else {
+        char path[4200];
+        snprintf(path, sizeof(path), "%s/frame_%04d.png", o->out_dir, index);
+        res = sb_png_write(path, w, h, sb_renderer_ldr(r));
+    }
+    return res || !o->hdr ? res : write_hdr(o, r, index);
+}
+
+/* The local time `hour` as HH:MM (the day after from 24). */
+static void format_hour(double hour, char *out, size_t size)
+{
+    long minutes = lround(hour * 60.0);
+    snprintf(out, size, "%02ld:%02ld%s", minutes / 60 % 24, minutes % 60, minutes >= 24 * 60 ? " +1d" : "");
+}
+
+/*
+ * A day: --frames frames from day_from to day_to, the sun on the path, each
+ * frame 1/fps after the one before (exposure adapts, clouds and fog drift and
+ * keep their history as in playback); the first is a cut. Each frame's hour,
+ * sun and exposure go to OUT_DIR/sequence.json.
+ */
+static enum sb_result render_day(const struct options *o, struct sb_renderer *r, struct sb_video *video)
+{
+    cJSON *root = cJSON_CreateObject();
+    cJSON_AddStringToObject(root, "skyview", SKYBAKE_VERSION);
+    cJSON_AddNumberToObject(root, "from_hour", o->day_from);
+    cJSON_AddNumberToObject(root, "to_hour", o->day_to);
+    cJSON_AddNumberToObject(root, "fps", o->fps);
+    cJSON_AddStringToObject(root, "output", video ? "day.mp4" : "frame_NNNN.png");
+    cJSON *frames = cJSON_AddArrayToObject(root, "frames");
+    enum sb_result res = SB_OK;
+    int largest_step_frame = -1;
+    double largest_step = 0.0, previous[3] = {0.0, 0.0, 0.0};
+    sb_progress("frames", 0, (unsigned)o->frames);
+    for (int i = 0; i < o->frames && !res; i++) {
+        double hour = o->day_from + (o->day_to - o->day_from) * i / (o->frames - 1);
+        struct sb_view view = o->view;
+        sb_sun_path_at(&o->sun_path, hour, &view.sun_elevation, &view.sun_azimuth);
+        view.snap_exposure = i == 0;
+        view.dt_s = 1.0 / o->fps;
+        view.time_s = i / o->fps;
+        res = sb_renderer_render(r, &view, true, NULL);
+        if (!res)
+            res = write_frame(o, r, i, video);
+        double d[3];
+        sb_direction(view.sun_azimuth, view.sun_elevation, d);
+        double step = acos(fmin(1.0, d[0] * previous[0] + d[1] * previous[1] + d[2] * previous[2])) / DEG;
+        if (i > 0 && step > largest_step) {
+            largest_step = step;
+            largest_step_frame = i;
+        }
+        memcpy(previous, d, sizeof(d));
+        float exposure[4];
+        sb_renderer_exposure(r, exposure);
+        cJSON *f = cJSON_CreateObject();
+        cJSON_AddNumberToObject(f, "frame", i);
+        cJSON_AddNumberToObject(f, "hour", hour);
+        cJSON_AddNumberToObject(f, "sun_elevation_deg", view.sun_elevation / DEG);
+        cJSON_AddNumberToObject(f, "sun_azimuth_deg", view.sun_azimuth / DEG);
+        cJSON_AddNumberToObject(f, "adapted_log2_luminance", exposure[0]);
+        cJSON_AddNumberToObject(f, "metered_log2_luminance", exposure[2]);
+        cJSON_AddNumberToObject(f, "exposure", exposure[1]);
+        cJSON_AddItemToArray(frames, f);
+        sb_progress("frames", (unsigned)i + 1, (unsigned)o->frames);
+    }
+    if (largest_step > SB_SUN_HISTORY_LIMIT_DEG)
+        sb_warn("the sun moves up to %.2f degrees a frame (frame %d): the fog's and clouds' history is dropped "
+                "past %.1f; --frames %d keeps it",
+                largest_step, largest_step_frame, SB_SUN_HISTORY_LIMIT_DEG, sweep_frames(o));
+    char path[4200];
+    snprintf(path, sizeof(path), "%s/sequence.json", o->out_dir);
+    if (res)
+        cJSON_Delete(root);
+    else
+        res = write_json(path, root);
+    return res;
+}
+
+/* Frames rendered at each hour of a contact sheet: the first a cut, the
+ * rest let the clouds' checkerboard and the fog's history fill in. */
+#define SHEET_SETTLE_FRAMES 8
+
+/* The day at every multiple of sheet_step_h hours in [day_from, day_to], in
+ * one PNG. Each hour's frames start from the same time_s, so every frame
+ * shows the same clouds under its own sun. */
+static enum sb_result render_contact_sheet(const struct options *o, struct sb_renderer *r)
+{
+    double hours[64];
+    int n = 0;
+    for (double k = ceil(o->day_from / o->sheet_step_h - 1e-9); n < 64; k++) {
+        double h = k * o->sheet_step_h;
+        if (h > o->day_to + 1e-9)
+            break;
+        hours[n++] = h;
+    }
+    uint32_t w, h;
+    sb_renderer_size(r, &w, &h);
+    struct sb_contact_sheet sheet;
+    enum sb_result res = sb_contact_sheet_init(&sheet, w, h, (uint32_t)n);
+    sb_progress("frames", 0, (unsigned)n);
+    for (int t = 0; t < n && !res; t++) {
+        struct sb_view view = o->view;
+        sb_sun_path_at(&o->sun_path, hours[t], &view.sun_elevation, &view.sun_azimuth);
+        view.dt_s = 1.0 / o->fps;
+        for (int f = 0; f < SHEET_SETTLE_FRAMES && !res; f++) {
+            view.snap_exposure = f == 0;
+            view.time_s = f / o->fps;
+            res = sb_renderer_render(r, &view, f == SHEET_SETTLE_FRAMES - 1, NULL);
+        }
+        if (res)
+            break;
+        char time[32], label[128];
+        format_hour(hours[t], time, sizeof(time));
+        snprintf(label, sizeof(label), "%s  sun %.1f\xc2\xb0 az %.0f\xc2\xb0", time, view.sun_elevation / DEG,
+                 view.sun_azimuth / DEG);
+        sb_contact_sheet_put(&sheet, (uint32_t)t, sb_renderer_ldr(r), label);
+        sb_progress("frames", (unsigned)t + 1, (unsigned)n);
+    }
+    if (!res) {
+        char path[4200];
+        snprintf(path, sizeof(path), "%s/contact_sheet.png", o->out_dir);
+        res = sb_png_write(path, sheet.width, sheet.height, sheet.rgba);
+        if (!res)
+            sb_info("contact sheet: %d frames, %g to %g h every %g h, %ux%u: %s", n, hours[0], hours[n - 1],
+                    o->sheet_step_h, sheet.width, sheet.height, path);
+    }
+    sb_contact_sheet_finish(&sheet);
     return res;
 }
 
@@ -507,6 +834,16 @@ static int run(const struct options *o)
     }
     struct sb_world world;
     struct sb_renderer_params params = o->params;
+    if (o->sheet_step_h > 0.0 && !params.width) {
+        params.width = 480;
+        params.height = 270;
+    }
+    bool ffmpeg_found = o->sweep && o->sheet_step_h <= 0.0 && o->encoder != ENCODER_PNG && sb_video_encoder_found();
+    if (o->encoder == ENCODER_FFMPEG && !ffmpeg_found) {
+        sb_error("--encoder ffmpeg: no ffmpeg on PATH (apt-get install ffmpeg); --encoder png writes numbered PNGs");
+        sb_pack_close(&pack);
+        return EXIT_USAGE;
+    }
     struct sb_lut3d grade = {0};
     if (o->grade && sb_lut3d_load(o->grade, &grade)) {
         sb_error("%s: refused; nothing was rendered", o->grade);
@@ -531,7 +868,19 @@ static int run(const struct options *o)
     struct sb_vk *vk = NULL;
     struct sb_renderer *r = NULL;
     struct sb_frame_timings *timings = NULL;
-    enum sb_result res = sb_vk_create(&o->vk, &vk);
+    struct sb_video *video = NULL;
+    char video_path[4200];
+    snprintf(video_path, sizeof(video_path), "%s/day.mp4", o->out_dir);
+    enum sb_result res = SB_OK;
+    /* ffmpeg starts before Vulkan does, so it forks a process without the driver's threads. */
+    if (ffmpeg_found && (res = sb_video_create(video_path, params.width ? params.width : 1280,
+                                               params.height ? params.height : 720, o->fps, &video))) {
+        code = EXIT_RENDER_FAILED;
+        goto done;
+    }
+    if (o->sweep && o->sheet_step_h <= 0.0 && !ffmpeg_found && o->encoder == ENCODER_AUTO)
+        sb_info("no ffmpeg on PATH: the sweep's frames go to numbered PNGs");
+    res = sb_vk_create(&o->vk, &vk);
     if (res) {
         code = res == SB_ERR_NO_DEVICE ? EXIT_NO_DEVICE : EXIT_RENDER_FAILED;
         goto done;
@@ -542,14 +891,28 @@ static int run(const struct options *o)
         code = res == SB_ERR_USAGE ? EXIT_USAGE : EXIT_RENDER_FAILED;
         goto done;
     }
+    if (o->sheet_step_h > 0.0 || o->sweep) {
+        res = o->sweep && o->sheet_step_h <= 0.0 ? render_day(o, r, video) : render_contact_sheet(o, r);
+        if (!res && video)
+            res = sb_video_destroy(&video, true);
+        if (res)
+            code = EXIT_RENDER_FAILED;
+        else if (o->sheet_step_h <= 0.0)
+            sb_info("wrote %d frames from %g to %g h to %s", o->frames, o->day_from, o->day_to,
+                    ffmpeg_found ? video_path : o->out_dir);
+        goto done;
+    }
     int total = o->frames + (o->bench ? o->warmup : 0);
     timings = calloc((size_t)o->frames, sizeof(*timings));
     if (!timings) {
         code = EXIT_RENDER_FAILED;
         goto done;
     }
+    sb_progress("frames", 0, (unsigned)total);
     for (int i = 0; i < total && !res; i++) {
         struct sb_view view = o->view;
+        if (o->time_of_day)
+            sb_sun_path_at(&o->sun_path, o->day_from, &view.sun_elevation, &view.sun_azimuth);
         view.snap_exposure = i == 0;
         view.dt_s = 1.0 / 60.0;
         view.time_s = i * view.dt_s;
@@ -557,7 +920,8 @@ static int run(const struct options *o)
         bool write = !o->bench || i == total - 1;
         res = sb_renderer_render(r, &view, write, measured >= 0 ? &timings[measured] : NULL);
         if (!res && write)
-            res = write_frame(o, r, o->bench ? 0 : i);
+            res = write_frame(o, r, o->bench ? 0 : i, NULL);
+        sb_progress("frames", (unsigned)i + 1, (unsigned)total);
     }
     if (!res && o->bench) {
         uint32_t w, h;
@@ -572,6 +936,7 @@ static int run(const struct options *o)
         sb_info("wrote %d frame(s) to %s", o->bench ? 1 : o->frames, o->out_dir);
 
 done:
+    sb_video_destroy(&video, false);
     sb_renderer_destroy(&r);
     unsigned messages = vk ? sb_vk_validation_messages(vk) : 0;
     sb_vk_destroy(&vk);

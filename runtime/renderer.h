@@ -94,6 +94,10 @@ void sb_planckian_xy(double kelvin, double xy[2]);
 void sb_rec709_to_xyz(double m[3][3]);
 void sb_rec709_to_ap1(double m[3][3]);
 
+/* The fog's and clouds' history is dropped when the sun moves more than
+ * this between two frames (degrees): their lighting would lag behind it. */
+#define SB_SUN_HISTORY_LIMIT_DEG 0.2
+
 /* What one frame looks at. Angles in radians; lengths in metres. */
 struct sb_view {
     double camera_m[3];   /* in the world: y up, the origin on the ground */

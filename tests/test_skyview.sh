@@ -133,6 +133,85 @@ for pass in "cloud shadow" clouds; do
     check "bench table has $pass" grep -q "^$pass " "$tmp/out"
 done
 
+# Time of day: a sweep's frames, its sequence.json (the sun where the date
+# puts it, exposure adapting between frames), the video through ffmpeg (the
+# same frames within H.264's loss), a contact sheet, and the bad combinations.
+stats="python3 $root/tests/png_stats.py"
+sweep="--time-of-day 19.6-20.2 --frames 4 --location 47,8"
+check "a sweep into PNGs" expect_exit 0 "$skyview" "$tmp/pack" -o "$tmp/d1" $small $sweep --encoder png
+check "writes frame_0003.png" test -s "$tmp/d1/frame_0003.png"
+check "and no video" test ! -e "$tmp/d1/day.mp4"
+check "warns that the sun moves too far a frame to keep the history" grep -q "history is dropped.*--frames" "$tmp/err"
+check "sequence.json: four frames, the sun on the June solstice at 47 N, exposure adapting" python3 - "$tmp/d1/sequence.json" <<'PY'
+import json, math, sys
+s = json.load(open(sys.argv[1]))
+f = s["frames"]
+assert len(f) == 4 and abs(f[0]["hour"] - 19.6) < 1e-12 and abs(f[3]["hour"] - 20.2) < 1e-12, f
+# Sunset, so the sun sinks westward and the metered frame darkens.
+assert all(a["sun_elevation_deg"] > b["sun_elevation_deg"] for a, b in zip(f, f[1:])), f
+assert all(270 < x["sun_azimuth_deg"] < 320 for x in f), f
+assert all(a["metered_log2_luminance"] > b["metered_log2_luminance"] for a, b in zip(f, f[1:])), f
+# The first frame is a cut (adapted = metered); later the adapted level lags
+# above the falling metered one, and moves toward it.
+assert f[0]["adapted_log2_luminance"] == f[0]["metered_log2_luminance"], f[0]
+for a, b in zip(f, f[1:]):
+    assert b["metered_log2_luminance"] < b["adapted_log2_luminance"] < a["adapted_log2_luminance"], (a, b)
+PY
+check "a sweep without --frames takes enough frames for the history" \
+    expect_exit 0 "$skyview" "$tmp/pack" -o "$tmp/d2" $small --time-of-day 12-12.1 --location 47,8 --encoder png
+check "and does not warn" sh -c "! grep -q 'history is dropped' '$tmp/err'"
+check "9 frames (13.8 degrees an hour, 0.19 a frame), noon at 66.4 degrees" python3 - "$tmp/d2/sequence.json" <<'PY'
+import json, sys
+f = json.load(open(sys.argv[1]))["frames"]
+assert len(f) == 9, len(f)
+assert abs(f[0]["sun_elevation_deg"] - (90 - 47 + 23.436)) < 0.05, f[0]
+PY
+check "one hour renders one sun" expect_exit 0 "$skyview" "$tmp/pack" -o "$tmp/d3" $small --time-of-day 19.6 --location 47,8
+check "the sweep's first frame is that hour's" cmp -s "$tmp/d1/frame_0000.png" "$tmp/d3/frame_0000.png"
+
+check "a sweep through ffmpeg" expect_exit 0 "$skyview" "$tmp/pack" -o "$tmp/v1" $small $sweep --encoder ffmpeg
+check "writes day.mp4 and no PNG" sh -c "test -s '$tmp/v1/day.mp4' && ! test -e '$tmp/v1/frame_0000.png'"
+check "the video is 4 frames of 64 x 36 H.264" test "$(ffprobe -v error -select_streams v:0 -count_frames \
+    -show_entries stream=codec_name,width,height,nb_read_frames -of csv=p=0 "$tmp/v1/day.mp4")" = "h264,64,36,4"
+ffmpeg -v error -i "$tmp/v1/day.mp4" -vf "select=eq(n\,3)" -frames:v 1 "$tmp/v1/decoded.png" </dev/null
+# H.264 at CRF 18 with 4:2:0 chroma: at 64 x 36 each frame decodes 2.7 to
+# 3.0 codes from its PNG on average, at most 51 (at the coloured boxes'
+# edges: a chroma sample spans 2 x 2 pixels of a tiny frame; 1.7 at
+# 320 x 180). Neighbouring frames of this sweep differ by 26 to 88, so the
+# bound tells the right frame (decoded as the Rec.709 it is tagged) apart.
+check "its last frame is the PNG sweep's within H.264's loss (mean < 4, max < 64 codes)" \
+    sh -c "$stats diff '$tmp/d1/frame_0003.png' '$tmp/v1/decoded.png' | tee '$tmp/v1/diff' |
+           awk '{ exit !(\$1 < 4 && \$2 < 64) }'"
+echo "video against PNG: $(cat "$tmp/v1/diff")"
+check "auto encodes with ffmpeg when it is on PATH" expect_exit 0 "$skyview" "$tmp/pack" -o "$tmp/v2" $small $sweep
+check "(day.mp4)" test -s "$tmp/v2/day.mp4"
+check "auto without ffmpeg on PATH writes PNGs" \
+    expect_exit 0 env PATH=/nonexistent "$skyview" "$tmp/pack" -o "$tmp/v3" $small $sweep
+check "(frame_0003.png, and says why)" sh -c "test -s '$tmp/v3/frame_0003.png' && grep -q 'no ffmpeg on PATH' '$tmp/err'"
+check "--encoder ffmpeg without ffmpeg is a usage error" \
+    expect_exit 2 env PATH=/nonexistent "$skyview" "$tmp/pack" -o "$tmp/x" $small $sweep --encoder ffmpeg
+check "that names the package" grep -q "apt-get install ffmpeg" "$tmp/err"
+check "ffmpeg left no partial file" sh -c "! ls '$tmp/v1' '$tmp/v2' | grep -q partial"
+
+check "a contact sheet" expect_exit 0 "$skyview" "$tmp/pack" -o "$tmp/s1" $small --time-of-day 6-18 \
+    --contact-sheet 6 --location 47,8
+check "3 frames of 64 x 36 in a 2 x 2 grid with label strips: 134 x 100" \
+    test "$($stats size "$tmp/s1/contact_sheet.png")" = "134 100"
+check "a label under the first frame" test "$($stats ink "$tmp/s1/contact_sheet.png" 2 38 64 11 24 24 24)" -gt 20
+check "the fourth cell empty" test "$($stats ink "$tmp/s1/contact_sheet.png" 68 51 64 47 24 24 24)" = 0
+
+for bad in "--time-of-day 8-6" "--time-of-day 49" "--time-of-day 6-" "--time-of-day 12 --sun-elevation 10" \
+           "--location 47,8" "--time-of-day 6-8 --location 91,0" "--time-of-day 6-8 --date 2026-02-30" \
+           "--time-of-day 6-8 --sun-keys 6:0:90" "--time-of-day 6-8 --sun-keys 6:0:90,7:5:100 --date 2026-01-01" \
+           "--time-of-day 6-8 --frames 1" "--time-of-day 6-8 --bench" "--time-of-day 6 --encoder png" \
+           "--time-of-day 6-8 --encoder mkv" "--time-of-day 6.1-6.9 --contact-sheet 1" \
+           "--time-of-day 6-8 --contact-sheet 1 --frames 3" "--time-of-day 6-8 --fps 0"; do
+    check "$bad is a usage error" expect_exit 2 "$skyview" "$tmp/pack" -o "$tmp/x" $small $bad
+done
+check "a bad key's message names it" expect_exit 2 "$skyview" "$tmp/pack" -o "$tmp/x" --time-of-day 6-8 \
+    --sun-keys 6:0:90,5:5:100
+check "(key 2's hour)" grep -q "key 2's hour 5 does not follow" "$tmp/err"
+
 # Packs that must be refused, with what is wrong named.
 cp -r "$tmp/pack" "$tmp/edited"
 sed -i '0,/"content_hash":[[:space:]]*"[0-9a-f]*"/s//"content_hash": "00000000000000000000000000000000"/' \
