@@ -237,6 +237,7 @@ static void fill_params(struct sb_renderer *r, struct sb_clouds *c, struct sb_cl
     c->history_frames = keep ? c->history_frames + 1 : 0;
     g->temporal[1] = keep ? (float)HISTORY_WEIGHT : 0.0f;
     g->temporal[2] = (float)(c->history_frames < (1u << 20) ? c->history_frames : (1u << 20)); /* exact in fp32 */
+    g->temporal[3] = (float)(r->frame_scale / r->previous_frame_scale); /* the history's scale to this frame's */
     g->trace[0] = c->trace_size[0];
     g->trace[1] = c->trace_size[1];
     g->trace[2] = c->scale;

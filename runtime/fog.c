@@ -173,6 +173,8 @@ static void fill_params(struct sb_renderer *r, struct sb_fog *f, struct sb_fog_g
         g->noise[k] = (float)(drift - m->noise_scale_m * floor(drift / m->noise_scale_m));
         g->camera_motion_m[k] = (float)(v->camera_m[k] - f->camera_m[k]);
     }
+    /* The history was stored at the last frame's scale (pre-exposure). */
+    g->camera_motion_m[3] = (float)(r->frame_scale / r->previous_frame_scale);
     g->albedo[3] = (float)m->noise_amount;
     g->noise[3] = (float)(1.0 / m->noise_scale_m);
     /* Halton (2, 3, 5), a new point each frame; the first frame samples centres. */

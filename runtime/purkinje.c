@@ -21,6 +21,7 @@
 
 struct sb_purkinje {
     bool enabled;
+    double cd_m2_per_unit;   /* the pack's radiance unit in cd/m^2 */
     struct sb_buffer params; /* sb_purkinje_gpu */
     VkPipeline kernel;
 };
@@ -40,10 +41,8 @@ static enum sb_result purkinje_create(struct sb_renderer *r)
     enum sb_result res = sb_renderer_upload(r, NULL, sizeof(struct sb_purkinje_gpu), "Purkinje shift", &p->params);
     if (res)
         return res;
+    p->cd_m2_per_unit = lux / sun_y;
     struct sb_purkinje_gpu *gpu = p->params.mapped;
-    double scale = p->enabled ? lux / (sun_y * r->radiance_scale) : 1.0;
-    gpu->scale[0] = (float)scale;
-    gpu->scale[1] = (float)(1.0 / scale);
     gpu->scale[2] = (float)PHOTOPIC_CD_M2;
     gpu->scale[3] = (float)SCOTOPIC_CD_M2;
     sb_renderer_bind_buffer(r, SB_VIEW_BINDING_PURKINJE, &p->params);
@@ -67,6 +66,11 @@ static void purkinje_record(struct sb_renderer *r)
 {
     if (!r->purkinje->enabled)
         return;
+    /* The stored frame to cd/m^2 follows the frame's scale (pre-exposure). */
+    struct sb_purkinje_gpu *gpu = r->purkinje->params.mapped;
+    double scale = r->purkinje->cd_m2_per_unit / r->frame_scale;
+    gpu->scale[0] = (float)scale;
+    gpu->scale[1] = (float)(1.0 / scale);
     sb_renderer_dispatch(r, r->purkinje->kernel, NULL, (const uint32_t[3]){r->width, r->height, 1},
                          (const uint32_t[3]){SB_WORKGROUP_X, SB_WORKGROUP_Y, 1});
 }

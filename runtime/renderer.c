@@ -370,6 +370,7 @@ static enum sb_result upload_atmosphere(struct sb_renderer *r, const struct sb_p
     sb_atmosphere_gpu_pack(atm, &gpu);
     double sun_max = fmax(atm->solar_irradiance[0], fmax(atm->solar_irradiance[1], atm->solar_irradiance[2]));
     r->radiance_scale = sun_max > 0.0 ? 1.0 / sun_max : 1.0;
+    r->frame_scale = r->previous_frame_scale = r->next_frame_scale = r->readback_scale = r->radiance_scale;
     r->ground_radius_km = atm->ground_radius_km;
     r->thickness_km = gpu.radii[3];
 
@@ -969,7 +970,7 @@ static void fill_frame(struct sb_renderer *r, const struct sb_view *v, struct sb
     store4(f->camera_forward, forward[0], forward[1], forward[2], cos(sun_radius));
     store4(f->sun_direction, sun[0], sun[1], sun[2], sun_radius);
     store4(f->shadow, 0.1, 1.5, r->params.shadow_size, 1.0);
-    store4(f->aerial, AERIAL_FAR_KM, r->radiance_scale, 0.0, 0.0);
+    store4(f->aerial, AERIAL_FAR_KM, r->frame_scale, 0.0, 0.0);
     /* Bins 1 to 255 span 2^-20 to 2^12 of the solar irradiance's units:
      * from starlight-dark to beyond the sun-lit snow. */
     double log_sun = log2(1.0 / r->radiance_scale);
@@ -1254,7 +1255,72 @@ static void copy_input(struct sb_renderer *r)
     sb_renderer_barrier(r->cmd);
 }
 
+/*
+ * Pre-exposure: the frame is stored in halves as radiance times a scale that
+ * follows the exposure, so whatever the light, mid grey is stored within
+ * half a stop of 2^-PRE_EXPOSURE_EV (0.011; exposed, 0.18): 13 stops above the
+ * halves' subnormals and 20 below their largest (the sun's disk at noon
+ * fits). A fixed scale put twilight among the subnormals and night below
+ * them. The scale is the radiance scale times a power of two, so a frame
+ * reads back the same, bit for bit, whichever it was stored at, away from
+ * the halves' limits (a value subnormal at one scale and not at the other
+ * differs by its rounding). The next frame's comes from this frame's
+ * adapted exposure (a cut's from its metered one), so a frame's scale
+ * depends on the frame before alone; the fog's and clouds' histories are
+ * rescaled by the ratio as they are read. A post_input is stored at the radiance
+ * scale, so with one the scale stays that.
+ */
+#define PRE_EXPOSURE_EV 4
+/* A cut whose metered scale is more than this many stops from the one it
+ * was drawn with is drawn again with the metered one (once). */
+#define PRE_EXPOSURE_REDRAW_EV 3
+#define PRE_EXPOSURE_MIN_EV (-16)
+#define PRE_EXPOSURE_MAX_EV 24
+
+static double metered_frame_scale(const struct sb_renderer *r)
+{
+    if (r->params.post_input)
+        return r->radiance_scale;
+    float state[4];
+    sb_renderer_exposure(r, state);
+    double stops = log2((double)state[1] / r->radiance_scale) - PRE_EXPOSURE_EV;
+    if (!isfinite(stops))
+        return r->frame_scale;
+    stops = fmin(fmax(round(stops), PRE_EXPOSURE_MIN_EV), PRE_EXPOSURE_MAX_EV);
+    return r->radiance_scale * exp2(stops);
+}
+
+static enum sb_result render_once(struct sb_renderer *r, const struct sb_view *view, bool readback,
+                                  struct sb_frame_timings *timings);
+
 enum sb_result sb_renderer_render(struct sb_renderer *r, const struct sb_view *view, bool readback,
+                                  struct sb_frame_timings *timings)
+{
+    r->previous_frame_scale = r->frame_scale;
+    r->frame_scale = r->next_frame_scale;
+    if (view->fixed_pre_exposure && !r->params.post_input)
+        r->frame_scale =
+            r->radiance_scale * exp2(fmin(fmax(view->pre_exposure_stops, PRE_EXPOSURE_MIN_EV), PRE_EXPOSURE_MAX_EV));
+    enum sb_result res = render_once(r, view, readback, timings);
+    if (res)
+        return res;
+    r->next_frame_scale = metered_frame_scale(r);
+    if (view->snap_exposure && !view->fixed_pre_exposure &&
+        fabs(log2(r->next_frame_scale / r->frame_scale)) > PRE_EXPOSURE_REDRAW_EV) {
+        /* A cut keeps no history, so drawing it again gives the frame it
+         * would have been with the right scale; the same jitter too. */
+        r->frame_scale = r->next_frame_scale;
+        r->frame_index--;
+        if ((res = render_once(r, view, readback, timings)))
+            return res;
+        r->next_frame_scale = metered_frame_scale(r);
+    }
+    if (readback)
+        r->readback_scale = r->frame_scale;
+    return SB_OK;
+}
+
+static enum sb_result render_once(struct sb_renderer *r, const struct sb_view *view, bool readback,
                                   struct sb_frame_timings *timings)
 {
     enum sb_result res = SB_OK;
@@ -1350,18 +1416,18 @@ static void halves_to_rgb(const uint16_t *src, size_t pixels, double scale, floa
 
 void sb_renderer_hdr(const struct sb_renderer *r, float *rgb)
 {
-    halves_to_rgb(r->read_hdr.mapped, (size_t)r->width * r->height, r->radiance_scale, rgb);
+    halves_to_rgb(r->read_hdr.mapped, (size_t)r->width * r->height, r->readback_scale, rgb);
 }
 
 void sb_renderer_post_hdr(const struct sb_renderer *r, float *rgb)
 {
     const struct sb_buffer *b = r->post_in_place ? &r->read_post : &r->read_hdr;
-    halves_to_rgb(b->mapped, (size_t)r->width * r->height, r->radiance_scale, rgb);
+    halves_to_rgb(b->mapped, (size_t)r->width * r->height, r->readback_scale, rgb);
 }
 
 void sb_renderer_sky_view(const struct sb_renderer *r, float *rgb)
 {
-    halves_to_rgb(r->read_sky_view.mapped, (size_t)SB_SKY_VIEW_WIDTH * SB_SKY_VIEW_HEIGHT, r->radiance_scale, rgb);
+    halves_to_rgb(r->read_sky_view.mapped, (size_t)SB_SKY_VIEW_WIDTH * SB_SKY_VIEW_HEIGHT, r->readback_scale, rgb);
 }
 
 void sb_renderer_exposure(const struct sb_renderer *r, float state[4])

@@ -100,14 +100,18 @@ void sb_rec709_to_ap1(double m[3][3]);
 
 /* What one frame looks at. Angles in radians; lengths in metres. */
 struct sb_view {
-    double camera_m[3];   /* in the world: y up, the origin on the ground */
-    double yaw, pitch;    /* view direction: azimuth clockwise from -z (north) toward +x, elevation */
-    double fov_y;         /* vertical field of view; 0: 50 degrees */
-    double sun_azimuth;   /* same convention as yaw */
-    double sun_elevation; /* above the horizon; negative below */
-    double dt_s;          /* time since the previous frame, for exposure adaptation; 0: 1/60 s */
-    bool snap_exposure;   /* a cut: take the metered exposure at once, drop the fog's and clouds' history */
-    double time_s;        /* what the fog's noise and the clouds drift with (s) */
+    double camera_m[3];      /* in the world: y up, the origin on the ground */
+    double yaw, pitch;       /* view direction: azimuth clockwise from -z (north) toward +x, elevation */
+    double fov_y;            /* vertical field of view; 0: 50 degrees */
+    double sun_azimuth;      /* same convention as yaw */
+    double sun_elevation;    /* above the horizon; negative below */
+    double dt_s;             /* time since the previous frame, for exposure adaptation; 0: 1/60 s */
+    bool snap_exposure;      /* a cut: take the metered exposure at once, drop the fog's and clouds' history */
+    double time_s;           /* what the fog's noise and the clouds drift with (s) */
+    bool fixed_pre_exposure; /* store this frame at the radiance scale times 2^pre_exposure_stops instead
+                                of the scale its exposure sets (pre-exposure, renderer.c); the frame reads
+                                back the same away from the halves' limits. false: automatic */
+    int pre_exposure_stops;  /* with fixed_pre_exposure, [-16, 24] */
 };
 
 enum sb_pass {

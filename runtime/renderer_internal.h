@@ -55,7 +55,12 @@ struct sb_renderer {
     struct sb_caster_box *caster_boxes; /* shadows.h */
     unsigned caster_box_count;
     int32_t cascade_clear[SB_CASCADES][4]; /* this frame's texels to clear and draw in each cascade */
-    double radiance_scale;                 /* what stored radiance is multiplied by (fp16 headroom) */
+    double radiance_scale;                 /* 1 / the sun's largest channel: radiance in units of the sun */
+    double frame_scale;                    /* this frame's: what stored radiance is multiplied by, the
+                                              radiance scale times the pre-exposure (renderer.c) */
+    double previous_frame_scale;           /* the last frame's, which its history was stored with */
+    double next_frame_scale;               /* the next frame's, from this frame's exposure */
+    double readback_scale;                 /* the frame scale of the last frame read back */
     double ground_radius_km;
     float thickness_km;                    /* the atmosphere's, as the shaders hold it */
     bool camera_in_atmosphere;             /* this frame's: which sky kernel runs */

@@ -67,7 +67,7 @@ vec4 resolve(ivec2 pixel, vec2 uv, vec3 d)
      * a pixel's own extremes, which its traced neighbours lack, survive. */
     float moved_px = length((then - uv) * vec2(frame.size.xy));
     vec4 widen = (hi - lo) * clamp(1.0 - moved_px, 0.0, 1.0);
-    vec4 kept = clamp(textureLod(history, then, 0.0), lo - widen, hi + widen);
+    vec4 kept = clamp(textureLod(history, then, 0.0) * vec4(vec3(clouds.temporal.w), 1.0), lo - widen, hi + widen);
     float k = floor(clouds.temporal.z / float(s * s)); /* this pixel's traces before this frame */
     return traced ? mix(current, kept, min(weight, k / (k + 1.0))) : kept;
 }

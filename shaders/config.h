@@ -308,7 +308,8 @@ struct sb_fog_gpu {
     SB_VEC4(noise);              /* xyz: the noise's drift (m); w: 1 / its tile (1/m) */
     SB_VEC4(jitter);             /* xyz: this frame's sample in a froxel, [0, 1)^3; w: 1 for the height
                                     fog beyond the volume (the apply pass's tail) */
-    SB_VEC4(camera_motion_m);    /* xyz: this frame's camera minus the last frame's (m); w: unused */
+    SB_VEC4(camera_motion_m);    /* xyz: this frame's camera minus the last frame's (m); w: this frame's
+                                    radiance scale over the last's (the history's rgb times it) */
     SB_VEC4(volume_min[SB_FOG_VOLUMES]); /* xyz: a box's min corner (world, m); w: its extinction (1/m) */
     SB_VEC4(volume_max[SB_FOG_VOLUMES]); /* xyz: its max corner; w: its edge (m) */
 };
@@ -339,7 +340,8 @@ struct sb_clouds_gpu {
                             layer (m); w: the shortest view step (m) */
     SB_VEC4(shadow);     /* xy: the shadow map's centre (world xz, m); z: its width (m); w: steps a texel */
     SB_VEC4(temporal);   /* x: this frame's jitter offset, [0, 1); y: the history's weight (0: none);
-                            z: frames since the history began (this one's index); w: unused */
+                            z: frames since the history began (this one's index); w: this frame's
+                            radiance scale over the last's (the history's rgb times it) */
     SB_VEC4(camera_motion_m); /* xyz: this frame's camera minus the last frame's (m); w: unused */
     SB_UVEC4(trace);     /* xy: traced pixels; z: scale (a block's side, pixels); w: this frame's pixel in a
                             block, y scale + x */

@@ -60,7 +60,7 @@ void main()
     if (frame.size.w == SB_DEBUG_FOG)
         colour = inscatter;
     else if (frame.size.w == SB_DEBUG_FOG_TRANSMITTANCE)
-        colour = vec3(transmittance);
+        colour = vec3(transmittance * frame.aerial.y); /* read back divided by the scale */
     else if (frame.size.w == SB_DEBUG_NONE || frame.size.w == SB_DEBUG_ENV_SPECULAR)
         colour = colour * transmittance + inscatter;
     imageStore(hdr, pixel, vec4(fp16_safe(colour), 1.0));

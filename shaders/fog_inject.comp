@@ -51,7 +51,7 @@ void main()
          * reprojected: beyond them the history is an extrapolation. */
         vec3 margin = 0.5 / vec3(fog.grid.xyz);
         if (clip.w > 0.0 && all(greaterThanEqual(uvw, margin)) && all(lessThanEqual(uvw, 1.0 - margin)))
-            value = mix(value, textureLod(history, uvw, 0.0), weight);
+            value = mix(value, textureLod(history, uvw, 0.0) * vec4(vec3(fog.camera_motion_m.w), 1.0), weight);
     }
     imageStore(light_out, ivec3(id), value);
 }

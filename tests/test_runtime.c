@@ -243,14 +243,17 @@ static void test_caster_boxes_bounded(void)
  * a margin, is smaller than the map where the casters are few, and the
  * frames are the same, bit for bit, as with whole maps. */
 /* The frames of `n` views drawn by r and by a renderer made with `other`
- * (a setting that must not change them, named by `what`), equal bit for bit. */
+ * (a setting that must not change them, named by `what`), equal bit for bit.
+ * Each is drawn twice, so that both renderers store it at the scale its own
+ * exposure sets (pre-exposure, renderer.c): a value subnormal in a half at
+ * one scale and normal at the other would round differently. */
 static void check_same_frames(struct sb_renderer *r, const struct sb_renderer_params *other,
                               const struct sb_view *views, int n, const char *what)
 {
     struct sb_renderer *o = NULL;
     CHECK(sb_renderer_create(vk, &pack, &world, other, &o) == SB_OK, "renderer with %s", what);
     for (int i = 0; i < n && o; i++) {
-        if (!render(r, &views[i]) || !render(o, &views[i]))
+        if (!render(r, &views[i]) || !render(o, &views[i]) || !render(r, &views[i]) || !render(o, &views[i]))
             break;
         float *a = frame_rgb(r), *b = frame_rgb(o);
         CHECK(!memcmp(a, b, sizeof(float) * 3 * W * H), "view %d: the frame is the same as with %s", i, what);
@@ -540,6 +543,21 @@ static void test_exposure(struct sb_renderer *r)
     CHECK(dusk > 0.18 / 1.5 && dusk < 0.18 * 1.5, "dusk ends up at %.3f, within 1.5x of mid grey", dusk);
     CHECK(dusk_state[1] > 20.0 * noon_state[1], "dusk is exposed %.1fx more than noon (at least 20x)",
           dusk_state[1] / noon_state[1]);
+    /* Deep civil twilight, the sun 8 degrees down: 2^-12 of noon's light,
+     * among a half's subnormals at a fixed scale. Pre-exposure stores it
+     * near mid grey, so the frame meters like noon's. (At -12 degrees the
+     * frame is below the meter's darkest bin, 2^-20 of the sun's units.) */
+    v.sun_elevation = -8.0 * DEG;
+    if (!render(r, &v))
+        return;
+    float night_state[4];
+    sb_renderer_exposure(r, night_state);
+    double night = exposed_middle(r);
+    CHECK(night > 0.18 / 1.5 && night < 0.18 * 1.5, "twilight ends up at %.3f, within 1.5x of mid grey", night);
+    CHECK(night_state[1] > 1000.0 * noon_state[1], "twilight is exposed %.0fx more than noon (at least 1000x)",
+          night_state[1] / noon_state[1]);
+    printf("exposure: noon %.3g, dusk (-3 degrees) %.3g, twilight (-8) %.3g; exposed middles %.3f %.3f %.3f\n",
+           noon_state[1], dusk_state[1], night_state[1], noon, dusk, night);
 
     /* Adaptation: from noon, the dusk view moves the exposure a step of
      * 1 - exp(-dt * 1/s) of the way in log2 each frame. */
@@ -1021,6 +1039,34 @@ static float *fog_frame(struct sb_pack *p, struct sb_world *w, int debug, const 
     return rgb;
 }
 
+/* The fog's in-scattering (SB_DEBUG_FOG) after `frames` frames of one view
+ * kept in history, each stored at the radiance scale times 2^4, the last at
+ * 2^last_stops (pre-exposure fixed, renderer.h). */
+static float *fog_frames_scaled(struct sb_pack *p, struct sb_world *w, const struct sb_view *v, int frames,
+                                int last_stops)
+{
+    struct sb_renderer_params rp = {.width = FOG_W, .height = FOG_H, .shadow_size = 2048, .debug = SB_DEBUG_FOG};
+    struct sb_renderer *r = NULL;
+    if (sb_renderer_create(vk, p, w, &rp, &r) != SB_OK) {
+        CHECK(false, "fog renderer");
+        return NULL;
+    }
+    bool ok = true;
+    for (int i = 0; i < frames && ok; i++) {
+        struct sb_view f = *v;
+        f.snap_exposure = i == 0;
+        f.fixed_pre_exposure = true;
+        f.pre_exposure_stops = i == frames - 1 ? last_stops : 4;
+        ok = sb_renderer_render(r, &f, i == frames - 1, NULL) == SB_OK;
+    }
+    CHECK(ok, "render the fog");
+    float *rgb = ok ? malloc(sizeof(float) * 3 * FOG_W * FOG_H) : NULL;
+    if (rgb)
+        sb_renderer_hdr(r, rgb);
+    sb_renderer_destroy(&r);
+    return rgb;
+}
+
 static double henyey_greenstein(double g, double c)
 {
     double d = 1 + g * g - 2 * g * c;
@@ -1151,6 +1197,34 @@ static void test_fog(const char *dir)
            worst_t);
     free(S);
     free(T);
+
+    /* 1b. Pre-exposure: the froxels' history is stored at the last frame's
+     * scale and rescaled as it is read, so a frame whose scale jumps 5
+     * stops up or 3 down from its history's is the same as one that kept
+     * it (the scales are powers of two): bit for bit where a half holds the
+     * value as a normal number (test_scaled_frames_differ). Four frames, so
+     * the history counts. */
+    {
+        float *kept = fog_frames_scaled(&fog_pack, &w, &v, 4, 4);
+        float *up = fog_frames_scaled(&fog_pack, &w, &v, 4, 9);
+        float *down = fog_frames_scaled(&fog_pack, &w, &v, 4, 1);
+        float *alone = fog_frames_scaled(&fog_pack, &w, &v, 1, 4);
+        size_t bytes = sizeof(float) * 3 * FOG_W * FOG_H;
+        if (kept && up && down && alone) {
+            const double *sun = fog_pack.scene->atmosphere.solar_irradiance;
+            int n_up = test_scaled_frames_differ(kept, up, 3 * FOG_W * FOG_H, sun, 4);
+            int n_down = test_scaled_frames_differ(kept, down, 3 * FOG_W * FOG_H, sun, 1);
+            CHECK(n_up == 0, "fog history across a scale 32x up: %d values differ from the frame that kept its scale",
+                  n_up);
+            CHECK(n_down == 0,
+                  "fog history across a scale 8x down: %d values differ from the frame that kept its scale", n_down);
+            CHECK(memcmp(kept, alone, bytes) != 0, "the fog's history changes the frame (else 1b tests nothing)");
+        }
+        free(kept);
+        free(up);
+        free(down);
+        free(alone);
+    }
 
     /* 2. A light shaft: the sun low in the east; the tall box shadows the
      * fog west of it. Rays passing the box's shadow against rays just
@@ -1283,6 +1357,8 @@ int main(int argc, char **argv)
          * 0.5 m ulps), 5e-3 measured on lavapipe and the H200: 1e-2. */
         test_sky_view(r, 45.0, 2e-3);
         test_sky_view(r, 3.0, 1e-2);
+        /* Twilight, through pre-exposure: the same bound as the low sun. */
+        test_sky_view(r, -12.0, 1e-2);
         test_above_atmosphere(r);
     }
     sb_renderer_destroy(&r);
