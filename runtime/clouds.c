@@ -278,4 +278,17 @@ const struct sb_pass_class sb_pass_cloud_shadow = {
     .record = cloud_shadow_record,
 };
 
-const struct sb_pass_class sb_pass_clouds = {.name = "clouds", .record = clouds_record};
+/* Left out of a frame, the clouds' history goes stale: the next frame starts
+ * anew. (Their shadow map is another pass, which stays.) */
+static void clouds_skipped(struct sb_renderer *r)
+{
+    if (r->clouds)
+        r->clouds->has_history = false;
+}
+
+const struct sb_pass_class sb_pass_clouds = {
+    .name = "clouds",
+    .record = clouds_record,
+    .optional = true,
+    .skipped = clouds_skipped,
+};

@@ -219,11 +219,20 @@ static void fog_apply_record(struct sb_renderer *r)
                          (const uint32_t[3]){SB_WORKGROUP_X, SB_WORKGROUP_Y, 1});
 }
 
+/* Left out of a frame, the froxels' history goes stale: the next frame starts anew. */
+static void fog_skipped(struct sb_renderer *r)
+{
+    if (r->fog)
+        r->fog->has_history = false;
+}
+
 const struct sb_pass_class sb_pass_fog = {
     .name = "fog",
     .create = fog_create,
     .destroy = fog_destroy,
     .record = fog_record,
+    .optional = true,
+    .skipped = fog_skipped,
 };
 
-const struct sb_pass_class sb_pass_fog_apply = {.name = "fog apply", .record = fog_apply_record};
+const struct sb_pass_class sb_pass_fog_apply = {.name = "fog apply", .record = fog_apply_record, .optional = true};

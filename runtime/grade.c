@@ -292,9 +292,11 @@ const struct sb_pass_class sb_pass_grade_linear = {
     .create = grade_create,
     .destroy = grade_destroy,
     .record = grade_linear_record,
+    .optional = true,
 };
 
 const struct sb_pass_class sb_pass_grade = {
     .name = "grade",
     .record = grade_record,
+    .optional = true,
 };

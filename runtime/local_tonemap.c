@@ -101,4 +101,5 @@ const struct sb_pass_class sb_pass_local_tonemap = {
     .create = local_tonemap_create,
     .destroy = local_tonemap_destroy,
     .record = local_tonemap_record,
+    .optional = true,
 };

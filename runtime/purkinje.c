@@ -80,4 +80,5 @@ const struct sb_pass_class sb_pass_purkinje = {
     .create = purkinje_create,
     .destroy = purkinje_destroy,
     .record = purkinje_record,
+    .optional = true,
 };

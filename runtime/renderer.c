@@ -976,8 +976,8 @@ static void fill_frame(struct sb_renderer *r, const struct sb_view *v, struct sb
     double log_sun = log2(1.0 / r->radiance_scale);
     store4(f->exposure, log_sun - 20.0, 32.0, 0.10, 0.90);
     store4(f->adaptation, 3.0, 1.0, v->dt_s > 0.0 ? v->dt_s : 1.0 / 60.0, v->snap_exposure ? 1.0 : 0.0);
-    store4(f->post, 1.0, r->params.bloom_strength > 0.0 ? r->params.bloom_strength : 0.0,
-           r->params.exposure_compensation_ev, r->params.tonemap);
+    bool bloom = r->params.bloom_strength > 0.0 && !(v->disabled_passes >> SB_PASS_BLOOM & 1);
+    store4(f->post, 1.0, bloom ? r->params.bloom_strength : 0.0, r->params.exposure_compensation_ev, r->params.tonemap);
     f->size[0] = r->width;
     f->size[1] = r->height;
     f->size[2] = r->bloom_levels;
@@ -1205,7 +1205,8 @@ static const struct sb_pass_class pass_shadows = {.name = "shadows", .record = r
 static const struct sb_pass_class pass_scene = {.name = "scene", .record = record_scene};
 static const struct sb_pass_class pass_sky = {.name = "sky", .record = record_sky};
 static const struct sb_pass_class pass_exposure = {.name = "exposure", .record = record_exposure};
-static const struct sb_pass_class pass_bloom = {.name = "bloom", .record = record_bloom};
+/* Left out, the tone curve adds no bloom (fill_frame). */
+static const struct sb_pass_class pass_bloom = {.name = "bloom", .record = record_bloom, .optional = true};
 static const struct sb_pass_class pass_tonemap = {.name = "tonemap", .record = record_tonemap};
 
 /* A frame's passes, in order (enum sb_pass). */
@@ -1340,7 +1341,12 @@ static enum sb_result render_once(struct sb_renderer *r, const struct sb_view *v
     for (int p = 0; p < SB_PASS_COUNT; p++) {
         if (r->queries)
             vkCmdWriteTimestamp(r->cmd, VK_PIPELINE_STAGE_TOP_OF_PIPE_BIT, r->queries, 2 * p);
-        pass_classes[p]->record(r);
+        if (view->disabled_passes >> p & 1 && pass_classes[p]->optional) {
+            if (pass_classes[p]->skipped)
+                pass_classes[p]->skipped(r);
+        } else {
+            pass_classes[p]->record(r);
+        }
         if (r->queries)
             vkCmdWriteTimestamp(r->cmd, VK_PIPELINE_STAGE_BOTTOM_OF_PIPE_BIT, r->queries, 2 * p + 1);
         sb_renderer_barrier(r->cmd);
@@ -1412,6 +1418,11 @@ static void halves_to_rgb(const uint16_t *src, size_t pixels, double scale, floa
     for (size_t i = 0; i < pixels; i++)
         for (int c = 0; c < 3; c++)
             rgb[i * 3 + c] = (float)(sb_half_to_float(src[i * 4 + c]) / scale);
+}
+
+double sb_renderer_stored_scale(const struct sb_renderer *r)
+{
+    return r->readback_scale;
 }
 
 void sb_renderer_hdr(const struct sb_renderer *r, float *rgb)

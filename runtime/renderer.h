@@ -100,18 +100,22 @@ void sb_rec709_to_ap1(double m[3][3]);
 
 /* What one frame looks at. Angles in radians; lengths in metres. */
 struct sb_view {
-    double camera_m[3];      /* in the world: y up, the origin on the ground */
-    double yaw, pitch;       /* view direction: azimuth clockwise from -z (north) toward +x, elevation */
-    double fov_y;            /* vertical field of view; 0: 50 degrees */
-    double sun_azimuth;      /* same convention as yaw */
-    double sun_elevation;    /* above the horizon; negative below */
-    double dt_s;             /* time since the previous frame, for exposure adaptation; 0: 1/60 s */
-    bool snap_exposure;      /* a cut: take the metered exposure at once, drop the fog's and clouds' history */
-    double time_s;           /* what the fog's noise and the clouds drift with (s) */
-    bool fixed_pre_exposure; /* store this frame at the radiance scale times 2^pre_exposure_stops instead
-                                of the scale its exposure sets (pre-exposure, renderer.c); the frame reads
-                                back the same away from the halves' limits. false: automatic */
-    int pre_exposure_stops;  /* with fixed_pre_exposure, [-16, 24] */
+    double camera_m[3];       /* in the world: y up, the origin on the ground */
+    double yaw, pitch;        /* view direction: azimuth clockwise from -z (north) toward +x, elevation */
+    double fov_y;             /* vertical field of view; 0: 50 degrees */
+    double sun_azimuth;       /* same convention as yaw */
+    double sun_elevation;     /* above the horizon; negative below */
+    double dt_s;              /* time since the previous frame, for exposure adaptation; 0: 1/60 s */
+    bool snap_exposure;       /* a cut: take the metered exposure at once, drop the fog's and clouds' history */
+    double time_s;            /* what the fog's noise and the clouds drift with (s) */
+    bool fixed_pre_exposure;  /* store this frame at the radiance scale times 2^pre_exposure_stops instead
+                                 of the scale its exposure sets (pre-exposure, renderer.c); the frame reads
+                                 back the same away from the halves' limits. false: automatic */
+    int pre_exposure_stops;   /* with fixed_pre_exposure, [-16, 24] */
+    uint32_t disabled_passes; /* bit 1 << SB_PASS_x: leave that pass out of this frame, where the frame is
+                                 whole without it (fog, fog apply, clouds, purkinje, local tonemap, grade
+                                 linear, bloom, grade; others are drawn anyway). Its time reads 0. A pass
+                                 left out drops its history (fog, clouds); the clouds' shadow stays */
 };
 
 enum sb_pass {
@@ -177,6 +181,11 @@ const uint8_t *sb_renderer_ldr(const struct sb_renderer *renderer);
 void sb_renderer_hdr(const struct sb_renderer *renderer, float *rgb);
 void sb_renderer_post_hdr(const struct sb_renderer *renderer, float *rgb);
 void sb_renderer_sky_view(const struct sb_renderer *renderer, float *rgb);
+
+/* What the last frame read back was stored at in the HDR target: radiance
+ * in the pack's units times this is the half it held (pre-exposure; the
+ * post_hdr and sky_view images too). */
+double sb_renderer_stored_scale(const struct sb_renderer *renderer);
 
 /* The exposure state after the last frame: adapted log2 luminance, the
  * exposure multiplier, this frame's metered log2 luminance, and the pixels

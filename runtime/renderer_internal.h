@@ -124,6 +124,11 @@ struct sb_pass_class {
     enum sb_result (*create)(struct sb_renderer *r);
     void (*destroy)(struct sb_renderer *r);
     void (*record)(struct sb_renderer *r);
+    /* The frame is whole without it, so a view may leave it out
+     * (sb_view.disabled_passes); `skipped` (may be NULL) is called instead
+     * of `record` then, e.g. to drop a history that would go stale. */
+    bool optional;
+    void (*skipped)(struct sb_renderer *r);
 };
 
 /* scene_trace.c: whether to trace the scene; the BVH and kernels (stand-ins

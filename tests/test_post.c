@@ -51,6 +51,7 @@ struct frame {
     uint8_t ldr[PIXELS * 4];
     float hdr[PIXELS * 3];
     float exposure[4];
+    double stored_scale; /* what the frame's halves hold the pack's radiance times */
 };
 
 static const struct sb_renderer_params base_params = {.width = W, .height = H, .shadow_size = 512};
@@ -66,6 +67,7 @@ static bool render(const struct sb_renderer_params *p, const struct sb_view *v, 
         memcpy(f->ldr, sb_renderer_ldr(r), sizeof(f->ldr));
         sb_renderer_post_hdr(r, f->hdr);
         sb_renderer_exposure(r, f->exposure);
+        f->stored_scale = sb_renderer_stored_scale(r);
     }
     sb_renderer_destroy(&r);
     return res == SB_OK;
@@ -84,12 +86,10 @@ static void apply3(const double m[3][3], const double v[3], double out[3])
     memcpy(out, t, sizeof(t));
 }
 
-/* The HDR frame holds halves of the radiance times 1 / the sun's largest
- * channel: errors are measured in units in the last place of the half that
+/* The HDR frame holds halves of the radiance times the frame's stored scale
+ * (sb_renderer_stored_scale; pre-exposure): errors are measured in units in the last place of the half that
  * holds the wanted value (2^-24 among the subnormals). */
-static double stored_scale;
-
-static double half_ulps(double got, double want)
+static double half_ulps(double got, double want, double stored_scale)
 {
     double v = fabs(want) * stored_scale;
     double ulp = v < 0x1p-14 ? 0x1p-24 : exp2(floor(log2(v)) - 10.0);
@@ -101,10 +101,10 @@ struct worst {
     int pixel;
 };
 
-static void record(struct worst *w, const float *got, const double want[3], int pixel)
+static void record(struct worst *w, const float *got, const double want[3], int pixel, double stored_scale)
 {
     for (int c = 0; c < 3; c++) {
-        double e = half_ulps(got[c], want[c]);
+        double e = half_ulps(got[c], want[c], stored_scale);
         if (!(e <= w->ulps)) {
             w->ulps = e;
             w->pixel = pixel;
@@ -241,7 +241,7 @@ static void test_linear_grading(void)
         apply3(m, c, c);
         for (int k = 0; k < 3; k++)
             c[k] = 0.18 * pow(fmax(c[k], 0.0) / 0.18, p.grading.contrast) / e;
-        record(&w, on->hdr + 3 * i, c, i);
+        record(&w, on->hdr + 3 * i, c, i, on->stored_scale);
     }
     /* rounding to a half, which an image store may do toward zero (< 1 ulp),
      * and fp32 arithmetic (~1e-3 ulp) */
@@ -397,7 +397,7 @@ static void test_log_lut(void)
             apply3(from_ap1, c, c);
             for (int j = 0; j < 3; j++)
                 c[j] /= e;
-            record(&w, on->hdr + 3 * i, c, i);
+            record(&w, on->hdr + 3 * i, c, i, on->stored_scale);
         }
         /* rounding to a half (< 1 ulp) and fp32 log2 and exp2 (~1e-2 ulp) */
         CHECK(w.ulps < 1.01, "the %s LUT in ACEScct: %.3g half ulps off the fp64 model at pixel %d", luts[k].name,
@@ -556,7 +556,7 @@ static void test_purkinje(void)
             purkinje_model(c, c);
             for (int j = 0; j < 3; j++)
                 c[j] /= to_cd;
-            record(&w, on->hdr + 3 * i, c, i);
+            record(&w, on->hdr + 3 * i, c, i, on->stored_scale);
             const float *a = off->hdr + 3 * i, *b = on->hdr + 3 * i;
             blue_off += a[2] / fmax(a[0] + a[1] + a[2], 1e-30);
             blue_on += b[2] / fmax(b[0] + b[1] + b[2], 1e-30);
@@ -580,6 +580,37 @@ static void test_purkinje(void)
     free(on);
 }
 
+/* ---- Passes a view leaves out ------------------------------------------------------ */
+
+/* sb_view.disabled_passes: a frame without the Purkinje shift, local tone
+ * mapping, scene-linear grading and bloom, by the view's choice, is the
+ * frame of a renderer made without them, bit for bit; with them it is not
+ * (dusk, so that every one changes it). */
+static void test_disabled_passes(void)
+{
+    struct sb_renderer_params with = base_params, without = base_params;
+    with.purkinje = true;
+    with.local_contrast = 0.7;
+    with.grading = (struct sb_grading){.enabled = true, .white_balance_k = 5000.0, .saturation = 1.2, .contrast = 1.1};
+    without.bloom_strength = -1.0;
+    struct frame *left_out = malloc(sizeof(*left_out)), *made_without = malloc(sizeof(*made_without));
+    struct frame *all = malloc(sizeof(*all));
+    struct sb_view v = view_at(-5.0);
+    struct sb_view off = v;
+    off.disabled_passes = 1u << SB_PASS_PURKINJE | 1u << SB_PASS_LOCAL_TONEMAP | 1u << SB_PASS_GRADE_LINEAR |
+                          1u << SB_PASS_BLOOM | 1u << SB_PASS_SCENE; /* the scene is not optional: drawn anyway */
+    if (render(&with, &off, left_out, "the passes left out") && render(&without, &v, made_without, "made without") &&
+        render(&with, &v, all, "with them")) {
+        CHECK(!memcmp(left_out->ldr, made_without->ldr, sizeof(left_out->ldr)) &&
+                  !memcmp(left_out->hdr, made_without->hdr, sizeof(left_out->hdr)),
+              "passes left out by the view: not the frame of a renderer without them");
+        CHECK(memcmp(all->ldr, made_without->ldr, sizeof(all->ldr)) != 0, "the passes change nothing at dusk");
+    }
+    free(left_out);
+    free(made_without);
+    free(all);
+}
+
 int main(int argc, char **argv)
 {
     /* The world file; argv[1] overrides the source tree's (for runs elsewhere). */
@@ -596,13 +627,12 @@ int main(int argc, char **argv)
     test_view_pack(vk, dir, "post test", &pack);
     CHECK(sb_world_load(world_path, NULL, &world) == SB_OK, "the world loads");
     if (pack.scene && world.vertices) {
-        const double *sun = pack.scene->atmosphere.solar_irradiance;
-        stored_scale = 1.0 / fmax(sun[0], fmax(sun[1], sun[2]));
         test_linear_grading();
         test_display_lut();
         test_log_lut();
         test_local_tonemap();
         test_purkinje();
+        test_disabled_passes();
     }
     CHECK(sb_vk_validation_messages(vk) == 0, "%u validation messages", sb_vk_validation_messages(vk));
     sb_vk_destroy(&vk);
