@@ -30,6 +30,8 @@
 #include "sun_path.h"
 #include "transform.h"
 #include "video.h"
+#include "viewer.h"
+#include "window.h"
 #include "world.h"
 
 enum {
@@ -112,6 +114,18 @@ static void usage(FILE *f)
                "                          shadows); auto: traced on a GPU, rasterised on a CPU\n"
                "                          device (default)\n"
                "  --hdr                   also write the linear HDR frames, frame_0000.exr, ...\n"
+               "\n"
+               "a window (GLFW; headless is the default):\n"
+               "  --window                show the frames in a window, interactively: W A S D Q E\n"
+               "                          fly (Shift faster), drag the mouse to look, arrow keys\n"
+               "                          move the sun (with --time-of-day H, the hour), 1 to 7\n"
+               "                          switch fog, clouds, Purkinje, local tone mapping,\n"
+               "                          scene-linear grading, bloom, the LUT; H the timing\n"
+               "                          overlay, P a screenshot into OUT_DIR (default .), Esc\n"
+               "                          quits. With --frames N: N frames as headless, then close\n"
+               "  --screenshot FILE       with --window --frames N: the swapchain's last image as\n"
+               "                          PNG\n"
+               "  --no-overlay            start without the timing overlay\n"
                "\n"
                "time of day (the sun from a place and a date, or from keys; -z is north):\n"
                "  --time-of-day H | FROM-TO\n"
@@ -197,6 +211,8 @@ struct options {
     double fps;
     enum { ENCODER_AUTO, ENCODER_FFMPEG, ENCODER_PNG } encoder;
     double sheet_step_h; /* > 0: a contact sheet instead of the sweep */
+    bool window, no_overlay;
+    const char *screenshot;
     const char *set[16]; /* options given that only go with some others, for the checks after parsing */
     int set_count;
 };
@@ -286,6 +302,25 @@ static int check_combinations(struct options *o)
             return EXIT_USAGE;
         }
     }
+    static const char *const need_window[] = {"--screenshot", "--no-overlay"};
+    for (int i = 0; i < 2; i++)
+        if (!o->window && given(o, need_window[i])) {
+            fprintf(stderr, "skyview: %s goes with --window\n", need_window[i]);
+            return EXIT_USAGE;
+        }
+    if (o->window && (o->bench || o->sweep || o->hdr)) {
+        fprintf(stderr, "skyview: --window shows frames as they come: not with %s\n",
+                o->bench   ? "--bench"
+                : o->sweep ? "a sweep (--time-of-day FROM-TO)"
+                           : "--hdr");
+        return EXIT_USAGE;
+    }
+    if (o->screenshot && o->frames < 0) {
+        fprintf(stderr, "skyview: --screenshot is taken after --frames N: give N\n");
+        return EXIT_USAGE;
+    }
+    if (o->window)
+        return 0; /* frames < 0: until the window closes */
     if (o->frames < 0)
         o->frames = o->bench ? 30 : o->sweep ? sweep_frames(o) : 1;
     return 0;
@@ -391,6 +426,14 @@ static int parse_options(int argc, char **argv, struct options *o)
             const char *t = argv[++i];
             ok = !strcmp(t, "auto") || !strcmp(t, "ffmpeg") || !strcmp(t, "png");
             o->encoder = !strcmp(t, "ffmpeg") ? ENCODER_FFMPEG : !strcmp(t, "png") ? ENCODER_PNG : ENCODER_AUTO;
+            note_option(o, a);
+        } else if (!strcmp(a, "--window")) {
+            o->window = true;
+        } else if (!strcmp(a, "--no-overlay")) {
+            o->no_overlay = true;
+            note_option(o, a);
+        } else if (!strcmp(a, "--screenshot") && next) {
+            o->screenshot = argv[++i];
             note_option(o, a);
         } else if (!strcmp(a, "--contact-sheet") && next) {
             ok = parse_number(argv[++i], 1.0 / 60.0, 24, &o->sheet_step_h);
@@ -521,6 +564,8 @@ static int parse_options(int argc, char **argv, struct options *o)
         fprintf(stderr, "skyview: --grade-space acescct applies a LUT: it needs --grade FILE.cube\n");
         return EXIT_USAGE;
     }
+    if (o->window && !o->out_dir)
+        o->out_dir = "."; /* where P's screenshots go */
     if (!o->pack || !o->out_dir) {
         fprintf(stderr, "skyview: needs a PACK and -o OUT_DIR\n");
         usage(stderr);
@@ -869,6 +914,9 @@ static int run(const struct options *o)
     struct sb_renderer *r = NULL;
     struct sb_frame_timings *timings = NULL;
     struct sb_video *video = NULL;
+    struct sb_vk_params vk_params = o->vk;
+    struct sb_window *window = NULL;
+    bool window_system = false;
     char video_path[4200];
     snprintf(video_path, sizeof(video_path), "%s/day.mp4", o->out_dir);
     enum sb_result res = SB_OK;
@@ -880,7 +928,14 @@ static int run(const struct options *o)
     }
     if (o->sweep && o->sheet_step_h <= 0.0 && !ffmpeg_found && o->encoder == ENCODER_AUTO)
         sb_info("no ffmpeg on PATH: the sweep's frames go to numbered PNGs");
-    res = sb_vk_create(&o->vk, &vk);
+    if (o->window) {
+        if ((res = sb_window_system_init(&vk_params))) {
+            code = res == SB_ERR_USAGE ? EXIT_USAGE : EXIT_NO_DEVICE;
+            goto done;
+        }
+        window_system = true;
+    }
+    res = sb_vk_create(&vk_params, &vk);
     if (res) {
         code = res == SB_ERR_NO_DEVICE ? EXIT_NO_DEVICE : EXIT_RENDER_FAILED;
         goto done;
@@ -889,6 +944,29 @@ static int run(const struct options *o)
     res = sb_renderer_create(vk, &pack, &world, &params, &r);
     if (res) {
         code = res == SB_ERR_USAGE ? EXIT_USAGE : EXIT_RENDER_FAILED;
+        goto done;
+    }
+    if (o->window) {
+        uint32_t w, h;
+        sb_renderer_size(r, &w, &h);
+        char title[256];
+        snprintf(title, sizeof(title), "skyview: %s", o->pack);
+        struct sb_viewer_params vp = {
+            .view = o->view,
+            .sun_path = o->time_of_day ? &o->sun_path : NULL,
+            .hour = o->day_from,
+            .frames = o->frames > 0 ? o->frames : 0,
+            .screenshot = o->screenshot,
+            .out_dir = o->out_dir,
+            .overlay = !o->no_overlay,
+        };
+        if (o->time_of_day)
+            sb_sun_path_at(&o->sun_path, o->day_from, &vp.view.sun_elevation, &vp.view.sun_azimuth);
+        res = sb_window_create(vk, w, h, title, &window);
+        if (!res)
+            res = sb_viewer_run(r, window, &vp);
+        if (res)
+            code = res == SB_ERR_NO_DEVICE ? EXIT_NO_DEVICE : EXIT_RENDER_FAILED;
         goto done;
     }
     if (o->sheet_step_h > 0.0 || o->sweep) {
@@ -937,9 +1015,12 @@ static int run(const struct options *o)
 
 done:
     sb_video_destroy(&video, false);
+    sb_window_destroy(&window);
     sb_renderer_destroy(&r);
     unsigned messages = vk ? sb_vk_validation_messages(vk) : 0;
     sb_vk_destroy(&vk);
+    if (window_system)
+        sb_window_system_finish();
     free(timings);
     sb_world_finish(&world);
     sb_lut3d_finish(&grade);

@@ -2,8 +2,10 @@
 """Numbers about 8-bit PNGs for the shell tests (no imaging library needed).
 
 png_stats.py size A.png            -> "W H"
-png_stats.py diff A.png B.png      -> "MEAN MAX": the mean and largest absolute
-                                      difference of the RGB codes (same size)
+png_stats.py diff A.png B.png [X Y W H]
+                                   -> "MEAN MAX": the mean and largest absolute
+                                      difference of the RGB codes (same size),
+                                      over the rectangle if given
 png_stats.py ink A.png X Y W H R G B
                                    -> the pixels of the rectangle that are not
                                       the colour R G B
@@ -63,14 +65,15 @@ def main():
         wb, hb, cb, rb = read(args[1])
         if (wa, ha) != (wb, hb):
             sys.exit(f"sizes differ: {wa}x{ha} and {wb}x{hb}")
+        x0, y0, rw, rh = map(int, args[2:6]) if len(args) >= 6 else (0, 0, wa, ha)
         total, largest = 0, 0
-        for y in range(ha):
-            for x in range(wa):
+        for y in range(y0, y0 + rh):
+            for x in range(x0, x0 + rw):
                 for k in range(3):
                     d = abs(ra[y][x * ca + k] - rb[y][x * cb + k])
                     total += d
                     largest = max(largest, d)
-        print(f"{total / (wa * ha * 3):.4f} {largest}")
+        print(f"{total / (rw * rh * 3):.4f} {largest}")
     elif command == "ink":
         w, h, c, rows = read(args[0])
         x0, y0, rw, rh, *colour = map(int, args[1:])

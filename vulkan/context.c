@@ -175,7 +175,19 @@ enum sb_result sb_vk_create(const struct sb_vk_params *params, struct sb_vk **ou
     }
     bool debug_utils = has_instance_extension(VK_EXT_DEBUG_UTILS_EXTENSION_NAME);
     const char *layers[] = {VALIDATION_LAYER};
-    const char *extensions[] = {VK_EXT_DEBUG_UTILS_EXTENSION_NAME};
+    const char *extensions[17];
+    uint32_t extension_count = 0;
+    if (debug_utils)
+        extensions[extension_count++] = VK_EXT_DEBUG_UTILS_EXTENSION_NAME;
+    for (uint32_t i = 0; i < params->instance_extension_count && extension_count < 17; i++) {
+        if (!has_instance_extension(params->instance_extensions[i])) {
+            sb_error("the window needs the Vulkan instance extension %s, which no driver offers",
+                     params->instance_extensions[i]);
+            res = SB_ERR_NO_DEVICE;
+            goto cleanup;
+        }
+        extensions[extension_count++] = params->instance_extensions[i];
+    }
     VkApplicationInfo app = {
         .sType = VK_STRUCTURE_TYPE_APPLICATION_INFO,
         .pApplicationName = "skybake",
@@ -197,7 +209,7 @@ enum sb_result sb_vk_create(const struct sb_vk_params *params, struct sb_vk **ou
         .pApplicationInfo = &app,
         .enabledLayerCount = params->validate ? 1 : 0,
         .ppEnabledLayerNames = layers,
-        .enabledExtensionCount = debug_utils ? 1 : 0,
+        .enabledExtensionCount = extension_count,
         .ppEnabledExtensionNames = extensions,
     };
     VkResult r = vkCreateInstance(&instance_info, NULL, &vk->instance);
@@ -244,8 +256,20 @@ enum sb_result sb_vk_create(const struct sb_vk_params *params, struct sb_vk **ou
     int family = -1;
     for (uint32_t i = 0; i < nq && family < 0; i++) /* prefer a queue that does both */
         if ((qf[i].queueFlags & (VK_QUEUE_COMPUTE_BIT | VK_QUEUE_GRAPHICS_BIT)) ==
-            (VK_QUEUE_COMPUTE_BIT | VK_QUEUE_GRAPHICS_BIT))
+                (VK_QUEUE_COMPUTE_BIT | VK_QUEUE_GRAPHICS_BIT) &&
+            (!params->can_present || params->can_present(vk->instance, vk->physical_device, i)))
             family = (int)i;
+    if (params->can_present && family < 0) {
+        sb_error("%s has no queue that renders and presents to the window", vk->properties.deviceName);
+        res = SB_ERR_NO_DEVICE;
+        goto cleanup;
+    }
+    if (params->can_present && !has_device_extension(vk->physical_device, VK_KHR_SWAPCHAIN_EXTENSION_NAME)) {
+        sb_error("%s cannot present to a window (no %s)", vk->properties.deviceName, VK_KHR_SWAPCHAIN_EXTENSION_NAME);
+        res = SB_ERR_NO_DEVICE;
+        goto cleanup;
+    }
+    vk->present = params->can_present != NULL;
     for (uint32_t i = 0; i < nq && family < 0 && !params->graphics; i++)
         if (qf[i].queueFlags & VK_QUEUE_COMPUTE_BIT)
             family = (int)i;
@@ -294,16 +318,21 @@ enum sb_result sb_vk_create(const struct sb_vk_params *params, struct sb_vk **ou
         .pNext = &features12,
         .pipelineExecutableInfo = VK_TRUE,
     };
-    const char *device_extensions[] = {VK_KHR_PIPELINE_EXECUTABLE_PROPERTIES_EXTENSION_NAME};
+    const char *device_extensions[2];
+    uint32_t device_extension_count = 0;
     vk->statistics = params->statistics &&
                      has_device_extension(vk->physical_device, VK_KHR_PIPELINE_EXECUTABLE_PROPERTIES_EXTENSION_NAME);
+    if (vk->statistics)
+        device_extensions[device_extension_count++] = VK_KHR_PIPELINE_EXECUTABLE_PROPERTIES_EXTENSION_NAME;
+    if (vk->present)
+        device_extensions[device_extension_count++] = VK_KHR_SWAPCHAIN_EXTENSION_NAME;
     if (params->statistics && !vk->statistics)
         sb_warn("%s does not report pipeline statistics (no %s)", vk->properties.deviceName,
                 VK_KHR_PIPELINE_EXECUTABLE_PROPERTIES_EXTENSION_NAME);
     VkDeviceCreateInfo device_info = {
         .sType = VK_STRUCTURE_TYPE_DEVICE_CREATE_INFO,
         .pNext = vk->statistics ? (void *)&executable_features : (void *)&features12,
-        .enabledExtensionCount = vk->statistics ? 1 : 0,
+        .enabledExtensionCount = device_extension_count,
         .ppEnabledExtensionNames = device_extensions,
         .pEnabledFeatures = &features,
         .queueCreateInfoCount = 1,

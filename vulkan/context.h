@@ -28,6 +28,14 @@ struct sb_vk_params {
      * (VK_KHR_pipeline_executable_properties: registers, spills, workgroup
      * memory), where the device offers the extension; ignored elsewhere. */
     bool statistics;
+    /* Present to a window (skyview --window): the instance extensions its
+     * surface needs (glfwGetRequiredInstanceExtensions), and whether a queue
+     * family of a device can present there. With can_present the device
+     * enables VK_KHR_swapchain and its queue must present; else
+     * SB_ERR_NO_DEVICE. NULL: headless. */
+    const char *const *instance_extensions;
+    uint32_t instance_extension_count;
+    bool (*can_present)(VkInstance instance, VkPhysicalDevice device, uint32_t queue_family);
 };
 
 /* The parameters the environment asks for: SKYBAKE_VALIDATE and
@@ -50,6 +58,7 @@ struct sb_vk {
     bool depth_clamp; /* the depthClamp feature is enabled */
     bool has_timestamps;
     bool statistics; /* pipelines capture their statistics (sb_vk_params.statistics) */
+    bool present;    /* VK_KHR_swapchain is enabled and the queue presents (sb_vk_params.can_present) */
     double timestamp_period_ns;
     unsigned validation_messages;
     PFN_vkSetDebugUtilsObjectNameEXT set_object_name;
