@@ -11,10 +11,13 @@
 static const uint8_t background[4] = {24, 24, 24, 255};
 static const uint8_t ink[4] = {235, 235, 235, 255};
 
-/* The label's scale: about one twentieth of the frame's height, at least 1. */
-static uint32_t label_scale(uint32_t tile_height)
+/* The label's scale: glyphs about a twentieth of the frame's height, and
+ * LABEL_CHARS of them across it at most; at least 1. */
+#define LABEL_CHARS 28
+static uint32_t label_scale(uint32_t tile_width, uint32_t tile_height)
 {
-    uint32_t s = tile_height / (20 * SB_TEXT_GLYPH_H / 2 + 1);
+    uint32_t s = tile_height / (20 * SB_TEXT_GLYPH_H / 2 + 1), across = tile_width / (LABEL_CHARS * SB_TEXT_ADVANCE);
+    s = s < across ? s : across;
     return s < 1 ? 1 : s > 6 ? 6 : s;
 }
 
@@ -28,7 +31,7 @@ enum sb_result sb_contact_sheet_init(struct sb_contact_sheet *s, uint32_t tile_w
     s->tile_height = tile_height;
     s->columns = (uint32_t)ceil(sqrt((double)count));
     s->rows = (count + s->columns - 1) / s->columns;
-    uint32_t scale = label_scale(tile_height);
+    uint32_t scale = label_scale(tile_width, tile_height);
     s->label_height = (SB_TEXT_GLYPH_H + 4) * scale;
     s->gap = 2 * scale;
     uint64_t w = (uint64_t)s->columns * (tile_width + s->gap) + s->gap;
@@ -58,7 +61,7 @@ void sb_contact_sheet_put(struct sb_contact_sheet *s, uint32_t index, const uint
         memcpy(s->rgba + (((size_t)y0 + y) * s->width + x0) * 4, rgba + (size_t)y * s->tile_width * 4,
                (size_t)s->tile_width * 4);
     /* Draw into a strip the cell's width, so a long label is cut there. */
-    uint32_t scale = label_scale(s->tile_height);
+    uint32_t scale = label_scale(s->tile_width, s->tile_height);
     uint8_t *strip = malloc((size_t)s->tile_width * s->label_height * 4);
     if (!strip)
         return;

@@ -24,7 +24,8 @@ struct sb_contact_sheet {
 enum sb_result sb_contact_sheet_init(struct sb_contact_sheet *sheet, uint32_t tile_width, uint32_t tile_height,
                                      uint32_t count);
 /* Copy frame `index` (row-major order in the grid; tile_width x tile_height
- * RGBA) into its cell and write `label` under it (cut at the cell's width). */
+ * RGBA) into its cell and write `label` under it (sized for 28 characters
+ * across the cell; cut at its width). */
 void sb_contact_sheet_put(struct sb_contact_sheet *sheet, uint32_t index, const uint8_t *rgba, const char *label);
 void sb_contact_sheet_finish(struct sb_contact_sheet *sheet);
 

@@ -6,6 +6,7 @@ png_stats.py diff A.png B.png [X Y W H]
                                    -> "MEAN MAX": the mean and largest absolute
                                       difference of the RGB codes (same size),
                                       over the rectangle if given
+png_stats.py mean A.png            -> "R G B": the mean codes
 png_stats.py ink A.png X Y W H R G B
                                    -> the pixels of the rectangle that are not
                                       the colour R G B
@@ -74,6 +75,9 @@ def main():
                     total += d
                     largest = max(largest, d)
         print(f"{total / (rw * rh * 3):.4f} {largest}")
+    elif command == "mean":
+        w, h, c, rows = read(args[0])
+        print(" ".join(f"{sum(r[x * c + k] for r in rows for x in range(w)) / (w * h):.2f}" for k in range(3)))
     elif command == "ink":
         w, h, c, rows = read(args[0])
         x0, y0, rw, rh, *colour = map(int, args[1:])
