@@ -114,6 +114,14 @@ static void usage(FILE *f)
                "                          shadows); auto: traced on a GPU, rasterised on a CPU\n"
                "                          device (default)\n"
                "  --hdr                   also write the linear HDR frames, frame_0000.exr, ...\n"
+               "  --bench                 time the passes: warm-up frames, then --frames frames;\n"
+               "                          prints a table and writes OUT_DIR/bench.json\n"
+               "  --warmup N              warm-up frames for --bench (default 5)\n"
+               "  --device NAME|INDEX     Vulkan device by index or name substring\n"
+               "  --validate              enable Vulkan validation; any message fails the run\n"
+               "                          (also SKYBAKE_VALIDATE=1)\n"
+               "  -q, --quiet             warnings and errors only\n"
+               "  -v, --verbose           debug messages\n"
                "\n"
                "a window (GLFW; headless is the default):\n"
                "  --window                show the frames in a window, interactively: W A S D Q E\n"
@@ -152,15 +160,6 @@ static void usage(FILE *f)
                "                          at every multiple of STEP hours from FROM to TO, each\n"
                "                          frame settled (8 frames at its hour), labelled with\n"
                "                          its time and sun (--size is a frame's; default 480x270)\n"
-               "\n"
-               "  --bench                 time the passes: warm-up frames, then --frames frames;\n"
-               "                          prints a table and writes OUT_DIR/bench.json\n"
-               "  --warmup N              warm-up frames for --bench (default 5)\n"
-               "  --device NAME|INDEX     Vulkan device by index or name substring\n"
-               "  --validate              enable Vulkan validation; any message fails the run\n"
-               "                          (also SKYBAKE_VALIDATE=1)\n"
-               "  -q, --quiet             warnings and errors only\n"
-               "  -v, --verbose           debug messages\n"
                "\n"
                "environment: SKYBAKE_VALIDATE=1 as --validate; SKYBAKE_PIPELINE_STATS=1 logs\n"
                "each compute kernel's registers and memory as the driver reports them (on\n"
@@ -217,19 +216,20 @@ struct options {
     int set_count;
 };
 
-/* Remember that option `a` was given, for check_combinations. */
-static void note_option(struct options *o, const char *a)
-{
-    if (o->set_count < (int)(sizeof(o->set) / sizeof(o->set[0])))
-        o->set[o->set_count++] = a;
-}
-
 static bool given(const struct options *o, const char *name)
 {
     for (int i = 0; i < o->set_count; i++)
         if (!strcmp(o->set[i], name))
             return true;
     return false;
+}
+
+/* Remember that option `a` was given, for check_combinations (once: set[]
+ * has room for every option noted). */
+static void note_option(struct options *o, const char *a)
+{
+    if (!given(o, a) && o->set_count < (int)(sizeof(o->set) / sizeof(o->set[0])))
+        o->set[o->set_count++] = a;
 }
 
 /* The sweep's frames when --frames is not given: enough that the sun moves
@@ -250,6 +250,8 @@ static int sweep_frames(const struct options *o)
     double steps = ceil((o->day_to - o->day_from) * fastest / (0.95 * SB_SUN_HISTORY_LIMIT_DEG * DEG));
     return (int)fmin(100000.0, fmax(2.0, steps + 1.0));
 }
+
+#define SHEET_MAX_FRAMES 64 /* a contact sheet's */
 
 /* Options that go only with others, and the defaults that depend on them. */
 static int check_combinations(struct options *o)
@@ -290,6 +292,12 @@ static int check_combinations(struct options *o)
         if (o->sheet_step_h > 0.0 && ceil(o->day_from / o->sheet_step_h - 1e-9) * o->sheet_step_h > o->day_to + 1e-9) {
             fprintf(stderr, "skyview: --contact-sheet %g: no multiple of %g hours from %g to %g\n", o->sheet_step_h,
                     o->sheet_step_h, o->day_from, o->day_to);
+            return EXIT_USAGE;
+        }
+        double first = ceil(o->day_from / o->sheet_step_h - 1e-9), last = floor(o->day_to / o->sheet_step_h + 1e-9);
+        if (o->sheet_step_h > 0.0 && last - first + 1.0 > SHEET_MAX_FRAMES) {
+            fprintf(stderr, "skyview: --contact-sheet %g: %.0f frames from %g to %g h, more than %d\n", o->sheet_step_h,
+                    last - first + 1.0, o->day_from, o->day_to, SHEET_MAX_FRAMES);
             return EXIT_USAGE;
         }
         if (o->sheet_step_h > 0.0 && o->frames >= 0) {
@@ -758,9 +766,9 @@ static enum sb_result render_day(const struct options *o, struct sb_renderer *r,
  * shows the same clouds under its own sun. */
 static enum sb_result render_contact_sheet(const struct options *o, struct sb_renderer *r)
 {
-    double hours[64];
+    double hours[SHEET_MAX_FRAMES];
     int n = 0;
-    for (double k = ceil(o->day_from / o->sheet_step_h - 1e-9); n < 64; k++) {
+    for (double k = ceil(o->day_from / o->sheet_step_h - 1e-9); n < SHEET_MAX_FRAMES; k++) {
         double h = k * o->sheet_step_h;
         if (h > o->day_to + 1e-9)
             break;

@@ -205,7 +205,8 @@ for bad in "--time-of-day 8-6" "--time-of-day 49" "--time-of-day 6-" "--time-of-
            "--time-of-day 6-8 --sun-keys 6:0:90" "--time-of-day 6-8 --sun-keys 6:0:90,7:5:100 --date 2026-01-01" \
            "--time-of-day 6-8 --frames 1" "--time-of-day 6-8 --bench" "--time-of-day 6 --encoder png" \
            "--time-of-day 6-8 --encoder mkv" "--time-of-day 6.1-6.9 --contact-sheet 1" \
-           "--time-of-day 6-8 --contact-sheet 1 --frames 3" "--time-of-day 6-8 --fps 0"; do
+           "--time-of-day 6-8 --contact-sheet 1 --frames 3" "--time-of-day 6-8 --fps 0" \
+           "--time-of-day 0-48 --contact-sheet 0.5"; do
     check "$bad is a usage error" expect_exit 2 "$skyview" "$tmp/pack" -o "$tmp/x" $small $bad
 done
 check "a bad key's message names it" expect_exit 2 "$skyview" "$tmp/pack" -o "$tmp/x" --time-of-day 6-8 \
