@@ -972,7 +972,9 @@ static void fill_frame(struct sb_renderer *r, const struct sb_view *v, struct sb
     store4(f->shadow, 0.1, 1.5, r->params.shadow_size, 1.0);
     store4(f->aerial, AERIAL_FAR_KM, r->frame_scale, 0.0, 0.0);
     /* Bins 1 to 255 span 2^-20 to 2^12 of the solar irradiance's units:
-     * from starlight-dark to beyond the sun-lit snow. */
+     * from nautical twilight (the sun 12 to 14 degrees down, where the
+     * exposure stops following the light and night falls) to beyond the
+     * sun-lit snow. */
     double log_sun = log2(1.0 / r->radiance_scale);
     store4(f->exposure, log_sun - 20.0, 32.0, 0.10, 0.90);
     store4(f->adaptation, 3.0, 1.0, v->dt_s > 0.0 ? v->dt_s : 1.0 / 60.0, v->snap_exposure ? 1.0 : 0.0);
@@ -1268,8 +1270,8 @@ static void copy_input(struct sb_renderer *r)
  * differs by its rounding). The next frame's comes from this frame's
  * adapted exposure (a cut's from its metered one), so a frame's scale
  * depends on the frame before alone; the fog's and clouds' histories are
- * rescaled by the ratio as they are read. A post_input is stored at the radiance
- * scale, so with one the scale stays that.
+ * rescaled by the ratio as they are read. A post_input is stored at the
+ * radiance scale, so with one the scale stays that.
  */
 #define PRE_EXPOSURE_EV 4
 /* A cut whose metered scale is more than this many stops from the one it
