@@ -982,7 +982,7 @@ static void fill_frame(struct sb_renderer *r, const struct sb_view *v, struct sb
     store4(f->post, 1.0, bloom ? r->params.bloom_strength : 0.0, r->params.exposure_compensation_ev, r->params.tonemap);
     f->size[0] = r->width;
     f->size[1] = r->height;
-    f->size[2] = r->bloom_levels;
+    f->size[2] = bloom ? r->bloom_levels : 0; /* none: the tone curve reads no bloom (never written this frame) */
     f->size[3] = (uint32_t)r->params.debug;
 }
 
