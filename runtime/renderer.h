@@ -115,7 +115,8 @@ struct sb_view {
     uint32_t disabled_passes; /* bit 1 << SB_PASS_x: leave that pass out of this frame, where the frame is
                                  whole without it (fog, fog apply, clouds, purkinje, local tonemap, grade
                                  linear, bloom, grade; others are drawn anyway). Its time reads 0. A pass
-                                 left out drops its history (fog, clouds); the clouds' shadow stays */
+                                 left out drops its history (fog, clouds); the clouds' shadow stays; the
+                                 fog left out leaves out fog apply too */
 };
 
 enum sb_pass {

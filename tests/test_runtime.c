@@ -1198,6 +1198,26 @@ static void test_fog(const char *dir)
     free(S);
     free(T);
 
+    /* 1a. The fog left out by the view takes its apply pass with it (which
+     * would read froxels no pass wrote): the frame is the one with both left
+     * out, bit for bit, and not the frame with the fog. */
+    {
+        struct sb_view no_fog = v, no_volume = v;
+        no_fog.disabled_passes = 1u << SB_PASS_FOG | 1u << SB_PASS_FOG_APPLY;
+        no_volume.disabled_passes = 1u << SB_PASS_FOG;
+        float *both = fog_frame(&fog_pack, &w, SB_DEBUG_NONE, &no_fog, 1, NULL);
+        float *one = fog_frame(&fog_pack, &w, SB_DEBUG_NONE, &no_volume, 1, NULL);
+        float *with = fog_frame(&fog_pack, &w, SB_DEBUG_NONE, &v, 1, NULL);
+        if (both && one && with) {
+            size_t bytes = sizeof(float) * 3 * FOG_W * FOG_H;
+            CHECK(!memcmp(both, one, bytes), "the fog left out: fog apply still ran on unwritten froxels");
+            CHECK(memcmp(both, with, bytes) != 0, "the fog left out: the frame is the fog's");
+        }
+        free(both);
+        free(one);
+        free(with);
+    }
+
     /* 1b. Pre-exposure: the froxels' history is stored at the last frame's
      * scale and rescaled as it is read, so a frame whose scale jumps 5
      * stops up or 3 down from its history's is the same as one that kept
