@@ -4,19 +4,11 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
-#include <time.h>
 #include <unistd.h>
 
 #include "family.h"
 #include "log.h"
 #include "skybake_version.h"
-
-static double now_ms(void)
-{
-    struct timespec ts;
-    clock_gettime(CLOCK_MONOTONIC, &ts);
-    return ts.tv_sec * 1e3 + ts.tv_nsec * 1e-6;
-}
 
 static uint32_t depends_on(enum sb_product_id id)
 {
@@ -184,11 +176,11 @@ enum sb_result sb_bake_scene(struct sb_vk *vk, const struct sb_scene *scene, con
             continue;
         }
 
-        double t0 = now_ms();
+        double t0 = 1e3 * sb_now_s();
         struct sb_image *image = &baked[p];
         if ((res = family->bake(state, vk, scene, id, baked, image, a)))
             goto cleanup;
-        a->bake_ms = now_ms() - t0;
+        a->bake_ms = 1e3 * sb_now_s() - t0;
         if ((res = sb_pack_writer_add_image(writer, a, image)))
             goto cleanup;
         report_add(report, a, image, false);

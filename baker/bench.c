@@ -247,9 +247,9 @@ static enum sb_result bench_clouds(struct sb_vk *vk, const struct sb_bench_param
             res = SB_ERR_NOMEM;
             break;
         }
-        double t0 = sb_bench_now_s();
+        double t0 = sb_now_s();
         sb_cloud_ref(&pc, 0, (uint64_t)image.width * image.height * image.depth, ref);
-        row->reference_ms = (sb_bench_now_s() - t0) * 1e3;
+        row->reference_ms = (sb_now_s() - t0) * 1e3;
         row->values = sb_image_float_count(&image);
         for (uint64_t i = 0; i < row->values; i++)
             row->differing += memcmp(&ref[i], &image.data[i], sizeof(float)) != 0;
@@ -329,11 +329,11 @@ enum sb_result sb_bench_run(struct sb_vk *vk, const struct sb_atmosphere_params 
             continue;
         enum sb_product_id id = sweeps[w].product;
         const struct sb_atmosphere_product *product = sb_atmosphere_product(id);
-        double t0 = sb_bench_now_s();
+        double t0 = sb_now_s();
         if ((res =
                  sb_accuracy_ref_create(atmosphere, id, sweeps[w].lookup ? SB_ACCURACY_LOOKUP : 0, 0, 0, inputs, &ref)))
             break;
-        report->reference_s[w] = sb_bench_now_s() - t0;
+        report->reference_s[w] = sb_now_s() - t0;
         snprintf(report->probe[w], sizeof(report->probe[w]), "%s", sb_accuracy_ref_probe(ref));
         sb_info("%s: fp64 reference at %s in %.1f s", sweeps[w].name, report->probe[w], report->reference_s[w]);
 

@@ -122,11 +122,10 @@ struct sb_bench_report {
 enum sb_result sb_bench_warm_up(struct sb_vk *vk);
 
 /* bench_probes.c: also the terrain (rolling hills over 2 km, (n - 1)^2 x 2
- * triangles), the median of n values (sorted in place) and the monotonic
- * clock in seconds that the benches share. */
+ * triangles) and the median of n values (sorted in place), which the benches
+ * share (their clock is sb_now_s, formats/log.h). */
 enum sb_result sb_bench_terrain(uint32_t n, struct sb_mesh *mesh);
 double sb_bench_median(double *v, int n);
-double sb_bench_now_s(void);
 /* bench_reflection.c */
 enum sb_result sb_bench_reflection(struct sb_vk *vk, const struct sb_atmosphere_params *atmosphere,
                                    const struct sb_bench_params *params, struct sb_bench_report *report);

@@ -9,7 +9,6 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
-#include <time.h>
 #include <unistd.h>
 
 #include "bench.h"
@@ -23,13 +22,6 @@
 #include "sky_visibility.h"
 
 #define BENCH_IFC_HOUSE "/usr/share/assimp/models/IFC/AC14-FZK-Haus.ifc"
-
-double sb_bench_now_s(void)
-{
-    struct timespec ts;
-    clock_gettime(CLOCK_MONOTONIC, &ts);
-    return ts.tv_sec + ts.tv_nsec * 1e-9;
-}
 
 enum sb_result sb_bench_terrain(uint32_t n, struct sb_mesh *mesh)
 {
@@ -75,9 +67,9 @@ static enum sb_result bench_one(struct sb_vk *vk, const char *name, struct sb_me
     struct sb_raycaster *rc = NULL;
     struct sb_embree e = {0};
     float *positions = NULL, *out = NULL, *rays = NULL, *hits = NULL;
-    double t0 = sb_bench_now_s();
+    double t0 = sb_now_s();
     enum sb_result res = sb_bvh_build(mesh, &bvh);
-    row->bvh_ms = (sb_bench_now_s() - t0) * 1e3;
+    row->bvh_ms = (sb_now_s() - t0) * 1e3;
     if (res || (res = sb_raycaster_create(vk, &bvh, &rc)))
         goto done;
     /* 16^3 probes over the bounds, from 2 m above its bottom */

@@ -5,6 +5,7 @@
 #include <unistd.h>
 
 #include "bench.h"
+#include "log.h"
 
 bool sb_embree_create(const struct sb_mesh *mesh, struct sb_embree *e)
 {
@@ -76,7 +77,7 @@ double sb_embree_cast(const struct sb_embree *e, const float *rays, uint32_t cou
     int n = cores < 1 ? 1 : cores > 64 ? 64 : (int)cores;
     pthread_t threads[64];
     struct sb_embree_job jobs[64];
-    double t0 = sb_bench_now_s();
+    double t0 = sb_now_s();
     for (int i = 0; i < n; i++) {
         uint32_t first = (uint32_t)((uint64_t)count * i / n), end = (uint32_t)((uint64_t)count * (i + 1) / n);
         jobs[i] = (struct sb_embree_job){e, rays, hits, first, end - first};
@@ -84,5 +85,5 @@ double sb_embree_cast(const struct sb_embree *e, const float *rays, uint32_t cou
     }
     for (int i = 0; i < n; i++)
         pthread_join(threads[i], NULL);
-    return sb_bench_now_s() - t0;
+    return sb_now_s() - t0;
 }

@@ -10,7 +10,6 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
-#include <time.h>
 
 #include "bvh.h"
 #include "cube.h"
@@ -40,13 +39,6 @@ struct reflection_state {
     struct sb_reflection_kernels kernels;
     struct sb_vk *vk; /* the kernels' */
 };
-
-static double now_ms(void)
-{
-    struct timespec ts;
-    clock_gettime(CLOCK_MONOTONIC, &ts);
-    return ts.tv_sec * 1e3 + ts.tv_nsec * 1e-6;
-}
 
 static bool wants_cubes(const struct sb_scene *scene)
 {
@@ -149,7 +141,7 @@ static enum sb_result bake_cubes(struct reflection_state *st, struct sb_vk *vk, 
     const struct sb_reflection_params *p = &scene->reflections;
     uint32_t n = p->face_size, levels = sb_cube_levels(n), cubes = 1 + (uint32_t)p->probe_count;
     enum sb_result res = SB_OK;
-    double t0 = now_ms();
+    double t0 = 1e3 * sb_now_s();
     if (!st->atmosphere) {
         static const enum sb_product_id inputs[] = {SB_PRODUCT_TRANSMITTANCE, SB_PRODUCT_MULTISCATTERING,
                                                     SB_PRODUCT_IRRADIANCE_GROUND};
@@ -161,7 +153,7 @@ static enum sb_result bake_cubes(struct reflection_state *st, struct sb_vk *vk, 
         res = sb_raycaster_create(vk, &st->bvh, &st->rc);
     if (res)
         return res;
-    sb_debug("reflection_cubes: the atmosphere's LUTs and the BVH on the device in %.1f ms", now_ms() - t0);
+    sb_debug("reflection_cubes: the atmosphere's LUTs and the BVH on the device in %.1f ms", 1e3 * sb_now_s() - t0);
     uint64_t chain = sb_cube_level_offset(n, levels);
     float *level0 = malloc((size_t)6 * n * n * 4 * sizeof(float));
     float *filtered = malloc(chain * 4 * sizeof(float));
@@ -182,10 +174,11 @@ static enum sb_result bake_cubes(struct reflection_state *st, struct sb_vk *vk, 
         st->vk = vk;
         struct sb_capture_inputs in = {
             .atmosphere = st->atmosphere, .rc = i ? st->rc : NULL, .mesh = &st->mesh, .kernels = &st->kernels};
-        double t1 = now_ms();
+        double t1 = 1e3 * sb_now_s();
         if ((res = sb_reflection_capture(vk, &in, &cp, level0, &ms)))
             break;
-        sb_debug("reflection_cubes: probe %u captured in %.1f ms (%.3f ms on the device)", i, now_ms() - t1, ms);
+        sb_debug("reflection_cubes: probe %u captured in %.1f ms (%.3f ms on the device)", i, 1e3 * sb_now_s() - t1,
+                 ms);
         gpu_ms += ms;
         if (i == 0) /* the sky the surfaces of the other probes are lit by */
             sb_reflection_sh(level0, n, 0, cp.sky_sh);
@@ -202,10 +195,11 @@ static enum sb_result bake_cubes(struct reflection_state *st, struct sb_vk *vk, 
             break;
         }
         const struct sb_prefilter_params pp = {.samples = p->samples, .kernels = &st->kernels};
-        t1 = now_ms();
+        t1 = 1e3 * sb_now_s();
         if ((res = sb_reflection_prefilter(vk, level0, n, &pp, filtered, &ms)))
             break;
-        sb_debug("reflection_cubes: probe %u prefiltered in %.1f ms (%.3f ms on the device)", i, now_ms() - t1, ms);
+        sb_debug("reflection_cubes: probe %u prefiltered in %.1f ms (%.3f ms on the device)", i,
+                 1e3 * sb_now_s() - t1, ms);
         gpu_ms += ms;
         for (uint32_t l = 0; l < levels; l++) {
             uint32_t m = n >> l;

@@ -5,7 +5,6 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
-#include <time.h>
 
 #include "atmosphere.h"
 #include "atmosphere_ref.h"
@@ -117,13 +116,6 @@ static void summarise(struct sb_sky_error_sun *sun)
     sun->multiple_share = lit ? share / lit : 0;
 }
 
-static double now_s(void)
-{
-    struct timespec ts;
-    clock_gettime(CLOCK_MONOTONIC, &ts);
-    return (double)ts.tv_sec + ts.tv_nsec * 1e-9;
-}
-
 enum sb_result sb_sky_error_run(struct sb_vk *vk, const char *scene_name, const struct sb_scene *scene,
                                 const struct sb_sky_error_params *params, struct sb_sky_error_report *report)
 {
@@ -159,9 +151,9 @@ enum sb_result sb_sky_error_run(struct sb_vk *vk, const char *scene_name, const 
     sb_info("%s: path tracing %d suns x %d directions x 3 channels, %d paths each", scene_name, report->sun_count,
             SB_SKY_ERROR_DIRECTIONS, report->paths);
     struct job job = {&scene->atmosphere, luts, params, report};
-    double t0 = now_s();
+    double t0 = sb_now_s();
     sb_parallel_for(report->sun_count * SB_SKY_ERROR_DIRECTIONS * 3, run_one, &job);
-    report->path_trace_s = now_s() - t0;
+    report->path_trace_s = sb_now_s() - t0;
     for (int s = 0; s < report->sun_count; s++)
         summarise(&report->suns[s]);
 
@@ -223,8 +215,8 @@ void sb_sky_error_print(const struct sb_sky_error_report *reports, int count, bo
     }
     for (int i = 0; i < count; i++) {
         const struct sb_sky_error_report *r = &reports[i];
-        printf("%s: sky from %.6g km against the path tracer (%d paths per direction and channel, %.1f s)\n",
-               r->scene, r->altitude_km, r->paths, r->path_trace_s);
+        printf("%s: sky from %.6g km against the path tracer (%d paths per direction and channel, %.1f s)\n", r->scene,
+               r->altitude_km, r->paths, r->path_trace_s);
         printf("  %8s %9s %9s %9s %9s %9s  %s\n", "sun deg", "max rel", "rms rel", "mean rel", "noise", "multiple",
                "worst at (zenith, azimuth from the sun)");
         for (int s = 0; s < r->sun_count; s++) {

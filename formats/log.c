@@ -46,7 +46,7 @@ void sb_log(enum sb_log_level level, const char *fmt, ...)
         fprintf(stderr, "skybake: %s: %s\n", names[level], buf);
 }
 
-static double seconds_now(void)
+double sb_now_s(void)
 {
     struct timespec t;
     clock_gettime(CLOCK_MONOTONIC, &t);
@@ -59,10 +59,10 @@ void sb_progress(const char *what, unsigned done, unsigned total)
     if (log_sink || log_level < SB_LOG_INFO || !isatty(STDERR_FILENO))
         return;
     if (done == 0) {
-        start = seconds_now();
+        start = sb_now_s();
         return;
     }
-    if (!progress_shown && seconds_now() - start < 1.0)
+    if (!progress_shown && sb_now_s() - start < 1.0)
         return;
     progress_shown = true;
     fprintf(stderr, "\r%s: %u/%u", what, done, total);

@@ -25,6 +25,9 @@ __attribute__((format(printf, 2, 3)))
 #endif
 void sb_log(enum sb_log_level level, const char *fmt, ...);
 
+/* Seconds on a monotonic clock (CLOCK_MONOTONIC), for wall times and progress. */
+double sb_now_s(void);
+
 /*
  * Progress of long work: "what: done/total" rewritten in place on stderr,
  * first shown once a second has passed since the call with done 0, ended by

@@ -4,7 +4,6 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
-#include <time.h>
 
 #include "log.h"
 #include "pngfile.h"
@@ -27,13 +26,6 @@ static const uint32_t toggles[7] = {
     1u << SB_PASS_BLOOM,
     1u << SB_PASS_GRADE,
 };
-
-static double seconds_now(void)
-{
-    struct timespec t;
-    clock_gettime(CLOCK_MONOTONIC, &t);
-    return (double)t.tv_sec + 1e-9 * (double)t.tv_nsec;
-}
 
 static void shade_box(uint8_t *rgba, uint32_t width, uint32_t height, uint32_t w, uint32_t h)
 {
@@ -88,14 +80,14 @@ enum sb_result sb_viewer_run(struct sb_renderer *r, struct sb_window *window, co
     uint32_t disabled = 0;
     int shots = 0;
     struct sb_frame_timings timings = {0};
-    double last = seconds_now(), fps = 0.0;
+    double last = sb_now_s(), fps = 0.0;
     enum sb_result res = SB_OK;
     for (int i = 0; !res && (params->frames <= 0 || i < params->frames); i++) {
         struct sb_window_input in;
         sb_window_poll(window, &in);
         if (in.close)
             break;
-        double now = seconds_now();
+        double now = sb_now_s();
         double dt = params->frames > 0 ? 1.0 / 60.0 : fmin(now - last, 0.25);
         fps = i == 0 ? 0.0 : 0.9 * fps + 0.1 / fmax(now - last, 1e-6);
         last = now;

@@ -12,7 +12,6 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
-#include <time.h>
 #include <unistd.h>
 
 #include "bvh.h"
@@ -46,13 +45,6 @@
  * 2e-5, about 170 fp32 ulps.
  */
 #define BAND_RELATIVE 2e-5
-
-static double now_s(void)
-{
-    struct timespec ts;
-    clock_gettime(CLOCK_MONOTONIC, &ts);
-    return ts.tv_sec + ts.tv_nsec * 1e-9;
-}
 
 static uint64_t rng = 0x9e3779b97f4a7c15ull;
 
@@ -255,9 +247,9 @@ static void make_rays(const struct sb_mesh *m, enum ray_kind kind, uint32_t coun
 static void test_gpu_against_embree(struct sb_vk *vk, const char *name, const struct sb_mesh *m, uint32_t count)
 {
     struct sb_bvh bvh;
-    double t0 = now_s();
+    double t0 = sb_now_s();
     enum sb_result res = sb_bvh_build(m, &bvh);
-    double build_s = now_s() - t0;
+    double build_s = sb_now_s() - t0;
     CHECK(res == SB_OK, "%s: BVH", name);
     if (res)
         return;
@@ -273,9 +265,9 @@ static void test_gpu_against_embree(struct sb_vk *vk, const char *name, const st
     for (int kind = 0; kind < RAY_KIND_COUNT && rc && rays && gpu && any && ref && e.scene; kind++) {
         make_rays(m, (enum ray_kind)kind, count, rays);
         double gpu_ms = 0, any_ms = 0;
-        double g0 = now_s();
+        double g0 = sb_now_s();
         res = sb_raycaster_cast(rc, rays, count, false, gpu, &gpu_ms);
-        double gpu_wall = now_s() - g0;
+        double gpu_wall = sb_now_s() - g0;
         CHECK(res == SB_OK, "%s: cast: %s", name, sb_result_name(res));
         res = sb_raycaster_cast(rc, rays, count, true, any, &any_ms);
         CHECK(res == SB_OK, "%s: any-hit cast: %s", name, sb_result_name(res));
