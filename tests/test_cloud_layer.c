@@ -316,58 +316,13 @@ static void test_reprojection(const struct sb_pack *p)
     free(first);
 }
 
-/* Pre-exposure: the clouds' history is stored at its frame's scale and
- * rescaled as it is read, so a frame whose scale jumps 5 stops up or 3
- * down from its history's (powers of two) is the same as one that kept it:
- * bit for bit, but for the faint values a half keeps as subnormals at the
- * smaller scale (test_scaled_frames_differ). Eight frames, each at the radiance scale times 2^4 but the
- * last (renderer.h's fixed pre-exposure). */
-static float *scaled_frames(const struct sb_pack *p, const struct sb_view *v, int frames, int last_stops)
-{
-    struct sb_renderer_params rp = {.width = W, .height = H, .cloud_shadow_size = 64, .debug = SB_DEBUG_CLOUDS};
-    struct sb_renderer *r = NULL;
-    if (sb_renderer_create(vk, p, &world, &rp, &r) != SB_OK) {
-        CHECK(false, "the clouds' renderer");
-        return NULL;
-    }
-    bool ok = true;
-    for (int i = 0; i < frames && ok; i++) {
-        struct sb_view f = *v;
-        f.snap_exposure = i == 0;
-        f.fixed_pre_exposure = true;
-        f.pre_exposure_stops = i == frames - 1 ? last_stops : 4;
-        ok = sb_renderer_render(r, &f, i == frames - 1, NULL) == SB_OK;
-    }
-    CHECK(ok, "render the clouds");
-    float *rgb = ok ? malloc(sizeof(float) * 3 * W * H) : NULL;
-    if (rgb)
-        sb_renderer_hdr(r, rgb);
-    sb_renderer_destroy(&r);
-    return rgb;
-}
-
+/* Pre-exposure: the clouds' history rescaled (harness_view.h), over eight
+ * frames (two rounds of the 2 x 2 reconstruction). */
 static void test_pre_exposure(const struct sb_pack *p)
 {
     struct sb_view v = base_view();
-    float *kept = scaled_frames(p, &v, 8, 4), *up = scaled_frames(p, &v, 8, 9), *down = scaled_frames(p, &v, 8, 1);
-    float *alone = scaled_frames(p, &v, 1, 4);
-    size_t bytes = sizeof(float) * 3 * W * H;
-    if (kept && up && down && alone) {
-        const double *sun = p->scene->atmosphere.solar_irradiance;
-        int n_up = test_scaled_frames_differ(kept, up, 3 * W * H, sun, 4);
-        int n_down = test_scaled_frames_differ(kept, down, 3 * W * H, sun, 1);
-        CHECK(n_up == 0, "cloud history across a scale 32x up: %d values differ from the frame that kept its scale",
-              n_up);
-        CHECK(n_down == 0, "cloud history across a scale 8x down: %d values differ from the frame that kept its scale",
-              n_down);
-        CHECK(memcmp(kept, alone, bytes) != 0, "the clouds' history changes the frame (else this tests nothing)");
-    } else {
-        CHECK(false, "the pre-exposure frames");
-    }
-    free(kept);
-    free(up);
-    free(down);
-    free(alone);
+    struct sb_renderer_params rp = {.width = W, .height = H, .cloud_shadow_size = 64, .debug = SB_DEBUG_CLOUDS};
+    test_history_rescaled(vk, p, &world, &rp, &v, 8, "the clouds'");
 }
 
 /* Every value of the lit frame finite and not negative. */
