@@ -525,39 +525,32 @@ static double exposed_middle(struct sb_renderer *r)
 
 static void test_exposure(struct sb_renderer *r)
 {
+    /* Noon, dusk (the sun 3 degrees down) and deep civil twilight (8 down,
+     * 2^-12 of noon's light; at -12 degrees the frame is below the meter's
+     * darkest bin, 2^-20 of the sun's units), each a cut. The meter's own
+     * quantisation is 32/254 EV a bin; the middle 80% of the pixels is not
+     * exactly its 10%..90% window mean: a factor 1.5. (That twilight is
+     * stored at full precision, pre-exposure, is test_sky_view's at -12.) */
+    static const double elevations[3] = {30.0, -3.0, -8.0};
+    float states[3][4];
+    double middles[3];
     struct sb_view v = base_view();
-    if (!render(r, &v))
-        return;
-    float noon_state[4];
-    sb_renderer_exposure(r, noon_state);
-    double noon = exposed_middle(r);
-    v.sun_elevation = -3.0 * DEG;
-    if (!render(r, &v))
-        return;
-    float dusk_state[4];
-    sb_renderer_exposure(r, dusk_state);
-    double dusk = exposed_middle(r);
-    /* The meter's own quantisation is 32/254 EV a bin; the middle 80% of
-     * the pixels is not exactly its 10%..90% window mean: a factor 1.5. */
-    CHECK(noon > 0.18 / 1.5 && noon < 0.18 * 1.5, "noon ends up at %.3f, within 1.5x of mid grey", noon);
-    CHECK(dusk > 0.18 / 1.5 && dusk < 0.18 * 1.5, "dusk ends up at %.3f, within 1.5x of mid grey", dusk);
-    CHECK(dusk_state[1] > 20.0 * noon_state[1], "dusk is exposed %.1fx more than noon (at least 20x)",
-          dusk_state[1] / noon_state[1]);
-    /* Deep civil twilight, the sun 8 degrees down: 2^-12 of noon's light,
-     * among a half's subnormals at a fixed scale. Pre-exposure stores it
-     * near mid grey, so the frame meters like noon's. (At -12 degrees the
-     * frame is below the meter's darkest bin, 2^-20 of the sun's units.) */
-    v.sun_elevation = -8.0 * DEG;
-    if (!render(r, &v))
-        return;
-    float night_state[4];
-    sb_renderer_exposure(r, night_state);
-    double night = exposed_middle(r);
-    CHECK(night > 0.18 / 1.5 && night < 0.18 * 1.5, "twilight ends up at %.3f, within 1.5x of mid grey", night);
-    CHECK(night_state[1] > 1000.0 * noon_state[1], "twilight is exposed %.0fx more than noon (at least 1000x)",
-          night_state[1] / noon_state[1]);
+    for (int i = 0; i < 3; i++) {
+        v.sun_elevation = elevations[i] * DEG;
+        if (!render(r, &v))
+            return;
+        sb_renderer_exposure(r, states[i]);
+        middles[i] = exposed_middle(r);
+        CHECK(middles[i] > 0.18 / 1.5 && middles[i] < 0.18 * 1.5,
+              "the sun at %g degrees: the frame ends up at %.3f, within 1.5x of mid grey", elevations[i], middles[i]);
+    }
+    const float *noon_state = states[0];
+    CHECK(states[1][1] > 20.0 * noon_state[1], "dusk is exposed %.1fx more than noon (at least 20x)",
+          states[1][1] / noon_state[1]);
+    CHECK(states[2][1] > 1000.0 * noon_state[1], "twilight is exposed %.0fx more than noon (at least 1000x)",
+          states[2][1] / noon_state[1]);
     printf("exposure: noon %.3g, dusk (-3 degrees) %.3g, twilight (-8) %.3g; exposed middles %.3f %.3f %.3f\n",
-           noon_state[1], dusk_state[1], night_state[1], noon, dusk, night);
+           noon_state[1], states[1][1], states[2][1], middles[0], middles[1], middles[2]);
 
     /* Adaptation: from noon, the dusk view moves the exposure a step of
      * 1 - exp(-dt * 1/s) of the way in log2 each frame. */
