@@ -235,4 +235,10 @@ const struct sb_pass_class sb_pass_fog = {
     .skipped = fog_skipped,
 };
 
-const struct sb_pass_class sb_pass_fog_apply = {.name = "fog apply", .record = fog_apply_record, .optional = true};
+/* It reads the froxels: the fog left out, it is too. */
+const struct sb_pass_class sb_pass_fog_apply = {
+    .name = "fog apply",
+    .record = fog_apply_record,
+    .optional = true,
+    .needs = 1u << SB_PASS_FOG,
+};

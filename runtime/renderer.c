@@ -1340,14 +1340,16 @@ static enum sb_result render_once(struct sb_renderer *r, const struct sb_view *v
     if (r->queries)
         vkCmdResetQueryPool(r->cmd, r->queries, 0, 2 * SB_PASS_COUNT);
 
-    /* The fog's froxels left out, applying them would read what no pass wrote. */
-    uint32_t disabled = view->disabled_passes;
-    if (disabled >> SB_PASS_FOG & 1)
-        disabled |= 1u << SB_PASS_FOG_APPLY;
+    /* A pass whose input was left out is left out too (its `needs`); the
+     * passes come in order, so one sweep settles it. */
+    uint32_t disabled = 0;
+    for (int p = 0; p < SB_PASS_COUNT; p++)
+        if (pass_classes[p]->optional && (view->disabled_passes >> p & 1 || (disabled & pass_classes[p]->needs) != 0))
+            disabled |= 1u << p;
     for (int p = 0; p < SB_PASS_COUNT; p++) {
         if (r->queries)
             vkCmdWriteTimestamp(r->cmd, VK_PIPELINE_STAGE_TOP_OF_PIPE_BIT, r->queries, 2 * p);
-        if (disabled >> p & 1 && pass_classes[p]->optional) {
+        if (disabled >> p & 1) {
             if (pass_classes[p]->skipped)
                 pass_classes[p]->skipped(r);
         } else {

@@ -129,6 +129,9 @@ struct sb_pass_class {
      * of `record` then, e.g. to drop a history that would go stale. */
     bool optional;
     void (*skipped)(struct sb_renderer *r);
+    /* Bits 1 << SB_PASS_x of the optional passes whose output this one
+     * reads: with any of them left out, this one is left out too. */
+    uint32_t needs;
 };
 
 /* scene_trace.c: whether to trace the scene; the BVH and kernels (stand-ins
