@@ -40,14 +40,14 @@ static const struct sb_atmosphere_product products[SB_ATMOSPHERE_PRODUCT_COUNT] 
         {
             .id = SB_PRODUCT_MULTISCATTERING,
             .depends_on = BIT(SB_PRODUCT_TRANSMITTANCE),
-            .defaults = {.directions_mu = 16, .directions_phi = 12},
+            .defaults = {.directions_mu = 16, .directions_phi = 8},
             .workgroup_per_texel = true,
         },
     [SB_PRODUCT_IRRADIANCE_GROUND] =
         {
             .id = SB_PRODUCT_IRRADIANCE_GROUND,
             .depends_on = BIT(SB_PRODUCT_TRANSMITTANCE) | BIT(SB_PRODUCT_MULTISCATTERING),
-            .defaults = {.directions_mu = 12, .directions_phi = 12},
+            .defaults = {.directions_mu = 8, .directions_phi = 8},
             .workgroup_per_texel = true,
         },
     [SB_PRODUCT_IRRADIANCE_SKY] =
@@ -605,11 +605,12 @@ void sb_atmosphere_settings_json(enum sb_product_id id, const struct sb_atmosphe
         "{\"directions_mu\":%u,\"directions_phi\":%u,"
         "\"zenith\":\"gauss-legendre per piece, cut at %s\","
         "\"azimuth\":\"midpoint over [0, pi]%s\","
-        "\"ray_segments\":\"altitude levels, geometric from half the smallest scale height, the shadow "
+        "\"ray_segments\":\"altitude levels, geometric from half the smallest scale height,%s the shadow "
         "boundary and the sun grazing the ozone corners\",\"segment_quadrature\":\"gauss-legendre-%d\","
         "\"sun_transmittance\":\"the sun table: Catmull-Rom of Rayleigh and Mie airmasses on %dx%d nodes a region, "
         "ozone integrated\"%s}",
         s->directions_mu, s->directions_phi, zenith_cuts,
-        id == SB_PRODUCT_MULTISCATTERING ? "" : ", crowded toward the sun", SB_RAY_GL_ORDER, SB_SUN_COLUMNS_X,
+        id == SB_PRODUCT_MULTISCATTERING ? "" : ", crowded toward the sun",
+        id == SB_PRODUCT_IRRADIANCE_SKY ? "" : " the ozone corners,", SB_RAY_GL_ORDER, SB_SUN_COLUMNS_X,
         SB_SUN_COLUMNS_U, id == SB_PRODUCT_MULTISCATTERING ? "" : ",\"lut_lookup\":\"catmull-rom of the logarithm\"");
 }

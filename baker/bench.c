@@ -84,6 +84,8 @@ static const struct sweep_entry multiscattering_sweep[] = {
     {DIRS(4, 4), NULL, true},
     {DIRS(6, 6), NULL, false},
     {DIRS(8, 8), NULL, true},
+    {DIRS(12, 8), NULL, false},
+    {DIRS(16, 8), NULL, false},
     {DIRS(12, 12), NULL, false},
     {DIRS(16, 12), NULL, false},
     {DIRS(24, 16), NULL, false},

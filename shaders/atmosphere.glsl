@@ -698,9 +698,32 @@ float level_at(int i)
     return i < 4 ? atm.levels_a[i] : (i < 8 ? atm.levels_b[i - 4] : (i < 12 ? atm.levels_c[i - 8] : atm.levels_d[i - 12]));
 }
 
+/*
+ * The levels a ray is cut at: the geometric ones and, where the shader
+ * defines SB_RAY_OZONE_CORNERS, the ozone tent's corners, where the density
+ * kinks. Gauss-Legendre 4 across such a kink was the scattering bakes'
+ * largest error (2.2e-4 of multiscattering at 16 x 12 directions, 9.2e-5
+ * with the cuts; docs/accuracy.md). The runtime's rays go without: their
+ * frame time counts more than that error.
+ */
+int ray_level_count()
+{
+#ifdef SB_RAY_OZONE_CORNERS
+    return int(atm.level_count.x + atm.level_count.y);
+#else
+    return int(atm.level_count.x);
+#endif
+}
+
+float ray_level(int i)
+{
+    int n = int(atm.level_count.x);
+    return i < n ? level_at(i) : atm.ozone_levels[i - n];
+}
+
 /* Two crossings per level, two per shadow cylinder (the ground and the
  * three ozone corners), and both ends. */
-#define SB_RAY_MAX_BREAKS (2 * SB_MAX_LEVELS + 2 * 4 + 2)
+#define SB_RAY_MAX_BREAKS (2 * (SB_MAX_LEVELS + 3) + 2 * 4 + 2)
 
 /* Sorted distances in [0, t_end] where the ray crosses the altitude levels,
  * where the planet's shadow starts or ends along it (the sun's
@@ -713,8 +736,8 @@ int ray_breakpoints(float h0, float mu, float mu_s, float nu, float t_end, out f
     float s0 = (R + h0) * mu;
     int n = 0;
     ts[n++] = 0.0;
-    for (int i = 0; i < int(atm.level_count.x); i++) {
-        float level = level_at(i);
+    for (int i = 0; i < ray_level_count(); i++) {
+        float level = ray_level(i);
         float c = (level - h0) * (2.0 * R + level + h0);
         float disc = s0 * s0 + c;
         if (c > 0.0) {

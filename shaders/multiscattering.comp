@@ -9,6 +9,7 @@
  * One workgroup per texel (sphere.glsl). */
 #extension GL_GOOGLE_include_directive : require
 #include "config.h"
+#define SB_RAY_OZONE_CORNERS
 #include "atmosphere.glsl"
 #include "sphere.glsl"
 
