@@ -40,7 +40,7 @@ static const struct sb_atmosphere_product products[SB_ATMOSPHERE_PRODUCT_COUNT] 
         {
             .id = SB_PRODUCT_MULTISCATTERING,
             .depends_on = BIT(SB_PRODUCT_TRANSMITTANCE),
-            .defaults = {.directions_mu = 16, .directions_phi = 8},
+            .defaults = {.directions_mu = 16, .directions_phi = 12},
             .workgroup_per_texel = true,
         },
     [SB_PRODUCT_IRRADIANCE_GROUND] =
