@@ -62,6 +62,13 @@ float ozone_density(float h)
     return max(0.0, 1.0 - abs(h - atm.ozone_absorption.w) / atm.ground_albedo.w);
 }
 
+/* The ozone tent's corners, k = 0, 1, 2 from the bottom, where its density
+ * kinks; they may lie outside the atmosphere. */
+float ozone_corner(int k)
+{
+    return atm.ozone_absorption.w + float(k - 1) * atm.ground_albedo.w;
+}
+
 Medium medium_at(float h)
 {
     float rayleigh = exp(-h / atm.rayleigh_scattering.w);
@@ -709,7 +716,7 @@ float level_at(int i)
 int ray_level_count()
 {
 #ifdef SB_RAY_OZONE_CORNERS
-    return int(atm.level_count.x + atm.level_count.y);
+    return int(atm.level_count.x) + 3;
 #else
     return int(atm.level_count.x);
 #endif
@@ -718,7 +725,7 @@ int ray_level_count()
 float ray_level(int i)
 {
     int n = int(atm.level_count.x);
-    return i < n ? level_at(i) : atm.ozone_levels[i - n];
+    return i < n ? level_at(i) : ozone_corner(i - n); /* a corner outside the atmosphere crosses no ray */
 }
 
 /* Two crossings per level, two per shadow cylinder (the ground and the
@@ -760,7 +767,7 @@ int ray_breakpoints(float h0, float mu, float mu_s, float nu, float t_end, out f
     float r0 = R + h0, a = r0 * mu_s;
     float qa = 1.0 - nu * nu, qb = 2.0 * (r0 * mu - a * nu);
     for (int k = -1; k < 3; k++) {
-        float hc = k < 0 ? 0.0 : atm.ozone_absorption.w + float(k - 1) * atm.ground_albedo.w;
+        float hc = k < 0 ? 0.0 : ozone_corner(k);
         if (k >= 0 && (hc <= 0.0 || hc >= atmosphere_thickness()))
             continue;
         float qc = (h0 - hc) * (2.0 * R + h0 + hc) - a * a; /* r0^2 - (R + hc)^2 - a^2 */

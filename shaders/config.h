@@ -126,8 +126,7 @@ struct sb_atmosphere_gpu {
     SB_VEC4(levels_b);             /* padded with values above the top; count in */
     SB_VEC4(levels_c);             /* level_count */
     SB_VEC4(levels_d);
-    SB_VEC4(ozone_levels);         /* xyz: the ozone tent's corners, ascending */
-    SB_UVEC4(level_count);         /* x: number of levels used; y: of ozone_levels */
+    SB_UVEC4(level_count);         /* x: number of levels used */
 };
 
 /* Push constants of the atmosphere bakes. */

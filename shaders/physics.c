@@ -47,13 +47,6 @@ void sb_atmosphere_gpu_pack(const struct sb_atmosphere_params *p, struct sb_atmo
     for (int i = 0; i < SB_MAX_LEVELS; i++)
         dst[i / 4][i % 4] = i < n ? (float)levels[i] : (float)(2.0 * thickness);
     g->level_count[0] = (uint32_t)n;
-    int corners = 0;
-    for (int k = -1; k <= 1; k++) {
-        double corner = p->ozone_center_km + k * p->ozone_half_width_km;
-        if (corner > 0.0 && corner < thickness)
-            g->ozone_levels[corners++] = (float)corner;
-    }
-    g->level_count[1] = (uint32_t)corners;
 }
 
 size_t sb_lookup_float_count(enum sb_product_id id)

@@ -19,10 +19,7 @@
  * the quadrature the fp64 references and sb_sh9_tensor share. */
 void sb_gauss_legendre_node(int k, int n, double a, double b, double *x, double *w);
 
-/* Fill the std430 image of the parameters (config.h) from validated ones:
- * the altitude levels below, and the ozone tent's corners inside the
- * atmosphere, which the bakes that define SB_RAY_OZONE_CORNERS cut their
- * rays at too (atmosphere.glsl). */
+/* Fill the std430 image of the parameters (config.h) from validated ones. */
 void sb_atmosphere_gpu_pack(const struct sb_atmosphere_params *params, struct sb_atmosphere_gpu *gpu);
 
 /* The altitude levels (km, ascending) that cut rays into segments: geometric

@@ -130,7 +130,7 @@ SpherePieces sphere_pieces(float h, bool whole_sphere, float mu_s, bool peaked)
     sp.first_sky = sp.count;
     float from = mu_horizon;
     for (int c = -1; c <= 1; c++) {
-        float corner = atm.ozone_absorption.w + float(c) * atm.ground_albedo.w;
+        float corner = ozone_corner(c + 1);
         if (!whole_sphere || corner <= 0.0 || corner >= h)
             continue;
         /* mu of the ray from altitude h whose tangent point is at `corner` */
