@@ -737,12 +737,12 @@ float ray_level(int i)
  * transmittance jumps there), and where the sun's ray grazes an ozone
  * corner at its tangent point (the sun's transmittance kinks there, and at
  * twilight these cuts follow its steep rise out of the shadow). */
-int ray_breakpoints(float h0, float mu, float mu_s, float nu, float t_end, out float ts[SB_RAY_MAX_BREAKS])
+/* Append to ts the distances in (0, t_end) where the ray from altitude h0
+ * with cosine mu crosses the levels (ray_level). */
+void ray_level_crossings(float h0, float mu, float t_end, inout float ts[SB_RAY_MAX_BREAKS], inout int n)
 {
     float R = ground_radius();
     float s0 = (R + h0) * mu;
-    int n = 0;
-    ts[n++] = 0.0;
     for (int i = 0; i < ray_level_count(); i++) {
         float level = ray_level(i);
         float c = (level - h0) * (2.0 * R + level + h0);
@@ -760,6 +760,33 @@ int ray_breakpoints(float h0, float mu, float mu_s, float nu, float t_end, out f
                 ts[n++] = t2;
         }
     }
+}
+
+/* Insertion sort of ts[0, n), ascending. */
+void sort_breakpoints(inout float ts[SB_RAY_MAX_BREAKS], int n)
+{
+    for (int i = 1; i < n; i++) {
+        float v = ts[i];
+        int j = i - 1;
+        while (j >= 0 && ts[j] > v) {
+            ts[j + 1] = ts[j];
+            j--;
+        }
+        ts[j + 1] = v;
+    }
+}
+
+/* Sorted distances in [0, t_end] where the ray crosses the altitude levels,
+ * where the planet's shadow starts or ends along it (the sun's
+ * transmittance jumps there), and where the sun's ray grazes an ozone
+ * corner at its tangent point (the sun's transmittance kinks there, and at
+ * twilight these cuts follow its steep rise out of the shadow). */
+int ray_breakpoints(float h0, float mu, float mu_s, float nu, float t_end, out float ts[SB_RAY_MAX_BREAKS])
+{
+    float R = ground_radius();
+    int n = 0;
+    ts[n++] = 0.0;
+    ray_level_crossings(h0, mu, t_end, ts, n);
     /* The sun's ray from the point at t has its tangent point at altitude
      * hc where |y|^2 - (y.s)^2 = (R + hc)^2 with y.s = r0 mu_s + t nu < 0
      * (the ray goes down first): a quadratic in t per cylinder. hc = 0 is
@@ -787,15 +814,7 @@ int ray_breakpoints(float h0, float mu, float mu_s, float nu, float t_end, out f
                 ts[n++] = roots[i];
     }
     ts[n++] = t_end;
-    for (int i = 1; i < n; i++) {
-        float v = ts[i];
-        int j = i - 1;
-        while (j >= 0 && ts[j] > v) {
-            ts[j + 1] = ts[j];
-            j--;
-        }
-        ts[j + 1] = v;
-    }
+    sort_breakpoints(ts, n);
     return n;
 }
 
@@ -823,39 +842,62 @@ RayIntegrals ray_integrals_begin()
  * cosine mu_s, cosine nu between the ray and the sun) by Gauss-Legendre 4;
  * the segments must come in order along the ray. Altitudes under the ground
  * (a straight ray through the runtime's flat world) read the ground's medium. */
-void integrate_segment(inout RayIntegrals o, float h0, float mu, float mu_s, float nu, float t0, float t1, bool want_ms)
+/* The nodes of Gauss-Legendre 4 on the segment [t0, t1] of the ray from
+ * altitude h0 with cosine mu: their distances, altitudes and media.
+ * Altitudes under the ground (a straight ray through the runtime's flat
+ * world) read the ground's medium. */
+void ray_segment_nodes(float h0, float mu, float t0, float t1, out float ts[4], out float hs[4], out Medium m[4])
 {
     float half_len = 0.5 * (t1 - t0), mid = 0.5 * (t1 + t0);
-    if (half_len <= 0.0)
-        return;
-    float r0 = ground_radius() + h0;
-    Medium m[4];
-    float hs[4], mus[4];
     for (int j = 0; j < 4; j++) {
-        float t = mid + half_len * GL4_X[j];
-        hs[j] = max(altitude_along(h0, mu, t), 0.0);
-        float rt = ground_radius() + hs[j];
-        mus[j] = clamp((r0 * mu_s + t * nu) / rt, -1.0, 1.0);
+        ts[j] = mid + half_len * GL4_X[j];
+        hs[j] = max(altitude_along(h0, mu, ts[j]), 0.0);
         m[j] = medium_at(hs[j]);
     }
+}
+
+/* Add a segment of length 2 half_len from its nodes' media, the sun's
+ * transmittance there (or what stands for it) and, with want_ms, psi_ms
+ * there; the segments must come in order along the ray. */
+void ray_accumulate(inout RayIntegrals o, float half_len, Medium m[4], vec3 sun[4], vec3 psi[4], bool want_ms)
+{
     for (int i = 0; i < 4; i++) {
         vec3 depth = o.tau;
         for (int j = 0; j < 4; j++)
             depth += half_len * GL4_S[i * 4 + j] * m[j].extinction;
         vec3 tw = exp(-depth) * (half_len * GL4_W[i]);
-        vec3 sun = sun_transmittance(hs[i], mus[i]);
-        o.sun_rayleigh += tw * m[i].scattering_rayleigh * sun;
-        o.sun_mie += tw * m[i].scattering_mie * sun;
+        o.sun_rayleigh += tw * m[i].scattering_rayleigh * sun[i];
+        o.sun_mie += tw * m[i].scattering_mie * sun[i];
         o.scattering += tw * (m[i].scattering_rayleigh + m[i].scattering_mie);
         if (want_ms) {
-            vec3 psi = multiscattering_lut_sample(hs[i], mus[i]);
-            o.ms_rayleigh += tw * m[i].scattering_rayleigh * psi;
-            o.ms_mie += tw * m[i].scattering_mie * psi;
+            o.ms_rayleigh += tw * m[i].scattering_rayleigh * psi[i];
+            o.ms_mie += tw * m[i].scattering_mie * psi[i];
         }
     }
     for (int j = 0; j < 4; j++)
         o.tau += half_len * GL4_W[j] * m[j].extinction;
     o.transmittance = exp(-o.tau);
+}
+
+/* Add the segment [t0, t1] of the ray from altitude h0 with cosine mu (sun
+ * cosine mu_s, cosine nu between the ray and the sun) by Gauss-Legendre 4;
+ * the segments must come in order along the ray. */
+void integrate_segment(inout RayIntegrals o, float h0, float mu, float mu_s, float nu, float t0, float t1, bool want_ms)
+{
+    float half_len = 0.5 * (t1 - t0);
+    if (half_len <= 0.0)
+        return;
+    float r0 = ground_radius() + h0;
+    float ts[4], hs[4];
+    Medium m[4];
+    ray_segment_nodes(h0, mu, t0, t1, ts, hs, m);
+    vec3 sun[4], psi[4];
+    for (int i = 0; i < 4; i++) {
+        float mus = clamp((r0 * mu_s + ts[i] * nu) / (ground_radius() + hs[i]), -1.0, 1.0);
+        sun[i] = sun_transmittance(hs[i], mus);
+        psi[i] = want_ms ? multiscattering_lut_sample(hs[i], mus) : vec3(0.0);
+    }
+    ray_accumulate(o, half_len, m, sun, psi, want_ms);
     o.t_end = t1;
 }
 

@@ -215,32 +215,49 @@ uint sphere_direction_count(SpherePieces sp, uint n_mu, uint n_phi)
     return uint(sp.count) * n_mu * n_phi;
 }
 
-SphereDirection sphere_direction(SpherePieces sp, uint d, uint n_mu, uint n_phi)
+struct SphereZenith {
+    float mu;            /* cosine of the zenith angle */
+    float weight;        /* its weight in mu */
+    bool toward_ground;  /* below the horizon */
+};
+
+/* Node k of the n_mu on a piece of the zenith grid. */
+SphereZenith sphere_zenith(SpherePieces sp, uint piece, uint k)
 {
-    uint piece = d / (n_mu * n_phi), k = (d / n_phi) % n_mu, p = d % n_phi;
-    SphereDirection s;
-    s.toward_ground = int(piece) < sp.first_sky;
+    SphereZenith z;
+    z.toward_ground = int(piece) < sp.first_sky;
     float u = 0.5 + 0.5 * sphere_node[k], w_u = 0.5 * sphere_weight[k];
     float lo = sp.lo[piece], hi = sp.hi[piece];
     /* Crowd the nodes toward the horizon and toward the peak: a sky piece
      * toward its end on the peak's side, since the peak (Mie's, about 1 - g
      * wide) reaches well beyond the pieces that touch it. */
     bool peaked = sp.peak <= 1.0;
-    bool at_lo = int(piece) == sp.first_sky || (peaked && !s.toward_ground && lo >= sp.peak);
-    bool at_hi = int(piece) + 1 == sp.first_sky || (peaked && !s.toward_ground && hi <= sp.peak);
+    bool at_lo = int(piece) == sp.first_sky || (peaked && !z.toward_ground && lo >= sp.peak);
+    bool at_hi = int(piece) + 1 == sp.first_sky || (peaked && !z.toward_ground && hi <= sp.peak);
     float dx;
     float x = sphere_crowd(u, at_lo, at_hi, dx);
-    s.mu = lo + (hi - lo) * x;
+    z.mu = lo + (hi - lo) * x;
+    z.weight = (hi - lo) * dx * w_u;
+    return z;
+}
+
+SphereDirection sphere_direction(SpherePieces sp, uint d, uint n_mu, uint n_phi)
+{
+    uint piece = d / (n_mu * n_phi), k = (d / n_phi) % n_mu, p = d % n_phi;
+    SphereZenith z = sphere_zenith(sp, piece, k);
+    SphereDirection s;
+    s.toward_ground = z.toward_ground;
+    s.mu = z.mu;
     /* Azimuth: midpoint rule in v; with a peak, phi = pi (v - sin(2 pi v) /
      * (2 pi)), which crowds the nodes toward the sun's side (phi = 0, where
      * the Mie peak is) and keeps the rule's accuracy on the even, periodic
      * integrand. */
     float v = (float(p) + 0.5) / float(n_phi);
-    bool crowd = peaked;
+    bool crowd = sp.peak <= 1.0;
     float phi = crowd ? PI * (v - sin(2.0 * PI * v) / (2.0 * PI)) : PI * v;
     float dphi = crowd ? PI * (1.0 - cos(2.0 * PI * v)) : PI;
     s.cos_phi = cos(phi);
-    s.weight = (hi - lo) * dx * w_u * 2.0 * dphi / float(n_phi);
+    s.weight = z.weight * 2.0 * dphi / float(n_phi);
     return s;
 }
 
