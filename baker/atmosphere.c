@@ -18,6 +18,7 @@
 #include "multiscattering_hillaire.spv.h"
 #include "physics.h"
 #include "sun_columns.spv.h"
+#include "sun_rings.spv.h"
 #include "transmittance_gl0.spv.h"
 #include "transmittance_gl1.spv.h"
 #include "transmittance_gl2.spv.h"
@@ -40,8 +41,9 @@ static const struct sb_atmosphere_product products[SB_ATMOSPHERE_PRODUCT_COUNT] 
         {
             .id = SB_PRODUCT_MULTISCATTERING,
             .depends_on = BIT(SB_PRODUCT_TRANSMITTANCE),
-            .defaults = {.directions_mu = 16, .directions_phi = 12},
+            .defaults = {.directions_mu = 16, .directions_phi = 6},
             .workgroup_per_texel = true,
+            .rings = true,
         },
     [SB_PRODUCT_IRRADIANCE_GROUND] =
         {
@@ -109,6 +111,8 @@ static const struct spirv anchor_shaders[SB_ATMOSPHERE_PRODUCT_COUNT] = {
 };
 /* The scattering bakes' sun table (atmosphere.glsl). */
 static const struct spirv sun_columns_shader = SPIRV(sun_columns);
+/* Multiscattering's ring table (sun_rings.glsl). */
+static const struct spirv sun_rings_shader = SPIRV(sun_rings);
 #undef SPIRV
 
 /* The kernels a device runs: a CPU device's where it offers their
@@ -215,10 +219,12 @@ static enum sb_result check_settings(enum sb_product_id id, const struct sb_atmo
 }
 
 /* The most directions a texel of sphere.glsl's integrals has: the zenith
- * grid's pieces, and with `cap` those of the cap around Mie's peak. */
-static uint64_t sphere_directions(const struct sb_atmosphere_settings *s, bool cap)
+ * grid's pieces, and with `cap` those of the cap around Mie's peak; with
+ * `rings` (the azimuth integrated in the ring table), one per zenith node. */
+static uint64_t sphere_directions(const struct sb_atmosphere_settings *s, bool cap, bool rings)
 {
-    return (uint64_t)(SB_SPHERE_MAX_PIECES + (cap ? SB_SPHERE_CAP_PIECES : 0)) * s->directions_mu * s->directions_phi;
+    return (uint64_t)(SB_SPHERE_MAX_PIECES + (cap ? SB_SPHERE_CAP_PIECES : 0)) * s->directions_mu *
+           (rings ? 1 : s->directions_phi);
 }
 
 uint64_t sb_atmosphere_settings_cost(enum sb_product_id id, const struct sb_atmosphere_settings *settings)
@@ -227,7 +233,8 @@ uint64_t sb_atmosphere_settings_cost(enum sb_product_id id, const struct sb_atmo
     if (is_anchor(id, &s))
         return (uint64_t)s.directions_mu * s.directions_phi;
     if (id != SB_PRODUCT_TRANSMITTANCE)
-        return sphere_directions(&s, id != SB_PRODUCT_MULTISCATTERING);
+        return (uint64_t)(SB_SPHERE_MAX_PIECES + (id != SB_PRODUCT_MULTISCATTERING ? SB_SPHERE_CAP_PIECES : 0)) *
+               s.directions_mu * s.directions_phi;
     if (s.quadrature == SB_QUADRATURE_GAUSS_LEGENDRE)
         return 5ull * s.samples * s.subdivisions; /* five pieces, as on the earth */
     return s.quadrature == SB_QUADRATURE_TRAPEZOID ? s.samples + 1ull : s.samples;
@@ -262,6 +269,7 @@ struct sb_atmosphere_baker {
     struct sb_buffer dummy;
     struct sb_buffer scratch;     /* sphere.glsl's sums between passes */
     struct sb_buffer sun_columns; /* the scattering bakes' sun table */
+    struct sb_buffer sun_rings;   /* multiscattering's ring table, while it bakes */
     struct sb_buffer outputs[SB_ATMOSPHERE_PRODUCT_COUNT];
     struct sb_buffer lookups[SB_ATMOSPHERE_PRODUCT_COUNT]; /* the form later bakes read (config.h) */
     bool sky_cap; /* irradiance_sky integrates Mie's peak on a cap (sphere.glsl) */
@@ -314,6 +322,7 @@ void sb_atmosphere_baker_destroy(struct sb_atmosphere_baker **pb)
     sb_buffer_destroy(b->vk, &b->dummy);
     sb_buffer_destroy(b->vk, &b->scratch);
     sb_buffer_destroy(b->vk, &b->sun_columns);
+    sb_buffer_destroy(b->vk, &b->sun_rings);
     free(b);
     *pb = NULL;
 }
@@ -371,6 +380,7 @@ static enum sb_result run(struct sb_atmosphere_baker *b, const struct spirv *ker
         [SB_BINDING_OUTPUT] = output,
         [SB_BINDING_SCRATCH] = workgroup_per_texel ? &b->scratch : &b->dummy,
         [SB_BINDING_SUN_COLUMNS] = b->sun_columns.buffer && output != &b->sun_columns ? &b->sun_columns : &b->dummy,
+        [SB_BINDING_SUN_RINGS] = b->sun_rings.buffer && output != &b->sun_rings ? &b->sun_rings : &b->dummy,
     };
     sb_atmosphere_bind_inputs(b, bindings);
     for (int i = SB_BINDING_TRANSMITTANCE; i <= SB_BINDING_IRRADIANCE_GROUND; i++)
@@ -422,6 +432,24 @@ static enum sb_result build_sun_columns(struct sb_atmosphere_baker *b, double *g
     return res;
 }
 
+/* Multiscattering's ring table (sun_rings.glsl) for a LUT `width` columns
+ * wide, with the ring quadrature of `s`; *gpu_ms adds its time. */
+static enum sb_result build_sun_rings(struct sb_atmosphere_baker *b, uint32_t width,
+                                      const struct sb_atmosphere_settings *s, double *gpu_ms)
+{
+    sb_buffer_destroy(b->vk, &b->sun_rings);
+    enum sb_result res =
+        sb_buffer_create(b->vk, (size_t)width * SB_RINGS_COLUMN * 4 * sizeof(float), "sun rings", &b->sun_rings);
+    if (res)
+        return res;
+    double ms = 0;
+    res = run(b, &sun_rings_shader, "sun rings", &b->sun_rings, SB_RINGS_COLUMN, width, 0, false, s, &ms);
+    if (res)
+        sb_buffer_destroy(b->vk, &b->sun_rings);
+    *gpu_ms += ms;
+    return res;
+}
+
 /* The form in which later bakes read a product (physics.h). */
 static enum sb_result make_lookup(struct sb_atmosphere_baker *b, enum sb_product_id id, const struct sb_image *image)
 {
@@ -469,16 +497,21 @@ enum sb_result sb_atmosphere_bake(struct sb_atmosphere_baker *b, enum sb_product
             ? &transmittance_shaders[s.quadrature == SB_QUADRATURE_GAUSS_LEGENDRE ? s.samples : 0]
             : (anchor ? &anchor_shaders[id] : &scattering_shaders[b->kernels][id]);
     bool cap = id == SB_PRODUCT_IRRADIANCE_GROUND || (id == SB_PRODUCT_IRRADIANCE_SKY && b->sky_cap);
-    uint64_t directions = prod->workgroup_per_texel && !anchor ? sphere_directions(&s, cap) : 0;
+    uint64_t directions = prod->workgroup_per_texel && !anchor ? sphere_directions(&s, cap, prod->rings) : 0;
     /* The sun table is built afresh by every multiscattering bake, the
      * first of the scattering products, so that its time counts there. */
-    double table_ms = 0, product_ms = 0;
+    double table_ms = 0, rings_ms = 0, product_ms = 0;
     if (directions && (id == SB_PRODUCT_MULTISCATTERING || !b->sun_columns.buffer) &&
         (res = build_sun_columns(b, &table_ms)))
         goto cleanup;
+    if (directions && prod->rings && (res = build_sun_rings(b, width, &s, &rings_ms)))
+        goto cleanup;
     res = run(b, shader, sb_product_name(id), &b->outputs[id], width, height, directions, anchor, &s, &product_ms);
+    sb_buffer_destroy(b->vk, &b->sun_rings);
+    sb_log(SB_LOG_DEBUG, "%s: sun table %.3f ms, ring table %.3f ms, the product's kernel %.3f ms", sb_product_name(id),
+           table_ms, rings_ms, product_ms);
     if (gpu_ms)
-        *gpu_ms = table_ms + product_ms;
+        *gpu_ms = table_ms + rings_ms + product_ms;
     if (res)
         goto cleanup;
     memcpy(image->data, b->outputs[id].mapped, bytes);
@@ -531,6 +564,10 @@ void sb_atmosphere_code_hash(enum sb_product_id id, char out[SB_HASH_HEX_SIZE])
     }
     if (id != SB_PRODUCT_TRANSMITTANCE) { /* they read the sun table */
         sb_hash_bytes(sun_columns_shader.words, sun_columns_shader.size, text + n);
+        n += SB_HASH_HEX_SIZE - 1;
+    }
+    if (products[id].rings) {
+        sb_hash_bytes(sun_rings_shader.words, sun_rings_shader.size, text + n);
         n += SB_HASH_HEX_SIZE - 1;
     }
     snprintf(text + n, sizeof(text) - n, " recipe %d cap %a %a %d", SB_ATMOSPHERE_RECIPE, (double)SB_CAP_MIN_G,
@@ -594,11 +631,24 @@ void sb_atmosphere_settings_json(enum sb_product_id id, const struct sb_atmosphe
                      t.samples, (unsigned long long)sb_atmosphere_settings_cost(id, &t));
         return;
     }
+    if (products[id].rings) {
+        snprintf(out, size,
+                 "{\"directions_mu\":%u,\"directions_phi\":%u,"
+                 "\"zenith\":\"gauss-legendre per piece, cut at the horizon, two ground depths, the ozone corners, "
+                 "25 scale heights of tangent altitude and the sun's mirror\","
+                 "\"azimuth\":\"integrated first: the ring table, %d rows (split where the sun sets) x (%d + %d) "
+                 "angles (split at the shadow's tangency) a column, %d on the ground, Catmull-Rom; each ring "
+                 "gauss-legendre-%u a piece, cut at the shadow and the ozone tangencies\","
+                 "\"ray_segments\":\"altitude levels, geometric from half the smallest scale height, the ozone "
+                 "corners, the closest point, and where a ring touches the shadow or an ozone tangency\","
+                 "\"segment_quadrature\":\"gauss-legendre-%d\",\"sun_transmittance\":\"the sun table: "
+                 "Catmull-Rom of Rayleigh and Mie airmasses on %dx%d nodes a region, ozone integrated\"}",
+                 s->directions_mu, s->directions_phi, SB_RINGS_ROWS, SB_RINGS_INNER, SB_RINGS_OUTER, SB_RINGS_GROUND,
+                 s->directions_phi, SB_RAY_GL_ORDER, SB_SUN_COLUMNS_X, SB_SUN_COLUMNS_U);
+        return;
+    }
     const char *zenith_cuts = id == SB_PRODUCT_IRRADIANCE_GROUND ? "the sun's mirror and the sun (upper hemisphere)"
-                              : id == SB_PRODUCT_MULTISCATTERING
-                                  ? "the horizon, two ground depths, the ozone corners, 25 scale heights of "
-                                    "tangent altitude and the sun's mirror"
-                                  : "the horizon, two ground depths, the ozone corners, 25 scale heights of "
+                              : "the horizon, two ground depths, the ozone corners, 25 scale heights of "
                                     "tangent altitude, the sun's mirror and the sun";
     snprintf(
         out, size,
@@ -610,7 +660,6 @@ void sb_atmosphere_settings_json(enum sb_product_id id, const struct sb_atmosphe
         "\"sun_transmittance\":\"the sun table: Catmull-Rom of Rayleigh and Mie airmasses on %dx%d nodes a region, "
         "ozone integrated\"%s}",
         s->directions_mu, s->directions_phi, zenith_cuts,
-        id == SB_PRODUCT_MULTISCATTERING ? "" : ", crowded toward the sun",
-        id == SB_PRODUCT_IRRADIANCE_SKY ? "" : " the ozone corners,", SB_RAY_GL_ORDER, SB_SUN_COLUMNS_X,
-        SB_SUN_COLUMNS_U, id == SB_PRODUCT_MULTISCATTERING ? "" : ",\"lut_lookup\":\"catmull-rom of the logarithm\"");
+        ", crowded toward the sun", id == SB_PRODUCT_IRRADIANCE_SKY ? "" : " the ozone corners,", SB_RAY_GL_ORDER,
+        SB_SUN_COLUMNS_X, SB_SUN_COLUMNS_U, ",\"lut_lookup\":\"catmull-rom of the logarithm\"");
 }

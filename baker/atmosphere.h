@@ -42,6 +42,7 @@ struct sb_atmosphere_product {
     enum sb_product_id id;
     uint32_t depends_on;      /* bit mask of sb_product_id */
     bool workgroup_per_texel; /* sphere.glsl's layout, else 8x8 texels a workgroup */
+    bool rings;               /* the azimuth integrated first, in the ring table (sun_rings.glsl) */
     struct sb_atmosphere_settings defaults;
 };
 

@@ -80,16 +80,15 @@ static const struct sweep_entry multiscattering_sweep[] = {
     {HILLAIRE_DIRS(8, 20), HILLAIRE_MS, true},
     {HILLAIRE_DIRS(8, 80), NULL, false},
     {HILLAIRE_DIRS(8, 320), NULL, false},
-    {DIRS(2, 2), NULL, true},
-    {DIRS(4, 4), NULL, true},
-    {DIRS(6, 6), NULL, false},
-    {DIRS(8, 8), NULL, true},
-    {DIRS(12, 8), NULL, false},
-    {DIRS(16, 8), NULL, false},
-    {DIRS(12, 12), NULL, false},
-    {DIRS(16, 12), NULL, false},
-    {DIRS(24, 16), NULL, false},
-    {DIRS(32, 24), NULL, false},
+    /* zenith nodes a piece x the rings' Gauss-Legendre nodes a piece */
+    {DIRS(4, 3), NULL, true},
+    {DIRS(8, 4), NULL, true},
+    {DIRS(12, 4), NULL, false},
+    {DIRS(12, 6), NULL, false},
+    {DIRS(16, 4), NULL, false},
+    {DIRS(16, 6), NULL, true},
+    {DIRS(24, 8), NULL, false},
+    {DIRS(32, 12), NULL, false},
 };
 #define BRUNETON_DIRS(theta, phi, steps)                                                                               \
     {                                                                                                                  \

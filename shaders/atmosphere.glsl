@@ -108,6 +108,35 @@ float phase_mie(float nu)
 
 /* ---- Geometry ---------------------------------------------------------------- */
 
+/* atan(y / x) in (-pi, pi] to a few 1e-8: Vulkan lets atan, and acos and
+ * asin with it, be 4096 ulp off, and llvmpipe's are off by up to 1e-4 or
+ * so, too coarse for angles that are subtracted from each other (the ring
+ * table's, sun_rings.glsl). Reduced to |u| <= tan(pi / 12) by the
+ * octant and atan(t) = pi / 6 + atan((sqrt(3) t - 1) / (t + sqrt(3))), then
+ * Taylor to u^13. */
+float atan2_precise(float y, float x)
+{
+    const float tan_pi_12 = 0.2679491924311228, sqrt3 = 1.7320508075688772;
+    float ax = abs(x), ay = abs(y);
+    float hi = max(ax, ay), t = hi > 0.0 ? min(ax, ay) / hi : 0.0;
+    bool reduced = t > tan_pi_12;
+    float u = reduced ? (sqrt3 * t - 1.0) / (t + sqrt3) : t, u2 = u * u;
+    float a = u * (1.0 + u2 * (-1.0 / 3.0 + u2 * (1.0 / 5.0 + u2 * (-1.0 / 7.0 + u2 * (1.0 / 9.0
+                  + u2 * (-1.0 / 11.0 + u2 * (1.0 / 13.0)))))));
+    if (reduced)
+        a += PI / 6.0;
+    if (ay > ax)
+        a = 0.5 * PI - a;
+    if (x < 0.0)
+        a = PI - a;
+    return y < 0.0 ? -a : a;
+}
+
+float acos_precise(float x)
+{
+    return atan2_precise(sqrt(max((1.0 - x) * (1.0 + x), 0.0)), x);
+}
+
 /* rho: distance from the point at altitude h to the ground horizon. */
 float horizon_distance(float h)
 {
@@ -728,9 +757,11 @@ float ray_level(int i)
     return i < n ? level_at(i) : ozone_corner(i - n); /* a corner outside the atmosphere crosses no ray */
 }
 
-/* Two crossings per level, two per shadow cylinder (the ground and the
- * three ozone corners), and both ends. */
-#define SB_RAY_MAX_BREAKS (2 * (SB_MAX_LEVELS + 3) + 2 * 4 + 2)
+/* Two crossings per level and both ends, and either two per shadow
+ * cylinder (the ground and the three ozone corners: ray_breakpoints) or the
+ * ray's closest point and four per cylinder (ring_breakpoints,
+ * sun_rings.glsl). */
+#define SB_RAY_MAX_BREAKS (2 * (SB_MAX_LEVELS + 3) + 4 * 4 + 3)
 
 /* Sorted distances in [0, t_end] where the ray crosses the altitude levels,
  * where the planet's shadow starts or ends along it (the sun's

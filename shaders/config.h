@@ -82,7 +82,8 @@
 #define SB_BINDING_OUTPUT 4
 #define SB_BINDING_SCRATCH 5 /* sphere.glsl's partial sums between passes */
 #define SB_BINDING_SUN_COLUMNS 6 /* the scattering bakes' sun table (sun_columns.comp) */
-#define SB_BINDING_COUNT 7
+#define SB_BINDING_SUN_RINGS 7   /* multiscattering's ring table (sun_rings.comp) */
+#define SB_BINDING_COUNT 8
 
 /* The sun table of the scattering bakes (atmosphere.glsl, "The sun's optical
  * depth"): two regions of SB_SUN_COLUMNS_X x SB_SUN_COLUMNS_U nodes, each
@@ -90,6 +91,18 @@
 #define SB_SUN_COLUMNS_X 128
 #define SB_SUN_COLUMNS_U 64
 #define SB_SUN_COLUMNS_FLOATS (2 * (SB_SUN_COLUMNS_X + 2) * (SB_SUN_COLUMNS_U + 2) * 2)
+
+/* The ring table of multiscattering (sun_rings.glsl): per column of the
+ * LUT, SB_RINGS_ROWS rows in altitude (two blocks of half as many where the
+ * sun sets within the atmosphere) of SB_RINGS_INNER + SB_RINGS_OUTER
+ * entries in the angle from the texel's zenith, then SB_RINGS_GROUND
+ * entries of the ground's ring; four floats each. */
+#define SB_RINGS_ROWS 192
+#define SB_RINGS_INNER 8
+#define SB_RINGS_OUTER 24
+#define SB_RINGS_GROUND 512
+#define SB_RINGS_ANGLES (SB_RINGS_INNER + SB_RINGS_OUTER)
+#define SB_RINGS_COLUMN (SB_RINGS_ROWS * SB_RINGS_ANGLES + SB_RINGS_GROUND)
 
 /* Product sizes and channel counts of format version 1. */
 #define SB_TRANSMITTANCE_WIDTH 256

@@ -6,12 +6,15 @@
  *         + [ray hits ground] T(x,p) albedo/pi max(mu_s(p), 0) T_sun(p),
  *   f   = 1/(4 pi) * integral over the sphere of integral of T(x,y) sigma_s(y) dt dw,
  *   psi = E_sun L2 / (1 - f).
- * One workgroup per texel (sphere.glsl). */
+ * The azimuth is integrated first, in the ring table (sun_rings.glsl): one
+ * ray per zenith direction, pc.directions_mu Gauss-Legendre nodes a piece of
+ * the zenith grid (sphere.glsl), one workgroup per texel. */
 #extension GL_GOOGLE_include_directive : require
 #include "config.h"
 #define SB_RAY_OZONE_CORNERS
 #include "atmosphere.glsl"
 #include "sphere.glsl"
+#include "sun_rings.glsl"
 
 layout(std430, set = 0, binding = SB_BINDING_OUTPUT) writeonly buffer Output { float result[]; };
 
@@ -20,26 +23,40 @@ void main()
     uvec2 texel = gl_WorkGroupID.xy;
     vec2 geometry = subtexel_geometry(texel, uvec2(pc.width, pc.height));
     float h = geometry.x, mu_s = geometry.y;
-    float r = ground_radius() + h;
-    float sin_s = sqrt(max(1.0 - mu_s * mu_s, 0.0));
-    sphere_init(pc.directions_mu, pc.directions_phi, false);
+    RingColumn col = ring_column(mu_s);
+    sphere_init(pc.directions_mu, 0u, false);
     SpherePieces pieces = sphere_pieces(h, true, mu_s, false);
 
     sphere_begin();
-    uint count = sphere_direction_count(pieces, pc.directions_mu, pc.directions_phi);
+    uint count = uint(pieces.count) * pc.directions_mu;
     for (uint d = sphere_first_direction(); d < sphere_end_direction(count); d += SB_SPHERE_THREADS) {
-        SphereDirection s = sphere_direction(pieces, d, pc.directions_mu, pc.directions_phi);
-        float sin_v = sqrt(max(1.0 - s.mu * s.mu, 0.0));
-        float nu = clamp(sin_v * sin_s * s.cos_phi + s.mu * mu_s, -1.0, 1.0);
-        RayIntegrals ri = integrate_ray(h, s.mu, mu_s, nu, s.toward_ground, false);
-        vec3 lp = (ri.sun_rayleigh + ri.sun_mie) / (4.0 * PI);
-        if (s.toward_ground) {
-            float mu_sp = clamp((r * mu_s + ri.t_end * nu) / ground_radius(), -1.0, 1.0);
-            if (mu_sp > 0.0)
-                lp += ri.transmittance * atm.ground_albedo.rgb / PI * mu_sp * sun_transmittance(0.0, mu_sp);
+        SphereZenith z = sphere_zenith(pieces, d / pc.directions_mu, d % pc.directions_mu);
+        float sin_v = sqrt(max(1.0 - z.mu * z.mu, 0.0));
+        float t_end = z.toward_ground ? distance_to_ground(h, z.mu) : distance_to_top(h, z.mu);
+        float ts[SB_RAY_MAX_BREAKS];
+        int n = ring_breakpoints(h, z.mu, col, t_end, ts);
+        RayIntegrals ri = ray_integrals_begin();
+        for (int s = 0; s + 1 < n; s++) {
+            float half_len = 0.5 * (ts[s + 1] - ts[s]);
+            if (half_len <= 0.0)
+                continue;
+            float tn[4], hs[4];
+            Medium m[4];
+            ray_segment_nodes(h, z.mu, ts[s], ts[s + 1], tn, hs, m);
+            vec3 sun[4], unused[4];
+            for (int i = 0; i < 4; i++) {
+                sun[i] = ring_table_sample(texel.x, col, hs[i], ring_angle_along(h, z.mu, sin_v, tn[i]));
+                unused[i] = vec3(0.0);
+            }
+            ray_accumulate(ri, half_len, m, sun, unused, false);
         }
-        sphere_add3(0u, s.weight * lp);
-        sphere_add3(3u, s.weight * ri.scattering);
+        vec3 lp = (ri.sun_rayleigh + ri.sun_mie) / (4.0 * PI);
+        if (z.toward_ground)
+            lp += ri.transmittance * atm.ground_albedo.rgb / PI
+                * ring_ground_sample(texel.x, col, ring_angle_along(h, z.mu, sin_v, t_end));
+        float weight = 2.0 * PI * z.weight; /* both halves of the azimuth */
+        sphere_add3(0u, weight * lp);
+        sphere_add3(3u, weight * ri.scattering);
     }
     if (!sphere_finish(6u) || gl_LocalInvocationIndex != 0u)
         return;
