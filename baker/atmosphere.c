@@ -647,8 +647,9 @@ void sb_atmosphere_settings_json(enum sb_product_id id, const struct sb_atmosphe
                  s->directions_phi, SB_RAY_GL_ORDER, SB_SUN_COLUMNS_X, SB_SUN_COLUMNS_U);
         return;
     }
-    const char *zenith_cuts = id == SB_PRODUCT_IRRADIANCE_GROUND ? "the sun's mirror and the sun (upper hemisphere)"
-                              : "the horizon, two ground depths, the ozone corners, 25 scale heights of "
+    const char *zenith_cuts = id == SB_PRODUCT_IRRADIANCE_GROUND
+                                  ? "the sun's mirror and the sun (upper hemisphere)"
+                                  : "the horizon, two ground depths, the ozone corners, 25 scale heights of "
                                     "tangent altitude, the sun's mirror and the sun";
     snprintf(
         out, size,
@@ -659,7 +660,7 @@ void sb_atmosphere_settings_json(enum sb_product_id id, const struct sb_atmosphe
         "boundary and the sun grazing the ozone corners\",\"segment_quadrature\":\"gauss-legendre-%d\","
         "\"sun_transmittance\":\"the sun table: Catmull-Rom of Rayleigh and Mie airmasses on %dx%d nodes a region, "
         "ozone integrated\"%s}",
-        s->directions_mu, s->directions_phi, zenith_cuts,
-        ", crowded toward the sun", id == SB_PRODUCT_IRRADIANCE_SKY ? "" : " the ozone corners,", SB_RAY_GL_ORDER,
-        SB_SUN_COLUMNS_X, SB_SUN_COLUMNS_U, ",\"lut_lookup\":\"catmull-rom of the logarithm\"");
+        s->directions_mu, s->directions_phi, zenith_cuts, ", crowded toward the sun",
+        id == SB_PRODUCT_IRRADIANCE_SKY ? "" : " the ozone corners,", SB_RAY_GL_ORDER, SB_SUN_COLUMNS_X,
+        SB_SUN_COLUMNS_U, ",\"lut_lookup\":\"catmull-rom of the logarithm\"");
 }
