@@ -233,8 +233,7 @@ uint64_t sb_atmosphere_settings_cost(enum sb_product_id id, const struct sb_atmo
     if (is_anchor(id, &s))
         return (uint64_t)s.directions_mu * s.directions_phi;
     if (id != SB_PRODUCT_TRANSMITTANCE)
-        return (uint64_t)(SB_SPHERE_MAX_PIECES + (id != SB_PRODUCT_MULTISCATTERING ? SB_SPHERE_CAP_PIECES : 0)) *
-               s.directions_mu * s.directions_phi;
+        return sphere_directions(&s, id != SB_PRODUCT_MULTISCATTERING, false); /* rings: phi prices the table */
     if (s.quadrature == SB_QUADRATURE_GAUSS_LEGENDRE)
         return 5ull * s.samples * s.subdivisions; /* five pieces, as on the earth */
     return s.quadrature == SB_QUADRATURE_TRAPEZOID ? s.samples + 1ull : s.samples;

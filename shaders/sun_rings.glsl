@@ -141,10 +141,8 @@ float ring_entry_angle(RingColumn col, float h, int j)
  * either end, 3 v0 - 3 v1 + v2, folded into the entries it is made of. */
 int ring_taps(float f, int n, out float w[4])
 {
-    f = clamp(f, 0.0, float(n - 1));
-    int i = min(int(f), n - 2);
-    catmull_rom(f - float(i), w);
-    if (i == 0) {
+    int first = cubic_taps(f, n, w);
+    if (first < 0) {
         float g = w[0];
         w[0] = w[1] + 3.0 * g;
         w[1] = w[2] - 3.0 * g;
@@ -152,7 +150,7 @@ int ring_taps(float f, int n, out float w[4])
         w[3] = 0.0;
         return 0;
     }
-    if (i == n - 2) {
+    if (first + 3 >= n) {
         float g = w[3];
         w[3] = w[2] + 3.0 * g;
         w[2] = w[1] - 3.0 * g;
@@ -160,7 +158,7 @@ int ring_taps(float f, int n, out float w[4])
         w[0] = 0.0;
         return n - 4;
     }
-    return i - 1;
+    return first;
 }
 
 /* G(h, gamma) of column `column` from its table. */
