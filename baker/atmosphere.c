@@ -18,6 +18,7 @@
 #include "multiscattering_hillaire.spv.h"
 #include "physics.h"
 #include "sun_columns.spv.h"
+#include "sun_columns_ghosts.spv.h"
 #include "sun_rings.spv.h"
 #include "transmittance_gl0.spv.h"
 #include "transmittance_gl1.spv.h"
@@ -109,8 +110,9 @@ static const struct spirv anchor_shaders[SB_ATMOSPHERE_PRODUCT_COUNT] = {
     [SB_PRODUCT_MULTISCATTERING] = SPIRV(multiscattering_hillaire),
     [SB_PRODUCT_IRRADIANCE_GROUND] = SPIRV(irradiance_ground_bruneton),
 };
-/* The scattering bakes' sun table (atmosphere.glsl). */
+/* The scattering bakes' sun table (atmosphere.glsl): its nodes, then its ghosts. */
 static const struct spirv sun_columns_shader = SPIRV(sun_columns);
+static const struct spirv sun_columns_ghosts_shader = SPIRV(sun_columns_ghosts);
 /* Multiscattering's ring table (sun_rings.glsl). */
 static const struct spirv sun_rings_shader = SPIRV(sun_rings);
 #undef SPIRV
@@ -422,9 +424,13 @@ static enum sb_result build_sun_columns(struct sb_atmosphere_baker *b, double *g
         (res = sb_buffer_create(b->vk, SB_SUN_COLUMNS_FLOATS * sizeof(float), "sun columns", &b->sun_columns)))
         return res;
     const struct sb_atmosphere_settings none = {0};
-    double ms = 0;
+    double ms = 0, ghosts_ms = 0;
     res = run(b, &sun_columns_shader, "sun columns", &b->sun_columns, SB_SUN_COLUMNS_X + 2, 2 * (SB_SUN_COLUMNS_U + 2),
               0, false, &none, &ms);
+    if (!res)
+        res = run(b, &sun_columns_ghosts_shader, "sun columns' ghosts", &b->sun_columns, SB_SUN_COLUMNS_X + 2,
+                  2 * (SB_SUN_COLUMNS_U + 2), 0, false, &none, &ghosts_ms);
+    ms += ghosts_ms;
     if (res)
         sb_buffer_destroy(b->vk, &b->sun_columns);
     *gpu_ms += ms;
@@ -561,10 +567,12 @@ void sb_atmosphere_code_hash(enum sb_product_id id, char out[SB_HASH_HEX_SIZE])
         sb_hash_bytes(shaders[i]->words, shaders[i]->size, text + n);
         n += SB_HASH_HEX_SIZE - 1;
     }
-    if (id != SB_PRODUCT_TRANSMITTANCE) { /* they read the sun table */
-        sb_hash_bytes(sun_columns_shader.words, sun_columns_shader.size, text + n);
-        n += SB_HASH_HEX_SIZE - 1;
-    }
+    if (id != SB_PRODUCT_TRANSMITTANCE) /* they read the sun table */
+        for (int k = 0; k < 2; k++) {
+            const struct spirv *table = k ? &sun_columns_ghosts_shader : &sun_columns_shader;
+            sb_hash_bytes(table->words, table->size, text + n);
+            n += SB_HASH_HEX_SIZE - 1;
+        }
     if (products[id].rings) {
         sb_hash_bytes(sun_rings_shader.words, sun_rings_shader.size, text + n);
         n += SB_HASH_HEX_SIZE - 1;

@@ -2,16 +2,23 @@
 /* The scattering bakes' sun table (atmosphere.glsl, "The sun's optical depth
  * in the scattering bakes"): at each node of each region, the Rayleigh and
  * Mie columns from the node to the top along its path, over the densities
- * at the node. One invocation per node, ghosts included: the row at x < 0
- * mirrors x > 0 (both regions' columns are even in x), the other ghosts
- * extrapolate their four neighbours by a cubic. */
+ * at the node. One invocation per node, in two dispatches: the nodes inside
+ * the table, then (built with SB_SUN_COLUMNS_GHOSTS) the ghosts around it
+ * from those: the row at x < 0 mirrors x > 0 (both regions' columns are
+ * even in x), the other ghosts extrapolate their four neighbours by a
+ * cubic. Computed in one dispatch, a corner ghost integrated sixteen
+ * paths, and the whole table waited for it (0.08 ms on an H100). */
 #extension GL_GOOGLE_include_directive : require
 #include "config.h"
 #include "atmosphere.glsl"
 
 layout(local_size_x = SB_WORKGROUP_X, local_size_y = SB_WORKGROUP_Y) in;
 layout(push_constant) uniform Push { sb_bake_push pc; };
+#ifdef SB_SUN_COLUMNS_GHOSTS
+layout(std430, set = 0, binding = SB_BINDING_OUTPUT) buffer Output { vec2 result[]; };
+#else
 layout(std430, set = 0, binding = SB_BINDING_OUTPUT) writeonly buffer Output { vec2 result[]; };
+#endif
 
 /* The columns from t0 to the top of path p over the densities at t0: Gauss-
  * Legendre of SB_TRANSMITTANCE_GL_ORDER on pieces cut where the altitude has
@@ -48,6 +55,16 @@ vec2 interior_node(bool lower, int i, int j)
     return path_columns(p, sun_columns_t(u, p.t_end));
 }
 
+/* Node (i, j) inside the table: integrated, or read back for the ghosts. */
+vec2 inside_node(bool lower, int i, int j)
+{
+#ifdef SB_SUN_COLUMNS_GHOSTS
+    return result[sun_columns_index(lower, i, j)];
+#else
+    return interior_node(lower, i, j);
+#endif
+}
+
 vec2 cubic_ghost(vec2 a, vec2 b, vec2 c, vec2 d)
 {
     return 4.0 * a - 6.0 * b + 4.0 * c - d;
@@ -58,12 +75,12 @@ vec2 row_node(bool lower, int i, int j)
 {
     const int n = SB_SUN_COLUMNS_U;
     if (j < 0)
-        return cubic_ghost(interior_node(lower, i, 0), interior_node(lower, i, 1), interior_node(lower, i, 2),
-                           interior_node(lower, i, 3));
+        return cubic_ghost(inside_node(lower, i, 0), inside_node(lower, i, 1), inside_node(lower, i, 2),
+                           inside_node(lower, i, 3));
     if (j >= n)
-        return cubic_ghost(interior_node(lower, i, n - 1), interior_node(lower, i, n - 2),
-                           interior_node(lower, i, n - 3), interior_node(lower, i, n - 4));
-    return interior_node(lower, i, j);
+        return cubic_ghost(inside_node(lower, i, n - 1), inside_node(lower, i, n - 2), inside_node(lower, i, n - 3),
+                           inside_node(lower, i, n - 4));
+    return inside_node(lower, i, j);
 }
 
 void main()
@@ -74,6 +91,14 @@ void main()
     int i = int(gl_GlobalInvocationID.x) - 1, row = int(gl_GlobalInvocationID.y);
     bool lower = row >= SB_SUN_COLUMNS_U + 2;
     int j = row - (lower ? SB_SUN_COLUMNS_U + 2 : 0) - 1;
+    bool ghost = i < 0 || i >= n || j < 0 || j >= SB_SUN_COLUMNS_U;
+#ifdef SB_SUN_COLUMNS_GHOSTS
+    if (!ghost)
+        return;
+#else
+    if (ghost)
+        return;
+#endif
     vec2 v = i >= n ? cubic_ghost(row_node(lower, n - 1, j), row_node(lower, n - 2, j), row_node(lower, n - 3, j),
                                   row_node(lower, n - 4, j))
                     : row_node(lower, abs(i), j);
