@@ -15,7 +15,6 @@
 
 #include "json.h"
 #include "log.h"
-#include "warm_up.spv.h"
 
 #define HILLAIRE "Hillaire 2020 (40-step march, offset 0.3)"
 #define BRUNETON "Bruneton 2017 (500-step trapezoid)"
@@ -225,12 +224,13 @@ static enum sb_result bench_clouds(struct sb_vk *vk, const struct sb_bench_param
         struct sb_bench_cloud_row *row = &report->cloud_rows[report->cloud_row_count++];
         row->product = id;
         struct sb_image image = {0};
-        res = sb_bench_warm_up(vk);
         /* one untimed bake first when timing repeats, as for the atmosphere */
         for (int k = repeat >= 3 ? -1 : 0; k < repeat && !res; k++) {
             double ms;
             sb_image_finish(&image);
-            res = sb_cloud_bake(vk, id, &params->cloud_params, &image, k >= 0 ? &times[k] : &ms);
+            res = sb_warm_up(vk, k <= 0 ? SB_WARM_UP_MS : SB_KEEP_WARM_MS);
+            if (!res)
+                res = sb_cloud_bake(vk, id, &params->cloud_params, &image, k >= 0 ? &times[k] : &ms);
         }
         if (res)
             break;
@@ -262,41 +262,6 @@ static enum sb_result bench_clouds(struct sb_vk *vk, const struct sb_bench_param
     return res;
 }
 
-enum sb_result sb_bench_warm_up(struct sb_vk *vk)
-{
-    if (vk->properties.deviceType == VK_PHYSICAL_DEVICE_TYPE_CPU || !vk->has_timestamps)
-        return SB_OK;
-    enum { GROUPS = 4096 };
-    struct sb_buffer out = {0};
-    struct sb_pipeline pipeline = {0};
-    struct sb_pipeline_params pp = {
-        .spirv = sb_spv_warm_up,
-        .spirv_size = sizeof(sb_spv_warm_up),
-        .binding_count = 1,
-        .push_size = sizeof(uint32_t),
-        .name = "warm up",
-    };
-    enum sb_result res = sb_buffer_create(vk, GROUPS * 64 * sizeof(float), "warm up", &out);
-    if (!res)
-        res = sb_pipeline_create(vk, &pp, &pipeline);
-    if (!res) {
-        const struct sb_buffer *bindings[1] = {&out};
-        sb_pipeline_bind(vk, &pipeline, bindings);
-    }
-    /* Dispatches of about 10 ms, their length scaled from the last one. */
-    uint32_t rounds = 1024;
-    double busy = 0;
-    for (int n = 0; !res && busy < SB_BENCH_WARM_UP_MS && n < 256; n++) {
-        double ms = 0;
-        res = sb_dispatch(vk, &pipeline, &rounds, GROUPS, 1, 1, &ms);
-        busy += ms;
-        double scale = ms > 0 ? 10.0 / ms : 16.0;
-        rounds = (uint32_t)fmin(fmax(rounds * fmin(scale, 16.0), 1.0), 1e7);
-    }
-    sb_pipeline_destroy(vk, &pipeline);
-    sb_buffer_destroy(vk, &out);
-    return res;
-}
 
 enum sb_result sb_bench_run(struct sb_vk *vk, const struct sb_atmosphere_params *atmosphere,
                             const struct sb_bench_params *params, struct sb_bench_report *report)
@@ -347,12 +312,14 @@ enum sb_result sb_bench_run(struct sb_vk *vk, const struct sb_atmosphere_params 
             row->anchor = entry->anchor;
             row->cost = sb_atmosphere_settings_cost(id, &entry->settings);
             sb_atmosphere_settings_label(id, &entry->settings, row->label, sizeof(row->label));
-            res = sb_bench_warm_up(vk);
             /* one untimed bake first when timing repeats: pipeline caches settle */
             for (int k = repeat >= 3 ? -1 : 0; k < repeat && !res; k++) {
                 double ms;
                 sb_image_finish(&image);
-                res = sb_atmosphere_bake(baker, id, &entry->settings, &image, &row->settings, k >= 0 ? &times[k] : &ms);
+                res = sb_warm_up(vk, k <= 0 ? SB_WARM_UP_MS : SB_KEEP_WARM_MS);
+                if (!res)
+                    res = sb_atmosphere_bake(baker, id, &entry->settings, &image, &row->settings,
+                                             k >= 0 ? &times[k] : &ms);
             }
             if (res)
                 break;
@@ -493,7 +460,8 @@ void sb_bench_print(const struct sb_bench_report *report, const struct sb_vk *vk
     printf("skybake bench on %s (%s); GPU time is the median of the repeats", vk->properties.deviceName,
            vk->driver_name);
     if (vk->properties.deviceType != VK_PHYSICAL_DEVICE_TYPE_CPU)
-        printf(", each setting after %.0f ms of warm-up", SB_BENCH_WARM_UP_MS);
+        printf(", the GPU kept busy %.0f ms before each setting and %.0f ms before each bake", SB_WARM_UP_MS,
+               SB_KEEP_WARM_MS);
     printf("\n");
     printf("P: on the Pareto front; *: skybake's default\n");
     for (int w = 0; w < SB_BENCH_SWEEP_COUNT; w++) {

@@ -110,16 +110,9 @@ struct sb_bench_report {
     double reflection_capture_ms, reflection_reference_s;
 };
 
-/*
- * A GPU idles at its lowest clocks between bakes (an H100 at 345 of 1980
- * MHz), and a bake of a few milliseconds ends before they rise, so its time
- * says more about the clock governor than about the kernel. Every bench
- * keeps the GPU busy for SB_BENCH_WARM_UP_MS (shaders/warm_up.comp) before
- * timing a setting (docs/accuracy.md, "GPU clocks"); on a CPU device this
- * does nothing.
- */
-#define SB_BENCH_WARM_UP_MS 200.0
-enum sb_result sb_bench_warm_up(struct sb_vk *vk);
+/* Every bench keeps the GPU's clocks up before a timed bake (sb_warm_up,
+ * vulkan/compute.h): SB_WARM_UP_MS before a setting's first bake and its
+ * first timed one, SB_KEEP_WARM_MS before the others. */
 
 /* bench_probes.c: also the terrain (rolling hills over 2 km, (n - 1)^2 x 2
  * triangles) and the median of n values (sorted in place), which the benches

@@ -101,10 +101,11 @@ static enum sb_result bench_one(struct sb_vk *vk, const char *name, struct sb_me
         res = SB_ERR_NOMEM;
         goto done;
     }
-    res = sb_bench_warm_up(vk);
     for (int k = repeat >= 3 ? -1 : 0; k < repeat && !res; k++) {
         double ms, bms = 0;
-        res = sb_sky_visibility_bake(rc, positions, count, &params, out, &ms);
+        res = sb_warm_up(vk, k <= 0 ? SB_WARM_UP_MS : SB_KEEP_WARM_MS);
+        if (!res)
+            res = sb_sky_visibility_bake(rc, positions, count, &params, out, &ms);
         if (!res)
             res = sb_sky_bounce_bake(rc, mesh, positions, NULL, count, &bounce, bounced, &bms);
         if (k >= 0) {

@@ -189,9 +189,11 @@ enum sb_result sb_bench_reflection(struct sb_vk *vk, const struct sb_atmosphere_
                                                .lod_bias = settings[s].bias,
                                                .unfiltered = settings[s].unfiltered,
                                                .kernels = &kernels};
-        res = sb_bench_warm_up(vk);
-        for (int k = 0; k < repeat && !res; k++)
-            res = sb_reflection_prefilter(vk, level0, n, &pp, chain, &times[k]);
+        for (int k = 0; k < repeat && !res; k++) {
+            res = sb_warm_up(vk, k == 0 ? SB_WARM_UP_MS : SB_KEEP_WARM_MS);
+            if (!res)
+                res = sb_reflection_prefilter(vk, level0, n, &pp, chain, &times[k]);
+        }
         if (res)
             break;
         row->gpu_ms_min = times[0];

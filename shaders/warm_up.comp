@@ -1,6 +1,6 @@
 #version 450
-/* Keeps a GPU busy so that its clocks are up when skybake bench times a
- * bake (baker/bench.c): every invocation runs `rounds` dependent FMAs and
+/* Keeps a GPU busy so that its clocks are up when a bench times a bake or
+ * a frame (sb_warm_up, vulkan/compute.h): every invocation runs `rounds` dependent FMAs and
  * writes the result, so that none of it can be optimised away. */
 layout(local_size_x = 64) in;
 layout(push_constant) uniform Push { uint rounds; } pc;

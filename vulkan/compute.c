@@ -1,9 +1,11 @@
 #include "compute.h"
 
+#include <math.h>
 #include <string.h>
 
 #include "log.h"
 #include "pipeline.h"
+#include "warm_up.spv.h"
 
 enum sb_result sb_buffer_create(struct sb_vk *vk, VkDeviceSize size, const char *name, struct sb_buffer *b)
 {
@@ -249,5 +251,41 @@ enum sb_result sb_dispatch(struct sb_vk *vk, struct sb_pipeline *p, const void *
 cleanup:
     if (queries)
         vkDestroyQueryPool(vk->device, queries, NULL);
+    return res;
+}
+
+enum sb_result sb_warm_up(struct sb_vk *vk, double warm_ms)
+{
+    if (vk->properties.deviceType == VK_PHYSICAL_DEVICE_TYPE_CPU || !vk->has_timestamps)
+        return SB_OK;
+    enum { GROUPS = 4096 };
+    struct sb_buffer out = {0};
+    struct sb_pipeline pipeline = {0};
+    struct sb_pipeline_params pp = {
+        .spirv = sb_spv_warm_up,
+        .spirv_size = sizeof(sb_spv_warm_up),
+        .binding_count = 1,
+        .push_size = sizeof(uint32_t),
+        .name = "warm up",
+    };
+    enum sb_result res = sb_buffer_create(vk, GROUPS * 64 * sizeof(float), "warm up", &out);
+    if (!res)
+        res = sb_pipeline_create(vk, &pp, &pipeline);
+    if (!res) {
+        const struct sb_buffer *bindings[1] = {&out};
+        sb_pipeline_bind(vk, &pipeline, bindings);
+    }
+    /* Dispatches of about 10 ms, their length scaled from the last one. */
+    uint32_t rounds = 1024;
+    double busy = 0;
+    for (int n = 0; !res && busy < warm_ms && n < 256; n++) {
+        double ms = 0;
+        res = sb_dispatch(vk, &pipeline, &rounds, GROUPS, 1, 1, &ms);
+        busy += ms;
+        double scale = ms > 0 ? 10.0 / ms : 16.0;
+        rounds = (uint32_t)fmin(fmax(rounds * fmin(scale, 16.0), 1.0), 1e7);
+    }
+    sb_pipeline_destroy(vk, &pipeline);
+    sb_buffer_destroy(vk, &out);
     return res;
 }

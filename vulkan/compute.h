@@ -69,4 +69,21 @@ void sb_pipeline_bind(struct sb_vk *vk, struct sb_pipeline *pipeline, const stru
 enum sb_result sb_dispatch(struct sb_vk *vk, struct sb_pipeline *pipeline, const void *push, uint32_t groups_x,
                            uint32_t groups_y, uint32_t groups_z, double *gpu_ms);
 
+/*
+ * A GPU idles at its lowest clocks between short jobs (an H100 at 345 of
+ * 1980 MHz) and raises them only after some tens of milliseconds of steady
+ * work, so a bake or a frame of a few milliseconds timed cold measures the
+ * clock governor, not the kernels (docs/accuracy.md, "GPU clocks").
+ * sb_warm_up keeps the GPU busy for `ms` of its own time
+ * (shaders/warm_up.comp) and returns when that work is done; the benches
+ * call it before each timed bake or frame: SB_WARM_UP_MS first, after
+ * anything that may have left the GPU idle (a first bake compiles its
+ * kernels), and SB_KEEP_WARM_MS before each of the rest, since the clocks
+ * fall again within the gaps between short jobs. On a CPU device, or one
+ * without timestamps, it does nothing.
+ */
+#define SB_WARM_UP_MS 200.0
+#define SB_KEEP_WARM_MS 20.0
+enum sb_result sb_warm_up(struct sb_vk *vk, double ms);
+
 #endif
