@@ -262,7 +262,6 @@ static enum sb_result bench_clouds(struct sb_vk *vk, const struct sb_bench_param
     return res;
 }
 
-
 enum sb_result sb_bench_run(struct sb_vk *vk, const struct sb_atmosphere_params *atmosphere,
                             const struct sb_bench_params *params, struct sb_bench_report *report)
 {

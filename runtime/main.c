@@ -13,8 +13,8 @@
 #include <string.h>
 #include <sys/stat.h>
 
-#include "config.h"
 #include "compute.h"
+#include "config.h"
 #include "contact_sheet.h"
 #include "context.h"
 #include "default_world.h"
