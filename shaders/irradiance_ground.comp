@@ -17,7 +17,7 @@ layout(std430, set = 0, binding = SB_BINDING_OUTPUT) writeonly buffer Output { f
 
 void main()
 {
-    uvec2 texel = gl_WorkGroupID.xy;
+    uvec2 texel = sphere_texel();
     vec2 geometry = subtexel_geometry(texel, uvec2(pc.width, pc.height));
     float h = geometry.x, mu_s = geometry.y;
     vec3 sun = atm.solar_irradiance.rgb;

@@ -13,13 +13,14 @@
 #extension GL_GOOGLE_include_directive : require
 #include "config.h"
 #include "atmosphere.glsl"
+#define SB_SPHERE_BY_COLUMN
 #include "sphere.glsl"
 
 layout(std430, set = 0, binding = SB_BINDING_OUTPUT) writeonly buffer Output { float result[]; };
 
 void main()
 {
-    uvec2 texel = gl_WorkGroupID.xy;
+    uvec2 texel = sphere_texel();
     vec2 geometry = subtexel_geometry(texel, uvec2(pc.width, pc.height));
     float h = geometry.x, mu_s = geometry.y;
     float r = ground_radius() + h;

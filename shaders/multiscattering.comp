@@ -13,6 +13,7 @@
 #include "config.h"
 #define SB_RAY_OZONE_CORNERS
 #include "atmosphere.glsl"
+#define SB_SPHERE_BY_COLUMN
 #include "sphere.glsl"
 #include "sun_rings.glsl"
 
@@ -20,7 +21,7 @@ layout(std430, set = 0, binding = SB_BINDING_OUTPUT) writeonly buffer Output { f
 
 void main()
 {
-    uvec2 texel = gl_WorkGroupID.xy;
+    uvec2 texel = sphere_texel();
     vec2 geometry = subtexel_geometry(texel, uvec2(pc.width, pc.height));
     float h = geometry.x, mu_s = geometry.y;
     RingColumn col = ring_column(mu_s);
