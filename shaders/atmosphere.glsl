@@ -887,26 +887,43 @@ void ray_segment_nodes(float h0, float mu, float t0, float t1, out float ts[4], 
     }
 }
 
+/* The weights of a segment's nodes (length 2 half_len, from their media)
+ * along the ray: T(x, node) times the node's quadrature weight, tau being
+ * the optical depth from x to the segment's start. */
+void ray_node_weights(vec3 tau, float half_len, Medium m[4], out vec3 tw[4])
+{
+    for (int i = 0; i < 4; i++) {
+        vec3 depth = tau;
+        for (int j = 0; j < 4; j++)
+            depth += half_len * GL4_S[i * 4 + j] * m[j].extinction;
+        tw[i] = exp(-depth) * (half_len * GL4_W[i]);
+    }
+}
+
+/* The optical depth tau past that segment. */
+void ray_advance(inout vec3 tau, float half_len, Medium m[4])
+{
+    for (int j = 0; j < 4; j++)
+        tau += half_len * GL4_W[j] * m[j].extinction;
+}
+
 /* Add a segment of length 2 half_len from its nodes' media, the sun's
  * transmittance there (or what stands for it) and, with want_ms, psi_ms
  * there; the segments must come in order along the ray. */
 void ray_accumulate(inout RayIntegrals o, float half_len, Medium m[4], vec3 sun[4], vec3 psi[4], bool want_ms)
 {
+    vec3 tw[4];
+    ray_node_weights(o.tau, half_len, m, tw);
     for (int i = 0; i < 4; i++) {
-        vec3 depth = o.tau;
-        for (int j = 0; j < 4; j++)
-            depth += half_len * GL4_S[i * 4 + j] * m[j].extinction;
-        vec3 tw = exp(-depth) * (half_len * GL4_W[i]);
-        o.sun_rayleigh += tw * m[i].scattering_rayleigh * sun[i];
-        o.sun_mie += tw * m[i].scattering_mie * sun[i];
-        o.scattering += tw * (m[i].scattering_rayleigh + m[i].scattering_mie);
+        o.sun_rayleigh += tw[i] * m[i].scattering_rayleigh * sun[i];
+        o.sun_mie += tw[i] * m[i].scattering_mie * sun[i];
+        o.scattering += tw[i] * (m[i].scattering_rayleigh + m[i].scattering_mie);
         if (want_ms) {
-            o.ms_rayleigh += tw * m[i].scattering_rayleigh * psi[i];
-            o.ms_mie += tw * m[i].scattering_mie * psi[i];
+            o.ms_rayleigh += tw[i] * m[i].scattering_rayleigh * psi[i];
+            o.ms_mie += tw[i] * m[i].scattering_mie * psi[i];
         }
     }
-    for (int j = 0; j < 4; j++)
-        o.tau += half_len * GL4_W[j] * m[j].extinction;
+    ray_advance(o.tau, half_len, m);
     o.transmittance = exp(-o.tau);
 }
 

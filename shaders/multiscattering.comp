@@ -36,7 +36,8 @@ void main()
         float t_end = z.toward_ground ? distance_to_ground(h, z.mu) : distance_to_top(h, z.mu);
         float ts[SB_RAY_MAX_BREAKS];
         int n = ring_breakpoints(h, z.mu, col, t_end, ts);
-        RayIntegrals ri = ray_integrals_begin();
+        /* The phase is isotropic: Rayleigh and Mie are summed per node. */
+        vec3 tau = vec3(0.0), lit = vec3(0.0), scattered = vec3(0.0);
         for (int s = 0; s + 1 < n; s++) {
             float half_len = 0.5 * (ts[s + 1] - ts[s]);
             if (half_len <= 0.0)
@@ -44,20 +45,22 @@ void main()
             float tn[4], hs[4];
             Medium m[4];
             ray_segment_nodes(h, z.mu, ts[s], ts[s + 1], tn, hs, m);
-            vec3 sun[4], unused[4];
+            vec3 tw[4]; /* the nodes' exponentials before their table reads: 6% faster than interleaved */
+            ray_node_weights(tau, half_len, m, tw);
             for (int i = 0; i < 4; i++) {
-                sun[i] = ring_table_sample(texel.x, col, hs[i], ring_angle_along(h, z.mu, sin_v, tn[i]));
-                unused[i] = vec3(0.0);
+                vec3 scattering = tw[i] * (m[i].scattering_rayleigh + m[i].scattering_mie);
+                lit += scattering * ring_table_sample(texel.x, col, hs[i], ring_angle_along(h, z.mu, sin_v, tn[i]));
+                scattered += scattering;
             }
-            ray_accumulate(ri, half_len, m, sun, unused, false);
+            ray_advance(tau, half_len, m);
         }
-        vec3 lp = (ri.sun_rayleigh + ri.sun_mie) / (4.0 * PI);
+        vec3 lp = lit / (4.0 * PI);
         if (z.toward_ground)
-            lp += ri.transmittance * atm.ground_albedo.rgb / PI
+            lp += exp(-tau) * atm.ground_albedo.rgb / PI
                 * ring_ground_sample(texel.x, col, ring_angle_along(h, z.mu, sin_v, t_end));
         float weight = 2.0 * PI * z.weight; /* both halves of the azimuth */
         sphere_add3(0u, weight * lp);
-        sphere_add3(3u, weight * ri.scattering);
+        sphere_add3(3u, weight * scattered);
     }
     if (!sphere_finish(6u) || gl_LocalInvocationIndex != 0u)
         return;
