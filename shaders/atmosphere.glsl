@@ -869,10 +869,6 @@ RayIntegrals ray_integrals_begin()
     return o;
 }
 
-/* Add the segment [t0, t1] of the ray from altitude h0 with cosine mu (sun
- * cosine mu_s, cosine nu between the ray and the sun) by Gauss-Legendre 4;
- * the segments must come in order along the ray. Altitudes under the ground
- * (a straight ray through the runtime's flat world) read the ground's medium. */
 /* The nodes of Gauss-Legendre 4 on the segment [t0, t1] of the ray from
  * altitude h0 with cosine mu: their distances, altitudes and media.
  * Altitudes under the ground (a straight ray through the runtime's flat
@@ -907,26 +903,6 @@ void ray_advance(inout vec3 tau, float half_len, Medium m[4])
         tau += half_len * GL4_W[j] * m[j].extinction;
 }
 
-/* Add a segment of length 2 half_len from its nodes' media, the sun's
- * transmittance there (or what stands for it) and, with want_ms, psi_ms
- * there; the segments must come in order along the ray. */
-void ray_accumulate(inout RayIntegrals o, float half_len, Medium m[4], vec3 sun[4], vec3 psi[4], bool want_ms)
-{
-    vec3 tw[4];
-    ray_node_weights(o.tau, half_len, m, tw);
-    for (int i = 0; i < 4; i++) {
-        o.sun_rayleigh += tw[i] * m[i].scattering_rayleigh * sun[i];
-        o.sun_mie += tw[i] * m[i].scattering_mie * sun[i];
-        o.scattering += tw[i] * (m[i].scattering_rayleigh + m[i].scattering_mie);
-        if (want_ms) {
-            o.ms_rayleigh += tw[i] * m[i].scattering_rayleigh * psi[i];
-            o.ms_mie += tw[i] * m[i].scattering_mie * psi[i];
-        }
-    }
-    ray_advance(o.tau, half_len, m);
-    o.transmittance = exp(-o.tau);
-}
-
 /* Add the segment [t0, t1] of the ray from altitude h0 with cosine mu (sun
  * cosine mu_s, cosine nu between the ray and the sun) by Gauss-Legendre 4;
  * the segments must come in order along the ray. */
@@ -939,13 +915,24 @@ void integrate_segment(inout RayIntegrals o, float h0, float mu, float mu_s, flo
     float ts[4], hs[4];
     Medium m[4];
     ray_segment_nodes(h0, mu, t0, t1, ts, hs, m);
-    vec3 sun[4], psi[4];
+    /* The nodes' exponentials before the tables' reads: irradiance_ground
+     * 7% faster on the H100 than with the reads first. */
+    vec3 tw[4];
+    ray_node_weights(o.tau, half_len, m, tw);
     for (int i = 0; i < 4; i++) {
         float mus = clamp((r0 * mu_s + ts[i] * nu) / (ground_radius() + hs[i]), -1.0, 1.0);
-        sun[i] = sun_transmittance(hs[i], mus);
-        psi[i] = want_ms ? multiscattering_lut_sample(hs[i], mus) : vec3(0.0);
+        vec3 sun = sun_transmittance(hs[i], mus);
+        o.sun_rayleigh += tw[i] * m[i].scattering_rayleigh * sun;
+        o.sun_mie += tw[i] * m[i].scattering_mie * sun;
+        o.scattering += tw[i] * (m[i].scattering_rayleigh + m[i].scattering_mie);
+        if (want_ms) {
+            vec3 psi = multiscattering_lut_sample(hs[i], mus);
+            o.ms_rayleigh += tw[i] * m[i].scattering_rayleigh * psi;
+            o.ms_mie += tw[i] * m[i].scattering_mie * psi;
+        }
     }
-    ray_accumulate(o, half_len, m, sun, psi, want_ms);
+    ray_advance(o.tau, half_len, m);
+    o.transmittance = exp(-o.tau);
     o.t_end = t1;
 }
 
