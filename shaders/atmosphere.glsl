@@ -763,11 +763,6 @@ float ray_level(int i)
  * sun_rings.glsl). */
 #define SB_RAY_MAX_BREAKS (2 * (SB_MAX_LEVELS + 3) + 4 * 4 + 3)
 
-/* Sorted distances in [0, t_end] where the ray crosses the altitude levels,
- * where the planet's shadow starts or ends along it (the sun's
- * transmittance jumps there), and where the sun's ray grazes an ozone
- * corner at its tangent point (the sun's transmittance kinks there, and at
- * twilight these cuts follow its steep rise out of the shadow). */
 /* Append to ts the distances in (0, t_end) where the ray from altitude h0
  * with cosine mu crosses the levels (ray_level). */
 void ray_level_crossings(float h0, float mu, float t_end, inout float ts[SB_RAY_MAX_BREAKS], inout int n)
