@@ -74,7 +74,7 @@ enum sb_result sb_dispatch(struct sb_vk *vk, struct sb_pipeline *pipeline, const
  * 1980 MHz) and raises them only after some tens of milliseconds of steady
  * work, so a bake or a frame of a few milliseconds timed cold measures the
  * clock governor, not the kernels (docs/accuracy.md, "GPU clocks").
- * sb_warm_up keeps the GPU busy for `ms` of its own time
+ * sb_warm_up keeps the GPU busy for `warm_ms` of its own time
  * (shaders/warm_up.comp) and returns when that work is done; the benches
  * call it before each timed bake or frame: SB_WARM_UP_MS first, after
  * anything that may have left the GPU idle (a first bake compiles its
@@ -84,6 +84,6 @@ enum sb_result sb_dispatch(struct sb_vk *vk, struct sb_pipeline *pipeline, const
  */
 #define SB_WARM_UP_MS 200.0
 #define SB_KEEP_WARM_MS 20.0
-enum sb_result sb_warm_up(struct sb_vk *vk, double ms);
+enum sb_result sb_warm_up(struct sb_vk *vk, double warm_ms);
 
 #endif
