@@ -49,11 +49,8 @@ void aerial_perspective(vec2 uv, vec3 offset, out vec3 inscatter, out vec3 trans
     float h0 = max(r0 - ground_radius(), 0.0);
     float mu = dot(p0, d) / r0, mu_s = dot(p0, frame.sun_direction.xyz) / r0;
     float nu = dot(d, frame.sun_direction.xyz);
-    float ts[SB_RAY_MAX_BREAKS];
-    int n = ray_breakpoints(h0, mu, mu_s, nu, d_km - entry, ts);
     RayIntegrals ri = ray_integrals_begin();
-    for (int s = 0; s + 1 < n; s++)
-        integrate_segment(ri, h0, mu, mu_s, nu, ts[s], ts[s + 1], true);
+    integrate_ray_to(ri, h0, mu, mu_s, nu, d_km - entry, true);
     vec3 L = atm.solar_irradiance.rgb * (ri.sun_rayleigh * phase_rayleigh(nu) + ri.sun_mie * phase_mie(nu)) +
              ri.ms_rayleigh + ri.ms_mie;
     inscatter = L * frame.aerial.y;

@@ -34,17 +34,16 @@ void main()
         SphereZenith z = sphere_zenith(pieces, d / pc.directions_mu, d % pc.directions_mu);
         float sin_v = sqrt(max(1.0 - z.mu * z.mu, 0.0));
         float t_end = z.toward_ground ? distance_to_ground(h, z.mu) : distance_to_top(h, z.mu);
-        float ts[SB_RAY_MAX_BREAKS];
-        int n = ring_breakpoints(h, z.mu, col, t_end, ts);
+        RayCuts cuts = ring_cuts(h, z.mu, col);
         /* The phase is isotropic: Rayleigh and Mie are summed per node. */
         vec3 tau = vec3(0.0), lit = vec3(0.0), scattered = vec3(0.0);
-        for (int s = 0; s + 1 < n; s++) {
-            float half_len = 0.5 * (ts[s + 1] - ts[s]);
-            if (half_len <= 0.0)
-                continue;
+        for (float t0 = 0.0; t0 < t_end;) {
+            float t1 = ray_next_cut(cuts, t0, t_end);
+            float half_len = 0.5 * (t1 - t0);
             float tn[4], hs[4];
             Medium m[4];
-            ray_segment_nodes(h, z.mu, ts[s], ts[s + 1], tn, hs, m);
+            ray_segment_nodes(h, z.mu, t0, t1, tn, hs, m);
+            t0 = t1;
             vec3 tw[4]; /* the nodes' exponentials before their table reads: 6% faster than interleaved */
             ray_node_weights(tau, half_len, m, tw);
             for (int i = 0; i < 4; i++) {

@@ -205,16 +205,13 @@ float ring_angle_along(float h0, float mu, float sin_v, float t)
     return atan2_precise(t * sin_v, ground_radius() + h0 + t * mu);
 }
 
-/* Sorted distances in [0, t_end] that cut the ray from altitude h0 with
- * cosine mu for rings (above). */
-int ring_breakpoints(float h0, float mu, RingColumn col, float t_end, out float ts[SB_RAY_MAX_BREAKS])
+/* The cuts (atmosphere.glsl) of the ray from altitude h0 with cosine mu
+ * for rings (above). */
+RayCuts ring_cuts(float h0, float mu, RingColumn col)
 {
+    RayCuts cuts = ray_level_cuts(h0, mu);
     float R = ground_radius(), r0 = R + h0;
-    int n = 0;
-    ts[n++] = 0.0;
-    ray_level_crossings(h0, mu, t_end, ts, n);
-    if (-r0 * mu > 0.0 && -r0 * mu < t_end)
-        ts[n++] = -r0 * mu;
+    cuts.extra[0] = -r0 * mu; /* the closest point, where the ray passes it */
     float sin_v = sqrt(max(1.0 - mu * mu, 0.0));
     /* r sin(theta_s + sg gamma) = sin_s (r0 + t mu) + sg mu_s t sin_v =
      * side rc, where also r cos(theta_s + sg gamma) = mu_s (r0 + t mu) -
@@ -222,26 +219,21 @@ int ring_breakpoints(float h0, float mu, RingColumn col, float t_end, out float 
      * below the horizon). rc - sin_s r0 = (hc - h0) + r0 mu_s^2 / (1 + sin_s)
      * without cancelling. */
     float lift = r0 * col.mu_s * col.mu_s / (1.0 + col.sin_s);
-    for (int k = -1; k < 3; k++) {
+    [[unroll]] for (int k = -1; k < 3; k++) {
         float hc = k < 0 ? 0.0 : ozone_corner(k);
-        if (k >= 0 && (hc <= 0.0 || hc >= atmosphere_thickness()))
-            continue;
-        for (int e = 0; e < 4; e++) {
+        bool used = k < 0 || (hc > 0.0 && hc < atmosphere_thickness());
+        [[unroll]] for (int e = 0; e < 4; e++) {
             float sg = (e & 1) != 0 ? -1.0 : 1.0;
             bool far_side = e >= 2;
             float den = col.sin_s * mu + sg * col.mu_s * sin_v;
-            if (abs(den) < 1e-7)
-                continue;
             float num = far_side ? -(R + hc) - col.sin_s * r0 : (hc - h0) + lift;
             float t = num / den;
-            if (!(t > 0.0 && t < t_end) || col.mu_s * (r0 + t * mu) - sg * col.sin_s * t * sin_v >= 0.0)
-                continue;
-            ts[n++] = t;
+            bool cut = used && abs(den) >= 1e-7 && t > 0.0
+                    && col.mu_s * (r0 + t * mu) - sg * col.sin_s * t * sin_v < 0.0;
+            cuts.extra[1 + 4 * (k + 1) + e] = cut ? t : -1.0;
         }
     }
-    ts[n++] = t_end;
-    sort_breakpoints(ts, n);
-    return n;
+    return cuts;
 }
 
 #endif
