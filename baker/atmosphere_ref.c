@@ -229,24 +229,10 @@ void sb_ref_transmittance_coords(const struct sb_atmosphere_params *p, double r,
  * linear lookup overestimates them by up to 2x.
  */
 
-static void catmull_rom(double t, double w[4])
-{
-    double t2 = t * t, t3 = t2 * t;
-    w[0] = 0.5 * (-t3 + 2 * t2 - t);
-    w[1] = 0.5 * (3 * t3 - 5 * t2 + 2);
-    w[2] = 0.5 * (-3 * t3 + 4 * t2 + t);
-    w[3] = 0.5 * (t3 - t2);
-}
-
 /* First of the four texels around x in [0, 1] on n texels, and their weights. */
 static int cubic_taps(double x, int n, double w[4])
 {
-    double f = fmin(fmax(x, 0.0), 1.0) * (n - 1);
-    int i = n < 2 ? 0 : (int)f;
-    if (i > n - 2)
-        i = n - 2 < 0 ? 0 : n - 2;
-    catmull_rom(f - i, w);
-    return i - 1;
+    return sb_cubic_taps(fmin(fmax(x, 0.0), 1.0) * (n - 1), n, w);
 }
 
 static int clamp_index(int i, int n)

@@ -378,14 +378,17 @@ static enum sb_result upload_atmosphere(struct sb_renderer *r, const struct sb_p
     enum sb_result res = upload(r->vk, &gpu, sizeof(gpu), "atmosphere parameters", &r->atmosphere);
     if (!res)
         res = upload(r->vk, t->data, sb_image_float_count(t) * sizeof(float), "transmittance", &r->transmittance);
-    const enum sb_product_id lookups[2] = {SB_PRODUCT_MULTISCATTERING, SB_PRODUCT_IRRADIANCE_GROUND};
-    struct sb_buffer *dst[2] = {&r->multiscattering, &r->irradiance_ground};
-    for (int i = 0; i < 2 && !res; i++) {
-        res =
-            upload(r->vk, NULL, sb_lookup_float_count(lookups[i]) * sizeof(float), sb_product_name(lookups[i]), dst[i]);
-        if (!res)
-            sb_lookup_fill(lookups[i], &pack->images[lookups[i]], dst[i]->mapped);
-    }
+    if (!res)
+        res = upload(r->vk, NULL, sb_multiscattering_refined_float_count() * sizeof(float), "multiscattering",
+                     &r->multiscattering);
+    if (!res)
+        sb_multiscattering_refined_fill(&pack->images[SB_PRODUCT_MULTISCATTERING], r->multiscattering.mapped);
+    if (!res)
+        res = upload(r->vk, NULL, sb_lookup_float_count(SB_PRODUCT_IRRADIANCE_GROUND) * sizeof(float),
+                     "irradiance_ground", &r->irradiance_ground);
+    if (!res)
+        sb_lookup_fill(SB_PRODUCT_IRRADIANCE_GROUND, &pack->images[SB_PRODUCT_IRRADIANCE_GROUND],
+                       r->irradiance_ground.mapped);
     return res;
 }
 

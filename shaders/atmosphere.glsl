@@ -499,8 +499,20 @@ int cubic_taps(float f, int n, out float w[4])
 
 vec3 multiscattering_lut_sample(float h, float mu_s)
 {
-    const int n = SB_MULTISCATTERING_SIZE, stride = n + 2;
+    const int n = SB_MULTISCATTERING_SIZE;
     vec2 f = subtexel_coords(h, mu_s, uvec2(n));
+#ifdef SB_MULTISCATTERING_REFINED
+    /* skyview's form (config.h): bilinear between the refined nodes. */
+    const int m = SB_MULTISCATTERING_REFINED_SIZE;
+    vec2 fr = clamp(f * float(SB_MULTISCATTERING_REFINE), vec2(0.0), vec2(float(m - 1)));
+    ivec2 i = min(ivec2(fr), ivec2(m - 2));
+    vec2 w = fr - vec2(i);
+    int k = i.y * m + i.x;
+    vec3 lo = mix(SB_MULTISCATTERING_LOG(k), SB_MULTISCATTERING_LOG(k + 1), w.x);
+    vec3 hi = mix(SB_MULTISCATTERING_LOG(k + m), SB_MULTISCATTERING_LOG(k + m + 1), w.x);
+    return exp(mix(lo, hi, w.y));
+#else
+    const int stride = n + 2;
     float wx[4], wy[4];
     int x0 = cubic_taps(f.x, n, wx), y0 = cubic_taps(f.y, n, wy);
     int k = (y0 + 1) * stride + x0 + 1; /* the ghost texels sit at -1 and n */
@@ -509,6 +521,7 @@ vec3 multiscattering_lut_sample(float h, float mu_s)
         sum += wy[j] * (wx[0] * SB_MULTISCATTERING_LOG(k) + wx[1] * SB_MULTISCATTERING_LOG(k + 1)
                         + wx[2] * SB_MULTISCATTERING_LOG(k + 2) + wx[3] * SB_MULTISCATTERING_LOG(k + 3));
     return exp(sum);
+#endif
 }
 
 /* Row `row` of the ground irradiance lookup (physics.h) at sun cosine mu_s. */

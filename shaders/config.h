@@ -113,6 +113,11 @@
 /* The multiscattering LUT's lookup form (physics.h): its texels with a ghost
  * texel on every side, four floats each. */
 #define SB_MULTISCATTERING_LOOKUP_TEXELS ((SB_MULTISCATTERING_SIZE + 2) * (SB_MULTISCATTERING_SIZE + 2))
+/* skyview's form of it (physics.h): the same Catmull-Rom of its logarithm,
+ * evaluated on a grid SB_MULTISCATTERING_REFINE times finer, which the
+ * runtime reads bilinearly (four reads instead of sixteen). */
+#define SB_MULTISCATTERING_REFINE 8
+#define SB_MULTISCATTERING_REFINED_SIZE ((SB_MULTISCATTERING_SIZE - 1) * SB_MULTISCATTERING_REFINE + 1)
 #define SB_IRRADIANCE_WIDTH 64
 #define SB_IRRADIANCE_HEIGHT 16
 #define SB_IRRADIANCE_GROUND_CHANNELS 6 /* direct.rgb, sky.rgb */

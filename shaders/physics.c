@@ -90,6 +90,55 @@ void sb_lookup_fill(enum sb_product_id id, const struct sb_image *image, float *
     }
 }
 
+void sb_catmull_rom(double t, double w[4])
+{
+    double t2 = t * t, t3 = t2 * t;
+    w[0] = 0.5 * (-t3 + 2 * t2 - t);
+    w[1] = 0.5 * (3 * t3 - 5 * t2 + 2);
+    w[2] = 0.5 * (-3 * t3 + 4 * t2 + t);
+    w[3] = 0.5 * (t3 - t2);
+}
+
+int sb_cubic_taps(double f, int n, double w[4])
+{
+    f = fmin(fmax(f, 0.0), n - 1.0);
+    int i = n < 2 ? 0 : (int)f;
+    if (i > n - 2)
+        i = n - 2 < 0 ? 0 : n - 2;
+    sb_catmull_rom(f - i, w);
+    return i - 1;
+}
+
+size_t sb_multiscattering_refined_float_count(void)
+{
+    return (size_t)SB_MULTISCATTERING_REFINED_SIZE * SB_MULTISCATTERING_REFINED_SIZE * 4;
+}
+
+void sb_multiscattering_refined_fill(const struct sb_image *image, float *dst)
+{
+    const int n = SB_MULTISCATTERING_SIZE, m = SB_MULTISCATTERING_REFINED_SIZE;
+    for (int y = 0; y < m; y++) {
+        double wy[4];
+        int y0 = sb_cubic_taps((double)y / SB_MULTISCATTERING_REFINE, n, wy);
+        for (int x = 0; x < m; x++) {
+            double wx[4], sum[3] = {0, 0, 0};
+            int x0 = sb_cubic_taps((double)x / SB_MULTISCATTERING_REFINE, n, wx);
+            for (int b = 0; b < 4; b++)
+                for (int a = 0; a < 4; a++) {
+                    int sy = y0 + b < 0 ? 0 : (y0 + b < n ? y0 + b : n - 1);
+                    int sx = x0 + a < 0 ? 0 : (x0 + a < n ? x0 + a : n - 1);
+                    const float *texel = image->data + ((size_t)sy * n + sx) * 3;
+                    for (int c = 0; c < 3; c++)
+                        sum[c] += wy[b] * wx[a] * log_floor(texel[c]);
+                }
+            float *node = dst + ((size_t)y * m + x) * 4;
+            for (int c = 0; c < 3; c++)
+                node[c] = (float)sum[c];
+            node[3] = 0.0f;
+        }
+    }
+}
+
 void sb_gauss_legendre_node(int k, int n, double a, double b, double *x, double *w)
 {
     double z = cos(M_PI * (k + 0.75) / (n + 0.5)), dp = 1;

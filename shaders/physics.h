@@ -42,4 +42,23 @@ int sb_atmosphere_levels(const struct sb_atmosphere_params *params, double level
 size_t sb_lookup_float_count(enum sb_product_id id);
 void sb_lookup_fill(enum sb_product_id id, const struct sb_image *image, float *dst);
 
+/* Catmull-Rom's weights at t in [0, 1] for the four texels around it. */
+void sb_catmull_rom(double t, double w[4]);
+/* The first of the four texels around continuous texel coordinate f on n
+ * texels (clamped to [0, n - 1]; texel i at i), and their weights: what the
+ * shaders' cubic_taps computes. The first may be -1 and the last n: the
+ * caller repeats the edges. */
+int sb_cubic_taps(double f, int n, double w[4]);
+
+/*
+ * skyview's form of the multiscattering LUT (config.h): at each node of a
+ * grid SB_MULTISCATTERING_REFINE times finer (SB_MULTISCATTERING_REFINED_SIZE
+ * nodes a side, rows from h = 0, from mu_s = -1), the lookup form's
+ * Catmull-Rom of ln(max(psi, 1e-30)), as the bakes read it
+ * (multiscattering_lut_sample, atmosphere.glsl), four floats a node (the
+ * fourth 0). `image` must have multiscattering's format.
+ */
+size_t sb_multiscattering_refined_float_count(void);
+void sb_multiscattering_refined_fill(const struct sb_image *image, float *dst);
+
 #endif

@@ -7,6 +7,7 @@
 #define SB_VIEW_GLSL
 
 #define SB_SUN_TRANSMITTANCE_LUT
+#define SB_MULTISCATTERING_REFINED
 #include "atmosphere.glsl"
 #include "sky_radiance.glsl"
 
