@@ -25,7 +25,8 @@ layout(std430, set = 0, binding = SB_BINDING_ATMOSPHERE) readonly buffer Atmosph
 layout(std430, set = 0, binding = SB_BINDING_TRANSMITTANCE) readonly buffer TransmittanceBuffer {
     float transmittance_lut[];
 };
-/* The lookup forms of multiscattering and irradiance_ground (config.h). */
+/* The lookup forms of multiscattering and irradiance_ground (config.h);
+ * skyview binds multiscattering's refined form (SB_MULTISCATTERING_REFINED). */
 layout(std430, set = 0, binding = SB_BINDING_MULTISCATTERING) readonly buffer MultiscatteringBuffer {
     vec4 multiscattering_log[];
 };

@@ -116,7 +116,7 @@
 /* skyview's form of it (physics.h): the same Catmull-Rom of its logarithm,
  * evaluated on a grid SB_MULTISCATTERING_REFINE times finer, which the
  * runtime reads bilinearly (four reads instead of sixteen). */
-#define SB_MULTISCATTERING_REFINE 8
+#define SB_MULTISCATTERING_REFINE 16
 #define SB_MULTISCATTERING_REFINED_SIZE ((SB_MULTISCATTERING_SIZE - 1) * SB_MULTISCATTERING_REFINE + 1)
 #define SB_IRRADIANCE_WIDTH 64
 #define SB_IRRADIANCE_HEIGHT 16

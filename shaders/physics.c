@@ -117,6 +117,9 @@ size_t sb_multiscattering_refined_float_count(void)
 void sb_multiscattering_refined_fill(const struct sb_image *image, float *dst)
 {
     const int n = SB_MULTISCATTERING_SIZE, m = SB_MULTISCATTERING_REFINED_SIZE;
+    float ln[SB_MULTISCATTERING_SIZE * SB_MULTISCATTERING_SIZE * 3];
+    for (int i = 0; i < n * n * 3; i++)
+        ln[i] = log_floor(image->data[i]);
     for (int y = 0; y < m; y++) {
         double wy[4];
         int y0 = sb_cubic_taps((double)y / SB_MULTISCATTERING_REFINE, n, wy);
@@ -127,9 +130,9 @@ void sb_multiscattering_refined_fill(const struct sb_image *image, float *dst)
                 for (int a = 0; a < 4; a++) {
                     int sy = y0 + b < 0 ? 0 : (y0 + b < n ? y0 + b : n - 1);
                     int sx = x0 + a < 0 ? 0 : (x0 + a < n ? x0 + a : n - 1);
-                    const float *texel = image->data + ((size_t)sy * n + sx) * 3;
+                    const float *texel = ln + ((size_t)sy * n + sx) * 3;
                     for (int c = 0; c < 3; c++)
-                        sum[c] += wy[b] * wx[a] * log_floor(texel[c]);
+                        sum[c] += wy[b] * wx[a] * texel[c];
                 }
             float *node = dst + ((size_t)y * m + x) * 4;
             for (int c = 0; c < 3; c++)

@@ -1,7 +1,8 @@
 /*
  * What skyview's passes share: the frame's constants, the sky-view LUT's
  * mapping, the sun disk, and the atmosphere read from the pack (the baked
- * transmittance for the sun, see SB_SUN_TRANSMITTANCE_LUT).
+ * transmittance for the sun, see SB_SUN_TRANSMITTANCE_LUT; psi_ms from its
+ * refined form, SB_MULTISCATTERING_REFINED in config.h).
  */
 #ifndef SB_VIEW_GLSL
 #define SB_VIEW_GLSL
