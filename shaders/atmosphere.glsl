@@ -772,11 +772,12 @@ void ray_level_crossing(float h0, float s0, float level, out float t1, out float
  * jumps or kinks: the planet's shadow and the sun's ozone tangencies
  * (ray_cuts), or the rings' (ring_cuts, sun_rings.glsl). The cuts are kept
  * by what makes them, unsorted, -1 where there is none, past the ray's end
- * where they fall there, and walked in order by ray_next_cut. Every loop over them has a constant count, so the
- * compiler unrolls it and the cuts live in registers. Sorted into an array
- * indexed at run time, which llvmpipe keeps in memory, they made the
- * scattering bakes 11 to 16% slower there and 7 to 18% on an H100
- * (docs/accuracy.md, "A ray's cuts in registers").
+ * where they fall there, and walked in order by ray_next_cut. Every loop
+ * over them has a constant count, so the compiler unrolls it and the cuts
+ * live in registers. Sorted into an array indexed at run time, which
+ * llvmpipe keeps in memory, they made the scattering bakes 11 to 16% slower
+ * there and 7 to 18% on an H100 (docs/accuracy.md, "A ray's cuts in
+ * registers").
  *
  * The levels a ray is cut at: the geometric ones and, where the shader
  * defines SB_RAY_OZONE_CORNERS, the ozone tent's corners, where the density

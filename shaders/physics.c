@@ -116,10 +116,11 @@ size_t sb_multiscattering_refined_float_count(void)
 
 void sb_multiscattering_refined_fill(const struct sb_image *image, float *dst)
 {
-    const int n = SB_MULTISCATTERING_SIZE, m = SB_MULTISCATTERING_REFINED_SIZE;
-    float ln[SB_MULTISCATTERING_SIZE * SB_MULTISCATTERING_SIZE * 3];
-    for (int i = 0; i < n * n * 3; i++)
-        ln[i] = log_floor(image->data[i]);
+    /* from the lookup form itself, whose ghost texels repeat the edges as
+     * the shaders' taps expect */
+    const int n = SB_MULTISCATTERING_SIZE, stride = n + 2, m = SB_MULTISCATTERING_REFINED_SIZE;
+    float lookup[SB_MULTISCATTERING_LOOKUP_TEXELS * 4];
+    sb_lookup_fill(SB_PRODUCT_MULTISCATTERING, image, lookup);
     for (int y = 0; y < m; y++) {
         double wy[4];
         int y0 = sb_cubic_taps((double)y / SB_MULTISCATTERING_REFINE, n, wy);
@@ -128,9 +129,7 @@ void sb_multiscattering_refined_fill(const struct sb_image *image, float *dst)
             int x0 = sb_cubic_taps((double)x / SB_MULTISCATTERING_REFINE, n, wx);
             for (int b = 0; b < 4; b++)
                 for (int a = 0; a < 4; a++) {
-                    int sy = y0 + b < 0 ? 0 : (y0 + b < n ? y0 + b : n - 1);
-                    int sx = x0 + a < 0 ? 0 : (x0 + a < n ? x0 + a : n - 1);
-                    const float *texel = ln + ((size_t)sy * n + sx) * 3;
+                    const float *texel = lookup + ((size_t)(y0 + b + 1) * stride + x0 + a + 1) * 4;
                     for (int c = 0; c < 3; c++)
                         sum[c] += wy[b] * wx[a] * texel[c];
                 }
