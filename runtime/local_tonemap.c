@@ -19,12 +19,14 @@
 #include "local_tonemap_apply.spv.h"
 #include "local_tonemap_blur.spv.h"
 #include "local_tonemap_grid.spv.h"
+#include "local_tonemap_pivot.spv.h"
 
 struct sb_local_tonemap {
     bool enabled;
     struct sb_buffer params; /* sb_local_tonemap_gpu */
     struct sb_buffer grid;   /* the sums and counts, then the blurred grid */
-    VkPipeline grid_kernel, blur_kernel, apply_kernel;
+    VkDeviceSize sums_size;  /* the sums and counts' bytes, cleared each frame */
+    VkPipeline grid_kernel, pivot_kernel, blur_kernel, apply_kernel;
 };
 
 static enum sb_result local_tonemap_create(struct sb_renderer *r)
@@ -43,6 +45,7 @@ static enum sb_result local_tonemap_create(struct sb_renderer *r)
         sb_renderer_upload(r, NULL, sizeof(struct sb_local_tonemap_gpu), "local tone mapping", &t->params);
     if (!res)
         res = sb_renderer_upload(r, NULL, t->enabled ? cells * 16 : 16, "local tone mapping grid", &t->grid);
+    t->sums_size = cells * 8;
     if (res)
         return res;
     struct sb_local_tonemap_gpu *gpu = t->params.mapped;
@@ -56,6 +59,9 @@ static enum sb_result local_tonemap_create(struct sb_renderer *r)
     if (t->enabled) {
         res = sb_renderer_kernel(r, sb_spv_local_tonemap_grid, sizeof(sb_spv_local_tonemap_grid), "local tonemap grid",
                                  &t->grid_kernel);
+        if (!res)
+            res = sb_renderer_kernel(r, sb_spv_local_tonemap_pivot, sizeof(sb_spv_local_tonemap_pivot),
+                                     "local tonemap pivot", &t->pivot_kernel);
         if (!res)
             res = sb_renderer_kernel(r, sb_spv_local_tonemap_blur, sizeof(sb_spv_local_tonemap_blur),
                                      "local tonemap blur", &t->blur_kernel);
@@ -71,7 +77,7 @@ static void local_tonemap_destroy(struct sb_renderer *r)
     struct sb_local_tonemap *t = r->local_tonemap;
     if (!t)
         return;
-    sb_renderer_release(r, (const VkPipeline[]){t->grid_kernel, t->blur_kernel, t->apply_kernel}, 3, NULL, 0);
+    sb_renderer_release(r, (const VkPipeline[]){t->grid_kernel, t->pivot_kernel, t->blur_kernel, t->apply_kernel}, 4, NULL, 0);
     sb_buffer_destroy(r->vk, &t->params);
     sb_buffer_destroy(r->vk, &t->grid);
     free(t);
@@ -85,9 +91,13 @@ static void local_tonemap_record(struct sb_renderer *r)
         return;
     const struct sb_local_tonemap_gpu *gpu = t->params.mapped;
     vkCmdFillBuffer(r->cmd, t->params.buffer, offsetof(struct sb_local_tonemap_gpu, pivot), sizeof(gpu->pivot), 0);
+    vkCmdFillBuffer(r->cmd, t->grid.buffer, 0, t->sums_size, 0);
     sb_renderer_barrier(r->cmd);
-    sb_renderer_dispatch(r, t->grid_kernel, NULL, (const uint32_t[3]){gpu->grid[0] * 16, gpu->grid[1] * 16, 1},
-                         (const uint32_t[3]){16, 16, 1});
+    sb_renderer_dispatch(r, t->grid_kernel, NULL, (const uint32_t[3]){r->width, r->height, 1},
+                         (const uint32_t[3]){SB_WORKGROUP_X, SB_WORKGROUP_Y, 1});
+    sb_renderer_barrier(r->cmd);
+    sb_renderer_dispatch(r, t->pivot_kernel, NULL, (const uint32_t[3]){gpu->grid[0] * gpu->grid[1], 1, 1},
+                         (const uint32_t[3]){64, 1, 1});
     sb_renderer_barrier(r->cmd);
     sb_renderer_dispatch(r, t->blur_kernel, NULL, (const uint32_t[3]){gpu->grid[0], gpu->grid[1], gpu->grid[2]},
                          (const uint32_t[3]){4, 4, 4});

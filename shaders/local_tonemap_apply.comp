@@ -1,5 +1,5 @@
 #version 450
-/* Local tone mapping, step 3: each pixel's base layer, the grid read at
+/* Local tone mapping, step 4: each pixel's base layer, the grid read at
  * its position and log2 luminance (trilinear: deviation over count), is
  * its neighbourhood's log2 luminance among pixels of a like luminance,
  * relative to the frame's pivot. Its distance from the pivot is scaled by

@@ -1,5 +1,5 @@
 #version 450
-/* Local tone mapping, step 2: one invocation a cell. The cell's sum less
+/* Local tone mapping, step 3: one invocation a cell. The cell's sum less
  * its count times the pivot (an exact integer: 0 in a frame of one
  * luminance), then both blurred by [1 2 1] along each of the grid's three
  * axes, as floats. */
