@@ -39,11 +39,9 @@ vec3 prepare(vec3 c)
     return c * keep;
 }
 
-vec3 box(vec2 uv, vec2 t, vec2 a, vec2 b, vec2 c, vec2 d)
+vec3 tap(vec2 uv, vec2 t, float x, float y)
 {
-    vec3 s = prepare(textureLod(src, uv + a * t, 0.0).rgb) + prepare(textureLod(src, uv + b * t, 0.0).rgb) +
-             prepare(textureLod(src, uv + c * t, 0.0).rgb) + prepare(textureLod(src, uv + d * t, 0.0).rgb);
-    return 0.25 * s;
+    return prepare(textureLod(src, uv + vec2(x, y) * t, 0.0).rgb);
 }
 
 void main()
@@ -54,12 +52,15 @@ void main()
         return;
     vec2 uv = (vec2(pixel) + 0.5) / vec2(size);
     vec2 t = 1.0 / vec2(textureSize(src, 0));
-    vec3 boxes[5] = vec3[5](
-        box(uv, t, vec2(-1, -1), vec2(1, -1), vec2(-1, 1), vec2(1, 1)),  /* centre */
-        box(uv, t, vec2(-2, -2), vec2(0, -2), vec2(-2, 0), vec2(0, 0)),  /* corners */
-        box(uv, t, vec2(0, -2), vec2(2, -2), vec2(0, 0), vec2(2, 0)),
-        box(uv, t, vec2(-2, 0), vec2(0, 0), vec2(-2, 2), vec2(0, 2)),
-        box(uv, t, vec2(0, 0), vec2(2, 0), vec2(0, 2), vec2(2, 2)));
+    /* the 13 taps, each read once: four inner, nine on the outer lattice */
+    vec3 i00 = tap(uv, t, -1, -1), i10 = tap(uv, t, 1, -1), i01 = tap(uv, t, -1, 1), i11 = tap(uv, t, 1, 1);
+    vec3 o00 = tap(uv, t, -2, -2), o10 = tap(uv, t, 0, -2), o20 = tap(uv, t, 2, -2);
+    vec3 o01 = tap(uv, t, -2, 0), o11 = tap(uv, t, 0, 0), o21 = tap(uv, t, 2, 0);
+    vec3 o02 = tap(uv, t, -2, 2), o12 = tap(uv, t, 0, 2), o22 = tap(uv, t, 2, 2);
+    vec3 boxes[5] = vec3[5](0.25 * (i00 + i10 + i01 + i11), /* centre */
+                            0.25 * (o00 + o10 + o01 + o11), /* corners */
+                            0.25 * (o10 + o20 + o11 + o21), 0.25 * (o01 + o11 + o02 + o12),
+                            0.25 * (o11 + o21 + o12 + o22));
     const float weights[5] = float[5](0.5, 0.125, 0.125, 0.125, 0.125);
     vec3 sum = vec3(0.0);
     float norm = 0.0;
