@@ -68,9 +68,9 @@ static const struct {
 
 static const VkDescriptorType binding_types[SB_VIEW_BINDING_COUNT] = {
     [SB_BINDING_ATMOSPHERE] = VK_DESCRIPTOR_TYPE_STORAGE_BUFFER,
-    [SB_BINDING_TRANSMITTANCE] = VK_DESCRIPTOR_TYPE_STORAGE_BUFFER,
-    [SB_BINDING_MULTISCATTERING] = VK_DESCRIPTOR_TYPE_STORAGE_BUFFER,
-    [SB_BINDING_IRRADIANCE_GROUND] = VK_DESCRIPTOR_TYPE_STORAGE_BUFFER,
+    [SB_BINDING_TRANSMITTANCE] = VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER,
+    [SB_BINDING_MULTISCATTERING] = VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER,
+    [SB_BINDING_IRRADIANCE_GROUND] = VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER,
     [SB_VIEW_BINDING_FRAME] = VK_DESCRIPTOR_TYPE_STORAGE_BUFFER,
     [SB_VIEW_BINDING_VERTICES] = VK_DESCRIPTOR_TYPE_STORAGE_BUFFER,
     [SB_VIEW_BINDING_EXPOSURE] = VK_DESCRIPTOR_TYPE_STORAGE_BUFFER,
@@ -141,19 +141,11 @@ static void bind_own(struct sb_renderer *r)
         uint32_t binding;
         const struct sb_buffer *buffer;
     } buffers[] = {
-        {SB_BINDING_ATMOSPHERE, &r->atmosphere},
-        {SB_BINDING_TRANSMITTANCE, &r->transmittance},
-        {SB_BINDING_MULTISCATTERING, &r->multiscattering},
-        {SB_BINDING_IRRADIANCE_GROUND, &r->irradiance_ground},
-        {SB_VIEW_BINDING_FRAME, &r->frame},
-        {SB_VIEW_BINDING_VERTICES, &r->vertices},
-        {SB_VIEW_BINDING_EXPOSURE, &r->exposure},
-        {SB_VIEW_BINDING_PROBES, &r->probes},
-        {SB_VIEW_BINDING_PROBE_LIGHT, &r->probe_light},
-        {SB_VIEW_BINDING_REFLECTIONS, &r->reflections},
-        {SB_VIEW_BINDING_REFLECTION_CUBES, &r->reflection_cubes},
-        {SB_VIEW_BINDING_BVH_NODES, &r->bvh_nodes},
-        {SB_VIEW_BINDING_BVH_TRIANGLES, &r->bvh_triangles},
+        {SB_BINDING_ATMOSPHERE, &r->atmosphere},        {SB_VIEW_BINDING_FRAME, &r->frame},
+        {SB_VIEW_BINDING_VERTICES, &r->vertices},       {SB_VIEW_BINDING_EXPOSURE, &r->exposure},
+        {SB_VIEW_BINDING_PROBES, &r->probes},           {SB_VIEW_BINDING_PROBE_LIGHT, &r->probe_light},
+        {SB_VIEW_BINDING_REFLECTIONS, &r->reflections}, {SB_VIEW_BINDING_REFLECTION_CUBES, &r->reflection_cubes},
+        {SB_VIEW_BINDING_BVH_NODES, &r->bvh_nodes},     {SB_VIEW_BINDING_BVH_TRIANGLES, &r->bvh_triangles},
     };
     for (size_t i = 0; i < sizeof(buffers) / sizeof(buffers[0]); i++)
         sb_renderer_bind_buffer(r, buffers[i].binding, buffers[i].buffer);
@@ -176,6 +168,10 @@ static void bind_own(struct sb_renderer *r)
     };
     for (size_t i = 0; i < sizeof(views) / sizeof(views[0]); i++)
         sb_renderer_bind_view(r, views[i].binding, views[i].view, NULL);
+    /* read by texelFetch (atmosphere.glsl, SB_ATMOSPHERE_TEXTURES) */
+    sb_renderer_bind_view(r, SB_BINDING_TRANSMITTANCE, r->transmittance.view, r->nearest);
+    sb_renderer_bind_view(r, SB_BINDING_MULTISCATTERING, r->multiscattering.view, r->nearest);
+    sb_renderer_bind_view(r, SB_BINDING_IRRADIANCE_GROUND, r->irradiance_ground.view, r->nearest);
 }
 
 /* Write every binding of `set`; the bloom step's source and target vary per set. */
@@ -355,6 +351,31 @@ enum sb_result sb_renderer_upload_image(struct sb_renderer *r, const struct sb_i
     return res;
 }
 
+/* `count` texels of `channels` floats (3 or more) as RGBA, alpha 0. */
+static void rgb_to_rgba(float *dst, const float *src, uint32_t channels, size_t count)
+{
+    for (size_t i = 0; i < count; i++)
+        for (uint32_t c = 0; c < 4; c++)
+            dst[4 * i + c] = c < 3 ? src[i * channels + c] : 0.0f;
+}
+
+/* A sampled RGBA32F texture of width x height texels from `data`. */
+static enum sb_result upload_rgba32f(struct sb_renderer *r, const float *data, uint32_t width, uint32_t height,
+                                     const char *name, struct sb_texture *texture)
+{
+    struct sb_texture_params p = {
+        .width = width,
+        .height = height,
+        .format = VK_FORMAT_R32G32B32A32_SFLOAT,
+        .usage = VK_IMAGE_USAGE_SAMPLED_BIT | VK_IMAGE_USAGE_TRANSFER_DST_BIT,
+        .name = name,
+    };
+    enum sb_result res = sb_texture_create(r->vk, &p, texture);
+    if (!res)
+        res = sb_texture_upload(r->vk, texture, data, (size_t)width * height * 4 * sizeof(float), 4 * sizeof(float));
+    return res;
+}
+
 static enum sb_result upload_atmosphere(struct sb_renderer *r, const struct sb_pack *pack)
 {
     static const enum sb_product_id needed[] = {SB_PRODUCT_TRANSMITTANCE, SB_PRODUCT_MULTISCATTERING,
@@ -376,19 +397,32 @@ static enum sb_result upload_atmosphere(struct sb_renderer *r, const struct sb_p
 
     const struct sb_image *t = &pack->images[SB_PRODUCT_TRANSMITTANCE];
     enum sb_result res = upload(r->vk, &gpu, sizeof(gpu), "atmosphere parameters", &r->atmosphere);
-    if (!res)
-        res = upload(r->vk, t->data, sb_image_float_count(t) * sizeof(float), "transmittance", &r->transmittance);
-    if (!res)
-        res = upload(r->vk, NULL, sb_multiscattering_refined_float_count() * sizeof(float), "multiscattering",
-                     &r->multiscattering);
-    if (!res)
-        sb_multiscattering_refined_fill(&pack->images[SB_PRODUCT_MULTISCATTERING], r->multiscattering.mapped);
-    if (!res)
-        res = upload(r->vk, NULL, sb_lookup_float_count(SB_PRODUCT_IRRADIANCE_GROUND) * sizeof(float),
-                     "irradiance_ground", &r->irradiance_ground);
-    if (!res)
-        sb_lookup_fill(SB_PRODUCT_IRRADIANCE_GROUND, &pack->images[SB_PRODUCT_IRRADIANCE_GROUND],
-                       r->irradiance_ground.mapped);
+    /* Each as RGBA32F (atmosphere.glsl, SB_ATMOSPHERE_TEXTURES): the
+     * transmittance LUT; psi_ms refined, whose nodes are RGBA already; the
+     * ground irradiance's lookup form, rgb, two rows. */
+    size_t lut_texels = (size_t)t->width * t->height, ground_texels = (size_t)SB_IRRADIANCE_WIDTH * 2;
+    size_t floats = sb_multiscattering_refined_float_count();
+    floats = floats > lut_texels * 4 ? floats : lut_texels * 4;
+    float *staging = res ? NULL : malloc((floats + ground_texels * 3) * sizeof(float));
+    if (!res && !staging)
+        res = SB_ERR_NOMEM;
+    if (!res) {
+        rgb_to_rgba(staging, t->data, t->channel_count, lut_texels);
+        res = upload_rgba32f(r, staging, t->width, t->height, "transmittance", &r->transmittance);
+    }
+    if (!res) {
+        sb_multiscattering_refined_fill(&pack->images[SB_PRODUCT_MULTISCATTERING], staging);
+        res = upload_rgba32f(r, staging, SB_MULTISCATTERING_REFINED_SIZE, SB_MULTISCATTERING_REFINED_SIZE,
+                             "multiscattering (refined)", &r->multiscattering);
+    }
+    if (!res) {
+        float *rgb = staging + floats;
+        assert(sb_lookup_float_count(SB_PRODUCT_IRRADIANCE_GROUND) == ground_texels * 3);
+        sb_lookup_fill(SB_PRODUCT_IRRADIANCE_GROUND, &pack->images[SB_PRODUCT_IRRADIANCE_GROUND], rgb);
+        rgb_to_rgba(staging, rgb, 3, ground_texels);
+        res = upload_rgba32f(r, staging, SB_IRRADIANCE_WIDTH, 2, "irradiance_ground (lookup)", &r->irradiance_ground);
+    }
+    free(staging);
     return res;
 }
 
@@ -865,13 +899,23 @@ void sb_renderer_destroy(struct sb_renderer **pr)
         vkDestroySampler(d, r->shadow_compare, NULL);
     if (r->repeat)
         vkDestroySampler(d, r->repeat, NULL);
-    struct sb_texture *const textures[] = {&r->sky_view, &r->aerial, &r->aerial_t, &r->shadow,        &r->hdr,
-                                           &r->depth,    &r->bloom,  &r->ldr,      &r->depth_stand_in};
+    struct sb_texture *const textures[] = {&r->transmittance,
+                                           &r->multiscattering,
+                                           &r->irradiance_ground,
+                                           &r->sky_view,
+                                           &r->aerial,
+                                           &r->aerial_t,
+                                           &r->shadow,
+                                           &r->hdr,
+                                           &r->depth,
+                                           &r->bloom,
+                                           &r->ldr,
+                                           &r->depth_stand_in};
     sb_renderer_release(r, NULL, 0, textures, sizeof(textures) / sizeof(textures[0]));
-    struct sb_buffer *buffers[] = {&r->atmosphere,  &r->transmittance,    &r->multiscattering, &r->irradiance_ground,
-                                   &r->frame,       &r->vertices,         &r->exposure,        &r->read_ldr,
-                                   &r->read_hdr,    &r->read_sky_view,    &r->probes,          &r->probe_light,
-                                   &r->reflections, &r->reflection_cubes, &r->read_post,       &r->post_input};
+    struct sb_buffer *buffers[] = {&r->atmosphere,  &r->frame,       &r->vertices,         &r->exposure,
+                                   &r->read_ldr,    &r->read_hdr,    &r->read_sky_view,    &r->probes,
+                                   &r->probe_light, &r->reflections, &r->reflection_cubes, &r->read_post,
+                                   &r->post_input};
     for (size_t i = 0; i < sizeof(buffers) / sizeof(buffers[0]); i++)
         sb_buffer_destroy(vk, buffers[i]);
     free(r);

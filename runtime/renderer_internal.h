@@ -68,7 +68,9 @@ struct sb_renderer {
     bool aerial_volume_only;               /* this frame's: which scene pipeline draws */
     bool scene_traced;                     /* the scene pass traces (scene_trace.c): no cascades to draw */
 
-    struct sb_buffer atmosphere, transmittance, multiscattering, irradiance_ground;
+    struct sb_buffer atmosphere;
+    struct sb_texture transmittance, multiscattering, irradiance_ground; /* RGBA32F: the LUT; the refined and
+                                                                            lookup forms (physics.h) */
     struct sb_buffer frame, vertices, exposure;
     struct sb_buffer probes, probe_light;           /* sb_probes_gpu and its probes; the sky's and probes' SH */
     struct sb_buffer reflections, reflection_cubes; /* sb_reflections_gpu, its probes and the DFG; the cubes */

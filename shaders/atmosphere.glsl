@@ -22,14 +22,31 @@ const float PI = 3.14159265358979;
 layout(std430, set = 0, binding = SB_BINDING_ATMOSPHERE) readonly buffer AtmosphereBuffer {
     sb_atmosphere_gpu atm;
 };
+/*
+ * The bakes read the transmittance LUT and the lookup forms of
+ * multiscattering and irradiance_ground (config.h) from storage buffers.
+ * skyview (view.glsl defines SB_ATMOSPHERE_TEXTURES) binds the transmittance
+ * LUT, multiscattering's refined form (SB_MULTISCATTERING_REFINED) and
+ * irradiance_ground's lookup form as RGBA32F textures instead and reads their texels with texelFetch, through
+ * the same bilinear arithmetic, so the values are the same: llvmpipe loads a
+ * storage buffer at an index that varies across a SIMD group one invocation
+ * and one component at a time, a texel for the whole group at once (the
+ * sky-view LUT took half the time, docs/skyview.md).
+ */
+#ifdef SB_ATMOSPHERE_TEXTURES
+#ifndef SB_MULTISCATTERING_REFINED
+#error "the refined psi_ms is the only form bound as a texture"
+#endif
+layout(set = 0, binding = SB_BINDING_TRANSMITTANCE) uniform sampler2D transmittance_texture;
+layout(set = 0, binding = SB_BINDING_MULTISCATTERING) uniform sampler2D multiscattering_texture;
+#else
 layout(std430, set = 0, binding = SB_BINDING_TRANSMITTANCE) readonly buffer TransmittanceBuffer {
     float transmittance_lut[];
 };
-/* The lookup forms of multiscattering and irradiance_ground (config.h);
- * skyview binds multiscattering's refined form (SB_MULTISCATTERING_REFINED). */
 layout(std430, set = 0, binding = SB_BINDING_MULTISCATTERING) readonly buffer MultiscatteringBuffer {
     vec4 multiscattering_log[];
 };
+#endif
 /* A sphere bake (sphere.glsl) built with SB_MULTISCATTERING_SHARED defined
  * before this file reads the multiscattering LUT from a copy in workgroup
  * memory, which sphere_init fills: llvmpipe loads it much faster than a
@@ -41,9 +58,13 @@ shared vec4 multiscattering_shared[SB_MULTISCATTERING_LOOKUP_TEXELS];
 #else
 #define SB_MULTISCATTERING_LOG(k) multiscattering_log[k].rgb
 #endif
+#ifdef SB_ATMOSPHERE_TEXTURES
+layout(set = 0, binding = SB_BINDING_IRRADIANCE_GROUND) uniform sampler2D ground_irradiance_texture;
+#else
 layout(std430, set = 0, binding = SB_BINDING_IRRADIANCE_GROUND) readonly buffer IrradianceGroundBuffer {
     float ground_irradiance_log[];
 };
+#endif
 
 float ground_radius() { return atm.radii.x; }
 float top_radius() { return atm.radii.y; }
@@ -437,12 +458,28 @@ vec3 transmittance_to_top(float h, float mu)
         out_value[c_] = mix(mix(v00_, v10_, ax_), mix(v01_, v11_, ax_), ay_);                        \
     } }
 
+/* The same of an RGBA32F texture's rgb, by texelFetch. */
+#define SB_TEXTURE_BILINEAR(tex, width, height, fx, fy, out_value) {                                \
+    float sx_ = clamp(fx, 0.0, float(width - 1)), sy_ = clamp(fy, 0.0, float(height - 1));          \
+    int x0_ = min(int(sx_), width - 2), y0_ = min(int(sy_), height - 2);                            \
+    float ax_ = sx_ - float(x0_), ay_ = sy_ - float(y0_);                                           \
+    vec3 v00_ = texelFetch(tex, ivec2(x0_, y0_), 0).rgb, v10_ = texelFetch(tex, ivec2(x0_ + 1, y0_), 0).rgb; \
+    vec3 v01_ = texelFetch(tex, ivec2(x0_, y0_ + 1), 0).rgb;                                        \
+    vec3 v11_ = texelFetch(tex, ivec2(x0_ + 1, y0_ + 1), 0).rgb;                                    \
+    out_value = mix(mix(v00_, v10_, ax_), mix(v01_, v11_, ax_), ay_);                               \
+    }
+
 vec3 transmittance_lut_sample(float h, float mu)
 {
     vec2 x = transmittance_unit_coords(h, mu);
     vec3 v;
+#ifdef SB_ATMOSPHERE_TEXTURES
+    SB_TEXTURE_BILINEAR(transmittance_texture, SB_TRANSMITTANCE_WIDTH, SB_TRANSMITTANCE_HEIGHT,
+                        x.x * SB_TRANSMITTANCE_WIDTH - 0.5, x.y * SB_TRANSMITTANCE_HEIGHT - 0.5, v);
+#else
     SB_LUT_BILINEAR(transmittance_lut, 3, SB_TRANSMITTANCE_WIDTH, SB_TRANSMITTANCE_HEIGHT,
                     x.x * SB_TRANSMITTANCE_WIDTH - 0.5, x.y * SB_TRANSMITTANCE_HEIGHT - 0.5, v);
+#endif
     return v;
 }
 
@@ -508,9 +545,8 @@ vec3 multiscattering_lut_sample(float h, float mu_s)
     vec2 fr = clamp(f * float(SB_MULTISCATTERING_REFINE), vec2(0.0), vec2(float(m - 1)));
     ivec2 i = min(ivec2(fr), ivec2(m - 2));
     vec2 w = fr - vec2(i);
-    int k = i.y * m + i.x;
-    vec3 lo = mix(SB_MULTISCATTERING_LOG(k), SB_MULTISCATTERING_LOG(k + 1), w.x);
-    vec3 hi = mix(SB_MULTISCATTERING_LOG(k + m), SB_MULTISCATTERING_LOG(k + m + 1), w.x);
+    vec3 lo = mix(texelFetch(multiscattering_texture, i, 0).rgb, texelFetch(multiscattering_texture, i + ivec2(1, 0), 0).rgb, w.x);
+    vec3 hi = mix(texelFetch(multiscattering_texture, i + ivec2(0, 1), 0).rgb, texelFetch(multiscattering_texture, i + 1, 0).rgb, w.x);
     return exp(mix(lo, hi, w.y));
 #else
     const int stride = n + 2;
@@ -533,8 +569,12 @@ vec3 ground_irradiance_row(int row, float mu_s)
     int x0 = cubic_taps(subtexel_coords(0.0, mu_s, uvec2(n, SB_IRRADIANCE_HEIGHT)).x, n, w);
     vec3 sum = vec3(0.0);
     for (int i = 0; i < 4; i++) {
+#ifdef SB_ATMOSPHERE_TEXTURES
+        sum += w[i] * texelFetch(ground_irradiance_texture, ivec2(clamp(x0 + i, 0, n - 1), row), 0).rgb;
+#else
         int k = (row * n + clamp(x0 + i, 0, n - 1)) * 3;
         sum += w[i] * vec3(ground_irradiance_log[k], ground_irradiance_log[k + 1], ground_irradiance_log[k + 2]);
+#endif
     }
     return exp(sum);
 }

@@ -2,13 +2,15 @@
  * What skyview's passes share: the frame's constants, the sky-view LUT's
  * mapping, the sun disk, and the atmosphere read from the pack (the baked
  * transmittance for the sun, see SB_SUN_TRANSMITTANCE_LUT; psi_ms from its
- * refined form, SB_MULTISCATTERING_REFINED in config.h).
+ * refined form, SB_MULTISCATTERING_REFINED in config.h; both as textures,
+ * SB_ATMOSPHERE_TEXTURES in atmosphere.glsl).
  */
 #ifndef SB_VIEW_GLSL
 #define SB_VIEW_GLSL
 
 #define SB_SUN_TRANSMITTANCE_LUT
 #define SB_MULTISCATTERING_REFINED
+#define SB_ATMOSPHERE_TEXTURES
 #include "atmosphere.glsl"
 #include "sky_radiance.glsl"
 
