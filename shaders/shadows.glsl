@@ -72,12 +72,25 @@ float sun_visibility(vec3 offset, vec3 n, bool pcf)
         c++;
     if (c == SB_CASCADES)
         return 1.0;
-    float visibility = cascade_visibility(c, offset, n, pcf);
     float begin = c == 0 ? 0.0 : frame.cascade_ends[c - 1];
     float band = frame.shadow.x * (frame.cascade_ends[c] - begin);
     float f = band > 0.0 ? (depth - (frame.cascade_ends[c] - band)) / band : 0.0;
-    if (f > 0.0) /* toward the next cascade, or out of the shadows past the last */
-        visibility = mix(visibility, c + 1 < SB_CASCADES ? cascade_visibility(c + 1, offset, n, pcf) : 1.0, f);
+    /* In the band, toward the next cascade, or out of the shadows past the
+     * last. The next cascade is read in a loop's second turn, not in a
+     * branch: llvmpipe runs a branch's code whether or not an invocation
+     * takes it, but ends a loop when none of its SIMD group goes on, and
+     * few groups meet a band (the scene pass 46 -> 37 ms at 640 x 360). */
+    float visibility = 1.0, next = 1.0;
+    int last = f > 0.0 && c + 1 < SB_CASCADES ? c + 1 : c;
+    for (int k = c; k <= last; k++) {
+        float v = cascade_visibility(k, offset, n, pcf);
+        if (k == c)
+            visibility = v;
+        else
+            next = v;
+    }
+    if (f > 0.0)
+        visibility = mix(visibility, next, f);
     return visibility;
 }
 #endif /* SB_TRACED_SHADOWS */
