@@ -39,6 +39,6 @@ void main()
         t0 = t1;
         vec3 L = sun * (ri.sun_rayleigh * p_r + ri.sun_mie * p_m) + ri.ms_rayleigh + ri.ms_mie;
         imageStore(inscatter_out, ivec3(column, k), vec4(fp16_safe(L * frame.aerial.y), 1.0));
-        imageStore(transmittance_out, ivec3(column, k), vec4(ri.transmittance, 1.0));
+        imageStore(transmittance_out, ivec3(column, k), vec4(exp(-ri.tau), 1.0));
     }
 }
