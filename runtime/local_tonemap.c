@@ -14,11 +14,13 @@
 #include <stddef.h>
 #include <stdlib.h>
 
+#include "log.h"
 #include "renderer_internal.h"
 
 #include "local_tonemap_apply.spv.h"
 #include "local_tonemap_blur.spv.h"
 #include "local_tonemap_grid.spv.h"
+#include "local_tonemap_grid_subgroups.spv.h"
 #include "local_tonemap_pivot.spv.h"
 
 struct sb_local_tonemap {
@@ -57,8 +59,19 @@ static enum sb_result local_tonemap_create(struct sb_renderer *r)
     sb_renderer_bind_buffer(r, SB_VIEW_BINDING_LOCAL_TONEMAP, &t->params);
     sb_renderer_bind_buffer(r, SB_VIEW_BINDING_LOCAL_TONEMAP_GRID, &t->grid);
     if (t->enabled) {
-        res = sb_renderer_kernel(r, sb_spv_local_tonemap_grid, sizeof(sb_spv_local_tonemap_grid), "local tonemap grid",
-                                 &t->grid_kernel);
+        /* the grid's subgroups add before their atomics where they can (local_tonemap_grid.comp) */
+        const VkSubgroupFeatureFlags adds =
+            VK_SUBGROUP_FEATURE_BASIC_BIT | VK_SUBGROUP_FEATURE_BALLOT_BIT | VK_SUBGROUP_FEATURE_ARITHMETIC_BIT;
+        bool subgroups = (r->vk->compute_subgroup_ops & adds) == adds;
+        sb_debug("local tone mapping: the grid's atomics %s",
+                 subgroups ? "added up by subgroup first" : "a pixel each");
+        if (subgroups)
+            res =
+                sb_renderer_kernel(r, sb_spv_local_tonemap_grid_subgroups, sizeof(sb_spv_local_tonemap_grid_subgroups),
+                                   "local tonemap grid (subgroups)", &t->grid_kernel);
+        else
+            res = sb_renderer_kernel(r, sb_spv_local_tonemap_grid, sizeof(sb_spv_local_tonemap_grid),
+                                     "local tonemap grid", &t->grid_kernel);
         if (!res)
             res = sb_renderer_kernel(r, sb_spv_local_tonemap_pivot, sizeof(sb_spv_local_tonemap_pivot),
                                      "local tonemap pivot", &t->pivot_kernel);

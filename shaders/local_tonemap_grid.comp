@@ -5,10 +5,22 @@
  * sums do not depend on the order the pixels are added in. A workgroup a
  * cell with shared bins was three times slower on lavapipe: its barriers
  * make llvmpipe run the invocations as coroutines, and a cell of 20 pixels
- * square left a 16 x 16 workgroup's second pass mostly idle. */
+ * square left a 16 x 16 workgroup's second pass mostly idle.
+ *
+ * With SB_SUBGROUPS (chosen where the device's subgroups can ballot and
+ * add, runtime/local_tonemap.c), the invocations of a subgroup that share a
+ * cell and bin add their sums first and one of them adds the total: a GPU
+ * serialises atomics on one address, and one bin of one cell takes most of
+ * a smooth region's pixels (the pass took 0.11 ms on an H100 at 1920 x
+ * 1080 without, 0.06 with a workgroup a cell). */
 #extension GL_GOOGLE_include_directive : require
 #include "config.h"
 #include "local_tonemap.glsl"
+#ifdef SB_SUBGROUPS
+#extension GL_KHR_shader_subgroup_basic : require
+#extension GL_KHR_shader_subgroup_ballot : require
+#extension GL_KHR_shader_subgroup_arithmetic : require
+#endif
 
 layout(local_size_x = SB_WORKGROUP_X, local_size_y = SB_WORKGROUP_Y) in;
 layout(std430, set = 0, binding = SB_VIEW_BINDING_FRAME) readonly buffer FrameBuffer {
@@ -33,6 +45,21 @@ void main()
     float l = ltm_log_luminance(lum);
     uint bin = min(uint((l - SB_LTM_MIN_EV) / LTM_BIN_EV), uint(SB_LTM_BINS - 1));
     uint cell = ltm_cell(uvec3(p / ltm.grid.w, bin));
-    atomicAdd(ltm_cells[cell].x, uint(int(round(l * SB_LTM_Q)) + SB_LTM_BIAS));
+    uint value = uint(int(round(l * SB_LTM_Q)) + SB_LTM_BIAS);
+#ifdef SB_SUBGROUPS
+    /* One cell and bin a turn: the first invocation's, and those that share it. */
+    for (;;) {
+        if (cell == subgroupBroadcastFirst(cell)) {
+            uint sum = subgroupAdd(value), count = subgroupAdd(1u);
+            if (subgroupElect()) {
+                atomicAdd(ltm_cells[cell].x, sum);
+                atomicAdd(ltm_cells[cell].y, count);
+            }
+            break;
+        }
+    }
+#else
+    atomicAdd(ltm_cells[cell].x, value);
     atomicAdd(ltm_cells[cell].y, 1u);
+#endif
 }

@@ -241,9 +241,13 @@ enum sb_result sb_vk_create(const struct sb_vk_params *params, struct sb_vk **ou
         res = SB_ERR_NO_DEVICE;
         goto cleanup;
     }
-    VkPhysicalDeviceDriverProperties driver = {.sType = VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_DRIVER_PROPERTIES};
+    VkPhysicalDeviceSubgroupProperties subgroup = {.sType = VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_SUBGROUP_PROPERTIES};
+    VkPhysicalDeviceDriverProperties driver = {.sType = VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_DRIVER_PROPERTIES,
+                                               .pNext = &subgroup};
     VkPhysicalDeviceProperties2 props2 = {.sType = VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_PROPERTIES_2, .pNext = &driver};
     vkGetPhysicalDeviceProperties2(vk->physical_device, &props2);
+    vk->compute_subgroup_ops =
+        subgroup.supportedStages & VK_SHADER_STAGE_COMPUTE_BIT ? subgroup.supportedOperations : 0;
     snprintf(vk->driver_name, sizeof(vk->driver_name), "%s", driver.driverName);
     snprintf(vk->driver_info, sizeof(vk->driver_info), "%s", driver.driverInfo);
 

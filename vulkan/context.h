@@ -57,8 +57,9 @@ struct sb_vk {
     bool graphics;    /* created with sb_vk_params.graphics */
     bool depth_clamp; /* the depthClamp feature is enabled */
     bool has_timestamps;
-    bool statistics; /* pipelines capture their statistics (sb_vk_params.statistics) */
-    bool present;    /* VK_KHR_swapchain is enabled and the queue presents (sb_vk_params.can_present) */
+    VkSubgroupFeatureFlags compute_subgroup_ops; /* what compute shaders' subgroups can do (0: nothing) */
+    bool statistics;                             /* pipelines capture their statistics (sb_vk_params.statistics) */
+    bool present; /* VK_KHR_swapchain is enabled and the queue presents (sb_vk_params.can_present) */
     double timestamp_period_ns;
     unsigned validation_messages;
     PFN_vkSetDebugUtilsObjectNameEXT set_object_name;
