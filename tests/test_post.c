@@ -495,6 +495,25 @@ static void test_local_tonemap(void)
               "the halves move %+.3f and %+.3f EV, not -1 and +1", out_top - in_top, out_bottom - in_bottom);
         CHECK(fabs(step_out / step_in - 1.0) < 0.02, "the checker's steps go from %.3f to %.3f EV", step_in, step_out);
     }
+
+    /* The grid summed with a subgroup adding its pixels of a cell and bin
+     * first (where the device's subgroups can) and by an atomic a pixel:
+     * the same integers, so the same frame bit for bit, on the world's
+     * own frame (many cells and bins). */
+    struct sb_renderer_params world_params = base_params;
+    world_params.local_contrast = 0.7;
+    VkSubgroupFeatureFlags ops = vk->compute_subgroup_ops;
+    printf("local tone mapping: this device's subgroups %s\n",
+           (ops & VK_SUBGROUP_FEATURE_ARITHMETIC_BIT) && (ops & VK_SUBGROUP_FEATURE_BALLOT_BIT)
+               ? "add, so both grids are compared"
+               : "cannot add: one grid, compared with itself");
+    if (render(&world_params, &v, on, "the world, locally tone mapped")) {
+        vk->compute_subgroup_ops = 0;
+        bool ok = render(&world_params, &v, off, "the world, locally tone mapped without subgroups");
+        vk->compute_subgroup_ops = ops;
+        CHECK(ok && !memcmp(on->hdr, off->hdr, sizeof(on->hdr)) && !memcmp(on->ldr, off->ldr, sizeof(on->ldr)),
+              "the local tone mapping's grid by subgroups and by pixels give different frames");
+    }
     free(input);
     free(off);
     free(on);
