@@ -447,42 +447,27 @@ vec3 transmittance_to_top(float h, float mu)
     return exp(-optical_depth_to_top(rho, max(e, 0.0)));
 }
 
-/* Bilinear lookup of an interleaved fp32 LUT with texel centres at (i + 0.5) / size. */
-#define SB_LUT_BILINEAR(lut, channels, width, height, fx, fy, out_value) {                       \
-    float sx_ = clamp(fx, 0.0, float(width - 1)), sy_ = clamp(fy, 0.0, float(height - 1));          \
-    int x0_ = min(int(sx_), width - 2), y0_ = min(int(sy_), height - 2);                            \
-    float ax_ = sx_ - float(x0_), ay_ = sy_ - float(y0_);                                           \
-    for (int c_ = 0; c_ < channels; c_++) {                                                          \
-        float v00_ = lut[((y0_) * width + x0_) * channels + c_];                                     \
-        float v10_ = lut[((y0_) * width + x0_ + 1) * channels + c_];                                 \
-        float v01_ = lut[((y0_ + 1) * width + x0_) * channels + c_];                                 \
-        float v11_ = lut[((y0_ + 1) * width + x0_ + 1) * channels + c_];                             \
-        out_value[c_] = mix(mix(v00_, v10_, ax_), mix(v01_, v11_, ax_), ay_);                        \
-    } }
+/* Texel (x, y) of the transmittance LUT: skyview's texture, or the bakes'
+ * interleaved buffer. */
+vec3 transmittance_texel(int x, int y)
+{
+#ifdef SB_ATMOSPHERE_TEXTURES
+    return texelFetch(transmittance_texture, ivec2(x, y), 0).rgb;
+#else
+    int k = (y * SB_TRANSMITTANCE_WIDTH + x) * 3;
+    return vec3(transmittance_lut[k], transmittance_lut[k + 1], transmittance_lut[k + 2]);
+#endif
+}
 
-/* The same of an RGBA32F texture's rgb, by texelFetch. */
-#define SB_TEXTURE_BILINEAR(tex, width, height, fx, fy, out_value) {                                \
-    float sx_ = clamp(fx, 0.0, float(width - 1)), sy_ = clamp(fy, 0.0, float(height - 1));          \
-    int x0_ = min(int(sx_), width - 2), y0_ = min(int(sy_), height - 2);                            \
-    float ax_ = sx_ - float(x0_), ay_ = sy_ - float(y0_);                                           \
-    vec3 v00_ = texelFetch(tex, ivec2(x0_, y0_), 0).rgb, v10_ = texelFetch(tex, ivec2(x0_ + 1, y0_), 0).rgb; \
-    vec3 v01_ = texelFetch(tex, ivec2(x0_, y0_ + 1), 0).rgb;                                        \
-    vec3 v11_ = texelFetch(tex, ivec2(x0_ + 1, y0_ + 1), 0).rgb;                                    \
-    out_value = mix(mix(v00_, v10_, ax_), mix(v01_, v11_, ax_), ay_);                               \
-    }
-
+/* The transmittance LUT read bilinearly, its texel centres at (i + 0.5) / size. */
 vec3 transmittance_lut_sample(float h, float mu)
 {
-    vec2 x = transmittance_unit_coords(h, mu);
-    vec3 v;
-#ifdef SB_ATMOSPHERE_TEXTURES
-    SB_TEXTURE_BILINEAR(transmittance_texture, SB_TRANSMITTANCE_WIDTH, SB_TRANSMITTANCE_HEIGHT,
-                        x.x * SB_TRANSMITTANCE_WIDTH - 0.5, x.y * SB_TRANSMITTANCE_HEIGHT - 0.5, v);
-#else
-    SB_LUT_BILINEAR(transmittance_lut, 3, SB_TRANSMITTANCE_WIDTH, SB_TRANSMITTANCE_HEIGHT,
-                    x.x * SB_TRANSMITTANCE_WIDTH - 0.5, x.y * SB_TRANSMITTANCE_HEIGHT - 0.5, v);
-#endif
-    return v;
+    const ivec2 size = ivec2(SB_TRANSMITTANCE_WIDTH, SB_TRANSMITTANCE_HEIGHT);
+    vec2 s = clamp(transmittance_unit_coords(h, mu) * vec2(size) - 0.5, vec2(0.0), vec2(size - 1));
+    ivec2 i = min(ivec2(s), size - 2);
+    vec2 a = s - vec2(i);
+    return mix(mix(transmittance_texel(i.x, i.y), transmittance_texel(i.x + 1, i.y), a.x),
+               mix(transmittance_texel(i.x, i.y + 1), transmittance_texel(i.x + 1, i.y + 1), a.x), a.y);
 }
 
 /* ---- Multiple-scattering LUT and irradiance LUTs -------------------------------- */
