@@ -351,18 +351,18 @@ enum sb_result sb_renderer_upload_image(struct sb_renderer *r, const struct sb_i
     return res;
 }
 
-/* `count` texels of `channels` floats (3 or more) as RGBA, alpha 0. */
-static void rgb_to_rgba(float *dst, const float *src, uint32_t channels, size_t count)
+/* A sampled RGBA32F texture of width x height texels from `data`, `channels`
+ * floats (3 or more) a texel: the first three, alpha 0. */
+static enum sb_result upload_rgba32f(struct sb_renderer *r, const float *data, uint32_t channels, uint32_t width,
+                                     uint32_t height, const char *name, struct sb_texture *texture)
 {
-    for (size_t i = 0; i < count; i++)
+    size_t texels = (size_t)width * height;
+    float *rgba = channels == 4 ? NULL : malloc(texels * 4 * sizeof(float));
+    if (channels != 4 && !rgba)
+        return SB_ERR_NOMEM;
+    for (size_t i = 0; rgba && i < texels; i++)
         for (uint32_t c = 0; c < 4; c++)
-            dst[4 * i + c] = c < 3 ? src[i * channels + c] : 0.0f;
-}
-
-/* A sampled RGBA32F texture of width x height texels from `data`. */
-static enum sb_result upload_rgba32f(struct sb_renderer *r, const float *data, uint32_t width, uint32_t height,
-                                     const char *name, struct sb_texture *texture)
-{
+            rgba[4 * i + c] = c < 3 ? data[i * channels + c] : 0.0f;
     struct sb_texture_params p = {
         .width = width,
         .height = height,
@@ -372,7 +372,8 @@ static enum sb_result upload_rgba32f(struct sb_renderer *r, const float *data, u
     };
     enum sb_result res = sb_texture_create(r->vk, &p, texture);
     if (!res)
-        res = sb_texture_upload(r->vk, texture, data, (size_t)width * height * 4 * sizeof(float), 4 * sizeof(float));
+        res = sb_texture_upload(r->vk, texture, rgba ? rgba : data, texels * 4 * sizeof(float), 4 * sizeof(float));
+    free(rgba);
     return res;
 }
 
@@ -398,31 +399,24 @@ static enum sb_result upload_atmosphere(struct sb_renderer *r, const struct sb_p
     const struct sb_image *t = &pack->images[SB_PRODUCT_TRANSMITTANCE];
     enum sb_result res = upload(r->vk, &gpu, sizeof(gpu), "atmosphere parameters", &r->atmosphere);
     /* Each as RGBA32F (atmosphere.glsl, SB_ATMOSPHERE_TEXTURES): the
-     * transmittance LUT; psi_ms refined, whose nodes are RGBA already; the
-     * ground irradiance's lookup form, rgb, two rows. */
-    size_t lut_texels = (size_t)t->width * t->height, ground_texels = (size_t)SB_IRRADIANCE_WIDTH * 2;
-    size_t floats = sb_multiscattering_refined_float_count();
-    floats = floats > lut_texels * 4 ? floats : lut_texels * 4;
-    float *staging = res ? NULL : malloc((floats + ground_texels * 3) * sizeof(float));
-    if (!res && !staging)
+     * transmittance LUT; psi_ms refined; the ground irradiance's lookup form. */
+    if (!res)
+        res = upload_rgba32f(r, t->data, t->channel_count, t->width, t->height, "transmittance", &r->transmittance);
+    float *refined = res ? NULL : malloc(sb_multiscattering_refined_float_count() * sizeof(float));
+    if (!res && !refined)
         res = SB_ERR_NOMEM;
     if (!res) {
-        rgb_to_rgba(staging, t->data, t->channel_count, lut_texels);
-        res = upload_rgba32f(r, staging, t->width, t->height, "transmittance", &r->transmittance);
-    }
-    if (!res) {
-        sb_multiscattering_refined_fill(&pack->images[SB_PRODUCT_MULTISCATTERING], staging);
-        res = upload_rgba32f(r, staging, SB_MULTISCATTERING_REFINED_SIZE, SB_MULTISCATTERING_REFINED_SIZE,
+        sb_multiscattering_refined_fill(&pack->images[SB_PRODUCT_MULTISCATTERING], refined);
+        res = upload_rgba32f(r, refined, 4, SB_MULTISCATTERING_REFINED_SIZE, SB_MULTISCATTERING_REFINED_SIZE,
                              "multiscattering (refined)", &r->multiscattering);
     }
+    free(refined);
+    float ground[SB_IRRADIANCE_WIDTH * 2 * 3]; /* two rows (physics.h) */
+    assert(sb_lookup_float_count(SB_PRODUCT_IRRADIANCE_GROUND) == sizeof(ground) / sizeof(ground[0]));
     if (!res) {
-        float *rgb = staging + floats;
-        assert(sb_lookup_float_count(SB_PRODUCT_IRRADIANCE_GROUND) == ground_texels * 3);
-        sb_lookup_fill(SB_PRODUCT_IRRADIANCE_GROUND, &pack->images[SB_PRODUCT_IRRADIANCE_GROUND], rgb);
-        rgb_to_rgba(staging, rgb, 3, ground_texels);
-        res = upload_rgba32f(r, staging, SB_IRRADIANCE_WIDTH, 2, "irradiance_ground (lookup)", &r->irradiance_ground);
+        sb_lookup_fill(SB_PRODUCT_IRRADIANCE_GROUND, &pack->images[SB_PRODUCT_IRRADIANCE_GROUND], ground);
+        res = upload_rgba32f(r, ground, 3, SB_IRRADIANCE_WIDTH, 2, "irradiance_ground (lookup)", &r->irradiance_ground);
     }
-    free(staging);
     return res;
 }
 
