@@ -47,7 +47,7 @@ static enum sb_result local_tonemap_create(struct sb_renderer *r)
         sb_renderer_upload(r, NULL, sizeof(struct sb_local_tonemap_gpu), "local tone mapping", &t->params);
     if (!res)
         res = sb_renderer_upload(r, NULL, t->enabled ? cells * 16 : 16, "local tone mapping grid", &t->grid);
-    t->sums_size = cells * 8;
+    t->sums_size = t->enabled ? cells * 8 : 0;
     if (res)
         return res;
     struct sb_local_tonemap_gpu *gpu = t->params.mapped;
