@@ -14,7 +14,8 @@
 #include "irradiance_sky_shared.spv.h"
 #include "log.h"
 #include "multiscattering.spv.h"
-#include "multiscattering_gpu.spv.h"
+#include "multiscattering_gather.spv.h"
+#include "multiscattering_rays.spv.h"
 #include "multiscattering_hillaire.spv.h"
 #include "physics.h"
 #include "sun_columns.spv.h"
@@ -67,15 +68,17 @@ struct spirv {
     const uint32_t *words;
     size_t size;
     uint32_t threads; /* a sphere.glsl kernel's workgroup size */
+    /* A kernel that integrates one direction an invocation (sphere.glsl's
+     * SB_SPHERE_RAYS): the kernel that sums them, run after it. */
+    const struct spirv *gather;
 };
 
-#define SPIRV(name)                                                                                                    \
+#define SPIRV(name) {.words = sb_spv_##name, .size = sizeof(sb_spv_##name), .threads = SB_SPHERE_THREADS_CPU}
+#define SPIRV_GPU(name) {.words = sb_spv_##name, .size = sizeof(sb_spv_##name), .threads = SB_SPHERE_THREADS_GPU}
+#define SPIRV_RAYS(name, id)                                                                                           \
     {                                                                                                                  \
-        sb_spv_##name, sizeof(sb_spv_##name), SB_SPHERE_THREADS_CPU                                                    \
-    }
-#define SPIRV_GPU(name)                                                                                                \
-    {                                                                                                                  \
-        sb_spv_##name, sizeof(sb_spv_##name), SB_SPHERE_THREADS_GPU                                                    \
+        .words = sb_spv_##name##_rays, .size = sizeof(sb_spv_##name##_rays), .threads = SB_SPHERE_RAY_GROUP,           \
+        .gather = &gather_shaders[id],                                                                                 \
     }
 /* Transmittance: one shader per Gauss-Legendre order, 0 for the uniform rules (config.h). */
 static const struct spirv transmittance_shaders[SB_GL_MAX_ORDER + 1] = {
@@ -89,11 +92,24 @@ static const struct spirv transmittance_shaders[SB_GL_MAX_ORDER + 1] = {
  * multiscattering LUT from workgroup memory (atmosphere.glsl). Both compute
  * the same sums in another order. On the H100, workgroup memory took
  * irradiance_sky from 6.1 to 8.5 ms (irradiance_ground 1.13 -> 1.05 ms); on
- * llvmpipe, from 10.7 to 8.2 s (1.46 -> 1.25 s). */
+ * llvmpipe, from 10.7 to 8.2 s (1.46 -> 1.25 s).
+ *
+ * A GPU runs multiscattering one ray an invocation and sums the rays in a
+ * second kernel (sphere.glsl's SB_SPHERE_RAYS, SB_SPHERE_GATHER), in the CPU
+ * layout's order, so the two give the same bits where the compilers
+ * contract alike: on an H200 the default bake took 0.447 ms instead of
+ * 0.505 (12x4 0.351 instead of 0.458, 4x3 0.276 instead of 0.418; two
+ * alternating runs of skybake bench), its content hash unchanged. The
+ * irradiance bakes were slower so on an H100: irradiance_ground 0.368 ms
+ * against 0.314, irradiance_sky 5.13 against 4.17 (240 registers an
+ * invocation instead of 168), and keep a workgroup a texel. */
+static const struct spirv gather_shaders[SB_ATMOSPHERE_PRODUCT_COUNT] = {
+    [SB_PRODUCT_MULTISCATTERING] = SPIRV(multiscattering_gather),
+};
 static const struct spirv scattering_shaders[2][SB_ATMOSPHERE_PRODUCT_COUNT] = {
     [SB_ATMOSPHERE_KERNELS_GPU] =
         {
-            [SB_PRODUCT_MULTISCATTERING] = SPIRV_GPU(multiscattering_gpu),
+            [SB_PRODUCT_MULTISCATTERING] = SPIRV_RAYS(multiscattering, SB_PRODUCT_MULTISCATTERING),
             [SB_PRODUCT_IRRADIANCE_GROUND] = SPIRV_GPU(irradiance_ground_gpu),
             [SB_PRODUCT_IRRADIANCE_SKY] = SPIRV_GPU(irradiance_sky_gpu),
         },
@@ -116,6 +132,11 @@ static const struct spirv sun_columns_ghosts_shader = SPIRV(sun_columns_ghosts);
 /* Multiscattering's ring table (sun_rings.glsl). */
 static const struct spirv sun_rings_shader = SPIRV(sun_rings);
 #undef SPIRV
+
+bool sb_atmosphere_kernels_same_order(enum sb_product_id id)
+{
+    return id < SB_ATMOSPHERE_PRODUCT_COUNT && scattering_shaders[SB_ATMOSPHERE_KERNELS_GPU][id].gather;
+}
 
 /* The kernels a device runs: a CPU device's where it offers their
  * workgroup memory. */
@@ -355,9 +376,17 @@ static enum sb_result run(struct sb_atmosphere_baker *b, const struct spirv *ker
     };
     enum sb_result res = SB_OK;
     bool workgroup_per_texel = directions > 0;
+    /* One direction an invocation, then a kernel that sums them (sphere.glsl). */
+    const struct spirv *gather = workgroup_per_texel ? kernel->gather : NULL;
+    uint32_t ray_groups = 0;
+    if (gather) {
+        ray_groups = (uint32_t)((directions + kernel->threads - 1) / kernel->threads);
+        push.direction_slots = ray_groups * kernel->threads;
+    }
     if (workgroup_per_texel) {
-        push.step_count = (uint32_t)((directions + kernel->threads - 1) / kernel->threads);
-        size_t bytes = 16 + (size_t)width * height * kernel->threads * SB_SPHERE_MAX_SUMS * sizeof(float);
+        push.step_count = gather ? 1 : (uint32_t)((directions + kernel->threads - 1) / kernel->threads);
+        size_t per_texel = gather ? push.direction_slots : kernel->threads;
+        size_t bytes = 16 + (size_t)width * height * per_texel * SB_SPHERE_MAX_SUMS * sizeof(float);
         if (b->scratch.size < bytes) {
             sb_buffer_destroy(b->vk, &b->scratch);
             if ((res = sb_buffer_create(b->vk, bytes, "sphere scratch", &b->scratch)))
@@ -367,7 +396,7 @@ static enum sb_result run(struct sb_atmosphere_baker *b, const struct spirv *ker
         memcpy(b->scratch.mapped, header, sizeof(header));
     }
 
-    struct sb_pipeline pipeline = {0};
+    struct sb_pipeline pipeline = {0}, gather_pipeline = {0};
     struct sb_pipeline_params pp = {
         .spirv = kernel->words,
         .spirv_size = kernel->size,
@@ -377,6 +406,14 @@ static enum sb_result run(struct sb_atmosphere_baker *b, const struct spirv *ker
     };
     if ((res = sb_pipeline_create(b->vk, &pp, &pipeline)))
         return res;
+    if (gather) {
+        pp.spirv = gather->words;
+        pp.spirv_size = gather->size;
+        if ((res = sb_pipeline_create(b->vk, &pp, &gather_pipeline))) {
+            sb_pipeline_destroy(b->vk, &pipeline);
+            return res;
+        }
+    }
     const struct sb_buffer *bindings[SB_BINDING_COUNT] = {
         [SB_BINDING_OUTPUT] = output,
         [SB_BINDING_SCRATCH] = workgroup_per_texel ? &b->scratch : &b->dummy,
@@ -388,6 +425,8 @@ static enum sb_result run(struct sb_atmosphere_baker *b, const struct spirv *ker
         if (bindings[i] == output) /* a product is never its own input */
             bindings[i] = &b->dummy;
     sb_pipeline_bind(b->vk, &pipeline, bindings);
+    if (gather)
+        sb_pipeline_bind(b->vk, &gather_pipeline, bindings);
     group_per_texel = group_per_texel || workgroup_per_texel;
     uint32_t groups_x = group_per_texel ? width : (width + SB_WORKGROUP_X - 1) / SB_WORKGROUP_X;
     uint32_t groups_y = group_per_texel ? height : (height + SB_WORKGROUP_Y - 1) / SB_WORKGROUP_Y;
@@ -400,7 +439,12 @@ static enum sb_result run(struct sb_atmosphere_baker *b, const struct spirv *ker
         push.step_begin = step;
         push.step_end = workgroup_per_texel && push.step_count - step > per_pass ? step + per_pass : push.step_count;
         double ms = 0;
-        res = sb_dispatch(b->vk, &pipeline, &push, groups_x, groups_y, 1, &ms);
+        res = sb_dispatch(b->vk, &pipeline, &push, groups_x, groups_y, gather ? ray_groups : 1, &ms);
+        total_ms += ms;
+    }
+    if (!res && gather) {
+        double ms = 0;
+        res = sb_dispatch(b->vk, &gather_pipeline, &push, groups_x, groups_y, 1, &ms);
         total_ms += ms;
     }
     if (!res && workgroup_per_texel && *(const uint32_t *)b->scratch.mapped) {
@@ -412,6 +456,7 @@ static enum sb_result run(struct sb_atmosphere_baker *b, const struct spirv *ker
     if (gpu_ms)
         *gpu_ms = total_ms;
     sb_pipeline_destroy(b->vk, &pipeline);
+    sb_pipeline_destroy(b->vk, &gather_pipeline);
     return res;
 }
 
@@ -561,8 +606,11 @@ void sb_atmosphere_code_hash(enum sb_product_id id, char out[SB_HASH_HEX_SIZE])
         for (int i = 0; i <= SB_GL_MAX_ORDER; i++)
             shaders[count++] = &transmittance_shaders[i];
     else
-        for (int k = 0; k < 2; k++)
+        for (int k = 0; k < 2; k++) {
             shaders[count++] = &scattering_shaders[k][id];
+            if (scattering_shaders[k][id].gather)
+                shaders[count++] = scattering_shaders[k][id].gather;
+        }
     for (int i = 0; i < count; i++) {
         sb_hash_bytes(shaders[i]->words, shaders[i]->size, text + n);
         n += SB_HASH_HEX_SIZE - 1;
@@ -613,7 +661,7 @@ enum sb_result sb_atmosphere_run_kernel(struct sb_atmosphere_baker *b, const uin
     uint32_t width = record_count < per_row ? record_count : per_row;
     uint32_t height = (record_count + per_row - 1) / per_row;
     struct sb_atmosphere_settings s = {.directions_mu = record_count, .directions_phi = record_floats};
-    const struct spirv kernel = {spirv, spirv_size, 0};
+    const struct spirv kernel = {.words = spirv, .size = spirv_size};
     res = run(b, &kernel, "kernel", &io, width, height, 0, false, &s, NULL);
     if (!res)
         memcpy(records, io.mapped, bytes);

@@ -69,6 +69,12 @@ enum sb_atmosphere_kernels {
  * where the device has less. */
 enum sb_result sb_atmosphere_baker_set_kernels(struct sb_atmosphere_baker *baker, enum sb_atmosphere_kernels kernels);
 
+/* Whether the GPU layout of scattering product `id` computes its sums in
+ * the CPU layout's order (one direction an invocation, summed by a second
+ * kernel: sphere.glsl), so that the two differ only where a compiler
+ * contracts their arithmetic differently. */
+bool sb_atmosphere_kernels_same_order(enum sb_product_id id);
+
 /*
  * Bake one product into `image` (initialised here; the caller finishes it).
  * Its dependencies must have been baked by this baker first. `settings` may

@@ -38,7 +38,13 @@
  * The sums' order, and so the last bits, differ between the two. */
 #define SB_SPHERE_THREADS_CPU 64
 #define SB_SPHERE_THREADS_GPU 128
-#ifdef SB_SPHERE_GPU
+/* A GPU may instead integrate one direction an invocation, in workgroups of
+ * SB_SPHERE_RAY_GROUP (sphere.glsl's SB_SPHERE_RAYS), and sum them in a
+ * second kernel SB_SPHERE_THREADS_CPU wide (SB_SPHERE_GATHER). */
+#define SB_SPHERE_RAY_GROUP 32
+#if defined(SB_SPHERE_RAYS)
+#define SB_SPHERE_THREADS SB_SPHERE_RAY_GROUP
+#elif defined(SB_SPHERE_GPU)
 #define SB_SPHERE_THREADS SB_SPHERE_THREADS_GPU
 #else
 #define SB_SPHERE_THREADS SB_SPHERE_THREADS_CPU
@@ -159,6 +165,7 @@ struct sb_bake_push {
     SB_UINT quadrature;     /* transmittance: SB_QUADRATURE_* */
     SB_UINT samples;        /* transmittance: steps of a uniform rule (a Gauss-Legendre order is compiled in) */
     SB_UINT subdivisions;   /* transmittance, Gauss-Legendre: equal sub-pieces per piece */
+    SB_UINT direction_slots; /* sphere.glsl, one direction an invocation: slots a texel */
 };
 
 /* Quadratures of the transmittance bake (sb_bake_push.quadrature):

@@ -22,6 +22,22 @@
  * SB_SPHERE_THREADS, sphere_add3() its values, then sphere_finish(), which
  * returns true on the last pass with the sums in sphere_sum3().
  *
+ * A GPU may run the same kernel in two steps instead. Built with
+ * SB_SPHERE_RAYS, each invocation integrates one direction, in workgroups
+ * of SB_SPHERE_RAY_GROUP, the host dispatching pc.direction_slots /
+ * SB_SPHERE_RAY_GROUP of them a texel along z, and sphere_finish() stores
+ * the direction's values in the scratch buffer. Built with
+ * SB_SPHERE_GATHER, a workgroup per texel, SB_SPHERE_THREADS_CPU wide,
+ * integrates nothing: sphere_finish() sums the stored directions, invocation
+ * i those of d = i, i + SB_SPHERE_THREADS_CPU, ... in order, and reduces
+ * as above. That is the CPU layout's order to the last operation, so the
+ * two layouts differ only where the compilers contract differently. Why:
+ * a workgroup per texel holds a GPU's registers for its widest invocation
+ * and its longest ray; multiscattering's one ray a zenith direction (80 to
+ * 128 a texel) leaves a quarter of 128 invocations idle, and a walk along a
+ * ray is a long chain of dependent work, so what counts is how many rays
+ * are walked at once.
+ *
  * Directions: Gauss-Legendre with n_mu nodes in mu = cos(zenith) on each
  * piece of sphere_pieces() (the integrand jumps at the horizon, kinks where
  * the ray grazes an ozone corner, and peaks at the sun for Mie scattering),
@@ -51,6 +67,9 @@ layout(std430, set = 0, binding = SB_BINDING_SCRATCH) buffer SphereScratch {
 };
 
 float sphere_acc[SB_SPHERE_MAX_SUMS]; /* this invocation's sums */
+#if defined(SB_SPHERE_RAYS) || defined(SB_SPHERE_GATHER)
+uint sphere_count; /* the texel's directions, as sphere_end_direction saw them */
+#endif
 
 /*
  * The pieces of [-1, 1] in mu (of [0, 1] for the upper hemisphere) that get
@@ -164,11 +183,11 @@ SpherePieces sphere_pieces(float h, bool whole_sphere, float mu_s, bool peaked)
 void sphere_init(uint n_mu, uint n_phi, bool cap)
 {
     uint i = gl_LocalInvocationIndex;
-    if (i < n_mu) {
+    for (uint k = i; k < n_mu; k += SB_SPHERE_THREADS) {
         float x, w;
-        gauss_legendre(int(i), int(n_mu), -1.0, 1.0, x, w);
-        sphere_node[i] = x;
-        sphere_weight[i] = w;
+        gauss_legendre(int(k), int(n_mu), -1.0, 1.0, x, w);
+        sphere_node[k] = x;
+        sphere_weight[k] = w;
     }
 #ifdef SB_MULTISCATTERING_SHARED
     for (uint k = i; k < uint(SB_MULTISCATTERING_LOOKUP_TEXELS); k += SB_SPHERE_THREADS)
@@ -438,22 +457,53 @@ uint sphere_slot()
     return (sphere_group() * SB_SPHERE_THREADS + gl_LocalInvocationIndex) * SB_SPHERE_MAX_SUMS;
 }
 
+#ifdef SB_SPHERE_RAYS
+/* This invocation's direction. */
+uint sphere_ray()
+{
+    return gl_WorkGroupID.z * SB_SPHERE_THREADS + gl_LocalInvocationIndex;
+}
+#endif
+
+/* Where direction d of this texel keeps its sums, one direction an invocation. */
+uint sphere_ray_slot(uint d)
+{
+    return (sphere_group() * pc.direction_slots + d) * SB_SPHERE_MAX_SUMS;
+}
+
 /* Start this pass from the previous passes' sums. */
 void sphere_begin()
 {
+#if defined(SB_SPHERE_RAYS) || defined(SB_SPHERE_GATHER)
+    for (uint c = 0u; c < SB_SPHERE_MAX_SUMS; c++)
+        sphere_acc[c] = 0.0;
+#else
     uint slot = sphere_slot();
     for (uint c = 0u; c < SB_SPHERE_MAX_SUMS; c++)
         sphere_acc[c] = pc.step_begin > 0u ? sphere_partials[slot + c] : 0.0;
+#endif
 }
 
 uint sphere_first_direction()
 {
+#ifdef SB_SPHERE_RAYS
+    return sphere_ray();
+#else
     return gl_LocalInvocationIndex + pc.step_begin * SB_SPHERE_THREADS;
+#endif
 }
 
 uint sphere_end_direction(uint count)
 {
+#if defined(SB_SPHERE_RAYS)
+    sphere_count = count;
+    return min(count, sphere_ray() + 1u);
+#elif defined(SB_SPHERE_GATHER)
+    sphere_count = count;
+    return 0u; /* the directions were integrated by the SB_SPHERE_RAYS kernel */
+#else
     return min(count, pc.step_end * SB_SPHERE_THREADS);
+#endif
 }
 
 void sphere_add3(uint c, vec3 value)
@@ -477,6 +527,16 @@ bool sphere_finish(uint count)
         k++;
     if (k != 2u)
         sphere_truncated = 1u;
+#if defined(SB_SPHERE_RAYS)
+    if (sphere_ray() < sphere_count)
+        for (uint c = 0u; c < count; c++)
+            sphere_partials[sphere_ray_slot(sphere_ray()) + c] = sphere_acc[c];
+    return false;
+#elif defined(SB_SPHERE_GATHER)
+    for (uint d = gl_LocalInvocationIndex; d < sphere_count; d += SB_SPHERE_THREADS)
+        for (uint c = 0u; c < count; c++)
+            sphere_acc[c] += sphere_partials[sphere_ray_slot(d) + c];
+#endif
     if (pc.step_end < pc.step_count) {
         uint slot = sphere_slot();
         for (uint c = 0u; c < count; c++)
