@@ -195,18 +195,39 @@ const struct sb_atmosphere_settings *sb_bench_candidates(enum sb_product_id id, 
 
 /* Rows on the Pareto front of their sweep: no other row is as fast or faster
  * and strictly more accurate, or strictly faster and as accurate. */
+/* Whether row a dominates row b of the same sweep: at most b's time and
+ * error, and less of one of them. */
+static bool dominates(const struct sb_bench_row *a, const struct sb_bench_row *b)
+{
+    return a->sweep == b->sweep && isfinite(a->error.max_rel) && a->gpu_ms <= b->gpu_ms &&
+           a->error.max_rel <= b->error.max_rel && (a->gpu_ms < b->gpu_ms || a->error.max_rel < b->error.max_rel);
+}
+
 static void mark_pareto(struct sb_bench_row *rows, int count)
 {
     for (int i = 0; i < count; i++) {
         rows[i].pareto = isfinite(rows[i].error.max_rel);
-        for (int j = 0; j < count && rows[i].pareto; j++) {
-            if (j == i || rows[j].sweep != rows[i].sweep)
-                continue;
-            bool faster_eq = rows[j].gpu_ms <= rows[i].gpu_ms,
-                 better_eq = rows[j].error.max_rel <= rows[i].error.max_rel;
-            if (faster_eq && better_eq &&
-                (rows[j].gpu_ms < rows[i].gpu_ms || rows[j].error.max_rel < rows[i].error.max_rel))
+        for (int j = 0; j < count && rows[i].pareto; j++)
+            if (j != i && dominates(&rows[j], &rows[i]))
                 rows[i].pareto = false;
+    }
+}
+
+/* Each anchor row against skybake's settings of its sweep (not the other
+ * published rows, nor their variants). */
+static void mark_anchors(struct sb_bench_row *rows, int count)
+{
+    for (int i = 0; i < count; i++) {
+        rows[i].dominated_by = -1;
+        rows[i].dominated_by_default = false;
+        if (!rows[i].anchor)
+            continue;
+        for (int j = 0; j < count; j++) {
+            if (!rows[j].ours || !dominates(&rows[j], &rows[i]))
+                continue;
+            if (rows[i].dominated_by < 0 || rows[j].gpu_ms < rows[rows[i].dominated_by].gpu_ms)
+                rows[i].dominated_by = j;
+            rows[i].dominated_by_default = rows[i].dominated_by_default || rows[j].is_default;
         }
     }
 }
@@ -309,6 +330,7 @@ enum sb_result sb_bench_run(struct sb_vk *vk, const struct sb_atmosphere_params 
             struct sb_bench_row *row = &report->rows[report->row_count];
             row->sweep = (enum sb_bench_sweep)w;
             row->anchor = entry->anchor;
+            row->ours = entry->settings.quadrature == SB_QUADRATURE_GAUSS_LEGENDRE;
             row->cost = sb_atmosphere_settings_cost(id, &entry->settings);
             sb_atmosphere_settings_label(id, &entry->settings, row->label, sizeof(row->label));
             /* one untimed bake first when timing repeats: pipeline caches settle */
@@ -349,6 +371,8 @@ enum sb_result sb_bench_run(struct sb_vk *vk, const struct sb_atmosphere_params 
         res = sb_bench_reflection(vk, atmosphere, params, report);
     if (!res)
         mark_pareto(report->rows, report->row_count);
+    if (!res)
+        mark_anchors(report->rows, report->row_count);
     sb_image_finish(&image);
     for (int p = 0; p < SB_ATMOSPHERE_PRODUCT_COUNT; p++)
         sb_image_finish(&inputs[p]);
@@ -367,6 +391,15 @@ void sb_bench_report_finish(struct sb_bench_report *report)
 }
 
 /* ---- Output ---------------------------------------------------------------------- */
+
+/* Sweep w's default row, or NULL where the sweep (--quick) left it out. */
+static const struct sb_bench_row *default_row(const struct sb_bench_report *report, int w)
+{
+    for (int i = 0; i < report->row_count; i++)
+        if (report->rows[i].sweep == (enum sb_bench_sweep)w && report->rows[i].is_default)
+            return &report->rows[i];
+    return NULL;
+}
 
 static cJSON *report_json(const struct sb_bench_report *report, const struct sb_vk *vk)
 {
@@ -392,6 +425,7 @@ static cJSON *report_json(const struct sb_bench_report *report, const struct sb_
         if (r->anchor)
             cJSON_AddStringToObject(o, "anchor", r->anchor);
         cJSON_AddBoolToObject(o, "default", r->is_default);
+        cJSON_AddBoolToObject(o, "ours", r->ours);
         cJSON_AddNumberToObject(o, "cost", (double)r->cost);
         cJSON_AddNumberToObject(o, "gpu_ms", r->gpu_ms);
         cJSON_AddNumberToObject(o, "gpu_ms_min", r->gpu_ms_min);
@@ -405,6 +439,18 @@ static cJSON *report_json(const struct sb_bench_report *report, const struct sb_
         cJSON_AddItemToArray(worst, cJSON_CreateNumber(r->error.worst_y));
         cJSON_AddItemToArray(worst, cJSON_CreateNumber(r->error.worst_channel));
         cJSON_AddBoolToObject(o, "pareto", r->pareto);
+        if (r->anchor) {
+            const struct sb_bench_row *def = default_row(report, r->sweep);
+            if (def && r->gpu_ms > 0 && r->error.max_rel > 0 && isfinite(def->error.max_rel)) {
+                cJSON_AddNumberToObject(o, "default_time_ratio", def->gpu_ms / r->gpu_ms);
+                cJSON_AddNumberToObject(o, "default_error_ratio", def->error.max_rel / r->error.max_rel);
+            }
+            cJSON_AddBoolToObject(o, "dominated_by_default", r->dominated_by_default);
+            if (r->dominated_by >= 0)
+                cJSON_AddStringToObject(o, "dominated_by", report->rows[r->dominated_by].label);
+            else
+                cJSON_AddNullToObject(o, "dominated_by");
+        }
         cJSON_AddItemToArray(rows, o);
     }
     for (int i = 0; i < report->probe_row_count; i++) {
@@ -450,6 +496,31 @@ static cJSON *report_json(const struct sb_bench_report *report, const struct sb_
     return root;
 }
 
+/* Each published row of sweep w against skybake's default and settings,
+ * all measured in this run. */
+static void print_anchors(const struct sb_bench_report *report, int w)
+{
+    const struct sb_bench_row *def = default_row(report, w);
+    for (int i = 0; i < report->row_count; i++) {
+        const struct sb_bench_row *r = &report->rows[i];
+        if (r->sweep != (enum sb_bench_sweep)w || !r->anchor)
+            continue;
+        printf("  against %s:", r->label);
+        if (def && r->gpu_ms > 0 && r->error.max_rel > 0 && isfinite(def->error.max_rel))
+            printf(" the default (%s) takes %.3gx its time at %.3gx its error;", def->label, def->gpu_ms / r->gpu_ms,
+                   def->error.max_rel / r->error.max_rel);
+        const char *fastest = r->dominated_by >= 0 ? report->rows[r->dominated_by].label : NULL;
+        if (r->dominated_by_default && &report->rows[r->dominated_by] == def)
+            printf(" the default dominates it, the fastest setting that does\n");
+        else if (r->dominated_by_default)
+            printf(" the default dominates it, and so does %s, the fastest that does\n", fastest);
+        else if (fastest)
+            printf(" %s dominates it, the default does not\n", fastest);
+        else
+            printf(" no setting of skybake's dominates it\n");
+    }
+}
+
 void sb_bench_print(const struct sb_bench_report *report, const struct sb_vk *vk, bool json)
 {
     if (json) {
@@ -478,6 +549,7 @@ void sb_bench_print(const struct sb_bench_report *report, const struct sb_vk *vk
                    r->is_default ? '*' : ' ', r->label, (unsigned long long)r->cost, r->gpu_ms, r->error.max_rel,
                    r->error.rms_rel, r->error_half.max_rel, r->anchor ? r->anchor : "");
         }
+        print_anchors(report, w);
     }
     if (!report->cloud_row_count) {
         sb_bench_probes_print(report);

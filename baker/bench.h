@@ -40,6 +40,7 @@ struct sb_bench_row {
     struct sb_atmosphere_settings settings;
     char label[48];
     const char *anchor; /* the published setting this row reproduces, or NULL */
+    bool ours;          /* skybake's quadrature, not a published rule or a variant of one */
     bool is_default;    /* what skybake bakes without a tolerance */
     uint64_t cost;      /* sb_atmosphere_settings_cost */
     double gpu_ms;      /* median over the repeats */
@@ -47,6 +48,11 @@ struct sb_bench_row {
     struct sb_error error;
     struct sb_error error_half; /* the same bake stored in half precision */
     bool pareto;
+    /* An anchor row against skybake's settings of its sweep, measured in the
+     * same run: the fastest of them that dominates it (at most its time and
+     * its error, less of one), or -1; and whether the default does. */
+    int dominated_by; /* an index into the report's rows */
+    bool dominated_by_default;
 };
 
 /* A cloud product: the device against the CPU reference on one core. */

@@ -247,6 +247,28 @@ check "bench has Hillaire's row" grep -q "uniform0.3-40,.*Hillaire" "$tmp/bench/
 check "bench has Bruneton's row" grep -q "trapezoid-500,.*Bruneton" "$tmp/bench/bench.csv"
 check "bench marks a Pareto front" grep -Eq '"pareto":[[:space:]]*true' "$tmp/bench/bench.json"
 check "bench table names the default" grep -q '^.\*gl8x1' "$tmp/out"
+check "bench sets the default against each published row" test "$(grep -c '^  against ' "$tmp/out")" = 2
+# The verdicts, recomputed from the rows: the fastest of skybake's settings
+# at most as slow and as far off as the published row (less of one), and
+# whether the default is among them.
+check "bench.json's verdicts on the published rows follow from its rows" python3 -c '
+import json, sys
+rows = json.load(open(sys.argv[1]))["rows"]
+anchors = [a for a in rows if "anchor" in a]
+for a in anchors:
+    same = [r for r in rows if r["sweep"] == a["sweep"]]
+    def dominates(r):
+        return (r["ours"] and r["max_rel"] >= 0 and r["gpu_ms"] <= a["gpu_ms"] and r["max_rel"] <= a["max_rel"]
+                and (r["gpu_ms"] < a["gpu_ms"] or r["max_rel"] < a["max_rel"]))
+    by = [r for r in same if dominates(r)]
+    fastest = min(by, key=lambda r: r["gpu_ms"])["setting"] if by else None
+    default = [r for r in same if r["default"]][0]
+    assert a["dominated_by"] == fastest, (a["setting"], a["dominated_by"], fastest)
+    assert a["dominated_by_default"] == dominates(default), a["setting"]
+    assert abs(a["default_time_ratio"] * a["gpu_ms"] - default["gpu_ms"]) <= 1e-9 * default["gpu_ms"]
+    assert abs(a["default_error_ratio"] * a["max_rel"] - default["max_rel"]) <= 1e-9 * default["max_rel"]
+sys.exit(0 if len(anchors) == 2 else 1)
+' "$tmp/bench/bench.json"
 check "bench of multiscattering, quick" expect_exit 0 "$skybake" bench --product multiscattering --quick --repeat 1 -q -o "$tmp/benchm"
 check "bench has Hillaire's multiple-scattering row" grep -q "hillaire8x8-20,.*Hillaire 2020" "$tmp/benchm/bench.csv"
 check "bench of irradiance_ground, quick" expect_exit 0 "$skybake" bench --product irradiance_ground --quick --repeat 1 -q -o "$tmp/benche"
