@@ -193,8 +193,6 @@ const struct sb_atmosphere_settings *sb_bench_candidates(enum sb_product_id id, 
     return lists[id];
 }
 
-/* Rows on the Pareto front of their sweep: no other row is as fast or faster
- * and strictly more accurate, or strictly faster and as accurate. */
 /* Whether row a dominates row b of the same sweep: at most b's time and
  * error, and less of one of them. */
 static bool dominates(const struct sb_bench_row *a, const struct sb_bench_row *b)
@@ -203,6 +201,8 @@ static bool dominates(const struct sb_bench_row *a, const struct sb_bench_row *b
            a->error.max_rel <= b->error.max_rel && (a->gpu_ms < b->gpu_ms || a->error.max_rel < b->error.max_rel);
 }
 
+/* Rows on the Pareto front of their sweep: no other row is as fast or faster
+ * and strictly more accurate, or strictly faster and as accurate. */
 static void mark_pareto(struct sb_bench_row *rows, int count)
 {
     for (int i = 0; i < count; i++) {
@@ -401,6 +401,19 @@ static const struct sb_bench_row *default_row(const struct sb_bench_report *repo
     return NULL;
 }
 
+/* The default's time and error as multiples of anchor row r's; false where
+ * the sweep has no default row or the ratios are undefined. */
+static bool default_ratios(const struct sb_bench_report *report, const struct sb_bench_row *r, double *time,
+                           double *error)
+{
+    const struct sb_bench_row *def = default_row(report, r->sweep);
+    if (!def || !(r->gpu_ms > 0) || !(r->error.max_rel > 0) || !isfinite(def->error.max_rel))
+        return false;
+    *time = def->gpu_ms / r->gpu_ms;
+    *error = def->error.max_rel / r->error.max_rel;
+    return true;
+}
+
 static cJSON *report_json(const struct sb_bench_report *report, const struct sb_vk *vk)
 {
     cJSON *root = cJSON_CreateObject();
@@ -440,10 +453,10 @@ static cJSON *report_json(const struct sb_bench_report *report, const struct sb_
         cJSON_AddItemToArray(worst, cJSON_CreateNumber(r->error.worst_channel));
         cJSON_AddBoolToObject(o, "pareto", r->pareto);
         if (r->anchor) {
-            const struct sb_bench_row *def = default_row(report, r->sweep);
-            if (def && r->gpu_ms > 0 && r->error.max_rel > 0 && isfinite(def->error.max_rel)) {
-                cJSON_AddNumberToObject(o, "default_time_ratio", def->gpu_ms / r->gpu_ms);
-                cJSON_AddNumberToObject(o, "default_error_ratio", def->error.max_rel / r->error.max_rel);
+            double time, error;
+            if (default_ratios(report, r, &time, &error)) {
+                cJSON_AddNumberToObject(o, "default_time_ratio", time);
+                cJSON_AddNumberToObject(o, "default_error_ratio", error);
             }
             cJSON_AddBoolToObject(o, "dominated_by_default", r->dominated_by_default);
             if (r->dominated_by >= 0)
@@ -506,9 +519,9 @@ static void print_anchors(const struct sb_bench_report *report, int w)
         if (r->sweep != (enum sb_bench_sweep)w || !r->anchor)
             continue;
         printf("  against %s:", r->label);
-        if (def && r->gpu_ms > 0 && r->error.max_rel > 0 && isfinite(def->error.max_rel))
-            printf(" the default (%s) takes %.3gx its time at %.3gx its error;", def->label, def->gpu_ms / r->gpu_ms,
-                   def->error.max_rel / r->error.max_rel);
+        double time, error;
+        if (default_ratios(report, r, &time, &error))
+            printf(" the default (%s) takes %.3gx its time at %.3gx its error;", def->label, time, error);
         const char *fastest = r->dominated_by >= 0 ? report->rows[r->dominated_by].label : NULL;
         if (r->dominated_by_default && &report->rows[r->dominated_by] == def)
             printf(" the default dominates it, the fastest setting that does\n");

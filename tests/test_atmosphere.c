@@ -546,9 +546,9 @@ static void test_many_directions(struct sb_atmosphere_baker *baker)
  */
 static void test_kernel_layouts(struct sb_vk *vk, struct sb_atmosphere_baker *baker)
 {
-    /* multiscattering twice: at its default, 4 zenith pieces of 16 nodes
-     * a texel, and at 12 x 4, whose 48 directions leave invocations of the
-     * CPU layout empty */
+    /* multiscattering twice: at its default, 16 zenith nodes a piece, and
+     * at 12 x 4, 12 a piece, so that a texel's direction count is no
+     * multiple of the CPU layout's 64 invocations */
     static const struct {
         enum sb_product_id id;
         uint32_t directions_mu, directions_phi; /* 0: the default */
