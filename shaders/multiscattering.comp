@@ -48,7 +48,7 @@ void main()
             ray_node_weights(tau, half_len, m, tw);
             for (int i = 0; i < 4; i++) {
                 vec3 scattering = tw[i] * (m[i].scattering_rayleigh + m[i].scattering_mie);
-                lit += scattering * ring_table_sample(texel.x, col, hs[i], ring_angle_along(h, z.mu, sin_v, tn[i]));
+                lit += scattering * ring_table_sample(texel.x, col, hs[i], ring_tan_along(h, z.mu, sin_v, tn[i], hs[i]));
                 scattered += scattering;
             }
             ray_advance(tau, half_len, m);
@@ -56,7 +56,7 @@ void main()
         vec3 lp = lit / (4.0 * PI);
         if (z.toward_ground)
             lp += exp(-tau) * atm.ground_albedo.rgb / PI
-                * ring_ground_sample(texel.x, col, ring_angle_along(h, z.mu, sin_v, t_end));
+                * ring_ground_sample(texel.x, col, ring_tan_along(h, z.mu, sin_v, t_end, 0.0));
         float weight = 2.0 * PI * z.weight; /* both halves of the azimuth */
         sphere_add3(0u, weight * lp);
         sphere_add3(3u, weight * scattered);

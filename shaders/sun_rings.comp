@@ -28,10 +28,11 @@ void ring_add_cut(float a, float b, float mu, inout float cuts[6], inout int n)
 
 /* The mean over phi in [0, pi] of T_sun(h, A + B cos(phi)), or on the
  * ground of max(mu, 0) T_sun(0, mu). */
-vec3 ring_mean(RingColumn col, float h, float gamma, bool ground)
+vec3 ring_mean(RingColumn col, float h, float w, bool ground)
 {
     float R = ground_radius(), r = R + h;
-    float a = cos(gamma) * col.mu_s, b = sin(gamma) * col.sin_s;
+    float q = 1.0 / (1.0 + w * w); /* gamma from its half-angle tangent w */
+    float a = (1.0 - w * w) * q * col.mu_s, b = 2.0 * w * q * col.sin_s;
     float cuts[6];
     int n = 0;
     cuts[n++] = 0.0;
@@ -79,11 +80,11 @@ void main()
     RingColumn col = ring_column(2.0 * texel_unit(column, pc.height) - 1.0);
     vec3 value;
     if (entry >= uint(SB_RINGS_ROWS * SB_RINGS_ANGLES)) {
-        value = ring_mean(col, 0.0, ring_ground_angle(col, int(entry) - SB_RINGS_ROWS * SB_RINGS_ANGLES), true);
+        value = ring_mean(col, 0.0, ring_ground_tan(col, int(entry) - SB_RINGS_ROWS * SB_RINGS_ANGLES), true);
     } else {
         int row = int(entry) / SB_RINGS_ANGLES, j = int(entry) % SB_RINGS_ANGLES;
         float h = ring_row_altitude(col, row);
-        value = ring_mean(col, h, ring_entry_angle(col, h, j), false);
+        value = ring_mean(col, h, ring_entry_tan(col, h, j), false);
     }
     result[column * uint(SB_RINGS_COLUMN) + entry] = vec4(value, 0.0);
 }

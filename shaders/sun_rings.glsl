@@ -20,15 +20,19 @@
  *   from lit to shadowed there, so a table across it would be
  *   discontinuous): linear below, sqrt above (or sqrt over the whole
  *   atmosphere where the sun does not set within it);
- * - in gamma, split at the ring's tangency with the shadow,
+ * - in gamma, through its half-angle tangent w = tan(gamma / 2), which a
+ *   node has from its position without an arctangent (ring_tan_along),
+ *   split at the ring's tangency with the shadow, w_c for the angle
  *   c = |theta_s - theta_shadow(h)|, where G starts to fall as a square
- *   root: gamma = c v below (SB_RINGS_INNER entries), c + (gamma_max - c)
- *   v^2 above (SB_RINGS_OUTER), gamma_max the largest angle a node of a
- *   ray inside the atmosphere can have;
+ *   root: w = w_c v below (SB_RINGS_INNER entries), w_c + (w_max - w_c)
+ *   v^2 above (SB_RINGS_OUTER), w_max for the largest angle a node of a
+ *   ray inside the atmosphere can have (gamma < pi there, so w is finite
+ *   and increases with gamma; w - w_c is smooth in gamma - c, so the
+ *   square root's onset is where v^2 puts it);
  * - Catmull-Rom within each block, the ghost entries beyond a block's ends
  *   extrapolated quadratically (3 v0 - 3 v1 + v2).
  * The ground's ring (the mean of max(mu, 0) T_sun on the ground) is a 1D
- * table in gamma per column.
+ * table in w per column.
  *
  * A ray is cut where its nodes' rings change character: at the levels and
  * the ozone corners (as every ray), at its closest point to the centre,
@@ -55,8 +59,8 @@ float ring_table_top()
 /* What a column's table depends on. */
 struct RingColumn {
     float mu_s, sin_s;
-    float h_star;    /* where the sun sets, or -1 where it does not within the atmosphere */
-    float gamma_top; /* the angle from the ground to the horizon of the top */
+    float h_star; /* where the sun sets, or -1 where it does not within the atmosphere */
+    float w_top;  /* tan(gamma_top / 2), gamma_top the angle from the ground to the horizon of the top */
 };
 
 RingColumn ring_column(float mu_s)
@@ -73,25 +77,33 @@ RingColumn ring_column(float mu_s)
         if (h < ring_table_top())
             col.h_star = h;
     }
-    col.gamma_top = atan2_precise(horizon_top(), ground_radius());
+    /* tan(a / 2) = sin(a) / (1 + cos(a)), here rho_top / r_top over 1 + R / r_top */
+    col.w_top = horizon_top() / (top_radius() + ground_radius());
     return col;
 }
 
-float ring_gamma_max(RingColumn col, float h)
+/* w_max at altitude h: gamma_max = gamma_top + the horizon's angle from
+ * the node's zenith at h, whose half tangent is rho / (r + R); the sum's
+ * from tan((a + b) / 2) = (ta + tb) / (1 - ta tb), both half angles below
+ * pi / 4. */
+float ring_w_max(RingColumn col, float h)
 {
-    return col.gamma_top + atan2_precise(horizon_distance(h), ground_radius());
+    float tb = horizon_distance(h) / (2.0 * ground_radius() + h);
+    return (col.w_top + tb) / (1.0 - col.w_top * tb);
 }
 
-/* The ring's tangency with the shadow, the gamma axis' split: the angle
+/* The ring's tangency with the shadow, the gamma axis' split: the angle c
  * between the sun and the shadow's edge at altitude h, the ray grazing the
- * ground (cosine -rho / r, sine R / r), from its sine and cosine, which do
- * not cancel where it is small as the difference of the two angles would. */
+ * ground (cosine -rho / r, sine R / r), as tan(c / 2) = |sin c| / (1 + cos c)
+ * from its sine and cosine times r, which do not cancel where c is small as
+ * the difference of the two angles would (c < pi - pi / 6 within any
+ * atmosphere up to its planet's radius thick, so 1 + cos c does not either). */
 float ring_cut(RingColumn col, float h)
 {
-    float r = ground_radius() + h, rho = horizon_distance(h);
-    float s = (-col.sin_s * rho - col.mu_s * ground_radius()) / r;
-    float c = (-col.mu_s * rho + col.sin_s * ground_radius()) / r;
-    return min(abs(atan2_precise(s, c)), ring_gamma_max(col, h));
+    float R = ground_radius(), rho = horizon_distance(h);
+    float s = col.sin_s * rho + col.mu_s * R;
+    float c = col.sin_s * R - col.mu_s * rho;
+    return min(abs(s) / (R + h + c), ring_w_max(col, h));
 }
 
 /* The row block of altitude h: its first row and row count, and the
@@ -126,14 +138,14 @@ float ring_row_altitude(RingColumn col, int i)
     return i < half_rows ? x * col.h_star : col.h_star + x * x * (top - col.h_star);
 }
 
-/* The angle of entry j of a row at altitude h. */
-float ring_entry_angle(RingColumn col, float h, int j)
+/* The half-angle tangent of entry j of a row at altitude h. */
+float ring_entry_tan(RingColumn col, float h, int j)
 {
     float c = ring_cut(col, h);
     if (j < SB_RINGS_INNER)
         return c * float(j) / float(SB_RINGS_INNER - 1);
     float v = float(j - SB_RINGS_INNER) / float(SB_RINGS_OUTER - 1);
-    return c + (ring_gamma_max(col, h) - c) * v * v;
+    return c + (ring_w_max(col, h) - c) * v * v;
 }
 
 /* Catmull-Rom weights of continuous entry f of a block of n >= 4 entries,
@@ -161,15 +173,15 @@ int ring_taps(float f, int n, out float w[4])
     return first;
 }
 
-/* G(h, gamma) of column `column` from its table. */
-vec3 ring_table_sample(uint column, RingColumn col, float h, float gamma)
+/* G(h, gamma) of column `column` from its table, w = tan(gamma / 2). */
+vec3 ring_table_sample(uint column, RingColumn col, float h, float w)
 {
     int first, rows;
     float fr = ring_row(col, h, first, rows);
-    float c = ring_cut(col, h), gamma_max = ring_gamma_max(col, h);
-    bool outer = gamma >= c && gamma_max > c;
+    float c = ring_cut(col, h), w_max = ring_w_max(col, h);
+    bool outer = w >= c && w_max > c;
     int n = outer ? SB_RINGS_OUTER : SB_RINGS_INNER;
-    float u = outer ? sqrt(max(gamma - c, 0.0) / (gamma_max - c)) : (c > 0.0 ? gamma / c : 0.0);
+    float u = outer ? sqrt(max(w - c, 0.0) / (w_max - c)) : (c > 0.0 ? w / c : 0.0);
     float wr[4], wg[4];
     int i0 = ring_taps(fr, rows, wr), j0 = ring_taps(min(u, 1.0) * float(n - 1), n, wg);
     uint k = column * uint(SB_RINGS_COLUMN) + uint((first + i0) * SB_RINGS_ANGLES + (outer ? SB_RINGS_INNER : 0) + j0);
@@ -180,17 +192,19 @@ vec3 ring_table_sample(uint column, RingColumn col, float h, float gamma)
     return max(sum, vec3(0.0));
 }
 
-/* The angle of the ground ring's entry j, uniform over [0, gamma_top]. */
-float ring_ground_angle(RingColumn col, int j)
+/* The half-angle tangent of the ground ring's entry j, uniform over
+ * [0, w_top]. */
+float ring_ground_tan(RingColumn col, int j)
 {
-    return col.gamma_top * float(j) / float(SB_RINGS_GROUND - 1);
+    return col.w_top * float(j) / float(SB_RINGS_GROUND - 1);
 }
 
-/* The ground ring's mean of max(mu, 0) T_sun at angle gamma, from the table. */
-vec3 ring_ground_sample(uint column, RingColumn col, float gamma)
+/* The ground ring's mean of max(mu, 0) T_sun at w = tan(gamma / 2), from
+ * the table. */
+vec3 ring_ground_sample(uint column, RingColumn col, float wg)
 {
     float w[4];
-    int j0 = cubic_taps(gamma / col.gamma_top * float(SB_RINGS_GROUND - 1), SB_RINGS_GROUND, w);
+    int j0 = cubic_taps(wg / col.w_top * float(SB_RINGS_GROUND - 1), SB_RINGS_GROUND, w);
     uint base = column * uint(SB_RINGS_COLUMN) + uint(SB_RINGS_ROWS * SB_RINGS_ANGLES);
     vec3 sum = vec3(0.0);
     for (int i = 0; i < 4; i++)
@@ -198,11 +212,14 @@ vec3 ring_ground_sample(uint column, RingColumn col, float gamma)
     return max(sum, vec3(0.0));
 }
 
-/* The angle gamma at distance t along the ray from altitude h0 with cosine
- * mu (sine sin_v): r cos(gamma) = r0 + t mu, r sin(gamma) = t sin_v. */
-float ring_angle_along(float h0, float mu, float sin_v, float t)
+/* tan(gamma / 2) at distance t along the ray from altitude h0 with cosine
+ * mu (sine sin_v), where the altitude is h: r cos(gamma) = r0 + t mu,
+ * r sin(gamma) = t sin_v, and tan(gamma / 2) = r sin / (r + r cos), whose
+ * denominator stays above r / 2 (gamma < 2 pi / 3 within an atmosphere up
+ * to its planet's radius thick). */
+float ring_tan_along(float h0, float mu, float sin_v, float t, float h)
 {
-    return atan2_precise(t * sin_v, ground_radius() + h0 + t * mu);
+    return t * sin_v / (2.0 * ground_radius() + h + h0 + t * mu);
 }
 
 /* The cuts (atmosphere.glsl) of the ray from altitude h0 with cosine mu
