@@ -445,6 +445,7 @@ static enum sb_result run(struct sb_atmosphere_baker *b, const struct spirv *ker
     if (!res && gather) {
         double ms = 0;
         res = sb_dispatch(b->vk, &gather_pipeline, &push, groups_x, groups_y, 1, &ms);
+        sb_log(SB_LOG_DEBUG, "%s: the directions %.3f ms, their gather %.3f ms", name, total_ms, ms);
         total_ms += ms;
     }
     if (!res && workgroup_per_texel && *(const uint32_t *)b->scratch.mapped) {

@@ -814,12 +814,38 @@ void ray_level_crossing(float h0, float s0, float level, out float t1, out float
  * largest error (2.2e-4 of multiscattering at 16 x 12 directions, 9.2e-5
  * with the cuts; docs/accuracy.md). The runtime's rays go without: their
  * frame time counts more than that error.
+ *
+ * A shader that defines SB_RAY_LEVELS_DOUBLING is cut at levels a factor 2
+ * apart instead (every second one of the atmosphere's on the earth), from
+ * the same first level up to SB_RAY_DOUBLING_LEVELS of them: 2^9 of it is
+ * 256 of the smallest scale height, past where any air counts (the
+ * atmosphere's own levels stop at SB_MAX_LEVELS, which in one as thick as
+ * its planet leaves a last segment thousands of kilometres long, too long
+ * at a factor 2). With the ozone corners, multiscattering's rings lose no
+ * accuracy that way (docs/accuracy.md, "Levels a factor 2 apart").
  */
-#ifdef SB_RAY_OZONE_CORNERS
-#define SB_RAY_CUT_LEVELS (SB_MAX_LEVELS + 3)
+#ifdef SB_RAY_LEVELS_DOUBLING
+#define SB_RAY_DOUBLING_LEVELS 10
+#define SB_RAY_GEOMETRIC_LEVELS SB_RAY_DOUBLING_LEVELS
 #else
-#define SB_RAY_CUT_LEVELS SB_MAX_LEVELS
+#define SB_RAY_GEOMETRIC_LEVELS SB_MAX_LEVELS
 #endif
+#ifdef SB_RAY_OZONE_CORNERS
+#define SB_RAY_CUT_LEVELS (SB_RAY_GEOMETRIC_LEVELS + 3)
+#else
+#define SB_RAY_CUT_LEVELS SB_RAY_GEOMETRIC_LEVELS
+#endif
+
+/* Geometric level i a ray is cut at, or a negative altitude where there is none. */
+float ray_geometric_level(int i)
+{
+#ifdef SB_RAY_LEVELS_DOUBLING
+    float level = level_at(0) * exp2(float(i)); /* exact: a power of two */
+    return level < atmosphere_thickness() ? level : -1.0;
+#else
+    return i < int(atm.level_count.x) ? level_at(i) : -1.0;
+#endif
+}
 /* two per shadow cylinder (ray_cuts), or the closest point and four per
  * cylinder (ring_cuts); the ground and the three ozone corners */
 #define SB_RAY_EXTRA_CUTS 17
@@ -834,11 +860,12 @@ RayCuts ray_level_cuts(float h0, float mu)
 {
     RayCuts cuts;
     float s0 = (ground_radius() + h0) * mu;
-    int levels = int(atm.level_count.x);
     [[unroll]] for (int i = 0; i < SB_RAY_CUT_LEVELS; i++) {
         float t1, t2;
-        ray_level_crossing(h0, s0, i < SB_MAX_LEVELS ? level_at(i) : ozone_corner(i - SB_MAX_LEVELS), t1, t2);
-        bool used = i >= SB_MAX_LEVELS || i < levels; /* a corner outside the atmosphere crosses no ray */
+        float level = i < SB_RAY_GEOMETRIC_LEVELS ? ray_geometric_level(i) : ozone_corner(i - SB_RAY_GEOMETRIC_LEVELS);
+        ray_level_crossing(h0, s0, level, t1, t2);
+        /* a corner outside the atmosphere crosses no ray inside it */
+        bool used = i >= SB_RAY_GEOMETRIC_LEVELS || level >= 0.0;
         cuts.level[2 * i] = used ? t1 : -1.0;
         cuts.level[2 * i + 1] = used ? t2 : -1.0;
     }

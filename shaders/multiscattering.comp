@@ -12,6 +12,7 @@
 #extension GL_GOOGLE_include_directive : require
 #include "config.h"
 #define SB_RAY_OZONE_CORNERS
+#define SB_RAY_LEVELS_DOUBLING /* with the corners, no less accurate: a quarter faster */
 #include "atmosphere.glsl"
 #define SB_SPHERE_BY_COLUMN
 #include "sphere.glsl"
