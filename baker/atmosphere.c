@@ -14,7 +14,6 @@
 #include "irradiance_sky_shared.spv.h"
 #include "log.h"
 #include "multiscattering.spv.h"
-#include "multiscattering_gather.spv.h"
 #include "multiscattering_rays.spv.h"
 #include "multiscattering_hillaire.spv.h"
 #include "physics.h"
@@ -69,16 +68,16 @@ struct spirv {
     size_t size;
     uint32_t threads; /* a sphere.glsl kernel's workgroup size */
     /* A kernel that integrates one direction an invocation (sphere.glsl's
-     * SB_SPHERE_RAYS): the kernel that sums them, run after it. */
-    const struct spirv *gather;
+     * SB_SPHERE_RAYS), workgroups of `threads` dispatched along z. */
+    bool rays;
 };
 
 #define SPIRV(name) {.words = sb_spv_##name, .size = sizeof(sb_spv_##name), .threads = SB_SPHERE_THREADS_CPU}
 #define SPIRV_GPU(name) {.words = sb_spv_##name, .size = sizeof(sb_spv_##name), .threads = SB_SPHERE_THREADS_GPU}
-#define SPIRV_RAYS(name, id)                                                                                           \
+#define SPIRV_RAYS(name)                                                                                               \
     {                                                                                                                  \
         .words = sb_spv_##name##_rays, .size = sizeof(sb_spv_##name##_rays), .threads = SB_SPHERE_RAY_GROUP,           \
-        .gather = &gather_shaders[id],                                                                                 \
+        .rays = true,                                                                                                  \
     }
 /* Transmittance: one shader per Gauss-Legendre order, 0 for the uniform rules (config.h). */
 static const struct spirv transmittance_shaders[SB_GL_MAX_ORDER + 1] = {
@@ -94,8 +93,8 @@ static const struct spirv transmittance_shaders[SB_GL_MAX_ORDER + 1] = {
  * irradiance_sky from 6.1 to 8.5 ms (irradiance_ground 1.13 -> 1.05 ms); on
  * llvmpipe, from 10.7 to 8.2 s (1.46 -> 1.25 s).
  *
- * A GPU runs multiscattering one ray an invocation and sums the rays in a
- * second kernel (sphere.glsl's SB_SPHERE_RAYS, SB_SPHERE_GATHER), in the CPU
+ * A GPU runs multiscattering one ray an invocation, the last workgroup of
+ * a texel summing its rays (sphere.glsl's SB_SPHERE_RAYS) in the CPU
  * layout's order, so the two give the same bits where the compilers
  * contract alike: on an H200 the default bake took 0.447 ms instead of
  * 0.505 (12x4 0.351 instead of 0.458, 4x3 0.276 instead of 0.418; two
@@ -103,13 +102,10 @@ static const struct spirv transmittance_shaders[SB_GL_MAX_ORDER + 1] = {
  * irradiance bakes were slower so on an H100: irradiance_ground 0.368 ms
  * against 0.314, irradiance_sky 5.13 against 4.17 (240 registers an
  * invocation instead of 168), and keep a workgroup a texel. */
-static const struct spirv gather_shaders[SB_ATMOSPHERE_PRODUCT_COUNT] = {
-    [SB_PRODUCT_MULTISCATTERING] = SPIRV(multiscattering_gather),
-};
 static const struct spirv scattering_shaders[2][SB_ATMOSPHERE_PRODUCT_COUNT] = {
     [SB_ATMOSPHERE_KERNELS_GPU] =
         {
-            [SB_PRODUCT_MULTISCATTERING] = SPIRV_RAYS(multiscattering, SB_PRODUCT_MULTISCATTERING),
+            [SB_PRODUCT_MULTISCATTERING] = SPIRV_RAYS(multiscattering),
             [SB_PRODUCT_IRRADIANCE_GROUND] = SPIRV_GPU(irradiance_ground_gpu),
             [SB_PRODUCT_IRRADIANCE_SKY] = SPIRV_GPU(irradiance_sky_gpu),
         },
@@ -135,7 +131,7 @@ static const struct spirv sun_rings_shader = SPIRV(sun_rings);
 
 bool sb_atmosphere_kernels_same_order(enum sb_product_id id)
 {
-    return id < SB_ATMOSPHERE_PRODUCT_COUNT && scattering_shaders[SB_ATMOSPHERE_KERNELS_GPU][id].gather;
+    return id < SB_ATMOSPHERE_PRODUCT_COUNT && scattering_shaders[SB_ATMOSPHERE_KERNELS_GPU][id].rays;
 }
 
 /* The kernels a device runs: a CPU device's where it offers their
@@ -376,17 +372,19 @@ static enum sb_result run(struct sb_atmosphere_baker *b, const struct spirv *ker
     };
     enum sb_result res = SB_OK;
     bool workgroup_per_texel = directions > 0;
-    /* One direction an invocation, then a kernel that sums them (sphere.glsl). */
-    const struct spirv *gather = workgroup_per_texel ? kernel->gather : NULL;
+    /* One direction an invocation (sphere.glsl). */
+    bool rays = workgroup_per_texel && kernel->rays;
     uint32_t ray_groups = 0;
-    if (gather) {
+    if (rays) {
         ray_groups = (uint32_t)((directions + kernel->threads - 1) / kernel->threads);
         push.direction_slots = ray_groups * kernel->threads;
     }
     if (workgroup_per_texel) {
-        push.step_count = gather ? 1 : (uint32_t)((directions + kernel->threads - 1) / kernel->threads);
-        size_t per_texel = gather ? push.direction_slots : kernel->threads;
-        size_t bytes = 16 + (size_t)width * height * per_texel * SB_SPHERE_MAX_SUMS * sizeof(float);
+        push.step_count = rays ? 1 : (uint32_t)((directions + kernel->threads - 1) / kernel->threads);
+        size_t per_texel = rays ? push.direction_slots : kernel->threads;
+        size_t sums = (size_t)width * height * per_texel * SB_SPHERE_MAX_SUMS;
+        size_t counters = rays ? (size_t)width * height : 0; /* a texel's workgroups done */
+        size_t bytes = 16 + (sums + counters) * sizeof(float);
         if (b->scratch.size < bytes) {
             sb_buffer_destroy(b->vk, &b->scratch);
             if ((res = sb_buffer_create(b->vk, bytes, "sphere scratch", &b->scratch)))
@@ -394,9 +392,10 @@ static enum sb_result run(struct sb_atmosphere_baker *b, const struct spirv *ker
         }
         const uint32_t header[4] = {0, 1, 1, 0}; /* truncated flag, sentinel */
         memcpy(b->scratch.mapped, header, sizeof(header));
+        memset((uint32_t *)b->scratch.mapped + 4 + sums, 0, counters * sizeof(uint32_t));
     }
 
-    struct sb_pipeline pipeline = {0}, gather_pipeline = {0};
+    struct sb_pipeline pipeline = {0};
     struct sb_pipeline_params pp = {
         .spirv = kernel->words,
         .spirv_size = kernel->size,
@@ -406,14 +405,6 @@ static enum sb_result run(struct sb_atmosphere_baker *b, const struct spirv *ker
     };
     if ((res = sb_pipeline_create(b->vk, &pp, &pipeline)))
         return res;
-    if (gather) {
-        pp.spirv = gather->words;
-        pp.spirv_size = gather->size;
-        if ((res = sb_pipeline_create(b->vk, &pp, &gather_pipeline))) {
-            sb_pipeline_destroy(b->vk, &pipeline);
-            return res;
-        }
-    }
     const struct sb_buffer *bindings[SB_BINDING_COUNT] = {
         [SB_BINDING_OUTPUT] = output,
         [SB_BINDING_SCRATCH] = workgroup_per_texel ? &b->scratch : &b->dummy,
@@ -425,8 +416,6 @@ static enum sb_result run(struct sb_atmosphere_baker *b, const struct spirv *ker
         if (bindings[i] == output) /* a product is never its own input */
             bindings[i] = &b->dummy;
     sb_pipeline_bind(b->vk, &pipeline, bindings);
-    if (gather)
-        sb_pipeline_bind(b->vk, &gather_pipeline, bindings);
     group_per_texel = group_per_texel || workgroup_per_texel;
     uint32_t groups_x = group_per_texel ? width : (width + SB_WORKGROUP_X - 1) / SB_WORKGROUP_X;
     uint32_t groups_y = group_per_texel ? height : (height + SB_WORKGROUP_Y - 1) / SB_WORKGROUP_Y;
@@ -439,13 +428,7 @@ static enum sb_result run(struct sb_atmosphere_baker *b, const struct spirv *ker
         push.step_begin = step;
         push.step_end = workgroup_per_texel && push.step_count - step > per_pass ? step + per_pass : push.step_count;
         double ms = 0;
-        res = sb_dispatch(b->vk, &pipeline, &push, groups_x, groups_y, gather ? ray_groups : 1, &ms);
-        total_ms += ms;
-    }
-    if (!res && gather) {
-        double ms = 0;
-        res = sb_dispatch(b->vk, &gather_pipeline, &push, groups_x, groups_y, 1, &ms);
-        sb_log(SB_LOG_DEBUG, "%s: the directions %.3f ms, their gather %.3f ms", name, total_ms, ms);
+        res = sb_dispatch(b->vk, &pipeline, &push, groups_x, groups_y, rays ? ray_groups : 1, &ms);
         total_ms += ms;
     }
     if (!res && workgroup_per_texel && *(const uint32_t *)b->scratch.mapped) {
@@ -457,7 +440,6 @@ static enum sb_result run(struct sb_atmosphere_baker *b, const struct spirv *ker
     if (gpu_ms)
         *gpu_ms = total_ms;
     sb_pipeline_destroy(b->vk, &pipeline);
-    sb_pipeline_destroy(b->vk, &gather_pipeline);
     return res;
 }
 
@@ -607,11 +589,8 @@ void sb_atmosphere_code_hash(enum sb_product_id id, char out[SB_HASH_HEX_SIZE])
         for (int i = 0; i <= SB_GL_MAX_ORDER; i++)
             shaders[count++] = &transmittance_shaders[i];
     else
-        for (int k = 0; k < 2; k++) {
+        for (int k = 0; k < 2; k++)
             shaders[count++] = &scattering_shaders[k][id];
-            if (scattering_shaders[k][id].gather)
-                shaders[count++] = scattering_shaders[k][id].gather;
-        }
     for (int i = 0; i < count; i++) {
         sb_hash_bytes(shaders[i]->words, shaders[i]->size, text + n);
         n += SB_HASH_HEX_SIZE - 1;

@@ -39,8 +39,8 @@
 #define SB_SPHERE_THREADS_CPU 64
 #define SB_SPHERE_THREADS_GPU 128
 /* A GPU may instead integrate one direction an invocation, in workgroups of
- * SB_SPHERE_RAY_GROUP (sphere.glsl's SB_SPHERE_RAYS), and sum them in a
- * second kernel SB_SPHERE_THREADS_CPU wide (SB_SPHERE_GATHER). */
+ * SB_SPHERE_RAY_GROUP (sphere.glsl's SB_SPHERE_RAYS), the last of a texel
+ * summing them as a workgroup SB_SPHERE_THREADS_CPU wide would. */
 #define SB_SPHERE_RAY_GROUP 32
 #if defined(SB_SPHERE_RAYS)
 #define SB_SPHERE_THREADS SB_SPHERE_RAY_GROUP

@@ -22,16 +22,19 @@
  * SB_SPHERE_THREADS, sphere_add3() its values, then sphere_finish(), which
  * returns true on the last pass with the sums in sphere_sum3().
  *
- * A GPU may run the same kernel in two steps instead. Built with
+ * A GPU may run the same kernel another way instead. Built with
  * SB_SPHERE_RAYS, each invocation integrates one direction, in workgroups
  * of SB_SPHERE_RAY_GROUP, the host dispatching pc.direction_slots /
  * SB_SPHERE_RAY_GROUP of them a texel along z, and sphere_finish() stores
- * the direction's values in the scratch buffer. Built with
- * SB_SPHERE_GATHER, a workgroup per texel, SB_SPHERE_THREADS_CPU wide,
- * integrates nothing: sphere_finish() sums the stored directions, invocation
- * i those of d = i, i + SB_SPHERE_THREADS_CPU, ... in order, and reduces
- * as above. That is the CPU layout's order to the last operation, so the
- * two layouts differ only where the compilers contract differently. Why:
+ * the direction's values in the scratch buffer. The texel's workgroup that
+ * finishes last (a counter per texel in the scratch buffer) then sums the
+ * stored directions as a workgroup of SB_SPHERE_THREADS_CPU would,
+ * invocation i those of d = i, i + SB_SPHERE_THREADS_CPU, ... in order,
+ * and reduces as above. That is the CPU layout's order to the last
+ * operation, so the two layouts differ only where the compilers contract
+ * differently. (The sums were a second dispatch before: 0.012 ms of the
+ * H200's 0.26 for multiscattering at 12x4, now a few microseconds in the
+ * last workgroups.) Why:
  * a workgroup per texel holds a GPU's registers for its widest invocation
  * and its longest ray; multiscattering's one ray a zenith direction (80 to
  * 128 a texel) leaves a quarter of 128 invocations idle, and a walk along a
@@ -58,17 +61,28 @@ shared float sphere_node[SB_MAX_DIRECTIONS_MU];
 shared float sphere_weight[SB_MAX_DIRECTIONS_MU];
 shared float sphere_phi_node[SB_MAX_DIRECTIONS_PHI]; /* Gauss-Legendre on [0, 1], for the cap */
 shared float sphere_phi_weight[SB_MAX_DIRECTIONS_PHI];
-shared float sphere_partial[SB_SPHERE_THREADS * SB_SPHERE_MAX_SUMS];
+#ifdef SB_SPHERE_RAYS
+/* the sums of SB_SPHERE_THREADS_CPU invocations, which the last workgroup of a texel emulates */
+#define SB_SPHERE_REDUCED SB_SPHERE_THREADS_CPU
+#define SB_SPHERE_SCRATCH_QUALIFIER coherent
+#else
+#define SB_SPHERE_REDUCED SB_SPHERE_THREADS
+#define SB_SPHERE_SCRATCH_QUALIFIER
+#endif
+shared float sphere_partial[SB_SPHERE_REDUCED * SB_SPHERE_MAX_SUMS];
 
-layout(std430, set = 0, binding = SB_BINDING_SCRATCH) buffer SphereScratch {
+/* The sums are kept as their bits, so that the texels' counters of
+ * SB_SPHERE_RAYS (after every texel's sums) can be atomic. */
+layout(std430, set = 0, binding = SB_BINDING_SCRATCH) SB_SPHERE_SCRATCH_QUALIFIER buffer SphereScratch {
     uint sphere_truncated;    /* set when a pass ran out of loop iterations */
     uint sphere_sentinel[3];  /* 1, 1, 0, written by the host */
-    float sphere_partials[];  /* per texel, invocation and sum, between passes */
+    uint sphere_partials[];   /* per texel, invocation and sum, between passes; then a counter per texel */
 };
 
 float sphere_acc[SB_SPHERE_MAX_SUMS]; /* this invocation's sums */
-#if defined(SB_SPHERE_RAYS) || defined(SB_SPHERE_GATHER)
-uint sphere_count; /* the texel's directions, as sphere_end_direction saw them */
+#ifdef SB_SPHERE_RAYS
+uint sphere_count;        /* the texel's directions, as sphere_end_direction saw them */
+shared bool sphere_last;  /* this workgroup is the texel's last to finish */
 #endif
 
 /*
@@ -414,14 +428,14 @@ CapDirection sphere_cap_direction(SphereCap c, uint d, uint n_mu, uint n_phi)
     return cd;
 }
 
-/* Sum `count` values per invocation, stored at sphere_partial[i *
- * SB_SPHERE_MAX_SUMS + c], into sphere_partial[c]; a fixed pairwise tree. */
+/* Sum `count` values for each of SB_SPHERE_REDUCED invocations, stored at
+ * sphere_partial[i * SB_SPHERE_MAX_SUMS + c], into sphere_partial[c]; a
+ * fixed pairwise tree. */
 void sphere_reduce(uint count)
 {
-    uint i = gl_LocalInvocationIndex;
-    for (uint stride = SB_SPHERE_THREADS / 2u; stride > 0u; stride >>= 1u) {
+    for (uint stride = SB_SPHERE_REDUCED / 2u; stride > 0u; stride >>= 1u) {
         barrier();
-        if (i < stride)
+        for (uint i = gl_LocalInvocationIndex; i < stride; i += SB_SPHERE_THREADS)
             for (uint c = 0u; c < count; c++)
                 sphere_partial[i * SB_SPHERE_MAX_SUMS + c] += sphere_partial[(i + stride) * SB_SPHERE_MAX_SUMS + c];
     }
@@ -474,13 +488,13 @@ uint sphere_ray_slot(uint d)
 /* Start this pass from the previous passes' sums. */
 void sphere_begin()
 {
-#if defined(SB_SPHERE_RAYS) || defined(SB_SPHERE_GATHER)
+#ifdef SB_SPHERE_RAYS
     for (uint c = 0u; c < SB_SPHERE_MAX_SUMS; c++)
         sphere_acc[c] = 0.0;
 #else
     uint slot = sphere_slot();
     for (uint c = 0u; c < SB_SPHERE_MAX_SUMS; c++)
-        sphere_acc[c] = pc.step_begin > 0u ? sphere_partials[slot + c] : 0.0;
+        sphere_acc[c] = pc.step_begin > 0u ? uintBitsToFloat(sphere_partials[slot + c]) : 0.0;
 #endif
 }
 
@@ -498,9 +512,6 @@ uint sphere_end_direction(uint count)
 #if defined(SB_SPHERE_RAYS)
     sphere_count = count;
     return min(count, sphere_ray() + 1u);
-#elif defined(SB_SPHERE_GATHER)
-    sphere_count = count;
-    return 0u; /* the directions were integrated by the SB_SPHERE_RAYS kernel */
 #else
     return min(count, pc.step_end * SB_SPHERE_THREADS);
 #endif
@@ -527,24 +538,42 @@ bool sphere_finish(uint count)
         k++;
     if (k != 2u)
         sphere_truncated = 1u;
-#if defined(SB_SPHERE_RAYS)
+#ifdef SB_SPHERE_RAYS
     if (sphere_ray() < sphere_count)
         for (uint c = 0u; c < count; c++)
-            sphere_partials[sphere_ray_slot(sphere_ray()) + c] = sphere_acc[c];
-    return false;
-#elif defined(SB_SPHERE_GATHER)
-    for (uint d = gl_LocalInvocationIndex; d < sphere_count; d += SB_SPHERE_THREADS)
+            sphere_partials[sphere_ray_slot(sphere_ray()) + c] = floatBitsToUint(sphere_acc[c]);
+    /* The texel's counter, after every texel's sums: the workgroup that
+     * brings it to the texel's workgroup count sums the directions. */
+    memoryBarrierBuffer();
+    barrier();
+    if (gl_LocalInvocationIndex == 0u) {
+        uint counter = gl_NumWorkGroups.x * gl_NumWorkGroups.y * pc.direction_slots * SB_SPHERE_MAX_SUMS + sphere_group();
+        sphere_last = atomicAdd(sphere_partials[counter], 1u) + 1u == gl_NumWorkGroups.z;
+    }
+    barrier();
+    if (!sphere_last)
+        return false;
+    memoryBarrierBuffer();
+    for (uint i = gl_LocalInvocationIndex; i < SB_SPHERE_REDUCED; i += SB_SPHERE_THREADS) {
+        float acc[SB_SPHERE_MAX_SUMS];
         for (uint c = 0u; c < count; c++)
-            sphere_acc[c] += sphere_partials[sphere_ray_slot(d) + c];
-#endif
+            acc[c] = 0.0;
+        for (uint d = i; d < sphere_count; d += SB_SPHERE_REDUCED)
+            for (uint c = 0u; c < count; c++)
+                acc[c] += uintBitsToFloat(sphere_partials[sphere_ray_slot(d) + c]);
+        for (uint c = 0u; c < count; c++)
+            sphere_partial[i * SB_SPHERE_MAX_SUMS + c] = acc[c];
+    }
+#else
     if (pc.step_end < pc.step_count) {
         uint slot = sphere_slot();
         for (uint c = 0u; c < count; c++)
-            sphere_partials[slot + c] = sphere_acc[c];
+            sphere_partials[slot + c] = floatBitsToUint(sphere_acc[c]);
         return false;
     }
     for (uint c = 0u; c < count; c++)
         sphere_partial[gl_LocalInvocationIndex * SB_SPHERE_MAX_SUMS + c] = sphere_acc[c];
+#endif
     sphere_reduce(count);
     return true;
 }
