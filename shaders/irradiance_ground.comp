@@ -10,6 +10,7 @@
 #extension GL_GOOGLE_include_directive : require
 #include "config.h"
 #define SB_RAY_OZONE_CORNERS
+#define SB_RAY_LEVELS_DOUBLING /* with the corners, no less accurate (docs/accuracy.md) */
 #include "atmosphere.glsl"
 #include "sphere.glsl"
 
