@@ -32,9 +32,9 @@
  * invocation i those of d = i, i + SB_SPHERE_THREADS_CPU, ... in order,
  * and reduces as above. That is the CPU layout's order to the last
  * operation, so the two layouts differ only where the compilers contract
- * differently. (The sums were a second dispatch before: 0.012 ms of the
- * H200's 0.26 for multiscattering at 12x4, now a few microseconds in the
- * last workgroups.) Why:
+ * differently. (The sums were a second dispatch before, 0.012 ms of the
+ * H200's 0.262 for multiscattering at 12x4; summed by the last workgroups
+ * the bake took 0.253.) Why:
  * a workgroup per texel holds a GPU's registers for its widest invocation
  * and its longest ray; multiscattering's one ray a zenith direction (80 to
  * 128 a texel) leaves a quarter of 128 invocations idle, and a walk along a
