@@ -382,7 +382,7 @@ static enum sb_result run(struct sb_atmosphere_baker *b, const struct spirv *ker
     if (workgroup_per_texel) {
         push.step_count = rays ? 1 : (uint32_t)((directions + kernel->threads - 1) / kernel->threads);
         size_t per_texel = rays ? push.direction_slots : kernel->threads;
-        size_t sums = (size_t)width * height * per_texel * SB_SPHERE_MAX_SUMS;
+        size_t sums = SB_SPHERE_COUNTERS((size_t)width * height, per_texel);
         size_t counters = rays ? (size_t)width * height : 0; /* a texel's workgroups done */
         size_t bytes = 16 + (sums + counters) * sizeof(float);
         if (b->scratch.size < bytes) {

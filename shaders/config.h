@@ -50,6 +50,10 @@
 #define SB_SPHERE_THREADS SB_SPHERE_THREADS_CPU
 #endif
 #define SB_SPHERE_MAX_SUMS 9
+/* The scratch buffer of a sphere bake (sphere.glsl), in 32-bit words after
+ * its 4-word header: `slots` sums' slots a texel of `texels`, then, for
+ * SB_SPHERE_RAYS, a counter a texel; the first counter's index. */
+#define SB_SPHERE_COUNTERS(texels, slots) ((texels) * (slots) * SB_SPHERE_MAX_SUMS)
 /* Directions per invocation in one dispatch (sphere.glsl): the passes keep
  * every invocation far below llvmpipe's 65535 loop iterations. */
 #define SB_SPHERE_STEPS_PER_PASS 8

@@ -8,7 +8,8 @@
  *   psi = E_sun L2 / (1 - f).
  * The azimuth is integrated first, in the ring table (sun_rings.glsl): one
  * ray per zenith direction, pc.directions_mu Gauss-Legendre nodes a piece of
- * the zenith grid (sphere.glsl), one workgroup per texel. */
+ * the zenith grid (sphere.glsl): a workgroup a texel on a CPU device, a ray
+ * an invocation on a GPU (SB_SPHERE_RAYS). */
 #extension GL_GOOGLE_include_directive : require
 #include "config.h"
 #define SB_RAY_OZONE_CORNERS

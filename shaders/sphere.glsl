@@ -547,7 +547,7 @@ bool sphere_finish(uint count)
     memoryBarrierBuffer();
     barrier();
     if (gl_LocalInvocationIndex == 0u) {
-        uint counter = gl_NumWorkGroups.x * gl_NumWorkGroups.y * pc.direction_slots * SB_SPHERE_MAX_SUMS + sphere_group();
+        uint counter = SB_SPHERE_COUNTERS(gl_NumWorkGroups.x * gl_NumWorkGroups.y, pc.direction_slots) + sphere_group();
         sphere_last = atomicAdd(sphere_partials[counter], 1u) + 1u == gl_NumWorkGroups.z;
     }
     barrier();

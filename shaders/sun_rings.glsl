@@ -97,13 +97,14 @@ float ring_w_max(RingColumn col, float h)
  * ground (cosine -rho / r, sine R / r), as tan(c / 2) = |sin c| / (1 + cos c)
  * from its sine and cosine times r, which do not cancel where c is small as
  * the difference of the two angles would (c < pi - pi / 6 within any
- * atmosphere up to its planet's radius thick, so 1 + cos c does not either). */
-float ring_cut(RingColumn col, float h)
+ * atmosphere up to its planet's radius thick, so 1 + cos c does not either),
+ * at most w_max = ring_w_max(col, h). */
+float ring_cut(RingColumn col, float h, float w_max)
 {
     float R = ground_radius(), rho = horizon_distance(h);
     float s = col.sin_s * rho + col.mu_s * R;
     float c = col.sin_s * R - col.mu_s * rho;
-    return min(abs(s) / (R + h + c), ring_w_max(col, h));
+    return min(abs(s) / (R + h + c), w_max);
 }
 
 /* The row block of altitude h: its first row and row count, and the
@@ -141,11 +142,11 @@ float ring_row_altitude(RingColumn col, int i)
 /* The half-angle tangent of entry j of a row at altitude h. */
 float ring_entry_tan(RingColumn col, float h, int j)
 {
-    float c = ring_cut(col, h);
+    float w_max = ring_w_max(col, h), c = ring_cut(col, h, w_max);
     if (j < SB_RINGS_INNER)
         return c * float(j) / float(SB_RINGS_INNER - 1);
     float v = float(j - SB_RINGS_INNER) / float(SB_RINGS_OUTER - 1);
-    return c + (ring_w_max(col, h) - c) * v * v;
+    return c + (w_max - c) * v * v;
 }
 
 /* Catmull-Rom weights of continuous entry f of a block of n >= 4 entries,
@@ -178,7 +179,7 @@ vec3 ring_table_sample(uint column, RingColumn col, float h, float w)
 {
     int first, rows;
     float fr = ring_row(col, h, first, rows);
-    float c = ring_cut(col, h), w_max = ring_w_max(col, h);
+    float w_max = ring_w_max(col, h), c = ring_cut(col, h, w_max);
     bool outer = w >= c && w_max > c;
     int n = outer ? SB_RINGS_OUTER : SB_RINGS_INNER;
     float u = outer ? sqrt(max(w - c, 0.0) / (w_max - c)) : (c > 0.0 ? w / c : 0.0);
