@@ -686,16 +686,23 @@ void sb_atmosphere_settings_json(enum sb_product_id id, const struct sb_atmosphe
                                   ? "the sun's mirror and the sun (upper hemisphere)"
                                   : "the horizon, two ground depths, the ozone corners, 25 scale heights of "
                                     "tangent altitude, the sun's mirror and the sun";
+    char day_azimuths[256];
+    snprintf(day_azimuths, sizeof(day_azimuths),
+             "\"azimuth_by_day\":\"where the sun is %g rad above every seen point's horizontal: %u even nodes, "
+             "the phase functions by product integration, %d nodes\",",
+             SB_AZIMUTH_DAY_MARGIN, (s->directions_phi + 3) / 4, SB_AZIMUTH_DENSE);
     snprintf(
         out, size,
         "{\"directions_mu\":%u,\"directions_phi\":%u,"
         "\"zenith\":\"gauss-legendre per piece, cut at %s\","
         "\"azimuth\":\"midpoint over [0, pi]%s\","
+        "%s"
         "\"ray_segments\":\"altitude levels, geometric from half the smallest scale height,%s the shadow "
         "boundary and the sun grazing the ozone corners\",\"segment_quadrature\":\"gauss-legendre-%d\","
         "\"sun_transmittance\":\"the sun table: Catmull-Rom of Rayleigh and Mie airmasses on %dx%d nodes a region, "
         "ozone integrated\"%s}",
         s->directions_mu, s->directions_phi, zenith_cuts, ", crowded toward the sun",
+        id == SB_PRODUCT_IRRADIANCE_SKY ? day_azimuths : "",
         id == SB_PRODUCT_IRRADIANCE_SKY ? "" : " the ozone corners,", SB_RAY_GL_ORDER, SB_SUN_COLUMNS_X,
         SB_SUN_COLUMNS_U, ",\"lut_lookup\":\"catmull-rom of the logarithm\"");
 }

@@ -77,6 +77,12 @@
  * sides of the horizon. */
 #define SB_CAP_THETA 0.5
 #define SB_CAP_MIN_G 0.85
+/* irradiance_sky's azimuths (sphere.glsl, sphere_azimuth_weights): the
+ * dense rule for the phase functions' weights, and how far above every
+ * seen point's horizontal the sun must be for a quarter of the nodes
+ * (radians). */
+#define SB_AZIMUTH_DENSE 48
+#define SB_AZIMUTH_DAY_MARGIN 0.05
 #define SB_SPHERE_CAP_PIECES 6
 
 /* Every atmosphere bake pipeline has the same descriptor set layout: seven

@@ -9,7 +9,8 @@
  * each integrated along the ray with T(x,y). The direct sun is excluded.
  * For an isotropic scatterer, in-scattered radiance = sigma_s * (sum of the
  * three); the runtime may weight them separately. One workgroup per texel
- * (sphere.glsl). */
+ * (sphere.glsl); by day a quarter of the azimuths, the phase functions
+ * weighted by product integration (sphere_azimuths). */
 #extension GL_GOOGLE_include_directive : require
 #include "config.h"
 #include "atmosphere.glsl"
@@ -31,7 +32,8 @@ void main()
     SphereCap cap = sphere_cap(h, true, mu_s);
 
     sphere_begin();
-    uint count = sphere_direction_count(pieces, pc.directions_mu, pc.directions_phi);
+    SphereAzimuths az = sphere_azimuths(h, mu_s, pc.directions_phi);
+    uint count = sphere_direction_count(pieces, pc.directions_mu, az.n);
     uint total = count + sphere_cap_direction_count(cap, pc.directions_mu, pc.directions_phi);
     /* One integrate_ray for both grids, so that the invocations integrating
      * the cap's directions and those on the zenith grid run it together. */
@@ -39,6 +41,7 @@ void main()
         bool on_cap = d >= count; /* Mie single scattering's peak */
         SphereDirection s;
         float nu;
+        AzimuthWeights aw;
         if (on_cap) {
             CapDirection cd = sphere_cap_direction(cap, d - count, pc.directions_mu, pc.directions_phi);
             if (cd.phase_weight <= 0.0)
@@ -48,8 +51,14 @@ void main()
             s.toward_ground = cd.toward_ground;
             nu = cd.nu;
         } else {
-            s = sphere_direction(pieces, d, pc.directions_mu, pc.directions_phi);
+            uint p = d % az.n;
+            SphereZenith z = sphere_zenith(pieces, d / (pc.directions_mu * az.n), (d / az.n) % pc.directions_mu);
+            s.mu = z.mu;
+            s.toward_ground = z.toward_ground;
+            s.weight = 2.0 * z.weight;
             float sin_v = sqrt(max(1.0 - s.mu * s.mu, 0.0));
+            aw = sphere_azimuth_weights(s.mu * mu_s, sin_v * sin_s, p, az);
+            s.cos_phi = aw.cos_phi;
             nu = clamp(sin_v * sin_s * s.cos_phi + s.mu * mu_s, -1.0, 1.0);
         }
         RayIntegrals ri = integrate_ray(h, s.mu, mu_s, nu, s.toward_ground, !on_cap);
@@ -57,12 +66,11 @@ void main()
             sphere_add3(3u, s.weight * sun * ri.sun_mie);
             continue;
         }
-        sphere_add3(0u, s.weight * (sun * ri.sun_rayleigh * phase_rayleigh(nu) + ri.ms_rayleigh));
-        float mie = phase_mie(nu) * (1.0 - sphere_cap_window(true, nu));
-        sphere_add3(3u, s.weight * (sun * ri.sun_mie * mie + ri.ms_mie));
+        sphere_add3(0u, s.weight * (sun * ri.sun_rayleigh * aw.rayleigh + ri.ms_rayleigh * aw.iso));
+        sphere_add3(3u, s.weight * (sun * ri.sun_mie * aw.mie + ri.ms_mie * aw.iso));
         if (s.toward_ground) {
             float mu_sp = clamp((r * mu_s + ri.t_end * nu) / ground_radius(), -1.0, 1.0);
-            sphere_add3(6u, s.weight * ri.transmittance * atm.ground_albedo.rgb / PI * ground_irradiance_sample(mu_sp));
+            sphere_add3(6u, s.weight * aw.iso * ri.transmittance * atm.ground_albedo.rgb / PI * ground_irradiance_sample(mu_sp));
         }
     }
     if (!sphere_finish(9u) || gl_LocalInvocationIndex != 0u)
