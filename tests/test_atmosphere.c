@@ -636,7 +636,7 @@ int main(void)
         test_sampled(SB_PRODUCT_IRRADIANCE_GROUND, ig_x, 13, ig_y, 4, 1e-3, 1e-3);
         /* irradiance_sky's also either side of where its texels take a
          * quarter of the azimuths (sphere_azimuths: from x = 39 on the
-         * ground, x = 46 at the top) */
+         * ground, x = 44 at the top) */
         static const int is_x[] = {0, 16, 26, 27, 28, 29, 30, 31, 32, 33, 36, 40, 45, 48, 63};
         test_sampled(SB_PRODUCT_IRRADIANCE_SKY, is_x, 15, ig_y, 4, 1e-3, 1e-3);
         test_many_directions(baker);
