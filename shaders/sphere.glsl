@@ -274,6 +274,14 @@ SphereZenith sphere_zenith(SpherePieces sp, uint piece, uint k)
     return z;
 }
 
+/* Azimuth node at v in (0, 1) of the midpoint rule, and dphi/dv: phi = pi v,
+ * or, crowded, pi (v - sin(2 pi v) / (2 pi)). */
+float sphere_azimuth(float v, bool crowded, out float dphi)
+{
+    dphi = crowded ? PI * (1.0 - cos(2.0 * PI * v)) : PI;
+    return crowded ? PI * (v - sin(2.0 * PI * v) / (2.0 * PI)) : PI * v;
+}
+
 SphereDirection sphere_direction(SpherePieces sp, uint d, uint n_mu, uint n_phi)
 {
     uint piece = d / (n_mu * n_phi), k = (d / n_phi) % n_mu, p = d % n_phi;
@@ -285,11 +293,8 @@ SphereDirection sphere_direction(SpherePieces sp, uint d, uint n_mu, uint n_phi)
      * (2 pi)), which crowds the nodes toward the sun's side (phi = 0, where
      * the Mie peak is) and keeps the rule's accuracy on the even, periodic
      * integrand. */
-    float v = (float(p) + 0.5) / float(n_phi);
-    bool crowd = sp.peak <= 1.0;
-    float phi = crowd ? PI * (v - sin(2.0 * PI * v) / (2.0 * PI)) : PI * v;
-    float dphi = crowd ? PI * (1.0 - cos(2.0 * PI * v)) : PI;
-    s.cos_phi = cos(phi);
+    float dphi;
+    s.cos_phi = cos(sphere_azimuth((float(p) + 0.5) / float(n_phi), sp.peak <= 1.0, dphi));
     s.weight = z.weight * 2.0 * dphi / float(n_phi);
     return s;
 }
@@ -392,17 +397,15 @@ AzimuthWeights sphere_azimuth_weights(float a, float b, uint p, SphereAzimuths a
 {
     AzimuthWeights w;
     float v_p = (float(p) + 0.5) / float(az.n);
+    float dphi, phi_p = sphere_azimuth(v_p, az.crowded, dphi);
+    w.cos_phi = cos(phi_p);
     if (az.crowded) { /* as sphere_direction */
-        float dphi = 1.0 - cos(2.0 * PI * v_p);
-        w.cos_phi = cos(PI * (v_p - sin(2.0 * PI * v_p) / (2.0 * PI)));
         float nu = clamp(a + b * w.cos_phi, -1.0, 1.0);
-        w.iso = PI * dphi / float(az.n);
+        w.iso = dphi / float(az.n);
         w.rayleigh = w.iso * phase_rayleigh(nu);
         w.mie = w.iso * phase_mie(nu) * (1.0 - sphere_cap_window(true, nu));
         return w;
     }
-    float phi_p = PI * v_p;
-    w.cos_phi = cos(phi_p);
     /* 1 - nu = (1 - a - b) + 2 b sin^2(phi / 2), exact near the peak */
     float o_0 = max(1.0 - a - b, 0.0);
     float sum_i = 0.0, sum_r = 0.0, sum_m = 0.0;
