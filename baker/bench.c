@@ -79,7 +79,13 @@ static const struct sweep_entry multiscattering_sweep[] = {
     {HILLAIRE_DIRS(8, 20), HILLAIRE_MS, true},
     {HILLAIRE_DIRS(8, 80), NULL, false},
     {HILLAIRE_DIRS(8, 320), NULL, false},
+    /* the same method with more directions: how far they take it */
+    {HILLAIRE_DIRS(16, 20), NULL, false},
+    {HILLAIRE_DIRS(32, 20), NULL, false},
+    {HILLAIRE_DIRS(64, 20), NULL, false},
+    {HILLAIRE_DIRS(64, 80), NULL, false},
     /* zenith nodes a piece x the rings' Gauss-Legendre nodes a piece */
+    {DIRS(2, 2), NULL, false},
     {DIRS(4, 3), NULL, true},
     {DIRS(8, 4), NULL, true},
     {DIRS(12, 4), NULL, false},
@@ -401,6 +407,20 @@ static const struct sb_bench_row *default_row(const struct sb_bench_report *repo
     return NULL;
 }
 
+/* The most accurate row of anchor row r's own rule (r or a variant of it:
+ * more directions, more steps) in its sweep, or NULL where r is that row. */
+static const struct sb_bench_row *rule_best(const struct sb_bench_report *report, const struct sb_bench_row *r)
+{
+    const struct sb_bench_row *best = r;
+    for (int i = 0; i < report->row_count; i++) {
+        const struct sb_bench_row *v = &report->rows[i];
+        if (v->sweep == r->sweep && !v->ours && v->settings.quadrature == r->settings.quadrature &&
+            isfinite(v->error.max_rel) && v->error.max_rel < best->error.max_rel)
+            best = v;
+    }
+    return best != r ? best : NULL;
+}
+
 /* The default's time and error as multiples of anchor row r's; false where
  * the sweep has no default row or the ratios are undefined. */
 static bool default_ratios(const struct sb_bench_report *report, const struct sb_bench_row *r, double *time,
@@ -457,6 +477,12 @@ static cJSON *report_json(const struct sb_bench_report *report, const struct sb_
             if (default_ratios(report, r, &time, &error)) {
                 cJSON_AddNumberToObject(o, "default_time_ratio", time);
                 cJSON_AddNumberToObject(o, "default_error_ratio", error);
+            }
+            const struct sb_bench_row *best = rule_best(report, r);
+            if (best && default_ratios(report, best, &time, &error)) {
+                cJSON_AddStringToObject(o, "rule_best", best->label);
+                cJSON_AddNumberToObject(o, "rule_best_default_time_ratio", time);
+                cJSON_AddNumberToObject(o, "rule_best_default_error_ratio", error);
             }
             cJSON_AddBoolToObject(o, "dominated_by_default", r->dominated_by_default);
             if (r->dominated_by >= 0)
@@ -531,6 +557,11 @@ static void print_anchors(const struct sb_bench_report *report, int w)
             printf(" %s dominates it, the default does not\n", fastest);
         else
             printf(" no setting of skybake's dominates it\n");
+        const struct sb_bench_row *best = rule_best(report, r);
+        if (best && default_ratios(report, best, &time, &error))
+            printf("    its rule's most accurate row here, %s, is %.3g off: the default takes %.3gx its time at "
+                   "%.3gx its error\n",
+                   best->label, best->error.max_rel, time, error);
     }
 }
 

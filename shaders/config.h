@@ -205,8 +205,11 @@ struct sb_bake_push {
 /* skybake bench's anchor for multiple scattering: Hillaire 2020's LUT
  * (multiscattering_hillaire.comp), selected by quadrature
  * SB_QUADRATURE_UNIFORM_0_3 on that product: directions_mu x directions_phi
- * directions (at most a workgroup's), `samples` steps a ray. Never in a pack. */
-#define SB_ANCHOR_MAX_DIRECTIONS 64
+ * directions, `samples` steps a ray, an invocation walking every 64th
+ * direction: at most SB_ANCHOR_MAX_ITERATIONS steps an invocation, far below
+ * llvmpipe's 65535 loop iterations. Never in a pack. */
+#define SB_ANCHOR_MAX_DIRECTIONS 4096
+#define SB_ANCHOR_MAX_ITERATIONS 32768
 /* skybake bench's anchor for ground irradiance: Bruneton 2017's quadrature
  * (irradiance_ground_bruneton.comp), selected by SB_QUADRATURE_TRAPEZOID on
  * that product: directions_mu zenith angles by directions_phi azimuths over

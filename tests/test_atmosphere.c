@@ -532,6 +532,27 @@ static void test_many_directions(struct sb_atmosphere_baker *baker)
 }
 
 /*
+ * Hillaire's rule (the bench's anchor) walks every 64th direction in an
+ * invocation: past SB_ANCHOR_MAX_ITERATIONS steps an invocation llvmpipe's
+ * loop budget would cut its sums short, so such a setting is refused
+ * before it bakes, one step over the limit as well.
+ */
+static void test_anchor_limits(struct sb_atmosphere_baker *baker)
+{
+    struct sb_image img = {0};
+    struct sb_atmosphere_settings s = {
+        .quadrature = SB_QUADRATURE_UNIFORM_0_3, .samples = 600, .directions_mu = 64, .directions_phi = 64};
+    enum sb_result res = sb_atmosphere_bake(baker, SB_PRODUCT_MULTISCATTERING, &s, &img, NULL, NULL);
+    CHECK(res == SB_ERR_USAGE, "Hillaire's rule at 4096 directions of 600 steps: %s", sb_result_name(res));
+    sb_image_finish(&img);
+    s.samples = SB_ANCHOR_MAX_ITERATIONS / (SB_ANCHOR_MAX_DIRECTIONS / 64) + 1;
+    s.directions_mu = s.directions_phi = 64;
+    res = sb_atmosphere_bake(baker, SB_PRODUCT_MULTISCATTERING, &s, &img, NULL, NULL);
+    CHECK(res == SB_ERR_USAGE, "Hillaire's rule one step over the limit: %s", sb_result_name(res));
+    sb_image_finish(&img);
+}
+
+/*
  * The kernels laid out for a GPU (wider workgroups, the multiscattering LUT
  * read from its buffer) and for a CPU device (narrower, the LUT copied to
  * workgroup memory) must compute the same sums: both bake each scattering
@@ -640,6 +661,7 @@ int main(void)
         static const int is_x[] = {0, 16, 26, 27, 28, 29, 30, 31, 32, 33, 36, 40, 45, 48, 63};
         test_sampled(SB_PRODUCT_IRRADIANCE_SKY, is_x, 15, ig_y, 4, 1e-3, 1e-3);
         test_many_directions(baker);
+        test_anchor_limits(baker);
         test_kernel_layouts(vk, baker); /* last: it drops the products' lookups */
     }
     sb_atmosphere_baker_destroy(&baker);
