@@ -684,7 +684,8 @@ static enum sb_result write_plot(const struct sb_bench_report *report, const str
     text_add(&gp, "set terminal svg size 1500,%d dynamic font 'sans,11'\nset output 'bench.svg'\n",
              panels > 3 ? 1000 : 520);
     text_add(&gp, "set datafile separator ','\nset termoption noenhanced\nset logscale xy\nset grid\n");
-    text_add(&gp, "set key bottom left Left reverse font ',9'\nset xlabel 'GPU ms (median)'\nset ylabel 'max rel error vs fp64'\n");
+    text_add(&gp, "set key bottom left Left reverse font ',9'\n"
+                  "set xlabel 'GPU ms (median)'\nset ylabel 'max rel error vs fp64'\n");
     text_add(&gp, "set multiplot layout %d,3 title 'skybake bench on %s'\n", panels > 3 ? 2 : 1,
              vk->properties.deviceName);
     for (int w = 0; w < SB_BENCH_SWEEP_COUNT; w++) {
