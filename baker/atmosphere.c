@@ -193,15 +193,15 @@ static enum sb_result check_settings(enum sb_product_id id, const struct sb_atmo
         bool hillaire = id == SB_PRODUCT_MULTISCATTERING && s->quadrature == SB_QUADRATURE_UNIFORM_0_3 &&
                         directions >= 1 && directions <= SB_ANCHOR_MAX_DIRECTIONS && s->samples >= 1 &&
                         s->samples <= SB_UNIFORM_MAX_STEPS &&
-                        (directions + 63) / 64 * s->samples <= SB_ANCHOR_MAX_ITERATIONS;
+                        SB_ANCHOR_ITERATIONS(directions, s->samples) <= SB_ANCHOR_MAX_ITERATIONS;
         bool bruneton = id == SB_PRODUCT_IRRADIANCE_GROUND && s->quadrature == SB_QUADRATURE_TRAPEZOID &&
                         directions >= 1 && directions <= SB_BRUNETON_MAX_DIRECTIONS && s->samples >= 1 &&
                         s->samples <= SB_BRUNETON_MAX_STEPS;
         if (!hillaire && !bruneton) {
             sb_error("%s: the published rules are Hillaire 2020's multiscattering (uniform, 1 to %d directions, 1 to "
-                     "%d steps, steps times directions / 64 rounded up at most %d) and Bruneton 2017's "
+                     "%d steps, and steps times directions / %d rounded up at most %d) and Bruneton 2017's "
                      "irradiance_ground (trapezoid, 1 to %d directions, 1 to %d steps); got quadrature %u, %ux%u, %u",
-                     name, SB_ANCHOR_MAX_DIRECTIONS, SB_UNIFORM_MAX_STEPS, SB_ANCHOR_MAX_ITERATIONS,
+                     name, SB_ANCHOR_MAX_DIRECTIONS, SB_UNIFORM_MAX_STEPS, SB_ANCHOR_THREADS, SB_ANCHOR_MAX_ITERATIONS,
                      SB_BRUNETON_MAX_DIRECTIONS, SB_BRUNETON_MAX_STEPS, s->quadrature, s->directions_mu,
                      s->directions_phi, s->samples);
             return SB_ERR_USAGE;

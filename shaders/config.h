@@ -205,11 +205,15 @@ struct sb_bake_push {
 /* skybake bench's anchor for multiple scattering: Hillaire 2020's LUT
  * (multiscattering_hillaire.comp), selected by quadrature
  * SB_QUADRATURE_UNIFORM_0_3 on that product: directions_mu x directions_phi
- * directions, `samples` steps a ray, an invocation walking every 64th
- * direction: at most SB_ANCHOR_MAX_ITERATIONS steps an invocation, far below
- * llvmpipe's 65535 loop iterations. Never in a pack. */
+ * directions, `samples` steps a ray, in workgroups of SB_ANCHOR_THREADS
+ * an invocation walking every SB_ANCHOR_THREADS-th direction: at most
+ * SB_ANCHOR_MAX_ITERATIONS steps an invocation (SB_ANCHOR_ITERATIONS), far
+ * below llvmpipe's 65535 loop iterations. Never in a pack. */
+#define SB_ANCHOR_THREADS 64
 #define SB_ANCHOR_MAX_DIRECTIONS 4096
 #define SB_ANCHOR_MAX_ITERATIONS 32768
+#define SB_ANCHOR_ITERATIONS(directions, samples) \
+    (((directions) + SB_ANCHOR_THREADS - 1) / SB_ANCHOR_THREADS * (samples))
 /* skybake bench's anchor for ground irradiance: Bruneton 2017's quadrature
  * (irradiance_ground_bruneton.comp), selected by SB_QUADRATURE_TRAPEZOID on
  * that product: directions_mu zenith angles by directions_phi azimuths over

@@ -5,9 +5,10 @@
  * measured at the same points as ours:
  * - directions: the sphere in directions_mu x directions_phi cells (his
  *   8 x 8 = 64), uniform in cos(zenith) and in azimuth, one at each cell's
- *   centre, one invocation each (beyond 64, invocation i walks directions
- *   i, i + 64, ... and sums them in that order: the bench's rows with more
- *   directions show how the method converges);
+ *   centre, one invocation each (beyond SB_ANCHOR_THREADS, invocation i
+ *   walks directions i, i + SB_ANCHOR_THREADS, ... and sums them in that
+ *   order: the bench's rows with more directions show how the method
+ *   converges);
  * - each ray marched to the ground or the top in `samples` equal steps (his
  *   20), sampled at 0.3 of each step, each step integrated analytically
  *   with its sample's medium: (S - S e^(-sigma_t dt)) / sigma_t;
@@ -17,18 +18,19 @@
  * - psi_ms = E_sun L2 / (1 - f), L2 and f the means over the directions of
  *   the isotropically scattered light and of the scattering (his
  *   "MultiScatAs1"), as multiscattering.comp defines them.
- * One workgroup of 64 per texel; invocation 0 sums the 64 in a fixed order. */
+ * One workgroup of SB_ANCHOR_THREADS per texel; invocation 0 sums their
+ * sums in a fixed order. */
 #extension GL_GOOGLE_include_directive : require
 #include "config.h"
 #define SB_SUN_TRANSMITTANCE_LUT
 #include "atmosphere.glsl"
 
-layout(local_size_x = 64) in;
+layout(local_size_x = SB_ANCHOR_THREADS) in;
 layout(push_constant) uniform Push { sb_bake_push pc; };
 layout(std430, set = 0, binding = SB_BINDING_OUTPUT) writeonly buffer Output { float result[]; };
 
-shared vec3 light_sum[64];
-shared vec3 scattering_sum[64];
+shared vec3 light_sum[SB_ANCHOR_THREADS];
+shared vec3 scattering_sum[SB_ANCHOR_THREADS];
 
 void main()
 {
@@ -41,7 +43,7 @@ void main()
     uint i = gl_LocalInvocationIndex;
     uint count = pc.directions_mu * pc.directions_phi;
     vec3 light = vec3(0.0), scattering = vec3(0.0);
-    for (uint d = i; d < count; d += 64u) {
+    for (uint d = i; d < count; d += SB_ANCHOR_THREADS) {
         float a = (float(d / pc.directions_mu) + 0.5) / float(pc.directions_phi);
         float b = (float(d % pc.directions_mu) + 0.5) / float(pc.directions_mu);
         float phi = 2.0 * PI * a;
@@ -76,7 +78,7 @@ void main()
     if (i != 0u)
         return;
     vec3 l2 = vec3(0.0), f = vec3(0.0);
-    for (uint k = 0u; k < min(count, 64u); k++) {
+    for (uint k = 0u; k < min(count, uint(SB_ANCHOR_THREADS)); k++) {
         l2 += light_sum[k];
         f += scattering_sum[k];
     }
