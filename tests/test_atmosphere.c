@@ -624,7 +624,7 @@ int main(void)
     struct sb_vk *vk = NULL;
     enum sb_result res = test_vulkan(false, &vk);
     if (res == SB_ERR_NO_DEVICE)
-        return TEST_SKIP;
+        return test_no_device();
     if (res)
         return test_finish("atmosphere");
     struct sb_atmosphere_baker *baker = NULL;

@@ -18,7 +18,7 @@ int main(void)
     struct sb_vk *vk = NULL;
     enum sb_result res = test_vulkan(false, &vk);
     if (res == SB_ERR_NO_DEVICE)
-        return TEST_SKIP;
+        return test_no_device();
     if (res)
         return test_finish("dfg");
     struct sb_image lut = {0}, again = {0};

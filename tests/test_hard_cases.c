@@ -304,7 +304,7 @@ int main(int argc, char **argv)
     struct sb_vk *vk;
     enum sb_result res = test_vulkan(false, &vk);
     if (res == SB_ERR_NO_DEVICE)
-        return TEST_SKIP;
+        return test_no_device();
 
     static struct baked baked[MAX_SCENES];
     int baked_count = 0;

@@ -637,7 +637,7 @@ int main(int argc, char **argv)
     test_colour_science();
     enum sb_result res = test_vulkan(true, &vk);
     if (res == SB_ERR_NO_DEVICE)
-        return TEST_SKIP;
+        return test_no_device();
     if (res)
         return test_finish("post");
 

@@ -1361,7 +1361,7 @@ int main(int argc, char **argv)
     const char *world_path = argc > 1 ? argv[1] : TEST_WORLD;
     enum sb_result res = test_vulkan(true, &vk);
     if (res == SB_ERR_NO_DEVICE)
-        return TEST_SKIP;
+        return test_no_device();
     if (res)
         return test_finish("runtime");
 

@@ -699,7 +699,7 @@ int main(void)
     test_tensor();
     struct sb_vk *vk;
     if (test_vulkan(false, &vk) == SB_ERR_NO_DEVICE)
-        return TEST_SKIP;
+        return test_no_device();
     if (vk) {
         test_analytic(vk);
         test_house(vk);
