@@ -43,13 +43,21 @@ struct probes_state {
     struct sb_raycaster *rc;
 };
 
+static enum sb_result plan(const struct sb_scene *scene, const struct sb_mesh *mesh, struct sb_probe_layout *layout,
+                           uint64_t *grid_out);
+
 static enum sb_result probes_create(struct sb_vk *vk, const struct sb_scene *scene, void **out)
 {
     struct probes_state *st = calloc(1, sizeof(*st));
     if (!st)
         return SB_ERR_NOMEM;
     enum sb_result res = sb_mesh_load_world(&scene->world, scene->directory, &st->mesh, st->path, sizeof(st->path));
+    struct sb_probe_layout layout = {0};
+    uint64_t grid;
+    if (!res)
+        res = plan(scene, &st->mesh, &layout, &grid);
     if (res) {
+        sb_mesh_finish(&st->mesh); /* a failed load leaves what it had allocated */
         free(st);
         return res;
     }
@@ -108,9 +116,11 @@ static enum sb_result raycaster(struct probes_state *st, struct sb_vk *vk)
     return res;
 }
 
-/* The grid over the world's bounds (or the scene's), centred on them. */
-static enum sb_result place(const struct sb_scene *scene, const struct sb_mesh *mesh, struct sb_probe_layout *layout,
-                            float **positions, uint32_t *count)
+/* The grid over the world's bounds (or the scene's), centred on them, and
+ * its size checked against the caps: from the scene and its world alone,
+ * so that probes_create refuses a grid before any product is baked. */
+static enum sb_result plan(const struct sb_scene *scene, const struct sb_mesh *mesh, struct sb_probe_layout *layout,
+                           uint64_t *grid_out)
 {
     const struct sb_probe_params *p = &scene->probes;
     uint64_t grid = 0;
@@ -143,6 +153,18 @@ static enum sb_result place(const struct sb_scene *scene, const struct sb_mesh *
                  (unsigned long long)(grid + p->explicit_count), SB_PROBES_MAX_COUNT);
         return SB_ERR_TOO_LARGE;
     }
+    *grid_out = grid;
+    return SB_OK;
+}
+
+static enum sb_result place(const struct sb_scene *scene, const struct sb_mesh *mesh, struct sb_probe_layout *layout,
+                            float **positions, uint32_t *count)
+{
+    const struct sb_probe_params *p = &scene->probes;
+    uint64_t grid;
+    enum sb_result res = plan(scene, mesh, layout, &grid);
+    if (res)
+        return res;
     layout->explicit_count = (uint32_t)p->explicit_count;
     layout->ray_count = p->rays;
     *count = (uint32_t)grid + (uint32_t)p->explicit_count;

@@ -99,6 +99,17 @@ done
 scene '["sky_visibility"]' '{"preset":"earth"}' '' | sed 's/"spacing_m":4/"spacing_m":0.01/' >"$tmp/dense.json"
 check "a grid past the caps is refused" expect_exit 1 "$skybake" bake "$tmp/dense.json" -o "$tmp/n"
 check "it says to raise the spacing" grep -q "raise probes.spacing_m" "$tmp/err"
+# Found from the scene and its world, before any product is baked (it was
+# found after the atmosphere's bakes).
+scene '["transmittance","sky_visibility"]' '{"preset":"earth"}' '' | sed 's/"spacing_m":4/"spacing_m":0.01/' >"$tmp/dense2.json"
+check "a grid past the caps, beside the atmosphere" expect_exit 1 "$skybake" bake "$tmp/dense2.json" -o "$tmp/n"
+check "is refused before any product is baked" sh -c "! grep -q '^transmittance' '$tmp/err'"
+# A world file whose box lies beyond 10 km: refused, naming the file, and
+# (under LeakSanitizer) nothing of the half-built mesh leaks.
+printf '{"version":1,"boxes":[{"center_m":[9999,0,0],"size_m":[10,1,1]}]}' >"$tmp/far.json"
+printf '{"atmosphere":{"preset":"earth"},"products":["sky_visibility"],"world":{"file":"far.json"},"probes":{"spacing_m":4}}' >"$tmp/farscene.json"
+check "a world beyond 10 km is refused" expect_exit 1 "$skybake" bake "$tmp/farscene.json" -o "$tmp/n"
+check "naming the world file" grep -q "far.json: .*10000 m" "$tmp/err"
 check "the tolerance is refused for probes" sh -c "printf '{\"atmosphere\":{\"preset\":\"earth\"},\"products\":[\"sky_visibility\"],\"world\":{\"file\":\"w.obj\"},\"tolerance\":{\"sky_visibility\":0.01}}' >'$tmp/tol.json'; '$skybake' bake '$tmp/tol.json' -o '$tmp/n' 2>/dev/null; test \$? = 2"
 
 # The grid over given bounds instead of the world's (a world too wide for
