@@ -144,11 +144,6 @@ static const struct {
 #undef S
 };
 
-const char *sb_bench_sweep_name(enum sb_bench_sweep sweep)
-{
-    return sweeps[sweep].name;
-}
-
 bool sb_bench_sweep_from_name(const char *name, enum sb_bench_sweep *sweep)
 {
     for (int i = 0; i < SB_BENCH_SWEEP_COUNT; i++)

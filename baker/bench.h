@@ -135,7 +135,6 @@ enum sb_result sb_bench_probes(struct sb_vk *vk, const struct sb_bench_params *p
 void sb_bench_probes_print(const struct sb_bench_report *report);
 enum sb_result sb_bench_probes_csv(const struct sb_bench_report *report, const char *path);
 
-const char *sb_bench_sweep_name(enum sb_bench_sweep sweep);
 bool sb_bench_sweep_from_name(const char *name, enum sb_bench_sweep *sweep);
 
 /* Candidate settings of `id` at the format's resolution, cheapest first (for

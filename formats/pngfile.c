@@ -31,35 +31,3 @@ enum sb_result sb_png_write(const char *path, uint32_t width, uint32_t height, c
     }
     return SB_OK;
 }
-
-enum sb_result sb_png_read(const char *path, uint32_t *width, uint32_t *height, uint8_t **rgba)
-{
-    *rgba = NULL;
-    png_image image;
-    memset(&image, 0, sizeof(image));
-    image.version = PNG_IMAGE_VERSION;
-    if (!png_image_begin_read_from_file(&image, path)) {
-        sb_error("%s: not a readable PNG: %s", path, image.message);
-        return SB_ERR_IO;
-    }
-    if ((uint64_t)image.width * image.height > (64u << 20)) {
-        sb_error("%s: %ux%u is larger than 64 Mpixel", path, image.width, image.height);
-        png_image_free(&image);
-        return SB_ERR_OUT_OF_RANGE;
-    }
-    image.format = PNG_FORMAT_RGBA;
-    uint8_t *pixels = malloc(PNG_IMAGE_SIZE(image));
-    if (!pixels) {
-        png_image_free(&image);
-        return SB_ERR_NOMEM;
-    }
-    if (!png_image_finish_read(&image, NULL, pixels, 0, NULL)) {
-        sb_error("%s: cannot read the PNG: %s", path, image.message);
-        free(pixels);
-        return SB_ERR_IO;
-    }
-    *width = image.width;
-    *height = image.height;
-    *rgba = pixels;
-    return SB_OK;
-}

@@ -13,8 +13,4 @@
  * temporary file renamed into place. SB_ERR_IO, naming the path, on failure. */
 enum sb_result sb_png_write(const char *path, uint32_t width, uint32_t height, const uint8_t *rgba);
 
-/* Read a PNG as RGBA (top row first) into *rgba (malloc'd, the caller frees).
- * Refuses images over 64 Mpixel. */
-enum sb_result sb_png_read(const char *path, uint32_t *width, uint32_t *height, uint8_t **rgba);
-
 #endif
