@@ -1,12 +1,17 @@
 #include "exr.h"
 
+#include <errno.h>
+#include <fcntl.h>
 #include <openexr.h>
 #include <stdbool.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <sys/stat.h>
+#include <unistd.h>
 
 #include "exr_internal.h"
+#include "io.h"
 #include "log.h"
 
 #define EXR_DEFAULT_MAX_PIXELS (64ull << 20)
@@ -28,6 +33,54 @@ enum sb_result sb_exr_fail(const char *path, const char *what, exr_result_t rv)
              last_message);
     last_message[0] = '\0';
     return rv == EXR_ERR_FILE_ACCESS || rv == EXR_ERR_WRITE_IO ? SB_ERR_IO : SB_ERR_EXR;
+}
+
+static int64_t read_fd(exr_const_context_t ctxt, void *user, void *buffer, uint64_t size, uint64_t offset,
+                       exr_stream_error_func_ptr_t error_cb)
+{
+    int fd = *(const int *)user;
+    uint8_t *p = buffer;
+    uint64_t done = 0;
+    while (done < size) {
+        ssize_t n = pread(fd, p + done, size - done, (off_t)(offset + done));
+        if (n < 0 && errno == EINTR)
+            continue;
+        if (n < 0) {
+            error_cb(ctxt, EXR_ERR_READ_IO, "cannot read: %s", strerror(errno));
+            return -1;
+        }
+        if (n == 0)
+            break;
+        done += (uint64_t)n;
+    }
+    return (int64_t)done;
+}
+
+static int64_t size_fd(exr_const_context_t ctxt, void *user)
+{
+    (void)ctxt;
+    struct stat st;
+    return fstat(*(const int *)user, &st) == 0 ? (int64_t)st.st_size : -1;
+}
+
+enum sb_result sb_exr_start_read(const char *path, exr_context_initializer_t *init, exr_context_t *ctxt, int *fd)
+{
+    *ctxt = NULL;
+    *fd = sb_open_regular(AT_FDCWD, path, true, path);
+    if (*fd < 0)
+        return SB_ERR_IO;
+    init->user_data = fd;
+    init->read_fn = read_fd;
+    init->size_fn = size_fd;
+    exr_result_t rv = exr_start_read(ctxt, path, init);
+    if (rv != EXR_ERR_SUCCESS) {
+        sb_error("%s: not a readable EXR file: %s", path, exr_get_default_error_message(rv));
+        close(*fd);
+        *fd = -1;
+        *ctxt = NULL;
+        return rv == EXR_ERR_FILE_ACCESS || rv == EXR_ERR_READ_IO ? SB_ERR_IO : SB_ERR_EXR;
+    }
+    return SB_OK;
 }
 
 static _Thread_local exr_result_t (*library_compress)(exr_encode_pipeline_t *);
@@ -143,7 +196,6 @@ enum sb_result sb_exr_read(const char *path, const char *channel_order, uint64_t
     exr_decode_pipeline_t decoder;
     bool decoder_live = false;
     enum sb_result res = SB_OK;
-    exr_result_t rv;
     int map[SB_IMAGE_MAX_CHANNELS]; /* file channel -> image channel */
 
     memset(image, 0, sizeof(*image));
@@ -152,11 +204,9 @@ enum sb_result sb_exr_read(const char *path, const char *channel_order, uint64_t
     if (!max_pixels)
         max_pixels = EXR_DEFAULT_MAX_PIXELS;
 
-    rv = exr_start_read(&ctxt, path, &init);
-    if (rv != EXR_ERR_SUCCESS) {
-        sb_error("%s: not a readable EXR file: %s", path, exr_get_default_error_message(rv));
-        return rv == EXR_ERR_FILE_ACCESS || rv == EXR_ERR_WRITE_IO ? SB_ERR_IO : SB_ERR_EXR;
-    }
+    int fd;
+    if ((res = sb_exr_start_read(path, &init, &ctxt, &fd)))
+        return res;
     int parts = 0;
     SB_EXR_TRY(exr_get_count(ctxt, &parts), "counting parts");
     exr_storage_t storage;
@@ -287,6 +337,7 @@ cleanup:
     if (decoder_live)
         exr_decoding_destroy(ctxt, &decoder);
     exr_finish(&ctxt);
+    close(fd);
     if (res)
         sb_image_finish(image);
     return res;

@@ -6,6 +6,7 @@
 #include <stdbool.h>
 #include <stdio.h>
 #include <string.h>
+#include <unistd.h>
 
 #include "exr.h"
 #include "exr_internal.h"
@@ -284,11 +285,9 @@ enum sb_result sb_exr_cube_read(const char *path, const char *channel_order, uin
     sb_image_set_channel_names(&want, channel_order);
     while (want.channel_count < SB_IMAGE_MAX_CHANNELS && want.channel_names[want.channel_count][0])
         want.channel_count++;
-    exr_result_t rv = exr_start_read(&ctxt, path, &init);
-    if (rv != EXR_ERR_SUCCESS) {
-        sb_error("%s: not a readable EXR file: %s", path, exr_get_default_error_message(rv));
-        return rv == EXR_ERR_FILE_ACCESS ? SB_ERR_IO : SB_ERR_EXR;
-    }
+    int fd;
+    if ((res = sb_exr_start_read(path, &init, &ctxt, &fd)))
+        return res;
     int parts = 0;
     SB_EXR_TRY(exr_get_count(ctxt, &parts), "counting parts");
     if (parts != (int)cube_count) {
@@ -356,6 +355,7 @@ cleanup:
     if (decoder_live)
         exr_decoding_destroy(ctxt, &decoder);
     exr_finish(&ctxt);
+    close(fd);
     if (res)
         sb_image_finish(image);
     return res;

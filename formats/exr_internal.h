@@ -19,6 +19,15 @@ void sb_exr_error_handler(exr_const_context_t ctxt, exr_result_t code, const cha
  * access and writes, else SB_ERR_EXR). */
 enum sb_result sb_exr_fail(const char *path, const char *what, exr_result_t rv);
 
+/*
+ * exr_start_read on `path`, through a descriptor of ours: only a regular
+ * file is opened (io.h's sb_open_regular: a FIFO cannot block the reader),
+ * and OpenEXR reads it with pread. *fd receives the descriptor (-1 on
+ * failure); it must outlive the context: close it after exr_finish. Logs
+ * and returns SB_ERR_IO or SB_ERR_EXR on failure.
+ */
+enum sb_result sb_exr_start_read(const char *path, exr_context_initializer_t *init, exr_context_t *ctxt, int *fd);
+
 /* Run `call`; on failure set `res` from sb_exr_fail and go to `cleanup`. */
 #define SB_EXR_TRY(call, what)                                                                                         \
     do {                                                                                                               \

@@ -9,6 +9,8 @@
 #include <unistd.h>
 #include <xxhash.h>
 
+#include "io.h"
+
 enum sb_result sb_image_init_levels(struct sb_image *image, uint32_t width, uint32_t height, uint32_t depth,
                                     uint32_t channel_count, uint32_t levels)
 {
@@ -16,8 +18,8 @@ enum sb_result sb_image_init_levels(struct sb_image *image, uint32_t width, uint
     if (!width || !height || !depth || !channel_count || channel_count > SB_IMAGE_MAX_CHANNELS || !levels ||
         levels > 32)
         return SB_ERR_BAD_IMAGE;
-    struct sb_image shape = {.width = width, .height = height, .depth = depth, .channel_count = channel_count,
-                             .levels = levels};
+    struct sb_image shape = {
+        .width = width, .height = height, .depth = depth, .channel_count = channel_count, .levels = levels};
     uint64_t count = sb_image_float_count(&shape);
     if (count > SIZE_MAX / sizeof(float) || (uint64_t)width * height * depth > (1ull << 40))
         return SB_ERR_NOMEM;
@@ -117,7 +119,7 @@ void sb_hash_bytes(const void *data, size_t size, char out[SB_HASH_HEX_SIZE])
 
 enum sb_result sb_hash_file(int dir_fd, const char *name, char out[SB_HASH_HEX_SIZE])
 {
-    int fd = openat(dir_fd, name, O_RDONLY | O_CLOEXEC | O_NOFOLLOW);
+    int fd = sb_open_regular(dir_fd, name, false, NULL);
     if (fd < 0)
         return SB_ERR_IO;
     XXH3_state_t *state = XXH3_createState();

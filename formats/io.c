@@ -10,6 +10,30 @@
 
 #include "log.h"
 
+int sb_open_regular(int dir, const char *path, bool follow_symlinks, const char *source)
+{
+    int fd = openat(dir, path, O_RDONLY | O_CLOEXEC | O_NONBLOCK | (follow_symlinks ? 0 : O_NOFOLLOW));
+    if (fd < 0) {
+        int err = errno;
+        if (source && err == ELOOP)
+            sb_error("%s: is a symbolic link; refused", source);
+        else if (source)
+            sb_error("%s: cannot open: %s", source, strerror(err));
+        errno = err;
+        return -1;
+    }
+    struct stat st;
+    int flags = fcntl(fd, F_GETFL);
+    if (fstat(fd, &st) != 0 || !S_ISREG(st.st_mode) || flags < 0 || fcntl(fd, F_SETFL, flags & ~O_NONBLOCK) != 0) {
+        if (source)
+            sb_error("%s: not a regular file; refused", source);
+        close(fd);
+        errno = EINVAL;
+        return -1;
+    }
+    return fd;
+}
+
 bool sb_write_all(int fd, const void *data, size_t size)
 {
     const char *p = data;
@@ -72,18 +96,12 @@ enum sb_result sb_read_file(int dir, const char *path, const char *source, size_
 {
     *data = NULL;
     *size = 0;
-    int fd = openat(dir, path, O_RDONLY | O_CLOEXEC | (follow_symlinks ? 0 : O_NOFOLLOW));
-    if (fd < 0) {
-        if (errno == ELOOP) {
-            sb_error("%s: is a symbolic link; refused", source);
-            return SB_ERR_UNSAFE_PATH;
-        }
-        sb_error("%s: cannot open: %s", source, strerror(errno));
-        return SB_ERR_IO;
-    }
+    int fd = sb_open_regular(dir, path, follow_symlinks, source);
+    if (fd < 0)
+        return errno == ELOOP ? SB_ERR_UNSAFE_PATH : SB_ERR_IO;
     struct stat st;
-    if (fstat(fd, &st) != 0 || !S_ISREG(st.st_mode)) {
-        sb_error("%s: not a regular file", source);
+    if (fstat(fd, &st) != 0) {
+        sb_error("%s: cannot read: %s", source, strerror(errno));
         close(fd);
         return SB_ERR_IO;
     }

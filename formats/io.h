@@ -15,6 +15,17 @@
 extern "C" {
 #endif
 
+/*
+ * Open `path` (relative to the directory fd `dir`, or AT_FDCWD) for
+ * reading, only if it is a regular file: opened without blocking, so that a
+ * FIFO with no writer or a device cannot stall the caller, checked, then
+ * made blocking again. Returns the descriptor (O_CLOEXEC), or -1 with errno
+ * set: EINVAL for something that is not a regular file, ELOOP for a
+ * symbolic link unless follow_symlinks. When `source` is not NULL the
+ * failure is logged, naming it.
+ */
+int sb_open_regular(int dir, const char *path, bool follow_symlinks, const char *source);
+
 /* Write all `size` bytes; false with errno set (EIO when no progress). */
 bool sb_write_all(int fd, const void *data, size_t size);
 

@@ -1,6 +1,7 @@
 #include "json.h"
 
 #include <math.h>
+#include <stdbool.h>
 #include <stdint.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -8,6 +9,58 @@
 
 #include "io.h"
 #include "log.h"
+
+size_t sb_utf8_check(const char *text, size_t size)
+{
+    const unsigned char *s = (const unsigned char *)text;
+    size_t i = 0;
+    while (i < size) {
+        unsigned c = s[i];
+        if (c < 0x80) {
+            i++;
+            continue;
+        }
+        /* the length, and the least value of that length (no overlong forms) */
+        size_t n = c >= 0xc2 && c <= 0xdf ? 2 : c >= 0xe0 && c <= 0xef ? 3 : c >= 0xf0 && c <= 0xf4 ? 4 : 0;
+        if (!n || size - i < n)
+            return i;
+        uint32_t cp = c & (0x7f >> n);
+        for (size_t k = 1; k < n; k++) {
+            if ((s[i + k] & 0xc0) != 0x80)
+                return i;
+            cp = cp << 6 | (s[i + k] & 0x3f);
+        }
+        if ((n == 3 && cp < 0x800) || (n == 4 && cp < 0x10000) || cp > 0x10ffff || (cp >= 0xd800 && cp <= 0xdfff))
+            return i;
+        i += n;
+    }
+    return SIZE_MAX;
+}
+
+/* Where the text's strings escape a NUL ("\u0000"), which cJSON would
+ * silently end the string at; SIZE_MAX for nowhere. */
+static size_t find_escaped_nul(const char *text, size_t size)
+{
+    bool in_string = false;
+    for (size_t i = 0; i < size; i++) {
+        if (text[i] == '"') {
+            in_string = !in_string;
+        } else if (in_string && text[i] == '\\' && i + 1 < size) {
+            if (text[i + 1] == 'u' && size - i >= 6 && !memcmp(text + i + 2, "0000", 4))
+                return i;
+            i++; /* the escaped character */
+        }
+    }
+    return SIZE_MAX;
+}
+
+static size_t line_of(const char *text, size_t offset)
+{
+    size_t line = 1;
+    for (size_t i = 0; i < offset; i++)
+        line += text[i] == '\n';
+    return line;
+}
 
 enum sb_result sb_json_parse(const char *text, size_t size, const char *source, cJSON **root)
 {
@@ -20,14 +73,24 @@ enum sb_result sb_json_parse(const char *text, size_t size, const char *source, 
         sb_error("%s: contains a NUL byte: not a JSON text", source);
         return SB_ERR_JSON_SYNTAX;
     }
+    /* JSON is UTF-8 (RFC 8259), and what we read we write back into
+     * manifests: other bytes would make those invalid. */
+    size_t bad = sb_utf8_check(text, size);
+    if (bad != SIZE_MAX) {
+        sb_error("%s: line %zu: byte %zu is not UTF-8 text", source, line_of(text, bad), bad);
+        return SB_ERR_JSON_SYNTAX;
+    }
+    if ((bad = find_escaped_nul(text, size)) != SIZE_MAX) {
+        sb_error("%s: line %zu: a string holds \\u0000 (NUL) at byte %zu, which no name or path may", source,
+                 line_of(text, bad), bad);
+        return SB_ERR_JSON_SYNTAX;
+    }
     const char *end = NULL;
     cJSON *value = cJSON_ParseWithLengthOpts(text, size, &end, false);
     if (!value) {
         size_t offset = end ? (size_t)(end - text) : 0;
-        size_t line = 1;
-        for (size_t i = 0; i < offset && i < size; i++)
-            line += text[i] == '\n';
-        sb_error("%s: line %zu: malformed JSON near byte %zu", source, line, offset);
+        offset = offset < size ? offset : size;
+        sb_error("%s: line %zu: malformed JSON near byte %zu", source, line_of(text, offset), offset);
         return SB_ERR_JSON_SYNTAX;
     }
     /* Anything but whitespace after the value is an error. */
@@ -55,15 +118,35 @@ enum sb_result sb_json_load(int dir, const char *path, const char *source, size_
     return res;
 }
 
+static int compare_keys(const void *a, const void *b)
+{
+    return strcmp(*(const char *const *)a, *(const char *const *)b);
+}
+
 enum sb_result sb_json_check_duplicates(const cJSON *object, const char *source, const char *where)
 {
+    /* Sorted, so that an object of many keys costs n log n, not n^2. */
+    size_t n = 0;
     for (const cJSON *a = object->child; a; a = a->next)
-        for (const cJSON *b = a->next; b; b = b->next)
-            if (a->string && b->string && strcmp(a->string, b->string) == 0) {
-                sb_error("%s: %s%s%s: key given twice", source, where, *where ? "." : "", a->string);
-                return SB_ERR_DUPLICATE_KEY;
-            }
-    return SB_OK;
+        n += a->string != NULL;
+    if (n < 2)
+        return SB_OK;
+    const char **keys = malloc(n * sizeof(*keys));
+    if (!keys)
+        return SB_ERR_NOMEM;
+    n = 0;
+    for (const cJSON *a = object->child; a; a = a->next)
+        if (a->string)
+            keys[n++] = a->string;
+    qsort(keys, n, sizeof(*keys), compare_keys);
+    enum sb_result res = SB_OK;
+    for (size_t i = 1; i < n && !res; i++)
+        if (!strcmp(keys[i - 1], keys[i])) {
+            sb_error("%s: %s%s%s: key given twice", source, where, *where ? "." : "", keys[i]);
+            res = SB_ERR_DUPLICATE_KEY;
+        }
+    free(keys);
+    return res;
 }
 
 bool sb_json_emit(FILE *out, cJSON *root)

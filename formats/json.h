@@ -1,6 +1,7 @@
 /*
  * Strict JSON reading shared by the scene and manifest parsers: one value,
- * nothing after it but whitespace, no NUL bytes, no key given twice, and a
+ * nothing after it but whitespace, UTF-8 only, no NUL bytes (nor escaped
+ * ones), no key given twice, and a
  * size cap checked before parsing. Errors name the source and the line.
  */
 #ifndef SB_JSON_H
@@ -13,7 +14,13 @@
 
 #include "result.h"
 
-/* Parse `size` bytes of `text`; on success the caller owns *root (cJSON_Delete). */
+/* The offset of the first byte of text[size] that does not begin a valid
+ * UTF-8 sequence (overlong forms, surrogates and values past U+10FFFF are
+ * invalid), or SIZE_MAX when all of it is UTF-8. */
+size_t sb_utf8_check(const char *text, size_t size);
+
+/* Parse `size` bytes of `text`, which must be UTF-8 with no string escaping
+ * a NUL (\u0000); on success the caller owns *root (cJSON_Delete). */
 enum sb_result sb_json_parse(const char *text, size_t size, const char *source, cJSON **root);
 
 /*

@@ -7,6 +7,7 @@
 #include <libgen.h>
 #include <math.h>
 #include <signal.h>
+#include <stdint.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -337,7 +338,7 @@ enum sb_result sb_pack_writer_add_image(struct sb_pack_writer *w, struct sb_arti
         w->artifacts[i] = *artifact;
         res = sb_probes_write(path, &artifact->probes, image);
     } else {
-        res = format->storage == SB_STORAGE_VDB_HALF  ? sb_vdb_write(path, image, attrs, n)
+        res = format->storage == SB_STORAGE_VDB_HALF   ? sb_vdb_write(path, image, attrs, n)
               : format->storage == SB_STORAGE_EXR_CUBE ? sb_exr_cube_write(path, image, attrs, n)
                                                        : sb_exr_write(path, image, attrs, n);
     }
@@ -416,6 +417,15 @@ enum sb_result sb_pack_writer_commit(struct sb_pack_writer **writer, const char 
     char *text = manifest_json(w, scene_json, device);
     if (!text)
         return SB_ERR_NOMEM;
+    /* Scene files are read as UTF-8 only; this guards what else reaches
+     * the manifest (a path, a device's name), so that it stays JSON. */
+    size_t bad = sb_utf8_check(text, strlen(text));
+    if (bad != SIZE_MAX) {
+        sb_error("%s: the manifest would hold a byte that is not UTF-8 (byte %zu): a name or path is not UTF-8",
+                 w->out_dir, bad);
+        free(text);
+        return SB_ERR_OUT_OF_RANGE;
+    }
     snprintf(path, sizeof(path), "%s/%s", w->tmp_dir, SB_PACK_MANIFEST);
     FILE *f = fopen(path, "wb");
     bool ok = f && fputs(text, f) >= 0 && fputc('\n', f) != EOF;

@@ -246,10 +246,10 @@ enum sb_result sb_probes_read(const char *path, const char *channel_names, uint3
 {
     memset(layout, 0, sizeof(*layout));
     memset(image, 0, sizeof(*image));
-    int fd = open(path, O_RDONLY | O_CLOEXEC | O_NOFOLLOW);
+    int fd = sb_open_regular(AT_FDCWD, path, false, NULL);
     struct stat st;
     if (fd < 0 || fstat(fd, &st) != 0) {
-        sb_error("%s: cannot read: %s", path, strerror(errno));
+        sb_error("%s: cannot read: %s", path, errno == EINVAL ? "not a regular file" : strerror(errno));
         if (fd >= 0)
             close(fd);
         return SB_ERR_IO;

@@ -10,6 +10,7 @@
 #include <openvdb/io/Archive.h>
 #include <openvdb/io/File.h>
 #include <openvdb/openvdb.h>
+#include <tbb/task_arena.h>
 
 #include <algorithm>
 #include <cctype>
@@ -25,6 +26,7 @@
 extern "C" {
 #include "io.h"
 #include "log.h"
+#include "sandbox.h"
 #include "vdb.h"
 }
 
@@ -79,6 +81,129 @@ bool looks_like_uuid(const std::string &bytes, size_t at)
             return false;
     }
     return true;
+}
+
+// ---- the file's structure, checked before OpenVDB parses it ---------------------------
+//
+// OpenVDB trusts the lengths in a file: a VDB cut to 100 bytes made it
+// allocate 20 GB, and other cuts read lengths it never set. So the layout
+// OpenVDB's File::open walks (openvdb/io/Archive.cc, File.cc,
+// GridDescriptor.cc) is walked here first, every length and offset bounded
+// by the file: the header, the file's metadata, then each grid's
+// descriptor, whose offsets must lie in order within the file and end
+// exactly at its end. What lies inside a grid is left to OpenVDB, in a
+// sandboxed process (below).
+
+constexpr int64_t kMagic = 0x56444220;      // OPENVDB_MAGIC, " BDV"
+constexpr uint32_t kFirstFileVersion = 222; // node mask compression, the UUID, instancing
+constexpr uint32_t kMaxString = 4096, kMaxMeta = 256, kMaxMetaBytes = 1u << 20;
+
+class Cursor
+{
+  public:
+    Cursor(int fd, uint64_t size) : fd_(fd), size_(size)
+    {
+    }
+    uint64_t at() const
+    {
+        return at_;
+    }
+    bool ok() const
+    {
+        return ok_;
+    }
+    bool seek(uint64_t to)
+    {
+        return ok_ = ok_ && to <= size_ ? (at_ = to, true) : false;
+    }
+    bool bytes(void *out, uint64_t n)
+    {
+        if (!ok_ || n > size_ - at_)
+            return ok_ = false;
+        char *p = static_cast<char *>(out);
+        for (uint64_t done = 0; done < n;) {
+            ssize_t got = pread(fd_, p + done, n - done, off_t(at_ + done));
+            if (got < 0 && errno == EINTR)
+                continue;
+            if (got <= 0)
+                return ok_ = false;
+            done += uint64_t(got);
+        }
+        at_ += n;
+        return true;
+    }
+    template <typename T> T value()
+    {
+        T v{};
+        bytes(&v, sizeof(v));
+        return v;
+    }
+    // readString: a 32-bit length, then the characters
+    bool string(std::string *out, uint32_t max)
+    {
+        uint32_t n = value<uint32_t>();
+        if (!ok_ || n > max)
+            return ok_ = false;
+        out->resize(n);
+        return bytes(&(*out)[0], n);
+    }
+
+  private:
+    int fd_;
+    uint64_t size_, at_ = 0;
+    bool ok_ = true;
+};
+
+// Empty when the layout holds; else what is wrong, for "path: ...", with
+// *code SB_ERR_BAD_IMAGE for a sound VDB file of other grids, else SB_ERR_VDB.
+std::string check_structure(int fd, uint64_t size, uint32_t grids_expected, sb_result *code)
+{
+    *code = SB_ERR_VDB;
+    Cursor c(fd, size);
+    if (c.value<int64_t>() != kMagic || !c.ok())
+        return "not a VDB file (no magic number)";
+    uint32_t version = c.value<uint32_t>();
+    if (version < kFirstFileVersion || version > openvdb::OPENVDB_FILE_VERSION)
+        return "file format version " + std::to_string(version) + ", not one this reader knows (" +
+               std::to_string(kFirstFileVersion) + " to " + std::to_string(openvdb::OPENVDB_FILE_VERSION) + ")";
+    c.value<uint32_t>(); // the library's major and minor version
+    c.value<uint32_t>();
+    if (c.value<uint8_t>() != 1)
+        return "no grid offsets (skybake's files have them)";
+    std::string uuid(kUuidSize, ' ');
+    c.bytes(&uuid[0], kUuidSize);
+    if (!c.ok() || !looks_like_uuid(uuid, 0))
+        return "the header ends early or has no UUID";
+    std::string name, type;
+    uint32_t metas = c.value<uint32_t>();
+    if (!c.ok() || metas > kMaxMeta)
+        return "the file's metadata count is cut or past " + std::to_string(kMaxMeta);
+    for (uint32_t m = 0; m < metas; m++) {
+        if (!c.string(&name, kMaxString) || !c.string(&type, kMaxString))
+            return "metadata " + std::to_string(m) + ": its name or type is cut or too long";
+        uint32_t n = c.value<uint32_t>();
+        if (!c.ok() || n > kMaxMetaBytes || !c.seek(c.at() + n))
+            return "metadata \"" + name + "\": its value is cut or larger than 1 MiB";
+    }
+    int32_t grids = c.value<int32_t>();
+    if (c.ok() && grids >= 0 && uint32_t(grids) != grids_expected)
+        *code = SB_ERR_BAD_IMAGE;
+    if (!c.ok() || grids < 0 || uint32_t(grids) != grids_expected)
+        return "holds " + std::to_string(grids) + " grids, expected " + std::to_string(grids_expected) +
+               " (the channels)";
+    for (int32_t g = 0; g < grids; g++) {
+        std::string unique, parent;
+        if (!c.string(&unique, kMaxString) || !c.string(&type, kMaxString) || !c.string(&parent, kMaxString))
+            return "grid " + std::to_string(g) + ": its descriptor is cut";
+        int64_t grid_pos = c.value<int64_t>(), block_pos = c.value<int64_t>(), end_pos = c.value<int64_t>();
+        if (!c.ok() || grid_pos < int64_t(c.at()) || block_pos < grid_pos || end_pos < block_pos ||
+            uint64_t(end_pos) > size || (g + 1 == grids && uint64_t(end_pos) != size))
+            return "grid \"" + unique + "\": its offsets " + std::to_string(grid_pos) + ", " +
+                   std::to_string(block_pos) + ", " + std::to_string(end_pos) +
+                   " do not lie in order within the file's " + std::to_string(size) + " bytes";
+        c.seek(uint64_t(end_pos));
+    }
+    return std::string();
 }
 
 enum sb_result write_bytes(const char *path, const std::string &bytes)
@@ -217,23 +342,14 @@ extern "C" enum sb_result sb_vdb_write(const char *path, const struct sb_image *
     return write_bytes(path, bytes);
 }
 
-extern "C" enum sb_result sb_vdb_read(const char *path, const char *channel_order, uint64_t max_voxels,
-                                      struct sb_image *volume, struct sb_attribute *attributes, int *attribute_count)
+namespace
 {
-    std::memset(volume, 0, sizeof(*volume));
-    if (attribute_count)
-        *attribute_count = 0;
-    if (!max_voxels)
-        max_voxels = kDefaultMaxVoxels;
-    struct stat st;
-    if (stat(path, &st) != 0) {
-        sb_error("%s: cannot open the VDB file: %s", path, strerror(errno));
-        return SB_ERR_IO;
-    }
-    if (!S_ISREG(st.st_mode) || static_cast<uint64_t>(st.st_size) > kMaxFileBytes) {
-        sb_error("%s: not a regular file of at most %llu bytes", path, static_cast<unsigned long long>(kMaxFileBytes));
-        return SB_ERR_IO;
-    }
+
+// In the sandboxed child: the grids of the file OpenVDB opens at `file`
+// (the parent's descriptor, as /proc/self/fd/N), errors naming `path`.
+enum sb_result read_grids(const char *path, const char *file_name, const char *channel_order, uint64_t max_voxels,
+                          sb_image *volume, sb_attribute *attributes, int *attribute_count)
+{
     sb_image names = {};
     sb_image_set_channel_names(&names, channel_order);
     uint32_t expect_count = 0;
@@ -242,7 +358,7 @@ extern "C" enum sb_result sb_vdb_read(const char *path, const char *channel_orde
     enum sb_result res = SB_OK;
     try {
         openvdb::initialize();
-        openvdb::io::File file(path);
+        openvdb::io::File file(file_name);
         file.open(/*delayLoad=*/false);
         // The grids, by name: exactly the channels, each once.
         uint32_t grid_count = 0;
@@ -299,4 +415,143 @@ extern "C" enum sb_result sb_vdb_read(const char *path, const char *channel_orde
     if (res)
         sb_image_finish(volume);
     return res;
+}
+
+constexpr uint32_t kAnswerMagic = 0x534b4256; // "SKBV"
+
+struct Answer {
+    uint32_t magic;
+    int32_t result;
+    uint32_t width, height, depth, channel_count;
+    int32_t attribute_count;
+    char message[512];
+};
+
+struct ReadJob {
+    const char *path, *channel_order;
+    int fd;
+    uint64_t max_voxels;
+};
+
+int read_child(int out, void *user)
+{
+    const ReadJob *job = static_cast<const ReadJob *>(user);
+    Answer a = {};
+    a.magic = kAnswerMagic;
+    sb_sandbox_capture_log(a.message, sizeof(a.message));
+    char file_name[64];
+    std::snprintf(file_name, sizeof(file_name), "/proc/self/fd/%d", job->fd);
+    sb_image volume = {};
+    sb_attribute attributes[SB_FILE_MAX_ATTRIBUTES] = {};
+    int attribute_count = 0;
+    // One thread: the TBB of a forked process may hold workers that are
+    // not there any more.
+    tbb::task_arena arena(1);
+    arena.execute([&] {
+        a.result = read_grids(job->path, file_name, job->channel_order, job->max_voxels, &volume, attributes,
+                              &attribute_count);
+    });
+    if (!a.result) {
+        a.width = volume.width;
+        a.height = volume.height;
+        a.depth = volume.depth;
+        a.channel_count = volume.channel_count;
+        a.attribute_count = attribute_count;
+    }
+    bool ok = sb_write_all(out, &a, sizeof(a));
+    if (!a.result && ok)
+        ok = sb_write_all(out, attributes, sizeof(attributes)) &&
+             sb_write_all(out, volume.data, sb_image_float_count(&volume) * sizeof(float));
+    return ok ? 0 : 1;
+}
+
+} // namespace
+
+extern "C" enum sb_result sb_vdb_read(const char *path, const char *channel_order, uint64_t max_voxels,
+                                      struct sb_image *volume, struct sb_attribute *attributes, int *attribute_count)
+{
+    std::memset(volume, 0, sizeof(*volume));
+    if (attribute_count)
+        *attribute_count = 0;
+    if (!max_voxels)
+        max_voxels = kDefaultMaxVoxels;
+    sb_image names = {};
+    sb_image_set_channel_names(&names, channel_order);
+    uint32_t channels = 0;
+    while (channels < SB_IMAGE_MAX_CHANNELS && names.channel_names[channels][0])
+        channels++;
+    int fd = sb_open_regular(AT_FDCWD, path, true, nullptr);
+    if (fd < 0) {
+        sb_error("%s: cannot open the VDB file: %s", path, errno == EINVAL ? "not a regular file" : strerror(errno));
+        return SB_ERR_IO;
+    }
+    struct stat st;
+    if (fstat(fd, &st) != 0 || static_cast<uint64_t>(st.st_size) > kMaxFileBytes) {
+        sb_error("%s: not a file of at most %llu bytes", path, static_cast<unsigned long long>(kMaxFileBytes));
+        close(fd);
+        return SB_ERR_IO;
+    }
+    sb_result code;
+    std::string wrong = check_structure(fd, uint64_t(st.st_size), channels, &code);
+    if (!wrong.empty()) {
+        sb_error("%s: %s", path, wrong.c_str());
+        close(fd);
+        return code;
+    }
+    // OpenVDB in a child: the grids' contents are still OpenVDB's to parse.
+    // Memory for its tree and our copy: three times the volume, and room
+    // for OpenVDB's own buffers.
+    ReadJob job = {path, channel_order, fd, max_voxels};
+    sb_sandbox_limits limits = {};
+    limits.cpu_seconds = 60;
+    limits.address_space_bytes =
+        (128ull << 20) + 3 * std::min(max_voxels, kDefaultMaxVoxels) * channels * sizeof(float);
+    sb_sandbox box;
+    enum sb_result res = sb_sandbox_start(&box, &limits, read_child, &job);
+    close(fd); // the child has its copy
+    if (res)
+        return res;
+    Answer a;
+    char why[160];
+    if (!sb_sandbox_read(&box, &a, sizeof(a)) || a.magic != kAnswerMagic) {
+        sb_sandbox_finish(&box, why, sizeof(why));
+        sb_error("%s: OpenVDB did not finish reading it: its process %s", path, why);
+        return SB_ERR_VDB;
+    }
+    a.message[sizeof(a.message) - 1] = '\0';
+    if (a.result) {
+        sb_sandbox_finish(&box, nullptr, 0);
+        sb_error("%s", a.message[0] ? a.message : "OpenVDB cannot read the file");
+        return unsigned(a.result) < SB_RESULT_COUNT ? sb_result(a.result) : SB_ERR_VDB;
+    }
+    sb_attribute got[SB_FILE_MAX_ATTRIBUTES];
+    uint64_t voxels = uint64_t(a.width) * a.height * a.depth;
+    if (a.channel_count != channels || !a.width || !a.height || !a.depth || voxels > max_voxels ||
+        a.attribute_count < 0 || a.attribute_count > SB_FILE_MAX_ATTRIBUTES) {
+        sb_sandbox_finish(&box, nullptr, 0);
+        sb_error("%s: the reading process answered %ux%ux%u voxels of %u channels: not what was asked", path, a.width,
+                 a.height, a.depth, a.channel_count);
+        return SB_ERR_VDB;
+    }
+    res = sb_image_init_volume(volume, a.width, a.height, a.depth, channels);
+    if (!res && !(sb_sandbox_read(&box, got, sizeof(got)) &&
+                  sb_sandbox_read(&box, volume->data, sb_image_float_count(volume) * sizeof(float)))) {
+        sb_sandbox_finish(&box, why, sizeof(why));
+        sb_error("%s: OpenVDB stopped half way: its process %s", path, why);
+        res = SB_ERR_VDB;
+    }
+    sb_sandbox_finish(&box, nullptr, 0);
+    if (res) {
+        sb_image_finish(volume);
+        return res;
+    }
+    sb_image_set_channel_names(volume, channel_order);
+    for (int i = 0; attributes && i < a.attribute_count; i++) {
+        got[i].name[sizeof(got[i].name) - 1] = '\0';
+        got[i].value[sizeof(got[i].value) - 1] = '\0';
+        attributes[i] = got[i];
+    }
+    if (attribute_count)
+        *attribute_count = attributes ? a.attribute_count : 0;
+    return SB_OK;
 }

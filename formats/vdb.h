@@ -54,9 +54,11 @@ enum sb_result sb_vdb_write(const char *path, const struct sb_image *volume, con
  * SB_ERR_BAD_IMAGE (a file that is not such a volume), logging the path and
  * the reason; *volume is then empty. Thread-safe.
  *
- * OpenVDB's reader is not hardened against hostile files: read only files
- * whose bytes are vouched for (a pack checks each file's hash before its
- * grids are parsed; docs/pack.md).
+ * OpenVDB's reader is not hardened against hostile files, so the file's
+ * layout is checked first (header, metadata, each grid's offsets within the
+ * file) and OpenVDB parses the grids in a child process under CPU-time,
+ * memory and wall-clock limits (sandbox.h): a crafted file gets SB_ERR_VDB,
+ * never a crash or a hang of the caller.
  */
 enum sb_result sb_vdb_read(const char *path, const char *channel_order, uint64_t max_voxels, struct sb_image *volume,
                            struct sb_attribute *attributes, int *attribute_count);

@@ -1,25 +1,24 @@
 #include "mesh.h"
 
+#include <assimp/cfileio.h>
 #include <assimp/cimport.h>
 #include <assimp/material.h>
 #include <assimp/postprocess.h>
 #include <assimp/scene.h>
 #include <errno.h>
+#include <fcntl.h>
+#include <limits.h>
 #include <math.h>
-#include <poll.h>
-#include <signal.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
-#include <sys/resource.h>
 #include <sys/stat.h>
-#include <sys/wait.h>
-#include <time.h>
 #include <unistd.h>
 #include <xxhash.h>
 
 #include "io.h"
 #include "log.h"
+#include "sandbox.h"
 #include "scene.h"
 #include "world_file.h"
 
@@ -320,12 +319,94 @@ static enum sb_result add_materials(struct importer *im)
     return SB_OK;
 }
 
+/*
+ * assimp's file system in the child: regular files only, opened without
+ * blocking first, so that a FIFO or a device named by the file (an OBJ's
+ * mtllib, a glTF's buffer) is refused at once instead of stalling the
+ * import until its deadline.
+ */
+static size_t file_read(struct aiFile *f, char *buffer, size_t size, size_t count)
+{
+    return fread(buffer, size, count, (FILE *)f->UserData);
+}
+
+static size_t file_write(struct aiFile *f, const char *buffer, size_t size, size_t count)
+{
+    (void)f, (void)buffer, (void)size, (void)count;
+    return 0;
+}
+
+static size_t file_tell(struct aiFile *f)
+{
+    long at = ftell((FILE *)f->UserData);
+    return at < 0 ? 0 : (size_t)at;
+}
+
+static size_t file_size(struct aiFile *f)
+{
+    struct stat st;
+    return fstat(fileno((FILE *)f->UserData), &st) == 0 ? (size_t)st.st_size : 0;
+}
+
+static void file_flush(struct aiFile *f)
+{
+    (void)f;
+}
+
+static enum aiReturn file_seek(struct aiFile *f, size_t offset, enum aiOrigin origin)
+{
+    int whence = origin == aiOrigin_CUR ? SEEK_CUR : origin == aiOrigin_END ? SEEK_END : SEEK_SET;
+    return offset <= LONG_MAX && fseek((FILE *)f->UserData, (long)offset, whence) == 0 ? aiReturn_SUCCESS
+                                                                                       : aiReturn_FAILURE;
+}
+
+static struct aiFile *file_open(struct aiFileIO *io, const char *path, const char *mode)
+{
+    const char *importing = io->UserData;
+    if (strchr(mode, 'w') || strchr(mode, 'a') || strchr(mode, '+'))
+        return NULL;
+    int fd = sb_open_regular(AT_FDCWD, path, true, NULL);
+    if (fd < 0) {
+        if (errno == EINVAL)
+            sb_error("%s: names %s, which is not a regular file", importing, path);
+        return NULL;
+    }
+    FILE *stream = fdopen(fd, "rb");
+    struct aiFile *f = stream ? calloc(1, sizeof(*f)) : NULL;
+    if (!f) {
+        if (stream)
+            fclose(stream);
+        else
+            close(fd);
+        return NULL;
+    }
+    *f = (struct aiFile){.ReadProc = file_read,
+                         .WriteProc = file_write,
+                         .TellProc = file_tell,
+                         .FileSizeProc = file_size,
+                         .SeekProc = file_seek,
+                         .FlushProc = file_flush,
+                         .UserData = (aiUserData)stream};
+    return f;
+}
+
+static void file_close(struct aiFileIO *io, struct aiFile *f)
+{
+    (void)io;
+    if (f) {
+        fclose((FILE *)f->UserData);
+        free(f);
+    }
+}
+
 /* The import itself, into a fresh mesh, in the importing child: the
  * file's materials, then every instanced triangle. */
 static enum sb_result import(const char *path, const struct sb_mesh_load_params *params, struct sb_mesh *mesh)
 {
     struct importer im = {.path = path, .params = params, .mesh = mesh};
-    im.scene = aiImportFile(path, aiProcess_Triangulate | aiProcess_SortByPType | aiProcess_ValidateDataStructure);
+    struct aiFileIO io = {.OpenProc = file_open, .CloseProc = file_close, .UserData = (aiUserData)path};
+    im.scene =
+        aiImportFileEx(path, aiProcess_Triangulate | aiProcess_SortByPType | aiProcess_ValidateDataStructure, &io);
     enum sb_result res = SB_OK;
     if (!im.scene || !im.scene->mRootNode || (im.scene->mFlags & AI_SCENE_FLAGS_INCOMPLETE)) {
         sb_error("%s: assimp cannot read it: %s", path, im.scene ? "the scene is incomplete" : aiGetErrorString());
@@ -351,19 +432,10 @@ done:
 
 /*
  * assimp is not hardened: on this machine a PLY header claiming 10^11
- * vertices made it loop for ever, and a reader can crash. So a child
- * process imports, under a CPU-time and (without sanitizers) an
- * address-space limit, and sends the mesh back through a pipe; the parent
- * reads it with a deadline, checks every count against the caps, and turns
- * a hang, a crash or a limit into SB_ERR_MESH naming the file.
+ * vertices made it loop for ever, and a reader can crash. So a sandboxed
+ * child process imports (formats/sandbox.h) and sends the mesh back; the
+ * parent checks every count against the caps.
  */
-#if defined(__SANITIZE_ADDRESS__)
-#define MESH_UNDER_ASAN 1 /* its shadow memory needs the address space */
-#elif defined(__has_feature)
-#if __has_feature(address_sanitizer)
-#define MESH_UNDER_ASAN 1
-#endif
-#endif
 #define IMPORT_ADDRESS_SPACE (16ull << 30)
 #define IMPORT_MAGIC 0x534b424d /* "SKBM" */
 
@@ -374,28 +446,18 @@ struct import_header {
     char message[512];
 };
 
-static void first_error(void *user, enum sb_log_level level, const char *message)
-{
-    char *first = user;
-    if (level <= SB_LOG_WARN && !first[0])
-        snprintf(first, 512, "%s", message);
-    if (level > SB_LOG_WARN)
-        fprintf(stderr, "%s\n", message);
-}
+struct import_job {
+    const char *path;
+    const struct sb_mesh_load_params *params;
+};
 
-static _Noreturn void import_child(int fd, const char *path, const struct sb_mesh_load_params *params)
+static int import_child(int fd, void *user)
 {
-    rlim_t seconds = params->time_limit_s ? params->time_limit_s : SB_MESH_IMPORT_SECONDS;
-    struct rlimit cpu = {seconds, seconds + 5};
-    setrlimit(RLIMIT_CPU, &cpu);
-#if !defined(MESH_UNDER_ASAN)
-    struct rlimit as = {IMPORT_ADDRESS_SPACE, IMPORT_ADDRESS_SPACE};
-    setrlimit(RLIMIT_AS, &as);
-#endif
+    const struct import_job *job = user;
     struct import_header h = {.magic = IMPORT_MAGIC};
-    sb_log_set_sink(first_error, h.message);
+    sb_sandbox_capture_log(h.message, sizeof(h.message));
     struct sb_mesh mesh = {0};
-    h.result = import(path, params, &mesh);
+    h.result = import(job->path, job->params, &mesh);
     if (!h.result) {
         h.vertex_count = mesh.vertex_count;
         h.triangle_count = mesh.triangle_count;
@@ -407,39 +469,18 @@ static _Noreturn void import_child(int fd, const char *path, const struct sb_mes
         ok = sb_write_all(fd, mesh.material_list, (size_t)mesh.material_count * sizeof(*mesh.material_list)) &&
              sb_write_all(fd, mesh.positions, (size_t)mesh.vertex_count * 3 * sizeof(float)) &&
              sb_write_all(fd, mesh.materials, (size_t)mesh.triangle_count * sizeof(uint32_t));
-    _exit(ok ? 0 : 1);
-}
-
-/* Read exactly `size` bytes before the deadline (CLOCK_MONOTONIC seconds). */
-static bool read_all(int fd, void *data, size_t size, double deadline)
-{
-    char *p = data;
-    while (size) {
-        struct timespec ts;
-        clock_gettime(CLOCK_MONOTONIC, &ts);
-        double left = deadline - (ts.tv_sec + ts.tv_nsec * 1e-9);
-        struct pollfd pfd = {.fd = fd, .events = POLLIN};
-        if (left <= 0 || poll(&pfd, 1, (int)(left * 1e3) + 1) == 0)
-            return false;
-        ssize_t n = read(fd, p, size);
-        if (n < 0 && errno == EINTR)
-            continue;
-        if (n <= 0)
-            return false;
-        p += n;
-        size -= (size_t)n;
-    }
-    return true;
+    return ok ? 0 : 1;
 }
 
 /* Append what the child sent: the materials, then the triangles through
  * the checks every triangle meets. */
-static enum sb_result receive(int fd, const char *path, unsigned seconds, double deadline, struct sb_mesh *mesh)
+static enum sb_result receive(struct sb_sandbox *box, const char *path, struct sb_mesh *mesh)
 {
     struct import_header h;
-    if (!read_all(fd, &h, sizeof(h), deadline) || h.magic != IMPORT_MAGIC) {
-        sb_error("%s: assimp did not finish reading it (it crashed, ran out of memory or took more than %u s)", path,
-                 seconds);
+    if (!sb_sandbox_read(box, &h, sizeof(h)) || h.magic != IMPORT_MAGIC) {
+        char why[160];
+        sb_sandbox_finish(box, why, sizeof(why));
+        sb_error("%s: assimp did not finish reading it: its process %s", path, why);
         return SB_ERR_MESH;
     }
     h.message[sizeof(h.message) - 1] = '\0';
@@ -447,6 +488,8 @@ static enum sb_result receive(int fd, const char *path, unsigned seconds, double
         sb_error("%s", h.message[0] ? h.message : "the import failed");
         return (unsigned)h.result < SB_RESULT_COUNT ? (enum sb_result)h.result : SB_ERR_MESH;
     }
+    if (h.message[0]) /* what the import said of a file it read all the same */
+        sb_warn("%s", h.message);
     if (h.triangle_count > SB_MESH_MAX_TRIANGLES || h.vertex_count != 3 * h.triangle_count ||
         h.material_count > SB_MESH_MAX_MATERIALS || mesh->triangle_count + h.triangle_count > SB_MESH_MAX_TRIANGLES) {
         sb_error("%s: %u triangles, %u materials: past the caps (%u triangles in all, %u materials)", path,
@@ -457,10 +500,12 @@ static enum sb_result receive(int fd, const char *path, unsigned seconds, double
     float *positions = malloc((size_t)h.vertex_count * 3 * sizeof(float) + 1);
     uint32_t *triangle_materials = malloc((size_t)h.triangle_count * sizeof(uint32_t) + 1);
     enum sb_result res = materials && positions && triangle_materials ? SB_OK : SB_ERR_NOMEM;
-    if (!res && !(read_all(fd, materials, h.material_count * sizeof(*materials), deadline) &&
-                  read_all(fd, positions, (size_t)h.vertex_count * 3 * sizeof(float), deadline) &&
-                  read_all(fd, triangle_materials, (size_t)h.triangle_count * sizeof(uint32_t), deadline))) {
-        sb_error("%s: the import stopped half way", path);
+    if (!res && !(sb_sandbox_read(box, materials, h.material_count * sizeof(*materials)) &&
+                  sb_sandbox_read(box, positions, (size_t)h.vertex_count * 3 * sizeof(float)) &&
+                  sb_sandbox_read(box, triangle_materials, (size_t)h.triangle_count * sizeof(uint32_t)))) {
+        char why[160];
+        sb_sandbox_finish(box, why, sizeof(why));
+        sb_error("%s: the import stopped half way: its process %s", path, why);
         res = SB_ERR_MESH;
     }
     uint32_t first = mesh->material_count;
@@ -516,37 +561,21 @@ enum sb_result sb_mesh_load(const char *path, const struct sb_mesh_load_params *
                  SB_MESH_MAX_FILE_BYTES >> 20);
         return SB_ERR_TOO_LARGE;
     }
-    int fds[2];
-    if (pipe(fds) != 0) {
-        sb_error("%s: pipe: %s", path, strerror(errno));
-        return SB_ERR_IO;
-    }
-    fflush(NULL);
-    pid_t child = fork();
-    if (child < 0) {
-        sb_error("%s: fork: %s", path, strerror(errno));
-        close(fds[0]);
-        close(fds[1]);
-        return SB_ERR_IO;
-    }
-    if (child == 0) {
-        close(fds[0]);
-        import_child(fds[1], path, params);
-    }
-    close(fds[1]);
     /* Keep a copy of the counts: a failure leaves *mesh as it was. */
     struct sb_mesh before = *mesh;
-    struct timespec ts;
-    clock_gettime(CLOCK_MONOTONIC, &ts);
     unsigned seconds = params->time_limit_s ? params->time_limit_s : SB_MESH_IMPORT_SECONDS;
-    /* CPU time limits the child; the wall-clock deadline covers a child that sleeps */
-    double deadline = ts.tv_sec + ts.tv_nsec * 1e-9 + 2.0 * seconds + 10;
-    enum sb_result res = receive(fds[0], path, seconds, deadline, mesh);
-    close(fds[0]);
-    kill(child, SIGKILL); /* done or stuck: either way it has nothing more to say */
-    int status;
-    while (waitpid(child, &status, 0) < 0 && errno == EINTR)
-        ;
+    struct sb_sandbox_limits limits = {
+        .cpu_seconds = seconds,
+        .address_space_bytes = IMPORT_ADDRESS_SPACE,
+        .wall_seconds = seconds + 30, /* covers a child that sleeps; a busy one meets its CPU limit first */
+    };
+    struct import_job job = {.path = path, .params = params};
+    struct sb_sandbox box;
+    enum sb_result res = sb_sandbox_start(&box, &limits, import_child, &job);
+    if (res)
+        return res;
+    res = receive(&box, path, mesh);
+    sb_sandbox_finish(&box, NULL, 0);
     if (res) {
         mesh->vertex_count = before.vertex_count;
         mesh->triangle_count = before.triangle_count;

@@ -15,3 +15,9 @@ expect_exit() { # code, command... (stdout and stderr go to $tmp/out and $tmp/er
     got=$?
     [ "$got" = "$want" ] || { echo "exit $got, expected $want: $*"; cat "$tmp/err"; return 1; }
 }
+expect_exit_not() { # code, command...: any exit but that one (and not timeout's 124)
+    unwanted=$1; shift
+    "$@" >"$tmp/out" 2>"$tmp/err"
+    got=$?
+    [ "$got" != "$unwanted" ] && [ "$got" != 124 ] || { echo "exit $got: $*"; cat "$tmp/err"; return 1; }
+}

@@ -20,6 +20,25 @@ check "out-of-range scene is exit 2" expect_exit 2 "$skybake" bake "$tmp/bad.jso
 check "error names the JSON path" grep -q "atmosphere.mie_g" "$tmp/err"
 check "no pack after a refused scene" test ! -e "$tmp/p"
 
+# FIFOs block an ordinary open until a writer comes: each is refused at
+# once, named (a hang would end in timeout's 124).
+mkfifo "$tmp/fifo.json"
+check "a scene that is a FIFO is exit 2" expect_exit 2 timeout 60 "$skybake" bake "$tmp/fifo.json" -o "$tmp/p"
+check "and named" grep -q "fifo.json: not a regular file" "$tmp/err"
+mkdir -p "$tmp/fifopack"
+mkfifo "$tmp/fifopack/manifest.json"
+for cmd in info verify; do
+    check "$cmd of a pack whose manifest is a FIFO fails at once" expect_exit_not 0 timeout 60 "$skybake" $cmd "$tmp/fifopack"
+    check "$cmd names the manifest" grep -q "manifest.json: not a regular file" "$tmp/err"
+done
+check "diff with such a pack fails at once" expect_exit_not 0 timeout 60 "$skybake" diff "$tmp/fifopack" "$tmp/fifopack"
+printf '{"atmosphere":{"preset":"earth"},"products":["transmittance"]}' >"$tmp/t.json"
+check "a bake into that directory does not wait on it" expect_exit 0 timeout 60 "$skybake" bake "$tmp/t.json" -o "$tmp/fifopack" -q
+check "it replaces the pack that does not verify, saying why" grep -q "manifest.json: not a regular file" "$tmp/err"
+printf '{"version":1,"atmosphere":{"preset":"earth"},"products":["sky_visibility"],"world":{"file":"fifo.json"},"probes":{"spacing_m":4}}' >"$tmp/fifoworld.json"
+check "a world file that is a FIFO fails at once" expect_exit_not 0 timeout 60 "$skybake" bake "$tmp/fifoworld.json" -o "$tmp/p"
+check "and is named" grep -q "fifo.json: not a regular file" "$tmp/err"
+
 check "no Vulkan device is exit 3" expect_exit 3 env VK_DRIVER_FILES=/nonexistent.json VK_ICD_FILENAMES=/nonexistent.json "$skybake" bake "$scene" -o "$tmp/p"
 check "no-device message is one clear line" grep -q "no Vulkan device" "$tmp/err"
 check "unknown --device is exit 3" expect_exit 3 "$skybake" bake "$scene" -o "$tmp/p" --device no-such-gpu

@@ -3,9 +3,11 @@
 #include <cJSON.h>
 #include <fcntl.h>
 #include <math.h>
+#include <signal.h>
 #include <stdlib.h>
 #include <string.h>
 #include <sys/stat.h>
+#include <time.h>
 #include <unistd.h>
 #include <xxhash.h>
 
@@ -16,6 +18,7 @@
 #include "lut3d.h"
 #include "pack.h"
 #include "probes.h"
+#include "sandbox.h"
 #include "scene.h"
 #include "synthetic_pack.h"
 #include "vdb.h"
@@ -64,6 +67,15 @@ static bool read_cube(const char *path)
 {
     struct sb_image t;
     bool ok = sb_exr_cube_read(path, "R,G,B", 32, 3, &t) == SB_OK;
+    if (ok)
+        sb_image_finish(&t);
+    return ok;
+}
+
+static bool read_volume(const char *path)
+{
+    struct sb_image t;
+    bool ok = sb_vdb_read(path, "perlin_worley,worley.0,worley.1,worley.2", 13 * 9 * 20, &t, NULL, NULL) == SB_OK;
     if (ok)
         sb_image_finish(&t);
     return ok;
@@ -320,6 +332,16 @@ static void test_scenes(void)
         {EARTH "\"cloud_layer\":[]}", SB_ERR_WRONG_TYPE},
         {EARTH "\"view\":{\"sun_azimuth_deg\":400}}", SB_ERR_OUT_OF_RANGE},
         {EARTH "\"view\":{\"sun_azimuth_deg\":40}}", SB_OK},
+        /* Text that is not UTF-8 (it would reach the manifest as it is), and
+         * an escaped NUL (cJSON would end the string there, silently) */
+        {EARTH "\"name\":\"caf\xe9\"}", SB_ERR_JSON_SYNTAX},
+        {EARTH "\"name\":\"\xc0\xaf\"}", SB_ERR_JSON_SYNTAX},         /* overlong '/' */
+        {EARTH "\"name\":\"\xed\xa0\x80\"}", SB_ERR_JSON_SYNTAX},     /* a surrogate */
+        {EARTH "\"name\":\"\xf4\x90\x80\x80\"}", SB_ERR_JSON_SYNTAX}, /* past U+10FFFF */
+        {EARTH "\"name\":\"caf\xc3\xa9 \xf0\x9f\x8c\x85\"}", SB_OK},
+        {EARTH "\"name\":\"a\\u0000b\"}", SB_ERR_JSON_SYNTAX},
+        {EARTH "\"name\":\"a\\\\u0000b\"}", SB_OK}, /* a backslash, then the text u0000 */
+        {EARTH "\"name\":\"a\\u00e9\"}", SB_OK},
     };
     for (size_t i = 0; i < sizeof(cases) / sizeof(cases[0]); i++) {
         struct sb_scene scene;
@@ -342,6 +364,18 @@ static void test_scenes(void)
     static const char with_nul[] = "{\"atmosphere\":{\"preset\":\"earth\"}}\0{}";
     got = sb_scene_parse(with_nul, sizeof(with_nul) - 1, "nul", &nested);
     CHECK(got == SB_ERR_JSON_SYNTAX, "a NUL byte in the text: got %s", sb_result_name(got));
+
+    /* 40,000 keys with the last given twice: refused, naming it (the check
+     * sorts the keys; it was quadratic) */
+    size_t keys = 40000;
+    char *wide = malloc(keys * 16 + 64), *w = wide;
+    w += sprintf(w, "{\"atmosphere\":{\"preset\":\"earth\"},");
+    for (size_t k = 0; k < keys; k++)
+        w += sprintf(w, "\"k%zu\":0,", k);
+    w += sprintf(w, "\"k0\":1}");
+    got = sb_scene_parse(wide, (size_t)(w - wide), "wide", &nested);
+    CHECK(got == SB_ERR_DUPLICATE_KEY, "40000 keys, one twice: got %s", sb_result_name(got));
+    free(wide);
 
     /* A million reflection probes: refused by their count, naming the field;
      * 64, the cap, accepted. */
@@ -505,6 +539,35 @@ static void test_vdb(void)
     f = fopen(again, "wb");
     fclose(f);
     CHECK(sb_vdb_read(again, "a", 0, &back, NULL, NULL) == SB_ERR_VDB, "empty file");
+    /* Crafted files: OpenVDB trusts the lengths in a file (a cut one made it
+     * allocate 20 GB, others abort under ASan). Every prefix is refused,
+     * most by the structure check before OpenVDB sees them; bytes changed
+     * inside a grid, where only OpenVDB looks, cost the parent nothing. */
+    CHECK(sb_vdb_write(again, &v, attrs, 2) == SB_OK, "write");
+    CHECK(truncations_accepted(again, 300, 97, read_volume) == 0, "a cut VDB file is refused");
+    CHECK(sb_vdb_write(again, &v, attrs, 2) == SB_OK, "write");
+    f = fopen(again, "rb");
+    fseek(f, 0, SEEK_END);
+    long size = ftell(f);
+    fclose(f);
+    int accepted = 0, refused = 0;
+    for (long at = 200; at + 8 < size; at += size / 24) {
+        CHECK(sb_vdb_write(again, &v, attrs, 2) == SB_OK, "write");
+        int fd = open(again, O_WRONLY);
+        static const unsigned char junk[8] = {0xff, 0xff, 0xff, 0x7f, 0xff, 0xff, 0xff, 0x7f};
+        CHECK(fd >= 0 && pwrite(fd, junk, sizeof(junk), at) == (ssize_t)sizeof(junk), "corrupt at %ld", at);
+        close(fd);
+        struct sb_image t;
+        enum sb_result res =
+            sb_vdb_read(again, "perlin_worley,worley.0,worley.1,worley.2", 13 * 9 * 20, &t, NULL, NULL);
+        CHECK(res == SB_OK || res == SB_ERR_VDB || res == SB_ERR_BAD_IMAGE, "corrupt at %ld: %s", at,
+              sb_result_name(res));
+        if (res == SB_OK)
+            sb_image_finish(&t);
+        accepted += res == SB_OK;
+        refused += res != SB_OK;
+    }
+    CHECK(refused > 0, "bytes changed inside the grids: %d refused, %d read (values changed)", refused, accepted);
     CHECK(sb_vdb_write("/nonexistent/dir/x.vdb", &v, NULL, 0) == SB_ERR_IO, "unwritable path");
     struct sb_image flat;
     sb_image_init(&flat, 4, 4, 1);
@@ -1198,11 +1261,171 @@ static void test_lut3d(void)
         sb_log_set_sink(NULL, NULL);
 }
 
+/* ---- the parsing child (formats/sandbox.h) ---------------------------------------------- */
+
+static double seconds_now(void)
+{
+    struct timespec ts;
+    clock_gettime(CLOCK_MONOTONIC, &ts);
+    return ts.tv_sec + ts.tv_nsec * 1e-9;
+}
+
+static int child_answers(int fd, void *user)
+{
+    (void)user;
+    uint32_t answer[2] = {7, 11};
+    return write(fd, answer, sizeof(answer)) == (ssize_t)sizeof(answer) ? 0 : 1;
+}
+
+/* Exits at once with status 0 and nothing sent, while a grandchild of its
+ * own keeps the pipe's write end open for 20 s: the case where the parent
+ * never sees the pipe's end and must notice the exit itself. */
+static int child_leaves_writer(int fd, void *user)
+{
+    (void)fd;
+    (void)user;
+    if (fork() == 0) {
+        sleep(20);
+        _exit(0);
+    }
+    return 0;
+}
+
+static int child_sends_half(int fd, void *user)
+{
+    (void)user;
+    uint32_t half = 7;
+    if (fork() == 0) {
+        sleep(20);
+        _exit(0);
+    }
+    return write(fd, &half, sizeof(half)) == (ssize_t)sizeof(half) ? 0 : 1;
+}
+
+static int child_spins(int fd, void *user)
+{
+    (void)fd;
+    volatile uint64_t *n = user;
+    while (*n != UINT64_MAX)
+        (*n)++;
+    return 0;
+}
+
+static int child_sleeps(int fd, void *user)
+{
+    (void)fd;
+    (void)user;
+    sleep(60);
+    return 0;
+}
+
+static int child_crashes(int fd, void *user)
+{
+    (void)fd;
+    (void)user;
+    raise(SIGSEGV);
+    return 0;
+}
+
+static void test_sandbox(void)
+{
+    struct sb_sandbox box;
+    uint32_t got[2] = {0};
+    char why[160];
+    CHECK(sb_sandbox_start(&box, NULL, child_answers, NULL) == SB_OK, "start");
+    CHECK(sb_sandbox_read(&box, got, sizeof(got)) && got[0] == 7 && got[1] == 11, "the answer arrives");
+    sb_sandbox_finish(&box, NULL, 0);
+    CHECK(box.reaped && WIFEXITED(box.status) && WEXITSTATUS(box.status) == 0, "the child is reaped");
+
+    /* The mesh importer's hang in CI: a child that exits with status 0 but
+     * sends nothing, the pipe still held open elsewhere. The default
+     * deadline is 60 s; the read must return as soon as the child is gone. */
+    static const struct {
+        const char *name;
+        sb_sandbox_fn fn;
+        size_t size;
+        const char *why;
+    } gone[] = {
+        {"exits without an answer", child_leaves_writer, sizeof(got), "exited before sending its whole answer"},
+        {"exits half way", child_sends_half, sizeof(got), "exited before sending its whole answer"},
+        {"crashes", child_crashes, sizeof(got), "crashed"},
+    };
+    for (size_t i = 0; i < sizeof(gone) / sizeof(gone[0]); i++) {
+        double t0 = seconds_now();
+        CHECK(sb_sandbox_start(&box, NULL, gone[i].fn, NULL) == SB_OK, "start");
+        bool read = sb_sandbox_read(&box, got, gone[i].size);
+        double took = seconds_now() - t0;
+        sb_sandbox_finish(&box, why, sizeof(why));
+        CHECK(!read, "a child that %s: the read fails", gone[i].name);
+        CHECK(took < 5.0, "a child that %s: the parent returns in %.2f s, not at its deadline", gone[i].name, took);
+        CHECK(strstr(why, gone[i].why), "a child that %s: \"%s\"", gone[i].name, why);
+    }
+
+    uint64_t spins = 0;
+    double t0 = seconds_now();
+    CHECK(sb_sandbox_start(&box, &(struct sb_sandbox_limits){.cpu_seconds = 1}, child_spins, &spins) == SB_OK, "start");
+    CHECK(!sb_sandbox_read(&box, got, sizeof(got)), "a child that spins: no answer");
+    sb_sandbox_finish(&box, why, sizeof(why));
+    CHECK(strstr(why, "1 s of CPU time") && seconds_now() - t0 < 15, "a child that spins: \"%s\" after %.1f s", why,
+          seconds_now() - t0);
+
+    t0 = seconds_now();
+    CHECK(sb_sandbox_start(&box, &(struct sb_sandbox_limits){.wall_seconds = 1}, child_sleeps, NULL) == SB_OK, "start");
+    CHECK(!sb_sandbox_read(&box, got, sizeof(got)), "a child that sleeps: no answer");
+    sb_sandbox_finish(&box, why, sizeof(why));
+    CHECK(strstr(why, "within 1 s") && seconds_now() - t0 < 5, "a child that sleeps: \"%s\" after %.1f s", why,
+          seconds_now() - t0);
+    sb_sandbox_finish(&box, why, sizeof(why)); /* twice is harmless */
+}
+
+/* Every reader of a named file refuses a FIFO (which blocks an ordinary
+ * open until a writer comes) at once, naming it, instead of hanging. */
+static void alarm_fifo(int signal)
+{
+    (void)signal;
+    static const char message[] = "test_formats: a reader blocked on a FIFO\n";
+    (void)!write(2, message, sizeof(message) - 1);
+    _exit(1);
+}
+
+static void test_fifos(void)
+{
+    char dir[256], fifo[300], pack[300], manifest[340];
+    CHECK(test_temp_dir("skybake-fifo", dir, sizeof(dir)), "a temporary directory");
+    snprintf(fifo, sizeof(fifo), "%s/fifo.json", dir);
+    snprintf(pack, sizeof(pack), "%s/pack", dir);
+    snprintf(manifest, sizeof(manifest), "%s/pack/manifest.json", dir);
+    CHECK(mkfifo(fifo, 0600) == 0 && mkdir(pack, 0700) == 0 && mkfifo(manifest, 0600) == 0, "the FIFOs");
+    signal(SIGALRM, alarm_fifo);
+    alarm(60);
+    struct sb_scene scene;
+    CHECK(sb_scene_load(fifo, &scene) == SB_ERR_IO, "a scene that is a FIFO");
+    struct sb_pack p;
+    CHECK(sb_pack_open(pack, &p) != SB_OK, "a pack whose manifest is a FIFO");
+    struct sb_lut3d lut;
+    CHECK(sb_lut3d_load(fifo, &lut) == SB_ERR_IO, "a grade LUT that is a FIFO");
+    struct sb_image image;
+    struct sb_probe_layout layout;
+    CHECK(sb_probes_read(fifo, "a", 0, &layout, &image) == SB_ERR_IO, "probes that are a FIFO");
+    CHECK(sb_exr_read(fifo, "r", 0, &image, NULL, NULL) == SB_ERR_IO, "an EXR that is a FIFO");
+    CHECK(sb_vdb_read(fifo, "a", 0, &image, NULL, NULL) == SB_ERR_IO, "a VDB that is a FIFO");
+    char hash[SB_HASH_HEX_SIZE];
+    CHECK(sb_hash_file(AT_FDCWD, fifo, hash) == SB_ERR_IO, "hashing a FIFO");
+    alarm(0);
+    signal(SIGALRM, SIG_DFL);
+    unlink(manifest);
+    rmdir(pack);
+    unlink(fifo);
+    rmdir(dir);
+}
+
 int main(void)
 {
     if (!getenv("SKYBAKE_TEST_VERBOSE"))
         sb_log_set_sink(quiet, NULL);
     test_result_codes();
+    test_sandbox();
+    test_fifos();
     test_exr_round_trip();
     test_exr_cube();
     test_half();

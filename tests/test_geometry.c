@@ -12,6 +12,8 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <sys/stat.h>
+#include <time.h>
 #include <unistd.h>
 
 #include "bvh.h"
@@ -575,6 +577,39 @@ static void test_hostile(void)
     snprintf(path, sizeof(path), "%s/missing.obj", dir);
     CHECK(sb_mesh_load(path, NULL, &m) == SB_ERR_IO, "a missing file");
     CHECK(sb_mesh_load(dir, NULL, &m) == SB_ERR_IO, "a directory");
+    /* FIFOs, as the mesh or named by it (an OBJ's mtllib, a glTF's buffer),
+     * are refused at once: an open of one would block until a writer came */
+    char fifo[600];
+    snprintf(fifo, sizeof(fifo), "%s/fifo.bin", dir);
+    CHECK(mkfifo(fifo, 0600) == 0, "a FIFO");
+    CHECK(sb_mesh_load(fifo, NULL, &m) == SB_ERR_IO, "a FIFO as the mesh");
+    static const struct {
+        const char *name, *text;
+    } named[] = {
+        {"fifo.obj", "mtllib fifo.bin\nv 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n"},
+        {"fifo.gltf",
+         "{\"asset\": {\"version\": \"2.0\"}, \"buffers\": [{\"uri\": \"fifo.bin\", \"byteLength\": 36}], "
+         "\"bufferViews\": [{\"buffer\": 0, \"byteLength\": 36}], \"accessors\": [{\"bufferView\": 0, "
+         "\"componentType\": 5126, \"count\": 3, \"type\": \"VEC3\", \"min\": [0, 0, 0], \"max\": [1, 1, 0]}], "
+         "\"meshes\": [{\"primitives\": [{\"attributes\": {\"POSITION\": 0}}]}], \"nodes\": [{\"mesh\": 0}], "
+         "\"scenes\": [{\"nodes\": [0]}], \"scene\": 0}"},
+    };
+    for (size_t i = 0; i < sizeof(named) / sizeof(named[0]); i++) {
+        snprintf(path, sizeof(path), "%s/%s", dir, named[i].name);
+        write_file(path, named[i].text);
+        struct timespec t0, t1;
+        clock_gettime(CLOCK_MONOTONIC, &t0);
+        struct sb_mesh f = {0};
+        enum sb_result res = sb_mesh_load(path, &(struct sb_mesh_load_params){.time_limit_s = 60}, &f);
+        clock_gettime(CLOCK_MONOTONIC, &t1);
+        double took = (t1.tv_sec - t0.tv_sec) + 1e-9 * (t1.tv_nsec - t0.tv_nsec);
+        /* the OBJ loads without its material library, as with a missing one; the glTF has no buffer */
+        CHECK(took < 30 && (i == 0 ? res == SB_OK && f.triangle_count == 1 : res == SB_ERR_MESH),
+              "%s, naming a FIFO: %s in %.1f s", named[i].name, sb_result_name(res), took);
+        sb_mesh_finish(&f);
+        unlink(path);
+    }
+    unlink(fifo);
     snprintf(path, sizeof(path), "%s/big.obj", dir);
     int fd = open(path, O_CREAT | O_WRONLY, 0600);
     CHECK(fd >= 0 && ftruncate(fd, (off_t)(2ull << 30)) == 0, "a sparse 2 GiB file");
@@ -659,7 +694,7 @@ int main(void)
 
     struct sb_vk *vk;
     if (test_vulkan(false, &vk) == SB_ERR_NO_DEVICE)
-        return TEST_SKIP;
+        return test_no_device();
     if (vk) {
         test_gpu_against_embree(vk, "IFC house", &house, 1u << 17);
         test_gpu_against_embree(vk, "well", &well, 1u << 15);

@@ -56,6 +56,10 @@ printf 'LUT_3D_SIZE 2\n0 0 0\n1 1 1\n' >"$tmp/short.cube"
 check "a .cube short of entries is refused" expect_exit 2 "$skyview" "$tmp/pack" -o "$tmp/n" $small --grade "$tmp/short.cube"
 check "naming the file and the count" grep -q "short.cube: 2 entries; LUT_3D_SIZE 2 needs 8" "$tmp/err"
 check "a missing .cube is refused" expect_exit 2 "$skyview" "$tmp/pack" -o "$tmp/n" $small --grade "$tmp/none.cube"
+mkfifo "$tmp/fifo.cube" "$tmp/fifo.json"
+check "a .cube that is a FIFO is refused at once" expect_exit 2 timeout 60 "$skyview" "$tmp/pack" -o "$tmp/n" $small --grade "$tmp/fifo.cube"
+check "--world naming a FIFO is refused at once" expect_exit_not 0 timeout 60 "$skyview" "$tmp/pack" -o "$tmp/n" $small --world "$tmp/fifo.json"
+check "naming it" grep -q "fifo.json: not a regular file" "$tmp/err"
 # Scene-linear grading and the Purkinje shift (test_post checks the values):
 # neutral settings and daylight leave the frame as it was, the others change it.
 check "neutral grading settings" expect_exit 0 "$skyview" "$tmp/pack" -o "$tmp/n" $small --white-balance 6504,0 \
