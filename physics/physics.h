@@ -5,8 +5,8 @@
  * the runtime, which reads a pack. No Vulkan here; all functions are pure
  * and thread safe.
  */
-#ifndef SB_SHADERS_PHYSICS_H
-#define SB_SHADERS_PHYSICS_H
+#ifndef SB_PHYSICS_PHYSICS_H
+#define SB_PHYSICS_PHYSICS_H
 
 #include <stddef.h>
 

@@ -2,8 +2,8 @@
  * The C half of sh.glsl: the order-2 real SH basis (Sloan 2008), the probe
  * rays' directions, and deringing. Pure, thread safe, fp64.
  */
-#ifndef SB_SHADERS_SH_H
-#define SB_SHADERS_SH_H
+#ifndef SB_PHYSICS_SH_H
+#define SB_PHYSICS_SH_H
 
 #include <stdint.h>
 
