@@ -12,7 +12,7 @@
 #include <stdbool.h>
 #include <stdint.h>
 
-#include "pack.h"
+#include "product.h"
 #include "result.h"
 
 struct cJSON;

@@ -11,7 +11,7 @@
 #include <stddef.h>
 #include <stdint.h>
 
-#include "pack.h"
+#include "product.h"
 #include "result.h"
 
 /* All lengths in km, all coefficients in 1/km, RGB triples in linear Rec.709
