@@ -1277,17 +1277,27 @@ static int child_answers(int fd, void *user)
     return write(fd, answer, sizeof(answer)) == (ssize_t)sizeof(answer) ? 0 : 1;
 }
 
+/* A grandchild that keeps the pipe's write end (and nothing else the test
+ * runner waits on: its output goes to /dev/null) for 10 s. */
+static void hold_pipe_a_while(void)
+{
+    int null = open("/dev/null", O_RDWR);
+    dup2(null, 0);
+    dup2(null, 1);
+    dup2(null, 2);
+    sleep(10);
+    _exit(0);
+}
+
 /* Exits at once with status 0 and nothing sent, while a grandchild of its
- * own keeps the pipe's write end open for 20 s: the case where the parent
+ * own keeps the pipe's write end open for 10 s: the case where the parent
  * never sees the pipe's end and must notice the exit itself. */
 static int child_leaves_writer(int fd, void *user)
 {
     (void)fd;
     (void)user;
-    if (fork() == 0) {
-        sleep(20);
-        _exit(0);
-    }
+    if (fork() == 0)
+        hold_pipe_a_while();
     return 0;
 }
 
@@ -1295,10 +1305,8 @@ static int child_sends_half(int fd, void *user)
 {
     (void)user;
     uint32_t half = 7;
-    if (fork() == 0) {
-        sleep(20);
-        _exit(0);
-    }
+    if (fork() == 0)
+        hold_pipe_a_while();
     return write(fd, &half, sizeof(half)) == (ssize_t)sizeof(half) ? 0 : 1;
 }
 
@@ -1334,8 +1342,8 @@ static void test_sandbox(void)
     char why[160];
     CHECK(sb_sandbox_start(&box, NULL, child_answers, NULL) == SB_OK, "start");
     CHECK(sb_sandbox_read(&box, got, sizeof(got)) && got[0] == 7 && got[1] == 11, "the answer arrives");
-    sb_sandbox_finish(&box, NULL, 0);
-    CHECK(box.reaped && WIFEXITED(box.status) && WEXITSTATUS(box.status) == 0, "the child is reaped");
+    sb_sandbox_finish(&box, why, sizeof(why)); /* with `why`, it waits for the child's own exit */
+    CHECK(box.reaped && WIFEXITED(box.status) && WEXITSTATUS(box.status) == 0, "the child is reaped: %s", why);
 
     /* The mesh importer's hang in CI: a child that exits with status 0 but
      * sends nothing, the pipe still held open elsewhere. The default
