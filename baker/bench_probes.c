@@ -15,6 +15,7 @@
 #include "bvh.h"
 #include "embree_ref.h"
 #include "log.h"
+#include "load.h"
 #include "mesh.h"
 #include "raycast.h"
 #include "sh.h"

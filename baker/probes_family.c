@@ -19,6 +19,7 @@
 #include "family.h"
 #include "json.h"
 #include "log.h"
+#include "load.h"
 #include "mesh.h"
 #include "parallel.h"
 #include "raycast.h"

@@ -18,6 +18,7 @@
 #include "family.h"
 #include "json.h"
 #include "log.h"
+#include "load.h"
 #include "mesh.h"
 #include "probes.h"
 #include "reflection.h"

@@ -19,8 +19,6 @@
 #include "io.h"
 #include "log.h"
 #include "sandbox.h"
-#include "scene.h"
-#include "world_file.h"
 
 /* Node trees deeper than this are refused (a file can make them cyclic). */
 #define MESH_MAX_NODE_DEPTH 128
@@ -540,13 +538,10 @@ static enum sb_result receive(struct sb_sandbox *box, const char *path, struct s
     return res;
 }
 
-enum sb_result sb_mesh_load(const char *path, const struct sb_mesh_load_params *params, struct sb_mesh *mesh)
+enum sb_result sb_mesh_import(const char *path, const struct sb_mesh_load_params *params, struct sb_mesh *mesh)
 {
     static const struct sb_mesh_load_params defaults = {0};
     params = params ? params : &defaults;
-    size_t length = strlen(path);
-    if (length > 5 && !strcmp(path + length - 5, ".json"))
-        return sb_world_file_load(path, params, mesh);
     struct stat st;
     if (stat(path, &st) != 0) {
         sb_error("%s: cannot read the mesh: %s", path, strerror(errno));
@@ -625,33 +620,4 @@ void sb_mesh_finish(struct sb_mesh *mesh)
     free(mesh->materials);
     free(mesh->material_list);
     memset(mesh, 0, sizeof(*mesh));
-}
-
-enum sb_result sb_mesh_load_world(const struct sb_world_params *w, const char *directory, struct sb_mesh *mesh,
-                                  char *path_out, size_t path_size)
-{
-    char path[2100];
-    if (w->file[0] == '/' || !directory[0])
-        snprintf(path, sizeof(path), "%s", w->file);
-    else
-        snprintf(path, sizeof(path), "%s/%s", directory, w->file);
-    struct sb_mesh_albedo_override overrides[SB_WORLD_MAX_OVERRIDES];
-    for (int i = 0; i < w->override_count; i++) {
-        overrides[i].material = w->overrides[i].material;
-        memcpy(overrides[i].albedo, w->overrides[i].albedo, sizeof(overrides[i].albedo));
-    }
-    struct sb_mesh_load_params load = {
-        .transform = {.units_m = w->units_m, .scale = w->scale, .up_z = w->up_z},
-        .overrides = overrides,
-        .override_count = w->override_count,
-    };
-    memcpy(load.transform.rotate_deg, w->rotate_deg, sizeof(w->rotate_deg));
-    memcpy(load.transform.translate_m, w->translate_m, sizeof(w->translate_m));
-    enum sb_result res = sb_mesh_load(path, &load, mesh);
-    if (!res && path_out) {
-        char *absolute = realpath(path, NULL);
-        snprintf(path_out, path_size, "%s", absolute ? absolute : path);
-        free(absolute);
-    }
-    return res;
 }

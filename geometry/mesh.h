@@ -83,16 +83,13 @@ struct sb_mesh_load_params {
 };
 
 /*
- * Append the triangles of the mesh file at `path` to *mesh (which may hold
- * triangles already, or be zeroed). Every triangle of every mesh of the
- * file's node tree, with the nodes' transforms; points and lines are left
- * out; polygons are triangulated. Materials take the file's base colour
- * (glTF's baseColorFactor) or else its diffuse colour, clamped to [0, 1],
- * unless an override names them.
- *
- * A file named *.json is a skybake world file instead (world_file.h: a
- * ground, boxes and pillars), built here with the same transform and
- * overrides.
+ * Append the triangles of the mesh file at `path`, read through assimp, to
+ * *mesh (which may hold triangles already, or be zeroed). Every triangle of
+ * every mesh of the file's node tree, with the nodes' transforms; points
+ * and lines are left out; polygons are triangulated. Materials take the
+ * file's base colour (glTF's baseColorFactor) or else its diffuse colour,
+ * clamped to [0, 1], unless an override names them. load.h's sb_mesh_load
+ * also reads skybake world files; most callers want that.
  *
  * Refuses, naming the file and the reason, and leaving *mesh as it was: a
  * file that cannot be read or is over SB_MESH_MAX_FILE_BYTES
@@ -102,17 +99,10 @@ struct sb_mesh_load_params {
  * caps (SB_ERR_TOO_LARGE), and a file with no triangle of non-zero area
  * (SB_ERR_MESH). Zero-area triangles are left out and counted.
  */
-enum sb_result sb_mesh_load(const char *path, const struct sb_mesh_load_params *params, struct sb_mesh *mesh);
+enum sb_result sb_mesh_import(const char *path, const struct sb_mesh_load_params *params, struct sb_mesh *mesh);
 
 /* Where the transform takes point p (file units) in world metres. */
 void sb_mesh_transform_point(const struct sb_mesh_transform *t, const double p[3], double out[3]);
-
-/* Read a scene's world (formats/scene.h: its file, relative to
- * `directory` unless absolute or directory is "", placed and overridden as
- * the scene says); *path_out (may be NULL) gets the path read, absolute. */
-struct sb_world_params;
-enum sb_result sb_mesh_load_world(const struct sb_world_params *world, const char *directory, struct sb_mesh *mesh,
-                                  char *path_out, size_t path_size);
 
 /* Add a material (roughness 0.5, metallic 0, casting shadows: set the
  * fields afterwards to change them); returns its index in *index. */

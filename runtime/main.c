@@ -22,6 +22,7 @@
 #include "io.h"
 #include "log.h"
 #include "lut3d.h"
+#include "load.h"
 #include "mesh.h"
 #include "pack.h"
 #include "pngfile.h"

@@ -4,6 +4,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "load.h"
 #include "world_file.h"
 
 enum sb_result sb_world_from_mesh(const struct sb_mesh *mesh, struct sb_world *w)

@@ -21,6 +21,7 @@
 #include "harness_vk.h"
 #include "json.h"
 #include "log.h"
+#include "load.h"
 #include "mesh.h"
 #include "raycast.h"
 #include "shapes.h"

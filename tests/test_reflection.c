@@ -17,6 +17,7 @@
 #include "cube.h"
 #include "exr.h"
 #include "harness_vk.h"
+#include "load.h"
 #include "mesh.h"
 #include "reflection.h"
 #include "scene.h"

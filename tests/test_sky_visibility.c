@@ -16,6 +16,7 @@
 #include "embree_ref.h"
 #include "harness_vk.h"
 #include "log.h"
+#include "load.h"
 #include "mesh.h"
 #include "raycast.h"
 #include "sh.h"

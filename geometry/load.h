@@ -1,0 +1,42 @@
+/*
+ * A world's geometry from a file, whatever the file is: a mesh through
+ * assimp (mesh.h) or a skybake world file (world_file.h). The one place
+ * that knows both, so that neither knows the other.
+ */
+#ifndef SB_GEOMETRY_LOAD_H
+#define SB_GEOMETRY_LOAD_H
+
+#include <stddef.h>
+
+#include "mesh.h"
+
+/*
+ * Append the triangles of the mesh file at `path` to *mesh (which may hold
+ * triangles already, or be zeroed). Every triangle of every mesh of the
+ * file's node tree, with the nodes' transforms; points and lines are left
+ * out; polygons are triangulated. Materials take the file's base colour
+ * (glTF's baseColorFactor) or else its diffuse colour, clamped to [0, 1],
+ * unless an override names them.
+ *
+ * A file named *.json is a skybake world file instead (world_file.h: a
+ * ground, boxes and pillars), built with the same transform and overrides;
+ * any other is a mesh (sb_mesh_import).
+ *
+ * Refuses, naming the file and the reason, and leaving *mesh as it was: a
+ * file that cannot be read or is over SB_MESH_MAX_FILE_BYTES
+ * (SB_ERR_IO, SB_ERR_TOO_LARGE), one assimp refuses, crashes on or does
+ * not finish within the time limit (SB_ERR_MESH), a
+ * non-finite or out-of-extent coordinate (SB_ERR_NUMERIC), counts past the
+ * caps (SB_ERR_TOO_LARGE), and a file with no triangle of non-zero area
+ * (SB_ERR_MESH). Zero-area triangles are left out and counted.
+ */
+enum sb_result sb_mesh_load(const char *path, const struct sb_mesh_load_params *params, struct sb_mesh *mesh);
+
+/* Read a scene's world (formats/scene.h: its file, relative to
+ * `directory` unless absolute or directory is "", placed and overridden as
+ * the scene says); *path_out (may be NULL) gets the path read, absolute. */
+struct sb_world_params;
+enum sb_result sb_mesh_load_world(const struct sb_world_params *world, const char *directory, struct sb_mesh *mesh,
+                                  char *path_out, size_t path_size);
+
+#endif
