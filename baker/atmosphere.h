@@ -38,6 +38,44 @@ uint64_t sb_atmosphere_settings_cost(enum sb_product_id id, const struct sb_atmo
 void sb_atmosphere_settings_label(enum sb_product_id id, const struct sb_atmosphere_settings *settings, char *out,
                                   size_t size);
 
+/* A setting a product's bake may choose and bench sweeps
+ * (atmosphere_candidates.c). */
+struct sb_atmosphere_candidate {
+    struct sb_atmosphere_settings settings;
+    const char *anchor; /* the published method this setting reproduces, or NULL */
+    bool quick;         /* part of `skybake bench --quick` */
+};
+
+/* The sweeps: a product's candidates, or (lookup) the resolutions whose
+ * bilinear lookups bench measures. */
+enum sb_atmosphere_sweep_id {
+    SB_ATMOSPHERE_SWEEP_TRANSMITTANCE,
+    SB_ATMOSPHERE_SWEEP_TRANSMITTANCE_RESOLUTION,
+    SB_ATMOSPHERE_SWEEP_MULTISCATTERING,
+    SB_ATMOSPHERE_SWEEP_IRRADIANCE_GROUND,
+    SB_ATMOSPHERE_SWEEP_IRRADIANCE_SKY,
+    SB_ATMOSPHERE_SWEEP_COUNT,
+};
+
+struct sb_atmosphere_sweep {
+    const char *name; /* bench's --product */
+    enum sb_product_id product;
+    bool lookup; /* resolutions, measured through lookups: not bake candidates */
+    const struct sb_atmosphere_candidate *entries;
+    int count;
+    const char *error_name;
+};
+
+/* The sweeps, indexed by enum sb_atmosphere_sweep_id. */
+extern const struct sb_atmosphere_sweep sb_atmosphere_sweeps[SB_ATMOSPHERE_SWEEP_COUNT];
+
+#define SB_ATMOSPHERE_MAX_CANDIDATES 32
+
+/* The settings a bake under a tolerance tries for `id`, cheapest first
+ * (stable: ties keep the table's order), into out; returns their number.
+ * Thread-safe. */
+int sb_atmosphere_candidates(enum sb_product_id id, struct sb_atmosphere_settings out[SB_ATMOSPHERE_MAX_CANDIDATES]);
+
 struct sb_atmosphere_product {
     enum sb_product_id id;
     uint32_t depends_on;      /* bit mask of sb_product_id */

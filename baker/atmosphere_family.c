@@ -9,7 +9,6 @@
 
 #include "accuracy.h"
 #include "atmosphere.h"
-#include "bench.h"
 #include "family.h"
 #include "log.h"
 
@@ -32,8 +31,8 @@ static enum sb_result bake_to_tolerance(struct sb_atmosphere_baker *baker, const
     if (res)
         return res;
     snprintf(probe, probe_size, "%s", sb_accuracy_ref_probe(ref));
-    int count;
-    const struct sb_atmosphere_settings *candidates = sb_bench_candidates(id, &count);
+    struct sb_atmosphere_settings candidates[SB_ATMOSPHERE_MAX_CANDIDATES];
+    int count = sb_atmosphere_candidates(id, candidates);
     double best = INFINITY;
     char best_label[48] = "", label[48];
     double total_ms = 0;
@@ -114,8 +113,8 @@ static void atmosphere_key(void *state, const struct sb_scene *scene, enum sb_pr
     key_params(id, &scene->atmosphere, key);
     if (scene->tolerance[id] > 0) {
         sb_key_add(key, " tolerance=%a candidates", scene->tolerance[id]);
-        int count;
-        const struct sb_atmosphere_settings *candidates = sb_bench_candidates(id, &count);
+        struct sb_atmosphere_settings candidates[SB_ATMOSPHERE_MAX_CANDIDATES];
+        int count = sb_atmosphere_candidates(id, candidates);
         for (int i = 0; i < count; i++) {
             sb_atmosphere_settings_json(id, &candidates[i], settings, sizeof(settings));
             sb_key_add(key, " %s", settings);

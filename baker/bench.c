@@ -16,138 +16,12 @@
 #include "json.h"
 #include "log.h"
 
-#define HILLAIRE "Hillaire 2020 (40-step march, offset 0.3)"
-#define BRUNETON "Bruneton 2017 (500-step trapezoid)"
-#define HILLAIRE_MS "Hillaire 2020 (64 directions, 20-step march, LUT sun)"
-#define BRUNETON_E "Bruneton 2017 (16 x 64 directions, 50-step trapezoid, LUT transmittance)"
-
-struct sweep_entry {
-    struct sb_atmosphere_settings settings;
-    const char *anchor;
-    bool quick; /* part of --quick */
-};
-
-#define GL(n, s)                                                                                                       \
-    {                                                                                                                  \
-        .quadrature = SB_QUADRATURE_GAUSS_LEGENDRE, .samples = n, .subdivisions = s                                    \
-    }
-#define UNI(rule, n)                                                                                                   \
-    {                                                                                                                  \
-        .quadrature = rule, .samples = n                                                                               \
-    }
-static const struct sweep_entry transmittance_sweep[] = {
-    {GL(1, 1), NULL, true},
-    {GL(2, 1), NULL, true},
-    {GL(3, 1), NULL, true},
-    {GL(4, 1), NULL, true},
-    {GL(5, 1), NULL, false},
-    {GL(6, 1), NULL, true},
-    {GL(8, 1), NULL, true},
-    {GL(4, 2), NULL, false},
-    {GL(8, 2), NULL, true},
-    {GL(8, 4), NULL, false},
-    {GL(8, 16), NULL, false},
-    {UNI(SB_QUADRATURE_UNIFORM_0_3, 10), NULL, false},
-    {UNI(SB_QUADRATURE_UNIFORM_0_3, 20), NULL, false},
-    {UNI(SB_QUADRATURE_UNIFORM_0_3, 40), HILLAIRE, true},
-    {UNI(SB_QUADRATURE_UNIFORM_0_3, 80), NULL, false},
-    {UNI(SB_QUADRATURE_UNIFORM_0_3, 160), NULL, false},
-    {UNI(SB_QUADRATURE_UNIFORM_0_3, 320), NULL, false},
-    {UNI(SB_QUADRATURE_MIDPOINT, 40), NULL, false},
-    {UNI(SB_QUADRATURE_MIDPOINT, 160), NULL, false},
-    {UNI(SB_QUADRATURE_TRAPEZOID, 100), NULL, false},
-    {UNI(SB_QUADRATURE_TRAPEZOID, 500), BRUNETON, true},
-    {UNI(SB_QUADRATURE_TRAPEZOID, 2000), NULL, false},
-};
-#define RES(w, h)                                                                                                      \
-    {                                                                                                                  \
-        .quadrature = SB_QUADRATURE_GAUSS_LEGENDRE, .samples = 8, .subdivisions = 1, .width = w, .height = h           \
-    }
-static const struct sweep_entry resolution_sweep[] = {
-    {RES(64, 16), NULL, true},   {RES(128, 32), NULL, true},    {RES(256, 64), NULL, true},
-    {RES(512, 128), NULL, true}, {RES(1024, 256), NULL, false},
-};
-#define DIRS(m, p)                                                                                                     \
-    {                                                                                                                  \
-        .directions_mu = m, .directions_phi = p                                                                        \
-    }
-#define HILLAIRE_DIRS(n, steps)                                                                                        \
-    {                                                                                                                  \
-        .quadrature = SB_QUADRATURE_UNIFORM_0_3, .samples = steps, .directions_mu = n, .directions_phi = n             \
-    }
-static const struct sweep_entry multiscattering_sweep[] = {
-    {HILLAIRE_DIRS(8, 20), HILLAIRE_MS, true},
-    {HILLAIRE_DIRS(8, 80), NULL, false},
-    {HILLAIRE_DIRS(8, 320), NULL, false},
-    /* the same method with more directions: how far they take it */
-    {HILLAIRE_DIRS(16, 20), NULL, false},
-    {HILLAIRE_DIRS(32, 20), NULL, false},
-    {HILLAIRE_DIRS(64, 20), NULL, false},
-    {HILLAIRE_DIRS(64, 80), NULL, false},
-    /* zenith nodes a piece x the rings' Gauss-Legendre nodes a piece */
-    {DIRS(2, 2), NULL, false},
-    {DIRS(4, 3), NULL, true},
-    {DIRS(8, 4), NULL, true},
-    {DIRS(12, 4), NULL, false},
-    {DIRS(12, 6), NULL, false},
-    {DIRS(16, 4), NULL, false},
-    {DIRS(16, 6), NULL, true},
-    {DIRS(24, 8), NULL, false},
-    {DIRS(32, 12), NULL, false},
-};
-#define BRUNETON_DIRS(theta, phi, steps)                                                                               \
-    {                                                                                                                  \
-        .quadrature = SB_QUADRATURE_TRAPEZOID, .samples = steps, .directions_mu = theta, .directions_phi = phi         \
-    }
-static const struct sweep_entry irradiance_ground_sweep[] = {
-    {BRUNETON_DIRS(16, 64, 50), BRUNETON_E, true},
-    {BRUNETON_DIRS(8, 32, 50), NULL, false},
-    {BRUNETON_DIRS(32, 128, 50), NULL, false},
-    {BRUNETON_DIRS(16, 64, 200), NULL, false},
-    {DIRS(4, 4), NULL, true},
-    {DIRS(6, 6), NULL, true},
-    {DIRS(8, 8), NULL, true},
-    {DIRS(12, 12), NULL, false},
-    {DIRS(16, 16), NULL, false},
-    {DIRS(24, 24), NULL, false},
-};
-static const struct sweep_entry irradiance_sky_sweep[] = {
-    {DIRS(4, 4), NULL, true},    {DIRS(8, 8), NULL, true},    {DIRS(12, 12), NULL, false},
-    {DIRS(16, 16), NULL, false}, {DIRS(24, 24), NULL, false},
-};
-#undef GL
-#undef UNI
-#undef RES
-#undef DIRS
-#undef HILLAIRE_DIRS
-#undef BRUNETON_DIRS
-
-static const struct {
-    const char *name;
-    enum sb_product_id product;
-    bool lookup;
-    const struct sweep_entry *entries;
-    int count;
-    const char *error_name;
-} sweeps[SB_BENCH_SWEEP_COUNT] = {
-#define S(list) list, (int)(sizeof(list) / sizeof(list[0]))
-    [SB_BENCH_TRANSMITTANCE] = {"transmittance", SB_PRODUCT_TRANSMITTANCE, false, S(transmittance_sweep),
-                                "texel error"},
-    [SB_BENCH_TRANSMITTANCE_RESOLUTION] = {"transmittance_resolution", SB_PRODUCT_TRANSMITTANCE, true,
-                                           S(resolution_sweep), "bilinear lookup error"},
-    [SB_BENCH_MULTISCATTERING] = {"multiscattering", SB_PRODUCT_MULTISCATTERING, false, S(multiscattering_sweep),
-                                  "texel error"},
-    [SB_BENCH_IRRADIANCE_GROUND] = {"irradiance_ground", SB_PRODUCT_IRRADIANCE_GROUND, false,
-                                    S(irradiance_ground_sweep), "texel error"},
-    [SB_BENCH_IRRADIANCE_SKY] = {"irradiance_sky", SB_PRODUCT_IRRADIANCE_SKY, false, S(irradiance_sky_sweep),
-                                 "texel error"},
-#undef S
-};
-
+/* The sweeps are the products' candidate settings (atmosphere_candidates.c). */
+_Static_assert((int)SB_BENCH_SWEEP_COUNT == (int)SB_ATMOSPHERE_SWEEP_COUNT, "bench.h's sweeps are atmosphere.h's");
 bool sb_bench_sweep_from_name(const char *name, enum sb_bench_sweep *sweep)
 {
     for (int i = 0; i < SB_BENCH_SWEEP_COUNT; i++)
-        if (!strcmp(name, sweeps[i].name)) {
+        if (!strcmp(name, sb_atmosphere_sweeps[i].name)) {
             *sweep = (enum sb_bench_sweep)i;
             return true;
         }
@@ -161,37 +35,6 @@ static bool same_settings(enum sb_product_id id, const struct sb_atmosphere_sett
     sb_atmosphere_settings_label(id, a, la, sizeof(la));
     sb_atmosphere_settings_label(id, b, lb, sizeof(lb));
     return !strcmp(la, lb);
-}
-
-const struct sb_atmosphere_settings *sb_bench_candidates(enum sb_product_id id, int *count)
-{
-    /* Built once per product, sorted by cost (stable: ties keep the sweep's
-     * order, so the choice is the same on every run). Not thread safe on
-     * first use, like the logger. */
-    static struct sb_atmosphere_settings lists[SB_ATMOSPHERE_PRODUCT_COUNT][32];
-    static int counts[SB_ATMOSPHERE_PRODUCT_COUNT] = {-1, -1, -1, -1};
-    if (counts[id] < 0) {
-        int n = 0;
-        for (int w = 0; w < SB_BENCH_SWEEP_COUNT; w++) {
-            if (sweeps[w].product != id || sweeps[w].lookup)
-                continue;
-            for (int i = 0; i < sweeps[w].count && n < 32; i++)
-                lists[id][n++] = sweeps[w].entries[i].settings;
-        }
-        /* insertion sort: stable and small */
-        for (int i = 1; i < n; i++) {
-            struct sb_atmosphere_settings v = lists[id][i];
-            int j = i - 1;
-            while (j >= 0 && sb_atmosphere_settings_cost(id, &lists[id][j]) > sb_atmosphere_settings_cost(id, &v)) {
-                lists[id][j + 1] = lists[id][j];
-                j--;
-            }
-            lists[id][j + 1] = v;
-        }
-        counts[id] = n;
-    }
-    *count = counts[id];
-    return lists[id];
 }
 
 /* Whether row a dominates row b of the same sweep: at most b's time and
@@ -295,7 +138,7 @@ enum sb_result sb_bench_run(struct sb_vk *vk, const struct sb_atmosphere_params 
     double *times = calloc((size_t)repeat, sizeof(double));
     int total = 0;
     for (int w = 0; w < SB_BENCH_SWEEP_COUNT; w++)
-        total += params->sweeps[w] ? sweeps[w].count : 0;
+        total += params->sweeps[w] ? sb_atmosphere_sweeps[w].count : 0;
     report->rows = calloc((size_t)total + 1, sizeof(*report->rows));
     enum sb_result res = times && report->rows ? SB_OK : SB_ERR_NOMEM;
     if (!res)
@@ -306,7 +149,8 @@ enum sb_result sb_bench_run(struct sb_vk *vk, const struct sb_atmosphere_params 
     uint32_t need = 0;
     for (int w = 0; w < SB_BENCH_SWEEP_COUNT; w++)
         if (params->sweeps[w])
-            need |= sb_atmosphere_product(sweeps[w].product)->depends_on | 1u << sweeps[w].product;
+            need |= sb_atmosphere_product(sb_atmosphere_sweeps[w].product)->depends_on |
+                    1u << sb_atmosphere_sweeps[w].product;
     for (int p = 0; p < SB_ATMOSPHERE_PRODUCT_COUNT && !res; p++)
         if (need & 1u << p)
             res = sb_atmosphere_bake(baker, (enum sb_product_id)p, NULL, &inputs[p], NULL, NULL);
@@ -314,18 +158,19 @@ enum sb_result sb_bench_run(struct sb_vk *vk, const struct sb_atmosphere_params 
     for (int w = 0; w < SB_BENCH_SWEEP_COUNT && !res; w++) {
         if (!params->sweeps[w])
             continue;
-        enum sb_product_id id = sweeps[w].product;
+        enum sb_product_id id = sb_atmosphere_sweeps[w].product;
         const struct sb_atmosphere_product *product = sb_atmosphere_product(id);
         double t0 = sb_now_s();
-        if ((res =
-                 sb_accuracy_ref_create(atmosphere, id, sweeps[w].lookup ? SB_ACCURACY_LOOKUP : 0, 0, 0, inputs, &ref)))
+        if ((res = sb_accuracy_ref_create(atmosphere, id, sb_atmosphere_sweeps[w].lookup ? SB_ACCURACY_LOOKUP : 0, 0, 0,
+                                          inputs, &ref)))
             break;
         report->reference_s[w] = sb_now_s() - t0;
         snprintf(report->probe[w], sizeof(report->probe[w]), "%s", sb_accuracy_ref_probe(ref));
-        sb_info("%s: fp64 reference at %s in %.1f s", sweeps[w].name, report->probe[w], report->reference_s[w]);
+        sb_info("%s: fp64 reference at %s in %.1f s", sb_atmosphere_sweeps[w].name, report->probe[w],
+                report->reference_s[w]);
 
-        for (int e = 0; e < sweeps[w].count && !res; e++) {
-            const struct sweep_entry *entry = &sweeps[w].entries[e];
+        for (int e = 0; e < sb_atmosphere_sweeps[w].count && !res; e++) {
+            const struct sb_atmosphere_candidate *entry = &sb_atmosphere_sweeps[w].entries[e];
             if (params->quick && !entry->quick)
                 continue;
             struct sb_bench_row *row = &report->rows[report->row_count];
@@ -355,7 +200,7 @@ enum sb_result sb_bench_run(struct sb_vk *vk, const struct sb_atmosphere_params 
             sb_accuracy_measure(ref, &image, false, &row->error);
             sb_accuracy_measure(ref, &image, true, &row->error_half);
             report->row_count++;
-            sb_info("%-24s %-22s %10.3f ms  max %.3g  rms %.3g", sweeps[w].name, row->label, row->gpu_ms,
+            sb_info("%-24s %-22s %10.3f ms  max %.3g  rms %.3g", sb_atmosphere_sweeps[w].name, row->label, row->gpu_ms,
                     row->error.max_rel, row->error.rms_rel);
         }
         sb_accuracy_ref_destroy(&ref);
@@ -438,9 +283,9 @@ static cJSON *report_json(const struct sb_bench_report *report, const struct sb_
     for (int w = 0; w < SB_BENCH_SWEEP_COUNT; w++) {
         if (!report->probe[w][0])
             continue;
-        cJSON *o = cJSON_AddObjectToObject(sw, sweeps[w].name);
-        cJSON_AddStringToObject(o, "product", sb_product_name(sweeps[w].product));
-        cJSON_AddStringToObject(o, "error", sweeps[w].error_name);
+        cJSON *o = cJSON_AddObjectToObject(sw, sb_atmosphere_sweeps[w].name);
+        cJSON_AddStringToObject(o, "product", sb_product_name(sb_atmosphere_sweeps[w].product));
+        cJSON_AddStringToObject(o, "error", sb_atmosphere_sweeps[w].error_name);
         cJSON_AddStringToObject(o, "probe", report->probe[w]);
         cJSON_AddNumberToObject(o, "reference_s", report->reference_s[w]);
     }
@@ -448,7 +293,7 @@ static cJSON *report_json(const struct sb_bench_report *report, const struct sb_
     for (int i = 0; i < report->row_count; i++) {
         const struct sb_bench_row *r = &report->rows[i];
         cJSON *o = cJSON_CreateObject();
-        cJSON_AddStringToObject(o, "sweep", sweeps[r->sweep].name);
+        cJSON_AddStringToObject(o, "sweep", sb_atmosphere_sweeps[r->sweep].name);
         cJSON_AddStringToObject(o, "setting", r->label);
         if (r->anchor)
             cJSON_AddStringToObject(o, "anchor", r->anchor);
@@ -576,8 +421,8 @@ void sb_bench_print(const struct sb_bench_report *report, const struct sb_vk *vk
     for (int w = 0; w < SB_BENCH_SWEEP_COUNT; w++) {
         if (!report->probe[w][0])
             continue;
-        printf("\n%s (%s over %s; reference %.1f s)\n", sweeps[w].name, sweeps[w].error_name, report->probe[w],
-               report->reference_s[w]);
+        printf("\n%s (%s over %s; reference %.1f s)\n", sb_atmosphere_sweeps[w].name,
+               sb_atmosphere_sweeps[w].error_name, report->probe[w], report->reference_s[w]);
         printf("  %-22s %7s %11s %10s %10s %10s  %s\n", "setting", "cost", "gpu ms", "max rel", "rms rel", "fp16 max",
                "");
         for (int i = 0; i < report->row_count; i++) {
@@ -687,7 +532,7 @@ static enum sb_result write_plot(const struct sb_bench_report *report, const str
         if (!report->probe[w][0])
             continue;
         /* columns of bench.csv: 1 sweep, 2 setting, 5 gpu_ms, 7 max_rel, 12 pareto, 13 anchor, 4 default */
-        text_add(&gp, "set title '%s (%s)'\n", sweeps[w].name, sweeps[w].error_name);
+        text_add(&gp, "set title '%s (%s)'\n", sb_atmosphere_sweeps[w].name, sb_atmosphere_sweeps[w].error_name);
         text_add(
             &gp,
             "plot 'bench_%s.csv' using 5:7 with points pt 7 ps 0.6 lc rgb '#7f7f7f' title 'settings', \\\n"
@@ -697,7 +542,7 @@ static enum sb_result write_plot(const struct sb_bench_report *report, const str
             "     '' using 5:($4 > 0 ? $7 : 1/0) with points pt 5 ps 1.2 lc rgb '#2ca02c' title 'skybake default', "
             "\\\n"
             "     '' using 5:7:2 with labels offset 0.6,0.5 left font ',8' notitle\n",
-            sweeps[w].name);
+            sb_atmosphere_sweeps[w].name);
     }
     text_add(&gp, "unset multiplot\n");
     enum sb_result res = gp.failed ? SB_ERR_NOMEM : write_text(dir, "bench.gp", gp.data);
@@ -730,10 +575,10 @@ static enum sb_result write_plot(const struct sb_bench_report *report, const str
 
 static void csv_row(struct text *t, const struct sb_bench_row *r)
 {
-    text_add(t, "%s,%s,%llu,%d,%.6g,%.6g,%.6g,%.6g,%.6g,%.6g,%u,%d,%d,\"%s\"\n", sweeps[r->sweep].name, r->label,
-             (unsigned long long)r->cost, r->is_default, r->gpu_ms, r->gpu_ms_min, r->error.max_rel, r->error.rms_rel,
-             r->error_half.max_rel, r->error_half.rms_rel, r->error.count, r->pareto, r->anchor != NULL,
-             r->anchor ? r->anchor : "");
+    text_add(t, "%s,%s,%llu,%d,%.6g,%.6g,%.6g,%.6g,%.6g,%.6g,%u,%d,%d,\"%s\"\n", sb_atmosphere_sweeps[r->sweep].name,
+             r->label, (unsigned long long)r->cost, r->is_default, r->gpu_ms, r->gpu_ms_min, r->error.max_rel,
+             r->error.rms_rel, r->error_half.max_rel, r->error_half.rms_rel, r->error.count, r->pareto,
+             r->anchor != NULL, r->anchor ? r->anchor : "");
 }
 
 enum sb_result sb_bench_write(const struct sb_bench_report *report, const struct sb_vk *vk, const char *dir)
@@ -768,7 +613,7 @@ enum sb_result sb_bench_write(const struct sb_bench_report *report, const struct
             csv_row(&all, &report->rows[order[i]]);
         }
         char name[96];
-        snprintf(name, sizeof(name), "bench_%s.csv", sweeps[w].name);
+        snprintf(name, sizeof(name), "bench_%s.csv", sb_atmosphere_sweeps[w].name);
         res = one.failed ? SB_ERR_NOMEM : write_text(dir, name, one.data);
         free(one.data);
     }

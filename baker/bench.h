@@ -137,10 +137,6 @@ enum sb_result sb_bench_probes_csv(const struct sb_bench_report *report, const c
 
 bool sb_bench_sweep_from_name(const char *name, enum sb_bench_sweep *sweep);
 
-/* Candidate settings of `id` at the format's resolution, cheapest first (for
- * a tolerance): *count of them. */
-const struct sb_atmosphere_settings *sb_bench_candidates(enum sb_product_id id, int *count);
-
 enum sb_result sb_bench_run(struct sb_vk *vk, const struct sb_atmosphere_params *atmosphere,
                             const struct sb_bench_params *params, struct sb_bench_report *report);
 void sb_bench_report_finish(struct sb_bench_report *report);
