@@ -48,7 +48,8 @@ struct sb_family_baker {
     enum sb_result (*create)(struct sb_vk *vk, const struct sb_scene *scene, void **state);
     void (*destroy)(void **state);
     /* Bake `id` into *image (values as the pack's file stores them) and
-     * fill the artifact's settings_json and gpu_ms. baked[] holds every
+     * fill the artifact's settings_json and gpu_ms (and, for a product
+     * baked against the world, sb_artifact_set_world). baked[] holds every
      * product of lower id that this bake made or reused. */
     enum sb_result (*bake)(void *state, struct sb_vk *vk, const struct sb_scene *scene, enum sb_product_id id,
                            const struct sb_image baked[SB_PRODUCT_COUNT], struct sb_image *image,

@@ -72,6 +72,10 @@ static cJSON *info_json(const struct sb_pack *pack, const char *dir)
         cJSON *settings = cJSON_Parse(a->settings_json[0] ? a->settings_json : "{}");
         cJSON_AddItemToObject(o, "settings", settings ? settings : cJSON_CreateObject());
         cJSON_AddStringToObject(o, "content_hash", a->content_hash);
+        if (a->world_hash[0]) {
+            cJSON_AddStringToObject(o, "world_hash", a->world_hash);
+            cJSON_AddStringToObject(o, "world_path", a->world_path);
+        }
         cJSON_AddItemToArray(artifacts, o);
     }
     return root;
@@ -102,6 +106,9 @@ void sb_pack_info_print(const struct sb_pack *pack, const char *dir, bool json)
         channel_list(image, channels, sizeof(channels));
         printf("%-18s %-11s %-28s %10lld %9.3f  %-32s  %s\n", sb_product_name((enum sb_product_id)p), size, channels,
                file_bytes(dir, a->file), a->gpu_ms, a->content_hash, a->settings_json);
+        if (a->world_hash[0])
+            printf("%-18s baked against the world %s (%s)\n", "", a->world_path[0] ? a->world_path : "(path unknown)",
+                   a->world_hash);
     }
 }
 

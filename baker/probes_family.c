@@ -18,8 +18,8 @@
 #include "bvh.h"
 #include "family.h"
 #include "json.h"
-#include "log.h"
 #include "load.h"
+#include "log.h"
 #include "mesh.h"
 #include "parallel.h"
 #include "raycast.h"
@@ -340,11 +340,10 @@ static enum sb_result bake_visibility(struct probes_state *st, const struct sb_s
     a->gpu_ms = gpu_ms;
     snprintf(a->settings_json, sizeof(a->settings_json),
              "{\"rays\":%u,\"grid\":[%u,%u,%u],\"spacing_m\":%.9g,\"explicit\":%u,\"triangles\":%u,"
-             "\"inside\":%u,\"pushed_out\":%u,\"invalid\":%u,\"deringed\":%u,\"lowest_before_dering\":%.6g,"
-             "\"world_hash\":\"%s\",\"world_path\":\"%s\"}",
+             "\"inside\":%u,\"pushed_out\":%u,\"invalid\":%u,\"deringed\":%u,\"lowest_before_dering\":%.6g}",
              layout->ray_count, layout->grid[0], layout->grid[1], layout->grid[2], (double)layout->spacing_m[0],
-             layout->explicit_count, mesh->triangle_count, inside, pushed, inside - pushed, deringed, lowest,
-             st->mesh_hash, sb_json_safe(st->path) ? st->path : "");
+             layout->explicit_count, mesh->triangle_count, inside, pushed, inside - pushed, deringed, lowest);
+    sb_artifact_set_world(a, st->mesh_hash, st->path);
     sb_info("sky_visibility: %u probes over %u triangles; %u inside geometry, %u pushed out; %u deringed", count,
             mesh->triangle_count, inside, pushed, deringed);
 done:

@@ -17,8 +17,8 @@
 #include "exr.h"
 #include "family.h"
 #include "json.h"
-#include "log.h"
 #include "load.h"
+#include "log.h"
 #include "mesh.h"
 #include "probes.h"
 #include "reflection.h"
@@ -199,8 +199,8 @@ static enum sb_result bake_cubes(struct reflection_state *st, struct sb_vk *vk, 
         t1 = 1e3 * sb_now_s();
         if ((res = sb_reflection_prefilter(vk, level0, n, &pp, filtered, &ms)))
             break;
-        sb_debug("reflection_cubes: probe %u prefiltered in %.1f ms (%.3f ms on the device)", i,
-                 1e3 * sb_now_s() - t1, ms);
+        sb_debug("reflection_cubes: probe %u prefiltered in %.1f ms (%.3f ms on the device)", i, 1e3 * sb_now_s() - t1,
+                 ms);
         gpu_ms += ms;
         for (uint32_t l = 0; l < levels; l++) {
             uint32_t m = n >> l;
@@ -216,10 +216,10 @@ static enum sb_result bake_cubes(struct reflection_state *st, struct sb_vk *vk, 
     a->gpu_ms = gpu_ms;
     snprintf(a->settings_json, sizeof(a->settings_json),
              "{\"face_size\":%u,\"levels\":%u,\"cubes\":%u,\"samples\":%u,\"ambient_rays\":%u,"
-             "\"roughness\":\"l/(levels-1)=r(2-r)\",\"sun_disk\":\"analytic at runtime\",\"most_back_faces\":%.4f,"
-             "\"world_hash\":\"%s\",\"world_path\":\"%s\"}",
-             n, levels, cubes, p->samples, p->ambient_rays, worst_back, st->has_world ? st->mesh_hash : "",
-             st->has_world && sb_json_safe(st->path) ? st->path : "");
+             "\"roughness\":\"l/(levels-1)=r(2-r)\",\"sun_disk\":\"analytic at runtime\",\"most_back_faces\":%.4f}",
+             n, levels, cubes, p->samples, p->ambient_rays, worst_back);
+    if (st->has_world)
+        sb_artifact_set_world(a, st->mesh_hash, st->path);
 done:
     if (res)
         sb_image_finish(image);

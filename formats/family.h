@@ -1,7 +1,7 @@
 /*
  * Product families: what the formats tier knows of each family of products
  * (the atmosphere, the cloud noise, ...). A family is its products' rows in
- * the format table (pack.c), its scene section (parsed, validated and
+ * the format table (product.c), its scene section (parsed, validated and
  * normalised by the family's own file: scene_clouds.c for the clouds) and
  * one entry here. The baker's half of a family (its keys, bakes, references)
  * is baker/family.h. Internal to skybake; not installed.

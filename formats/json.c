@@ -209,14 +209,6 @@ enum sb_result sb_json_only_keys(const cJSON *obj, const char *source, const cha
     return res;
 }
 
-bool sb_json_safe(const char *s)
-{
-    for (; *s; s++)
-        if (*s == '"' || *s == '\\' || (unsigned char)*s < 0x20)
-            return false;
-    return true;
-}
-
 enum sb_result sb_json_box(const cJSON *item, const char *source, const char *path, double lo, double hi,
                            double box[2][3])
 {

@@ -42,10 +42,6 @@ bool sb_json_emit(FILE *out, cJSON *root);
  * twice; logs "source: section.key: reason" otherwise. */
 enum sb_result sb_json_only_keys(const cJSON *obj, const char *source, const char *section, const char *const *keys);
 
-/* True when `s` can go into JSON text between quotes as it is (no quote,
- * backslash or control character): what settings write paths through. */
-bool sb_json_safe(const char *s);
-
 /* A number in [lo, hi]; logs "source: path: reason" otherwise. */
 enum sb_result sb_json_number(const cJSON *item, const char *source, const char *path, double lo, double hi,
                               double *out);

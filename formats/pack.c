@@ -223,6 +223,19 @@ enum sb_result sb_pack_writer_create(const char *out_dir, struct sb_pack_writer 
     return SB_OK;
 }
 
+void sb_artifact_set_world(struct sb_artifact *a, const char *world_hash, const char *world_path)
+{
+    snprintf(a->world_hash, sizeof(a->world_hash), "%s", world_hash);
+    size_t length = strlen(world_path);
+    if (length >= sizeof(a->world_path) || sb_utf8_check(world_path, length) != SIZE_MAX) {
+        sb_warn("%s: the world's path is %s; the manifest does not record it (skyview will need --world)",
+                sb_product_name(a->product), length >= sizeof(a->world_path) ? "too long" : "not UTF-8 text");
+        a->world_path[0] = '\0';
+        return;
+    }
+    memcpy(a->world_path, world_path, length + 1);
+}
+
 enum sb_result sb_pack_writer_add_image(struct sb_pack_writer *w, struct sb_artifact *artifact,
                                         const struct sb_image *image)
 {
@@ -242,6 +255,21 @@ enum sb_result sb_pack_writer_add_image(struct sb_pack_writer *w, struct sb_arti
                  (unsigned long long)(texel / image->width / image->height),
                  image->channel_names[bad % image->channel_count], image->data[bad]);
         return SB_ERR_NUMERIC;
+    }
+    /* What the manifest will say of it, checked now rather than written as
+     * something else: settings are a JSON object, the world's path UTF-8. */
+    cJSON *settings = cJSON_Parse(artifact->settings_json[0] ? artifact->settings_json : "{}");
+    bool settings_ok = cJSON_IsObject(settings);
+    cJSON_Delete(settings);
+    if (!settings_ok) {
+        sb_error("%s: its settings are not a JSON object: %s", sb_product_name(artifact->product),
+                 artifact->settings_json);
+        return SB_ERR_JSON_SYNTAX;
+    }
+    if (sb_utf8_check(artifact->world_path, strlen(artifact->world_path)) != SIZE_MAX) {
+        sb_error("%s: the world's path is not UTF-8 text: %s", sb_product_name(artifact->product),
+                 artifact->world_path);
+        return SB_ERR_OUT_OF_RANGE;
     }
     sb_image_content_hash(image, artifact->content_hash);
 
@@ -324,7 +352,17 @@ static char *manifest_json(const struct sb_pack_writer *w, const char *scene_jso
         cJSON_AddStringToObject(o, "pixel_type", sb_product_format(a->product)->pixel_type);
         cJSON_AddStringToObject(o, "parameterization", a->parameterization);
         cJSON *settings = cJSON_Parse(a->settings_json[0] ? a->settings_json : "{}");
-        cJSON_AddItemToObject(o, "settings", settings ? settings : cJSON_CreateObject());
+        if (!cJSON_IsObject(settings)) { /* sb_pack_writer_add_image checked them: out of memory */
+            cJSON_Delete(settings);
+            cJSON_Delete(o);
+            cJSON_Delete(root);
+            return NULL;
+        }
+        cJSON_AddItemToObject(o, "settings", settings);
+        if (a->world_hash[0]) {
+            cJSON_AddStringToObject(o, "world_hash", a->world_hash);
+            cJSON_AddStringToObject(o, "world_path", a->world_path);
+        }
         cJSON_AddNumberToObject(o, "bake_ms", a->bake_ms);
         cJSON_AddNumberToObject(o, "gpu_ms", a->gpu_ms);
         cJSON_AddStringToObject(o, "content_hash", a->content_hash);
@@ -609,6 +647,22 @@ static enum sb_result read_artifact_entry(const cJSON *entry, int index, struct 
     if (cJSON_IsObject(settings) &&
         !cJSON_PrintPreallocated((cJSON *)settings, a->settings_json, (int)sizeof(a->settings_json) - 5, false))
         a->settings_json[0] = '\0';
+    /* The world a probe or reflection product was baked against: its own
+     * fields, or (packs of skybake before them) the same names in settings. */
+    const cJSON *world = cJSON_GetObjectItemCaseSensitive(entry, "world_hash") ? entry : settings;
+    if (cJSON_GetObjectItemCaseSensitive(world, "world_hash")) {
+        if ((res = manifest_string(world, "world_hash", a->world_hash, sizeof(a->world_hash), source, where)))
+            return res;
+        if (a->world_hash[0] && (strlen(a->world_hash) != SB_HASH_HEX_SIZE - 1 ||
+                                 strspn(a->world_hash, "0123456789abcdef") != SB_HASH_HEX_SIZE - 1)) {
+            sb_error("%s: %sworld_hash: \"%s\" is not 32 lowercase hex digits", source, where, a->world_hash);
+            a->world_hash[0] = '\0';
+            return SB_ERR_OUT_OF_RANGE;
+        }
+        if (cJSON_GetObjectItemCaseSensitive(world, "world_path") &&
+            (res = manifest_string(world, "world_path", a->world_path, sizeof(a->world_path), source, where)))
+            return res;
+    }
     const cJSON *ms = cJSON_GetObjectItemCaseSensitive(entry, "bake_ms");
     a->bake_ms = cJSON_IsNumber(ms) ? ms->valuedouble : 0.0;
     ms = cJSON_GetObjectItemCaseSensitive(entry, "gpu_ms");

@@ -34,8 +34,18 @@ struct sb_artifact {
     char content_hash[SB_HASH_HEX_SIZE];
     char file_hash[SB_HASH_HEX_SIZE]; /* of the file's bytes; "" in a version 1 pack */
     char key[SB_HASH_HEX_SIZE];       /* the bake key (baker/bake.h); "" when not recorded */
-    struct sb_probe_layout probes;    /* where a probe product's probes are (its file's header) */
+    /* The world a probe or reflection product was baked against: its
+     * geometry's hash (geometry/mesh.h, sb_mesh_hash) and its file as the
+     * baker read it (absolute, UTF-8; "" when not known); "" for the rest. */
+    char world_hash[SB_HASH_HEX_SIZE];
+    char world_path[1024];
+    struct sb_probe_layout probes; /* where a probe product's probes are (its file's header) */
 };
+
+/* Record the world an artifact was baked against. A path that is not UTF-8
+ * or does not fit is recorded as "" (skyview then needs --world), with a
+ * warning. */
+void sb_artifact_set_world(struct sb_artifact *artifact, const char *world_hash, const char *world_path);
 
 struct sb_device_info {
     char name[256];

@@ -20,9 +20,9 @@
 #include "default_world.h"
 #include "exr.h"
 #include "io.h"
+#include "load.h"
 #include "log.h"
 #include "lut3d.h"
-#include "load.h"
 #include "mesh.h"
 #include "pack.h"
 #include "pngfile.h"
@@ -814,17 +814,6 @@ static enum sb_result render_contact_sheet(const struct options *o, struct sb_re
     return res;
 }
 
-/* A string member of a JSON object's text; "" when missing. */
-static void settings_string(const char *json, const char *key, char *out, size_t size)
-{
-    out[0] = '\0';
-    cJSON *root = cJSON_Parse(json);
-    const cJSON *item = cJSON_GetObjectItemCaseSensitive(root, key);
-    if (cJSON_IsString(item))
-        snprintf(out, size, "%s", item->valuestring);
-    cJSON_Delete(root);
-}
-
 /*
  * The world to draw: --world, else the world the pack's probes (or its
  * reflection cubes) were baked against (its scene's world, read from where
@@ -841,9 +830,9 @@ static enum sb_result load_world(const struct options *o, const struct sb_pack *
         const struct sb_artifact *a = &pack->artifacts[baked_against[i]];
         if (!pack->present[baked_against[i]])
             continue;
-        settings_string(a->settings_json, "world_hash", hash[i], sizeof(hash[i]));
+        snprintf(hash[i], sizeof(hash[i]), "%s", a->world_hash);
         if (!baked_path[0])
-            settings_string(a->settings_json, "world_path", baked_path, sizeof(baked_path));
+            snprintf(baked_path, sizeof(baked_path), "%s", a->world_path);
     }
     enum sb_result res;
     if (o->world) {

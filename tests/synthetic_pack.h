@@ -3,8 +3,8 @@
  * the pack writer: what the pack reader's tests and the manifest fuzzer
  * open. The cloud products are small (the scene's sizes: 16^3, 8^3, 8^2,
  * 8^2); the probes are 5 explicit ones over a world "world.obj" that the
- * pack does not need; the reflection cubes 2 of 16^2 a face. `images` (may be NULL) receives each product's image, which the
- * caller finishes; `name` is the scene's and the device's.
+ * pack does not need; the reflection cubes 2 of 16^2 a face. `images` (may be NULL) receives each product's image,
+ * which the caller finishes; `name` is the scene's and the device's.
  */
 #ifndef SB_TEST_SYNTHETIC_PACK_H
 #define SB_TEST_SYNTHETIC_PACK_H
@@ -15,6 +15,10 @@
 
 #include "pack.h"
 #include "scene.h"
+
+/* The world its probe and reflection products record. */
+#define SYNTHETIC_WORLD_HASH "0123456789abcdef0123456789abcdef"
+#define SYNTHETIC_WORLD_PATH "/worlds/caf\xc3\xa9 \"quoted\"/world.obj"
 
 static inline enum sb_result write_synthetic_pack(const char *dir, const char *name,
                                                   struct sb_image images[SB_PRODUCT_COUNT])
@@ -72,6 +76,8 @@ static inline enum sb_result write_synthetic_pack(const char *dir, const char *n
                                 .probes = {.explicit_count = probes ? shape[0] : 0, .ray_count = 64}};
         snprintf(a.file, sizeof(a.file), "%s.%s", f->name, f->extension);
         snprintf(a.parameterization, sizeof(a.parameterization), "%s", f->parameterization);
+        if (f->family == SB_FAMILY_PROBES || p == SB_PRODUCT_REFLECTION_CUBES)
+            sb_artifact_set_world(&a, SYNTHETIC_WORLD_HASH, SYNTHETIC_WORLD_PATH);
         res = sb_pack_writer_add_image(w, &a, &image);
         if (images)
             images[p] = image;

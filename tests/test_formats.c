@@ -826,6 +826,32 @@ static void edit_artifacts_type(cJSON *r)
 {
     cJSON_ReplaceItemInObject(r, "artifacts", cJSON_CreateObject());
 }
+/* The probes' world as packs before the typed fields held it: in settings. */
+static int probes_entry(cJSON *r)
+{
+    for (int i = 0; i < cJSON_GetArraySize(cJSON_GetObjectItem(r, "artifacts")); i++)
+        if (!strcmp(cJSON_GetStringValue(cJSON_GetObjectItem(artifact(r, i), "name")), "sky_visibility"))
+            return i;
+    return 0;
+}
+
+static void edit_world_in_settings(cJSON *r)
+{
+    cJSON *a = artifact(r, probes_entry(r)), *settings = cJSON_GetObjectItem(a, "settings");
+    cJSON_AddItemToObject(settings, "world_hash", cJSON_DetachItemFromObject(a, "world_hash"));
+    cJSON_AddItemToObject(settings, "world_path", cJSON_DetachItemFromObject(a, "world_path"));
+}
+
+static void edit_world_hash(cJSON *r)
+{
+    set_string(artifact(r, probes_entry(r)), "world_hash", "not a hash");
+}
+
+static void edit_world_path(cJSON *r)
+{
+    cJSON_ReplaceItemInObject(artifact(r, probes_entry(r)), "world_path", cJSON_CreateNumber(1));
+}
+
 static void edit_artifact_number(cJSON *r)
 {
     cJSON_ReplaceItemInArray(cJSON_GetObjectItem(r, "artifacts"), 1, cJSON_CreateNumber(1));
@@ -858,6 +884,10 @@ static void test_pack_reader(void)
         sb_image_finish(&images[p]);
     }
     CHECK(pack->format_version == SB_PACK_FORMAT_VERSION && !strcmp(pack->device.name, "test device"), "header");
+    const struct sb_artifact *probes = &pack->artifacts[SB_PRODUCT_SKY_VISIBILITY];
+    CHECK(!strcmp(probes->world_hash, SYNTHETIC_WORLD_HASH) && !strcmp(probes->world_path, SYNTHETIC_WORLD_PATH),
+          "the world the probes were baked against reads back: %s %s", probes->world_hash, probes->world_path);
+    CHECK(!pack->artifacts[SB_PRODUCT_TRANSMITTANCE].world_hash[0], "the atmosphere has no world");
     CHECK(pack->scene && !strcmp(pack->scene->name, "test") && pack->scene->atmosphere.mie_g == 0.8,
           "the scene reads back");
     sb_pack_close(pack);
@@ -946,6 +976,9 @@ static void test_pack_reader(void)
         {"another format", edit_format, NULL, SB_ERR_VERSION, false},
         {"artifacts not an array", edit_artifacts_type, NULL, SB_ERR_WRONG_TYPE, false},
         {"artifact entry not an object", edit_artifact_number, NULL, SB_ERR_WRONG_TYPE, false},
+        {"the world in settings, as earlier builds wrote it", edit_world_in_settings, NULL, SB_OK, false},
+        {"a world hash that is not one", edit_world_hash, NULL, SB_ERR_OUT_OF_RANGE, false},
+        {"a world path that is not a string", edit_world_path, NULL, SB_ERR_WRONG_TYPE, false},
         {"key given twice in the manifest", NULL,
          "sed -i '0,/\"skybake_version\"/s//\"skybake_version\": \"x\", \"skybake_version\"/' manifest.json",
          SB_ERR_DUPLICATE_KEY, false},
@@ -958,6 +991,33 @@ static void test_pack_reader(void)
         CHECK(got == cases[i].expect, "pack with %s: got %s, expected %s", cases[i].what, sb_result_name(got),
               sb_result_name(cases[i].expect));
     }
+    /* A pack of an earlier build, its world in the probes' settings: read from there. */
+    open_edited(good, bad, edit_world_in_settings, NULL, false);
+    struct sb_pack *older = calloc(1, sizeof(*older));
+    CHECK(sb_pack_open(bad, older) == SB_OK &&
+              !strcmp(older->artifacts[SB_PRODUCT_SKY_VISIBILITY].world_hash, SYNTHETIC_WORLD_HASH) &&
+              !strcmp(older->artifacts[SB_PRODUCT_SKY_VISIBILITY].world_path, SYNTHETIC_WORLD_PATH),
+          "the world read from an earlier build's settings");
+    sb_pack_close(older);
+    free(older);
+    /* The writer refuses settings that are not a JSON object, and records a
+     * world path that is not UTF-8 as unknown. */
+    struct sb_pack_writer *writer = NULL;
+    char scratch[300];
+    snprintf(scratch, sizeof(scratch), "%s/scratch", pack_root);
+    CHECK(sb_pack_writer_create(scratch, &writer) == SB_OK, "a writer");
+    struct sb_image tiny;
+    sb_image_init(&tiny, 2, 2, 2);
+    sb_image_set_channel_names(&tiny, "dfg.x,dfg.y");
+    struct sb_artifact bad_settings = {.product = SB_PRODUCT_DFG, .file = "dfg.exr", .settings_json = "{\"a\":"};
+    CHECK(sb_pack_writer_add_image(writer, &bad_settings, &tiny) == SB_ERR_JSON_SYNTAX, "settings that do not parse");
+    struct sb_artifact odd_path = {.product = SB_PRODUCT_SKY_VISIBILITY};
+    sb_artifact_set_world(&odd_path, SYNTHETIC_WORLD_HASH, "/worlds/caf\xe9.obj");
+    CHECK(!strcmp(odd_path.world_hash, SYNTHETIC_WORLD_HASH) && !odd_path.world_path[0],
+          "a world path that is not UTF-8 is not recorded");
+    sb_image_finish(&tiny);
+    sb_pack_writer_destroy(&writer);
+
     /* verify goes on past each problem: three of them, each counted. */
     open_edited(good, bad, edit_hash, "rm irradiance_ground.exr && echo x > notes.txt", false);
     unsigned problems = 0;

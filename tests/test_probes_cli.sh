@@ -124,7 +124,8 @@ sed -i 's/"rays":256/"rays":256,"bounds_m":[[-8,0.5,-30],[8,8.5,-14]]/' "$tmp/ou
 check "a grid over the scene's bounds" expect_exit 0 "$skybake" bake "$tmp/outdoor.json" -o "$tmp/o"
 check "5 x 3 x 5 probes" expect_exit 0 "$skybake" info "$tmp/o"
 check "info shows that grid" grep -q '"grid":\[5,3,5\]' "$tmp/out"
-check "the world's hash and path are recorded" grep -q "world_path.*data/worlds/test.json" "$tmp/out"
+check "the world's hash and path are recorded" grep -Eq "baked against the world .*data/worlds/test.json \([0-9a-f]{32}\)" "$tmp/out"
+check "in the manifest's own fields" grep -q '"world_path":[[:space:]]*".*data/worlds/test.json"' "$tmp/o/manifest.json"
 
 # A probe file edited in the pack: verify names it.
 cp -r "$tmp/p" "$tmp/edited"
