@@ -12,6 +12,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "history.h"
 #include "image.h"
 #include "log.h"
 #include "renderer_internal.h"
@@ -36,11 +37,8 @@ struct sb_clouds {
     struct sb_texture shape, detail, curl, weather;
     struct sb_texture shadow, trace, depth, out, history;
     VkPipeline shadow_kernel, trace_kernel, resolve_kernel;
-    /* The last frame, for reprojection. */
-    bool has_history;
-    uint64_t history_frames; /* frames since the history began */
-    struct sb_mat4 view_proj;
-    double camera_m[3], sun[3];
+    struct sb_history history_state; /* the last frame, for reprojection */
+    uint64_t history_frames;         /* frames since the history began */
 };
 
 static const enum sb_product_id noise_products[4] = {SB_PRODUCT_CLOUD_SHAPE, SB_PRODUCT_CLOUD_DETAIL,
@@ -188,13 +186,10 @@ static void fill_params(struct sb_renderer *r, struct sb_clouds *c, struct sb_cl
 {
     const struct sb_view *v = r->view;
     const struct sb_cloud_layer_params *m = &c->layer;
-    double sun[3];
-    sb_direction(v->sun_azimuth, v->sun_elevation, sun);
-    bool keep =
-        c->has_history && !v->snap_exposure &&
-        sun[0] * c->sun[0] + sun[1] * c->sun[1] + sun[2] * c->sun[2] > cos(SB_SUN_HISTORY_LIMIT_DEG * M_PI / 180.0);
+    struct sb_history_step step;
+    sb_history_advance(&c->history_state, r, &step);
     memset(g, 0, sizeof(*g));
-    sb_mat4_store(&c->view_proj, g->previous_view_proj);
+    sb_mat4_store(&step.previous_view_proj, g->previous_view_proj);
     double thickness = m->top_altitude_m - m->base_altitude_m;
     g->layer[0] = (float)m->base_altitude_m;
     g->layer[1] = (float)m->top_altitude_m;
@@ -217,7 +212,7 @@ static void fill_params(struct sb_renderer *r, struct sb_clouds *c, struct sb_cl
         g->weather_offset[k] = k == 1 ? 0.0f : (float)wrap(drift, m->weather_scale_m);
         g->shape_offset[k] = (float)wrap(drift, m->shape_scale_m);
         g->detail_offset[k] = (float)wrap(drift, m->detail_scale_m);
-        g->camera_motion_m[k] = (float)(v->camera_m[k] - c->camera_m[k]);
+        g->camera_motion_m[k] = (float)step.camera_motion_m[k];
     }
     g->phase[0] = (float)m->phase_forward_g;
     g->phase[1] = (float)m->phase_backward_g;
@@ -234,18 +229,14 @@ static void fill_params(struct sb_renderer *r, struct sb_clouds *c, struct sb_cl
     g->shadow[2] = (float)SHADOW_WIDTH_M;
     g->shadow[3] = (float)SHADOW_STEPS;
     g->temporal[0] = (float)wrap(GOLDEN * (double)r->frame_index, 1.0);
-    c->history_frames = keep ? c->history_frames + 1 : 0;
-    g->temporal[1] = keep ? (float)HISTORY_WEIGHT : 0.0f;
+    c->history_frames = step.keep ? c->history_frames + 1 : 0;
+    g->temporal[1] = step.keep ? (float)HISTORY_WEIGHT : 0.0f;
     g->temporal[2] = (float)(c->history_frames < (1u << 20) ? c->history_frames : (1u << 20)); /* exact in fp32 */
-    g->temporal[3] = (float)(r->frame_scale / r->previous_frame_scale); /* the history's scale to this frame's */
+    g->temporal[3] = (float)step.scale_ratio; /* the history's scale to this frame's */
     g->trace[0] = c->trace_size[0];
     g->trace[1] = c->trace_size[1];
     g->trace[2] = c->scale;
     g->trace[3] = block_pixel(r->frame_index, c->scale);
-    c->view_proj = r->view_proj;
-    memcpy(c->camera_m, v->camera_m, sizeof(c->camera_m));
-    memcpy(c->sun, sun, sizeof(c->sun));
-    c->has_history = true;
 }
 
 static void cloud_shadow_record(struct sb_renderer *r)
@@ -283,7 +274,7 @@ const struct sb_pass_class sb_pass_cloud_shadow = {
 static void clouds_skipped(struct sb_renderer *r)
 {
     if (r->clouds)
-        r->clouds->has_history = false;
+        sb_history_drop(&r->clouds->history_state);
 }
 
 const struct sb_pass_class sb_pass_clouds = {

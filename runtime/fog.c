@@ -10,6 +10,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "history.h"
 #include "image.h"
 #include "log.h"
 #include "renderer_internal.h"
@@ -34,10 +35,7 @@ struct sb_fog {
     struct sb_buffer params;
     struct sb_texture light, history, integrated, noise;
     VkPipeline inject, integrate, apply;
-    /* The last frame, for reprojection. */
-    bool has_history;
-    struct sb_mat4 view_proj;
-    double camera_m[3], sun[3];
+    struct sb_history history_state; /* the last frame, for reprojection */
 };
 
 static enum sb_result volume(struct sb_renderer *r, struct sb_texture *t, const uint32_t size[3],
@@ -147,13 +145,10 @@ static void fill_params(struct sb_renderer *r, struct sb_fog *f, struct sb_fog_g
 {
     const struct sb_view *v = r->view;
     const struct sb_fog_params *m = &f->medium;
-    double sun[3];
-    sb_direction(v->sun_azimuth, v->sun_elevation, sun);
-    bool keep =
-        f->has_history && !v->snap_exposure &&
-        sun[0] * f->sun[0] + sun[1] * f->sun[1] + sun[2] * f->sun[2] > cos(SB_SUN_HISTORY_LIMIT_DEG * M_PI / 180.0);
+    struct sb_history_step step;
+    sb_history_advance(&f->history_state, r, &step);
     memset(g, 0, sizeof(*g));
-    sb_mat4_store(&f->view_proj, g->previous_view_proj);
+    sb_mat4_store(&step.previous_view_proj, g->previous_view_proj);
     g->grid[0] = f->grid[0];
     g->grid[1] = f->grid[1];
     g->grid[2] = f->grid[2];
@@ -161,7 +156,7 @@ static void fill_params(struct sb_renderer *r, struct sb_fog *f, struct sb_fog_g
     g->slices[0] = (float)f->far_m;
     g->slices[1] = (float)SLICE_SCALE_M;
     g->slices[2] = (float)log2(1.0 + f->far_m / SLICE_SCALE_M);
-    g->slices[3] = keep ? (float)HISTORY_WEIGHT : 0.0f;
+    g->slices[3] = step.keep ? (float)HISTORY_WEIGHT : 0.0f;
     g->medium[0] = (float)m->extinction_per_m;
     g->medium[1] = (float)m->base_altitude_m;
     g->medium[2] = (float)(1.0 / m->falloff_height_m);
@@ -171,10 +166,10 @@ static void fill_params(struct sb_renderer *r, struct sb_fog *f, struct sb_fog_g
         /* The drift wrapped to the noise's tile, so fp32 keeps it exact over hours. */
         double drift = -m->noise_wind_m_s[k] * v->time_s;
         g->noise[k] = (float)(drift - m->noise_scale_m * floor(drift / m->noise_scale_m));
-        g->camera_motion_m[k] = (float)(v->camera_m[k] - f->camera_m[k]);
+        g->camera_motion_m[k] = (float)step.camera_motion_m[k];
     }
     /* The history was stored at the last frame's scale (pre-exposure). */
-    g->camera_motion_m[3] = (float)(r->frame_scale / r->previous_frame_scale);
+    g->camera_motion_m[3] = (float)step.scale_ratio;
     g->albedo[3] = (float)m->noise_amount;
     g->noise[3] = (float)(1.0 / m->noise_scale_m);
     /* Halton (2, 3, 5), a new point each frame; the first frame samples centres. */
@@ -191,10 +186,6 @@ static void fill_params(struct sb_renderer *r, struct sb_fog *f, struct sb_fog_g
         g->volume_min[b][3] = (float)m->volumes[b].extinction_per_m;
         g->volume_max[b][3] = (float)m->volumes[b].edge_m;
     }
-    f->view_proj = r->view_proj;
-    memcpy(f->camera_m, v->camera_m, sizeof(f->camera_m));
-    memcpy(f->sun, sun, sizeof(f->sun));
-    f->has_history = true;
 }
 
 static void fog_record(struct sb_renderer *r)
@@ -223,7 +214,7 @@ static void fog_apply_record(struct sb_renderer *r)
 static void fog_skipped(struct sb_renderer *r)
 {
     if (r->fog)
-        r->fog->has_history = false;
+        sb_history_drop(&r->fog->history_state);
 }
 
 const struct sb_pass_class sb_pass_fog = {
