@@ -323,16 +323,16 @@ static enum sb_result bake_visibility(struct probes_state *st, const struct sb_s
         deringed += window > 0;
         lowest = fmin(lowest, job.before[i]);
         for (int k = 0; k < 3; k++) {
-            o[k] = positions[3 * (size_t)i + k];
-            o[3 + k] = offsets[3 * (size_t)i + k];
+            o[SB_SKY_VISIBILITY_POSITION + k] = positions[3 * (size_t)i + k];
+            o[SB_SKY_VISIBILITY_OFFSET + k] = offsets[3 * (size_t)i + k];
         }
-        o[6] = valid[i];
-        o[7] = r[SB_PROBE_SH];
-        o[8] = r[SB_PROBE_SH + 1];
-        o[9] = r[SB_PROBE_SH + 2];
-        o[10] = (float)window;
+        o[SB_SKY_VISIBILITY_VALID] = valid[i];
+        o[SB_SKY_VISIBILITY_BACK_FRACTION] = r[SB_PROBE_SH];
+        o[SB_SKY_VISIBILITY_HIT_FRACTION] = r[SB_PROBE_SH + 1];
+        o[SB_SKY_VISIBILITY_MEAN_DISTANCE] = r[SB_PROBE_SH + 2];
+        o[SB_SKY_VISIBILITY_DERING_WINDOW] = (float)window;
         for (int k = 0; k < SB_PROBE_SH; k++)
-            o[11 + k] = (float)c[k];
+            o[SB_SKY_VISIBILITY_SH + k] = (float)c[k];
     }
     free(job.window);
     free(job.before);
@@ -382,8 +382,8 @@ static enum sb_result bake_bounce(struct probes_state *st, const struct sb_scene
     for (uint32_t i = 0; i < count; i++) {
         const float *v = &visibility->data[(size_t)i * SB_SKY_VISIBILITY_CHANNEL_COUNT];
         memcpy(&positions[3 * (size_t)i], v, 3 * sizeof(float));
-        valid[i] = v[6];
-        valid_count += v[6] != 0;
+        valid[i] = v[SB_SKY_VISIBILITY_VALID];
+        valid_count += v[SB_SKY_VISIBILITY_VALID] != 0;
     }
     struct sb_sky_bounce_params params = {.ray_count = scene->probes.bounce_rays,
                                           .secondary = scene->probes.bounce_secondary};

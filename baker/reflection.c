@@ -201,12 +201,12 @@ void sb_reflection_sh(const float *level0, uint32_t n, int irradiance, double sh
                     for (int c = 0; c < 3; c++)
                         sh[k][c] += w * basis[k] * L[c];
             }
-    if (irradiance) { /* Ramamoorthi and Hanrahan 2001: pi, 2 pi / 3, pi / 4 */
-        static const double band[9] = {M_PI,     2 * M_PI / 3, 2 * M_PI / 3, 2 * M_PI / 3, M_PI / 4,
-                                       M_PI / 4, M_PI / 4,     M_PI / 4,     M_PI / 4};
+    if (irradiance) { /* the clamped cosine's factor of each band (config.h) */
+        static const double cosine[3] = {SB_SH_COSINE_FACTORS};
+        static const int band[SB_PROBE_SH] = {SB_SH_BANDS};
         for (int k = 0; k < SB_PROBE_SH; k++)
             for (int c = 0; c < 3; c++)
-                sh[k][c] *= band[k];
+                sh[k][c] *= cosine[band[k]];
     }
 }
 

@@ -49,6 +49,21 @@
     "position.x,position.y,position.z,offset.x,offset.y,offset.z,valid,back_fraction,hit_fraction,"                    \
     "mean_distance_m,dering_window,sh.0,sh.1,sh.2,sh.3,sh.4,sh.5,sh.6,sh.7,sh.8"
 #define SB_SKY_VISIBILITY_CHANNEL_COUNT 20
+/* Where each of those channels is in a probe's record (tests/test_formats.c
+ * checks them against the names). */
+enum sb_sky_visibility_channel {
+    SB_SKY_VISIBILITY_POSITION = 0, /* x, y, z: m */
+    SB_SKY_VISIBILITY_OFFSET = 3,   /* x, y, z: the push out of geometry, m */
+    SB_SKY_VISIBILITY_VALID = 6,
+    SB_SKY_VISIBILITY_BACK_FRACTION = 7,
+    SB_SKY_VISIBILITY_HIT_FRACTION = 8,
+    SB_SKY_VISIBILITY_MEAN_DISTANCE = 9,
+    SB_SKY_VISIBILITY_DERING_WINDOW = 10,
+    SB_SKY_VISIBILITY_SH = 11, /* the SH coefficients, 9 of them */
+};
+#ifndef __cplusplus
+_Static_assert(SB_SKY_VISIBILITY_SH + 9 == SB_SKY_VISIBILITY_CHANNEL_COUNT, "the SH are the last channels");
+#endif
 
 /* The sky-bounce product's channels (docs/probes.md, "Bounce"): the
  * one-bounce transfer B[m][k] per colour, m < 4 the order-1 SH of the
@@ -67,9 +82,9 @@
  * zero), and the order-2 SH of the irradiance its cube sees (the cosine
  * convolution of its radiance, per colour): channel "irradiance.k.c". */
 #define SB_IRRADIANCE_3(k) "irradiance." #k ".r,irradiance." #k ".g,irradiance." #k ".b"
-#define SB_REFLECTION_PROBES_CHANNELS                                                                                  \
-    "position.x,position.y,position.z,box_min.x,box_min.y,box_min.z,box_max.x,box_max.y,box_max.z," SB_IRRADIANCE_3( \
-        0) "," SB_IRRADIANCE_3(1) "," SB_IRRADIANCE_3(2) "," SB_IRRADIANCE_3(3) "," SB_IRRADIANCE_3(4) "," SB_IRRADIANCE_3(5) "," SB_IRRADIANCE_3(6) "," SB_IRRADIANCE_3(7) "," SB_IRRADIANCE_3(8)
+#define SB_REFLECTION_PROBES_CHANNELS                                                                                                                              \
+    "position.x,position.y,position.z,box_min.x,box_min.y,box_min.z,box_max.x,box_max.y,box_max.z," SB_IRRADIANCE_3(0) "," SB_IRRADIANCE_3(1) "," SB_IRRADIANCE_3( \
+        2) "," SB_IRRADIANCE_3(3) "," SB_IRRADIANCE_3(4) "," SB_IRRADIANCE_3(5) "," SB_IRRADIANCE_3(6) "," SB_IRRADIANCE_3(7) "," SB_IRRADIANCE_3(8)
 #define SB_REFLECTION_PROBES_CHANNEL_COUNT 36
 
 /* Where the probes are: a grid (x fastest) then explicit ones. */

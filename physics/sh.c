@@ -68,7 +68,7 @@ void sb_sh9_from_zonal(const double z[3], const double axis[3], double c[SB_PROB
 {
     double y[SB_PROBE_SH];
     sb_sh9_basis(axis, y);
-    static const int band[SB_PROBE_SH] = {0, 1, 1, 1, 2, 2, 2, 2, 2};
+    static const int band[SB_PROBE_SH] = {SB_SH_BANDS};
     for (int k = 0; k < SB_PROBE_SH; k++)
         c[k] = sqrt(4.0 * M_PI / (2 * band[k] + 1)) * z[band[k]] * y[k];
 }
@@ -113,7 +113,7 @@ void sb_sh9_window_factors(double h, double w[3])
 
 static void window(const double c[SB_PROBE_SH], double h, double out[SB_PROBE_SH])
 {
-    static const int band[SB_PROBE_SH] = {0, 1, 1, 1, 2, 2, 2, 2, 2};
+    static const int band[SB_PROBE_SH] = {SB_SH_BANDS};
     double w[3];
     sb_sh9_window_factors(h, w);
     for (int k = 0; k < SB_PROBE_SH; k++)

@@ -441,9 +441,8 @@ static void mean_albedo(const struct sb_world *world, float out[3])
         out[i] = area > 0 ? (float)(sum[i] / area) : 0.0f;
 }
 
-/* Floats a probe takes in the probes buffer (probes.glsl): 4 vec4s, then
- * the bounce's 108 floats (27 vec4s). */
-#define PROBE_FLOATS (16 + SB_BOUNCE_FLOATS)
+/* Floats a probe takes in the probes buffer (config.h, probes.glsl). */
+#define PROBE_FLOATS (4 * SB_PROBE_VEC4S)
 
 /*
  * The pack's sky-visibility probes, or none: the grid's probes (explicit
@@ -503,18 +502,20 @@ static enum sb_result upload_probes(struct sb_renderer *r, const struct sb_pack 
         const float *c = &image->data[(size_t)p * SB_SKY_VISIBILITY_CHANNEL_COUNT];
         float *o = &out[PROBE_FLOATS * (size_t)p];
         if (has_bounce)
-            memcpy(o + 16, &bounce->data[(size_t)p * SB_SKY_BOUNCE_CHANNEL_COUNT], SB_BOUNCE_FLOATS * sizeof(float));
-        memcpy(o, c, 3 * sizeof(float)); /* position, after any push out of geometry */
-        o[3] = c[6];                     /* valid */
+            memcpy(o + 4 * SB_PROBE_BOUNCE_VEC4, &bounce->data[(size_t)p * SB_SKY_BOUNCE_CHANNEL_COUNT],
+                   SB_BOUNCE_FLOATS * sizeof(float));
+        memcpy(o, c + SB_SKY_VISIBILITY_POSITION, 3 * sizeof(float)); /* after any push out of geometry */
+        o[3] = c[SB_SKY_VISIBILITY_VALID];
         /* The visibility as projected, the deringing window undone where it
          * can be: windowing before the product with the sky would blur the
          * horizon into the ground (open ground lost 17% of its sky light);
          * the irradiance is clamped at the end instead. */
-        static const int band[SB_PROBE_SH] = {0, 1, 1, 1, 2, 2, 2, 2, 2};
+        static const int band[SB_PROBE_SH] = {SB_SH_BANDS};
         double w[3];
-        sb_sh9_window_factors(c[10], w);
+        sb_sh9_window_factors(c[SB_SKY_VISIBILITY_DERING_WINDOW], w);
+        const float *sh = c + SB_SKY_VISIBILITY_SH;
         for (int k = 0; k < SB_PROBE_SH; k++)
-            o[4 + k] = w[band[k]] > 1e-3 ? (float)(c[11 + k] / w[band[k]]) : c[11 + k];
+            o[4 + k] = w[band[k]] > 1e-3 ? (float)(sh[k] / w[band[k]]) : sh[k];
     }
     sb_info("probes: %u x %u x %u, %.3g m apart, light the world (bounce %s)", layout->grid[0], layout->grid[1],
             layout->grid[2], (double)layout->spacing_m[0], has_bounce ? "baked" : "modelled");

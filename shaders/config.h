@@ -245,7 +245,7 @@ struct sb_bake_push {
 #define SB_VIEW_BINDING_BLOOM_DST 17     /* image2D rgba16f: a bloom step's target (per set) */
 #define SB_VIEW_BINDING_BLOOM 18         /* sampler2D: the finished bloom, mip 0 */
 #define SB_VIEW_BINDING_LDR 19           /* image2D rgba8: the display-referred frame */
-#define SB_VIEW_BINDING_PROBES 20        /* struct sb_probes_gpu, then 3 vec4 a probe (probes.glsl) */
+#define SB_VIEW_BINDING_PROBES 20        /* struct sb_probes_gpu, then SB_PROBE_VEC4S vec4s a probe */
 #define SB_VIEW_BINDING_PROBE_LIGHT 21   /* the sky's SH, then each probe's irradiance SH (probes.glsl) */
 #define SB_VIEW_BINDING_REFLECTIONS 22   /* struct sb_reflections_gpu, then its probes and the DFG LUT */
 #define SB_VIEW_BINDING_REFLECTION_CUBES 23 /* the reflection cubes' texels, vec4 (reflections.glsl) */
@@ -542,6 +542,12 @@ struct sb_raycast_push {
 #define SB_PROBE_BINDING_COUNT 5
 #define SB_PROBE_MAX_RAYS 65536
 #define SB_PROBE_SH 9
+/* The band l of each SH coefficient k (Y_lm in the order sh.glsl and
+ * physics/sh.c write them), and the clamped cosine's zonal factor of each
+ * band (pi, 2 pi / 3, pi / 4: Ramamoorthi and Hanrahan 2001): lists for C
+ * and GLSL tables, {SB_SH_BANDS} and int[](SB_SH_BANDS). */
+#define SB_SH_BANDS 0, 1, 1, 1, 2, 2, 2, 2, 2
+#define SB_SH_COSINE_FACTORS 3.141592653589793, 2.0943951023931953, 0.7853981633974483
 #define SB_VISIBILITY_FLOATS 12 /* sh[9], back-face fraction, hit fraction, mean hit distance (m) */
 
 /* The one-bounce transfer at probes (probe_bounce.comp, baker/sky_bounce.h):
@@ -557,6 +563,17 @@ struct sb_raycast_push {
 #define SB_BOUNCE_BINDING_COUNT 5
 #define SB_BOUNCE_SH 4 /* order 1 at the probe */
 #define SB_BOUNCE_FLOATS (SB_BOUNCE_SH * SB_PROBE_SH * 3)
+
+/* skyview's probes buffer (probes.glsl, SB_VIEW_BINDING_PROBES): after
+ * struct sb_probes_gpu, SB_PROBE_VEC4S vec4s a probe: (position m, valid),
+ * the visibility's SB_PROBE_SH coefficients in the next 3 (x, y, z, w, ...),
+ * then from vec4 SB_PROBE_BOUNCE_VEC4 the bounce transfer's SB_BOUNCE_FLOATS. */
+#define SB_PROBE_BOUNCE_VEC4 4
+#define SB_PROBE_VEC4S (SB_PROBE_BOUNCE_VEC4 + SB_BOUNCE_FLOATS / 4)
+#ifndef GL_core_profile
+_Static_assert(SB_BOUNCE_FLOATS % 4 == 0 && 4 + SB_PROBE_SH <= 4 * SB_PROBE_BOUNCE_VEC4,
+               "the probes buffer's record holds the visibility's SH and whole vec4s of the bounce");
+#endif
 
 struct sb_bounce_push {
     SB_UINT probe_count;

@@ -28,10 +28,10 @@ void main()
         return;
     float v[SB_PROBE_SH];
     for (int k = 0; k < 4; k++) {
-        v[k] = probe_data[PROBE_VEC4S * i + 1][k];
-        v[4 + k] = probe_data[PROBE_VEC4S * i + 2][k];
+        v[k] = probe_data[SB_PROBE_VEC4S * i + 1][k];
+        v[4 + k] = probe_data[SB_PROBE_VEC4S * i + 2][k];
     }
-    v[8] = probe_data[PROBE_VEC4S * i + 3].x;
+    v[8] = probe_data[SB_PROBE_VEC4S * i + 3].x;
 
     vec3 vl[SB_PROBE_SH];
     for (int k = 0; k < SB_PROBE_SH; k++)
@@ -65,7 +65,7 @@ void main()
             uint at = 3u * uint(m * SB_PROBE_SH + k);
             vec3 b;
             for (int c = 0; c < 3; c++) /* 3 floats of the packed rgb triples */
-                b[c] = probe_data[PROBE_VEC4S * i + PROBE_BOUNCE_VEC4 + (at + uint(c)) / 4u][(at + uint(c)) % 4u];
+                b[c] = probe_data[SB_PROBE_VEC4S * i + SB_PROBE_BOUNCE_VEC4 + (at + uint(c)) / 4u][(at + uint(c)) % 4u];
             bounce[m] += b * (sky_sh[k].rgb + e_sun * ys[k]);
         }
     }

@@ -25,12 +25,10 @@ layout(std430, set = 0, binding = SB_VIEW_BINDING_PROBE_LIGHT) readonly buffer P
     vec4 probe_irradiance[];    /* SB_PROBE_SH a probe, rgb: irradiance E(n) = sum_k E_k Y_k(n) */
 };
 
-#define PROBE_VEC4S 31
-#define PROBE_BOUNCE_VEC4 4
 
 /* The clamped cosine's zonal factors per band (Ramamoorthi and Hanrahan 2001). */
-const float SH_COSINE[3] = float[3](3.141592653589793, 2.0943951023931953, 0.7853981633974483);
-const int SH_BAND[SB_PROBE_SH] = int[SB_PROBE_SH](0, 1, 1, 1, 2, 2, 2, 2, 2);
+const float SH_COSINE[3] = float[3](SB_SH_COSINE_FACTORS);
+const int SH_BAND[SB_PROBE_SH] = int[SB_PROBE_SH](SB_SH_BANDS);
 
 #ifndef PROBE_LIGHT_WRITABLE
 /*
@@ -71,7 +69,7 @@ void probe_lookup(vec3 pos, vec3 n, vec3 r, out vec3 e_n, out vec3 e_r, out floa
         vec3 tri = mix(1.0 - f, f, o);
         float w = tri.x * tri.y * tri.z;
         uint index = at.x + probes.grid.x * (at.y + probes.grid.y * at.z);
-        vec4 where = probe_data[PROBE_VEC4S * index];
+        vec4 where = probe_data[SB_PROBE_VEC4S * index];
         if (w <= 0.0 || where.w == 0.0)
             continue;
         vec3 to = where.xyz - pos;

@@ -1103,6 +1103,27 @@ static void restamp(uint8_t *b, size_t size)
 
 static void test_probes(void)
 {
+    /* The channel indices C code uses are the names' positions. */
+    static const struct {
+        int index;
+        const char *name;
+    } channels[] = {
+        {SB_SKY_VISIBILITY_POSITION, "position.x"},
+        {SB_SKY_VISIBILITY_OFFSET, "offset.x"},
+        {SB_SKY_VISIBILITY_VALID, "valid"},
+        {SB_SKY_VISIBILITY_BACK_FRACTION, "back_fraction"},
+        {SB_SKY_VISIBILITY_HIT_FRACTION, "hit_fraction"},
+        {SB_SKY_VISIBILITY_MEAN_DISTANCE, "mean_distance_m"},
+        {SB_SKY_VISIBILITY_DERING_WINDOW, "dering_window"},
+        {SB_SKY_VISIBILITY_SH, "sh.0"},
+        {SB_SKY_VISIBILITY_SH + 8, "sh.8"},
+    };
+    struct sb_image names = {0};
+    sb_image_set_channel_names(&names, SB_SKY_VISIBILITY_CHANNELS);
+    for (size_t i = 0; i < sizeof(channels) / sizeof(channels[0]); i++)
+        CHECK(!strcmp(names.channel_names[channels[i].index], channels[i].name), "channel %d is %s, not %s",
+              channels[i].index, names.channel_names[channels[i].index], channels[i].name);
+
     char dir[256], path[300];
     CHECK(test_temp_dir("skybake-probes", dir, sizeof(dir)), "temporary directory");
     snprintf(path, sizeof(path), "%s/p.sbprobes", dir);
