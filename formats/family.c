@@ -12,6 +12,7 @@ static const struct sb_family_format families[SB_FAMILY_COUNT] = {
         {
             .name = "clouds",
             .section = "clouds",
+            .set_defaults = sb_clouds_set_defaults,
             .parse_section = sb_clouds_section_parse,
             .section_json = sb_clouds_section_json,
             .product_shape = sb_clouds_product_shape,
@@ -22,14 +23,17 @@ static const struct sb_family_format families[SB_FAMILY_COUNT] = {
         {
             .name = "probes",
             .section = "probes",
+            .set_defaults = sb_probes_set_defaults,
             .parse_section = sb_probes_section_parse,
             .section_json = sb_probes_section_json,
+            .validate = sb_probes_validate,
             .no_tolerance = "the probes' error is set by their ray count (probes.rays), not by a tolerance",
         },
     [SB_FAMILY_REFLECTIONS] =
         {
             .name = "reflections",
             .section = "reflections",
+            .set_defaults = sb_reflections_set_defaults,
             .parse_section = sb_reflections_section_parse,
             .section_json = sb_reflections_section_json,
             .product_shape = sb_reflections_product_shape,

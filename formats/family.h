@@ -24,6 +24,9 @@ struct sb_family_format {
      * NULL. (The atmosphere's section is the scene's core: required, parsed
      * by scene.c.) */
     const char *section;
+    /* Set the family's scene parameters to their defaults, before the
+     * scene is parsed; NULL when it has none. */
+    void (*set_defaults)(struct sb_scene *scene);
     /* Parse and validate the section into *scene, logging "source: path:
      * reason" for the first problem. */
     enum sb_result (*parse_section)(const struct cJSON *section, struct sb_scene *scene, const char *source);
@@ -36,6 +39,10 @@ struct sb_family_format {
      * zeros of shape[3] (width, height, depth, as the format has them);
      * NULL when no product of the family does. */
     void (*product_shape)(const struct sb_scene *scene, enum sb_product_id id, uint32_t shape[3]);
+    /* Check what the whole scene asks of the family, once every section is
+     * read (a product that needs another section, ...), logging "source:
+     * path: reason"; NULL when there is nothing to check. */
+    enum sb_result (*validate)(const struct sb_scene *scene, const char *source);
     bool default_products; /* baked when a scene names no products */
     /* Why a scene may not give the family's products a tolerance; NULL when
      * it may (the bake then picks the cheapest setting within it). */
@@ -46,6 +53,7 @@ struct sb_family_format {
 const struct sb_family_format *sb_family_format(enum sb_family family);
 
 /* The clouds' section (scene_clouds.c). */
+void sb_clouds_set_defaults(struct sb_scene *scene);
 enum sb_result sb_clouds_section_parse(const struct cJSON *section, struct sb_scene *scene, const char *source);
 struct cJSON *sb_clouds_section_json(const struct sb_scene *scene);
 void sb_clouds_product_shape(const struct sb_scene *scene, enum sb_product_id id, uint32_t shape[3]);
@@ -53,10 +61,13 @@ void sb_clouds_product_shape(const struct sb_scene *scene, enum sb_product_id id
 /* The world's and the probes' sections (scene_world.c). */
 enum sb_result sb_world_section_parse(const struct cJSON *section, struct sb_scene *scene, const char *source);
 struct cJSON *sb_world_section_json(const struct sb_scene *scene);
+void sb_probes_set_defaults(struct sb_scene *scene);
+enum sb_result sb_probes_validate(const struct sb_scene *scene, const char *source);
 enum sb_result sb_probes_section_parse(const struct cJSON *section, struct sb_scene *scene, const char *source);
 struct cJSON *sb_probes_section_json(const struct sb_scene *scene);
 
 /* The reflections' section (scene_reflections.c). */
+void sb_reflections_set_defaults(struct sb_scene *scene);
 enum sb_result sb_reflections_section_parse(const struct cJSON *section, struct sb_scene *scene, const char *source);
 struct cJSON *sb_reflections_section_json(const struct sb_scene *scene);
 void sb_reflections_product_shape(const struct sb_scene *scene, enum sb_product_id id, uint32_t shape[3]);

@@ -403,9 +403,9 @@ static enum sb_result parse_root(const cJSON *root, struct sb_scene *scene, cons
         return res;
     bool have_atmosphere = false, have_products = false;
     scene->view = (struct sb_scene_view){.altitude_km = 0.002, .sun_elevation_deg = 30.0, .sun_azimuth_deg = 150.0};
-    sb_cloud_params_default(&scene->clouds);
-    sb_probe_params_default(&scene->probes);
-    sb_reflection_params_default(&scene->reflections);
+    for (int f = 0; f < SB_FAMILY_COUNT; f++)
+        if (sb_family_format((enum sb_family)f)->set_defaults)
+            sb_family_format((enum sb_family)f)->set_defaults(scene);
     sb_cloud_layer_params_default(&scene->cloud_layer);
     for (const cJSON *item = root->child; item; item = item->next) {
         if (strcmp(item->string, "version") == 0) {
@@ -456,14 +456,14 @@ static enum sb_result parse_root(const cJSON *root, struct sb_scene *scene, cons
         sb_error("%s: atmosphere: missing", source);
         return SB_ERR_MISSING_FIELD;
     }
-    if ((scene->wants[SB_PRODUCT_SKY_VISIBILITY] || scene->wants[SB_PRODUCT_SKY_BOUNCE]) && !scene->has_world) {
-        sb_error("%s: products: %s needs a \"world\" (the geometry the probes see)", source,
-                 scene->wants[SB_PRODUCT_SKY_VISIBILITY] ? "sky_visibility" : "sky_bounce");
-        return SB_ERR_MISSING_FIELD;
-    }
     if (!have_products)
         for (int p = 0; p < SB_PRODUCT_COUNT; p++)
             scene->wants[p] = sb_family_format(sb_product_format((enum sb_product_id)p)->family)->default_products;
+    for (int f = 0; f < SB_FAMILY_COUNT; f++) {
+        const struct sb_family_format *family = sb_family_format((enum sb_family)f);
+        if (family->validate && (res = family->validate(scene, source)))
+            return res;
+    }
     return SB_OK;
 }
 

@@ -30,6 +30,11 @@ void sb_cloud_params_default(struct sb_cloud_params *p)
     };
 }
 
+void sb_clouds_set_defaults(struct sb_scene *scene)
+{
+    sb_cloud_params_default(&scene->clouds);
+}
+
 /* One row per key of "clouds" (object NULL) or of one of its products'
  * objects: count integers (an array when 3) at offset, each in [min, max]. */
 struct cloud_field {

@@ -20,6 +20,11 @@ void sb_reflection_params_default(struct sb_reflection_params *p)
     *p = (struct sb_reflection_params){.face_size = 128, .samples = 512, .ambient_rays = 64};
 }
 
+void sb_reflections_set_defaults(struct sb_scene *scene)
+{
+    sb_reflection_params_default(&scene->reflections);
+}
+
 /* A count in [lo, hi], a multiple of `multiple` (a power of two when
  * multiple is 0). */
 static enum sb_result count(const cJSON *obj, const char *key, double lo, double hi, uint32_t multiple,

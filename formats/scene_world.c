@@ -14,7 +14,6 @@
 #include "log.h"
 #include "scene.h"
 
-
 enum sb_result sb_world_section_parse(const cJSON *obj, struct sb_scene *scene, const char *source)
 {
     static const char *const keys[] = {"file", "units_m", "scale", "up", "rotate_deg", "translate_m", "albedo", NULL};
@@ -97,6 +96,21 @@ void sb_probe_params_default(struct sb_probe_params *p)
 {
     *p = (struct sb_probe_params){
         .spacing_m = 2.0, .rays = 2048, .inside_fraction = 0.25, .bounce_rays = 256, .bounce_secondary = 64};
+}
+
+void sb_probes_set_defaults(struct sb_scene *scene)
+{
+    sb_probe_params_default(&scene->probes);
+}
+
+enum sb_result sb_probes_validate(const struct sb_scene *scene, const char *source)
+{
+    if ((scene->wants[SB_PRODUCT_SKY_VISIBILITY] || scene->wants[SB_PRODUCT_SKY_BOUNCE]) && !scene->has_world) {
+        sb_error("%s: products: %s needs a \"world\" (the geometry the probes see)", source,
+                 scene->wants[SB_PRODUCT_SKY_VISIBILITY] ? "sky_visibility" : "sky_bounce");
+        return SB_ERR_MISSING_FIELD;
+    }
+    return SB_OK;
 }
 
 enum sb_result sb_probes_section_parse(const cJSON *obj, struct sb_scene *scene, const char *source)
