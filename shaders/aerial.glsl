@@ -10,6 +10,9 @@
 #ifndef SB_AERIAL_GLSL
 #define SB_AERIAL_GLSL
 
+#include "config.h"
+#include "view.glsl"
+
 layout(set = 0, binding = SB_VIEW_BINDING_AERIAL) uniform sampler3D aerial_inscatter;
 layout(set = 0, binding = SB_VIEW_BINDING_AERIAL_T) uniform sampler3D aerial_transmittance;
 

@@ -14,6 +14,8 @@
 #ifndef SB_ATMOSPHERE_GLSL
 #define SB_ATMOSPHERE_GLSL
 
+#include "config.h"
+
 #extension GL_GOOGLE_include_directive : require
 #extension GL_EXT_control_flow_attributes : require
 

@@ -8,9 +8,7 @@
 #include "config.h"
 
 layout(local_size_x = SB_WORKGROUP_X, local_size_y = SB_WORKGROUP_Y) in;
-layout(std430, set = 0, binding = SB_VIEW_BINDING_FRAME) readonly buffer FrameBuffer {
-    sb_frame_gpu frame;
-};
+#include "frame.glsl"
 layout(std430, set = 0, binding = SB_VIEW_BINDING_EXPOSURE) readonly buffer ExposureBuffer {
     uint bins[SB_HISTOGRAM_BINS];
     sb_exposure_gpu exposure;

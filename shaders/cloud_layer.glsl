@@ -39,6 +39,10 @@
 #ifndef SB_CLOUD_LAYER_GLSL
 #define SB_CLOUD_LAYER_GLSL
 
+#include "config.h"
+#include "view.glsl"
+#include "phase.glsl"
+
 layout(std430, set = 0, binding = SB_VIEW_BINDING_CLOUDS) readonly buffer CloudBuffer {
     sb_clouds_gpu clouds;
 };
@@ -124,12 +128,6 @@ float cloud_exit_m(float h_km, float mu)
     return max(t, 0.0) * 1e3;
 }
 
-float cloud_hg(float g, float nu)
-{
-    float d = 1.0 + g * g - 2.0 * g * nu;
-    return (1.0 - g * g) / (4.0 * PI * d * sqrt(d));
-}
-
 /* The optical depth toward the sun from q (altitude h_km, the sun at
  * cosine mu_s there) to the layer's edge or SB_CLOUD_LIGHT_DISTANCE_M, over
  * `steps` pieces growing linearly (piece k is k + 1 units long: fine near
@@ -163,7 +161,7 @@ vec3 cloud_light(vec3 q, vec3 up, float h_km, float f, float nu, int light_steps
         float tau = cloud_light_depth(q, h_km, mu_s, light_steps, jitter);
         float a = 1.0;
         for (int i = 0; i < int(clouds.phase.w); i++) {
-            float p = mix(cloud_hg(clouds.phase.y * a, nu), cloud_hg(clouds.phase.x * a, nu), clouds.phase.z);
+            float p = mix(phase_hg(clouds.phase.y * a, nu), phase_hg(clouds.phase.x * a, nu), clouds.phase.z);
             octaves += a * exp(-a * tau) * p;
             a *= 0.5;
         }

@@ -5,6 +5,8 @@
 #ifndef SB_CUBE_GLSL
 #define SB_CUBE_GLSL
 
+#include "config.h"
+
 vec3 cube_direction(uint face, vec2 uv)
 {
     float u = uv.x, v = uv.y;

@@ -18,6 +18,10 @@
 #ifndef SB_FOG_GLSL
 #define SB_FOG_GLSL
 
+#include "config.h"
+#include "view.glsl"
+#include "phase.glsl"
+
 layout(std430, set = 0, binding = SB_VIEW_BINDING_FOG) readonly buffer FogBuffer {
     sb_fog_gpu fog;
 };
@@ -62,12 +66,6 @@ float fog_extinction(vec3 p)
             sigma += fog.volume_min[i].w * clamp(depth / max(fog.volume_max[i].w, 1e-6), 0.0, 1.0);
     }
     return sigma;
-}
-
-float phase_hg(float g, float cos_theta)
-{
-    float d = 1.0 + g * g - 2.0 * g * cos_theta;
-    return (1.0 - g * g) / (4.0 * PI * d * sqrt(d));
 }
 
 /* The sun's light reaching world point p (offset from the camera), before

@@ -10,9 +10,7 @@
 #include "lut3d.glsl"
 
 layout(local_size_x = SB_WORKGROUP_X, local_size_y = SB_WORKGROUP_Y) in;
-layout(std430, set = 0, binding = SB_VIEW_BINDING_FRAME) readonly buffer FrameBuffer {
-    sb_frame_gpu frame;
-};
+#include "frame.glsl"
 layout(set = 0, binding = SB_VIEW_BINDING_LDR, rgba8) uniform image2D ldr;
 
 void main()

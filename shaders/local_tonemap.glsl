@@ -7,6 +7,8 @@
 #ifndef SB_LOCAL_TONEMAP_GLSL
 #define SB_LOCAL_TONEMAP_GLSL
 
+#include "config.h"
+
 layout(std430, set = 0, binding = SB_VIEW_BINDING_LOCAL_TONEMAP) buffer LocalTonemapBuffer {
     sb_local_tonemap_gpu ltm;
 };

@@ -4,6 +4,8 @@
 #ifndef SB_LUT3D_GLSL
 #define SB_LUT3D_GLSL
 
+#include "config.h"
+
 layout(std430, set = 0, binding = SB_VIEW_BINDING_GRADE_LUT) readonly buffer GradeLut {
     vec4 lut_min; /* rgb: the domain's minimum; w: the LUT's size N */
     vec4 lut_max; /* rgb: the domain's maximum */

@@ -9,6 +9,8 @@
 #ifndef SB_NOISE_GLSL
 #define SB_NOISE_GLSL
 
+#include "config.h"
+
 /* Jarzynski and Olano's pcg3d: three 32-bit hashes of three integers. */
 uvec3 noise_hash(uvec3 v)
 {

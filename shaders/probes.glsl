@@ -7,6 +7,8 @@
 #ifndef SB_PROBES_GLSL
 #define SB_PROBES_GLSL
 
+#include "config.h"
+
 #include "sh.glsl"
 
 layout(std430, set = 0, binding = SB_VIEW_BINDING_PROBES) readonly buffer ProbeBuffer {

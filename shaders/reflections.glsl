@@ -8,6 +8,8 @@
 #ifndef SB_REFLECTIONS_GLSL
 #define SB_REFLECTIONS_GLSL
 
+#include "config.h"
+
 #include "cube.glsl"
 
 layout(std430, set = 0, binding = SB_VIEW_BINDING_REFLECTIONS) readonly buffer ReflectionBuffer {

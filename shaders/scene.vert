@@ -3,9 +3,7 @@
 #extension GL_GOOGLE_include_directive : require
 #include "config.h"
 
-layout(std430, set = 0, binding = SB_VIEW_BINDING_FRAME) readonly buffer FrameBuffer {
-    sb_frame_gpu frame;
-};
+#include "frame.glsl"
 #include "world.glsl"
 
 layout(location = 0) out vec3 out_offset; /* from the camera, m */

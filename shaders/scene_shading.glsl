@@ -24,6 +24,8 @@
 #ifndef SB_SCENE_SHADING_GLSL
 #define SB_SCENE_SHADING_GLSL
 
+#include "config.h"
+
 #include "view.glsl"
 #include "probes.glsl"
 #include "reflections.glsl"

@@ -4,6 +4,8 @@
 #ifndef SB_SH_GLSL
 #define SB_SH_GLSL
 
+#include "config.h"
+
 void sh9_basis(vec3 d, out float y[SB_PROBE_SH])
 {
     y[0] = 0.28209479177387814;

@@ -17,6 +17,9 @@
 #ifndef SB_SHADOWS_GLSL
 #define SB_SHADOWS_GLSL
 
+#include "config.h"
+#include "frame.glsl"
+
 #ifdef SB_TRACED_SHADOWS
 layout(std430, set = 0, binding = SB_VIEW_BINDING_BVH_NODES) readonly buffer BvhNodes { vec4 bvh_nodes[]; };
 layout(std430, set = 0, binding = SB_VIEW_BINDING_BVH_TRIANGLES) readonly buffer BvhTriangles { vec4 bvh_triangles[]; };

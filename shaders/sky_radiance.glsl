@@ -3,6 +3,9 @@
 #ifndef SB_SKY_RADIANCE_GLSL
 #define SB_SKY_RADIANCE_GLSL
 
+#include "config.h"
+#include "atmosphere.glsl"
+
 /* Radiance of the sky along a ray from altitude h (km) with view cosine mu,
  * sun cosine mu_s and view-sun cosine nu: single scattering with the baked
  * transmittance toward the sun, multiple scattering from psi_ms, and the

@@ -54,6 +54,9 @@
 #ifndef SB_SPHERE_GLSL
 #define SB_SPHERE_GLSL
 
+#include "config.h"
+#include "atmosphere.glsl"
+
 layout(local_size_x = SB_SPHERE_THREADS) in;
 layout(push_constant) uniform Push { sb_bake_push pc; };
 

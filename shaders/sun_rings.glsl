@@ -43,6 +43,9 @@
 #ifndef SB_SUN_RINGS_GLSL
 #define SB_SUN_RINGS_GLSL
 
+#include "config.h"
+#include "atmosphere.glsl"
+
 layout(std430, set = 0, binding = SB_BINDING_SUN_RINGS) readonly buffer SunRingsBuffer {
     vec4 sun_rings[];
 };

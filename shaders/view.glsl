@@ -8,15 +8,15 @@
 #ifndef SB_VIEW_GLSL
 #define SB_VIEW_GLSL
 
+#include "config.h"
+
 #define SB_SUN_TRANSMITTANCE_LUT
 #define SB_MULTISCATTERING_REFINED
 #define SB_ATMOSPHERE_TEXTURES
 #include "atmosphere.glsl"
 #include "sky_radiance.glsl"
 
-layout(std430, set = 0, binding = SB_VIEW_BINDING_FRAME) readonly buffer FrameBuffer {
-    sb_frame_gpu frame;
-};
+#include "frame.glsl"
 
 layout(push_constant) uniform ViewPush {
     sb_view_push pc;

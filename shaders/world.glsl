@@ -2,6 +2,9 @@
 #ifndef SB_WORLD_GLSL
 #define SB_WORLD_GLSL
 
+#include "config.h"
+#include "frame.glsl"
+
 layout(std430, set = 0, binding = SB_VIEW_BINDING_VERTICES) readonly buffer VertexBuffer {
     sb_vertex_gpu vertices[];
 };
