@@ -46,6 +46,21 @@ const char *sb_pass_name(enum sb_pass pass)
     return pass < SB_PASS_COUNT ? pass_classes[pass]->name : "?";
 }
 
+int sb_pass_toggles(uint32_t toggles[SB_PASS_COUNT])
+{
+    int n = 0;
+    for (int p = 0; p < SB_PASS_COUNT; p++) {
+        if (!pass_classes[p]->optional || pass_classes[p]->needs)
+            continue;
+        uint32_t mask = 1u << p;
+        for (int q = 0; q < SB_PASS_COUNT; q++)
+            if (pass_classes[q]->optional && (pass_classes[q]->needs >> p & 1))
+                mask |= 1u << q;
+        toggles[n++] = mask;
+    }
+    return n;
+}
+
 static const struct {
     const uint32_t *words;
     size_t size;

@@ -145,6 +145,12 @@ enum sb_pass {
  * "fog apply", "purkinje", "exposure", "local tonemap", "grade linear", "bloom", "tonemap", "grade". */
 const char *sb_pass_name(enum sb_pass pass);
 
+/* The switches a viewer offers, from the passes' table: one for each
+ * optional pass that needs no other, leaving out with it the optional
+ * passes that need it (the fog takes its application along). Masks of
+ * 1 << SB_PASS_x, in pass order, into toggles[]; returns their number. */
+int sb_pass_toggles(uint32_t toggles[SB_PASS_COUNT]);
+
 struct sb_frame_timings {
     bool valid;               /* false when the queue has no timestamps */
     double ms[SB_PASS_COUNT]; /* GPU time of each pass */

@@ -16,17 +16,6 @@
 #define SUN_ELEVATION_DEG_S 10.0
 #define HOURS_PER_S 1.0
 
-/* The passes keys 1 to 7 switch. */
-static const uint32_t toggles[7] = {
-    1u << SB_PASS_FOG | 1u << SB_PASS_FOG_APPLY,
-    1u << SB_PASS_CLOUDS,
-    1u << SB_PASS_PURKINJE,
-    1u << SB_PASS_LOCAL_TONEMAP,
-    1u << SB_PASS_GRADE_LINEAR,
-    1u << SB_PASS_BLOOM,
-    1u << SB_PASS_GRADE,
-};
-
 static void shade_box(uint8_t *rgba, uint32_t width, uint32_t height, uint32_t w, uint32_t h)
 {
     for (uint32_t y = 0; y < h && y < height; y++)
@@ -77,8 +66,8 @@ enum sb_result sb_viewer_run(struct sb_renderer *r, struct sb_window *window, co
     struct sb_view view = params->view;
     double hour = params->hour;
     bool overlay = params->overlay, want_shot = false;
-    uint32_t disabled = 0;
-    int shots = 0;
+    uint32_t disabled = 0, toggles[SB_PASS_COUNT];
+    int shots = 0, toggle_count = sb_pass_toggles(toggles);
     struct sb_frame_timings timings = {0};
     double last = sb_now_s(), fps = 0.0;
     enum sb_result res = SB_OK;
@@ -110,7 +99,7 @@ enum sb_result sb_viewer_run(struct sb_renderer *r, struct sb_window *window, co
                 fmin(fmax(view.sun_elevation + (in.sun_up - in.sun_down) * SUN_ELEVATION_DEG_S * DEG * dt, -90.0 * DEG),
                      90.0 * DEG);
         }
-        for (int k = 1; k <= 7; k++)
+        for (int k = 1; k <= toggle_count && k <= 9; k++) /* keys 1 to 9 switch the passes' toggles */
             if (in.pressed_digits >> k & 1)
                 disabled ^= toggles[k - 1];
         overlay ^= in.toggle_overlay;

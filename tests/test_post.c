@@ -630,8 +630,29 @@ static void test_disabled_passes(void)
     free(all);
 }
 
+/* The viewer's keys 1 to 7, from the passes' table, are the switches
+ * docs/skyview.md lists, in its order. */
+static void test_toggles(void)
+{
+    static const uint32_t documented[] = {
+        1u << SB_PASS_FOG | 1u << SB_PASS_FOG_APPLY,
+        1u << SB_PASS_CLOUDS,
+        1u << SB_PASS_PURKINJE,
+        1u << SB_PASS_LOCAL_TONEMAP,
+        1u << SB_PASS_GRADE_LINEAR,
+        1u << SB_PASS_BLOOM,
+        1u << SB_PASS_GRADE,
+    };
+    uint32_t toggles[SB_PASS_COUNT];
+    int n = sb_pass_toggles(toggles);
+    CHECK(n == (int)(sizeof(documented) / sizeof(documented[0])), "%d toggles", n);
+    for (int i = 0; i < n && i < (int)(sizeof(documented) / sizeof(documented[0])); i++)
+        CHECK(toggles[i] == documented[i], "key %d switches %#x, documented %#x", i + 1, toggles[i], documented[i]);
+}
+
 int main(int argc, char **argv)
 {
+    test_toggles();
     /* The world file; argv[1] overrides the source tree's (for runs elsewhere). */
     const char *world_path = argc > 1 ? argv[1] : TEST_WORLD;
     test_colour_science();
