@@ -980,9 +980,8 @@ static void fill_frame(struct sb_renderer *r, const struct sb_view *v, struct sb
         sb_mat4_store(&cascades.view_proj[c], f->shadow_view_proj[c]);
         f->cascade_ends[c] = (float)cascades.ends_m[c];
         f->cascade_texel[c] = (float)cascades.texel_m[c];
-        /* Texels to clear and draw: the casters' box and 5 more each side;
-         * lookups read the map within 2 of the box (their 3 x 3 taps and
-         * bilinear compares reach 2.5 texels further) and see the sun
+        /* Texels to clear and draw: the casters' box and a margin each side
+         * that covers what the lookups read (config.h); they see the sun
          * outside, exactly as if the whole map were cleared and drawn. */
         int32_t box[4], size = (int32_t)r->params.shadow_size;
         int32_t *clear = r->cascade_clear[c];
@@ -994,15 +993,17 @@ static void fill_frame(struct sb_renderer *r, const struct sb_view *v, struct sb
                                    r->params.shadow_size, box);
         }
         for (int k = 0; k < 2; k++) {
-            clear[k] = box[k] - 5 > 0 ? box[k] - 5 : 0;
-            clear[k + 2] = box[k + 2] + 5 < size ? box[k + 2] + 5 : size;
+            clear[k] = box[k] - SB_SHADOW_CLEAR_MARGIN_TEXELS > 0 ? box[k] - SB_SHADOW_CLEAR_MARGIN_TEXELS : 0;
+            clear[k + 2] =
+                box[k + 2] + SB_SHADOW_CLEAR_MARGIN_TEXELS < size ? box[k + 2] + SB_SHADOW_CLEAR_MARGIN_TEXELS : size;
         }
         if (box[0] >= box[2]) { /* no casters: nothing to draw, every lookup lit */
             clear[0] = clear[1] = clear[2] = clear[3] = 0;
             store4(f->cascade_rect[c], 2.0, 2.0, -1.0, -1.0);
         } else {
-            store4(f->cascade_rect[c], (box[0] - 2.0) / size, (box[1] - 2.0) / size, (box[2] + 2.0) / size,
-                   (box[3] + 2.0) / size);
+            const double m = SB_SHADOW_RECT_MARGIN_TEXELS;
+            store4(f->cascade_rect[c], (box[0] - m) / size, (box[1] - m) / size, (box[2] + m) / size,
+                   (box[3] + m) / size);
         }
     }
 

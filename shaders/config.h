@@ -296,6 +296,19 @@ struct sb_bake_push {
 #define SB_SKY_VIEW_HEIGHT 108 /* zenith angle, the horizon between rows 53 and 54 */
 #define SB_AERIAL_SIZE 32      /* x, y: screen; z: distance slices */
 #define SB_CASCADES 4
+/* The margins of a cascade's casters' box (renderer.c, shadows.glsl): the
+ * lookups are made within SB_SHADOW_RECT_MARGIN_TEXELS of the box
+ * (frame.cascade_rect), and the raster's filter (3 x 3 taps a texel apart,
+ * each a bilinear compare) reads SB_SHADOW_FILTER_REACH_HALF_TEXELS / 2
+ * texels further; SB_SHADOW_CLEAR_MARGIN_TEXELS are cleared and drawn past
+ * the box, so every texel a lookup reads holds what a whole map would. */
+#define SB_SHADOW_RECT_MARGIN_TEXELS 2
+#define SB_SHADOW_FILTER_REACH_HALF_TEXELS 5
+#define SB_SHADOW_CLEAR_MARGIN_TEXELS 5
+#ifndef GL_core_profile
+_Static_assert(2 * SB_SHADOW_CLEAR_MARGIN_TEXELS >= 2 * SB_SHADOW_RECT_MARGIN_TEXELS + SB_SHADOW_FILTER_REACH_HALF_TEXELS,
+               "the cleared margin covers what the filter reads past the lookups' box");
+#endif
 #define SB_HISTOGRAM_BINS 256
 #define SB_BLOOM_MAX_LEVELS 6
 
