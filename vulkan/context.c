@@ -203,9 +203,20 @@ enum sb_result sb_vk_create(const struct sb_vk_params *params, struct sb_vk **ou
         .pfnUserCallback = on_validation,
         .pUserData = vk,
     };
+    /* Validation includes synchronisation validation: a missing barrier
+     * between two passes or dispatches is a message like any other (it
+     * finds hazards on lavapipe too, whose queue runs in order). */
+    static const VkValidationFeatureEnableEXT enabled_features[] = {
+        VK_VALIDATION_FEATURE_ENABLE_SYNCHRONIZATION_VALIDATION_EXT};
+    VkValidationFeaturesEXT validation_features = {
+        .sType = VK_STRUCTURE_TYPE_VALIDATION_FEATURES_EXT,
+        .pNext = debug_utils ? &messenger_info : NULL,
+        .enabledValidationFeatureCount = 1,
+        .pEnabledValidationFeatures = enabled_features,
+    };
     VkInstanceCreateInfo instance_info = {
         .sType = VK_STRUCTURE_TYPE_INSTANCE_CREATE_INFO,
-        .pNext = params->validate && debug_utils ? &messenger_info : NULL,
+        .pNext = params->validate ? (const void *)&validation_features : NULL,
         .pApplicationInfo = &app,
         .enabledLayerCount = params->validate ? 1 : 0,
         .ppEnabledLayerNames = layers,
