@@ -55,7 +55,8 @@ enum sb_result sb_sandbox_start(struct sb_sandbox *box, const struct sb_sandbox_
         struct rlimit cpu = {box->cpu_seconds, box->cpu_seconds + 5};
         setrlimit(RLIMIT_CPU, &cpu);
         /* Beyond what is mapped now, so that AddressSanitizer's shadow
-         * (terabytes, reserved before the limit) does not count. */
+         * (terabytes, reserved before the limit) does not count; without
+         * /proc to say what that is, no limit rather than a wrong one. */
         unsigned long long mapped_pages = 0;
         FILE *statm = fopen("/proc/self/statm", "r");
         if (statm) {
@@ -63,9 +64,11 @@ enum sb_result sb_sandbox_start(struct sb_sandbox *box, const struct sb_sandbox_
                 mapped_pages = 0;
             fclose(statm);
         }
-        rlim_t limit = (rlim_t)(mapped_pages * (unsigned long long)sysconf(_SC_PAGESIZE) + address_space);
-        struct rlimit as = {limit, limit};
-        setrlimit(RLIMIT_AS, &as);
+        if (mapped_pages) {
+            rlim_t limit = (rlim_t)(mapped_pages * (unsigned long long)sysconf(_SC_PAGESIZE) + address_space);
+            struct rlimit as = {limit, limit};
+            setrlimit(RLIMIT_AS, &as);
+        }
         signal(SIGPIPE, SIG_DFL);
         _exit(fn(fds[1], user));
     }

@@ -32,7 +32,7 @@ extern "C" {
 struct sb_sandbox_limits {
     unsigned cpu_seconds; /* the child's CPU time [30] */
     /* The address space the child may map beyond what the process has
-     * mapped at the fork [4 GiB]. */
+     * mapped at the fork (read from /proc; none where it cannot be) [4 GiB]. */
     uint64_t address_space_bytes;
     unsigned wall_seconds; /* the whole exchange, from the fork [cpu_seconds + 30] */
 };
