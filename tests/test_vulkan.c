@@ -24,7 +24,10 @@ static unsigned two_writes(struct sb_vk *vk, struct sb_buffer *buffer, bool barr
 {
     unsigned before = sb_vk_validation_messages(vk);
     VkCommandBuffer cmd;
-    CHECK(sb_vk_begin_once(vk, &cmd) == SB_OK, "a command buffer");
+    enum sb_result res = sb_vk_begin_once(vk, &cmd);
+    CHECK(res == SB_OK, "a command buffer");
+    if (res)
+        return 0;
     vkCmdFillBuffer(cmd, buffer->buffer, 0, VK_WHOLE_SIZE, 1u);
     if (barrier) {
         VkMemoryBarrier b = {
