@@ -35,7 +35,8 @@ struct sb_clouds {
     uint32_t trace_size[2];
     struct sb_buffer params;
     struct sb_texture shape, detail, curl, weather;
-    struct sb_texture shadow, trace, depth, out, history;
+    struct sb_texture shadow, trace, depth;
+    struct sb_texture out[2]; /* a history: this frame's clouds at full resolution, and the last frame's */
     VkPipeline shadow_kernel, trace_kernel, resolve_kernel;
     struct sb_history history_state; /* the last frame, for reprojection */
     uint64_t history_frames;         /* frames since the history began */
@@ -43,6 +44,7 @@ struct sb_clouds {
 
 static const enum sb_product_id noise_products[4] = {SB_PRODUCT_CLOUD_SHAPE, SB_PRODUCT_CLOUD_DETAIL,
                                                      SB_PRODUCT_CLOUD_CURL, SB_PRODUCT_WEATHER};
+static const char *const noise_names[4] = {"cloud shape", "cloud detail", "cloud curl", "cloud weather"};
 
 static enum sb_result target(struct sb_renderer *r, struct sb_texture *t, uint32_t width, uint32_t height,
                              VkFormat format, VkImageUsageFlags usage, const char *name)
@@ -72,6 +74,14 @@ static bool wanted(struct sb_renderer *r, const struct sb_clouds *c)
     if (!scene->has_cloud_layer)
         sb_info("clouds: the scene has no cloud_layer: the default layer (docs/scene.md)");
     return true;
+}
+
+/* The layer's parameters and noise, which its kernels read. */
+static void declare_noise(struct sb_renderer *r)
+{
+    sb_pass_use(r, SB_VIEW_BINDING_CLOUDS, sb_pass_find(r, "clouds"), SB_USE_LOAD);
+    for (uint32_t i = 0; i < 4; i++)
+        sb_pass_sample(r, SB_VIEW_BINDING_CLOUD_SHAPE + i, sb_pass_find(r, noise_names[i]), r->repeat);
 }
 
 static enum sb_result clouds_create(struct sb_renderer *r)
@@ -104,46 +114,38 @@ static enum sb_result clouds_create(struct sb_renderer *r)
     c->trace_size[1] = th;
 
     const VkImageUsageFlags storage_sampled = VK_IMAGE_USAGE_STORAGE_BIT | VK_IMAGE_USAGE_SAMPLED_BIT;
-    const char *names[4] = {"cloud shape", "cloud detail", "cloud curl", "cloud weather"};
     struct sb_texture *noise[4] = {&c->shape, &c->detail, &c->curl, &c->weather};
     enum sb_result res = sb_renderer_upload(r, NULL, sizeof(struct sb_clouds_gpu), "cloud parameters", &c->params);
     for (int i = 0; i < 4 && !res; i++)
         res = sb_renderer_upload_image(r, c->enabled ? &r->pack->images[noise_products[i]] : NULL, i < 2, 0.0f,
-                                       names[i], noise[i]);
+                                       noise_names[i], noise[i]);
     if (!res)
         res = target(r, &c->shadow, ss, ss, CLOUD_FORMAT, storage_sampled, "cloud shadow map");
     if (!res)
         res = target(r, &c->trace, tw, th, CLOUD_FORMAT, storage_sampled, "clouds traced");
     if (!res)
         res = target(r, &c->depth, tw, th, VK_FORMAT_R32_SFLOAT, storage_sampled, "clouds traced distance");
-    if (!res)
-        res = target(r, &c->out, fw, fh, CLOUD_FORMAT, storage_sampled | VK_IMAGE_USAGE_TRANSFER_SRC_BIT,
-                     "clouds resolved");
-    if (!res)
-        res = target(r, &c->history, fw, fh, CLOUD_FORMAT, VK_IMAGE_USAGE_SAMPLED_BIT | VK_IMAGE_USAGE_TRANSFER_DST_BIT,
-                     "clouds history");
-    if (!res)
-        res =
-            sb_renderer_kernel(r, sb_spv_cloud_shadow, sizeof(sb_spv_cloud_shadow), "cloud shadow", &c->shadow_kernel);
-    if (!res)
-        res = sb_renderer_kernel(r, sb_spv_cloud_trace, sizeof(sb_spv_cloud_trace), "cloud trace", &c->trace_kernel);
-    if (!res)
-        res = sb_renderer_kernel(r, sb_spv_cloud_resolve, sizeof(sb_spv_cloud_resolve), "cloud resolve",
-                                 &c->resolve_kernel);
+    for (int i = 0; i < 2 && !res; i++)
+        res = target(r, &c->out[i], fw, fh, CLOUD_FORMAT, storage_sampled,
+                     i ? "clouds resolved (history)" : "clouds resolved");
     if (res)
         return res;
-    sb_renderer_bind_buffer(r, SB_VIEW_BINDING_CLOUDS, &c->params);
+    /* The scene and the fog read the layer and its shadow, drawn or not
+     * (a shadow map of one texel, never written, when not). */
+    sb_graph_buffer(r, "clouds", &c->params);
+    sb_resource shadow = sb_graph_image(r, "cloud shadow", &c->shadow);
+    sb_graph_image(r, "clouds traced", &c->trace);
+    sb_graph_image(r, "clouds traced distance", &c->depth);
+    sb_graph_history(r, "clouds resolved", c->out);
     for (int i = 0; i < 4; i++)
-        sb_renderer_bind_view(r, SB_VIEW_BINDING_CLOUD_SHAPE + (uint32_t)i, noise[i]->view, r->repeat);
-    sb_renderer_bind_view(r, SB_VIEW_BINDING_CLOUD_SHADOW, c->shadow.view, NULL);
-    sb_renderer_bind_view(r, SB_VIEW_BINDING_CLOUD_SHADOW_OUT, c->shadow.view, NULL);
-    sb_renderer_bind_view(r, SB_VIEW_BINDING_CLOUD_TRACE, c->trace.view, NULL);
-    sb_renderer_bind_view(r, SB_VIEW_BINDING_CLOUD_TRACE_OUT, c->trace.view, NULL);
-    sb_renderer_bind_view(r, SB_VIEW_BINDING_CLOUD_DEPTH, c->depth.view, r->nearest); /* r32f need not filter */
-    sb_renderer_bind_view(r, SB_VIEW_BINDING_CLOUD_DEPTH_OUT, c->depth.view, NULL);
-    sb_renderer_bind_view(r, SB_VIEW_BINDING_CLOUD_HISTORY, c->history.view, NULL);
-    sb_renderer_bind_view(r, SB_VIEW_BINDING_CLOUD_OUT, c->out.view, NULL);
-    if (c->enabled)
+        sb_graph_image(r, noise_names[i], noise[i]);
+    if (!c->enabled)
+        return SB_OK;
+    sb_pass_read_atmosphere(r);
+    declare_noise(r);
+    sb_pass_use(r, SB_VIEW_BINDING_CLOUD_SHADOW_OUT, shadow, SB_USE_STORE);
+    res = sb_renderer_kernel(r, sb_spv_cloud_shadow, sizeof(sb_spv_cloud_shadow), "cloud shadow", &c->shadow_kernel);
+    if (!res)
         sb_info("clouds: %g to %g m, coverage %g; traced at 1 pixel in %u x %u (%u x %u), %u steps, %u light steps; "
                 "shadow map %u^2 over %g km",
                 c->layer.base_altitude_m, c->layer.top_altitude_m, c->layer.coverage, c->scale, c->scale, tw, th,
@@ -157,8 +159,8 @@ static void clouds_destroy(struct sb_renderer *r)
     if (!c)
         return;
     const VkPipeline pipelines[] = {c->shadow_kernel, c->trace_kernel, c->resolve_kernel};
-    struct sb_texture *const textures[] = {&c->shape, &c->detail, &c->curl, &c->weather, &c->shadow,
-                                           &c->trace, &c->depth,  &c->out,  &c->history};
+    struct sb_texture *const textures[] = {&c->shape, &c->detail, &c->curl,   &c->weather, &c->shadow,
+                                           &c->trace, &c->depth,  &c->out[0], &c->out[1]};
     sb_renderer_release(r, pipelines, sizeof(pipelines) / sizeof(pipelines[0]), textures,
                         sizeof(textures) / sizeof(textures[0]));
     sb_buffer_destroy(r->vk, &c->params);
@@ -258,8 +260,34 @@ static void clouds_record(struct sb_renderer *r)
     sb_renderer_dispatch(r, c->trace_kernel, NULL, (const uint32_t[3]){c->trace_size[0], c->trace_size[1], 1}, group);
     sb_renderer_barrier(r->cmd);
     sb_renderer_dispatch(r, c->resolve_kernel, NULL, (const uint32_t[3]){r->width, r->height, 1}, group);
-    sb_renderer_barrier(r->cmd);
-    sb_renderer_copy_texture(r, &c->out, &c->history); /* this frame's clouds are the next one's history */
+}
+
+/* Traced, then resolved with the last frame's clouds and composited. */
+static enum sb_result clouds_pass_create(struct sb_renderer *r)
+{
+    struct sb_clouds *c = r->clouds;
+    if (!c->enabled)
+        return SB_OK;
+    sb_resource trace = sb_pass_find(r, "clouds traced"), distance = sb_pass_find(r, "clouds traced distance");
+    sb_resource resolved = sb_pass_find(r, "clouds resolved");
+    sb_pass_read_atmosphere(r);
+    declare_noise(r);
+    sb_pass_sample(r, SB_VIEW_BINDING_AERIAL, sb_pass_find(r, "aerial"), NULL);
+    sb_pass_sample(r, SB_VIEW_BINDING_AERIAL_T, sb_pass_find(r, "aerial transmittance"), NULL);
+    sb_pass_sample(r, SB_VIEW_BINDING_DEPTH, sb_pass_find(r, "depth"), r->nearest);
+    sb_pass_use(r, SB_VIEW_BINDING_HDR, sb_pass_find(r, "hdr"), SB_USE_LOAD_STORE);
+    sb_pass_use(r, SB_VIEW_BINDING_CLOUD_TRACE_OUT, trace, SB_USE_STORE);
+    sb_pass_sample(r, SB_VIEW_BINDING_CLOUD_TRACE, trace, NULL);
+    sb_pass_use(r, SB_VIEW_BINDING_CLOUD_DEPTH_OUT, distance, SB_USE_STORE);
+    sb_pass_sample(r, SB_VIEW_BINDING_CLOUD_DEPTH, distance, r->nearest); /* r32f need not filter */
+    sb_pass_use(r, SB_VIEW_BINDING_CLOUD_OUT, resolved, SB_USE_STORE);
+    sb_pass_sample(r, SB_VIEW_BINDING_CLOUD_HISTORY, SB_PREVIOUS(resolved), NULL);
+    enum sb_result res =
+        sb_renderer_kernel(r, sb_spv_cloud_trace, sizeof(sb_spv_cloud_trace), "cloud trace", &c->trace_kernel);
+    if (!res)
+        res = sb_renderer_kernel(r, sb_spv_cloud_resolve, sizeof(sb_spv_cloud_resolve), "cloud resolve",
+                                 &c->resolve_kernel);
+    return res;
 }
 
 const struct sb_pass_class sb_pass_cloud_shadow = {
@@ -279,6 +307,7 @@ static void clouds_skipped(struct sb_renderer *r)
 
 const struct sb_pass_class sb_pass_clouds = {
     .name = "clouds",
+    .create = clouds_pass_create,
     .record = clouds_record,
     .optional = true,
     .skipped = clouds_skipped,

@@ -33,7 +33,8 @@ struct sb_fog {
     uint32_t grid[3];
     double far_m;
     struct sb_buffer params;
-    struct sb_texture light, history, integrated, noise;
+    struct sb_texture light[2]; /* a history: this frame's froxel light, and the last frame's */
+    struct sb_texture integrated, noise;
     VkPipeline inject, integrate, apply;
     struct sb_history history_state; /* the last frame, for reprojection */
 };
@@ -76,44 +77,69 @@ static enum sb_result fog_create(struct sb_renderer *r)
     f->medium = scene->fog;
     f->enabled =
         scene->has_fog && !r->params.no_fog && (f->medium.extinction_per_m > 0.0 || f->medium.volume_count > 0);
+    if (!f->enabled)
+        return SB_OK;
     uint32_t tile = r->params.fog_tile_px ? r->params.fog_tile_px : 8;
-    f->grid[0] = f->enabled ? (r->width + tile - 1) / tile : 1;
-    f->grid[1] = f->enabled ? (r->height + tile - 1) / tile : 1;
-    f->grid[2] = f->enabled ? (r->params.fog_slices ? r->params.fog_slices : 64) : 2;
+    f->grid[0] = (r->width + tile - 1) / tile;
+    f->grid[1] = (r->height + tile - 1) / tile;
+    f->grid[2] = r->params.fog_slices ? r->params.fog_slices : 64;
     f->far_m = r->params.fog_far_m > 0.0 ? r->params.fog_far_m : 256.0;
 
     const VkImageUsageFlags storage_sampled = VK_IMAGE_USAGE_STORAGE_BIT | VK_IMAGE_USAGE_SAMPLED_BIT;
     enum sb_result res = sb_renderer_upload(r, NULL, sizeof(struct sb_fog_gpu), "fog parameters", &f->params);
-    if (!res)
-        res = volume(r, &f->light, f->grid, storage_sampled | VK_IMAGE_USAGE_TRANSFER_SRC_BIT, "froxel light");
-    if (!res)
-        res = volume(r, &f->history, f->grid, VK_IMAGE_USAGE_SAMPLED_BIT | VK_IMAGE_USAGE_TRANSFER_DST_BIT,
-                     "froxel history");
+    for (int i = 0; i < 2 && !res; i++)
+        res = volume(r, &f->light[i], f->grid, storage_sampled, i ? "froxel light (history)" : "froxel light");
     if (!res)
         res = volume(r, &f->integrated, f->grid, storage_sampled, "froxels integrated");
     if (!res)
         res = upload_noise(r, f);
-    if (!res)
-        res = r->scene_traced
-                  ? sb_renderer_kernel(r, sb_spv_fog_inject_traced, sizeof(sb_spv_fog_inject_traced),
-                                       "fog inject (shadow rays)", &f->inject)
-                  : sb_renderer_kernel(r, sb_spv_fog_inject, sizeof(sb_spv_fog_inject), "fog inject", &f->inject);
+    if (res)
+        return res;
+    sb_resource params = sb_graph_buffer(r, "fog", &f->params);
+    sb_resource light = sb_graph_history(r, "froxel light", f->light);
+    sb_resource froxels = sb_graph_image(r, "froxels", &f->integrated);
+    sb_pass_read_atmosphere(r);
+    sb_pass_use(r, SB_VIEW_BINDING_FOG, params, SB_USE_LOAD);
+    sb_pass_use(r, SB_VIEW_BINDING_FROXEL_LIGHT_OUT, light, SB_USE_LOAD_STORE);
+    sb_pass_sample(r, SB_VIEW_BINDING_FROXEL_HISTORY, SB_PREVIOUS(light), NULL);
+    sb_pass_use(r, SB_VIEW_BINDING_FROXEL_OUT, froxels, SB_USE_STORE);
+    sb_pass_sample(r, SB_VIEW_BINDING_FOG_NOISE, sb_graph_image(r, "fog noise", &f->noise), r->repeat);
+    sb_pass_use(r, SB_VIEW_BINDING_PROBES, sb_pass_find(r, "probes"), SB_USE_LOAD);
+    sb_pass_use(r, SB_VIEW_BINDING_PROBE_LIGHT, sb_pass_find(r, "probe light"), SB_USE_LOAD);
+    sb_pass_use(r, SB_VIEW_BINDING_CLOUDS, sb_pass_find(r, "clouds"), SB_USE_LOAD);
+    sb_pass_sample(r, SB_VIEW_BINDING_CLOUD_SHADOW, sb_pass_find(r, "cloud shadow"), NULL);
+    if (r->scene_traced) {
+        sb_pass_use(r, SB_VIEW_BINDING_BVH_NODES, sb_pass_find(r, "bvh nodes"), SB_USE_LOAD);
+        sb_pass_use(r, SB_VIEW_BINDING_BVH_TRIANGLES, sb_pass_find(r, "bvh triangles"), SB_USE_LOAD);
+        res = sb_renderer_kernel(r, sb_spv_fog_inject_traced, sizeof(sb_spv_fog_inject_traced),
+                                 "fog inject (shadow rays)", &f->inject);
+    } else {
+        sb_pass_sample(r, SB_VIEW_BINDING_SHADOW, sb_pass_find(r, "shadow cascades"), r->shadow_compare);
+        res = sb_renderer_kernel(r, sb_spv_fog_inject, sizeof(sb_spv_fog_inject), "fog inject", &f->inject);
+    }
     if (!res)
         res = sb_renderer_kernel(r, sb_spv_fog_integrate, sizeof(sb_spv_fog_integrate), "fog integrate", &f->integrate);
     if (!res)
-        res = sb_renderer_kernel(r, sb_spv_fog_apply, sizeof(sb_spv_fog_apply), "fog apply", &f->apply);
-    if (res)
-        return res;
-    sb_renderer_bind_buffer(r, SB_VIEW_BINDING_FOG, &f->params);
-    sb_renderer_bind_view(r, SB_VIEW_BINDING_FROXEL_LIGHT_OUT, f->light.view, NULL);
-    sb_renderer_bind_view(r, SB_VIEW_BINDING_FROXEL_HISTORY, f->history.view, NULL);
-    sb_renderer_bind_view(r, SB_VIEW_BINDING_FROXEL_OUT, f->integrated.view, NULL);
-    sb_renderer_bind_view(r, SB_VIEW_BINDING_FROXEL, f->integrated.view, NULL);
-    sb_renderer_bind_view(r, SB_VIEW_BINDING_FOG_NOISE, f->noise.view, r->repeat);
-    if (f->enabled)
         sb_info("fog: %u x %u x %u froxels to %g m%s, %d boxes", f->grid[0], f->grid[1], f->grid[2], f->far_m,
                 f->medium.noise_amount > 0.0 ? ", noise" : "", f->medium.volume_count);
-    return SB_OK;
+    return res;
+}
+
+/* The froxels applied to the frame. */
+static enum sb_result fog_apply_create(struct sb_renderer *r)
+{
+    if (!r->fog->enabled)
+        return SB_OK;
+    sb_pass_read_atmosphere(r);
+    sb_pass_use(r, SB_VIEW_BINDING_HDR, sb_pass_find(r, "hdr"), SB_USE_LOAD_STORE);
+    sb_pass_sample(r, SB_VIEW_BINDING_DEPTH, sb_pass_find(r, "depth"), r->nearest);
+    sb_pass_use(r, SB_VIEW_BINDING_FOG, sb_pass_find(r, "fog"), SB_USE_LOAD);
+    sb_pass_sample(r, SB_VIEW_BINDING_FROXEL, sb_pass_find(r, "froxels"), NULL);
+    sb_pass_use(r, SB_VIEW_BINDING_PROBES, sb_pass_find(r, "probes"), SB_USE_LOAD);
+    sb_pass_use(r, SB_VIEW_BINDING_PROBE_LIGHT, sb_pass_find(r, "probe light"), SB_USE_LOAD);
+    sb_pass_use(r, SB_VIEW_BINDING_CLOUDS, sb_pass_find(r, "clouds"), SB_USE_LOAD);
+    sb_pass_sample(r, SB_VIEW_BINDING_CLOUD_SHADOW, sb_pass_find(r, "cloud shadow"), NULL);
+    return sb_renderer_kernel(r, sb_spv_fog_apply, sizeof(sb_spv_fog_apply), "fog apply", &r->fog->apply);
 }
 
 static void fog_destroy(struct sb_renderer *r)
@@ -122,7 +148,7 @@ static void fog_destroy(struct sb_renderer *r)
     if (!f)
         return;
     const VkPipeline pipelines[] = {f->inject, f->integrate, f->apply};
-    struct sb_texture *const textures[] = {&f->light, &f->history, &f->integrated, &f->noise};
+    struct sb_texture *const textures[] = {&f->light[0], &f->light[1], &f->integrated, &f->noise};
     sb_renderer_release(r, pipelines, sizeof(pipelines) / sizeof(pipelines[0]), textures,
                         sizeof(textures) / sizeof(textures[0]));
     sb_buffer_destroy(r->vk, &f->params);
@@ -196,7 +222,6 @@ static void fog_record(struct sb_renderer *r)
     fill_params(r, f, f->params.mapped);
     sb_renderer_dispatch(r, f->inject, NULL, f->grid, (const uint32_t[3]){SB_FOG_GROUP, SB_FOG_GROUP, SB_FOG_GROUP});
     sb_renderer_barrier(r->cmd);
-    sb_renderer_copy_texture(r, &f->light, &f->history); /* this frame's light is the next frame's history */
     sb_renderer_dispatch(r, f->integrate, NULL, (const uint32_t[3]){f->grid[0], f->grid[1], 1},
                          (const uint32_t[3]){SB_WORKGROUP_X, SB_WORKGROUP_Y, 1});
 }
@@ -229,6 +254,7 @@ const struct sb_pass_class sb_pass_fog = {
 /* It reads the froxels: the fog left out, it is too. */
 const struct sb_pass_class sb_pass_fog_apply = {
     .name = "fog apply",
+    .create = fog_apply_create,
     .record = fog_apply_record,
     .optional = true,
     .needs = 1u << SB_PASS_FOG,

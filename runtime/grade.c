@@ -215,7 +215,6 @@ static enum sb_result grade_create(struct sb_renderer *r)
     bool log_lut = lut && r->params.grade_log;
     g->display = lut && !log_lut;
     g->linear = log_lut || !sb_grading_is_neutral(&r->params.grading);
-    r->post_in_place |= g->linear;
     size_t entries = lut ? (size_t)lut->size * lut->size * lut->size * 3 : 0;
     size_t bytes = 8 * sizeof(float) + (entries ? entries : 3) * sizeof(float);
     enum sb_result res = sb_renderer_upload(r, NULL, bytes, "grading LUT", &g->lut);
@@ -244,16 +243,30 @@ static enum sb_result grade_create(struct sb_renderer *r)
     invert3(m, inv);
     store_rows(m, gpu->to_ap1);
     store_rows(inv, gpu->from_ap1);
-    if (g->display)
-        res = sb_renderer_kernel(r, sb_spv_grade, sizeof(sb_spv_grade), "grade", &g->display_kernel);
-    if (!res && g->linear)
-        res = log_lut ? sb_renderer_kernel(r, sb_spv_grade_linear_lut, sizeof(sb_spv_grade_linear_lut), "grade linear",
-                                           &g->linear_kernel)
-                      : sb_renderer_kernel(r, sb_spv_grade_linear, sizeof(sb_spv_grade_linear), "grade linear",
-                                           &g->linear_kernel);
-    sb_renderer_bind_buffer(r, SB_VIEW_BINDING_GRADE_LUT, &g->lut);
-    sb_renderer_bind_buffer(r, SB_VIEW_BINDING_GRADING, &g->grading);
-    return res;
+    sb_resource lut_id = sb_graph_buffer(r, "grade lut", &g->lut);
+    sb_resource grading = sb_graph_buffer(r, "grading", &g->grading);
+    if (!g->linear)
+        return SB_OK;
+    sb_pass_use(r, SB_VIEW_BINDING_FRAME, sb_pass_find(r, "frame"), SB_USE_LOAD);
+    sb_pass_use(r, SB_VIEW_BINDING_EXPOSURE, sb_pass_find(r, "exposure"), SB_USE_LOAD);
+    sb_pass_use(r, SB_VIEW_BINDING_HDR, sb_pass_find(r, "hdr"), SB_USE_LOAD_STORE);
+    sb_pass_use(r, SB_VIEW_BINDING_GRADE_LUT, lut_id, SB_USE_LOAD);
+    sb_pass_use(r, SB_VIEW_BINDING_GRADING, grading, SB_USE_LOAD);
+    return log_lut ? sb_renderer_kernel(r, sb_spv_grade_linear_lut, sizeof(sb_spv_grade_linear_lut), "grade linear",
+                                        &g->linear_kernel)
+                   : sb_renderer_kernel(r, sb_spv_grade_linear, sizeof(sb_spv_grade_linear), "grade linear",
+                                        &g->linear_kernel);
+}
+
+/* The LUT on the display-referred frame. */
+static enum sb_result grade_display_create(struct sb_renderer *r)
+{
+    if (!r->grade->display)
+        return SB_OK;
+    sb_pass_use(r, SB_VIEW_BINDING_FRAME, sb_pass_find(r, "frame"), SB_USE_LOAD);
+    sb_pass_use(r, SB_VIEW_BINDING_LDR, sb_pass_find(r, "ldr"), SB_USE_LOAD_STORE);
+    sb_pass_use(r, SB_VIEW_BINDING_GRADE_LUT, sb_pass_find(r, "grade lut"), SB_USE_LOAD);
+    return sb_renderer_kernel(r, sb_spv_grade, sizeof(sb_spv_grade), "grade", &r->grade->display_kernel);
 }
 
 static void grade_destroy(struct sb_renderer *r)
@@ -289,6 +302,7 @@ static void grade_record(struct sb_renderer *r)
 /* The linear pass creates and destroys what both use. */
 const struct sb_pass_class sb_pass_grade_linear = {
     .name = "grade linear",
+    .post = true,
     .create = grade_create,
     .destroy = grade_destroy,
     .record = grade_linear_record,
@@ -297,6 +311,8 @@ const struct sb_pass_class sb_pass_grade_linear = {
 
 const struct sb_pass_class sb_pass_grade = {
     .name = "grade",
+    .post = true,
+    .create = grade_display_create,
     .record = grade_record,
     .optional = true,
 };

@@ -1,9 +1,8 @@
 /*
  * A pass's temporal history: what the frame before saw (its camera, its
  * sun, its view-projection), and the rule by which this frame may blend
- * with it. The fog and the clouds share it. (Their history images are
- * still copied by each pass; the render graph of issue 46 will make them
- * declared ping-pong pairs.)
+ * with it. The fog and the clouds share it; their images are histories of
+ * the render graph (graph.h), pairs that swap after each frame.
  */
 #ifndef SB_RUNTIME_HISTORY_H
 #define SB_RUNTIME_HISTORY_H

@@ -39,15 +39,16 @@ static enum sb_result local_tonemap_create(struct sb_renderer *r)
     r->local_tonemap = t;
     double contrast = r->params.local_contrast;
     t->enabled = contrast > 0.0 && contrast != 1.0;
-    r->post_in_place |= t->enabled;
+    if (!t->enabled)
+        return SB_OK;
     uint32_t side = (r->width + SB_LTM_GRID_X - 1) / SB_LTM_GRID_X;
     uint32_t gx = (r->width + side - 1) / side, gy = (r->height + side - 1) / side;
     size_t cells = (size_t)gx * gy * SB_LTM_BINS;
     enum sb_result res =
         sb_renderer_upload(r, NULL, sizeof(struct sb_local_tonemap_gpu), "local tone mapping", &t->params);
     if (!res)
-        res = sb_renderer_upload(r, NULL, t->enabled ? cells * 16 : 16, "local tone mapping grid", &t->grid);
-    t->sums_size = t->enabled ? cells * 8 : 0;
+        res = sb_renderer_upload(r, NULL, cells * 16, "local tone mapping grid", &t->grid);
+    t->sums_size = cells * 8;
     if (res)
         return res;
     struct sb_local_tonemap_gpu *gpu = t->params.mapped;
@@ -55,33 +56,33 @@ static enum sb_result local_tonemap_create(struct sb_renderer *r)
     gpu->grid[1] = gy;
     gpu->grid[2] = SB_LTM_BINS;
     gpu->grid[3] = side;
-    gpu->params[0] = (float)(t->enabled ? contrast : 1.0);
-    sb_renderer_bind_buffer(r, SB_VIEW_BINDING_LOCAL_TONEMAP, &t->params);
-    sb_renderer_bind_buffer(r, SB_VIEW_BINDING_LOCAL_TONEMAP_GRID, &t->grid);
-    if (t->enabled) {
-        /* the grid's subgroups add before their atomics where they can (local_tonemap_grid.comp) */
-        const VkSubgroupFeatureFlags adds =
-            VK_SUBGROUP_FEATURE_BASIC_BIT | VK_SUBGROUP_FEATURE_BALLOT_BIT | VK_SUBGROUP_FEATURE_ARITHMETIC_BIT;
-        bool subgroups = (r->vk->compute_subgroup_ops & adds) == adds;
-        sb_debug("local tone mapping: the grid's atomics %s",
-                 subgroups ? "added up by subgroup first" : "a pixel each");
-        if (subgroups)
-            res =
-                sb_renderer_kernel(r, sb_spv_local_tonemap_grid_subgroups, sizeof(sb_spv_local_tonemap_grid_subgroups),
-                                   "local tonemap grid (subgroups)", &t->grid_kernel);
-        else
-            res = sb_renderer_kernel(r, sb_spv_local_tonemap_grid, sizeof(sb_spv_local_tonemap_grid),
-                                     "local tonemap grid", &t->grid_kernel);
-        if (!res)
-            res = sb_renderer_kernel(r, sb_spv_local_tonemap_pivot, sizeof(sb_spv_local_tonemap_pivot),
-                                     "local tonemap pivot", &t->pivot_kernel);
-        if (!res)
-            res = sb_renderer_kernel(r, sb_spv_local_tonemap_blur, sizeof(sb_spv_local_tonemap_blur),
-                                     "local tonemap blur", &t->blur_kernel);
-        if (!res)
-            res = sb_renderer_kernel(r, sb_spv_local_tonemap_apply, sizeof(sb_spv_local_tonemap_apply),
-                                     "local tonemap apply", &t->apply_kernel);
-    }
+    gpu->params[0] = (float)contrast;
+    sb_pass_use(r, SB_VIEW_BINDING_FRAME, sb_pass_find(r, "frame"), SB_USE_LOAD);
+    sb_pass_use(r, SB_VIEW_BINDING_EXPOSURE, sb_pass_find(r, "exposure"), SB_USE_LOAD);
+    sb_pass_use(r, SB_VIEW_BINDING_HDR, sb_pass_find(r, "hdr"), SB_USE_LOAD_STORE);
+    sb_pass_use(r, SB_VIEW_BINDING_LOCAL_TONEMAP, sb_graph_buffer(r, "local tonemap", &t->params), SB_USE_LOAD_STORE);
+    sb_pass_use(r, SB_VIEW_BINDING_LOCAL_TONEMAP_GRID, sb_graph_buffer(r, "local tonemap grid", &t->grid),
+                SB_USE_LOAD_STORE);
+    /* the grid's subgroups add before their atomics where they can (local_tonemap_grid.comp) */
+    const VkSubgroupFeatureFlags adds =
+        VK_SUBGROUP_FEATURE_BASIC_BIT | VK_SUBGROUP_FEATURE_BALLOT_BIT | VK_SUBGROUP_FEATURE_ARITHMETIC_BIT;
+    bool subgroups = (r->vk->compute_subgroup_ops & adds) == adds;
+    sb_debug("local tone mapping: the grid's atomics %s", subgroups ? "added up by subgroup first" : "a pixel each");
+    if (subgroups)
+        res = sb_renderer_kernel(r, sb_spv_local_tonemap_grid_subgroups, sizeof(sb_spv_local_tonemap_grid_subgroups),
+                                 "local tonemap grid (subgroups)", &t->grid_kernel);
+    else
+        res = sb_renderer_kernel(r, sb_spv_local_tonemap_grid, sizeof(sb_spv_local_tonemap_grid), "local tonemap grid",
+                                 &t->grid_kernel);
+    if (!res)
+        res = sb_renderer_kernel(r, sb_spv_local_tonemap_pivot, sizeof(sb_spv_local_tonemap_pivot),
+                                 "local tonemap pivot", &t->pivot_kernel);
+    if (!res)
+        res = sb_renderer_kernel(r, sb_spv_local_tonemap_blur, sizeof(sb_spv_local_tonemap_blur), "local tonemap blur",
+                                 &t->blur_kernel);
+    if (!res)
+        res = sb_renderer_kernel(r, sb_spv_local_tonemap_apply, sizeof(sb_spv_local_tonemap_apply),
+                                 "local tonemap apply", &t->apply_kernel);
     return res;
 }
 
@@ -122,6 +123,7 @@ static void local_tonemap_record(struct sb_renderer *r)
 
 const struct sb_pass_class sb_pass_local_tonemap = {
     .name = "local tonemap",
+    .post = true,
     .create = local_tonemap_create,
     .destroy = local_tonemap_destroy,
     .record = local_tonemap_record,

@@ -37,7 +37,8 @@ static enum sb_result purkinje_create(struct sb_renderer *r)
     double sun_y = weights[0] * sun[0] + weights[1] * sun[1] + weights[2] * sun[2];
     double lux = r->params.sun_illuminance_lux > 0.0 ? r->params.sun_illuminance_lux : EARTH_SUN_LUX;
     p->enabled = r->params.purkinje && sun_y > 0.0;
-    r->post_in_place |= p->enabled;
+    if (!p->enabled)
+        return SB_OK;
     enum sb_result res = sb_renderer_upload(r, NULL, sizeof(struct sb_purkinje_gpu), "Purkinje shift", &p->params);
     if (res)
         return res;
@@ -45,10 +46,10 @@ static enum sb_result purkinje_create(struct sb_renderer *r)
     struct sb_purkinje_gpu *gpu = p->params.mapped;
     gpu->scale[2] = (float)PHOTOPIC_CD_M2;
     gpu->scale[3] = (float)SCOTOPIC_CD_M2;
-    sb_renderer_bind_buffer(r, SB_VIEW_BINDING_PURKINJE, &p->params);
-    if (p->enabled)
-        res = sb_renderer_kernel(r, sb_spv_purkinje, sizeof(sb_spv_purkinje), "purkinje", &p->kernel);
-    return res;
+    sb_pass_use(r, SB_VIEW_BINDING_FRAME, sb_pass_find(r, "frame"), SB_USE_LOAD);
+    sb_pass_use(r, SB_VIEW_BINDING_HDR, sb_pass_find(r, "hdr"), SB_USE_LOAD_STORE);
+    sb_pass_use(r, SB_VIEW_BINDING_PURKINJE, sb_graph_buffer(r, "purkinje", &p->params), SB_USE_LOAD);
+    return sb_renderer_kernel(r, sb_spv_purkinje, sizeof(sb_spv_purkinje), "purkinje", &p->kernel);
 }
 
 static void purkinje_destroy(struct sb_renderer *r)
@@ -77,6 +78,7 @@ static void purkinje_record(struct sb_renderer *r)
 
 const struct sb_pass_class sb_pass_purkinje = {
     .name = "purkinje",
+    .post = true,
     .create = purkinje_create,
     .destroy = purkinje_destroy,
     .record = purkinje_record,

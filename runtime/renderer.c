@@ -79,236 +79,63 @@ static const struct {
     [KERNEL_PROBE_LIGHT] = {sb_spv_probe_light, sizeof(sb_spv_probe_light), "probe light"},
 };
 
-/* ---- Descriptors --------------------------------------------------------------- */
+/* ---- Declarations ----------------------------------------------------------------- */
 
-static const VkDescriptorType binding_types[SB_VIEW_BINDING_COUNT] = {
-    [SB_BINDING_ATMOSPHERE] = VK_DESCRIPTOR_TYPE_STORAGE_BUFFER,
-    [SB_BINDING_TRANSMITTANCE] = VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER,
-    [SB_BINDING_MULTISCATTERING] = VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER,
-    [SB_BINDING_IRRADIANCE_GROUND] = VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER,
-    [SB_VIEW_BINDING_FRAME] = VK_DESCRIPTOR_TYPE_STORAGE_BUFFER,
-    [SB_VIEW_BINDING_VERTICES] = VK_DESCRIPTOR_TYPE_STORAGE_BUFFER,
-    [SB_VIEW_BINDING_EXPOSURE] = VK_DESCRIPTOR_TYPE_STORAGE_BUFFER,
-    [SB_VIEW_BINDING_SKY_VIEW] = VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER,
-    [SB_VIEW_BINDING_SKY_VIEW_OUT] = VK_DESCRIPTOR_TYPE_STORAGE_IMAGE,
-    [SB_VIEW_BINDING_AERIAL] = VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER,
-    [SB_VIEW_BINDING_AERIAL_T] = VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER,
-    [SB_VIEW_BINDING_AERIAL_OUT] = VK_DESCRIPTOR_TYPE_STORAGE_IMAGE,
-    [SB_VIEW_BINDING_AERIAL_T_OUT] = VK_DESCRIPTOR_TYPE_STORAGE_IMAGE,
-    [SB_VIEW_BINDING_SHADOW] = VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER,
-    [SB_VIEW_BINDING_HDR] = VK_DESCRIPTOR_TYPE_STORAGE_IMAGE,
-    [SB_VIEW_BINDING_DEPTH] = VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER,
-    [SB_VIEW_BINDING_BLOOM_SRC] = VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER,
-    [SB_VIEW_BINDING_BLOOM_DST] = VK_DESCRIPTOR_TYPE_STORAGE_IMAGE,
-    [SB_VIEW_BINDING_BLOOM] = VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER,
-    [SB_VIEW_BINDING_LDR] = VK_DESCRIPTOR_TYPE_STORAGE_IMAGE,
-    [SB_VIEW_BINDING_PROBES] = VK_DESCRIPTOR_TYPE_STORAGE_BUFFER,
-    [SB_VIEW_BINDING_PROBE_LIGHT] = VK_DESCRIPTOR_TYPE_STORAGE_BUFFER,
-    [SB_VIEW_BINDING_REFLECTIONS] = VK_DESCRIPTOR_TYPE_STORAGE_BUFFER,
-    [SB_VIEW_BINDING_REFLECTION_CUBES] = VK_DESCRIPTOR_TYPE_STORAGE_BUFFER,
-    [SB_VIEW_BINDING_FOG] = VK_DESCRIPTOR_TYPE_STORAGE_BUFFER,
-    [SB_VIEW_BINDING_FROXEL_LIGHT_OUT] = VK_DESCRIPTOR_TYPE_STORAGE_IMAGE,
-    [SB_VIEW_BINDING_FROXEL_HISTORY] = VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER,
-    [SB_VIEW_BINDING_FROXEL_OUT] = VK_DESCRIPTOR_TYPE_STORAGE_IMAGE,
-    [SB_VIEW_BINDING_FROXEL] = VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER,
-    [SB_VIEW_BINDING_FOG_NOISE] = VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER,
-    [SB_VIEW_BINDING_CLOUDS] = VK_DESCRIPTOR_TYPE_STORAGE_BUFFER,
-    [SB_VIEW_BINDING_CLOUD_SHAPE] = VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER,
-    [SB_VIEW_BINDING_CLOUD_DETAIL] = VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER,
-    [SB_VIEW_BINDING_CLOUD_CURL] = VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER,
-    [SB_VIEW_BINDING_CLOUD_WEATHER] = VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER,
-    [SB_VIEW_BINDING_CLOUD_SHADOW] = VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER,
-    [SB_VIEW_BINDING_CLOUD_SHADOW_OUT] = VK_DESCRIPTOR_TYPE_STORAGE_IMAGE,
-    [SB_VIEW_BINDING_CLOUD_TRACE] = VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER,
-    [SB_VIEW_BINDING_CLOUD_TRACE_OUT] = VK_DESCRIPTOR_TYPE_STORAGE_IMAGE,
-    [SB_VIEW_BINDING_CLOUD_DEPTH] = VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER,
-    [SB_VIEW_BINDING_CLOUD_DEPTH_OUT] = VK_DESCRIPTOR_TYPE_STORAGE_IMAGE,
-    [SB_VIEW_BINDING_CLOUD_HISTORY] = VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER,
-    [SB_VIEW_BINDING_CLOUD_OUT] = VK_DESCRIPTOR_TYPE_STORAGE_IMAGE,
-    [SB_VIEW_BINDING_BVH_NODES] = VK_DESCRIPTOR_TYPE_STORAGE_BUFFER,
-    [SB_VIEW_BINDING_BVH_TRIANGLES] = VK_DESCRIPTOR_TYPE_STORAGE_BUFFER,
-    [SB_VIEW_BINDING_DEPTH_OUT] = VK_DESCRIPTOR_TYPE_STORAGE_IMAGE,
-    [SB_VIEW_BINDING_GRADE_LUT] = VK_DESCRIPTOR_TYPE_STORAGE_BUFFER,
-    [SB_VIEW_BINDING_GRADING] = VK_DESCRIPTOR_TYPE_STORAGE_BUFFER,
-    [SB_VIEW_BINDING_PURKINJE] = VK_DESCRIPTOR_TYPE_STORAGE_BUFFER,
-    [SB_VIEW_BINDING_LOCAL_TONEMAP] = VK_DESCRIPTOR_TYPE_STORAGE_BUFFER,
-    [SB_VIEW_BINDING_LOCAL_TONEMAP_GRID] = VK_DESCRIPTOR_TYPE_STORAGE_BUFFER,
-};
-_Static_assert(SB_VIEW_BINDING_COUNT == 51, "every binding has a type above");
-
-void sb_renderer_bind_buffer(struct sb_renderer *r, uint32_t binding, const struct sb_buffer *buffer)
+void sb_pass_read_atmosphere(struct sb_renderer *r)
 {
-    assert(binding < SB_VIEW_BINDING_COUNT && binding_types[binding] == VK_DESCRIPTOR_TYPE_STORAGE_BUFFER);
-    r->bound_buffer[binding] = buffer;
+    sb_pass_use(r, SB_BINDING_ATMOSPHERE, sb_pass_find(r, "atmosphere"), SB_USE_LOAD);
+    /* read by texelFetch (atmosphere.glsl, SB_ATMOSPHERE_TEXTURES) */
+    sb_pass_sample(r, SB_BINDING_TRANSMITTANCE, sb_pass_find(r, "transmittance"), r->nearest);
+    sb_pass_sample(r, SB_BINDING_MULTISCATTERING, sb_pass_find(r, "multiscattering"), r->nearest);
+    sb_pass_sample(r, SB_BINDING_IRRADIANCE_GROUND, sb_pass_find(r, "irradiance ground"), r->nearest);
+    sb_pass_use(r, SB_VIEW_BINDING_FRAME, sb_pass_find(r, "frame"), SB_USE_LOAD);
 }
 
-void sb_renderer_bind_view(struct sb_renderer *r, uint32_t binding, VkImageView view, VkSampler sampler)
+sb_resource sb_pass_find(struct sb_renderer *r, const char *name)
 {
-    assert(binding < SB_VIEW_BINDING_COUNT && binding_types[binding] != VK_DESCRIPTOR_TYPE_STORAGE_BUFFER);
-    r->bound_view[binding] = view;
-    r->bound_sampler[binding] = sampler;
+    sb_resource id = sb_graph_find(r, name);
+    if (!id)
+        sb_error("skyview: the %s pass uses \"%s\", which no earlier pass made", pass_classes[r->pass]->name, name);
+    assert(id);
+    return id;
 }
 
-/* The renderer's own resources; the bloom step's bindings vary per set. */
-static void bind_own(struct sb_renderer *r)
+/* The renderer's own resources in the graph's table. */
+static void add_resources(struct sb_renderer *r)
 {
     const struct {
-        uint32_t binding;
+        const char *name;
         const struct sb_buffer *buffer;
     } buffers[] = {
-        {SB_BINDING_ATMOSPHERE, &r->atmosphere},        {SB_VIEW_BINDING_FRAME, &r->frame},
-        {SB_VIEW_BINDING_VERTICES, &r->vertices},       {SB_VIEW_BINDING_EXPOSURE, &r->exposure},
-        {SB_VIEW_BINDING_PROBES, &r->probes},           {SB_VIEW_BINDING_PROBE_LIGHT, &r->probe_light},
-        {SB_VIEW_BINDING_REFLECTIONS, &r->reflections}, {SB_VIEW_BINDING_REFLECTION_CUBES, &r->reflection_cubes},
-        {SB_VIEW_BINDING_BVH_NODES, &r->bvh_nodes},     {SB_VIEW_BINDING_BVH_TRIANGLES, &r->bvh_triangles},
+        {"atmosphere", &r->atmosphere},   {"frame", &r->frame},
+        {"vertices", &r->vertices},       {"exposure", &r->exposure},
+        {"probes", &r->probes},           {"probe light", &r->probe_light},
+        {"reflections", &r->reflections}, {"reflection cubes", &r->reflection_cubes},
     };
     for (size_t i = 0; i < sizeof(buffers) / sizeof(buffers[0]); i++)
-        sb_renderer_bind_buffer(r, buffers[i].binding, buffers[i].buffer);
+        sb_graph_buffer(r, buffers[i].name, buffers[i].buffer);
+    if (r->scene_traced) {
+        sb_graph_buffer(r, "bvh nodes", &r->bvh_nodes);
+        sb_graph_buffer(r, "bvh triangles", &r->bvh_triangles);
+    }
     const struct {
-        uint32_t binding;
-        VkImageView view;
-    } views[] = {
-        {SB_VIEW_BINDING_SKY_VIEW, r->sky_view.view},
-        {SB_VIEW_BINDING_SKY_VIEW_OUT, r->sky_view.view},
-        {SB_VIEW_BINDING_AERIAL, r->aerial.view},
-        {SB_VIEW_BINDING_AERIAL_T, r->aerial_t.view},
-        {SB_VIEW_BINDING_AERIAL_OUT, r->aerial.view},
-        {SB_VIEW_BINDING_AERIAL_T_OUT, r->aerial_t.view},
-        {SB_VIEW_BINDING_SHADOW, r->shadow.view},
-        {SB_VIEW_BINDING_HDR, r->hdr.view},
-        {SB_VIEW_BINDING_DEPTH, r->depth.view},
-        {SB_VIEW_BINDING_DEPTH_OUT, r->scene_traced ? r->depth.view : r->depth_stand_in.view},
-        {SB_VIEW_BINDING_BLOOM, r->bloom.subview_count ? r->bloom.subviews[0] : r->bloom.view},
-        {SB_VIEW_BINDING_LDR, r->ldr.view},
+        const char *name;
+        struct sb_texture *texture;
+    } images[] = {
+        {"transmittance", &r->transmittance},
+        {"multiscattering", &r->multiscattering},
+        {"irradiance ground", &r->irradiance_ground},
+        {"aerial", &r->aerial},
+        {"aerial transmittance", &r->aerial_t},
+        {"shadow cascades", &r->shadow},
+        {"depth", &r->depth},
+        {"bloom", &r->bloom},
     };
-    for (size_t i = 0; i < sizeof(views) / sizeof(views[0]); i++)
-        sb_renderer_bind_view(r, views[i].binding, views[i].view, NULL);
-    /* read by texelFetch (atmosphere.glsl, SB_ATMOSPHERE_TEXTURES) */
-    sb_renderer_bind_view(r, SB_BINDING_TRANSMITTANCE, r->transmittance.view, r->nearest);
-    sb_renderer_bind_view(r, SB_BINDING_MULTISCATTERING, r->multiscattering.view, r->nearest);
-    sb_renderer_bind_view(r, SB_BINDING_IRRADIANCE_GROUND, r->irradiance_ground.view, r->nearest);
-}
-
-/* Write every binding of `set`; the bloom step's source and target vary per set. */
-static void write_set(struct sb_renderer *r, VkDescriptorSet set, VkImageView bloom_src, VkImageView bloom_dst)
-{
-    VkDescriptorBufferInfo buffers[SB_VIEW_BINDING_COUNT] = {0};
-    VkDescriptorImageInfo images[SB_VIEW_BINDING_COUNT] = {0};
-    VkWriteDescriptorSet writes[SB_VIEW_BINDING_COUNT];
-    for (uint32_t b = 0; b < SB_VIEW_BINDING_COUNT; b++) {
-        writes[b] = (VkWriteDescriptorSet){
-            .sType = VK_STRUCTURE_TYPE_WRITE_DESCRIPTOR_SET,
-            .dstSet = set,
-            .dstBinding = b,
-            .descriptorCount = 1,
-            .descriptorType = binding_types[b],
-        };
-        if (binding_types[b] == VK_DESCRIPTOR_TYPE_STORAGE_BUFFER) {
-            assert(r->bound_buffer[b]);
-            buffers[b] = (VkDescriptorBufferInfo){.buffer = r->bound_buffer[b]->buffer, .range = VK_WHOLE_SIZE};
-            writes[b].pBufferInfo = &buffers[b];
-        } else {
-            VkImageView view = b == SB_VIEW_BINDING_BLOOM_SRC   ? bloom_src
-                               : b == SB_VIEW_BINDING_BLOOM_DST ? bloom_dst
-                                                                : r->bound_view[b];
-            assert(view);
-            images[b] = (VkDescriptorImageInfo){
-                .sampler = r->bound_sampler[b]           ? r->bound_sampler[b]
-                           : b == SB_VIEW_BINDING_SHADOW ? r->shadow_compare
-                           : b == SB_VIEW_BINDING_DEPTH  ? r->nearest /* depth formats need not filter */
-                                                         : r->linear,
-                .imageView = view,
-                .imageLayout = b == SB_VIEW_BINDING_SHADOW || (b == SB_VIEW_BINDING_DEPTH && !r->scene_traced)
-                                   ? VK_IMAGE_LAYOUT_DEPTH_STENCIL_READ_ONLY_OPTIMAL
-                                   : VK_IMAGE_LAYOUT_GENERAL,
-            };
-            writes[b].pImageInfo = &images[b];
-        }
-    }
-    vkUpdateDescriptorSets(r->vk->device, SB_VIEW_BINDING_COUNT, writes, 0, NULL);
-}
-
-/* The layout every pass's pipelines share: config.h's bindings and sb_view_push. */
-static enum sb_result create_layout(struct sb_renderer *r)
-{
-    enum sb_result res = SB_OK;
-    struct sb_vk *vk = r->vk;
-    VkDescriptorSetLayoutBinding bindings[SB_VIEW_BINDING_COUNT];
-    for (uint32_t b = 0; b < SB_VIEW_BINDING_COUNT; b++)
-        bindings[b] = (VkDescriptorSetLayoutBinding){
-            .binding = b,
-            .descriptorType = binding_types[b],
-            .descriptorCount = 1,
-            .stageFlags = VK_SHADER_STAGE_ALL,
-        };
-    VkDescriptorSetLayoutCreateInfo set_info = {
-        .sType = VK_STRUCTURE_TYPE_DESCRIPTOR_SET_LAYOUT_CREATE_INFO,
-        .bindingCount = SB_VIEW_BINDING_COUNT,
-        .pBindings = bindings,
-    };
-    VK(vkCreateDescriptorSetLayout(vk->device, &set_info, NULL, &r->set_layout));
-    VkPushConstantRange range = {.stageFlags = VK_SHADER_STAGE_ALL, .size = sizeof(struct sb_view_push)};
-    VkPipelineLayoutCreateInfo layout_info = {
-        .sType = VK_STRUCTURE_TYPE_PIPELINE_LAYOUT_CREATE_INFO,
-        .setLayoutCount = 1,
-        .pSetLayouts = &r->set_layout,
-        .pushConstantRangeCount = 1,
-        .pPushConstantRanges = &range,
-    };
-    VK(vkCreatePipelineLayout(vk->device, &layout_info, NULL, &r->layout));
-cleanup:
-    return res;
-}
-
-/* The main set and the bloom steps' sets, every binding written. */
-static enum sb_result create_sets(struct sb_renderer *r)
-{
-    enum sb_result res = SB_OK;
-    struct sb_vk *vk = r->vk;
-    uint32_t counts[16] = {0};
-    for (uint32_t b = 0; b < SB_VIEW_BINDING_COUNT; b++)
-        counts[binding_types[b]]++;
-    bind_own(r);
-    const uint32_t set_count = 1 + SB_BLOOM_SETS;
-    VkDescriptorPoolSize sizes[4];
-    uint32_t n = 0;
-    const VkDescriptorType types[] = {VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER,
-                                      VK_DESCRIPTOR_TYPE_STORAGE_IMAGE};
-    for (size_t i = 0; i < sizeof(types) / sizeof(types[0]); i++)
-        sizes[n++] = (VkDescriptorPoolSize){.type = types[i], .descriptorCount = counts[types[i]] * set_count};
-    VkDescriptorPoolCreateInfo pool_info = {
-        .sType = VK_STRUCTURE_TYPE_DESCRIPTOR_POOL_CREATE_INFO,
-        .maxSets = set_count,
-        .poolSizeCount = n,
-        .pPoolSizes = sizes,
-    };
-    VK(vkCreateDescriptorPool(vk->device, &pool_info, NULL, &r->pool));
-    VkDescriptorSetLayout layouts[1 + SB_BLOOM_SETS];
-    for (uint32_t i = 0; i < set_count; i++)
-        layouts[i] = r->set_layout;
-    VkDescriptorSet sets[1 + SB_BLOOM_SETS];
-    VkDescriptorSetAllocateInfo alloc = {
-        .sType = VK_STRUCTURE_TYPE_DESCRIPTOR_SET_ALLOCATE_INFO,
-        .descriptorPool = r->pool,
-        .descriptorSetCount = set_count,
-        .pSetLayouts = layouts,
-    };
-    VK(vkAllocateDescriptorSets(vk->device, &alloc, sets));
-    r->set = sets[0];
-    memcpy(r->bloom_sets, sets + 1, sizeof(r->bloom_sets));
-
-    VkImageView mip[SB_BLOOM_MAX_LEVELS];
-    for (uint32_t i = 0; i < SB_BLOOM_MAX_LEVELS; i++)
-        mip[i] = r->bloom.subview_count ? r->bloom.subviews[i < r->bloom_levels ? i : 0] : r->bloom.view;
-    write_set(r, r->set, r->hdr.view, mip[0]);
-    /* Down step i reads level i - 1 (the frame for i = 0) and writes level i;
-     * up step i reads level i + 1 and adds into level i. */
-    for (uint32_t i = 0; i < SB_BLOOM_MAX_LEVELS; i++) {
-        write_set(r, r->bloom_sets[i], i == 0 ? r->hdr.view : mip[i - 1], mip[i]);
-        write_set(r, r->bloom_sets[SB_BLOOM_MAX_LEVELS + i], mip[i + 1 < SB_BLOOM_MAX_LEVELS ? i + 1 : i], mip[i]);
-    }
-cleanup:
-    return res;
+    for (size_t i = 0; i < sizeof(images) / sizeof(images[0]); i++)
+        sb_graph_image(r, images[i].name, images[i].texture);
+    r->hdr_id = sb_graph_image(r, "hdr", &r->hdr);
+    r->ldr_id = sb_graph_image(r, "ldr", &r->ldr);
+    r->sky_view_id = sb_graph_image(r, "sky-view", &r->sky_view);
 }
 
 /* ---- Creation ------------------------------------------------------------------ */
@@ -330,7 +157,15 @@ enum sb_result sb_renderer_upload(struct sb_renderer *r, const void *data, size_
 enum sb_result sb_renderer_kernel(struct sb_renderer *r, const uint32_t *spirv, size_t spirv_size, const char *name,
                                   VkPipeline *pipeline)
 {
-    return sb_compute_pipeline_create(r->vk, r->layout, spirv, spirv_size, name, pipeline);
+    VkPipelineLayout layout;
+    enum sb_result res = sb_pass_layout(r, &layout);
+    return res ? res : sb_compute_pipeline_create(r->vk, layout, spirv, spirv_size, name, pipeline);
+}
+
+/* One of the renderer's kernels, for the pass being created. */
+static enum sb_result create_kernel(struct sb_renderer *r, enum compute_kernel k)
+{
+    return sb_renderer_kernel(r, kernel_spirv[k].words, kernel_spirv[k].size, kernel_spirv[k].name, &r->kernels[k]);
 }
 
 enum sb_result sb_renderer_upload_image(struct sb_renderer *r, const struct sb_image *image, bool volume, float fill,
@@ -660,9 +495,6 @@ static enum sb_result create_images(struct sb_renderer *r)
     if (!res && !r->scene_traced)
         res = create_texture(r, &r->depth, r->width, r->height, 1, 1, 1, SB_DEPTH_FORMAT,
                              VK_IMAGE_USAGE_DEPTH_STENCIL_ATTACHMENT_BIT | VK_IMAGE_USAGE_SAMPLED_BIT, "scene depth");
-    if (!res && !r->scene_traced)
-        res = create_texture(r, &r->depth_stand_in, 1, 1, 1, 1, 1, VK_FORMAT_R32_SFLOAT, VK_IMAGE_USAGE_STORAGE_BIT,
-                             "traced depth stand-in");
     if (!res)
         res = create_texture(r, &r->bloom, bw, bh, 1, 1, r->bloom_levels > 1 ? r->bloom_levels : 2, SB_HDR_FORMAT,
                              storage_sampled, "bloom chain");
@@ -694,57 +526,6 @@ static enum sb_result create_images(struct sb_renderer *r)
     info.addressModeU = info.addressModeV = info.addressModeW = VK_SAMPLER_ADDRESS_MODE_REPEAT;
     VK(vkCreateSampler(vk->device, &info, NULL, &r->repeat));
 cleanup:
-    return res;
-}
-
-static enum sb_result create_pipelines(struct sb_renderer *r)
-{
-    enum sb_result res = SB_OK;
-    for (int k = 0; k < KERNEL_COUNT && !res; k++)
-        res = sb_compute_pipeline_create(r->vk, r->layout, kernel_spirv[k].words, kernel_spirv[k].size,
-                                         kernel_spirv[k].name, &r->kernels[k]);
-    if (res)
-        return res;
-    struct sb_graphics_pipeline_params shadow = {
-        .layout = r->layout,
-        .vertex_spirv = sb_spv_shadow_vert,
-        .vertex_size = sizeof(sb_spv_shadow_vert),
-        .depth_format = SHADOW_FORMAT,
-        .depth_compare = VK_COMPARE_OP_LESS,
-        .depth_clamp = true, /* casters behind the near plane still cast ("pancaking") */
-        .depth_bias_constant = 1.0f,
-        .depth_bias_slope = 1.5f,
-        .name = "shadow cascades",
-    };
-    res = sb_graphics_pipeline_create(r->vk, &shadow, &r->shadow_pipeline);
-    /* scene.frag's specialization: what the pack holds */
-    bool generic = r->params.generic_shaders;
-    const VkBool32 has[2] = {generic || r->probe_count > 0, generic || r->reflection_count > 0};
-    const VkSpecializationMapEntry entries[2] = {
-        {.constantID = 0, .offset = 0, .size = sizeof(VkBool32)},
-        {.constantID = 1, .offset = sizeof(VkBool32), .size = sizeof(VkBool32)},
-    };
-    const VkSpecializationInfo specialization = {
-        .mapEntryCount = 2, .pMapEntries = entries, .dataSize = sizeof(has), .pData = has};
-    struct sb_graphics_pipeline_params scene = {
-        .layout = r->layout,
-        .fragment_specialization = &specialization,
-        .vertex_spirv = sb_spv_scene_vert,
-        .vertex_size = sizeof(sb_spv_scene_vert),
-        .fragment_spirv = sb_spv_scene_frag,
-        .fragment_size = sizeof(sb_spv_scene_frag),
-        .color_format = SB_HDR_FORMAT,
-        .depth_format = SB_DEPTH_FORMAT,
-        .depth_compare = VK_COMPARE_OP_GREATER, /* reverse Z */
-        .name = "scene",
-    };
-    if (!res)
-        res = sb_graphics_pipeline_create(r->vk, &scene, &r->scene_pipeline);
-    scene.fragment_spirv = sb_spv_scene_frag_volume;
-    scene.fragment_size = sizeof(sb_spv_scene_frag_volume);
-    scene.name = "scene (aerial volume only)";
-    if (!res)
-        res = sb_graphics_pipeline_create(r->vk, &scene, &r->scene_volume_pipeline);
     return res;
 }
 
@@ -831,20 +612,32 @@ enum sb_result sb_renderer_create(struct sb_vk *vk, const struct sb_pack *pack, 
     if (!res)
         res = create_images(r);
     if (!res)
-        res = create_layout(r);
-    if (!res)
-        res = create_pipelines(r);
-    if (!res)
         res = sb_scene_trace_create(r, world);
+    r->graph.passes = calloc(SB_PASS_COUNT, sizeof(*r->graph.passes));
+    if (!res && !r->graph.passes)
+        res = SB_ERR_NOMEM;
+    if (!res)
+        add_resources(r);
     r->pack = pack;
-    for (int p = 0; p < SB_PASS_COUNT && !res; p++)
-        if (assert(pass_classes[p]), pass_classes[p]->create)
-            res = pass_classes[p]->create(r);
+    for (r->pass = 0; r->pass < SB_PASS_COUNT && !res; r->pass++)
+        if (assert(pass_classes[r->pass]), pass_classes[r->pass]->create)
+            res = pass_classes[r->pass]->create(r);
     r->pack = NULL;
+    /* The lit frame is whole before the first post-processing pass; when
+     * one of them writes it, what they made is read back too. */
+    r->first_post = SB_PASS_COUNT;
+    for (int p = SB_PASS_COUNT; p-- > 0;)
+        if (pass_classes[p]->post)
+            r->first_post = p;
+    for (int p = r->first_post; !res && p < SB_PASS_COUNT; p++)
+        for (uint32_t u = 0; u < r->graph.passes[p].use_count; u++) {
+            const struct sb_graph_use *use = &r->graph.passes[p].uses[u];
+            r->post_in_place |= use->resource == r->hdr_id && use->use != SB_USE_SAMPLED && use->use != SB_USE_LOAD;
+        }
     if (!res && r->post_in_place)
         res = upload(vk, NULL, (size_t)r->width * r->height * 8, "post-processed HDR readback", &r->read_post);
     if (!res)
-        res = create_sets(r);
+        res = sb_graph_write_sets(r);
     if (res)
         goto cleanup;
 
@@ -895,12 +688,7 @@ void sb_renderer_destroy(struct sb_renderer **pr)
     const VkPipeline raster[] = {r->shadow_pipeline, r->scene_pipeline, r->scene_volume_pipeline};
     sb_renderer_release(r, r->kernels, KERNEL_COUNT, NULL, 0);
     sb_renderer_release(r, raster, 3, NULL, 0);
-    if (r->pool)
-        vkDestroyDescriptorPool(d, r->pool, NULL);
-    if (r->layout)
-        vkDestroyPipelineLayout(d, r->layout, NULL);
-    if (r->set_layout)
-        vkDestroyDescriptorSetLayout(d, r->set_layout, NULL);
+    sb_graph_destroy(r);
     if (r->linear)
         vkDestroySampler(d, r->linear, NULL);
     if (r->nearest)
@@ -919,8 +707,7 @@ void sb_renderer_destroy(struct sb_renderer **pr)
                                            &r->hdr,
                                            &r->depth,
                                            &r->bloom,
-                                           &r->ldr,
-                                           &r->depth_stand_in};
+                                           &r->ldr};
     sb_renderer_release(r, NULL, 0, textures, sizeof(textures) / sizeof(textures[0]));
     struct sb_buffer *buffers[] = {&r->atmosphere,  &r->frame,       &r->vertices,         &r->exposure,
                                    &r->read_ldr,    &r->read_hdr,    &r->read_sky_view,    &r->probes,
@@ -1065,28 +852,15 @@ void sb_renderer_release(struct sb_renderer *r, const VkPipeline *pipelines, siz
         sb_texture_destroy(r->vk, textures[i]);
 }
 
-void sb_renderer_copy_texture(struct sb_renderer *r, const struct sb_texture *src, const struct sb_texture *dst)
+static void dispatch_on(struct sb_renderer *r, VkPipeline pipeline, uint32_t set, const struct sb_view_push *push,
+                        const uint32_t size[3], const uint32_t group[3])
 {
-    VkImageCopy region = {
-        .srcSubresource = {VK_IMAGE_ASPECT_COLOR_BIT, 0, 0, 1},
-        .dstSubresource = {VK_IMAGE_ASPECT_COLOR_BIT, 0, 0, 1},
-        .extent = {src->width, src->height, src->depth ? src->depth : 1},
-    };
-    sb_texture_barrier(r->cmd, src, VK_IMAGE_LAYOUT_GENERAL, VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL);
-    sb_texture_barrier(r->cmd, dst, VK_IMAGE_LAYOUT_GENERAL, VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL);
-    vkCmdCopyImage(r->cmd, src->image, VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL, dst->image,
-                   VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL, 1, &region);
-    sb_texture_barrier(r->cmd, src, VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL, VK_IMAGE_LAYOUT_GENERAL);
-    sb_texture_barrier(r->cmd, dst, VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL, VK_IMAGE_LAYOUT_GENERAL);
-}
-
-static void dispatch_on(struct sb_renderer *r, VkPipeline pipeline, VkDescriptorSet set,
-                        const struct sb_view_push *push, const uint32_t size[3], const uint32_t group[3])
-{
+    const struct sb_graph_pass *p = &r->graph.passes[r->pass];
     struct sb_view_push none = {0};
+    assert(set < p->set_count);
     vkCmdBindPipeline(r->cmd, VK_PIPELINE_BIND_POINT_COMPUTE, pipeline);
-    vkCmdBindDescriptorSets(r->cmd, VK_PIPELINE_BIND_POINT_COMPUTE, r->layout, 0, 1, &set, 0, NULL);
-    vkCmdPushConstants(r->cmd, r->layout, VK_SHADER_STAGE_ALL, 0, sizeof(none), push ? push : &none);
+    vkCmdBindDescriptorSets(r->cmd, VK_PIPELINE_BIND_POINT_COMPUTE, p->layout, 0, 1, &p->sets[set], 0, NULL);
+    vkCmdPushConstants(r->cmd, p->layout, VK_SHADER_STAGE_ALL, 0, sizeof(none), push ? push : &none);
     vkCmdDispatch(r->cmd, (size[0] + group[0] - 1) / group[0], (size[1] + group[1] - 1) / group[1],
                   (size[2] + group[2] - 1) / group[2]);
 }
@@ -1094,11 +868,26 @@ static void dispatch_on(struct sb_renderer *r, VkPipeline pipeline, VkDescriptor
 void sb_renderer_dispatch(struct sb_renderer *r, VkPipeline pipeline, const struct sb_view_push *push,
                           const uint32_t size[3], const uint32_t group[3])
 {
-    dispatch_on(r, pipeline, r->set, push, size, group);
+    dispatch_on(r, pipeline, 0, push, size, group);
+}
+
+void sb_renderer_dispatch_set(struct sb_renderer *r, uint32_t set, VkPipeline pipeline, const struct sb_view_push *push,
+                              const uint32_t size[3], const uint32_t group[3])
+{
+    dispatch_on(r, pipeline, set, push, size, group);
+}
+
+void sb_renderer_bind_graphics(struct sb_renderer *r, VkPipeline pipeline, const struct sb_view_push *push)
+{
+    const struct sb_graph_pass *p = &r->graph.passes[r->pass];
+    struct sb_view_push none = {0};
+    vkCmdBindPipeline(r->cmd, VK_PIPELINE_BIND_POINT_GRAPHICS, pipeline);
+    vkCmdBindDescriptorSets(r->cmd, VK_PIPELINE_BIND_POINT_GRAPHICS, p->layout, 0, 1, &p->sets[0], 0, NULL);
+    vkCmdPushConstants(r->cmd, p->layout, VK_SHADER_STAGE_ALL, 0, sizeof(none), push ? push : &none);
 }
 
 /* A 2D dispatch of one of the renderer's kernels. */
-static void dispatch(struct sb_renderer *r, enum compute_kernel k, VkDescriptorSet set, const struct sb_view_push *push,
+static void dispatch(struct sb_renderer *r, enum compute_kernel k, uint32_t set, const struct sb_view_push *push,
                      uint32_t width, uint32_t height, uint32_t group_x, uint32_t group_y)
 {
     dispatch_on(r, r->kernels[k], set, push, (const uint32_t[3]){width, height, 1},
@@ -1113,21 +902,88 @@ static void set_viewport(VkCommandBuffer cmd, uint32_t w, uint32_t h)
     vkCmdSetScissor(cmd, 0, 1, &scissor);
 }
 
+/* ---- The renderer's passes ------------------------------------------------------- */
+
+static enum sb_result sky_view_create(struct sb_renderer *r)
+{
+    sb_pass_read_atmosphere(r);
+    sb_pass_use(r, SB_VIEW_BINDING_SKY_VIEW_OUT, r->sky_view_id, SB_USE_STORE);
+    return create_kernel(r, KERNEL_SKY_VIEW);
+}
+
+static void record_sky_view(struct sb_renderer *r)
+{
+    dispatch(r, KERNEL_SKY_VIEW, 0, NULL, SB_SKY_VIEW_WIDTH, SB_SKY_VIEW_HEIGHT, SB_WORKGROUP_X, SB_WORKGROUP_Y);
+}
+
+static enum sb_result probes_create(struct sb_renderer *r)
+{
+    if (!r->probe_count)
+        return SB_OK;
+    sb_pass_read_atmosphere(r);
+    sb_pass_sample(r, SB_VIEW_BINDING_SKY_VIEW, r->sky_view_id, NULL);
+    sb_pass_use(r, SB_VIEW_BINDING_PROBES, sb_pass_find(r, "probes"), SB_USE_LOAD);
+    sb_pass_use(r, SB_VIEW_BINDING_PROBE_LIGHT, sb_pass_find(r, "probe light"), SB_USE_LOAD_STORE);
+    enum sb_result res = create_kernel(r, KERNEL_PROBE_SKY);
+    return res ? res : create_kernel(r, KERNEL_PROBE_LIGHT);
+}
+
+static void record_probes(struct sb_renderer *r)
+{
+    if (!r->probe_count)
+        return;
+    dispatch(r, KERNEL_PROBE_SKY, 0, NULL, 1, 1, 1, 1);
+    sb_renderer_barrier(r->cmd);
+    dispatch(r, KERNEL_PROBE_LIGHT, 0, NULL, r->probe_count, 1, SB_PROBE_THREADS, 1);
+}
+
+static enum sb_result aerial_create(struct sb_renderer *r)
+{
+    sb_pass_read_atmosphere(r);
+    sb_pass_use(r, SB_VIEW_BINDING_AERIAL_OUT, sb_pass_find(r, "aerial"), SB_USE_STORE);
+    sb_pass_use(r, SB_VIEW_BINDING_AERIAL_T_OUT, sb_pass_find(r, "aerial transmittance"), SB_USE_STORE);
+    return create_kernel(r, KERNEL_AERIAL);
+}
+
+static void record_aerial(struct sb_renderer *r)
+{
+    dispatch(r, KERNEL_AERIAL, 0, NULL, SB_AERIAL_SIZE, SB_AERIAL_SIZE, SB_WORKGROUP_X, SB_WORKGROUP_Y);
+}
+
+static enum sb_result shadows_create(struct sb_renderer *r)
+{
+    if (r->scene_traced) /* shadow rays instead */
+        return SB_OK;
+    sb_pass_use(r, SB_VIEW_BINDING_FRAME, sb_pass_find(r, "frame"), SB_USE_LOAD);
+    sb_pass_use(r, SB_VIEW_BINDING_VERTICES, sb_pass_find(r, "vertices"), SB_USE_LOAD);
+    sb_pass_use(r, SB_NO_BINDING, sb_pass_find(r, "shadow cascades"), SB_USE_DEPTH_TARGET);
+    struct sb_graphics_pipeline_params shadow = {
+        .vertex_spirv = sb_spv_shadow_vert,
+        .vertex_size = sizeof(sb_spv_shadow_vert),
+        .depth_format = SHADOW_FORMAT,
+        .depth_compare = VK_COMPARE_OP_LESS,
+        .depth_clamp = true, /* casters behind the near plane still cast ("pancaking") */
+        .depth_bias_constant = 1.0f,
+        .depth_bias_slope = 1.5f,
+        .name = "shadow cascades",
+    };
+    enum sb_result res = sb_pass_layout(r, &shadow.layout);
+    return res ? res : sb_graphics_pipeline_create(r->vk, &shadow, &r->shadow_pipeline);
+}
+
 /* Depth attachments are written in the attachment-optimal layout (a general
  * one costs NVIDIA its depth compression: the H200 drew the cascades in
  * 2.46 ms from the general layout, 1.30 ms from this one)
- * and read in the read-only one. Their contents do not survive a frame. */
+ * and read in the read-only one (graph.c). Their contents do not survive a frame. */
 #define DEPTH_WRITE VK_IMAGE_LAYOUT_DEPTH_STENCIL_ATTACHMENT_OPTIMAL
-#define DEPTH_READ VK_IMAGE_LAYOUT_DEPTH_STENCIL_READ_ONLY_OPTIMAL
 
 static void record_shadows(struct sb_renderer *r)
 {
     if (r->scene_traced) /* shadow rays instead */
         return;
     uint32_t s = r->params.shadow_size;
-    sb_texture_barrier(r->cmd, &r->shadow, VK_IMAGE_LAYOUT_UNDEFINED, DEPTH_WRITE); /* cleared anyway */
-    vkCmdBindPipeline(r->cmd, VK_PIPELINE_BIND_POINT_GRAPHICS, r->shadow_pipeline);
-    vkCmdBindDescriptorSets(r->cmd, VK_PIPELINE_BIND_POINT_GRAPHICS, r->layout, 0, 1, &r->set, 0, NULL);
+    sb_renderer_bind_graphics(r, r->shadow_pipeline, NULL);
+    const VkPipelineLayout layout = r->graph.passes[r->pass].layout;
     for (uint32_t c = 0; c < SB_CASCADES; c++) {
         const int32_t *clear = r->cascade_clear[c];
         if (clear[0] >= clear[2] || clear[1] >= clear[3])
@@ -1151,11 +1007,63 @@ static void record_shadows(struct sb_renderer *r)
         set_viewport(r->cmd, s, s);
         vkCmdSetScissor(r->cmd, 0, 1, &area);
         struct sb_view_push push = {.cascade = c};
-        vkCmdPushConstants(r->cmd, r->layout, VK_SHADER_STAGE_ALL, 0, sizeof(push), &push);
+        vkCmdPushConstants(r->cmd, layout, VK_SHADER_STAGE_ALL, 0, sizeof(push), &push);
         vkCmdDraw(r->cmd, r->vertex_count - r->caster_first_vertex, 1, r->caster_first_vertex, 0);
         vkCmdEndRendering(r->cmd);
     }
-    sb_texture_barrier(r->cmd, &r->shadow, DEPTH_WRITE, DEPTH_READ);
+}
+
+static enum sb_result scene_create(struct sb_renderer *r)
+{
+    sb_pass_read_atmosphere(r);
+    sb_pass_use(r, SB_VIEW_BINDING_VERTICES, sb_pass_find(r, "vertices"), SB_USE_LOAD);
+    sb_pass_sample(r, SB_VIEW_BINDING_AERIAL, sb_pass_find(r, "aerial"), NULL);
+    sb_pass_sample(r, SB_VIEW_BINDING_AERIAL_T, sb_pass_find(r, "aerial transmittance"), NULL);
+    static const struct {
+        uint32_t binding;
+        const char *name;
+    } buffers[] = {
+        {SB_VIEW_BINDING_PROBES, "probes"},           {SB_VIEW_BINDING_PROBE_LIGHT, "probe light"},
+        {SB_VIEW_BINDING_REFLECTIONS, "reflections"}, {SB_VIEW_BINDING_REFLECTION_CUBES, "reflection cubes"},
+        {SB_VIEW_BINDING_CLOUDS, "clouds"},
+    };
+    for (size_t i = 0; i < sizeof(buffers) / sizeof(buffers[0]); i++)
+        sb_pass_use(r, buffers[i].binding, sb_pass_find(r, buffers[i].name), SB_USE_LOAD);
+    sb_pass_sample(r, SB_VIEW_BINDING_CLOUD_SHADOW, sb_pass_find(r, "cloud shadow"), NULL);
+    if (r->scene_traced)
+        return sb_scene_trace_create_pass(r);
+    sb_pass_sample(r, SB_VIEW_BINDING_SHADOW, sb_pass_find(r, "shadow cascades"), r->shadow_compare);
+    sb_pass_use(r, SB_NO_BINDING, r->hdr_id, SB_USE_COLOR_TARGET);
+    sb_pass_use(r, SB_NO_BINDING, sb_pass_find(r, "depth"), SB_USE_DEPTH_TARGET);
+    /* scene.frag's specialization: what the pack holds */
+    bool generic = r->params.generic_shaders;
+    const VkBool32 has[2] = {generic || r->probe_count > 0, generic || r->reflection_count > 0};
+    const VkSpecializationMapEntry entries[2] = {
+        {.constantID = 0, .offset = 0, .size = sizeof(VkBool32)},
+        {.constantID = 1, .offset = sizeof(VkBool32), .size = sizeof(VkBool32)},
+    };
+    const VkSpecializationInfo specialization = {
+        .mapEntryCount = 2, .pMapEntries = entries, .dataSize = sizeof(has), .pData = has};
+    struct sb_graphics_pipeline_params scene = {
+        .fragment_specialization = &specialization,
+        .vertex_spirv = sb_spv_scene_vert,
+        .vertex_size = sizeof(sb_spv_scene_vert),
+        .fragment_spirv = sb_spv_scene_frag,
+        .fragment_size = sizeof(sb_spv_scene_frag),
+        .color_format = SB_HDR_FORMAT,
+        .depth_format = SB_DEPTH_FORMAT,
+        .depth_compare = VK_COMPARE_OP_GREATER, /* reverse Z */
+        .name = "scene",
+    };
+    enum sb_result res = sb_pass_layout(r, &scene.layout);
+    if (!res)
+        res = sb_graphics_pipeline_create(r->vk, &scene, &r->scene_pipeline);
+    scene.fragment_spirv = sb_spv_scene_frag_volume;
+    scene.fragment_size = sizeof(sb_spv_scene_frag_volume);
+    scene.name = "scene (aerial volume only)";
+    if (!res)
+        res = sb_graphics_pipeline_create(r->vk, &scene, &r->scene_volume_pipeline);
+    return res;
 }
 
 static void record_scene(struct sb_renderer *r)
@@ -1164,8 +1072,6 @@ static void record_scene(struct sb_renderer *r)
         sb_scene_trace_record(r);
         return;
     }
-    sb_texture_barrier(r->cmd, &r->hdr, VK_IMAGE_LAYOUT_UNDEFINED, VK_IMAGE_LAYOUT_COLOR_ATTACHMENT_OPTIMAL);
-    sb_texture_barrier(r->cmd, &r->depth, VK_IMAGE_LAYOUT_UNDEFINED, DEPTH_WRITE);
     VkRenderingAttachmentInfo color = {
         .sType = VK_STRUCTURE_TYPE_RENDERING_ATTACHMENT_INFO,
         .imageView = r->hdr.view,
@@ -1191,15 +1097,69 @@ static void record_scene(struct sb_renderer *r)
     };
     vkCmdBeginRendering(r->cmd, &info);
     set_viewport(r->cmd, r->width, r->height);
-    vkCmdBindPipeline(r->cmd, VK_PIPELINE_BIND_POINT_GRAPHICS,
-                      r->aerial_volume_only ? r->scene_volume_pipeline : r->scene_pipeline);
-    vkCmdBindDescriptorSets(r->cmd, VK_PIPELINE_BIND_POINT_GRAPHICS, r->layout, 0, 1, &r->set, 0, NULL);
-    struct sb_view_push push = {0};
-    vkCmdPushConstants(r->cmd, r->layout, VK_SHADER_STAGE_ALL, 0, sizeof(push), &push);
+    sb_renderer_bind_graphics(r, r->aerial_volume_only ? r->scene_volume_pipeline : r->scene_pipeline, NULL);
     vkCmdDraw(r->cmd, r->vertex_count, 1, 0, 0);
     vkCmdEndRendering(r->cmd);
-    sb_texture_barrier(r->cmd, &r->hdr, VK_IMAGE_LAYOUT_COLOR_ATTACHMENT_OPTIMAL, VK_IMAGE_LAYOUT_GENERAL);
-    sb_texture_barrier(r->cmd, &r->depth, DEPTH_WRITE, DEPTH_READ);
+}
+
+static enum sb_result sky_create(struct sb_renderer *r)
+{
+    sb_pass_read_atmosphere(r);
+    sb_pass_sample(r, SB_VIEW_BINDING_SKY_VIEW, r->sky_view_id, NULL);
+    sb_pass_use(r, SB_VIEW_BINDING_HDR, r->hdr_id, SB_USE_LOAD_STORE);
+    sb_pass_sample(r, SB_VIEW_BINDING_DEPTH, sb_pass_find(r, "depth"), r->nearest);
+    enum sb_result res = create_kernel(r, KERNEL_SKY);
+    return res ? res : create_kernel(r, KERNEL_SKY_FROM_SPACE);
+}
+
+static void record_sky(struct sb_renderer *r)
+{
+    dispatch(r, r->camera_in_atmosphere ? KERNEL_SKY : KERNEL_SKY_FROM_SPACE, 0, NULL, r->width, r->height,
+             SB_WORKGROUP_X, SB_WORKGROUP_Y);
+}
+
+static enum sb_result exposure_create(struct sb_renderer *r)
+{
+    sb_pass_use(r, SB_VIEW_BINDING_FRAME, sb_pass_find(r, "frame"), SB_USE_LOAD);
+    sb_pass_use(r, SB_VIEW_BINDING_EXPOSURE, sb_pass_find(r, "exposure"), SB_USE_LOAD_STORE);
+    sb_pass_use(r, SB_VIEW_BINDING_HDR, r->hdr_id, SB_USE_LOAD);
+    enum sb_result res = create_kernel(r, KERNEL_HISTOGRAM);
+    return res ? res : create_kernel(r, KERNEL_EXPOSURE);
+}
+
+static void record_exposure(struct sb_renderer *r)
+{
+    dispatch(r, KERNEL_HISTOGRAM, 0, NULL, r->width, r->height, 16, 16);
+    sb_renderer_barrier(r->cmd);
+    dispatch(r, KERNEL_EXPOSURE, 0, NULL, 1, 1, 1, 1);
+}
+
+/* Bloom's steps, a set each: down step i reads level i - 1 (the frame for
+ * i = 0) and writes level i; up step i reads level i + 1 and adds into
+ * level i. */
+static enum sb_result bloom_create(struct sb_renderer *r)
+{
+    if (!r->bloom_levels)
+        return SB_OK;
+    sb_resource bloom = sb_pass_find(r, "bloom");
+    sb_pass_use(r, SB_VIEW_BINDING_FRAME, sb_pass_find(r, "frame"), SB_USE_LOAD);
+    sb_pass_use(r, SB_VIEW_BINDING_EXPOSURE, sb_pass_find(r, "exposure"), SB_USE_LOAD);
+    sb_pass_sample(r, SB_VIEW_BINDING_BLOOM_SRC, r->hdr_id, NULL);
+    sb_pass_use(r, SB_VIEW_BINDING_BLOOM_DST, bloom, SB_USE_LOAD_STORE);
+    sb_pass_sets(r, SB_BLOOM_SETS);
+    VkImageView mip[SB_BLOOM_MAX_LEVELS];
+    for (uint32_t i = 0; i < SB_BLOOM_MAX_LEVELS; i++)
+        mip[i] = r->bloom.subview_count ? r->bloom.subviews[i < r->bloom_levels ? i : 0] : r->bloom.view;
+    for (uint32_t i = 0; i < SB_BLOOM_MAX_LEVELS; i++) {
+        if (i > 0)
+            sb_pass_set_view(r, i, SB_VIEW_BINDING_BLOOM_SRC, mip[i - 1]);
+        sb_pass_set_view(r, i, SB_VIEW_BINDING_BLOOM_DST, mip[i]);
+        sb_pass_set_view(r, SB_BLOOM_MAX_LEVELS + i, SB_VIEW_BINDING_BLOOM_SRC,
+                         mip[i + 1 < SB_BLOOM_MAX_LEVELS ? i + 1 : i]);
+        sb_pass_set_view(r, SB_BLOOM_MAX_LEVELS + i, SB_VIEW_BINDING_BLOOM_DST, mip[i]);
+    }
+    enum sb_result res = create_kernel(r, KERNEL_BLOOM_DOWN);
+    return res ? res : create_kernel(r, KERNEL_BLOOM_UP);
 }
 
 static void record_bloom(struct sb_renderer *r)
@@ -1209,65 +1169,53 @@ static void record_bloom(struct sb_renderer *r)
     uint32_t w = r->bloom.width, h = r->bloom.height;
     for (uint32_t i = 0; i < r->bloom_levels; i++) {
         struct sb_view_push push = {.level = i, .first_level = i == 0};
-        dispatch(r, KERNEL_BLOOM_DOWN, r->bloom_sets[i], &push, w >> i ? w >> i : 1, h >> i ? h >> i : 1,
-                 SB_WORKGROUP_X, SB_WORKGROUP_Y);
-        sb_renderer_barrier(r->cmd);
+        dispatch(r, KERNEL_BLOOM_DOWN, i, &push, w >> i ? w >> i : 1, h >> i ? h >> i : 1, SB_WORKGROUP_X,
+                 SB_WORKGROUP_Y);
+        if (r->bloom_levels > 1) /* the up steps read it */
+            sb_renderer_barrier(r->cmd);
     }
     for (uint32_t i = r->bloom_levels - 1; i-- > 0;) {
         struct sb_view_push push = {.level = i};
-        dispatch(r, KERNEL_BLOOM_UP, r->bloom_sets[SB_BLOOM_MAX_LEVELS + i], &push, w >> i ? w >> i : 1,
-                 h >> i ? h >> i : 1, SB_WORKGROUP_X, SB_WORKGROUP_Y);
-        sb_renderer_barrier(r->cmd);
+        dispatch(r, KERNEL_BLOOM_UP, SB_BLOOM_MAX_LEVELS + i, &push, w >> i ? w >> i : 1, h >> i ? h >> i : 1,
+                 SB_WORKGROUP_X, SB_WORKGROUP_Y);
+        if (i > 0)
+            sb_renderer_barrier(r->cmd);
     }
 }
 
-static void record_sky_view(struct sb_renderer *r)
+static enum sb_result tonemap_create(struct sb_renderer *r)
 {
-    dispatch(r, KERNEL_SKY_VIEW, r->set, NULL, SB_SKY_VIEW_WIDTH, SB_SKY_VIEW_HEIGHT, SB_WORKGROUP_X, SB_WORKGROUP_Y);
-}
-
-static void record_probes(struct sb_renderer *r)
-{
-    if (!r->probe_count)
-        return;
-    dispatch(r, KERNEL_PROBE_SKY, r->set, NULL, 1, 1, 1, 1);
-    sb_renderer_barrier(r->cmd);
-    dispatch(r, KERNEL_PROBE_LIGHT, r->set, NULL, r->probe_count, 1, SB_PROBE_THREADS, 1);
-}
-
-static void record_aerial(struct sb_renderer *r)
-{
-    dispatch(r, KERNEL_AERIAL, r->set, NULL, SB_AERIAL_SIZE, SB_AERIAL_SIZE, SB_WORKGROUP_X, SB_WORKGROUP_Y);
-}
-
-static void record_sky(struct sb_renderer *r)
-{
-    dispatch(r, r->camera_in_atmosphere ? KERNEL_SKY : KERNEL_SKY_FROM_SPACE, r->set, NULL, r->width, r->height,
-             SB_WORKGROUP_X, SB_WORKGROUP_Y);
-}
-
-static void record_exposure(struct sb_renderer *r)
-{
-    dispatch(r, KERNEL_HISTOGRAM, r->set, NULL, r->width, r->height, 16, 16);
-    sb_renderer_barrier(r->cmd);
-    dispatch(r, KERNEL_EXPOSURE, r->set, NULL, 1, 1, 1, 1);
+    sb_resource bloom = sb_pass_find(r, "bloom");
+    sb_pass_use(r, SB_VIEW_BINDING_FRAME, sb_pass_find(r, "frame"), SB_USE_LOAD);
+    sb_pass_use(r, SB_VIEW_BINDING_EXPOSURE, sb_pass_find(r, "exposure"), SB_USE_LOAD);
+    sb_pass_use(r, SB_VIEW_BINDING_HDR, r->hdr_id, SB_USE_LOAD);
+    sb_pass_sample(r, SB_VIEW_BINDING_BLOOM, bloom, NULL);
+    sb_pass_set_view(r, 0, SB_VIEW_BINDING_BLOOM, r->bloom.subview_count ? r->bloom.subviews[0] : r->bloom.view);
+    sb_pass_use(r, SB_VIEW_BINDING_LDR, r->ldr_id, SB_USE_STORE);
+    return create_kernel(r, KERNEL_TONEMAP);
 }
 
 static void record_tonemap(struct sb_renderer *r)
 {
-    dispatch(r, KERNEL_TONEMAP, r->set, NULL, r->width, r->height, SB_WORKGROUP_X, SB_WORKGROUP_Y);
+    dispatch(r, KERNEL_TONEMAP, 0, NULL, r->width, r->height, SB_WORKGROUP_X, SB_WORKGROUP_Y);
 }
 
-static const struct sb_pass_class pass_sky_view = {.name = "sky-view", .record = record_sky_view};
-static const struct sb_pass_class pass_probes = {.name = "probes", .record = record_probes};
-static const struct sb_pass_class pass_aerial = {.name = "aerial perspective", .record = record_aerial};
-static const struct sb_pass_class pass_shadows = {.name = "shadows", .record = record_shadows};
-static const struct sb_pass_class pass_scene = {.name = "scene", .record = record_scene};
-static const struct sb_pass_class pass_sky = {.name = "sky", .record = record_sky};
-static const struct sb_pass_class pass_exposure = {.name = "exposure", .record = record_exposure};
+static const struct sb_pass_class pass_sky_view = {
+    .name = "sky-view", .create = sky_view_create, .record = record_sky_view};
+static const struct sb_pass_class pass_probes = {.name = "probes", .create = probes_create, .record = record_probes};
+static const struct sb_pass_class pass_aerial = {
+    .name = "aerial perspective", .create = aerial_create, .record = record_aerial};
+static const struct sb_pass_class pass_shadows = {
+    .name = "shadows", .create = shadows_create, .record = record_shadows};
+static const struct sb_pass_class pass_scene = {.name = "scene", .create = scene_create, .record = record_scene};
+static const struct sb_pass_class pass_sky = {.name = "sky", .create = sky_create, .record = record_sky};
+static const struct sb_pass_class pass_exposure = {
+    .name = "exposure", .post = true, .create = exposure_create, .record = record_exposure};
 /* Left out, the tone curve adds no bloom (fill_frame). */
-static const struct sb_pass_class pass_bloom = {.name = "bloom", .record = record_bloom, .optional = true};
-static const struct sb_pass_class pass_tonemap = {.name = "tonemap", .record = record_tonemap};
+static const struct sb_pass_class pass_bloom = {
+    .name = "bloom", .post = true, .create = bloom_create, .record = record_bloom, .optional = true};
+static const struct sb_pass_class pass_tonemap = {
+    .name = "tonemap", .post = true, .create = tonemap_create, .record = record_tonemap};
 
 /* A frame's passes, in order (enum sb_pass). */
 static const struct sb_pass_class *const pass_classes[SB_PASS_COUNT] = {
@@ -1290,16 +1238,16 @@ static const struct sb_pass_class *const pass_classes[SB_PASS_COUNT] = {
     [SB_PASS_GRADE] = &sb_pass_grade, /* grade.c */
 };
 
-/* Copies leave the general layout for the transfer-optimal one and come back. */
-static void copy_image(struct sb_renderer *r, const struct sb_texture *t, const struct sb_buffer *b)
+/* A readback: the whole of an image into a host-visible buffer. */
+static void copy_image(struct sb_renderer *r, sb_resource image, const struct sb_buffer *b)
 {
+    const struct sb_texture *t = sb_graph_texture(r, image);
     VkBufferImageCopy region = {
         .imageSubresource = {VK_IMAGE_ASPECT_COLOR_BIT, 0, 0, 1},
         .imageExtent = {t->width, t->height, 1},
     };
-    sb_texture_barrier(r->cmd, t, VK_IMAGE_LAYOUT_GENERAL, VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL);
+    sb_graph_access(r, image, SB_USE_COPY_SRC);
     vkCmdCopyImageToBuffer(r->cmd, t->image, VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL, b->buffer, 1, &region);
-    sb_texture_barrier(r->cmd, t, VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL, VK_IMAGE_LAYOUT_GENERAL);
 }
 
 /* The lit frame replaced by params.post_input's (its halves, uploaded once). */
@@ -1309,11 +1257,9 @@ static void copy_input(struct sb_renderer *r)
         .imageSubresource = {VK_IMAGE_ASPECT_COLOR_BIT, 0, 0, 1},
         .imageExtent = {r->width, r->height, 1},
     };
-    sb_texture_barrier(r->cmd, &r->hdr, VK_IMAGE_LAYOUT_GENERAL, VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL);
+    sb_graph_access(r, r->hdr_id, SB_USE_COPY_DST);
     vkCmdCopyBufferToImage(r->cmd, r->post_input.buffer, r->hdr.image, VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL, 1,
                            &region);
-    sb_texture_barrier(r->cmd, &r->hdr, VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL, VK_IMAGE_LAYOUT_GENERAL);
-    sb_renderer_barrier(r->cmd);
 }
 
 /*
@@ -1395,6 +1341,7 @@ static enum sb_result render_once(struct sb_renderer *r, const struct sb_view *v
         .flags = VK_COMMAND_BUFFER_USAGE_ONE_TIME_SUBMIT_BIT,
     };
     VK(vkBeginCommandBuffer(r->cmd, &begin));
+    sb_graph_begin_frame(r);
     if (r->queries)
         vkCmdResetQueryPool(r->cmd, r->queries, 0, 2 * SB_PASS_COUNT);
 
@@ -1404,32 +1351,36 @@ static enum sb_result render_once(struct sb_renderer *r, const struct sb_view *v
     for (int p = 0; p < SB_PASS_COUNT; p++)
         if (pass_classes[p]->optional && (view->disabled_passes >> p & 1 || (disabled & pass_classes[p]->needs) != 0))
             disabled |= 1u << p;
-    for (int p = 0; p < SB_PASS_COUNT; p++) {
+    for (r->pass = 0; r->pass < SB_PASS_COUNT; r->pass++) {
+        int p = r->pass;
+        if (p == r->first_post) { /* the lit frame is whole: post-processing takes it from here */
+            if (r->params.post_input)
+                copy_input(r);
+            if (readback)
+                copy_image(r, r->hdr_id, &r->read_hdr);
+        }
+        /* A pass's time: from the end of every command before it to the end
+         * of its own, what it adds to the frame where passes overlap. */
         if (r->queries)
-            vkCmdWriteTimestamp(r->cmd, VK_PIPELINE_STAGE_TOP_OF_PIPE_BIT, r->queries, 2 * p);
+            vkCmdWriteTimestamp(r->cmd, VK_PIPELINE_STAGE_BOTTOM_OF_PIPE_BIT, r->queries, 2 * p);
         if (disabled >> p & 1) {
             if (pass_classes[p]->skipped)
                 pass_classes[p]->skipped(r);
         } else {
+            sb_graph_before_pass(r, p);
             pass_classes[p]->record(r);
         }
         if (r->queries)
             vkCmdWriteTimestamp(r->cmd, VK_PIPELINE_STAGE_BOTTOM_OF_PIPE_BIT, r->queries, 2 * p + 1);
-        sb_renderer_barrier(r->cmd);
-        if (p == SB_PASS_LAST_LIT) { /* the lit frame is whole: post-processing takes it from here */
-            if (r->params.post_input)
-                copy_input(r);
-            if (readback)
-                copy_image(r, &r->hdr, &r->read_hdr);
-        }
     }
 
     if (readback) {
-        copy_image(r, &r->ldr, &r->read_ldr);
+        copy_image(r, r->ldr_id, &r->read_ldr);
         if (r->post_in_place)
-            copy_image(r, &r->hdr, &r->read_post);
-        copy_image(r, &r->sky_view, &r->read_sky_view);
+            copy_image(r, r->hdr_id, &r->read_post);
+        copy_image(r, r->sky_view_id, &r->read_sky_view);
     }
+    sb_graph_end_frame(r);
     VkMemoryBarrier to_host = {
         .sType = VK_STRUCTURE_TYPE_MEMORY_BARRIER,
         .srcAccessMask = VK_ACCESS_MEMORY_WRITE_BIT,

@@ -130,7 +130,6 @@ enum sb_pass {
     SB_PASS_SKY,
     SB_PASS_CLOUDS,
     SB_PASS_FOG_APPLY,
-    SB_PASS_LAST_LIT = SB_PASS_FOG_APPLY, /* the last pass that lights the frame; post-processing follows */
     SB_PASS_PURKINJE,
     SB_PASS_EXPOSURE,
     SB_PASS_LOCAL_TONEMAP,

@@ -4,17 +4,17 @@
  * adding a pass is a file that defines its class, an entry in enum sb_pass
  * (renderer.h) and one in that table (renderer.c).
  *
- * Every pass sees one descriptor set layout, the bindings of config.h's
- * SB_VIEW_BINDING_*: the renderer binds its own resources, and a pass binds
- * the ones it owns in its create hook (sb_renderer_bind_*), before the sets
- * are written. Every binding must be bound by then, so a pass that has
- * nothing to do in a frame still binds (small) resources.
+ * A pass's create hook makes what it owns, adds it to the render graph's
+ * table of resources (graph.h), and declares what it uses of the table,
+ * through which bindings of config.h's SB_VIEW_BINDING_*; the graph gives
+ * it its own descriptor set and the barriers before it.
  */
 #ifndef SB_RUNTIME_RENDERER_INTERNAL_H
 #define SB_RUNTIME_RENDERER_INTERNAL_H
 
 #include "compute.h"
 #include "config.h"
+#include "graph.h"
 #include "renderer.h"
 #include "shadows.h"
 #include "texture.h"
@@ -30,6 +30,7 @@ struct sb_image;
 #define SB_HDR_FORMAT VK_FORMAT_R16G16B16A16_SFLOAT
 #define SB_DEPTH_FORMAT VK_FORMAT_D32_SFLOAT
 #define SB_BLOOM_SETS (2 * SB_BLOOM_MAX_LEVELS)
+_Static_assert(SB_BLOOM_SETS <= SB_GRAPH_MAX_SETS, "a bloom step a set");
 
 enum compute_kernel {
     KERNEL_SKY_VIEW,
@@ -78,29 +79,21 @@ struct sb_renderer {
     uint32_t reflection_count;                      /* reflection probes the scene reads (0: none) */
     struct sb_buffer read_ldr, read_hdr, read_sky_view;
     struct sb_buffer read_post;  /* the HDR frame after post-processing, when post_in_place */
-    bool post_in_place;          /* a pass after SB_PASS_LAST_LIT changes the HDR frame in place: each such
-                                    pass sets it in its create hook when it will run */
+    bool post_in_place;          /* a post-processing pass writes the HDR frame (from the graph) */
+    int first_post;              /* the first post-processing pass: the lit frame is whole before it */
     struct sb_buffer post_input; /* params.post_input as halves, or none */
 
     struct sb_texture sky_view, aerial, aerial_t, shadow, hdr, depth, bloom, ldr;
     VkSampler linear, nearest, shadow_compare, repeat; /* repeat: linear, wrapping (tileable noise) */
 
-    /* What each binding of the sets points at (sb_renderer_bind_*). */
-    const struct sb_buffer *bound_buffer[SB_VIEW_BINDING_COUNT];
-    VkImageView bound_view[SB_VIEW_BINDING_COUNT];
-    VkSampler bound_sampler[SB_VIEW_BINDING_COUNT]; /* NULL: the renderer's choice */
-
-    VkDescriptorSetLayout set_layout;
-    VkPipelineLayout layout;
-    VkDescriptorPool pool;
-    VkDescriptorSet set;                       /* everything, bloom bindings at level 0 */
-    VkDescriptorSet bloom_sets[SB_BLOOM_SETS]; /* down steps 0..L-1, then up steps */
+    struct sb_graph graph; /* graph.h */
+    int pass;              /* the pass being created or recorded */
+    sb_resource hdr_id, ldr_id, sky_view_id;
     VkPipeline kernels[KERNEL_COUNT];
     VkPipeline shadow_pipeline, scene_pipeline;
     VkPipeline scene_volume_pipeline;          /* aerial perspective from its volume alone (aerial.glsl) */
     VkPipeline scene_trace[2];                 /* traced: generic, aerial perspective from its volume alone */
-    struct sb_buffer bvh_nodes, bvh_triangles; /* the world's BVH when traced, else stand-ins */
-    struct sb_texture depth_stand_in;          /* the depth output's binding when rasterised */
+    struct sb_buffer bvh_nodes, bvh_triangles; /* the world's BVH when traced */
 
     struct sb_fog *fog;                     /* fog.c */
     struct sb_clouds *clouds;               /* clouds.c */
@@ -118,11 +111,15 @@ struct sb_renderer {
 };
 
 /* A pass: hooks called in sb_pass_classes' order. `create` (may be NULL)
- * makes what the pass owns and binds it; `destroy` (may be NULL) frees it
- * and accepts a partly created pass; `record` adds the pass's commands to
- * r->cmd (its timestamps and the barrier after it are the renderer's). */
+ * makes what the pass owns, adds it to the graph's table and declares its
+ * uses (graph.h); `destroy` (may be NULL) frees it and accepts a partly
+ * created pass; `record` adds the pass's commands to r->cmd (its
+ * timestamps and the barriers before it are the renderer's). */
 struct sb_pass_class {
     const char *name; /* in timing tables */
+    /* Post-processing: it takes the lit frame, which is whole before the
+     * first such pass (readback, params.post_input). */
+    bool post;
     enum sb_result (*create)(struct sb_renderer *r);
     void (*destroy)(struct sb_renderer *r);
     void (*record)(struct sb_renderer *r);
@@ -136,10 +133,11 @@ struct sb_pass_class {
     uint32_t needs;
 };
 
-/* scene_trace.c: whether to trace the scene; the BVH and kernels (stand-ins
- * when not traced), bound; a frame's traced scene pass. */
+/* scene_trace.c: whether to trace the scene; the BVH (none when not
+ * traced); the traced scene pass's uses and kernels, and a frame of it. */
 bool sb_scene_trace_wanted(const struct sb_renderer_params *params, const struct sb_vk *vk, uint32_t vertex_count);
 enum sb_result sb_scene_trace_create(struct sb_renderer *r, const struct sb_world *world);
+enum sb_result sb_scene_trace_create_pass(struct sb_renderer *r);
 void sb_scene_trace_destroy(struct sb_renderer *r);
 void sb_scene_trace_record(struct sb_renderer *r);
 
@@ -152,11 +150,12 @@ extern const struct sb_pass_class sb_pass_local_tonemap; /* local_tonemap.c: bas
 extern const struct sb_pass_class sb_pass_grade_linear;  /* grade.c: scene-linear grading (and its resources) */
 extern const struct sb_pass_class sb_pass_grade;         /* grade.c: the LUT on the display-referred frame */
 
-/* Point a binding at a buffer, or at an image view with a sampler (NULL:
- * linear filtering clamped to the edge). They are kept by pointer or handle
- * and must outlive the renderer's sets. */
-void sb_renderer_bind_buffer(struct sb_renderer *r, uint32_t binding, const struct sb_buffer *buffer);
-void sb_renderer_bind_view(struct sb_renderer *r, uint32_t binding, VkImageView view, VkSampler sampler);
+/* In a create hook: the pass reads the atmosphere (its parameters and
+ * LUTs, SB_BINDING_*) and the frame constants (SB_VIEW_BINDING_FRAME). */
+void sb_pass_read_atmosphere(struct sb_renderer *r);
+/* The resource the renderer or an earlier pass added under `name`, which
+ * must be there. */
+sb_resource sb_pass_find(struct sb_renderer *r, const char *name);
 
 /* A host-visible storage buffer of `bytes`, filled from `data` unless NULL (then zeroed). */
 enum sb_result sb_renderer_upload(struct sb_renderer *r, const void *data, size_t bytes, const char *name,
@@ -168,25 +167,27 @@ enum sb_result sb_renderer_upload(struct sb_renderer *r, const void *data, size_
 enum sb_result sb_renderer_upload_image(struct sb_renderer *r, const struct sb_image *image, bool volume, float fill,
                                         const char *name, struct sb_texture *texture);
 
-/* A compute pipeline on the renderer's layout. */
+/* A compute pipeline on the pass's layout (its uses declared before). */
 enum sb_result sb_renderer_kernel(struct sb_renderer *r, const uint32_t *spirv, size_t spirv_size, const char *name,
                                   VkPipeline *pipeline);
 
-/* Record a dispatch of `pipeline` on the main set covering width x height x
- * depth invocations in groups of group_x x group_y x group_z. */
+/* Record a dispatch of `pipeline` with the pass's first set (or set `set`)
+ * covering width x height x depth invocations in groups of group_x x
+ * group_y x group_z. */
 void sb_renderer_dispatch(struct sb_renderer *r, VkPipeline pipeline, const struct sb_view_push *push,
                           const uint32_t size[3], const uint32_t group[3]);
-
-/* Record a copy of the whole of `src` into `dst` (same size and format),
- * both in the general layout before and after. */
-void sb_renderer_copy_texture(struct sb_renderer *r, const struct sb_texture *src, const struct sb_texture *dst);
+void sb_renderer_dispatch_set(struct sb_renderer *r, uint32_t set, VkPipeline pipeline, const struct sb_view_push *push,
+                              const uint32_t size[3], const uint32_t group[3]);
+/* Bind a graphics pipeline, the pass's first set and `push`. */
+void sb_renderer_bind_graphics(struct sb_renderer *r, VkPipeline pipeline, const struct sb_view_push *push);
 
 /* Destroy what a pass made: its pipelines (VK_NULL_HANDLE ones skipped) and
  * textures (zeroed ones accepted). */
 void sb_renderer_release(struct sb_renderer *r, const VkPipeline *pipelines, size_t pipeline_count,
                          struct sb_texture *const *textures, size_t texture_count);
 
-/* A full memory barrier: every earlier command's writes before every later command. */
+/* A full memory barrier: every earlier command's writes before every later
+ * command (between the steps of a pass). */
 void sb_renderer_barrier(VkCommandBuffer cmd);
 
 #endif

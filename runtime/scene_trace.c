@@ -37,12 +37,8 @@ bool sb_scene_trace_wanted(const struct sb_renderer_params *params, const struct
 enum sb_result sb_scene_trace_create(struct sb_renderer *r, const struct sb_world *world)
 {
     enum sb_result res = SB_OK;
-    if (!r->scene_traced) { /* stand-ins for the bindings */
-        res = sb_renderer_upload(r, NULL, sizeof(struct sb_bvh_node), "BVH stand-in", &r->bvh_nodes);
-        if (!res)
-            res = sb_renderer_upload(r, NULL, sizeof(struct sb_bvh_triangle), "BVH stand-in", &r->bvh_triangles);
-        return res;
-    }
+    if (!r->scene_traced)
+        return SB_OK;
     struct sb_mesh mesh;
     struct sb_bvh bvh = {0};
     if ((res = sb_world_mesh(world, false, &mesh)))
@@ -58,8 +54,17 @@ enum sb_result sb_scene_trace_create(struct sb_renderer *r, const struct sb_worl
         sb_info("scene traced: %u triangles, a BVH of %u nodes, %u deep", bvh.triangle_count, bvh.node_count,
                 bvh.depth);
     sb_bvh_finish(&bvh);
-    if (!res)
-        res = sb_renderer_kernel(r, sb_spv_scene_trace, sizeof(sb_spv_scene_trace), "scene traced", &r->scene_trace[0]);
+    return res;
+}
+
+enum sb_result sb_scene_trace_create_pass(struct sb_renderer *r)
+{
+    sb_pass_use(r, SB_VIEW_BINDING_HDR, r->hdr_id, SB_USE_OVERWRITE);
+    sb_pass_use(r, SB_VIEW_BINDING_DEPTH_OUT, sb_pass_find(r, "depth"), SB_USE_OVERWRITE);
+    sb_pass_use(r, SB_VIEW_BINDING_BVH_NODES, sb_pass_find(r, "bvh nodes"), SB_USE_LOAD);
+    sb_pass_use(r, SB_VIEW_BINDING_BVH_TRIANGLES, sb_pass_find(r, "bvh triangles"), SB_USE_LOAD);
+    enum sb_result res =
+        sb_renderer_kernel(r, sb_spv_scene_trace, sizeof(sb_spv_scene_trace), "scene traced", &r->scene_trace[0]);
     if (!res)
         res = sb_renderer_kernel(r, sb_spv_scene_trace_volume, sizeof(sb_spv_scene_trace_volume),
                                  "scene traced (aerial volume only)", &r->scene_trace[1]);
@@ -75,8 +80,6 @@ void sb_scene_trace_destroy(struct sb_renderer *r)
 
 void sb_scene_trace_record(struct sb_renderer *r)
 {
-    sb_texture_barrier(r->cmd, &r->hdr, VK_IMAGE_LAYOUT_UNDEFINED, VK_IMAGE_LAYOUT_GENERAL);
-    sb_texture_barrier(r->cmd, &r->depth, VK_IMAGE_LAYOUT_UNDEFINED, VK_IMAGE_LAYOUT_GENERAL);
     VkPipeline pipeline = r->scene_trace[r->aerial_volume_only ? 1 : 0];
     sb_renderer_dispatch(r, pipeline, NULL, (const uint32_t[3]){r->width, r->height, 1},
                          (const uint32_t[3]){SB_WORKGROUP_X, SB_WORKGROUP_Y, 1});
