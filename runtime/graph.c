@@ -486,7 +486,13 @@ void sb_graph_begin_frame(struct sb_renderer *r)
     /* The last frame's commands are done (the renderer waits for them);
      * one full barrier orders this frame's after them, so the table starts
      * with nothing pending. */
-    sb_renderer_barrier(r->cmd);
+    VkMemoryBarrier all = {
+        .sType = VK_STRUCTURE_TYPE_MEMORY_BARRIER,
+        .srcAccessMask = VK_ACCESS_MEMORY_WRITE_BIT,
+        .dstAccessMask = VK_ACCESS_MEMORY_READ_BIT | VK_ACCESS_MEMORY_WRITE_BIT,
+    };
+    vkCmdPipelineBarrier(r->cmd, VK_PIPELINE_STAGE_ALL_COMMANDS_BIT, VK_PIPELINE_STAGE_ALL_COMMANDS_BIT, 0, 1, &all, 0,
+                         NULL, 0, NULL);
     for (uint32_t i = 1; i <= g->resource_count; i++) {
         struct sb_graph_resource *res = &g->resources[i];
         res->write_stages = res->read_stages = res->visible_stages = 0;

@@ -20,7 +20,7 @@
 #include "pack.h"
 #include "world.h"
 
-/* How the scene pass finds the world's points (runtime/scene_trace.c). */
+/* How the scene pass finds the world's points (runtime/passes/scene.c). */
 enum sb_scene_method {
     SB_SCENE_AUTO,   /* traced on a GPU, rasterised on a CPU device (llvmpipe) */
     SB_SCENE_RASTER, /* rasterised, shadows from cascaded shadow maps */
@@ -29,7 +29,7 @@ enum sb_scene_method {
 
 struct sb_lut3d;
 
-/* Scene-linear grading (runtime/grade.c): on the exposed frame (mid grey at
+/* Scene-linear grading (runtime/grading.c, passes/grade_linear.c): on the exposed frame (mid grey at
  * 0.18), before bloom and the tone curve. */
 #define SB_GRADING_NEUTRAL_K 6504.0 /* D65's correlated colour temperature */
 struct sb_grading {

@@ -296,7 +296,7 @@ struct sb_bake_push {
 #define SB_SKY_VIEW_HEIGHT 108 /* zenith angle, the horizon between rows 53 and 54 */
 #define SB_AERIAL_SIZE 32      /* x, y: screen; z: distance slices */
 #define SB_CASCADES 4
-/* The margins of a cascade's casters' box (renderer.c, shadows.glsl): the
+/* The margins of a cascade's casters' box (renderer.c, passes/shadows.c, shadows.glsl): the
  * lookups are made within SB_SHADOW_RECT_MARGIN_TEXELS of the box
  * (frame.cascade_rect), and the raster's filter (3 x 3 taps a texel apart,
  * each a bilinear compare) reads SB_SHADOW_FILTER_REACH_HALF_TEXELS / 2
@@ -349,7 +349,7 @@ struct sb_frame_gpu {
     SB_UVEC4(size);            /* xy: frame size; z: bloom levels; w: SB_DEBUG_* */
 };
 
-/* The froxel fog (fog.glsl; runtime/fog.c): a camera-aligned volume of
+/* The froxel fog (fog.glsl; runtime/passes/fog.c): a camera-aligned volume of
  * froxels, slice w in [0, 1] at distance c ((1 + far / c)^w - 1) along each
  * view ray, lit by fog_inject.comp in 4 x 4 x 4 workgroups and integrated
  * front to back by fog_integrate.comp, one invocation a column in
@@ -372,7 +372,7 @@ struct sb_fog_gpu {
     SB_VEC4(volume_max[SB_FOG_VOLUMES]); /* xyz: its max corner; w: its edge (m) */
 };
 
-/* Volumetric clouds (cloud_layer.glsl; runtime/clouds.c; docs/clouds.md): a
+/* Volumetric clouds (cloud_layer.glsl; runtime/passes/clouds.c; docs/clouds.md): a
  * layer between two altitudes over the curved planet, its density from the
  * pack's weather map, shape and detail noise and curl. cloud_shadow.comp
  * writes the shadow map (SB_WORKGROUP_X x SB_WORKGROUP_Y), cloud_trace.comp
@@ -444,7 +444,7 @@ struct sb_exposure_gpu {
  * and GLSL (vec3(SB_LUMINANCE_RGB)) alike. */
 #define SB_LUMINANCE_RGB 0.2126, 0.7152, 0.0722
 
-/* Scene-linear grading (runtime/grade.c, grade_linear.comp), on the
+/* Scene-linear grading (runtime/grading.c, passes/grade_linear.c, grade_linear.comp), on the
  * exposed frame before bloom and the tone curve: c = matrix * c (white
  * balance, then saturation), then each channel pivot * (c / pivot)^contrast,
  * then, with a LUT in ACEScct, the LUT. */
@@ -455,14 +455,14 @@ struct sb_grading_gpu {
     SB_VEC4(from_ap1[3]); /* rows: its inverse */
 };
 
-/* The Purkinje shift (runtime/purkinje.c, purkinje.comp). */
+/* The Purkinje shift (runtime/passes/purkinje.c, purkinje.comp). */
 struct sb_purkinje_gpu {
     SB_VEC4(scale); /* x: cd/m^2 per unit of stored radiance, y: its inverse,
                        z: photopic luminance (cd/m^2, no shift at or above),
                        w: scotopic luminance (the whole shift at or below) */
 };
 
-/* Local tone mapping (runtime/local_tonemap.c, local_tonemap.glsl): a
+/* Local tone mapping (runtime/passes/local_tonemap.c, local_tonemap.glsl): a
  * bilateral grid of the exposed frame's log2 luminance, SB_LTM_GRID_X
  * cells across (square, whole pixels), SB_LTM_BINS bins from SB_LTM_MIN_EV
  * to SB_LTM_MAX_EV; sums in fixed point, 1 / SB_LTM_Q EV, offset by

@@ -1,5 +1,5 @@
 #version 450
-/* Scene-linear grading (runtime/grade.c), in place on the lit frame after
+/* Scene-linear grading (runtime/grading.c, passes/grade_linear.c), in place on the lit frame after
  * exposure is metered and before bloom and the tone curve, on the exposed
  * values (mid grey at 0.18):
  * - the colour matrix: white balance (a von Kries adaptation in Bradford's

@@ -1,4 +1,4 @@
-/* Local tone mapping's shared declarations (runtime/local_tonemap.c): its
+/* Local tone mapping's shared declarations (runtime/passes/local_tonemap.c): its
  * constants and bilateral grid. The grid holds, per cell, the fixed-point
  * sum of the biased log2 luminance of the pixels that fall in it and their
  * count (exact integers, so that the result does not depend on the order

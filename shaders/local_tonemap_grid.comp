@@ -8,7 +8,7 @@
  * square left a 16 x 16 workgroup's second pass mostly idle.
  *
  * With SB_SUBGROUPS (chosen where the device's subgroups can ballot and
- * add, runtime/local_tonemap.c), the invocations of a subgroup that share a
+ * add, runtime/passes/local_tonemap.c), the invocations of a subgroup that share a
  * cell and bin add their sums first and one of them adds the total: a GPU
  * serialises atomics on one address, and one bin of one cell takes most of
  * a smooth region's pixels (the pass took 0.112 ms on an H100 at 1920 x

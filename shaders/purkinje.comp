@@ -1,5 +1,5 @@
 #version 450
-/* The Purkinje shift (runtime/purkinje.c), in place on the lit frame
+/* The Purkinje shift (runtime/passes/purkinje.c), in place on the lit frame
  * before exposure: in dim light the rods add their response to the cones',
  * and a night scene looks blue, not grey.
  *

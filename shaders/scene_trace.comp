@@ -6,7 +6,7 @@
  * writes: the lit radiance, zero where no triangle is hit (the sky pass
  * fills those), and the depth as the rasteriser's reverse-Z projection
  * would (0 for the sky). For GPUs whose rasteriser is their weak part
- * (runtime/scene_trace.c). Built with SB_AERIAL_VOLUME_ONLY too, as
+ * (runtime/passes/scene.c). Built with SB_AERIAL_VOLUME_ONLY too, as
  * scene.frag is. */
 #extension GL_GOOGLE_include_directive : require
 #include "config.h"

@@ -2,13 +2,13 @@
  * skyview's post-processing passes on the Vulkan device (validation on),
  * each against the frame rendered without it, through an fp64 model of
  * what it must do:
- * - the colour science of grading (runtime/grade.c) against published
+ * - the colour science of grading (runtime/grading.c, passes/grade_linear.c) against published
  *   values: the Planckian locus, D65, Rec.709's luminance row, the
  *   Rec.709-to-AP1 matrix; white balance making its white neutral;
  * - scene-linear grading (white balance, saturation, contrast) and a LUT in
  *   ACEScct, on the HDR frame, value by value;
  * - a LUT on the display-referred frame, byte by byte;
- * - the Purkinje shift (runtime/purkinje.c): nothing where the light is
+ * - the Purkinje shift (runtime/passes/purkinje.c): nothing where the light is
  *   photopic, the model's shift where it is not.
  */
 #include <math.h>
@@ -446,7 +446,7 @@ static double mean_step(const float *hdr, int y0, int y1)
 }
 
 /*
- * Local tone mapping (runtime/local_tonemap.c) on images given to the post
+ * Local tone mapping (runtime/passes/local_tonemap.c) on images given to the post
  * chain (params.post_input):
  * - a frame of one colour, at three levels, is left bit for bit as it was
  *   (the base layer is an exact 0 there);

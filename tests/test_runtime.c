@@ -334,7 +334,7 @@ static void test_specialised_shaders(struct sb_renderer *r, const struct sb_rend
 }
 
 /*
- * The traced scene (runtime/scene_trace.c) against Embree and against the
+ * The traced scene (runtime/passes/scene.c) against Embree and against the
  * raster scene, on views with shadows near and far:
  * - its shadows (the sun's visibility, SB_DEBUG_SUN_VISIBILITY) against
  *   Embree's: a primary ray a pixel through its centre, then a shadow ray

@@ -1,9 +1,8 @@
 /*
  * Froxel fog (docs/fog.md): the scene's "fog" in a camera-aligned volume of
  * froxels, lit each frame and blended with the last frame's (fog_inject),
- * integrated front to back (fog_integrate), then applied to the frame
- * (fog_apply). Two passes of the renderer's table: "fog", after the
- * shadows, and "fog apply", after the sky.
+ * integrated front to back (fog_integrate): "froxels" in the graph's
+ * table, which the fog apply pass (fog_apply.c) applies to the frame.
  */
 #include <math.h>
 #include <stdint.h>
@@ -16,7 +15,6 @@
 #include "renderer_internal.h"
 #include "scene.h"
 
-#include "fog_apply.spv.h"
 #include "fog_inject.spv.h"
 #include "fog_inject_traced.spv.h"
 #include "fog_integrate.spv.h"
@@ -35,7 +33,7 @@ struct sb_fog {
     struct sb_buffer params;
     struct sb_texture light[2]; /* a history: this frame's froxel light, and the last frame's */
     struct sb_texture integrated, noise;
-    VkPipeline inject, integrate, apply;
+    VkPipeline inject, integrate;
     struct sb_history history_state; /* the last frame, for reprojection */
 };
 
@@ -72,7 +70,7 @@ static enum sb_result fog_create(struct sb_renderer *r)
     struct sb_fog *f = calloc(1, sizeof(*f));
     if (!f)
         return SB_ERR_NOMEM;
-    r->fog = f;
+    sb_pass_set_data(r, f);
     const struct sb_scene *scene = r->pack->scene;
     f->medium = scene->fog;
     f->enabled =
@@ -125,35 +123,17 @@ static enum sb_result fog_create(struct sb_renderer *r)
     return res;
 }
 
-/* The froxels applied to the frame. */
-static enum sb_result fog_apply_create(struct sb_renderer *r)
-{
-    if (!r->fog->enabled)
-        return SB_OK;
-    sb_pass_read_atmosphere(r);
-    sb_pass_use(r, SB_VIEW_BINDING_HDR, sb_pass_find(r, "hdr"), SB_USE_LOAD_STORE);
-    sb_pass_sample(r, SB_VIEW_BINDING_DEPTH, sb_pass_find(r, "depth"), r->nearest);
-    sb_pass_use(r, SB_VIEW_BINDING_FOG, sb_pass_find(r, "fog"), SB_USE_LOAD);
-    sb_pass_sample(r, SB_VIEW_BINDING_FROXEL, sb_pass_find(r, "froxels"), NULL);
-    sb_pass_use(r, SB_VIEW_BINDING_PROBES, sb_pass_find(r, "probes"), SB_USE_LOAD);
-    sb_pass_use(r, SB_VIEW_BINDING_PROBE_LIGHT, sb_pass_find(r, "probe light"), SB_USE_LOAD);
-    sb_pass_use(r, SB_VIEW_BINDING_CLOUDS, sb_pass_find(r, "clouds"), SB_USE_LOAD);
-    sb_pass_sample(r, SB_VIEW_BINDING_CLOUD_SHADOW, sb_pass_find(r, "cloud shadow"), NULL);
-    return sb_renderer_kernel(r, sb_spv_fog_apply, sizeof(sb_spv_fog_apply), "fog apply", &r->fog->apply);
-}
-
 static void fog_destroy(struct sb_renderer *r)
 {
-    struct sb_fog *f = r->fog;
+    struct sb_fog *f = sb_pass_data(r);
     if (!f)
         return;
-    const VkPipeline pipelines[] = {f->inject, f->integrate, f->apply};
+    const VkPipeline pipelines[] = {f->inject, f->integrate};
     struct sb_texture *const textures[] = {&f->light[0], &f->light[1], &f->integrated, &f->noise};
     sb_renderer_release(r, pipelines, sizeof(pipelines) / sizeof(pipelines[0]), textures,
                         sizeof(textures) / sizeof(textures[0]));
     sb_buffer_destroy(r->vk, &f->params);
     free(f);
-    r->fog = NULL;
 }
 
 /* The radical inverse of i in `base`: Halton's sequence, for the jitter. */
@@ -216,7 +196,7 @@ static void fill_params(struct sb_renderer *r, struct sb_fog *f, struct sb_fog_g
 
 static void fog_record(struct sb_renderer *r)
 {
-    struct sb_fog *f = r->fog;
+    struct sb_fog *f = sb_pass_data(r);
     if (!f->enabled)
         return;
     fill_params(r, f, f->params.mapped);
@@ -226,20 +206,12 @@ static void fog_record(struct sb_renderer *r)
                          (const uint32_t[3]){SB_WORKGROUP_X, SB_WORKGROUP_Y, 1});
 }
 
-static void fog_apply_record(struct sb_renderer *r)
-{
-    struct sb_fog *f = r->fog;
-    if (!f->enabled)
-        return;
-    sb_renderer_dispatch(r, f->apply, NULL, (const uint32_t[3]){r->width, r->height, 1},
-                         (const uint32_t[3]){SB_WORKGROUP_X, SB_WORKGROUP_Y, 1});
-}
-
 /* Left out of a frame, the froxels' history goes stale: the next frame starts anew. */
 static void fog_skipped(struct sb_renderer *r)
 {
-    if (r->fog)
-        sb_history_drop(&r->fog->history_state);
+    struct sb_fog *f = sb_pass_data(r);
+    if (f)
+        sb_history_drop(&f->history_state);
 }
 
 const struct sb_pass_class sb_pass_fog = {
@@ -249,13 +221,4 @@ const struct sb_pass_class sb_pass_fog = {
     .record = fog_record,
     .optional = true,
     .skipped = fog_skipped,
-};
-
-/* It reads the froxels: the fog left out, it is too. */
-const struct sb_pass_class sb_pass_fog_apply = {
-    .name = "fog apply",
-    .create = fog_apply_create,
-    .record = fog_apply_record,
-    .optional = true,
-    .needs = 1u << SB_PASS_FOG,
 };

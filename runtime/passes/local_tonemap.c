@@ -36,7 +36,7 @@ static enum sb_result local_tonemap_create(struct sb_renderer *r)
     struct sb_local_tonemap *t = calloc(1, sizeof(*t));
     if (!t)
         return SB_ERR_NOMEM;
-    r->local_tonemap = t;
+    sb_pass_set_data(r, t);
     double contrast = r->params.local_contrast;
     t->enabled = contrast > 0.0 && contrast != 1.0;
     if (!t->enabled)
@@ -88,7 +88,7 @@ static enum sb_result local_tonemap_create(struct sb_renderer *r)
 
 static void local_tonemap_destroy(struct sb_renderer *r)
 {
-    struct sb_local_tonemap *t = r->local_tonemap;
+    struct sb_local_tonemap *t = sb_pass_data(r);
     if (!t)
         return;
     sb_renderer_release(r, (const VkPipeline[]){t->grid_kernel, t->pivot_kernel, t->blur_kernel, t->apply_kernel}, 4,
@@ -96,12 +96,11 @@ static void local_tonemap_destroy(struct sb_renderer *r)
     sb_buffer_destroy(r->vk, &t->params);
     sb_buffer_destroy(r->vk, &t->grid);
     free(t);
-    r->local_tonemap = NULL;
 }
 
 static void local_tonemap_record(struct sb_renderer *r)
 {
-    struct sb_local_tonemap *t = r->local_tonemap;
+    struct sb_local_tonemap *t = sb_pass_data(r);
     if (!t->enabled)
         return;
     const struct sb_local_tonemap_gpu *gpu = t->params.mapped;

@@ -4,8 +4,9 @@
  * scale x scale block a frame (cloud_trace), rebuilt at full resolution
  * with the last frame's result and composited (cloud_resolve); and their
  * shadow map, which the scene and the fog read (cloud_shadow). Two passes
- * of the renderer's table: "cloud shadow", after the cascades, and
- * "clouds", after the sky.
+ * of the renderer's table, "cloud shadow" after the cascades and "clouds"
+ * after the sky, in one file: they share the layer's state (its
+ * parameters, filled once a frame, and its history).
  */
 #include <math.h>
 #include <stdint.h>
@@ -44,6 +45,12 @@ struct sb_clouds {
 
 static const enum sb_product_id noise_products[4] = {SB_PRODUCT_CLOUD_SHAPE, SB_PRODUCT_CLOUD_DETAIL,
                                                      SB_PRODUCT_CLOUD_CURL, SB_PRODUCT_WEATHER};
+/* The layer's state, which both passes read: the cloud shadow pass's. */
+static struct sb_clouds *layer(struct sb_renderer *r)
+{
+    return r->pass_data[SB_PASS_CLOUD_SHADOW];
+}
+
 static const char *const noise_names[4] = {"cloud shape", "cloud detail", "cloud curl", "cloud weather"};
 
 static enum sb_result target(struct sb_renderer *r, struct sb_texture *t, uint32_t width, uint32_t height,
@@ -89,7 +96,7 @@ static enum sb_result clouds_create(struct sb_renderer *r)
     struct sb_clouds *c = calloc(1, sizeof(*c));
     if (!c)
         return SB_ERR_NOMEM;
-    r->clouds = c;
+    sb_pass_set_data(r, c);
     const struct sb_scene *scene = r->pack->scene;
     if (scene->has_cloud_layer)
         c->layer = scene->cloud_layer;
@@ -155,7 +162,7 @@ static enum sb_result clouds_create(struct sb_renderer *r)
 
 static void clouds_destroy(struct sb_renderer *r)
 {
-    struct sb_clouds *c = r->clouds;
+    struct sb_clouds *c = layer(r);
     if (!c)
         return;
     const VkPipeline pipelines[] = {c->shadow_kernel, c->trace_kernel, c->resolve_kernel};
@@ -165,7 +172,6 @@ static void clouds_destroy(struct sb_renderer *r)
                         sizeof(textures) / sizeof(textures[0]));
     sb_buffer_destroy(r->vk, &c->params);
     free(c);
-    r->clouds = NULL;
 }
 
 /* x - tile floor(x / tile): a drift kept within one tile, so fp32 holds it exactly over hours. */
@@ -243,7 +249,7 @@ static void fill_params(struct sb_renderer *r, struct sb_clouds *c, struct sb_cl
 
 static void cloud_shadow_record(struct sb_renderer *r)
 {
-    struct sb_clouds *c = r->clouds;
+    struct sb_clouds *c = layer(r);
     if (!c->enabled)
         return;
     fill_params(r, c, c->params.mapped);
@@ -253,19 +259,19 @@ static void cloud_shadow_record(struct sb_renderer *r)
 
 static void clouds_record(struct sb_renderer *r)
 {
-    struct sb_clouds *c = r->clouds;
+    struct sb_clouds *c = layer(r);
     if (!c->enabled)
         return;
     const uint32_t group[3] = {SB_WORKGROUP_X, SB_WORKGROUP_Y, 1};
     sb_renderer_dispatch(r, c->trace_kernel, NULL, (const uint32_t[3]){c->trace_size[0], c->trace_size[1], 1}, group);
     sb_renderer_barrier(r->cmd);
-    sb_renderer_dispatch(r, c->resolve_kernel, NULL, (const uint32_t[3]){r->width, r->height, 1}, group);
+    sb_renderer_dispatch_frame(r, c->resolve_kernel);
 }
 
 /* Traced, then resolved with the last frame's clouds and composited. */
 static enum sb_result clouds_pass_create(struct sb_renderer *r)
 {
-    struct sb_clouds *c = r->clouds;
+    struct sb_clouds *c = layer(r);
     if (!c->enabled)
         return SB_OK;
     sb_resource trace = sb_pass_find(r, "clouds traced"), distance = sb_pass_find(r, "clouds traced distance");
@@ -301,8 +307,8 @@ const struct sb_pass_class sb_pass_cloud_shadow = {
  * anew. (Their shadow map is another pass, which stays.) */
 static void clouds_skipped(struct sb_renderer *r)
 {
-    if (r->clouds)
-        sb_history_drop(&r->clouds->history_state);
+    if (layer(r))
+        sb_history_drop(&layer(r)->history_state);
 }
 
 const struct sb_pass_class sb_pass_clouds = {

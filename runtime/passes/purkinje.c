@@ -31,7 +31,7 @@ static enum sb_result purkinje_create(struct sb_renderer *r)
     struct sb_purkinje *p = calloc(1, sizeof(*p));
     if (!p)
         return SB_ERR_NOMEM;
-    r->purkinje = p;
+    sb_pass_set_data(r, p);
     const double *sun = r->pack->scene->atmosphere.solar_irradiance;
     static const double weights[3] = {SB_LUMINANCE_RGB};
     double sun_y = weights[0] * sun[0] + weights[1] * sun[1] + weights[2] * sun[2];
@@ -54,26 +54,25 @@ static enum sb_result purkinje_create(struct sb_renderer *r)
 
 static void purkinje_destroy(struct sb_renderer *r)
 {
-    struct sb_purkinje *p = r->purkinje;
+    struct sb_purkinje *p = sb_pass_data(r);
     if (!p)
         return;
     sb_renderer_release(r, &p->kernel, 1, NULL, 0);
     sb_buffer_destroy(r->vk, &p->params);
     free(p);
-    r->purkinje = NULL;
 }
 
 static void purkinje_record(struct sb_renderer *r)
 {
-    if (!r->purkinje->enabled)
+    struct sb_purkinje *p = sb_pass_data(r);
+    if (!p->enabled)
         return;
     /* The stored frame to cd/m^2 follows the frame's scale (pre-exposure). */
-    struct sb_purkinje_gpu *gpu = r->purkinje->params.mapped;
-    double scale = r->purkinje->cd_m2_per_unit / r->frame_scale;
+    struct sb_purkinje_gpu *gpu = p->params.mapped;
+    double scale = p->cd_m2_per_unit / r->frame_scale;
     gpu->scale[0] = (float)scale;
     gpu->scale[1] = (float)(1.0 / scale);
-    sb_renderer_dispatch(r, r->purkinje->kernel, NULL, (const uint32_t[3]){r->width, r->height, 1},
-                         (const uint32_t[3]){SB_WORKGROUP_X, SB_WORKGROUP_Y, 1});
+    sb_renderer_dispatch_frame(r, p->kernel);
 }
 
 const struct sb_pass_class sb_pass_purkinje = {

@@ -1,12 +1,9 @@
 /*
- * Colour grading, two passes of the renderer's table:
- * - "grade linear" (grade_linear.comp), on the exposed scene-linear frame
- *   before bloom and the tone curve: white balance, saturation, contrast,
- *   and a .cube LUT when it is made in ACEScct;
- * - "grade" (grade.comp), after "tonemap": a .cube LUT on the
- *   display-referred 8-bit frame.
- * Neutral settings and no LUT record nothing, so the frame is the tone
- * mapper's bit for bit. The matrices are made here in double precision.
+ * Colour grading's science, for two passes (passes/grade_linear.c on the
+ * exposed scene-linear frame, passes/grade.c on the display-referred one):
+ * white balance along the Planckian locus, saturation, contrast, the
+ * matrices to and from ACES AP1, made here in double precision; and the
+ * LUT as the shaders read it (lut3d.glsl).
  */
 #include <math.h>
 #include <stdlib.h>
@@ -14,18 +11,6 @@
 
 #include "lut3d.h"
 #include "renderer_internal.h"
-
-#include "grade.spv.h"
-#include "grade_linear.spv.h"
-#include "grade_linear_lut.spv.h"
-
-struct sb_grade {
-    bool linear;              /* the linear pass runs */
-    bool display;             /* the display pass runs */
-    struct sb_buffer lut;     /* lut3d.glsl's GradeLut: domain and size, then the entries */
-    struct sb_buffer grading; /* sb_grading_gpu */
-    VkPipeline linear_kernel, display_kernel;
-};
 
 typedef double mat3[3][3];
 
@@ -205,114 +190,34 @@ static void store_rows(const mat3 m, float (*rows)[4])
             rows[i][j] = j < 3 ? (float)m[i][j] : 0.0f;
 }
 
-static enum sb_result grade_create(struct sb_renderer *r)
+void sb_grading_gpu_fill(const struct sb_grading *grading, struct sb_grading_gpu *gpu)
 {
-    struct sb_grade *g = calloc(1, sizeof(*g));
-    if (!g)
-        return SB_ERR_NOMEM;
-    r->grade = g;
-    const struct sb_lut3d *lut = r->params.grade;
-    bool log_lut = lut && r->params.grade_log;
-    g->display = lut && !log_lut;
-    g->linear = log_lut || !sb_grading_is_neutral(&r->params.grading);
-    size_t entries = lut ? (size_t)lut->size * lut->size * lut->size * 3 : 0;
-    size_t bytes = 8 * sizeof(float) + (entries ? entries : 3) * sizeof(float);
-    enum sb_result res = sb_renderer_upload(r, NULL, bytes, "grading LUT", &g->lut);
-    if (!res)
-        res = sb_renderer_upload(r, NULL, sizeof(struct sb_grading_gpu), "grading", &g->grading);
-    if (res)
-        return res;
-    if (lut) {
-        float *dst = g->lut.mapped;
-        for (int c = 0; c < 3; c++) {
-            dst[c] = lut->domain_min[c];
-            dst[4 + c] = lut->domain_max[c];
-        }
-        dst[3] = (float)lut->size;
-        memcpy(dst + 8, lut->rgb, entries * sizeof(float));
-    }
-    struct sb_grading_gpu *gpu = g->grading.mapped;
-    bool neutral = sb_grading_is_neutral(&r->params.grading);
+    bool neutral = sb_grading_is_neutral(grading);
     mat3 m = {{1, 0, 0}, {0, 1, 0}, {0, 0, 1}}, inv; /* neutral: exactly the identity */
     if (!neutral)
-        sb_grading_matrix(&r->params.grading, m);
+        sb_grading_matrix(grading, m);
     store_rows(m, gpu->matrix);
-    gpu->tone[0] = neutral ? 1.0f : (float)r->params.grading.contrast;
+    gpu->tone[0] = neutral ? 1.0f : (float)grading->contrast;
     gpu->tone[1] = 0.18f;
     sb_rec709_to_ap1(m);
     invert3(m, inv);
     store_rows(m, gpu->to_ap1);
     store_rows(inv, gpu->from_ap1);
-    sb_resource lut_id = sb_graph_buffer(r, "grade lut", &g->lut);
-    sb_resource grading = sb_graph_buffer(r, "grading", &g->grading);
-    if (!g->linear)
-        return SB_OK;
-    sb_pass_use(r, SB_VIEW_BINDING_FRAME, sb_pass_find(r, "frame"), SB_USE_LOAD);
-    sb_pass_use(r, SB_VIEW_BINDING_EXPOSURE, sb_pass_find(r, "exposure"), SB_USE_LOAD);
-    sb_pass_use(r, SB_VIEW_BINDING_HDR, sb_pass_find(r, "hdr"), SB_USE_LOAD_STORE);
-    sb_pass_use(r, SB_VIEW_BINDING_GRADE_LUT, lut_id, SB_USE_LOAD);
-    sb_pass_use(r, SB_VIEW_BINDING_GRADING, grading, SB_USE_LOAD);
-    return log_lut ? sb_renderer_kernel(r, sb_spv_grade_linear_lut, sizeof(sb_spv_grade_linear_lut), "grade linear",
-                                        &g->linear_kernel)
-                   : sb_renderer_kernel(r, sb_spv_grade_linear, sizeof(sb_spv_grade_linear), "grade linear",
-                                        &g->linear_kernel);
 }
 
-/* The LUT on the display-referred frame. */
-static enum sb_result grade_display_create(struct sb_renderer *r)
+enum sb_result sb_grade_lut_upload(struct sb_renderer *r, const struct sb_lut3d *lut, struct sb_buffer *buffer)
 {
-    if (!r->grade->display)
-        return SB_OK;
-    sb_pass_use(r, SB_VIEW_BINDING_FRAME, sb_pass_find(r, "frame"), SB_USE_LOAD);
-    sb_pass_use(r, SB_VIEW_BINDING_LDR, sb_pass_find(r, "ldr"), SB_USE_LOAD_STORE);
-    sb_pass_use(r, SB_VIEW_BINDING_GRADE_LUT, sb_pass_find(r, "grade lut"), SB_USE_LOAD);
-    return sb_renderer_kernel(r, sb_spv_grade, sizeof(sb_spv_grade), "grade", &r->grade->display_kernel);
+    size_t entries = lut ? (size_t)lut->size * lut->size * lut->size * 3 : 0;
+    size_t bytes = 8 * sizeof(float) + (entries ? entries : 3) * sizeof(float);
+    enum sb_result res = sb_renderer_upload(r, NULL, bytes, "grading LUT", buffer);
+    if (res || !lut)
+        return res;
+    float *dst = buffer->mapped;
+    for (int c = 0; c < 3; c++) {
+        dst[c] = lut->domain_min[c];
+        dst[4 + c] = lut->domain_max[c];
+    }
+    dst[3] = (float)lut->size;
+    memcpy(dst + 8, lut->rgb, entries * sizeof(float));
+    return SB_OK;
 }
-
-static void grade_destroy(struct sb_renderer *r)
-{
-    struct sb_grade *g = r->grade;
-    if (!g)
-        return;
-    sb_renderer_release(r, (const VkPipeline[]){g->linear_kernel, g->display_kernel}, 2, NULL, 0);
-    sb_buffer_destroy(r->vk, &g->lut);
-    sb_buffer_destroy(r->vk, &g->grading);
-    free(g);
-    r->grade = NULL;
-}
-
-static void dispatch_frame(struct sb_renderer *r, VkPipeline kernel)
-{
-    sb_renderer_dispatch(r, kernel, NULL, (const uint32_t[3]){r->width, r->height, 1},
-                         (const uint32_t[3]){SB_WORKGROUP_X, SB_WORKGROUP_Y, 1});
-}
-
-static void grade_linear_record(struct sb_renderer *r)
-{
-    if (r->grade->linear)
-        dispatch_frame(r, r->grade->linear_kernel);
-}
-
-static void grade_record(struct sb_renderer *r)
-{
-    if (r->grade->display)
-        dispatch_frame(r, r->grade->display_kernel);
-}
-
-/* The linear pass creates and destroys what both use. */
-const struct sb_pass_class sb_pass_grade_linear = {
-    .name = "grade linear",
-    .post = true,
-    .create = grade_create,
-    .destroy = grade_destroy,
-    .record = grade_linear_record,
-    .optional = true,
-};
-
-const struct sb_pass_class sb_pass_grade = {
-    .name = "grade",
-    .post = true,
-    .create = grade_display_create,
-    .record = grade_record,
-    .optional = true,
-};

@@ -1,0 +1,84 @@
+/*
+ * The pack's atmosphere as skyview's passes read it (atmosphere.glsl,
+ * SB_ATMOSPHERE_TEXTURES): its parameters, and its transmittance,
+ * multiple-scattering and ground-irradiance LUTs as RGBA32F textures in
+ * the forms the shaders look up (physics.h); and the radiance scale that
+ * makes the sun's largest channel 1.
+ */
+#include <assert.h>
+#include <math.h>
+#include <stdlib.h>
+
+#include "log.h"
+#include "physics.h"
+#include "renderer_internal.h"
+#include "scene.h"
+
+/* A sampled RGBA32F texture of width x height texels from `data`, `channels`
+ * floats (3 or more) a texel: the first three, alpha 0. */
+static enum sb_result upload_rgba32f(struct sb_renderer *r, const float *data, uint32_t channels, uint32_t width,
+                                     uint32_t height, const char *name, struct sb_texture *texture)
+{
+    size_t texels = (size_t)width * height;
+    float *rgba = channels == 4 ? NULL : malloc(texels * 4 * sizeof(float));
+    if (channels != 4 && !rgba)
+        return SB_ERR_NOMEM;
+    for (size_t i = 0; rgba && i < texels; i++)
+        for (uint32_t c = 0; c < 4; c++)
+            rgba[4 * i + c] = c < 3 ? data[i * channels + c] : 0.0f;
+    struct sb_texture_params p = {
+        .width = width,
+        .height = height,
+        .format = VK_FORMAT_R32G32B32A32_SFLOAT,
+        .usage = VK_IMAGE_USAGE_SAMPLED_BIT | VK_IMAGE_USAGE_TRANSFER_DST_BIT,
+        .name = name,
+    };
+    enum sb_result res = sb_texture_create(r->vk, &p, texture);
+    if (!res)
+        res = sb_texture_upload(r->vk, texture, rgba ? rgba : data, texels * 4 * sizeof(float), 4 * sizeof(float));
+    free(rgba);
+    return res;
+}
+
+enum sb_result sb_atmosphere_upload(struct sb_renderer *r, const struct sb_pack *pack)
+{
+    static const enum sb_product_id needed[] = {SB_PRODUCT_TRANSMITTANCE, SB_PRODUCT_MULTISCATTERING,
+                                                SB_PRODUCT_IRRADIANCE_GROUND};
+    for (size_t i = 0; i < sizeof(needed) / sizeof(needed[0]); i++)
+        if (!pack->present[needed[i]]) {
+            sb_error("the pack has no %s, which skyview needs: bake a scene that asks for it",
+                     sb_product_name(needed[i]));
+            return SB_ERR_USAGE;
+        }
+    const struct sb_atmosphere_params *atm = &pack->scene->atmosphere;
+    struct sb_atmosphere_gpu gpu;
+    sb_atmosphere_gpu_pack(atm, &gpu);
+    double sun_max = fmax(atm->solar_irradiance[0], fmax(atm->solar_irradiance[1], atm->solar_irradiance[2]));
+    r->radiance_scale = sun_max > 0.0 ? 1.0 / sun_max : 1.0;
+    r->frame_scale = r->previous_frame_scale = r->next_frame_scale = r->readback_scale = r->radiance_scale;
+    r->ground_radius_km = atm->ground_radius_km;
+    r->thickness_km = gpu.radii[3];
+
+    const struct sb_image *t = &pack->images[SB_PRODUCT_TRANSMITTANCE];
+    enum sb_result res = sb_renderer_upload(r, &gpu, sizeof(gpu), "atmosphere parameters", &r->atmosphere);
+    /* Each as RGBA32F (atmosphere.glsl, SB_ATMOSPHERE_TEXTURES): the
+     * transmittance LUT; psi_ms refined; the ground irradiance's lookup form. */
+    if (!res)
+        res = upload_rgba32f(r, t->data, t->channel_count, t->width, t->height, "transmittance", &r->transmittance);
+    float *refined = res ? NULL : malloc(sb_multiscattering_refined_float_count() * sizeof(float));
+    if (!res && !refined)
+        res = SB_ERR_NOMEM;
+    if (!res) {
+        sb_multiscattering_refined_fill(&pack->images[SB_PRODUCT_MULTISCATTERING], refined);
+        res = upload_rgba32f(r, refined, 4, SB_MULTISCATTERING_REFINED_SIZE, SB_MULTISCATTERING_REFINED_SIZE,
+                             "multiscattering (refined)", &r->multiscattering);
+    }
+    free(refined);
+    float ground[SB_IRRADIANCE_WIDTH * 2 * 3]; /* two rows (physics.h) */
+    assert(sb_lookup_float_count(SB_PRODUCT_IRRADIANCE_GROUND) == sizeof(ground) / sizeof(ground[0]));
+    if (!res) {
+        sb_lookup_fill(SB_PRODUCT_IRRADIANCE_GROUND, &pack->images[SB_PRODUCT_IRRADIANCE_GROUND], ground);
+        res = upload_rgba32f(r, ground, 3, SB_IRRADIANCE_WIDTH, 2, "irradiance_ground (lookup)", &r->irradiance_ground);
+    }
+    return res;
+}

@@ -1,0 +1,178 @@
+/*
+ * The sky-visibility probes relit each frame (probes.glsl): the sky's SH
+ * from the sky-view LUT (probe_sky), then each probe's irradiance SH from
+ * its visibility and bounce (probe_light), which the scene and the fog
+ * read. The pack's probe grid is uploaded here; without one the buffers
+ * hold a probe of zeros and the pass records nothing. "probes" and "probe
+ * light" in the graph's table.
+ */
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "log.h"
+#include "renderer_internal.h"
+#include "sh.h"
+
+#include "probe_light.spv.h"
+#include "probe_sky.spv.h"
+
+struct probes {
+    struct sb_buffer probes, light; /* sb_probes_gpu and its probes; the sky's and probes' SH */
+    VkPipeline sky_kernel, light_kernel;
+};
+
+/* The world's mean albedo, weighted by area: the bounce model's surfaces. */
+static void mean_albedo(const struct sb_world *world, float out[3])
+{
+    double sum[3] = {0, 0, 0}, area = 0;
+    for (uint32_t v = 0; v + 2 < world->vertex_count; v += 3) {
+        const struct sb_vertex_gpu *t = &world->vertices[v];
+        double e1[3], e2[3];
+        for (int i = 0; i < 3; i++) {
+            e1[i] = (double)t[1].position[i] - t[0].position[i];
+            e2[i] = (double)t[2].position[i] - t[0].position[i];
+        }
+        double n[3] = {e1[1] * e2[2] - e1[2] * e2[1], e1[2] * e2[0] - e1[0] * e2[2], e1[0] * e2[1] - e1[1] * e2[0]};
+        double a = 0.5 * sqrt(n[0] * n[0] + n[1] * n[1] + n[2] * n[2]);
+        for (int i = 0; i < 3; i++)
+            sum[i] += a * t[0].albedo[i];
+        area += a;
+    }
+    for (int i = 0; i < 3; i++)
+        out[i] = area > 0 ? (float)(sum[i] / area) : 0.0f;
+}
+
+/* Floats a probe takes in the probes buffer (config.h, probes.glsl). */
+#define PROBE_FLOATS (4 * SB_PROBE_VEC4S)
+
+/*
+ * The pack's sky-visibility probes, or none: the grid's probes (explicit
+ * ones are for other uses: a runtime interpolates a grid), each as
+ * (position, valid), its 9 SH coefficients; the tensor's non-zero entries;
+ * the light buffer the probes pass writes.
+ */
+static enum sb_result upload_probes(struct sb_renderer *r, struct probes *s)
+{
+    const struct sb_pack *pack = r->pack;
+    const struct sb_probe_layout *layout = &pack->artifacts[SB_PRODUCT_SKY_VISIBILITY].probes;
+    const struct sb_image *image = &pack->images[SB_PRODUCT_SKY_VISIBILITY];
+    uint64_t grid = (uint64_t)layout->grid[0] * layout->grid[1] * layout->grid[2];
+    bool use = pack->present[SB_PRODUCT_SKY_VISIBILITY] && !r->params.no_probes && grid > 0 && grid <= image->width &&
+               image->channel_count == SB_SKY_VISIBILITY_CHANNEL_COUNT;
+    if (pack->present[SB_PRODUCT_SKY_VISIBILITY] && !r->params.no_probes && !use)
+        sb_warn("the pack's sky_visibility has no probe grid: the world is lit by the sky alone");
+    r->probe_count = use ? (uint32_t)grid : 0;
+    size_t count = r->probe_count ? r->probe_count : 1;
+    enum sb_result res = sb_renderer_upload(
+        r, NULL, sizeof(struct sb_probes_gpu) + count * PROBE_FLOATS * sizeof(float), "probes", &s->probes);
+    if (!res)
+        res = sb_renderer_upload(r, NULL, (SB_PROBE_SH + count * SB_PROBE_SH) * 4 * sizeof(float), "probe light",
+                                 &s->light);
+    if (res || !r->probe_count)
+        return res;
+    struct sb_probes_gpu *g = s->probes.mapped;
+    double t[SB_PROBE_SH][SB_PROBE_SH][SB_PROBE_SH]; /* 5.8 KB; not static: renderers on other threads */
+    sb_sh9_tensor(t);
+    uint32_t entries = 0;
+    for (int i = 0; i < SB_PROBE_SH; i++)
+        for (int j = 0; j < SB_PROBE_SH; j++)
+            for (int k = 0; k < SB_PROBE_SH; k++)
+                if (t[i][j][k] != 0 && entries < SB_SH_TENSOR_MAX) {
+                    float *e = g->tensor[entries++];
+                    e[0] = (float)t[i][j][k];
+                    e[1] = (float)i;
+                    e[2] = (float)j;
+                    e[3] = (float)k;
+                }
+    for (int k = 0; k < 3; k++) {
+        g->grid[k] = layout->grid[k];
+        g->origin_m[k] = layout->origin_m[k];
+        g->spacing_m[k] = layout->spacing_m[k];
+    }
+    g->grid[3] = r->probe_count;
+    g->origin_m[3] = (float)entries;
+    mean_albedo(r->world, g->bounce_albedo);
+    const struct sb_image *bounce = &pack->images[SB_PRODUCT_SKY_BOUNCE];
+    const struct sb_probe_layout *bounce_layout = &pack->artifacts[SB_PRODUCT_SKY_BOUNCE].probes;
+    bool has_bounce = pack->present[SB_PRODUCT_SKY_BOUNCE] && bounce->width == image->width &&
+                      !memcmp(bounce_layout->grid, layout->grid, sizeof(layout->grid));
+    if (pack->present[SB_PRODUCT_SKY_BOUNCE] && !has_bounce)
+        sb_warn("the pack's sky_bounce has another grid than its sky_visibility: the bounce is modelled");
+    g->spacing_m[3] = has_bounce ? 1.0f : 0.0f;
+    float *out = (float *)(g + 1);
+    for (uint32_t p = 0; p < r->probe_count; p++) {
+        const float *c = &image->data[(size_t)p * SB_SKY_VISIBILITY_CHANNEL_COUNT];
+        float *o = &out[PROBE_FLOATS * (size_t)p];
+        if (has_bounce)
+            memcpy(o + 4 * SB_PROBE_BOUNCE_VEC4, &bounce->data[(size_t)p * SB_SKY_BOUNCE_CHANNEL_COUNT],
+                   SB_BOUNCE_FLOATS * sizeof(float));
+        memcpy(o, c + SB_SKY_VISIBILITY_POSITION, 3 * sizeof(float)); /* after any push out of geometry */
+        o[3] = c[SB_SKY_VISIBILITY_VALID];
+        /* The visibility as projected, the deringing window undone where it
+         * can be: windowing before the product with the sky would blur the
+         * horizon into the ground (open ground lost 17% of its sky light);
+         * the irradiance is clamped at the end instead. */
+        static const int band[SB_PROBE_SH] = {SB_SH_BANDS};
+        double w[3];
+        sb_sh9_window_factors(c[SB_SKY_VISIBILITY_DERING_WINDOW], w);
+        const float *sh = c + SB_SKY_VISIBILITY_SH;
+        for (int k = 0; k < SB_PROBE_SH; k++)
+            o[4 + k] = w[band[k]] > 1e-3 ? (float)(sh[k] / w[band[k]]) : sh[k];
+    }
+    sb_info("probes: %u x %u x %u, %.3g m apart, light the world (bounce %s)", layout->grid[0], layout->grid[1],
+            layout->grid[2], (double)layout->spacing_m[0], has_bounce ? "baked" : "modelled");
+    return SB_OK;
+}
+
+static enum sb_result probes_create(struct sb_renderer *r)
+{
+    struct probes *s = calloc(1, sizeof(*s));
+    if (!s)
+        return SB_ERR_NOMEM;
+    sb_pass_set_data(r, s);
+    enum sb_result res = upload_probes(r, s);
+    if (res)
+        return res;
+    sb_resource probes = sb_graph_buffer(r, "probes", &s->probes);
+    sb_resource light = sb_graph_buffer(r, "probe light", &s->light);
+    if (!r->probe_count)
+        return SB_OK;
+    sb_pass_read_atmosphere(r);
+    sb_pass_sample(r, SB_VIEW_BINDING_SKY_VIEW, sb_pass_find(r, "sky-view"), NULL);
+    sb_pass_use(r, SB_VIEW_BINDING_PROBES, probes, SB_USE_LOAD);
+    sb_pass_use(r, SB_VIEW_BINDING_PROBE_LIGHT, light, SB_USE_LOAD_STORE);
+    res = sb_renderer_kernel(r, sb_spv_probe_sky, sizeof(sb_spv_probe_sky), "probe sky", &s->sky_kernel);
+    if (!res)
+        res = sb_renderer_kernel(r, sb_spv_probe_light, sizeof(sb_spv_probe_light), "probe light", &s->light_kernel);
+    return res;
+}
+
+static void probes_destroy(struct sb_renderer *r)
+{
+    struct probes *s = sb_pass_data(r);
+    if (!s)
+        return;
+    sb_renderer_release(r, (const VkPipeline[]){s->sky_kernel, s->light_kernel}, 2, NULL, 0);
+    sb_buffer_destroy(r->vk, &s->probes);
+    sb_buffer_destroy(r->vk, &s->light);
+    free(s);
+}
+
+static void probes_record(struct sb_renderer *r)
+{
+    struct probes *s = sb_pass_data(r);
+    if (!r->probe_count)
+        return;
+    sb_renderer_dispatch(r, s->sky_kernel, NULL, (const uint32_t[3]){1, 1, 1}, (const uint32_t[3]){1, 1, 1});
+    sb_renderer_barrier(r->cmd);
+    sb_renderer_dispatch(r, s->light_kernel, NULL, (const uint32_t[3]){r->probe_count, 1, 1},
+                         (const uint32_t[3]){SB_PROBE_THREADS, 1, 1});
+}
+
+const struct sb_pass_class sb_pass_probes = {
+    .name = "probes",
+    .create = probes_create,
+    .destroy = probes_destroy,
+    .record = probes_record,
+};

@@ -1,0 +1,253 @@
+/*
+ * The scene: the world lit by the sun (its shadows), the sky (the probes'
+ * irradiance, or the sky's on open ground), the reflection probes and the
+ * aerial perspective, into the HDR frame and its depth. Rasterised (the
+ * shadows from the cascades), or traced (sb_renderer_params.scene): a ray a
+ * pixel through the world's BVH (renderer.c builds it, geometry/bvh.h), the
+ * hit lit as a fragment is (scene_shading.glsl), the sun's visibility from
+ * a shadow ray, so the shadow pass has nothing to draw; the fog traces its
+ * shadow rays too (fog_inject_traced).
+ *
+ * Why trace: a data-centre GPU's rasteriser is its weak part. On the H100
+ * the raster scene pass took 1.98 ms at 1080p, 0.71 ms of it to rasterise
+ * with a one-line fragment shader, and the cascades 0.37 ms
+ * (docs/skyview.md). llvmpipe rasterises well and traces slowly, so a CPU
+ * device rasterises. The traced frame differs from the raster one only in
+ * its shadows (hard and exact at every distance, where the maps are
+ * filtered and end at shadow_distance_m) and in the last bits of each
+ * point's position; test_runtime holds the two together and the shadows to
+ * Embree.
+ *
+ * The pack's reflection probes are uploaded here: "reflections" and
+ * "reflection cubes" in the graph's table.
+ */
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "image.h"
+#include "log.h"
+#include "physics.h"
+#include "pipeline.h"
+#include "renderer_internal.h"
+#include "scene.h"
+#include "sh.h"
+
+#include "scene_frag.spv.h"
+#include "scene_frag_volume.spv.h"
+#include "scene_trace.spv.h"
+#include "scene_trace_volume.spv.h"
+#include "scene_vert.spv.h"
+
+struct scene {
+    struct sb_buffer reflections, cubes; /* sb_reflections_gpu, its probes and the DFG; the cubes */
+    uint32_t reflection_count;           /* reflection probes the scene reads (0: none) */
+    /* Generic, and with aerial perspective from its volume alone (aerial.glsl). */
+    VkPipeline raster[2], traced[2];
+};
+
+/*
+ * The pack's reflection probes (reflections.glsl), or none: the cubes
+ * reordered from the pack's level-major image to one chain a cube, the
+ * probes' positions and boxes, and the DFG LUT when the pack has it (else
+ * the shader's analytic fit). The sky-only cube's irradiance on an upward
+ * surface, for relighting under another sun.
+ */
+static enum sb_result upload_reflections(struct sb_renderer *r, struct scene *s)
+{
+    const struct sb_pack *pack = r->pack;
+    const struct sb_image *cubes = &pack->images[SB_PRODUCT_REFLECTION_CUBES];
+    const struct sb_image *records = &pack->images[SB_PRODUCT_REFLECTION_PROBES];
+    bool use = pack->present[SB_PRODUCT_REFLECTION_CUBES] && pack->present[SB_PRODUCT_REFLECTION_PROBES] &&
+               !r->params.no_reflections && records->width == cubes->depth && cubes->levels < 16; /* [3].w: the chain */
+    bool dfg = use && pack->present[SB_PRODUCT_DFG];
+    uint32_t count = use ? cubes->depth : 0, n = use ? cubes->width : 1, levels = use ? cubes->levels : 1;
+    uint64_t chain = 0;
+    for (uint32_t l = 0; l < levels; l++)
+        chain += 6ull * sb_image_level_size(n, l) * sb_image_level_size(n, l);
+    size_t header_vec4s = (sizeof(struct sb_reflections_gpu) + 15) / 16;
+    size_t vec4s = header_vec4s + 3 * (size_t)count + (dfg ? (size_t)SB_DFG_SIZE * SB_DFG_SIZE : 0);
+    enum sb_result res = sb_renderer_upload(r, NULL, vec4s * 16, "reflection probes", &s->reflections);
+    if (!res)
+        res = sb_renderer_upload(r, NULL, (use ? chain * count : 1) * 16, "reflection cubes", &s->cubes);
+    if (res || !use)
+        return res;
+    struct sb_reflections_gpu *g = s->reflections.mapped;
+    g->info[0] = n;
+    g->info[1] = levels;
+    g->info[2] = count;
+    s->reflection_count = count;
+    g->info[3] = dfg;
+    double el = pack->scene->view.sun_elevation_deg * M_PI / 180, az = pack->scene->view.sun_azimuth_deg * M_PI / 180;
+    double sun[3];
+    sb_direction(az, el, sun);
+    for (int k = 0; k < 3; k++)
+        g->baked_sun[k] = (float)sun[k];
+    /* The sky-only cube's irradiance SH (its record's channels 9 on, k then rgb) at +y. */
+    const double up[3] = {0, 1, 0};
+    for (int c = 0; c < 3; c++) {
+        double coefficients[SB_PROBE_SH];
+        for (int k = 0; k < SB_PROBE_SH; k++)
+            coefficients[k] = records->data[9 + 3 * k + c];
+        g->baked_sky_up[c] = (float)sb_sh9_eval(coefficients, up);
+    }
+    uint64_t at = 0;
+    for (uint32_t l = 0; l < levels; l++) {
+        g->level_offsets[l / 4][l % 4] = (uint32_t)at;
+        at += 6ull * sb_image_level_size(n, l) * sb_image_level_size(n, l);
+    }
+    g->level_offsets[3][3] = (uint32_t)chain;
+    float *data = (float *)s->reflections.mapped + 4 * header_vec4s;
+    for (uint32_t i = 0; i < count; i++)
+        for (int k = 0; k < 9; k++) /* position, box min, box max: the record's first nine channels */
+            data[12 * i + 4 * (k / 3) + k % 3] = records->data[(size_t)i * records->channel_count + k];
+    if (dfg) {
+        const struct sb_image *lut = &pack->images[SB_PRODUCT_DFG];
+        float *d = data + 12 * (size_t)count;
+        for (size_t t = 0; t < (size_t)SB_DFG_SIZE * SB_DFG_SIZE; t++) {
+            d[4 * t] = lut->data[2 * t];
+            d[4 * t + 1] = lut->data[2 * t + 1];
+        }
+    }
+    float *texels = s->cubes.mapped;
+    for (uint32_t l = 0; l < levels; l++) {
+        uint32_t m = sb_image_level_size(n, l);
+        const float *src = cubes->data + sb_image_level_offset(cubes, l);
+        for (uint32_t i = 0; i < count; i++)
+            for (size_t t = 0; t < 6ull * m * m; t++) {
+                float *o = texels + 4 * (i * chain + g->level_offsets[l / 4][l % 4] + t);
+                memcpy(o, src + 3 * ((size_t)i * 6 * m * m + t), 3 * sizeof(float));
+            }
+    }
+    sb_info("reflections: %u cubes of %u^2, %u levels%s", count, n, levels, dfg ? ", the DFG LUT" : "");
+    return SB_OK;
+}
+
+/* The traced scene writes every pixel of the frame and its depth. */
+static enum sb_result create_traced(struct sb_renderer *r, struct scene *s)
+{
+    sb_pass_use(r, SB_VIEW_BINDING_HDR, sb_pass_find(r, "hdr"), SB_USE_OVERWRITE);
+    sb_pass_use(r, SB_VIEW_BINDING_DEPTH_OUT, sb_pass_find(r, "depth"), SB_USE_OVERWRITE);
+    sb_pass_use(r, SB_VIEW_BINDING_BVH_NODES, sb_pass_find(r, "bvh nodes"), SB_USE_LOAD);
+    sb_pass_use(r, SB_VIEW_BINDING_BVH_TRIANGLES, sb_pass_find(r, "bvh triangles"), SB_USE_LOAD);
+    enum sb_result res =
+        sb_renderer_kernel(r, sb_spv_scene_trace, sizeof(sb_spv_scene_trace), "scene traced", &s->traced[0]);
+    if (!res)
+        res = sb_renderer_kernel(r, sb_spv_scene_trace_volume, sizeof(sb_spv_scene_trace_volume),
+                                 "scene traced (aerial volume only)", &s->traced[1]);
+    return res;
+}
+
+static enum sb_result create_raster(struct sb_renderer *r, struct scene *s)
+{
+    sb_pass_sample(r, SB_VIEW_BINDING_SHADOW, sb_pass_find(r, "shadow cascades"), r->shadow_compare);
+    sb_pass_use(r, SB_NO_BINDING, sb_pass_find(r, "hdr"), SB_USE_COLOR_TARGET);
+    sb_pass_use(r, SB_NO_BINDING, sb_pass_find(r, "depth"), SB_USE_DEPTH_TARGET);
+    /* scene.frag's specialization: what the pack holds */
+    bool generic = r->params.generic_shaders;
+    const VkBool32 has[2] = {generic || r->probe_count > 0, generic || s->reflection_count > 0};
+    const VkSpecializationMapEntry entries[2] = {
+        {.constantID = 0, .offset = 0, .size = sizeof(VkBool32)},
+        {.constantID = 1, .offset = sizeof(VkBool32), .size = sizeof(VkBool32)},
+    };
+    const VkSpecializationInfo specialization = {
+        .mapEntryCount = 2, .pMapEntries = entries, .dataSize = sizeof(has), .pData = has};
+    struct sb_graphics_pipeline_params params = {
+        .fragment_specialization = &specialization,
+        .vertex_spirv = sb_spv_scene_vert,
+        .vertex_size = sizeof(sb_spv_scene_vert),
+        .fragment_spirv = sb_spv_scene_frag,
+        .fragment_size = sizeof(sb_spv_scene_frag),
+        .color_format = SB_HDR_FORMAT,
+        .depth_format = SB_DEPTH_FORMAT,
+        .depth_compare = VK_COMPARE_OP_GREATER, /* reverse Z */
+        .name = "scene",
+    };
+    enum sb_result res = sb_pass_layout(r, &params.layout);
+    if (!res)
+        res = sb_graphics_pipeline_create(r->vk, &params, &s->raster[0]);
+    params.fragment_spirv = sb_spv_scene_frag_volume;
+    params.fragment_size = sizeof(sb_spv_scene_frag_volume);
+    params.name = "scene (aerial volume only)";
+    if (!res)
+        res = sb_graphics_pipeline_create(r->vk, &params, &s->raster[1]);
+    return res;
+}
+
+static enum sb_result scene_create(struct sb_renderer *r)
+{
+    struct scene *s = calloc(1, sizeof(*s));
+    if (!s)
+        return SB_ERR_NOMEM;
+    sb_pass_set_data(r, s);
+    enum sb_result res = upload_reflections(r, s);
+    if (res)
+        return res;
+    sb_pass_read_atmosphere(r);
+    sb_pass_use(r, SB_VIEW_BINDING_VERTICES, sb_pass_find(r, "vertices"), SB_USE_LOAD);
+    sb_pass_sample(r, SB_VIEW_BINDING_AERIAL, sb_pass_find(r, "aerial"), NULL);
+    sb_pass_sample(r, SB_VIEW_BINDING_AERIAL_T, sb_pass_find(r, "aerial transmittance"), NULL);
+    sb_pass_use(r, SB_VIEW_BINDING_PROBES, sb_pass_find(r, "probes"), SB_USE_LOAD);
+    sb_pass_use(r, SB_VIEW_BINDING_PROBE_LIGHT, sb_pass_find(r, "probe light"), SB_USE_LOAD);
+    sb_pass_use(r, SB_VIEW_BINDING_REFLECTIONS, sb_graph_buffer(r, "reflections", &s->reflections), SB_USE_LOAD);
+    sb_pass_use(r, SB_VIEW_BINDING_REFLECTION_CUBES, sb_graph_buffer(r, "reflection cubes", &s->cubes), SB_USE_LOAD);
+    sb_pass_use(r, SB_VIEW_BINDING_CLOUDS, sb_pass_find(r, "clouds"), SB_USE_LOAD);
+    sb_pass_sample(r, SB_VIEW_BINDING_CLOUD_SHADOW, sb_pass_find(r, "cloud shadow"), NULL);
+    return r->scene_traced ? create_traced(r, s) : create_raster(r, s);
+}
+
+static void scene_destroy(struct sb_renderer *r)
+{
+    struct scene *s = sb_pass_data(r);
+    if (!s)
+        return;
+    const VkPipeline pipelines[] = {s->raster[0], s->raster[1], s->traced[0], s->traced[1]};
+    sb_renderer_release(r, pipelines, 4, NULL, 0);
+    sb_buffer_destroy(r->vk, &s->reflections);
+    sb_buffer_destroy(r->vk, &s->cubes);
+    free(s);
+}
+
+static void scene_record(struct sb_renderer *r)
+{
+    struct scene *s = sb_pass_data(r);
+    if (r->scene_traced) {
+        sb_renderer_dispatch_frame(r, s->traced[r->aerial_volume_only ? 1 : 0]);
+        return;
+    }
+    VkRenderingAttachmentInfo color = {
+        .sType = VK_STRUCTURE_TYPE_RENDERING_ATTACHMENT_INFO,
+        .imageView = r->hdr.view,
+        .imageLayout = VK_IMAGE_LAYOUT_COLOR_ATTACHMENT_OPTIMAL,
+        .loadOp = VK_ATTACHMENT_LOAD_OP_CLEAR,
+        .storeOp = VK_ATTACHMENT_STORE_OP_STORE,
+    };
+    VkRenderingAttachmentInfo depth = {
+        .sType = VK_STRUCTURE_TYPE_RENDERING_ATTACHMENT_INFO,
+        .imageView = r->depth.view,
+        .imageLayout = VK_IMAGE_LAYOUT_DEPTH_STENCIL_ATTACHMENT_OPTIMAL,
+        .loadOp = VK_ATTACHMENT_LOAD_OP_CLEAR,
+        .storeOp = VK_ATTACHMENT_STORE_OP_STORE,
+        .clearValue = {.depthStencil = {0.0f, 0}}, /* reverse Z: 0 is infinitely far */
+    };
+    VkRenderingInfo info = {
+        .sType = VK_STRUCTURE_TYPE_RENDERING_INFO,
+        .renderArea = {{0, 0}, {r->width, r->height}},
+        .layerCount = 1,
+        .colorAttachmentCount = 1,
+        .pColorAttachments = &color,
+        .pDepthAttachment = &depth,
+    };
+    vkCmdBeginRendering(r->cmd, &info);
+    sb_renderer_viewport(r, r->width, r->height);
+    sb_renderer_bind_graphics(r, s->raster[r->aerial_volume_only ? 1 : 0], NULL);
+    vkCmdDraw(r->cmd, r->vertex_count, 1, 0, 0);
+    vkCmdEndRendering(r->cmd);
+}
+
+const struct sb_pass_class sb_pass_scene = {
+    .name = "scene",
+    .create = scene_create,
+    .destroy = scene_destroy,
+    .record = scene_record,
+};
