@@ -619,9 +619,32 @@ static enum sb_result write_json(const char *path, cJSON *root)
     return res;
 }
 
+/* What --bench measures of a frame: each pass alone (a barrier after
+ * each, sb_view.isolate_passes), and the frame as it is rendered (the
+ * render graph's barriers alone), on the GPU's clock and the host's
+ * (recording, submission and the wait: on llvmpipe, whose timestamps can
+ * book one pass's work to another, the truer figure). */
+struct bench_frame {
+    struct sb_frame_timings alone, rendered;
+    double wall_ms;
+};
+
+/* One row of the table and of bench.json: the median, min and max of the n values. */
+static void bench_row(cJSON *array, const char *name, double *v, int n)
+{
+    double med = median(v, n);
+    printf("%-28s %12.3f %12.3f %12.3f\n", name, med, v[0], v[n - 1]);
+    cJSON *item = cJSON_CreateObject();
+    cJSON_AddStringToObject(item, "pass", name);
+    cJSON_AddNumberToObject(item, "median_ms", med);
+    cJSON_AddNumberToObject(item, "min_ms", v[0]);
+    cJSON_AddNumberToObject(item, "max_ms", v[n - 1]);
+    cJSON_AddItemToArray(array, item);
+}
+
 /* The bench table on stdout and the same numbers as JSON in OUT_DIR/bench.json. */
 static enum sb_result report_bench(const struct options *o, const struct sb_vk *vk, uint32_t w, uint32_t h,
-                                   const struct sb_frame_timings *t, int n)
+                                   const struct bench_frame *f, int n)
 {
     double *v = malloc((size_t)n * sizeof(double));
     if (!v)
@@ -638,20 +661,19 @@ static enum sb_result report_bench(const struct options *o, const struct sb_vk *
     cJSON *passes = cJSON_AddArrayToObject(root, "passes");
     printf("skyview bench: %ux%u on %s, median of %d frames after %d warm-up\n", w, h, vk->properties.deviceName, n,
            o->warmup);
-    printf("%-20s %12s %12s %12s\n", "pass", "median ms", "min ms", "max ms");
+    printf("%-28s %12s %12s %12s\n", "pass (each alone)", "median ms", "min ms", "max ms");
     for (int p = 0; p <= SB_PASS_COUNT; p++) {
         for (int i = 0; i < n; i++)
-            v[i] = p < SB_PASS_COUNT ? t[i].ms[p] : t[i].total_ms;
-        double med = median(v, n);
-        const char *name = p < SB_PASS_COUNT ? sb_pass_name((enum sb_pass)p) : "total";
-        printf("%-20s %12.3f %12.3f %12.3f\n", name, med, v[0], v[n - 1]);
-        cJSON *item = cJSON_CreateObject();
-        cJSON_AddStringToObject(item, "pass", name);
-        cJSON_AddNumberToObject(item, "median_ms", med);
-        cJSON_AddNumberToObject(item, "min_ms", v[0]);
-        cJSON_AddNumberToObject(item, "max_ms", v[n - 1]);
-        cJSON_AddItemToArray(passes, item);
+            v[i] = p < SB_PASS_COUNT ? f[i].alone.ms[p] : f[i].alone.total_ms;
+        bench_row(passes, p < SB_PASS_COUNT ? sb_pass_name((enum sb_pass)p) : "total", v, n);
     }
+    cJSON *frame = cJSON_AddArrayToObject(root, "frame");
+    for (int i = 0; i < n; i++)
+        v[i] = f[i].rendered.total_ms;
+    bench_row(frame, "frame as rendered, GPU", v, n);
+    for (int i = 0; i < n; i++)
+        v[i] = f[i].wall_ms;
+    bench_row(frame, "frame as rendered, wall", v, n);
     free(v);
     char path[4200];
     snprintf(path, sizeof(path), "%s/bench.json", o->out_dir);
@@ -914,7 +936,7 @@ static int run(const struct options *o)
     int code = 0;
     struct sb_vk *vk = NULL;
     struct sb_renderer *r = NULL;
-    struct sb_frame_timings *timings = NULL;
+    struct bench_frame *timings = NULL;
     struct sb_video *video = NULL;
     struct sb_vk_params vk_params = o->vk;
     struct sb_window *window = NULL;
@@ -1001,8 +1023,17 @@ static int run(const struct options *o)
         /* The GPU's clocks up, as skybake bench keeps them (sb_warm_up). */
         if (o->bench)
             res = sb_warm_up(vk, i == 0 || measured == 0 ? SB_WARM_UP_MS : SB_KEEP_WARM_MS);
+        /* Measured, each frame twice: its passes alone, then as rendered. */
+        struct bench_frame *f = o->bench && measured >= 0 ? &timings[measured] : NULL;
+        view.isolate_passes = f != NULL;
+        if (!res && f)
+            res = sb_renderer_render(r, &view, false, &f->alone);
+        view.isolate_passes = false;
+        double start = sb_now_s();
         if (!res)
-            res = sb_renderer_render(r, &view, write, measured >= 0 ? &timings[measured] : NULL);
+            res = sb_renderer_render(r, &view, write, f ? &f->rendered : NULL);
+        if (f)
+            f->wall_ms = (sb_now_s() - start) * 1e3;
         if (!res && write)
             res = write_frame(o, r, o->bench ? 0 : i, NULL);
         sb_progress("frames", (unsigned)i + 1, (unsigned)total);
@@ -1010,7 +1041,7 @@ static int run(const struct options *o)
     if (!res && o->bench) {
         uint32_t w, h;
         sb_renderer_size(r, &w, &h);
-        if (!timings[0].valid)
+        if (!timings[0].alone.valid)
             sb_warn("%s has no timestamps on its queue: the bench measures nothing", vk->properties.deviceName);
         res = report_bench(o, vk, w, h, timings, o->frames);
     }

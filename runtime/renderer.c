@@ -510,6 +510,19 @@ enum sb_result sb_renderer_render(struct sb_renderer *r, const struct sb_view *v
     return SB_OK;
 }
 
+/* A pass's start or end. Isolated, every command before it is done first
+ * and after it too: llvmpipe takes a timestamp when its rasteriser threads
+ * next run, and only a barrier makes them run at once. */
+static void timestamp(struct sb_renderer *r, const struct sb_view *view, uint32_t query)
+{
+    if (view->isolate_passes)
+        sb_renderer_barrier(r->cmd);
+    if (r->queries)
+        vkCmdWriteTimestamp(r->cmd, VK_PIPELINE_STAGE_BOTTOM_OF_PIPE_BIT, r->queries, query);
+    if (view->isolate_passes)
+        sb_renderer_barrier(r->cmd);
+}
+
 static enum sb_result render_once(struct sb_renderer *r, const struct sb_view *view, bool readback,
                                   struct sb_frame_timings *timings)
 {
@@ -543,19 +556,15 @@ static enum sb_result render_once(struct sb_renderer *r, const struct sb_view *v
             if (readback)
                 copy_image(r, r->hdr_id, &r->read_hdr);
         }
-        /* A pass's time: from the end of every command before it to the end
-         * of its own, what it adds to the frame where passes overlap. */
-        if (r->queries)
-            vkCmdWriteTimestamp(r->cmd, VK_PIPELINE_STAGE_BOTTOM_OF_PIPE_BIT, r->queries, 2 * p);
-        if (disabled >> p & 1) {
-            if (sb_pass_classes[p]->skipped)
-                sb_pass_classes[p]->skipped(r);
-        } else {
+        bool skip = disabled >> p & 1;
+        if (!skip)
             sb_graph_before_pass(r, p);
+        timestamp(r, view, 2 * p);
+        if (skip && sb_pass_classes[p]->skipped)
+            sb_pass_classes[p]->skipped(r);
+        else if (!skip)
             sb_pass_classes[p]->record(r);
-        }
-        if (r->queries)
-            vkCmdWriteTimestamp(r->cmd, VK_PIPELINE_STAGE_BOTTOM_OF_PIPE_BIT, r->queries, 2 * p + 1);
+        timestamp(r, view, 2 * p + 1);
     }
 
     if (readback) {

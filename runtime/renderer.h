@@ -117,6 +117,10 @@ struct sb_view {
                                  linear, bloom, grade; others are drawn anyway). Its time reads 0. A pass
                                  left out drops its history (fog, clouds); the clouds' shadow stays; the
                                  fog left out leaves out fog apply too */
+    bool isolate_passes;      /* a full barrier after each pass, so that each pass's time is its own: the
+                                 render graph's barriers alone let passes that do not depend on each other
+                                 overlap, and a GPU (or llvmpipe, whose compute runs behind its timestamps)
+                                 then books one pass's work to another. The same frame, slower */
 };
 
 enum sb_pass {
@@ -152,7 +156,7 @@ int sb_pass_toggles(uint32_t toggles[SB_PASS_COUNT]);
 
 struct sb_frame_timings {
     bool valid;               /* false when the queue has no timestamps */
-    double ms[SB_PASS_COUNT]; /* GPU time of each pass */
+    double ms[SB_PASS_COUNT]; /* GPU time of each pass (its own with sb_view.isolate_passes) */
     double total_ms;          /* from the first pass's start to the last one's end */
 };
 

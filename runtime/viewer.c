@@ -106,6 +106,7 @@ enum sb_result sb_viewer_run(struct sb_renderer *r, struct sb_window *window, co
         want_shot |= in.screenshot;
 
         view.disabled_passes = disabled;
+        view.isolate_passes = overlay; /* its times, each pass's own */
         view.snap_exposure = i == 0;
         view.dt_s = dt;
         view.time_s = params->frames > 0 ? i / 60.0 : view.time_s + dt;

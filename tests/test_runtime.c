@@ -1254,6 +1254,24 @@ static void test_fog(const char *dir)
         free(with);
     }
 
+    /* 1c. Each pass alone (a barrier after each, as --bench times them)
+     * draws the frame the render graph's barriers alone draw, bit for bit,
+     * over frames that read the froxels' history (its halves swapping) and
+     * a last one from a moved camera. */
+    {
+        struct sb_view alone = v, moved = v, moved_alone;
+        alone.isolate_passes = true;
+        moved.camera_m[0] += 0.5;
+        moved_alone = moved;
+        moved_alone.isolate_passes = true;
+        float *a = fog_frame(&fog_pack, &w, SB_DEBUG_NONE, &alone, 3, &moved_alone);
+        float *b = fog_frame(&fog_pack, &w, SB_DEBUG_NONE, &v, 3, &moved);
+        if (a && b)
+            CHECK(!memcmp(a, b, sizeof(float) * 3 * FOG_W * FOG_H), "the passes alone draw another frame");
+        free(a);
+        free(b);
+    }
+
     /* 1b. Pre-exposure: the froxels' history rescaled (harness_view.h),
      * over four frames. */
     {

@@ -89,6 +89,10 @@ for pass in sky-view probes "aerial perspective" shadows scene sky purkinje expo
     check "bench table has $pass" grep -q "^$pass " "$tmp/out"
     check "bench.json has $pass" grep -q "\"pass\":[[:space:]]*\"$pass\"" "$tmp/b/bench.json"
 done
+for row in "frame as rendered, GPU" "frame as rendered, wall"; do
+    check "bench table has $row" grep -q "^$row " "$tmp/out"
+    check "bench.json has $row" grep -q "\"pass\":[[:space:]]*\"$row\"" "$tmp/b/bench.json"
+done
 
 # A pack with probes over the test world (its atmosphere reused from the
 # first pack): skyview draws the world they were baked against and lights
