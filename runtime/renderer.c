@@ -510,16 +510,20 @@ enum sb_result sb_renderer_render(struct sb_renderer *r, const struct sb_view *v
     return SB_OK;
 }
 
-/* A pass's start or end. Isolated, every command before it is done first
- * and after it too: llvmpipe takes a timestamp when its rasteriser threads
- * next run, and only a barrier makes them run at once. */
-static void timestamp(struct sb_renderer *r, const struct sb_view *view, uint32_t query)
+/* A pass's start or end. Isolated, every command before the start is done
+ * first, and the end's before any command after it. llvmpipe takes a
+ * timestamp when its rasteriser threads next run, which a barrier makes
+ * them do at once: there both sides of each timestamp get one. */
+static void timestamp(struct sb_renderer *r, const struct sb_view *view, uint32_t query, bool start)
 {
-    if (view->isolate_passes)
+    bool cpu = r->vk->properties.deviceType == VK_PHYSICAL_DEVICE_TYPE_CPU;
+    if (view->isolate_passes && (start || cpu))
         sb_renderer_barrier(r->cmd);
     if (r->queries)
-        vkCmdWriteTimestamp(r->cmd, VK_PIPELINE_STAGE_BOTTOM_OF_PIPE_BIT, r->queries, query);
-    if (view->isolate_passes)
+        vkCmdWriteTimestamp(r->cmd,
+                            start && !cpu ? VK_PIPELINE_STAGE_TOP_OF_PIPE_BIT : VK_PIPELINE_STAGE_BOTTOM_OF_PIPE_BIT,
+                            r->queries, query);
+    if (view->isolate_passes && (!start || cpu))
         sb_renderer_barrier(r->cmd);
 }
 
@@ -559,12 +563,12 @@ static enum sb_result render_once(struct sb_renderer *r, const struct sb_view *v
         bool skip = disabled >> p & 1;
         if (!skip)
             sb_graph_before_pass(r, p);
-        timestamp(r, view, 2 * p);
+        timestamp(r, view, 2 * p, true);
         if (skip && sb_pass_classes[p]->skipped)
             sb_pass_classes[p]->skipped(r);
         else if (!skip)
             sb_pass_classes[p]->record(r);
-        timestamp(r, view, 2 * p + 1);
+        timestamp(r, view, 2 * p + 1, false);
     }
 
     if (readback) {
