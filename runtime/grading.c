@@ -9,6 +9,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "grading_gpu.h"
 #include "lut3d.h"
 #include "renderer_internal.h"
 

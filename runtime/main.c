@@ -13,6 +13,7 @@
 #include <string.h>
 #include <sys/stat.h>
 
+#include "clouds_gpu.h"
 #include "compute.h"
 #include "config.h"
 #include "contact_sheet.h"

@@ -358,7 +358,7 @@ static void fill_frame(struct sb_renderer *r, const struct sb_view *v, struct sb
         f->cascade_ends[c] = (float)cascades.ends_m[c];
         f->cascade_texel[c] = (float)cascades.texel_m[c];
         /* Texels to clear and draw: the casters' box and a margin each side
-         * that covers what the lookups read (config.h); they see the sun
+         * that covers what the lookups read (view_gpu.h); they see the sun
          * outside, exactly as if the whole map were cleared and drawn. */
         int32_t box[4], size = (int32_t)r->params.shadow_size;
         int32_t *clear = r->cascade_clear[c];

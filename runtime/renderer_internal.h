@@ -7,7 +7,7 @@
  *
  * A pass's create hook makes what it owns, adds it to the render graph's
  * table of resources (graph.h), and declares what it uses of the table,
- * through which bindings of config.h's SB_VIEW_BINDING_*; the graph gives
+ * through which bindings (shaders/view/view_gpu.h and its own *_gpu.h); the graph gives
  * it its own descriptor set and the barriers before it.
  */
 #ifndef SB_RUNTIME_RENDERER_INTERNAL_H
@@ -20,6 +20,7 @@
 #include "shadows.h"
 #include "texture.h"
 #include "transform.h"
+#include "view_gpu.h"
 
 struct sb_image;
 
@@ -171,6 +172,7 @@ enum sb_result sb_atmosphere_upload(struct sb_renderer *r, const struct sb_pack 
 /* grading.c: the scene-linear grading's GPU form; a .cube LUT (NULL: a
  * stand-in) as lut3d.glsl reads it, in a buffer of its own. */
 struct sb_lut3d;
+struct sb_grading_gpu;
 void sb_grading_gpu_fill(const struct sb_grading *grading, struct sb_grading_gpu *gpu);
 enum sb_result sb_grade_lut_upload(struct sb_renderer *r, const struct sb_lut3d *lut, struct sb_buffer *buffer);
 

@@ -11,8 +11,8 @@
 #include <stdbool.h>
 #include <stdint.h>
 
-#include "config.h"
 #include "transform.h"
+#include "view_gpu.h"
 
 struct sb_cascade_params {
     double near_m;          /* the camera's near plane */

@@ -12,9 +12,9 @@
 #include <stddef.h>
 #include <stdint.h>
 
-#include "config.h"
 #include "mesh.h"
 #include "result.h"
+#include "view_gpu.h"
 
 struct sb_world {
     struct sb_vertex_gpu *vertices; /* owned: vertex_count, a triangle list */

@@ -8,6 +8,7 @@
 #include <string.h>
 
 #include "atmosphere_ref.h"
+#include "clouds_gpu.h"
 #include "config.h"
 
 /* A value as the runtime's RGBA16F textures hold it. */

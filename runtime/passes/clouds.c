@@ -13,6 +13,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "clouds_gpu.h"
 #include "history.h"
 #include "image.h"
 #include "log.h"

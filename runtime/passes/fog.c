@@ -9,9 +9,12 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "clouds_gpu.h"
+#include "fog_gpu.h"
 #include "history.h"
 #include "image.h"
 #include "log.h"
+#include "probes_gpu.h"
 #include "renderer_internal.h"
 #include "scene.h"
 
@@ -23,7 +26,7 @@
 #define SLICE_SCALE_M 1.0  /* c in distance(w) = c ((1 + far / c)^w - 1) */
 #define HISTORY_WEIGHT 0.9 /* the last frame's share in a froxel (10 frames to settle) */
 
-_Static_assert(SB_FOG_VOLUMES == SB_FOG_MAX_VOLUMES, "config.h and scene.h agree on the fog's boxes");
+_Static_assert(SB_FOG_VOLUMES == SB_FOG_MAX_VOLUMES, "fog_gpu.h and scene.h agree on the fog's boxes");
 
 struct sb_fog {
     bool enabled;

@@ -6,6 +6,9 @@
  */
 #include <stdlib.h>
 
+#include "clouds_gpu.h"
+#include "fog_gpu.h"
+#include "probes_gpu.h"
 #include "renderer_internal.h"
 
 #include "fog_apply.spv.h"

@@ -5,6 +5,7 @@
  */
 #include <stdlib.h>
 
+#include "grading_gpu.h"
 #include "renderer_internal.h"
 
 #include "grade.spv.h"

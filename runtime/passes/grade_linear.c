@@ -7,6 +7,7 @@
  */
 #include <stdlib.h>
 
+#include "grading_gpu.h"
 #include "renderer_internal.h"
 
 #include "grade_linear.spv.h"

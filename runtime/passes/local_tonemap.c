@@ -14,6 +14,7 @@
 #include <stddef.h>
 #include <stdlib.h>
 
+#include "local_tonemap_gpu.h"
 #include "log.h"
 #include "renderer_internal.h"
 

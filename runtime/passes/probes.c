@@ -11,6 +11,7 @@
 #include <string.h>
 
 #include "log.h"
+#include "probes_gpu.h"
 #include "renderer_internal.h"
 #include "sh.h"
 
@@ -43,7 +44,7 @@ static void mean_albedo(const struct sb_world *world, float out[3])
         out[i] = area > 0 ? (float)(sum[i] / area) : 0.0f;
 }
 
-/* Floats a probe takes in the probes buffer (config.h, probes.glsl). */
+/* Floats a probe takes in the probes buffer (config.h, probes_gpu.h, probes.glsl). */
 #define PROBE_FLOATS (4 * SB_PROBE_VEC4S)
 
 /*

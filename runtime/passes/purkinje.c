@@ -8,6 +8,7 @@
  */
 #include <stdlib.h>
 
+#include "purkinje_gpu.h"
 #include "renderer_internal.h"
 #include "scene.h"
 

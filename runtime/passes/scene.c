@@ -25,10 +25,13 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "clouds_gpu.h"
 #include "image.h"
 #include "log.h"
 #include "physics.h"
 #include "pipeline.h"
+#include "probes_gpu.h"
+#include "reflections_gpu.h"
 #include "renderer_internal.h"
 #include "scene.h"
 #include "sh.h"

@@ -1,0 +1,64 @@
+/*
+ * Aerial perspective between the camera and a point (Hillaire 2020, section
+ * 5.4): the aerial-perspective volume inside its range, else the same
+ * integral along the ray (cameras above the atmosphere, far points). For
+ * the scene and the clouds. A shader that defines SB_AERIAL_VOLUME_ONLY
+ * leaves the ray's integral out: its caller must know that the camera is in
+ * the atmosphere and every point within the volume's range (llvmpipe runs
+ * the integral's code for every fragment even when none takes it).
+ */
+#ifndef SB_AERIAL_GLSL
+#define SB_AERIAL_GLSL
+
+#include "view_gpu.h"
+#include "view.glsl"
+
+layout(set = 0, binding = SB_VIEW_BINDING_AERIAL) uniform sampler3D aerial_inscatter;
+layout(set = 0, binding = SB_VIEW_BINDING_AERIAL_T) uniform sampler3D aerial_transmittance;
+
+/* In-scattered radiance (rgb, scaled like the frame) and transmittance from
+ * the camera to a point `offset` metres away, seen at screen position uv
+ * ([0, 1]^2, the volume's columns). */
+void aerial_perspective(vec2 uv, vec3 offset, out vec3 inscatter, out vec3 transmittance)
+{
+    float d_km = length(offset) * 1e-3;
+    float far_km = frame.aerial.x;
+#ifndef SB_AERIAL_VOLUME_ONLY
+    if (frame.camera_km.w < atmosphere_thickness() && d_km <= far_km)
+#endif
+    {
+        float w = sqrt(d_km / far_km);
+        const float w0 = 0.5 / float(SB_AERIAL_SIZE);
+        vec3 uvw = vec3(uv, max(w, w0));
+        inscatter = textureLod(aerial_inscatter, uvw, 0.0).rgb;
+        transmittance = textureLod(aerial_transmittance, uvw, 0.0).rgb;
+        if (w < w0) { /* before the first slice, linear in distance */
+            float f = (w / w0) * (w / w0);
+            inscatter *= f;
+            transmittance = mix(vec3(1.0), transmittance, f);
+        }
+        return;
+    }
+#ifndef SB_AERIAL_VOLUME_ONLY
+    vec3 d = normalize(offset);
+    vec3 p = frame.camera_km.xyz;
+    float entry = atmosphere_entry(p, d);
+    inscatter = vec3(0.0);
+    transmittance = vec3(1.0);
+    if (entry < 0.0 || entry >= d_km)
+        return;
+    vec3 p0 = p + d * entry;
+    float r0 = length(p0);
+    float h0 = max(r0 - ground_radius(), 0.0);
+    float mu = dot(p0, d) / r0, mu_s = dot(p0, frame.sun_direction.xyz) / r0;
+    float nu = dot(d, frame.sun_direction.xyz);
+    RayIntegrals ri = ray_integrals_begin();
+    integrate_ray_to(ri, h0, mu, mu_s, nu, d_km - entry, true);
+    vec3 L = atm.solar_irradiance.rgb * (ri.sun_rayleigh * phase_rayleigh(nu) + ri.sun_mie * phase_mie(nu)) +
+             ri.ms_rayleigh + ri.ms_mie;
+    inscatter = L * frame.aerial.y;
+    transmittance = ri.transmittance;
+#endif
+}
+
+#endif

@@ -1,0 +1,102 @@
+/* skyview's sky-visibility probes (probes_gpu.h, sb_probes_gpu): the grid of a
+ * pack's sky_visibility product, each probe 4 vec4s (position and validity,
+ * then its 9 SH coefficients of visibility), and what probe_sky.comp and
+ * probe_light.comp make of them each frame: the sky's radiance as SH, and
+ * each probe's irradiance as SH (rgb, in the pack's units before the
+ * frame's radiance scale). The compute passes define PROBE_LIGHT_WRITABLE. */
+#ifndef SB_PROBES_GLSL
+#define SB_PROBES_GLSL
+
+#include "probes_gpu.h"
+#include "view_gpu.h"
+
+#include "sh.glsl"
+
+layout(std430, set = 0, binding = SB_VIEW_BINDING_PROBES) readonly buffer ProbeBuffer {
+    sb_probes_gpu probes;
+    /* per probe: (position m, valid), (sh 0-3), (sh 4-7), (sh 8, 0, 0, 0), then the
+     * bounce transfer B[m][k].rgb (sky_bounce's order, 27 vec4s; zeros without) */
+    vec4 probe_data[];
+};
+
+#ifdef PROBE_LIGHT_WRITABLE
+layout(std430, set = 0, binding = SB_VIEW_BINDING_PROBE_LIGHT) buffer ProbeLightBuffer {
+#else
+layout(std430, set = 0, binding = SB_VIEW_BINDING_PROBE_LIGHT) readonly buffer ProbeLightBuffer {
+#endif
+    vec4 sky_sh[SB_PROBE_SH];   /* rgb: the sky's (and the planet ground's) radiance */
+    vec4 probe_irradiance[];    /* SB_PROBE_SH a probe, rgb: irradiance E(n) = sum_k E_k Y_k(n) */
+};
+
+
+/* The clamped cosine's zonal factors per band (Ramamoorthi and Hanrahan 2001). */
+const float SH_COSINE[3] = float[3](SB_SH_COSINE_FACTORS);
+const int SH_BAND[SB_PROBE_SH] = int[SB_PROBE_SH](SB_SH_BANDS);
+
+#ifndef PROBE_LIGHT_WRITABLE
+/*
+ * Irradiance from the probes at world point pos (m) on a surface of normal
+ * n, and along a second direction r (the mirror direction, for the
+ * ambient specular): trilinear between the 8 grid probes around pos pushed
+ * a quarter of a spacing along n, each weighted by DDGI's wrap of the
+ * direction toward it, probes flagged invalid skipped and the weights
+ * renormalised. *coverage is 1 inside the grid (and half a spacing past
+ * its outer probes), fading to 0 one spacing further, and 0 with no probe
+ * (or no valid one) around.
+ */
+void probe_lookup(vec3 pos, vec3 n, vec3 r, out vec3 e_n, out vec3 e_r, out float coverage)
+{
+    e_n = vec3(0.0);
+    e_r = vec3(0.0);
+    coverage = 0.0;
+    if (probes.grid.w == 0u)
+        return;
+    vec3 spacing = probes.spacing_m.xyz;
+    vec3 q = pos + n * (0.25 * min(spacing.x, min(spacing.y, spacing.z)));
+    vec3 g = (q - probes.origin_m.xyz) / spacing;
+    vec3 last = vec3(probes.grid.xyz) - 1.0;
+    vec3 outside = max(max(-g, g - last) - 0.5, vec3(0.0)); /* each probe owns a cell around it */
+    float fade = clamp(1.0 - max(outside.x, max(outside.y, outside.z)), 0.0, 1.0);
+    if (fade <= 0.0)
+        return;
+    vec3 c = clamp(g, vec3(0.0), last);
+    vec3 base = min(floor(c), max(last - 1.0, vec3(0.0)));
+    vec3 f = c - base;
+    float yn[SB_PROBE_SH], yr[SB_PROBE_SH];
+    sh9_basis(n, yn);
+    sh9_basis(r, yr);
+    float wsum = 0.0;
+    for (int corner = 0; corner < 8; corner++) {
+        vec3 o = vec3(corner & 1, (corner >> 1) & 1, (corner >> 2) & 1);
+        uvec3 at = uvec3(min(base + o, last));
+        vec3 tri = mix(1.0 - f, f, o);
+        float w = tri.x * tri.y * tri.z;
+        uint index = at.x + probes.grid.x * (at.y + probes.grid.y * at.z);
+        vec4 where = probe_data[SB_PROBE_VEC4S * index];
+        if (w <= 0.0 || where.w == 0.0)
+            continue;
+        vec3 to = where.xyz - pos;
+        float len = length(to);
+        float wrap = len > 1e-4 ? 0.5 * (dot(to / len, n) + 1.0) : 1.0;
+        w *= wrap * wrap + 0.2;
+        vec3 sn = vec3(0.0), sr = vec3(0.0);
+        for (int k = 0; k < SB_PROBE_SH; k++) {
+            vec3 e = probe_irradiance[SB_PROBE_SH * index + k].rgb;
+            sn += e * yn[k];
+            sr += e * yr[k];
+        }
+        e_n += w * max(sn, vec3(0.0));
+        e_r += w * max(sr, vec3(0.0));
+        wsum += w;
+    }
+    if (wsum <= 1e-6) {
+        e_n = e_r = vec3(0.0);
+        return;
+    }
+    e_n /= wsum;
+    e_r /= wsum;
+    coverage = fade;
+}
+#endif
+
+#endif

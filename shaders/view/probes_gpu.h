@@ -1,0 +1,30 @@
+/*
+ * The sky-visibility probes' bindings and GPU form (runtime/passes/probes.c,
+ * probes.glsl); the scene and the fog read them too. config.h's rules.
+ */
+#ifndef SB_SHADERS_PROBES_GPU_H
+#define SB_SHADERS_PROBES_GPU_H
+
+#include "config.h"
+
+#define SB_VIEW_BINDING_PROBES 20        /* struct sb_probes_gpu, then SB_PROBE_VEC4S vec4s a probe */
+#define SB_VIEW_BINDING_PROBE_LIGHT 21   /* the sky's SH, then each probe's irradiance SH (probes.glsl) */
+
+/* The sky-visibility probes skyview lights the world with (probes.glsl):
+ * the grid of a pack's sky_visibility product, and the SH triple-product
+ * tensor's non-zero entries (sb_sh9_tensor). probe_sky.comp projects the
+ * sky's radiance on SH over SB_PROBE_SKY_DIRECTIONS directions, one
+ * workgroup of SB_PROBE_SKY_THREADS; probe_light.comp relights each probe,
+ * SB_PROBE_THREADS a workgroup. */
+#define SB_SH_TENSOR_MAX 128 /* 83 are not zero */
+#define SB_PROBE_SKY_THREADS 64
+#define SB_PROBE_SKY_DIRECTIONS 4096
+struct sb_probes_gpu {
+    SB_UVEC4(grid);          /* xyz: probes along each axis; w: grid probes (0: none, the sky-only ambient) */
+    SB_VEC4(origin_m);       /* xyz: the first probe (world, m); w: tensor entries */
+    SB_VEC4(spacing_m);      /* xyz: between probes; w: 1 when the pack's sky_bounce is in probe_data */
+    SB_VEC4(bounce_albedo);  /* rgb: the world's mean albedo by area (the bounce model); w: unused */
+    SB_VEC4(tensor[SB_SH_TENSOR_MAX]); /* x: the integral of Y_i Y_j Y_k; y, z, w: i, j, k */
+};
+
+#endif

@@ -1,0 +1,44 @@
+#version 450
+/* The world traced: one ray a pixel through the world's BVH (bvh.glsl)
+ * from the camera through the pixel's centre, where the rasteriser samples
+ * too, lit by scene_shading.glsl with a shadow ray for the sun's visibility
+ * (shadows.glsl, SB_TRACED_SHADOWS). It writes what the raster scene pass
+ * writes: the lit radiance, zero where no triangle is hit (the sky pass
+ * fills those), and the depth as the rasteriser's reverse-Z projection
+ * would (0 for the sky). For GPUs whose rasteriser is their weak part
+ * (runtime/passes/scene.c). Built with SB_AERIAL_VOLUME_ONLY too, as
+ * scene.frag is. */
+#extension GL_GOOGLE_include_directive : require
+#include "view_gpu.h"
+#include "scene_shading.glsl"
+#include "shadows.glsl"
+#include "world.glsl"
+
+layout(local_size_x = SB_WORKGROUP_X, local_size_y = SB_WORKGROUP_Y) in;
+layout(set = 0, binding = SB_VIEW_BINDING_HDR, rgba16f) uniform writeonly image2D hdr;
+layout(set = 0, binding = SB_VIEW_BINDING_DEPTH_OUT, r32f) uniform writeonly image2D depth_out;
+
+void main()
+{
+    ivec2 pixel = ivec2(gl_GlobalInvocationID.xy);
+    if (any(greaterThanEqual(uvec2(pixel), frame.size.xy)))
+        return;
+    vec2 uv = (vec2(pixel) + 0.5) / vec2(frame.size.xy);
+    vec3 d = view_ray(uv);
+    /* from the near plane on, as the rasteriser clips */
+    float t_near = frame.camera_m.w / max(dot(d, frame.camera_forward.xyz), 1e-6);
+    BvhHit hit = bvh_trace(frame.camera_m.xyz, d, t_near, 1e30, false);
+    if (hit.triangle == SB_BVH_MISS) {
+        imageStore(hdr, pixel, vec4(0.0));
+        imageStore(depth_out, pixel, vec4(0.0));
+        return;
+    }
+    sb_vertex_gpu v = vertices[3u * (hit.triangle & ~SB_BVH_BACK_FACE)];
+    vec3 offset = d * hit.t;
+    vec3 n = v.normal.xyz;
+    vec4 clip = frame.view_proj * vec4(offset, 1.0);
+    imageStore(depth_out, pixel, vec4(clip.z / clip.w));
+    /* a face turned from the sun gets none of it, shadowed or not */
+    float visibility = dot(n, frame.sun_direction.xyz) > 0.0 ? sun_visibility(offset, n, true) : 0.0;
+    imageStore(hdr, pixel, scene_shade(offset, n, v.albedo.rgb, vec2(v.position.w, v.normal.w), uv, visibility));
+}

@@ -1,0 +1,123 @@
+/*
+ * What skyview's passes share: the frame's constants, the sky-view LUT's
+ * mapping, the sun disk, and the atmosphere read from the pack (the baked
+ * transmittance for the sun, see SB_SUN_TRANSMITTANCE_LUT; psi_ms from its
+ * refined form, SB_MULTISCATTERING_REFINED in config.h; both as textures,
+ * SB_ATMOSPHERE_TEXTURES in atmosphere.glsl).
+ */
+#ifndef SB_VIEW_GLSL
+#define SB_VIEW_GLSL
+
+#include "view_gpu.h"
+
+#define SB_SUN_TRANSMITTANCE_LUT
+#define SB_MULTISCATTERING_REFINED
+#define SB_ATMOSPHERE_TEXTURES
+#include "atmosphere.glsl"
+#include "sky_radiance.glsl"
+
+#include "frame.glsl"
+
+layout(push_constant) uniform ViewPush {
+    sb_view_push pc;
+};
+
+/* The unit view ray from the camera through uv of the frame (0 to 1, x
+ * right, y down; a pixel's centre is at (pixel + 0.5) / size). */
+vec3 view_ray(vec2 uv)
+{
+    vec4 point = frame.inv_view_proj * vec4(uv * 2.0 - 1.0, 0.5, 1.0);
+    return normalize(point.xyz / point.w);
+}
+
+/* Planet-centred position (km) of a camera-relative world offset (m). */
+vec3 planet_position(vec3 offset_m)
+{
+    return frame.camera_km.xyz + offset_m * 1e-3;
+}
+
+/* The sky-view LUT (after Hillaire 2020): u is the azimuth from the sun,
+ * phi = pi u^2, dense toward the sun; v is the zenith angle, split at the
+ * horizon (the ray that grazes the planet) with a square law on each side,
+ * so rows crowd toward the horizon from above and below. */
+float horizon_zenith_angle(float h)
+{
+    /* pi/2 plus the horizon's dip, atan(rho / R): pi - asin(R / r) would
+     * lose the dip to rounding a few metres above the ground. */
+    return 0.5 * PI + atan(horizon_distance(h), ground_radius());
+}
+
+/* (azimuth from the sun, zenith angle) of LUT coordinates uv at altitude h. */
+vec2 sky_view_angles(vec2 uv, float h)
+{
+    float theta_h = horizon_zenith_angle(h);
+    float theta;
+    if (uv.y < 0.5) {
+        float c = 1.0 - 2.0 * uv.y;
+        theta = theta_h * (1.0 - c * c);
+    } else {
+        float c = 2.0 * uv.y - 1.0;
+        theta = theta_h + (PI - theta_h) * c * c;
+    }
+    return vec2(PI * uv.x * uv.x, theta);
+}
+
+vec2 sky_view_uv(float phi, float theta, float h)
+{
+    float theta_h = horizon_zenith_angle(h);
+    float v = theta < theta_h ? 0.5 * (1.0 - sqrt(max(1.0 - theta / theta_h, 0.0)))
+                              : 0.5 * (1.0 + sqrt(max((theta - theta_h) / (PI - theta_h), 0.0)));
+    return vec2(sqrt(clamp(phi / PI, 0.0, 1.0)), v);
+}
+
+/* Where the sky-view LUT holds direction d from the camera (inside the
+ * atmosphere): the azimuth from the sun about the zenith, the zenith
+ * angle, at the camera's altitude. */
+vec2 sky_view_uv_toward(vec3 d)
+{
+    vec3 up = normalize(frame.camera_km.xyz), l = frame.sun_direction.xyz;
+    float h = clamp(frame.camera_km.w, 0.0, atmosphere_thickness()); /* as the LUT was made */
+    float mu = clamp(dot(up, d), -1.0, 1.0), mu_s = clamp(dot(up, l), -1.0, 1.0);
+    vec3 d_flat = d - up * mu, l_flat = l - up * mu_s;
+    float len = length(d_flat) * length(l_flat);
+    float cos_phi = len > 1e-7 ? clamp(dot(d_flat, l_flat) / len, -1.0, 1.0) : 1.0;
+    return sky_view_uv(acos(cos_phi), acos(mu), h);
+}
+
+/* The sun's disk along a view direction at angle cos_angle from its centre:
+ * radiance with limb darkening I(m)/I(1) = 1 - u (1 - m), u = 0.6 (a
+ * visible-band value), normalised so the disk delivers the solar
+ * irradiance; zero outside the disk. Multiply by the transmittance toward it. */
+vec3 sun_disk(float cos_angle)
+{
+    float alpha = frame.sun_direction.w;
+    if (cos_angle < frame.camera_forward.w)
+        return vec3(0.0);
+    float s = sqrt(max(1.0 - cos_angle * cos_angle, 0.0)) / sin(alpha);
+    float m = sqrt(max(1.0 - s * s, 0.0));
+    const float u = 0.6;
+    float darkening = (1.0 - u * (1.0 - m)) / (1.0 - u / 3.0);
+    return atm.solar_irradiance.rgb / (PI * alpha * alpha) * darkening;
+}
+
+/* Where a ray from planet-centred p along unit d enters the atmosphere
+ * (0 when p is inside); -1 when it misses the atmosphere. */
+float atmosphere_entry(vec3 p, vec3 d)
+{
+    float r2 = dot(p, p), top = top_radius();
+    if (r2 <= top * top)
+        return 0.0;
+    float b = dot(p, d);
+    float disc = b * b - (r2 - top * top);
+    if (b >= 0.0 || disc < 0.0)
+        return -1.0;
+    return -b - sqrt(disc);
+}
+
+/* Keep stored radiance finite in fp16 (65504). */
+vec3 fp16_safe(vec3 c)
+{
+    return min(c, vec3(65000.0));
+}
+
+#endif

@@ -1,0 +1,127 @@
+/*
+ * skyview's contracts shared between C and GLSL (config.h's rules): what
+ * more than one pass reads, and the frame's constants. Each pass has its
+ * own descriptor set (runtime/graph.h), of the bindings it declares; these
+ * are the numbers of the resources several passes share, bindings 0 to 3
+ * being the atmosphere's (config.h, in their lookup forms). A pass's own
+ * bindings and GPU struct are in its header beside it (fog_gpu.h,
+ * clouds_gpu.h, probes_gpu.h, reflections_gpu.h, grading_gpu.h,
+ * purkinje_gpu.h, local_tonemap_gpu.h). The world frame is y up, in
+ * metres, with the origin on the ground; the planet's centre is at
+ * (0, -ground radius, 0). Shaders work relative to the camera.
+ */
+#ifndef SB_SHADERS_VIEW_GPU_H
+#define SB_SHADERS_VIEW_GPU_H
+
+#include "config.h"
+
+#define SB_VIEW_BINDING_FRAME 4          /* struct sb_frame_gpu */
+#define SB_VIEW_BINDING_VERTICES 5       /* struct sb_vertex_gpu[] */
+#define SB_VIEW_BINDING_EXPOSURE 6       /* histogram bins, then struct sb_exposure_gpu */
+#define SB_VIEW_BINDING_SKY_VIEW 7       /* sampler2D: the sky-view LUT */
+#define SB_VIEW_BINDING_SKY_VIEW_OUT 8   /* image2D rgba16f: the same, written */
+#define SB_VIEW_BINDING_AERIAL 9         /* sampler3D: in-scattered radiance (rgb) */
+#define SB_VIEW_BINDING_AERIAL_T 10      /* sampler3D: transmittance (rgb) */
+#define SB_VIEW_BINDING_AERIAL_OUT 11    /* image3D rgba16f */
+#define SB_VIEW_BINDING_AERIAL_T_OUT 12  /* image3D rgba16f */
+#define SB_VIEW_BINDING_SHADOW 13        /* sampler2DArrayShadow: the cascades */
+#define SB_VIEW_BINDING_HDR 14           /* image2D rgba16f: the lit frame */
+#define SB_VIEW_BINDING_DEPTH 15         /* sampler2D: the scene's depth (reverse Z, 0 = sky) */
+#define SB_VIEW_BINDING_BLOOM_SRC 16     /* sampler2D: a bloom step's source (per descriptor set) */
+#define SB_VIEW_BINDING_BLOOM_DST 17     /* image2D rgba16f: a bloom step's target (per set) */
+#define SB_VIEW_BINDING_BLOOM 18         /* sampler2D: the finished bloom, mip 0 */
+#define SB_VIEW_BINDING_LDR 19           /* image2D rgba8: the display-referred frame */
+#define SB_VIEW_BINDING_BVH_NODES 43        /* the world's BVH (geometry/bvh.h) when traced: its nodes */
+#define SB_VIEW_BINDING_BVH_TRIANGLES 44    /* its triangles; material 1: casts shadows, 0: does not */
+#define SB_VIEW_BINDING_DEPTH_OUT 45        /* image2D r32f: the traced scene's depth, written */
+/* A shadow ray's reach: past any two points of a world (4 x SB_MESH_MAX_EXTENT_M, geometry/mesh.h). */
+#define SB_TRACE_FAR_M 4.0e4
+
+/* What the scene pass writes (sb_frame_gpu.size.w): the lit frame, or for
+ * tests one term of it, in the pack's radiance units times the frame's
+ * scale, without aerial perspective. */
+#define SB_DEBUG_NONE 0
+#define SB_DEBUG_ENV_SPECULAR 1 /* the ambient specular alone */
+#define SB_DEBUG_FOG 2          /* the fog's in-scattering alone (rgb), after the fog apply pass */
+#define SB_DEBUG_FOG_TRANSMITTANCE 3 /* the fog's transmittance (grey), likewise */
+#define SB_DEBUG_CLOUDS 4             /* the clouds' in-scattering alone (rgb), before aerial perspective */
+#define SB_DEBUG_CLOUD_TRANSMITTANCE 5 /* the clouds' transmittance (grey) */
+#define SB_DEBUG_CLOUD_SHADOW 6       /* the scene: the clouds' transmittance toward the sun (grey) */
+#define SB_DEBUG_SUN_VISIBILITY 7     /* the scene: the sun's visibility, its shadows (grey) */
+
+#define SB_SKY_VIEW_WIDTH 192 /* azimuth from the sun, 0 to pi */
+#define SB_SKY_VIEW_HEIGHT 108 /* zenith angle, the horizon between rows 53 and 54 */
+#define SB_AERIAL_SIZE 32      /* x, y: screen; z: distance slices */
+#define SB_CASCADES 4
+/* The margins of a cascade's casters' box (renderer.c, passes/shadows.c, shadows.glsl): the
+ * lookups are made within SB_SHADOW_RECT_MARGIN_TEXELS of the box
+ * (frame.cascade_rect), and the raster's filter (3 x 3 taps a texel apart,
+ * each a bilinear compare) reads SB_SHADOW_FILTER_REACH_HALF_TEXELS / 2
+ * texels further; SB_SHADOW_CLEAR_MARGIN_TEXELS are cleared and drawn past
+ * the box, so every texel a lookup reads holds what a whole map would. */
+#define SB_SHADOW_RECT_MARGIN_TEXELS 2
+#define SB_SHADOW_FILTER_REACH_HALF_TEXELS 5
+#define SB_SHADOW_CLEAR_MARGIN_TEXELS 5
+#ifndef GL_core_profile
+_Static_assert(2 * SB_SHADOW_CLEAR_MARGIN_TEXELS >= 2 * SB_SHADOW_RECT_MARGIN_TEXELS + SB_SHADOW_FILTER_REACH_HALF_TEXELS,
+               "the cleared margin covers what the filter reads past the lookups' box");
+#endif
+#define SB_HISTOGRAM_BINS 256
+#define SB_BLOOM_MAX_LEVELS 6
+
+/* Tone mappers, sb_frame_gpu.post.w. */
+#define SB_TONEMAP_AGX 0
+#define SB_TONEMAP_ACES 1
+#define SB_TONEMAP_GT 2
+
+/* One vertex of the world: a triangle list, each vertex carrying its material. */
+struct sb_vertex_gpu {
+    SB_VEC4(position); /* xyz: m, world; w: metallic */
+    SB_VEC4(normal);   /* xyz: unit normal; w: perceptual roughness */
+    SB_VEC4(albedo);   /* rgb: base colour, linear; w: unused */
+};
+
+/* Per-frame constants (std430). */
+struct sb_frame_gpu {
+    SB_MAT4(view_proj);        /* camera-relative world (m) to clip, reverse Z, infinite far */
+    SB_MAT4(inv_view_proj);
+    SB_MAT4(shadow_view_proj[SB_CASCADES]); /* camera-relative world (m) to each cascade's clip */
+    SB_VEC4(camera_m);         /* the camera in the world (m); w: the near plane's distance (m) */
+    SB_VEC4(camera_km);        /* planet-centred camera (km); w: its altitude (km) */
+    SB_VEC4(camera_forward);   /* unit view direction, world; w: cos of the sun's angular radius */
+    SB_VEC4(sun_direction);    /* unit vector toward the sun, world; w: sun's angular radius (rad) */
+    SB_VEC4(cascade_ends);     /* view depth (m) where each cascade ends */
+    SB_VEC4(cascade_texel);    /* a shadow texel's width (m) in each cascade */
+    SB_VEC4(cascade_rect[SB_CASCADES]); /* uv box (min xy, max xy) outside which a cascade has no caster:
+                                           lookups there see the sun without reading the map */
+    SB_VEC4(shadow);           /* x: blend band (fraction of a cascade), y: normal offset (texels),
+                                  z: shadow map size (texels), w: 1 to use shadows */
+    SB_VEC4(aerial);           /* x: the volume's far distance (km); y: radiance scale (what the frame's
+                                  radiance is multiplied by before storage); zw: unused */
+    SB_VEC4(exposure);         /* x: log2 luminance at bin 1, y: log2 range of bins 1..255,
+                                  z, w: low and high percentile of the metering window */
+    SB_VEC4(adaptation);       /* x: speed to brighter (1/s), y: to darker (1/s), z: dt (s), w: 1 to snap */
+    SB_VEC4(post);             /* x: bloom threshold (exposed), y: bloom strength, z: exposure
+                                  compensation (EV), w: tone mapper (SB_TONEMAP_*) */
+    SB_UVEC4(size);            /* xy: frame size; z: bloom levels; w: SB_DEBUG_* */
+};
+
+/* What exposure.comp keeps between frames, after the histogram's bins. */
+struct sb_exposure_gpu {
+    SB_VEC4(state); /* x: adapted log2 luminance; y: exposure (multiplier); z: metered log2 luminance
+                       of this frame; w: pixels in the metering window */
+};
+
+/* Rec.709's luminance weights (linear R, G, B), for C ({SB_LUMINANCE_RGB})
+ * and GLSL (vec3(SB_LUMINANCE_RGB)) alike. */
+#define SB_LUMINANCE_RGB 0.2126, 0.7152, 0.0722
+
+/* Push constants of skyview's passes. */
+struct sb_view_push {
+    SB_UINT cascade;     /* shadow.vert: the cascade drawn */
+    SB_UINT level;       /* bloom: the mip level written */
+    SB_UINT first_level; /* bloom_down: 1 when reading the frame (threshold and Karis average) */
+    SB_UINT pad;
+};
+
+#endif
