@@ -14,23 +14,9 @@
 
 #include "context.h"
 #include "image.h"
+#include "key.h"
 #include "pack.h"
 #include "scene.h"
-
-/* A bake key's text, before it is hashed (bake.h says what goes in). */
-struct sb_key_text {
-    char text[8192];
-    size_t length; /* may exceed sizeof(text) - 1 when cut; hashing takes what fits */
-};
-
-/* Append printf-style text to a key's text. */
-#if defined(__GNUC__)
-__attribute__((format(printf, 2, 3)))
-#endif
-void sb_key_add(struct sb_key_text *key, const char *fmt, ...);
-
-/* Append " name=%a,%a,%a" (hexadecimal floats: exact). */
-void sb_key_add3(struct sb_key_text *key, const char *name, const double v[3]);
 
 struct sb_family_baker {
     /* The products `id` reads (bit mask of sb_product_id, all of lower ids

@@ -80,4 +80,10 @@ struct cJSON *sb_fog_section_json(const struct sb_scene *scene);
 enum sb_result sb_cloud_layer_section_parse(const struct cJSON *section, struct sb_scene *scene, const char *source);
 struct cJSON *sb_cloud_layer_section_json(const struct sb_scene *scene);
 
+/* The product's width, height and depth for `scene` (fixed by its format,
+ * or, where the format says 0, set by its family's scene parameters: the
+ * cloud products' sizes). */
+struct sb_scene;
+void sb_product_shape(const struct sb_scene *scene, enum sb_product_id id, uint32_t shape[3]);
+
 #endif

@@ -46,17 +46,6 @@ static const struct sb_product_format product_formats[SB_PRODUCT_COUNT] = {
                                       SB_STORAGE_PROBES, "float32", "sbprobes", SB_FAMILY_REFLECTIONS},
 };
 
-void sb_product_shape(const struct sb_scene *scene, enum sb_product_id id, uint32_t shape[3])
-{
-    const struct sb_product_format *f = &product_formats[id];
-    const struct sb_family_format *family = sb_family_format(f->family);
-    shape[0] = f->width;
-    shape[1] = f->height;
-    shape[2] = f->depth;
-    if (family->product_shape)
-        family->product_shape(scene, id, shape);
-}
-
 const struct sb_product_format *sb_product_format(enum sb_product_id id)
 {
     return &product_formats[id];

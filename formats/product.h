@@ -59,7 +59,7 @@ enum sb_storage {
 /* What a product's file holds in this format version. */
 struct sb_product_format {
     const char *name;              /* "transmittance", ..., "cloud_shape", "cloud_detail", "cloud_curl", "weather" */
-    uint32_t width, height, depth; /* 0: set by the scene (sb_product_shape) */
+    uint32_t width, height, depth; /* 0: set by the scene (sb_product_shape, family.h) */
     uint32_t channel_count;
     const char *channel_names;    /* comma-separated, in storage order */
     const char *parameterization; /* mapping id, see docs/pack.md */
@@ -73,11 +73,5 @@ struct sb_product_format {
 const struct sb_product_format *sb_product_format(enum sb_product_id id);
 const char *sb_product_name(enum sb_product_id id);
 bool sb_product_from_name(const char *name, enum sb_product_id *id);
-
-/* The product's width, height and depth for `scene` (fixed by its format,
- * or, where the format says 0, set by its family's scene parameters: the
- * cloud products' sizes). */
-struct sb_scene;
-void sb_product_shape(const struct sb_scene *scene, enum sb_product_id id, uint32_t shape[3]);
 
 #endif
