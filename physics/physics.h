@@ -42,7 +42,9 @@ int sb_atmosphere_levels(const struct sb_atmosphere_params *params, double level
 size_t sb_lookup_float_count(enum sb_product_id id);
 void sb_lookup_fill(enum sb_product_id id, const struct sb_image *image, float *dst);
 
-/* Catmull-Rom's weights at t in [0, 1] for the four texels around it. */
+/* Catmull-Rom's weights at t in [0, 1] for the four texels around it; the
+ * same as atmosphere.glsl's catmull_rom and cubic_taps, which
+ * test_atmosphere holds to these (through the multiscattering lookup). */
 void sb_catmull_rom(double t, double w[4]);
 /* The first of the four texels around continuous texel coordinate f on n
  * texels (clamped to [0, n - 1]; texel i at i), and their weights: what the

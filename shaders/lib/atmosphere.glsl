@@ -506,6 +506,9 @@ vec2 subtexel_coords(float h, float mu_s, uvec2 size)
  * them by up to 2x. The multiscattering LUT's ghost texels (config.h) stand
  * for the repeated edges; the ground irradiance's rows are clamped.
  */
+/* The same weights and taps as physics.c's sb_catmull_rom and
+ * sb_cubic_taps: test_atmosphere holds multiscattering_lut_sample to the
+ * fp64 lookup built on those (sb_ref_multiscattering_lookup) within 1e-5. */
 void catmull_rom(float t, out float w[4])
 {
     float t2 = t * t, t3 = t2 * t;
