@@ -163,3 +163,27 @@ void sb_renderer_viewport(struct sb_renderer *r, uint32_t width, uint32_t height
     vkCmdSetViewport(r->cmd, 0, 1, &viewport);
     vkCmdSetScissor(r->cmd, 0, 1, &scissor);
 }
+
+enum sb_result sb_pass_frame_kernel(struct sb_renderer *r, const uint32_t *spirv, size_t spirv_size, const char *name)
+{
+    VkPipeline *kernel = calloc(1, sizeof(*kernel));
+    if (!kernel)
+        return SB_ERR_NOMEM;
+    sb_pass_set_data(r, kernel);
+    return sb_renderer_kernel(r, spirv, spirv_size, name, kernel);
+}
+
+void sb_pass_frame_kernel_destroy(struct sb_renderer *r)
+{
+    VkPipeline *kernel = sb_pass_data(r);
+    if (kernel)
+        sb_renderer_release(r, kernel, 1, NULL, 0);
+    free(kernel);
+}
+
+void sb_pass_frame_kernel_record(struct sb_renderer *r)
+{
+    VkPipeline *kernel = sb_pass_data(r);
+    if (kernel)
+        sb_renderer_dispatch_frame(r, *kernel);
+}

@@ -154,6 +154,13 @@ void sb_renderer_dispatch_frame(struct sb_renderer *r, VkPipeline pipeline);
 void sb_renderer_bind_graphics(struct sb_renderer *r, VkPipeline pipeline, const struct sb_view_push *push);
 void sb_renderer_viewport(struct sb_renderer *r, uint32_t width, uint32_t height);
 
+/* A pass that is one kernel over the frame: made after the pass's
+ * declarations and kept as its data; its destroy and record hooks. A pass
+ * that makes none (it has nothing to do) records nothing. */
+enum sb_result sb_pass_frame_kernel(struct sb_renderer *r, const uint32_t *spirv, size_t spirv_size, const char *name);
+void sb_pass_frame_kernel_destroy(struct sb_renderer *r);
+void sb_pass_frame_kernel_record(struct sb_renderer *r);
+
 /* Destroy what a pass made: its pipelines (VK_NULL_HANDLE ones skipped) and
  * textures (zeroed ones accepted). */
 void sb_renderer_release(struct sb_renderer *r, const VkPipeline *pipelines, size_t pipeline_count,

@@ -4,8 +4,6 @@
  * volume ("froxels"), the height fog beyond it in closed form. Without fog
  * (no "froxels" in the graph's table) it declares and records nothing.
  */
-#include <stdlib.h>
-
 #include "clouds_gpu.h"
 #include "fog_gpu.h"
 #include "probes_gpu.h"
@@ -18,10 +16,6 @@ static enum sb_result fog_apply_create(struct sb_renderer *r)
     sb_resource froxels = sb_graph_find(r, "froxels");
     if (!froxels)
         return SB_OK;
-    VkPipeline *kernel = calloc(1, sizeof(*kernel));
-    if (!kernel)
-        return SB_ERR_NOMEM;
-    sb_pass_set_data(r, kernel);
     sb_pass_read_atmosphere(r);
     sb_pass_use(r, SB_VIEW_BINDING_HDR, sb_pass_find(r, "hdr"), SB_USE_LOAD_STORE);
     sb_pass_sample(r, SB_VIEW_BINDING_DEPTH, sb_pass_find(r, "depth"), r->nearest);
@@ -31,31 +25,15 @@ static enum sb_result fog_apply_create(struct sb_renderer *r)
     sb_pass_use(r, SB_VIEW_BINDING_PROBE_LIGHT, sb_pass_find(r, "probe light"), SB_USE_LOAD);
     sb_pass_use(r, SB_VIEW_BINDING_CLOUDS, sb_pass_find(r, "clouds"), SB_USE_LOAD);
     sb_pass_sample(r, SB_VIEW_BINDING_CLOUD_SHADOW, sb_pass_find(r, "cloud shadow"), NULL);
-    return sb_renderer_kernel(r, sb_spv_fog_apply, sizeof(sb_spv_fog_apply), "fog apply", kernel);
-}
-
-static void fog_apply_destroy(struct sb_renderer *r)
-{
-    VkPipeline *kernel = sb_pass_data(r);
-    if (!kernel)
-        return;
-    sb_renderer_release(r, kernel, 1, NULL, 0);
-    free(kernel);
-}
-
-static void fog_apply_record(struct sb_renderer *r)
-{
-    VkPipeline *kernel = sb_pass_data(r);
-    if (kernel)
-        sb_renderer_dispatch_frame(r, *kernel);
+    return sb_pass_frame_kernel(r, sb_spv_fog_apply, sizeof(sb_spv_fog_apply), "fog apply");
 }
 
 /* It reads the froxels: the fog left out, it is too. */
 const struct sb_pass_class sb_pass_fog_apply = {
     .name = "fog apply",
     .create = fog_apply_create,
-    .destroy = fog_apply_destroy,
-    .record = fog_apply_record,
+    .destroy = sb_pass_frame_kernel_destroy,
+    .record = sb_pass_frame_kernel_record,
     .optional = true,
     .needs = 1u << SB_PASS_FOG,
 };

@@ -2,18 +2,12 @@
  * The tone curve (AgX, ACES or GT, sb_renderer_params.tonemap): the exposed
  * frame and its bloom to sRGB-encoded 8-bit, into the renderer's "ldr".
  */
-#include <stdlib.h>
-
 #include "renderer_internal.h"
 
 #include "tonemap.spv.h"
 
 static enum sb_result tonemap_create(struct sb_renderer *r)
 {
-    VkPipeline *kernel = calloc(1, sizeof(*kernel));
-    if (!kernel)
-        return SB_ERR_NOMEM;
-    sb_pass_set_data(r, kernel);
     sb_resource bloom = sb_pass_find(r, "bloom");
     const struct sb_texture *chain = sb_graph_texture(r, bloom);
     sb_pass_use(r, SB_VIEW_BINDING_FRAME, sb_pass_find(r, "frame"), SB_USE_LOAD);
@@ -22,27 +16,13 @@ static enum sb_result tonemap_create(struct sb_renderer *r)
     sb_pass_sample(r, SB_VIEW_BINDING_BLOOM, bloom, NULL);
     sb_pass_set_view(r, 0, SB_VIEW_BINDING_BLOOM, chain->subview_count ? chain->subviews[0] : chain->view);
     sb_pass_use(r, SB_VIEW_BINDING_LDR, sb_pass_find(r, "ldr"), SB_USE_STORE);
-    return sb_renderer_kernel(r, sb_spv_tonemap, sizeof(sb_spv_tonemap), "tonemap", kernel);
-}
-
-static void tonemap_destroy(struct sb_renderer *r)
-{
-    VkPipeline *kernel = sb_pass_data(r);
-    if (!kernel)
-        return;
-    sb_renderer_release(r, kernel, 1, NULL, 0);
-    free(kernel);
-}
-
-static void tonemap_record(struct sb_renderer *r)
-{
-    sb_renderer_dispatch_frame(r, *(VkPipeline *)sb_pass_data(r));
+    return sb_pass_frame_kernel(r, sb_spv_tonemap, sizeof(sb_spv_tonemap), "tonemap");
 }
 
 const struct sb_pass_class sb_pass_tonemap = {
     .name = "tonemap",
     .post = true,
     .create = tonemap_create,
-    .destroy = tonemap_destroy,
-    .record = tonemap_record,
+    .destroy = sb_pass_frame_kernel_destroy,
+    .record = sb_pass_frame_kernel_record,
 };
