@@ -125,10 +125,13 @@ void sb_pass_sets(struct sb_renderer *r, uint32_t count)
 void sb_pass_set_view(struct sb_renderer *r, uint32_t set, uint32_t binding, VkImageView view)
 {
     struct sb_graph_pass *p = creating(r);
-    assert(set < SB_GRAPH_MAX_SETS);
-    for (uint32_t u = 0; u < p->use_count; u++)
-        if (p->uses[u].binding == binding)
-            p->set_views[set][u] = view;
+    assert(set < (p->set_count ? p->set_count : 1) && "sb_pass_sets first");
+    uint32_t u = 0;
+    while (u < p->use_count && p->uses[u].binding != binding)
+        u++;
+    assert(u < p->use_count && "a binding the pass declared");
+    if (u < p->use_count && set < SB_GRAPH_MAX_SETS)
+        p->set_views[set][u] = view;
 }
 
 static bool is_buffer(const struct sb_renderer *r, sb_resource resource)
@@ -302,6 +305,17 @@ void sb_graph_destroy(struct sb_renderer *r)
 }
 
 /* ---- Barriers --------------------------------------------------------------------- */
+
+void sb_renderer_barrier(VkCommandBuffer cmd)
+{
+    VkMemoryBarrier b = {
+        .sType = VK_STRUCTURE_TYPE_MEMORY_BARRIER,
+        .srcAccessMask = VK_ACCESS_MEMORY_WRITE_BIT,
+        .dstAccessMask = VK_ACCESS_MEMORY_READ_BIT | VK_ACCESS_MEMORY_WRITE_BIT,
+    };
+    vkCmdPipelineBarrier(cmd, VK_PIPELINE_STAGE_ALL_COMMANDS_BIT, VK_PIPELINE_STAGE_ALL_COMMANDS_BIT, 0, 1, &b, 0, NULL,
+                         0, NULL);
+}
 
 struct access {
     VkPipelineStageFlags stages;
@@ -490,13 +504,7 @@ void sb_graph_begin_frame(struct sb_renderer *r)
     /* The last frame's commands are done (the renderer waits for them);
      * one full barrier orders this frame's after them, so the table starts
      * with nothing pending. */
-    VkMemoryBarrier all = {
-        .sType = VK_STRUCTURE_TYPE_MEMORY_BARRIER,
-        .srcAccessMask = VK_ACCESS_MEMORY_WRITE_BIT,
-        .dstAccessMask = VK_ACCESS_MEMORY_READ_BIT | VK_ACCESS_MEMORY_WRITE_BIT,
-    };
-    vkCmdPipelineBarrier(r->cmd, VK_PIPELINE_STAGE_ALL_COMMANDS_BIT, VK_PIPELINE_STAGE_ALL_COMMANDS_BIT, 0, 1, &all, 0,
-                         NULL, 0, NULL);
+    sb_renderer_barrier(r->cmd);
     for (uint32_t i = 1; i <= g->resource_count; i++) {
         struct sb_graph_resource *res = &g->resources[i];
         res->write_stages = res->read_stages = res->visible_stages = 0;

@@ -111,17 +111,6 @@ void sb_renderer_release(struct sb_renderer *r, const VkPipeline *pipelines, siz
         sb_texture_destroy(r->vk, textures[i]);
 }
 
-void sb_renderer_barrier(VkCommandBuffer cmd)
-{
-    VkMemoryBarrier b = {
-        .sType = VK_STRUCTURE_TYPE_MEMORY_BARRIER,
-        .srcAccessMask = VK_ACCESS_MEMORY_WRITE_BIT,
-        .dstAccessMask = VK_ACCESS_MEMORY_READ_BIT | VK_ACCESS_MEMORY_WRITE_BIT,
-    };
-    vkCmdPipelineBarrier(cmd, VK_PIPELINE_STAGE_ALL_COMMANDS_BIT, VK_PIPELINE_STAGE_ALL_COMMANDS_BIT, 0, 1, &b, 0, NULL,
-                         0, NULL);
-}
-
 void sb_renderer_dispatch_set(struct sb_renderer *r, uint32_t set, VkPipeline pipeline, const struct sb_view_push *push,
                               const uint32_t size[3], const uint32_t group[3])
 {

@@ -167,7 +167,7 @@ void sb_renderer_release(struct sb_renderer *r, const VkPipeline *pipelines, siz
                          struct sb_texture *const *textures, size_t texture_count);
 
 /* A full memory barrier: every earlier command's writes before every later
- * command (between the steps of a pass). */
+ * command (between the steps of a pass; graph.c). */
 void sb_renderer_barrier(VkCommandBuffer cmd);
 
 /* atmosphere.c: the pack's atmosphere (which must hold transmittance,
