@@ -3,10 +3,8 @@
 #include <assert.h>
 
 static const struct sb_family_baker *const families[SB_FAMILY_COUNT] = {
-    [SB_FAMILY_ATMOSPHERE] = &sb_atmosphere_family,
-    [SB_FAMILY_CLOUDS] = &sb_clouds_family,
-    [SB_FAMILY_PROBES] = &sb_probes_family,
-    [SB_FAMILY_REFLECTIONS] = &sb_reflection_family,
+#define SB_FAMILY(id, name) [SB_FAMILY_##id] = &sb_##name##_family,
+#include "products.def"
 };
 
 const struct sb_family_baker *sb_family_baker(enum sb_family family)

@@ -4,7 +4,7 @@
  * baked, and how a product reused from an older pack is handed back to the
  * family for the products that read it. bake.c drives every family through
  * this table alone; a new family is one file (atmosphere_family.c,
- * clouds_family.c) and one row in family.c.
+ * clouds_family.c) and its rows in formats/products.def.
  */
 #ifndef SB_BAKER_FAMILY_H
 #define SB_BAKER_FAMILY_H
@@ -51,10 +51,8 @@ const struct sb_family_baker *sb_family_baker(enum sb_family family);
 /* The family baker of product `id`. */
 const struct sb_family_baker *sb_product_baker(enum sb_product_id id);
 
-/* The rows (each family's file). */
-extern const struct sb_family_baker sb_atmosphere_family;
-extern const struct sb_family_baker sb_clouds_family;
-extern const struct sb_family_baker sb_probes_family;
-extern const struct sb_family_baker sb_reflection_family;
+/* The rows, each in its family's file (<name>_family.c, products.def). */
+#define SB_FAMILY(id, name) extern const struct sb_family_baker sb_##name##_family;
+#include "products.def"
 
 #endif

@@ -1,9 +1,9 @@
 /*
  * Product families: what the formats tier knows of each family of products
- * (the atmosphere, the cloud noise, ...). A family is its products' rows in
- * the format table (product.c), its scene section (parsed, validated and
- * normalised by the family's own file: scene_clouds.c for the clouds) and
- * one entry here. The baker's half of a family (its keys, bakes, references)
+ * (the atmosphere, the cloud noise, ...). A family is its rows in
+ * products.def and its scene section (parsed, validated and normalised by
+ * the family's own file, scene_clouds.c for the clouds, which also holds
+ * the family's entry here). The baker's half of a family (its keys, bakes, references)
  * is baker/family.h. Internal to skybake; not installed.
  */
 #ifndef SB_FAMILY_H
@@ -52,25 +52,19 @@ struct sb_family_format {
 /* The family's entry; `family` < SB_FAMILY_COUNT. */
 const struct sb_family_format *sb_family_format(enum sb_family family);
 
-/* The clouds' section (scene_clouds.c). */
-void sb_clouds_set_defaults(struct sb_scene *scene);
-enum sb_result sb_clouds_section_parse(const struct cJSON *section, struct sb_scene *scene, const char *source);
-struct cJSON *sb_clouds_section_json(const struct sb_scene *scene);
-void sb_clouds_product_shape(const struct sb_scene *scene, enum sb_product_id id, uint32_t shape[3]);
+/* The rows, each in its family's scene file (scene_<name>.c). */
+#define SB_FAMILY(id, name) extern const struct sb_family_format sb_##name##_family_format;
+#include "products.def"
 
-/* The world's and the probes' sections (scene_world.c). */
+/* The atmosphere's section, the scene's core, which scene.c reads and
+ * writes first (scene_atmosphere.c). */
+enum sb_result sb_atmosphere_section_parse(const struct cJSON *section, struct sb_scene *scene, const char *source);
+struct cJSON *sb_atmosphere_section_json(const struct sb_scene *scene);
+
+/* The world's section (scene_world.c): no family's, read by those that
+ * bake against it. */
 enum sb_result sb_world_section_parse(const struct cJSON *section, struct sb_scene *scene, const char *source);
 struct cJSON *sb_world_section_json(const struct sb_scene *scene);
-void sb_probes_set_defaults(struct sb_scene *scene);
-enum sb_result sb_probes_validate(const struct sb_scene *scene, const char *source);
-enum sb_result sb_probes_section_parse(const struct cJSON *section, struct sb_scene *scene, const char *source);
-struct cJSON *sb_probes_section_json(const struct sb_scene *scene);
-
-/* The reflections' section (scene_reflections.c). */
-void sb_reflections_set_defaults(struct sb_scene *scene);
-enum sb_result sb_reflections_section_parse(const struct cJSON *section, struct sb_scene *scene, const char *source);
-struct cJSON *sb_reflections_section_json(const struct sb_scene *scene);
-void sb_reflections_product_shape(const struct sb_scene *scene, enum sb_product_id id, uint32_t shape[3]);
 
 /* The fog's section (scene_fog.c), skyview's alone. */
 enum sb_result sb_fog_section_parse(const struct cJSON *section, struct sb_scene *scene, const char *source);

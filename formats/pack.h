@@ -17,9 +17,9 @@
 #include "product.h"
 #include "result.h"
 
-/* The version this build writes; it reads this one and every older one
- * (each a subset of the next; docs/pack.md). */
-#define SB_PACK_FORMAT_VERSION 6
+/* This build writes SB_PACK_FORMAT_VERSION (product.h, the last of
+ * products.def's) and reads it and every older one (each a subset of the
+ * next; docs/pack.md). */
 #define SB_PACK_FORMAT_VERSION_OLDEST 1
 #define SB_PACK_MANIFEST "manifest.json"
 

@@ -1,6 +1,6 @@
 /*
  * The products a pack may hold, as its format names and stores them: one
- * row of product.c's table a product, and the families that bake them
+ * row of products.def a product, and the families that bake them
  * (family.h). Files and scenes read this table; it reads neither.
  */
 #ifndef SB_PRODUCT_H
@@ -9,24 +9,18 @@
 #include <stdbool.h>
 #include <stdint.h>
 
+/* The pack format's versions (products.def); this build writes the last. */
+enum sb_format_version {
+    SB_FORMAT_VERSION_NONE,
+#define SB_FORMAT_VERSION(version, what) SB_FORMAT_VERSION_##version,
+#include "products.def"
+    SB_FORMAT_VERSION_NEXT,
+};
+#define SB_PACK_FORMAT_VERSION ((int)SB_FORMAT_VERSION_NEXT - 1)
+
 enum sb_product_id {
-    /* The atmosphere (format version 1 on). */
-    SB_PRODUCT_TRANSMITTANCE,
-    SB_PRODUCT_MULTISCATTERING,
-    SB_PRODUCT_IRRADIANCE_GROUND,
-    SB_PRODUCT_IRRADIANCE_SKY,
-    /* Cloud noise (format version 2 on). */
-    SB_PRODUCT_CLOUD_SHAPE,
-    SB_PRODUCT_CLOUD_DETAIL,
-    SB_PRODUCT_CLOUD_CURL,
-    SB_PRODUCT_WEATHER,
-    /* Probes over the scene's world (format version 3 on). */
-    SB_PRODUCT_SKY_VISIBILITY,
-    SB_PRODUCT_SKY_BOUNCE, /* format version 4 on */
-    /* Reflections (format version 5 on). */
-    SB_PRODUCT_DFG,
-    SB_PRODUCT_REFLECTION_CUBES,  /* format version 6 on */
-    SB_PRODUCT_REFLECTION_PROBES, /* format version 6 on */
+#define SB_PRODUCT(id, family, since, ...) SB_PRODUCT_##id,
+#include "products.def"
     SB_PRODUCT_COUNT,
 };
 
@@ -38,13 +32,11 @@ static inline bool sb_product_is_cloud(enum sb_product_id id)
     return id >= SB_PRODUCT_CLOUD_SHAPE && id <= SB_PRODUCT_WEATHER;
 }
 
-/* Families of products: each is one file of its own per tier plus a row in
- * the family tables (formats/family.h, baker/family.h). */
+/* Families of products: each is one file of its own per tier plus its rows
+ * in products.def. */
 enum sb_family {
-    SB_FAMILY_ATMOSPHERE,
-    SB_FAMILY_CLOUDS,
-    SB_FAMILY_PROBES,
-    SB_FAMILY_REFLECTIONS,
+#define SB_FAMILY(id, name) SB_FAMILY_##id,
+#include "products.def"
     SB_FAMILY_COUNT,
 };
 

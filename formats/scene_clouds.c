@@ -30,7 +30,7 @@ void sb_cloud_params_default(struct sb_cloud_params *p)
     };
 }
 
-void sb_clouds_set_defaults(struct sb_scene *scene)
+static void clouds_set_defaults(struct sb_scene *scene)
 {
     sb_cloud_params_default(&scene->clouds);
 }
@@ -215,14 +215,14 @@ static enum sb_result parse_cloud_object(const cJSON *obj, const char *object, s
     return res;
 }
 
-enum sb_result sb_clouds_section_parse(const cJSON *obj, struct sb_scene *scene, const char *source)
+static enum sb_result clouds_section_parse(const cJSON *obj, struct sb_scene *scene, const char *source)
 {
     enum sb_result res = parse_cloud_object(obj, NULL, &scene->clouds, source);
     scene->has_clouds = true;
     return res ? res : sb_cloud_params_validate(&scene->clouds, source);
 }
 
-cJSON *sb_clouds_section_json(const struct sb_scene *scene)
+static cJSON *clouds_section_json(const struct sb_scene *scene)
 {
     /* Only when given or used, so that scenes without clouds keep the hashes
      * they had in format version 1. */
@@ -254,7 +254,7 @@ cJSON *sb_clouds_section_json(const struct sb_scene *scene)
     return clouds;
 }
 
-void sb_clouds_product_shape(const struct sb_scene *scene, enum sb_product_id id, uint32_t shape[3])
+static void clouds_product_shape(const struct sb_scene *scene, enum sb_product_id id, uint32_t shape[3])
 {
     const struct sb_cloud_params *c = &scene->clouds;
     uint32_t n = id == SB_PRODUCT_CLOUD_SHAPE    ? c->shape_size
@@ -265,3 +265,13 @@ void sb_clouds_product_shape(const struct sb_scene *scene, enum sb_product_id id
     for (int k = 0; k < 3; k++)
         shape[k] = shape[k] ? shape[k] : n;
 }
+
+const struct sb_family_format sb_clouds_family_format = {
+    .name = "clouds",
+    .section = "clouds",
+    .set_defaults = clouds_set_defaults,
+    .parse_section = clouds_section_parse,
+    .section_json = clouds_section_json,
+    .product_shape = clouds_product_shape,
+    .no_tolerance = "the cloud noise is baked exactly (bit for bit with its CPU reference) and takes no tolerance",
+};

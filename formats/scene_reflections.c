@@ -20,7 +20,7 @@ void sb_reflection_params_default(struct sb_reflection_params *p)
     *p = (struct sb_reflection_params){.face_size = 128, .samples = 512, .ambient_rays = 64};
 }
 
-void sb_reflections_set_defaults(struct sb_scene *scene)
+static void reflections_set_defaults(struct sb_scene *scene)
 {
     sb_reflection_params_default(&scene->reflections);
 }
@@ -83,7 +83,7 @@ static enum sb_result parse_probe(const cJSON *e, int i, struct sb_reflection_pa
     return res;
 }
 
-enum sb_result sb_reflections_section_parse(const cJSON *obj, struct sb_scene *scene, const char *source)
+static enum sb_result reflections_section_parse(const cJSON *obj, struct sb_scene *scene, const char *source)
 {
     static const char *const keys[] = {"face_size", "samples", "ambient_rays", "probes", NULL};
     struct sb_reflection_params *p = &scene->reflections;
@@ -109,7 +109,7 @@ enum sb_result sb_reflections_section_parse(const cJSON *obj, struct sb_scene *s
     return res;
 }
 
-cJSON *sb_reflections_section_json(const struct sb_scene *scene)
+static cJSON *reflections_section_json(const struct sb_scene *scene)
 {
     bool used = scene->has_reflections;
     for (int id = 0; id < SB_PRODUCT_COUNT; id++)
@@ -134,7 +134,7 @@ cJSON *sb_reflections_section_json(const struct sb_scene *scene)
     return o;
 }
 
-void sb_reflections_product_shape(const struct sb_scene *scene, enum sb_product_id id, uint32_t shape[3])
+static void reflections_product_shape(const struct sb_scene *scene, enum sb_product_id id, uint32_t shape[3])
 {
     uint32_t n = scene->reflections.face_size, cubes = 1 + (uint32_t)scene->reflections.probe_count;
     if (id == SB_PRODUCT_REFLECTION_CUBES) {
@@ -145,3 +145,14 @@ void sb_reflections_product_shape(const struct sb_scene *scene, enum sb_product_
         shape[0] = cubes;
     }
 }
+
+const struct sb_family_format sb_reflections_family_format = {
+    .name = "reflections",
+    .section = "reflections",
+    .set_defaults = reflections_set_defaults,
+    .parse_section = reflections_section_parse,
+    .section_json = reflections_section_json,
+    .product_shape = reflections_product_shape,
+    .no_tolerance = "the reflections' accuracy is set by their sample counts (reflections.samples; the DFG LUT's is "
+                    "fixed, within 1e-3 of its fp64 reference)",
+};

@@ -13,6 +13,7 @@
 #include <stdio.h>
 #include <stdlib.h>
 
+#include "family.h"
 #include "pack.h"
 #include "scene.h"
 

@@ -27,6 +27,14 @@ for f in "$bin/skybake" "$bin/skyview"; do
         sh -c "! readelf -d '$f' | grep -qE 'R(UN)?PATH'"
 done
 
+# The installed headers are whole: an engine's file that includes them all
+# compiles against the staged include folder alone.
+inc=$(dirname "$(find "$tmp/root" -type f -name skybake.h -path '*/include/*' | head -n 1)")
+for h in "$inc"/*.h; do printf '#include "%s"\n' "$(basename "$h")"; done >"$tmp/headers.c"
+printf 'int main(void) { return SB_PACK_FORMAT_VERSION > 0 ? 0 : 1; }\n' >>"$tmp/headers.c"
+check "the installed headers compile alone" cc -std=c11 -fsyntax-only $(pkg-config --cflags OpenEXR) -I"$inc" \
+    "$tmp/headers.c"
+
 printf '{"version":1,"name":"inst","atmosphere":{"preset":"earth"},"products":["irradiance_ground"]}' >"$tmp/scene.json"
 check "the installed skybake bakes from /" sh -c "cd / && '$bin/skybake' bake '$tmp/scene.json' -o '$tmp/pack' -q"
 check "the pack has a manifest" test -s "$tmp/pack/manifest.json"

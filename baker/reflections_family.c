@@ -289,7 +289,7 @@ static enum sb_result reflection_bake(void *state, struct sb_vk *vk, const struc
     return res;
 }
 
-const struct sb_family_baker sb_reflection_family = {
+const struct sb_family_baker sb_reflections_family = {
     .depends_on = reflection_depends_on,
     .key = reflection_key,
     .create = reflection_create,
