@@ -343,6 +343,10 @@ static cJSON *report_json(const struct sb_bench_report *report, const struct sb_
         cJSON_AddNumberToObject(o, "probes", r->probes);
         cJSON_AddNumberToObject(o, "rays_per_probe", r->rays_per_probe);
         cJSON_AddNumberToObject(o, "bvh_ms", r->bvh_ms);
+        cJSON_AddNumberToObject(o, "bvh_threads", r->bvh_threads);
+        cJSON_AddNumberToObject(o, "bvh_one_thread_ms", r->bvh_one_thread_ms);
+        cJSON_AddNumberToObject(o, "embree_medium_build_ms", r->embree_medium_ms);
+        cJSON_AddNumberToObject(o, "embree_high_build_ms", r->embree_high_ms);
         cJSON_AddNumberToObject(o, "gpu_ms", r->gpu_ms);
         cJSON_AddNumberToObject(o, "gpu_rays_per_s", r->gpu_rays_per_s);
         cJSON_AddNumberToObject(o, "embree_s", r->embree_s);

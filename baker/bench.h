@@ -68,7 +68,11 @@ struct sb_bench_cloud_row {
 struct sb_bench_probe_row {
     char scene[32];
     uint32_t triangles, probes, rays_per_probe;
-    double bvh_ms;                 /* the BVH's build on one thread */
+    /* BVH builds, wall ms, each the median of three: ours on every thread
+     * (bvh_threads) and on one, Embree's binned SAH (medium quality) and
+     * its spatial splits (high) on every core, all in the same run. */
+    double bvh_ms, bvh_one_thread_ms, embree_medium_ms, embree_high_ms;
+    int bvh_threads;
     double gpu_ms, gpu_rays_per_s; /* the bake (median of the repeats) */
     double embree_s, embree_rays_per_s;
     int embree_threads;

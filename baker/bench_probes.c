@@ -17,6 +17,7 @@
 #include "log.h"
 #include "load.h"
 #include "mesh.h"
+#include "parallel.h"
 #include "raycast.h"
 #include "sh.h"
 #include "sky_bounce.h"
@@ -57,6 +58,37 @@ double sb_bench_median(double *v, int n)
     return v[n / 2];
 }
 
+/* Our build on every thread and on one, Embree's medium and high, the
+ * median of three each; the last of ours in *bvh. */
+static enum sb_result time_builds(const struct sb_mesh *mesh, struct sb_bench_probe_row *row, struct sb_bvh *bvh)
+{
+    double ours[3], one[3], medium[3], high[3];
+    enum sb_result res = SB_OK;
+    int all = row->bvh_threads = sb_parallel_threads();
+    /* ours first: Embree's threads spin a while after its builds */
+    for (int pass = 0; pass < 2 && !res; pass++) {
+        sb_parallel_set_threads(pass ? all : 1);
+        for (int k = 0; k < 3 && !res; k++) {
+            double t0 = sb_now_s();
+            res = sb_bvh_build(mesh, bvh);
+            (pass ? ours : one)[k] = (sb_now_s() - t0) * 1e3;
+            if (!res && (!pass || k < 2))
+                sb_bvh_finish(bvh);
+        }
+    }
+    for (int k = 0; k < 3 && !res; k++) {
+        medium[k] = sb_embree_build_ms(mesh, RTC_BUILD_QUALITY_MEDIUM);
+        high[k] = sb_embree_build_ms(mesh, RTC_BUILD_QUALITY_HIGH);
+    }
+    if (res)
+        return res;
+    row->bvh_ms = sb_bench_median(ours, 3);
+    row->bvh_one_thread_ms = sb_bench_median(one, 3);
+    row->embree_medium_ms = sb_bench_median(medium, 3);
+    row->embree_high_ms = sb_bench_median(high, 3);
+    return SB_OK;
+}
+
 static enum sb_result bench_one(struct sb_vk *vk, const char *name, struct sb_mesh *mesh, uint32_t rays_per_probe,
                                 int repeat, struct sb_bench_probe_row *row)
 {
@@ -68,9 +100,7 @@ static enum sb_result bench_one(struct sb_vk *vk, const char *name, struct sb_me
     struct sb_raycaster *rc = NULL;
     struct sb_embree e = {0};
     float *positions = NULL, *out = NULL, *rays = NULL, *hits = NULL;
-    double t0 = sb_now_s();
-    enum sb_result res = sb_bvh_build(mesh, &bvh);
-    row->bvh_ms = (sb_now_s() - t0) * 1e3;
+    enum sb_result res = time_builds(mesh, row, &bvh);
     if (res || (res = sb_raycaster_create(vk, &bvh, &rc)))
         goto done;
     /* 16^3 probes over the bounds, from 2 m above its bottom */
@@ -203,13 +233,23 @@ void sb_bench_probes_print(const struct sb_bench_report *report)
     printf("\nsky visibility (4096 probes; Embree casts the same rays on every core of this machine) and sky bounce "
            "(the same probes, %u x %u rays)\n",
            report->probe_rows[0].bounce_rays, report->probe_rows[0].bounce_secondary);
-    printf("%-12s %10s %7s %6s %9s %11s %12s %11s %12s %9s %11s\n", "scene", "triangles", "probes", "rays", "bvh ms",
-           "gpu ms", "gpu Mrays/s", "embree s", "embree Mr/s", "differ", "bounce ms");
+    printf("%-12s %10s %7s %6s %11s %12s %11s %12s %9s %11s\n", "scene", "triangles", "probes", "rays", "gpu ms",
+           "gpu Mrays/s", "embree s", "embree Mr/s", "differ", "bounce ms");
     for (int i = 0; i < report->probe_row_count; i++) {
         const struct sb_bench_probe_row *r = &report->probe_rows[i];
-        printf("%-12s %10u %7u %6u %9.1f %11.3f %12.3f %11.3f %12.3f %9llu %11.3f\n", r->scene, r->triangles, r->probes,
-               r->rays_per_probe, r->bvh_ms, r->gpu_ms, r->gpu_rays_per_s * 1e-6, r->embree_s,
-               r->embree_rays_per_s * 1e-6, (unsigned long long)r->hits_differ, r->bounce_ms);
+        printf("%-12s %10u %7u %6u %11.3f %12.3f %11.3f %12.3f %9llu %11.3f\n", r->scene, r->triangles, r->probes,
+               r->rays_per_probe, r->gpu_ms, r->gpu_rays_per_s * 1e-6, r->embree_s, r->embree_rays_per_s * 1e-6,
+               (unsigned long long)r->hits_differ, r->bounce_ms);
+    }
+    printf("\nBVH build, wall ms (median of 3): ours on %d threads and on one, Embree's binned SAH (medium) and "
+           "spatial splits (high) on %d\n",
+           report->probe_rows[0].bvh_threads, report->probe_rows[0].embree_threads);
+    printf("%-12s %10s %10s %10s %10s %10s %9s\n", "scene", "triangles", "ours", "ours 1t", "medium", "high",
+           "/medium");
+    for (int i = 0; i < report->probe_row_count; i++) {
+        const struct sb_bench_probe_row *r = &report->probe_rows[i];
+        printf("%-12s %10u %10.1f %10.1f %10.1f %10.1f %9.2f\n", r->scene, r->triangles, r->bvh_ms,
+               r->bvh_one_thread_ms, r->embree_medium_ms, r->embree_high_ms, r->bvh_ms / r->embree_medium_ms);
     }
 }
 
@@ -222,12 +262,14 @@ enum sb_result sb_bench_probes_csv(const struct sb_bench_report *report, const c
         sb_error("%s: cannot write", path);
         return SB_ERR_IO;
     }
-    fprintf(f, "scene,triangles,probes,rays_per_probe,bvh_ms,gpu_ms,gpu_rays_per_s,embree_s,embree_threads,"
+    fprintf(f, "scene,triangles,probes,rays_per_probe,bvh_ms,bvh_threads,bvh_one_thread_ms,embree_medium_build_ms,"
+               "embree_high_build_ms,gpu_ms,gpu_rays_per_s,embree_s,embree_threads,"
                "embree_rays_per_s,hits_differ,bounce_rays,bounce_secondary,bounce_gpu_ms\n");
     for (int i = 0; i < report->probe_row_count; i++) {
         const struct sb_bench_probe_row *r = &report->probe_rows[i];
-        fprintf(f, "%s,%u,%u,%u,%.6g,%.6g,%.6g,%.6g,%d,%.6g,%llu,%u,%u,%.6g\n", r->scene, r->triangles, r->probes,
-                r->rays_per_probe, r->bvh_ms, r->gpu_ms, r->gpu_rays_per_s, r->embree_s, r->embree_threads,
+        fprintf(f, "%s,%u,%u,%u,%.6g,%d,%.6g,%.6g,%.6g,%.6g,%.6g,%.6g,%d,%.6g,%llu,%u,%u,%.6g\n", r->scene,
+                r->triangles, r->probes, r->rays_per_probe, r->bvh_ms, r->bvh_threads, r->bvh_one_thread_ms,
+                r->embree_medium_ms, r->embree_high_ms, r->gpu_ms, r->gpu_rays_per_s, r->embree_s, r->embree_threads,
                 r->embree_rays_per_s, (unsigned long long)r->hits_differ, r->bounce_rays, r->bounce_secondary,
                 r->bounce_ms);
     }

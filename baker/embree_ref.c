@@ -7,14 +7,17 @@
 #include "bench.h"
 #include "log.h"
 
-bool sb_embree_create(const struct sb_mesh *mesh, struct sb_embree *e)
+/* A scene of the mesh, built at `quality`; its build's wall time in *ms. */
+static bool create(const struct sb_mesh *mesh, enum RTCBuildQuality quality, struct sb_embree *e, double *ms)
 {
     e->device = rtcNewDevice(NULL);
     if (!e->device)
         return false;
     e->scene = rtcNewScene(e->device);
     rtcSetSceneFlags(e->scene, RTC_SCENE_FLAG_ROBUST);
+    rtcSetSceneBuildQuality(e->scene, quality);
     RTCGeometry g = rtcNewGeometry(e->device, RTC_GEOMETRY_TYPE_TRIANGLE);
+    rtcSetGeometryBuildQuality(g, quality);
     float *v =
         rtcSetNewGeometryBuffer(g, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT3, 3 * sizeof(float), mesh->vertex_count);
     unsigned *idx = rtcSetNewGeometryBuffer(g, RTC_BUFFER_TYPE_INDEX, 0, RTC_FORMAT_UINT3, 3 * sizeof(unsigned),
@@ -24,8 +27,25 @@ bool sb_embree_create(const struct sb_mesh *mesh, struct sb_embree *e)
     rtcCommitGeometry(g);
     rtcAttachGeometry(e->scene, g);
     rtcReleaseGeometry(g);
+    double t0 = sb_now_s();
     rtcCommitScene(e->scene);
+    *ms = (sb_now_s() - t0) * 1e3;
     return true;
+}
+
+bool sb_embree_create(const struct sb_mesh *mesh, struct sb_embree *e)
+{
+    double ms;
+    return create(mesh, RTC_BUILD_QUALITY_MEDIUM, e, &ms);
+}
+
+double sb_embree_build_ms(const struct sb_mesh *mesh, enum RTCBuildQuality quality)
+{
+    struct sb_embree e = {0};
+    double ms = -1;
+    if (create(mesh, quality, &e, &ms))
+        sb_embree_destroy(&e);
+    return ms;
 }
 
 void sb_embree_destroy(struct sb_embree *e)

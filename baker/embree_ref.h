@@ -21,6 +21,11 @@ struct sb_embree {
 bool sb_embree_create(const struct sb_mesh *mesh, struct sb_embree *e);
 void sb_embree_destroy(struct sb_embree *e);
 
+/* The wall time of Embree's build of the mesh's scene (robust mode) at
+ * `quality` on every core, in ms (the bench's yardstick); < 0 if Embree
+ * refuses. */
+double sb_embree_build_ms(const struct sb_mesh *mesh, enum RTCBuildQuality quality);
+
 /* Closest hits of `count` rays (8 floats each: origin, tmin, direction,
  * tmax) into hits (4 floats each: t, triangle bits or SB_BVH_MISS, u, v),
  * on every core; returns the wall time in seconds. */

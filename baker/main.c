@@ -19,6 +19,7 @@
 #include "json.h"
 #include "log.h"
 #include "pack_tools.h"
+#include "parallel.h"
 #include "scene.h"
 #include "sky_error.h"
 #include "skybake_version.h"
@@ -63,6 +64,9 @@ static void usage(FILE *f)
                "  --force             bake every product, reusing nothing\n"
                "  --device NAME|INDEX Vulkan device by index or name substring\n"
                "                      (default: first discrete GPU, else the first device)\n"
+               "  --threads N         CPU threads for the BVH build and the CPU steps\n"
+               "                      (default: every core, at most 64); the pack's bytes\n"
+               "                      do not depend on it\n"
                "  --validate          enable Vulkan validation; any message fails the bake\n"
                "                      (also SKYBAKE_VALIDATE=1)\n"
                "  --json              print a machine-readable summary on stdout\n"
@@ -158,7 +162,16 @@ static bool common_option(int argc, char **argv, int *i, struct sb_vk_params *vk
         vk_params->validate = true;
     else if (!strcmp(a, "--json"))
         *json = true;
-    else if (!strcmp(a, "-q") || !strcmp(a, "--quiet"))
+    else if (!strcmp(a, "--threads") && *i + 1 < argc) {
+        char *end;
+        long n = strtol(argv[++*i], &end, 10);
+        if (*end || end == argv[*i] || n < 1 || n > SB_PARALLEL_MAX_THREADS) {
+            fprintf(stderr, "skybake: --threads: '%s' is not a count from 1 to %d\n", argv[*i],
+                    SB_PARALLEL_MAX_THREADS);
+            return false;
+        }
+        sb_parallel_set_threads((int)n);
+    } else if (!strcmp(a, "-q") || !strcmp(a, "--quiet"))
         sb_log_set_level(SB_LOG_WARN);
     else if (!strcmp(a, "-v") || !strcmp(a, "--verbose"))
         sb_log_set_level(SB_LOG_DEBUG);

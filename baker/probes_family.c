@@ -87,7 +87,7 @@ static void probes_key(void *state, const struct sb_scene *scene, enum sb_produc
     const struct probes_state *st = state;
     const struct sb_probe_params *p = &scene->probes;
     char code[SB_HASH_HEX_SIZE];
-    sb_key_add(key, " recipe %d world %s", PROBES_RECIPE, st->mesh_hash);
+    sb_key_add(key, " recipe %d world %s bvh %d", PROBES_RECIPE, st->mesh_hash, SB_BVH_VERSION);
     sb_key_add(key, " spacing_m=%a margin_m=%a rays=%u inside=%a", p->spacing_m, p->margin_m, p->rays,
                p->inside_fraction);
     if (p->has_bounds) {

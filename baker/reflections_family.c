@@ -110,6 +110,8 @@ static void reflection_key(void *state, const struct sb_scene *scene, enum sb_pr
     sb_key_add(key, " recipe %d face %u samples %u ambient %u altitude_km=%a sun=%a,%a world %s code %s", CUBES_RECIPE,
                p->face_size, p->samples, p->ambient_rays, scene->view.altitude_km, scene->view.sun_elevation_deg,
                scene->view.sun_azimuth_deg, st->has_world ? st->mesh_hash : "none", code);
+    if (st->has_world)
+        sb_key_add(key, " bvh %d", SB_BVH_VERSION);
     for (int i = 0; i < p->probe_count; i++)
         sb_key_add3(key, "at", p->probes[i].position_m);
 }

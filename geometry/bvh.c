@@ -8,41 +8,64 @@
 #include <xxhash.h>
 
 #include "log.h"
+#include "parallel.h"
 
 #define BVH_BINS 32
 /* SAH costs relative to one triangle test. */
 #define BVH_COST_TRAVERSAL 1.0
 #define BVH_COST_TRIANGLE 1.0
+/* A range of at most this many triangles is built whole by one thread (a
+ * task); larger ones are split with every thread binning and partitioning
+ * chunks of BVH_CHUNK. Both are fixed, not taken from the thread count, so
+ * that the bytes are the same on any number of threads. */
+#ifndef BVH_TASK_PRIMS /* (a bench may try others) */
+#define BVH_TASK_PRIMS 65536
+#endif
+#define BVH_CHUNK 16384
 
+/* min and max for the build's finite values: one instruction each, where
+ * fminf and fmaxf's NaN rules cost a call. */
+static inline float min_f(float a, float b)
+{
+    return a < b ? a : b;
+}
+
+static inline float max_f(float a, float b)
+{
+    return a > b ? a : b;
+}
+
+/* Four lanes, the fourth unused (0 in a triangle's box), so that the
+ * compiler makes each loop over them one vector instruction. */
 struct box {
-    float min[3], max[3];
+    float min[4], max[4];
 };
 
 static void box_empty(struct box *b)
 {
-    for (int i = 0; i < 3; i++) {
+    for (int i = 0; i < 4; i++) {
         b->min[i] = FLT_MAX;
         b->max[i] = -FLT_MAX;
     }
 }
 
-static void box_grow(struct box *b, const struct box *o)
+static inline void box_grow(struct box *b, const struct box *o)
 {
-    for (int i = 0; i < 3; i++) {
-        b->min[i] = fminf(b->min[i], o->min[i]);
-        b->max[i] = fmaxf(b->max[i], o->max[i]);
+    for (int i = 0; i < 4; i++) {
+        b->min[i] = min_f(b->min[i], o->min[i]);
+        b->max[i] = max_f(b->max[i], o->max[i]);
     }
 }
 
-static void box_grow_point(struct box *b, const float p[3])
+static inline void box_grow_point(struct box *b, const float p[4])
 {
-    for (int i = 0; i < 3; i++) {
-        b->min[i] = fminf(b->min[i], p[i]);
-        b->max[i] = fmaxf(b->max[i], p[i]);
+    for (int i = 0; i < 4; i++) {
+        b->min[i] = min_f(b->min[i], p[i]);
+        b->max[i] = max_f(b->max[i], p[i]);
     }
 }
 
-static double box_area(const struct box *b)
+static inline double box_area(const struct box *b)
 {
     double d[3];
     for (int i = 0; i < 3; i++)
@@ -50,70 +73,125 @@ static double box_area(const struct box *b)
     return d[0] * d[1] + d[1] * d[2] + d[2] * d[0];
 }
 
-struct builder {
-    const struct sb_mesh *mesh;
-    struct box *bounds; /* per mesh triangle */
-    float (*centroid)[3];
-    uint32_t *order; /* mesh triangle indices, partitioned in place */
-    struct sb_bvh *bvh;
+/* A triangle while building: its padded box (prims[]) and its index in
+ * the mesh (the same place of index[]). Its centroid is taken doubled,
+ * min + max, everywhere. */
+struct prim {
+    struct box box;
 };
 
-struct task {
-    uint32_t node, begin, end, depth;
-};
-
-/* Make node a leaf of order[begin, end). */
-static void make_leaf(struct builder *b, struct sb_bvh_node *node, uint32_t begin, uint32_t end)
+static inline void prim_centroid(const struct prim *p, float c[4])
 {
-    node->first = begin;
-    node->count = end - begin;
-    if (node->count > b->bvh->max_leaf)
-        b->bvh->max_leaf = node->count;
+    for (int i = 0; i < 4; i++)
+        c[i] = p->box.min[i] + p->box.max[i];
 }
 
-/*
- * The best binned-SAH split of order[begin, end) within centroid bounds
- * `cb`: its axis and the first bin on the right. Returns false when no
- * split beats a leaf (or the centroids coincide).
- */
-static bool find_split(struct builder *b, uint32_t begin, uint32_t end, const struct box *cb, double parent_area,
-                       int *best_axis, int *best_bin, bool must)
+/* A node to split: the triangles prims[begin, end), their box and their
+ * (doubled) centroids' box. */
+struct range {
+    uint32_t node, begin, end, depth;
+    struct box box, centroids;
+};
+
+/* Binned counts and boxes along the three axes. */
+struct bins {
+    struct box box[3][BVH_BINS];
+    uint32_t count[3][BVH_BINS];
+};
+
+/* How centroids map to bins: bin = (c - lo) * scale, clamped to the
+ * first `count`. A node of fewer triangles than BVH_BINS gets as many bins
+ * as triangles, so that a node's cost follows its size. */
+struct binning {
+    float lo[3], scale[3];
+    int count;
+};
+
+static struct binning binning_of(const struct box *centroids, uint32_t triangles)
 {
-    double best = must ? INFINITY : BVH_COST_TRIANGLE * (end - begin);
+    struct binning m = {.count = triangles < BVH_BINS ? (triangles < 2 ? 2 : (int)triangles) : BVH_BINS};
+    for (int a = 0; a < 3; a++) {
+        float extent = centroids->max[a] - centroids->min[a];
+        m.lo[a] = centroids->min[a];
+        m.scale[a] = extent > 0 ? m.count / extent : 0.0f;
+    }
+    return m;
+}
+
+static inline int bin_of(const struct binning *m, int axis, float c)
+{
+    int k = (int)((c - m->lo[axis]) * m->scale[axis]);
+    return k < 0 ? 0 : k >= m->count ? m->count - 1 : k;
+}
+
+static void bins_empty(struct bins *b, const struct binning *m)
+{
+    for (int a = 0; a < 3; a++)
+        for (int k = 0; k < m->count; k++) {
+            box_empty(&b->box[a][k]);
+            b->count[a][k] = 0;
+        }
+}
+
+static void bins_fill(struct bins *b, const struct binning *m, const struct prim *prims, uint32_t begin, uint32_t end)
+{
+    bins_empty(b, m);
+    for (uint32_t i = begin; i < end; i++) {
+        float c[4];
+        prim_centroid(&prims[i], c);
+        for (int a = 0; a < 3; a++) {
+            int k = bin_of(m, a, c[a]);
+            b->count[a][k]++;
+            box_grow(&b->box[a][k], &prims[i].box);
+        }
+    }
+}
+
+/* Min, max and sums: the same whatever the order they are merged in. */
+static void bins_merge(struct bins *into, const struct bins *b, const struct binning *m)
+{
+    for (int a = 0; a < 3; a++)
+        for (int k = 0; k < m->count; k++) {
+            box_grow(&into->box[a][k], &b->box[a][k]);
+            into->count[a][k] += b->count[a][k];
+        }
+}
+
+struct split {
+    int axis, bin; /* the first bin on the right */
+    struct box left, right;
+};
+
+/*
+ * The best binned-SAH split of `count` triangles from their bins: false
+ * when no split beats a leaf (must: when there is no split at all, the
+ * centroids coinciding).
+ */
+static bool best_split(const struct bins *b, const struct binning *m, uint32_t count, double parent_area, bool must,
+                       struct split *out)
+{
+    double best = must ? INFINITY : BVH_COST_TRIANGLE * count;
     bool found = false;
     for (int axis = 0; axis < 3; axis++) {
-        float lo = cb->min[axis], extent = cb->max[axis] - cb->min[axis];
-        if (!(extent > 0))
+        if (!(m->scale[axis] > 0))
             continue;
-        struct box bins[BVH_BINS];
-        uint32_t counts[BVH_BINS] = {0};
-        for (int k = 0; k < BVH_BINS; k++)
-            box_empty(&bins[k]);
-        float scale = BVH_BINS / extent;
-        for (uint32_t i = begin; i < end; i++) {
-            uint32_t t = b->order[i];
-            int k = (int)((b->centroid[t][axis] - lo) * scale);
-            k = k < 0 ? 0 : k >= BVH_BINS ? BVH_BINS - 1 : k;
-            counts[k]++;
-            box_grow(&bins[k], &b->bounds[t]);
-        }
         /* right-to-left sweep of areas and counts, then left to right */
         double right_area[BVH_BINS];
         uint32_t right_count[BVH_BINS];
         struct box acc;
         box_empty(&acc);
         uint32_t n = 0;
-        for (int k = BVH_BINS - 1; k > 0; k--) {
-            box_grow(&acc, &bins[k]);
-            n += counts[k];
+        for (int k = m->count - 1; k > 0; k--) {
+            box_grow(&acc, &b->box[axis][k]);
+            n += b->count[axis][k];
             right_area[k] = box_area(&acc);
             right_count[k] = n;
         }
         box_empty(&acc);
         n = 0;
-        for (int k = 1; k < BVH_BINS; k++) {
-            box_grow(&acc, &bins[k - 1]);
-            n += counts[k - 1];
+        for (int k = 1; k < m->count; k++) {
+            box_grow(&acc, &b->box[axis][k - 1]);
+            n += b->count[axis][k - 1];
             if (!n || !right_count[k])
                 continue;
             double cost = BVH_COST_TRAVERSAL + BVH_COST_TRIANGLE *
@@ -121,82 +199,411 @@ static bool find_split(struct builder *b, uint32_t begin, uint32_t end, const st
                                                    fmax(parent_area, DBL_MIN);
             if (cost < best) {
                 best = cost;
-                *best_axis = axis;
-                *best_bin = k;
+                out->axis = axis;
+                out->bin = k;
                 found = true;
             }
         }
     }
+    if (found) {
+        box_empty(&out->left);
+        box_empty(&out->right);
+        for (int k = 0; k < m->count; k++)
+            box_grow(k < out->bin ? &out->left : &out->right, &b->box[out->axis][k]);
+    }
     return found;
 }
 
-static void node_bounds(struct builder *b, struct sb_bvh_node *node, uint32_t begin, uint32_t end, struct box *cb)
+/* The boxes of prims[begin, end) and of their centroids. */
+static void range_bounds(const struct prim *prims, uint32_t begin, uint32_t end, struct box *box,
+                         struct box *centroids)
 {
-    struct box nb;
-    box_empty(&nb);
-    box_empty(cb);
+    box_empty(box);
+    box_empty(centroids);
     for (uint32_t i = begin; i < end; i++) {
-        uint32_t t = b->order[i];
-        box_grow(&nb, &b->bounds[t]);
-        box_grow_point(cb, b->centroid[t]);
+        float c[4];
+        prim_centroid(&prims[i], c);
+        box_grow(box, &prims[i].box);
+        box_grow_point(centroids, c);
     }
-    memcpy(node->min, nb.min, sizeof(nb.min));
-    memcpy(node->max, nb.max, sizeof(nb.max));
 }
 
-static void build(struct builder *b, struct task *stack)
+/*
+ * Split `r` into its children's ranges, partitioning in place by swaps
+ * (one thread): false when it stays a leaf.
+ */
+static bool split_serial(struct prim *prims, uint32_t *index, const struct range *r, struct range *left,
+                         struct range *right)
+{
+    uint32_t count = r->end - r->begin;
+    if (count <= 1 || r->depth >= SB_BVH_MAX_DEPTH)
+        return false;
+    struct binning m = binning_of(&r->centroids, count);
+    struct bins b;
+    bins_fill(&b, &m, prims, r->begin, r->end);
+    struct split s;
+    bool must = count > SB_BVH_MAX_LEAF;
+    uint32_t mid;
+    if (best_split(&b, &m, count, box_area(&r->box), must, &s)) {
+        struct box lc, rc;
+        box_empty(&lc);
+        box_empty(&rc);
+        uint32_t i = r->begin, j = r->end;
+        while (i < j) {
+            float c[4];
+            prim_centroid(&prims[i], c);
+            if (bin_of(&m, s.axis, c[s.axis]) < s.bin) {
+                box_grow_point(&lc, c);
+                i++;
+            } else {
+                box_grow_point(&rc, c);
+                struct prim t = prims[i];
+                uint32_t ti = index[i];
+                prims[i] = prims[--j];
+                index[i] = index[j];
+                prims[j] = t;
+                index[j] = ti;
+            }
+        }
+        mid = i;
+        left->box = s.left;
+        right->box = s.right;
+        left->centroids = lc;
+        right->centroids = rc;
+    } else if (must) {
+        /* Coincident centroids: halve in the order they lie. */
+        mid = r->begin + count / 2;
+        range_bounds(prims, r->begin, mid, &left->box, &left->centroids);
+        range_bounds(prims, mid, r->end, &right->box, &right->centroids);
+    } else {
+        return false;
+    }
+    left->begin = r->begin;
+    left->end = right->begin = mid;
+    right->end = r->end;
+    left->depth = right->depth = r->depth + 1;
+    return true;
+}
+
+static void set_node(struct sb_bvh_node *node, const struct box *box, uint32_t first, uint32_t count)
+{
+    memcpy(node->min, box->min, sizeof(box->min));
+    memcpy(node->max, box->max, sizeof(box->max));
+    node->first = first;
+    node->count = count;
+}
+
+/* A range built whole by one thread into nodes of its own (nodes[0] its
+ * root, children indices local), placed after the top nodes at `base`. */
+struct task {
+    struct range range;
+    struct sb_bvh_node *nodes;
+    uint32_t node_count, depth, max_leaf, base;
+};
+
+static void build_task(struct prim *prims, uint32_t *index, struct task *t)
+{
+    /* One range per level at most waits on the stack, plus the one popped. */
+    struct range stack[(SB_BVH_MAX_DEPTH + 2) * 2];
+    int top = 0;
+    stack[top++] = t->range;
+    stack[0].node = 0;
+    t->node_count = 1;
+    while (top) {
+        struct range r = stack[--top], left, right;
+        if (r.depth > t->depth)
+            t->depth = r.depth;
+        if (!split_serial(prims, index, &r, &left, &right)) {
+            set_node(&t->nodes[r.node], &r.box, r.begin, r.end - r.begin);
+            if (r.end - r.begin > t->max_leaf)
+                t->max_leaf = r.end - r.begin;
+            continue;
+        }
+        left.node = t->node_count;
+        right.node = t->node_count + 1;
+        t->node_count += 2;
+        set_node(&t->nodes[r.node], &r.box, left.node, 0);
+        /* right first on the stack, so the left subtree is laid out first */
+        stack[top++] = right;
+        stack[top++] = left;
+    }
+}
+
+/* ---- the steps every thread shares ---------------------------------------------------- */
+
+struct builder {
+    const struct sb_mesh *mesh;
+    struct prim *prims, *scratch;
+    uint32_t *index, *scratch_index; /* each triangle's in the mesh, moved with prims */
+    struct sb_bvh *bvh;
+    struct task *tasks;
+    uint32_t task_count, *task_order;
+    /* the range being split on every thread */
+    const struct range *range;
+    struct binning binning;
+    struct split split;
+    uint32_t chunk_count;
+    struct bins *chunk_bins;
+    struct {
+        uint32_t left, right; /* counts, then where the chunk's go */
+        struct box left_centroids, right_centroids;
+    } *chunks;
+};
+
+static uint32_t chunk_begin(const struct builder *b, uint32_t chunk)
+{
+    return b->range->begin + chunk * BVH_CHUNK;
+}
+
+static uint32_t chunk_end(const struct builder *b, uint32_t chunk)
+{
+    uint32_t end = chunk_begin(b, chunk) + BVH_CHUNK;
+    return end < b->range->end ? end : b->range->end;
+}
+
+/* A triangle's box: its vertices, and where v0 + e1 and v0 + e2 round to
+ * (what the triangle test sees), padded by a few ulps of the coordinates
+ * and the triangle's extent, so that a hit the triangle test finds is
+ * never outside its boxes (Ize 2013's concern). */
+static void make_prims(void *user, int chunk)
+{
+    struct builder *b = user;
+    const struct sb_mesh *mesh = b->mesh;
+    uint32_t end = (uint32_t)chunk * BVH_CHUNK + BVH_CHUNK;
+    end = end < mesh->triangle_count ? end : mesh->triangle_count;
+    for (uint32_t t = (uint32_t)chunk * BVH_CHUNK; t < end; t++) {
+        float v[3][4] = {{0}};
+        struct prim *p = &b->prims[t];
+        box_empty(&p->box);
+        for (int k = 0; k < 3; k++) {
+            memcpy(v[k], &mesh->positions[3 * (size_t)mesh->indices[3 * (size_t)t + k]], 3 * sizeof(float));
+            box_grow_point(&p->box, v[k]);
+        }
+        for (int k = 1; k < 3; k++) {
+            float r[4] = {0};
+            for (int i = 0; i < 3; i++)
+                r[i] = v[0][i] + (v[k][i] - v[0][i]);
+            box_grow_point(&p->box, r);
+        }
+        for (int i = 0; i < 3; i++) {
+            float pad = 1e-6f * (max_f(fabsf(p->box.min[i]), fabsf(p->box.max[i])) + (p->box.max[i] - p->box.min[i]));
+            p->box.min[i] -= pad;
+            p->box.max[i] += pad;
+        }
+        b->index[t] = t;
+    }
+}
+
+static void chunk_bounds(void *user, int chunk)
+{
+    struct builder *b = user;
+    struct bins *out = &b->chunk_bins[chunk];
+    /* the box in box[0][0], the centroids' in box[1][0] */
+    range_bounds(b->prims, chunk_begin(b, (uint32_t)chunk), chunk_end(b, (uint32_t)chunk), &out->box[0][0],
+                 &out->box[1][0]);
+}
+
+static void chunk_bin(void *user, int chunk)
+{
+    struct builder *b = user;
+    bins_fill(&b->chunk_bins[chunk], &b->binning, b->prims, chunk_begin(b, (uint32_t)chunk),
+              chunk_end(b, (uint32_t)chunk));
+}
+
+static bool goes_left(const struct builder *b, const struct prim *p, float c[4])
+{
+    prim_centroid(p, c);
+    return bin_of(&b->binning, b->split.axis, c[b->split.axis]) < b->split.bin;
+}
+
+static void chunk_count(void *user, int chunk)
+{
+    struct builder *b = user;
+    uint32_t left = 0, begin = chunk_begin(b, (uint32_t)chunk), end = chunk_end(b, (uint32_t)chunk);
+    for (uint32_t i = begin; i < end; i++) {
+        float c[4];
+        left += goes_left(b, &b->prims[i], c);
+    }
+    b->chunks[chunk].left = left;
+    b->chunks[chunk].right = end - begin - left;
+}
+
+/* Stable: each chunk's triangles go to the places the counts gave it. */
+static void chunk_scatter(void *user, int chunk)
+{
+    struct builder *b = user;
+    uint32_t l = b->chunks[chunk].left, r = b->chunks[chunk].right;
+    struct box *lc = &b->chunks[chunk].left_centroids, *rc = &b->chunks[chunk].right_centroids;
+    box_empty(lc);
+    box_empty(rc);
+    for (uint32_t i = chunk_begin(b, (uint32_t)chunk); i < chunk_end(b, (uint32_t)chunk); i++) {
+        float c[4];
+        if (goes_left(b, &b->prims[i], c)) {
+            b->scratch_index[l] = b->index[i];
+            b->scratch[l++] = b->prims[i];
+            box_grow_point(lc, c);
+        } else {
+            b->scratch_index[r] = b->index[i];
+            b->scratch[r++] = b->prims[i];
+            box_grow_point(rc, c);
+        }
+    }
+}
+
+static void chunk_copy_back(void *user, int chunk)
+{
+    struct builder *b = user;
+    uint32_t begin = chunk_begin(b, (uint32_t)chunk), end = chunk_end(b, (uint32_t)chunk);
+    memcpy(&b->prims[begin], &b->scratch[begin], (end - begin) * sizeof(*b->prims));
+    memcpy(&b->index[begin], &b->scratch_index[begin], (end - begin) * sizeof(*b->index));
+}
+
+/* Split a range too large for one thread: binned and partitioned (stably)
+ * by chunks on every thread. Such a range always splits, but at the depth
+ * limit. */
+static bool split_parallel(struct builder *b, const struct range *r, struct range *left, struct range *right)
+{
+    if (r->depth >= SB_BVH_MAX_DEPTH)
+        return false;
+    b->range = r;
+    b->binning = binning_of(&r->centroids, r->end - r->begin);
+    b->chunk_count = (r->end - r->begin + BVH_CHUNK - 1) / BVH_CHUNK;
+    sb_parallel_for((int)b->chunk_count, chunk_bin, b);
+    struct bins all;
+    bins_empty(&all, &b->binning);
+    for (uint32_t c = 0; c < b->chunk_count; c++)
+        bins_merge(&all, &b->chunk_bins[c], &b->binning);
+    uint32_t mid;
+    if (best_split(&all, &b->binning, r->end - r->begin, box_area(&r->box), true, &b->split)) {
+        sb_parallel_for((int)b->chunk_count, chunk_count, b);
+        uint32_t l = r->begin, total_left = 0;
+        for (uint32_t c = 0; c < b->chunk_count; c++)
+            total_left += b->chunks[c].left;
+        uint32_t rr = r->begin + total_left;
+        for (uint32_t c = 0; c < b->chunk_count; c++) {
+            uint32_t nl = b->chunks[c].left, nr = b->chunks[c].right;
+            b->chunks[c].left = l;
+            b->chunks[c].right = rr;
+            l += nl;
+            rr += nr;
+        }
+        sb_parallel_for((int)b->chunk_count, chunk_scatter, b);
+        sb_parallel_for((int)b->chunk_count, chunk_copy_back, b);
+        mid = r->begin + total_left;
+        left->box = b->split.left;
+        right->box = b->split.right;
+        box_empty(&left->centroids);
+        box_empty(&right->centroids);
+        for (uint32_t c = 0; c < b->chunk_count; c++) {
+            box_grow(&left->centroids, &b->chunks[c].left_centroids);
+            box_grow(&right->centroids, &b->chunks[c].right_centroids);
+        }
+    } else {
+        /* Coincident centroids: halve in the order they lie. */
+        mid = r->begin + (r->end - r->begin) / 2;
+        range_bounds(b->prims, r->begin, mid, &left->box, &left->centroids);
+        range_bounds(b->prims, mid, r->end, &right->box, &right->centroids);
+    }
+    left->begin = r->begin;
+    left->end = right->begin = mid;
+    right->end = r->end;
+    left->depth = right->depth = r->depth + 1;
+    return true;
+}
+
+static int larger_task_first(const void *a, const void *b, void *user)
+{
+    const struct task *tasks = user;
+    const struct range *ra = &tasks[*(const uint32_t *)a].range, *rb = &tasks[*(const uint32_t *)b].range;
+    uint32_t na = ra->end - ra->begin, nb = rb->end - rb->begin;
+    return na != nb ? (na < nb) - (na > nb) : (ra->begin > rb->begin) - (ra->begin < rb->begin);
+}
+
+static void run_task(void *user, int index)
+{
+    struct builder *b = user;
+    build_task(b->prims, b->index, &b->tasks[b->task_order[index]]);
+}
+
+/* A task's nodes into their places: its root where the top level left it,
+ * the rest from its base on, children indices made global. */
+static void place_task(void *user, int index)
+{
+    struct builder *b = user;
+    const struct task *t = &b->tasks[index];
+    for (uint32_t i = 0; i < t->node_count; i++) {
+        struct sb_bvh_node n = t->nodes[i];
+        if (!n.count)
+            n.first = t->base + n.first - 1;
+        b->bvh->nodes[i ? t->base + i - 1 : t->range.node] = n;
+    }
+}
+
+static void write_triangles(void *user, int chunk)
+{
+    struct builder *b = user;
+    const struct sb_mesh *mesh = b->mesh;
+    uint32_t end = (uint32_t)chunk * BVH_CHUNK + BVH_CHUNK;
+    end = end < b->bvh->triangle_count ? end : b->bvh->triangle_count;
+    for (uint32_t i = (uint32_t)chunk * BVH_CHUNK; i < end; i++) {
+        uint32_t t = b->index[i];
+        const float *v[3];
+        for (int k = 0; k < 3; k++)
+            v[k] = &mesh->positions[3 * (size_t)mesh->indices[3 * (size_t)t + k]];
+        struct sb_bvh_triangle *out = &b->bvh->triangles[i];
+        for (int c = 0; c < 3; c++) {
+            out->v0[c] = v[0][c];
+            out->e1[c] = v[1][c] - v[0][c];
+            out->e2[c] = v[2][c] - v[0][c];
+        }
+        out->triangle = t;
+        out->material = mesh->materials[t];
+        out->pad = 0;
+    }
+}
+
+/* The top levels, split on every thread, until the ranges are tasks. */
+static enum sb_result build_top(struct builder *b)
 {
     struct sb_bvh *bvh = b->bvh;
+    struct range stack[(SB_BVH_MAX_DEPTH + 2) * 2];
     int top = 0;
-    stack[top++] = (struct task){0, 0, bvh->triangle_count, 0};
+    uint32_t capacity = 0;
+    struct range root = {.node = 0, .begin = 0, .end = bvh->triangle_count};
+    b->range = &root;
+    b->chunk_count = (bvh->triangle_count + BVH_CHUNK - 1) / BVH_CHUNK;
+    sb_parallel_for((int)b->chunk_count, chunk_bounds, b);
+    box_empty(&root.box);
+    box_empty(&root.centroids);
+    for (uint32_t c = 0; c < b->chunk_count; c++) {
+        box_grow(&root.box, &b->chunk_bins[c].box[0][0]);
+        box_grow(&root.centroids, &b->chunk_bins[c].box[1][0]);
+    }
+    stack[top++] = root;
     bvh->node_count = 1;
     while (top) {
-        struct task task = stack[--top];
-        struct sb_bvh_node *node = &bvh->nodes[task.node];
-        struct box cb;
-        node_bounds(b, node, task.begin, task.end, &cb);
-        if (task.depth > bvh->depth)
-            bvh->depth = task.depth;
-        uint32_t count = task.end - task.begin;
-        if (count <= 1 || task.depth >= SB_BVH_MAX_DEPTH) {
-            make_leaf(b, node, task.begin, task.end);
-            continue;
-        }
-        struct box nb;
-        memcpy(nb.min, node->min, sizeof(nb.min));
-        memcpy(nb.max, node->max, sizeof(nb.max));
-        int axis = 0, bin = 0;
-        uint32_t mid;
-        if (find_split(b, task.begin, task.end, &cb, box_area(&nb), &axis, &bin, count > SB_BVH_MAX_LEAF)) {
-            float lo = cb.min[axis], scale = BVH_BINS / (cb.max[axis] - cb.min[axis]);
-            uint32_t i = task.begin, j = task.end;
-            while (i < j) {
-                int k = (int)((b->centroid[b->order[i]][axis] - lo) * scale);
-                k = k < 0 ? 0 : k >= BVH_BINS ? BVH_BINS - 1 : k;
-                if (k < bin) {
-                    i++;
-                } else {
-                    uint32_t tmp = b->order[i];
-                    b->order[i] = b->order[--j];
-                    b->order[j] = tmp;
-                }
+        struct range r = stack[--top], left, right;
+        if (r.depth > bvh->depth)
+            bvh->depth = r.depth;
+        if (r.end - r.begin <= BVH_TASK_PRIMS || !split_parallel(b, &r, &left, &right)) {
+            if (b->task_count == capacity) {
+                capacity = capacity ? 2 * capacity : 64;
+                struct task *grown = realloc(b->tasks, capacity * sizeof(*grown));
+                if (!grown)
+                    return SB_ERR_NOMEM;
+                b->tasks = grown;
             }
-            mid = i;
-        } else if (count > SB_BVH_MAX_LEAF) {
-            /* Coincident centroids: halve in index order. */
-            mid = task.begin + count / 2;
-        } else {
-            make_leaf(b, node, task.begin, task.end);
+            b->tasks[b->task_count++] = (struct task){.range = r};
             continue;
         }
-        uint32_t left = bvh->node_count;
+        left.node = bvh->node_count;
+        right.node = bvh->node_count + 1;
         bvh->node_count += 2;
-        node->first = left;
-        node->count = 0;
-        /* right first on the stack, so the left subtree is laid out first */
-        stack[top++] = (struct task){left + 1, mid, task.end, task.depth + 1};
-        stack[top++] = (struct task){left, task.begin, mid, task.depth + 1};
+        set_node(&bvh->nodes[r.node], &r.box, left.node, 0);
+        stack[top++] = right;
+        stack[top++] = left;
     }
+    return SB_OK;
 }
 
 enum sb_result sb_bvh_build(const struct sb_mesh *mesh, struct sb_bvh *bvh)
@@ -207,69 +614,59 @@ enum sb_result sb_bvh_build(const struct sb_mesh *mesh, struct sb_bvh *bvh)
         sb_error("BVH: the mesh has no triangle");
         return SB_ERR_MESH;
     }
+    uint32_t chunks = (n + BVH_CHUNK - 1) / BVH_CHUNK;
     struct builder b = {.mesh = mesh, .bvh = bvh};
-    b.bounds = malloc(n * sizeof(*b.bounds));
-    b.centroid = malloc(n * sizeof(*b.centroid));
-    b.order = malloc(n * sizeof(*b.order));
-    /* One task per level at most waits on the stack, plus the one popped. */
-    struct task *stack = malloc((SB_BVH_MAX_DEPTH + 2) * 2 * sizeof(*stack));
+    b.prims = malloc(n * sizeof(*b.prims));
+    b.scratch = malloc(n * sizeof(*b.scratch));
+    b.index = malloc(n * sizeof(*b.index));
+    b.scratch_index = malloc(n * sizeof(*b.scratch_index));
+    b.chunk_bins = malloc(chunks * sizeof(*b.chunk_bins));
+    b.chunks = malloc(chunks * sizeof(*b.chunks));
+    /* the tasks' own nodes: a task of c triangles has at most 2c - 1 */
+    struct sb_bvh_node *task_nodes = malloc(2 * (size_t)n * sizeof(*task_nodes));
     bvh->nodes = calloc(2 * (size_t)n, sizeof(*bvh->nodes));
     bvh->triangles = calloc(n, sizeof(*bvh->triangles));
-    if (!b.bounds || !b.centroid || !b.order || !stack || !bvh->nodes || !bvh->triangles) {
-        free(b.bounds);
-        free(b.centroid);
-        free(b.order);
-        free(stack);
-        sb_bvh_finish(bvh);
-        return SB_ERR_NOMEM;
-    }
+    enum sb_result res = SB_ERR_NOMEM;
+    if (!b.prims || !b.scratch || !b.index || !b.scratch_index || !b.chunk_bins || !b.chunks || !task_nodes || !bvh->nodes || !bvh->triangles)
+        goto done;
     bvh->triangle_count = n;
-    for (uint32_t t = 0; t < n; t++) {
-        /* The vertices, and where v0 + e1 and v0 + e2 round to (what the
-         * triangle test sees), padded by a few ulps of the coordinates
-         * and the triangle's extent, so that a hit the triangle test finds
-         * is never outside its boxes (Ize 2013's concern). */
-        const float *v[3];
-        struct box *tb = &b.bounds[t];
-        box_empty(tb);
-        for (int k = 0; k < 3; k++) {
-            v[k] = &mesh->positions[3 * (size_t)mesh->indices[3 * (size_t)t + k]];
-            box_grow_point(tb, v[k]);
-        }
-        for (int k = 1; k < 3; k++) {
-            float r[3];
-            for (int i = 0; i < 3; i++)
-                r[i] = v[0][i] + (v[k][i] - v[0][i]);
-            box_grow_point(tb, r);
-        }
-        for (int i = 0; i < 3; i++) {
-            float pad = 1e-6f * (fmaxf(fabsf(tb->min[i]), fabsf(tb->max[i])) + (tb->max[i] - tb->min[i]));
-            tb->min[i] -= pad;
-            tb->max[i] += pad;
-            b.centroid[t][i] = 0.5f * (tb->min[i] + tb->max[i]);
-        }
-        b.order[t] = t;
+    sb_parallel_for((int)chunks, make_prims, &b);
+    if ((res = build_top(&b)))
+        goto done;
+    for (uint32_t i = 0; i < b.task_count; i++)
+        b.tasks[i].nodes = &task_nodes[2 * (size_t)b.tasks[i].range.begin];
+    /* the largest tasks first, so that no thread is left with one at the end */
+    b.task_order = malloc(b.task_count * sizeof(*b.task_order));
+    if (!b.task_order) {
+        res = SB_ERR_NOMEM;
+        goto done;
     }
-    build(&b, stack);
-    for (uint32_t i = 0; i < n; i++) {
-        uint32_t t = b.order[i];
-        const float *v[3];
-        for (int k = 0; k < 3; k++)
-            v[k] = &mesh->positions[3 * (size_t)mesh->indices[3 * (size_t)t + k]];
-        struct sb_bvh_triangle *out = &bvh->triangles[i];
-        for (int c = 0; c < 3; c++) {
-            out->v0[c] = v[0][c];
-            out->e1[c] = v[1][c] - v[0][c];
-            out->e2[c] = v[2][c] - v[0][c];
-        }
-        out->triangle = t;
-        out->material = mesh->materials[t];
+    for (uint32_t i = 0; i < b.task_count; i++)
+        b.task_order[i] = i;
+    qsort_r(b.task_order, b.task_count, sizeof(*b.task_order), larger_task_first, b.tasks);
+    sb_parallel_for((int)b.task_count, run_task, &b);
+    for (uint32_t i = 0; i < b.task_count; i++) {
+        struct task *t = &b.tasks[i];
+        t->base = bvh->node_count;
+        bvh->node_count += t->node_count - 1;
+        bvh->depth = t->depth > bvh->depth ? t->depth : bvh->depth;
+        bvh->max_leaf = t->max_leaf > bvh->max_leaf ? t->max_leaf : bvh->max_leaf;
     }
-    free(b.bounds);
-    free(b.centroid);
-    free(b.order);
-    free(stack);
-    return SB_OK;
+    sb_parallel_for((int)b.task_count, place_task, &b);
+    sb_parallel_for((int)chunks, write_triangles, &b);
+done:
+    free(b.prims);
+    free(b.scratch);
+    free(b.index);
+    free(b.scratch_index);
+    free(b.chunk_bins);
+    free(b.chunks);
+    free(b.tasks);
+    free(b.task_order);
+    free(task_nodes);
+    if (res)
+        sb_bvh_finish(bvh);
+    return res;
 }
 
 void sb_bvh_finish(struct sb_bvh *bvh)

@@ -2,8 +2,9 @@
  * A bounding volume hierarchy over a mesh's triangles, built on the CPU by
  * binned SAH (Wald 2007) and laid out for the GPU's traversal
  * (shaders/bvh.glsl) and the CPU's (sb_bvh_intersect), which share one
- * algorithm and one triangle test. Deterministic: the same triangles give
- * the same bytes, on one thread, whatever the machine's thread count.
+ * algorithm and one triangle test. Built on every thread (parallel.h) and
+ * deterministic: the same triangles give the same bytes on any number of
+ * threads.
  */
 #ifndef SB_GEOMETRY_BVH_H
 #define SB_GEOMETRY_BVH_H
@@ -14,6 +15,13 @@
 #include "config.h"
 #include "mesh.h"
 #include "result.h"
+
+/* The builder's recipe, in the bake keys of every product that traces the
+ * BVH: bump it whenever the bytes built for some mesh change (the splits,
+ * the order, the layout), since a hit between coincident triangles
+ * follows them. 2: built on every thread, stable partitions above 8192
+ * triangles, as many bins as triangles below 32. */
+#define SB_BVH_VERSION 2
 
 /* One node, 32 bytes (two vec4s in GLSL). count 0: an interior node whose
  * children are nodes first and first + 1; else a leaf of `count` triangles

@@ -17,6 +17,7 @@
 #include <unistd.h>
 
 #include "bvh.h"
+#include "parallel.h"
 #include "embree_ref.h"
 #include "harness_vk.h"
 #include "json.h"
@@ -316,13 +317,22 @@ static void test_gpu_against_embree(struct sb_vk *vk, const char *name, const st
  * their caps; the CPU traversal equal to brute force over every triangle. */
 static void test_bvh_structure(const char *name, const struct sb_mesh *m)
 {
+    /* The same bytes on 1, 3 and 8 threads (more threads than cores too). */
     struct sb_bvh bvh, again;
+    sb_parallel_set_threads(8);
     CHECK(sb_bvh_build(m, &bvh) == SB_OK, "%s: BVH", name);
-    CHECK(sb_bvh_build(m, &again) == SB_OK, "%s: BVH again", name);
     char h1[33], h2[33];
     sb_bvh_hash(&bvh, h1);
-    sb_bvh_hash(&again, h2);
-    CHECK(!strcmp(h1, h2) && bvh.node_count == again.node_count, "%s: two builds differ (%s, %s)", name, h1, h2);
+    for (int threads = 1; threads <= 3; threads += 2) {
+        sb_parallel_set_threads(threads);
+        CHECK(sb_bvh_build(m, &again) == SB_OK, "%s: BVH again", name);
+        sb_bvh_hash(&again, h2);
+        CHECK(!strcmp(h1, h2) && bvh.node_count == again.node_count,
+              "%s: the builds on 8 and %d threads differ (%s, %s)", name, threads, h1, h2);
+        if (threads == 1)
+            sb_bvh_finish(&again);
+    }
+    sb_parallel_set_threads(0);
     uint8_t *seen = calloc(m->triangle_count, 1);
     uint32_t leaves = 0, bad = 0;
     for (uint32_t n = 0; n < bvh.node_count; n++) {
@@ -647,15 +657,16 @@ static void test_hostile(void)
     rmdir(dir);
 }
 
-/* Many triangles with one centroid: the builder must still halve them. */
+/* Many triangles with one centroid, more than one thread's share: the
+ * builder must still halve them. */
 static void test_coincident(void)
 {
     struct sb_mesh m = {0};
     uint32_t mat;
     double grey[3] = {0.5, 0.5, 0.5};
     sb_mesh_add_material(&m, "grey", grey, &mat);
-    for (int i = 0; i < 1000; i++) {
-        double s = 1 + i * 1e-3;
+    for (int i = 0; i < 70000; i++) {
+        double s = 1 + i * 1e-5;
         double a[3] = {-s, 0, -s}, b[3] = {s, 0, -s}, c[3] = {0, 0, 2 * s};
         sb_mesh_add_triangle(&m, a, b, c, mat, "coincident");
     }
@@ -692,6 +703,24 @@ int main(void)
     test_bvh_structure("well", &well);
     test_bvh_structure("room", &room);
     test_bvh_structure("soup", &soup);
+    /* Hills of 80,000 triangles: more than one thread's share of the build
+     * (BVH_TASK_PRIMS), so the top levels are split by every thread. */
+    struct sb_mesh hills = {0};
+    sb_mesh_add_material(&hills, "hills", grey, &mat);
+    for (int j = 0; j < 200; j++)
+        for (int i = 0; i < 200; i++) {
+            double p[4][3];
+            for (int k = 0; k < 4; k++) {
+                double x = i + (k & 1), z = j + (k >> 1);
+                p[k][0] = x;
+                p[k][1] = 3 * sin(x / 13) * cos(z / 17) + 0.3 * sin(x * 0.9 + z * 0.7);
+                p[k][2] = z;
+            }
+            sb_mesh_add_triangle(&hills, p[0], p[2], p[1], mat, "hills");
+            sb_mesh_add_triangle(&hills, p[1], p[2], p[3], mat, "hills");
+        }
+    test_bvh_structure("hills", &hills);
+    sb_mesh_finish(&hills);
 
     struct sb_vk *vk;
     if (test_vulkan(false, &vk) == SB_ERR_NO_DEVICE)
