@@ -142,9 +142,13 @@ enum sb_result sb_bake_scene(struct sb_vk *vk, const struct sb_scene *scene, con
 
     char keys[SB_PRODUCT_COUNT][SB_HASH_HEX_SIZE];
     sb_bake_keys(scene, mask, states, keys);
+    int total = 0, done = 0;
+    for (int p = 0; p < SB_PRODUCT_COUNT; p++)
+        total += (mask >> p) & 1;
     for (int p = 0; p < SB_PRODUCT_COUNT; p++) {
         if (!(mask & (1u << p)))
             continue;
+        sb_status("%s (%d of %d products)", sb_product_name((enum sb_product_id)p), ++done, total);
         enum sb_product_id id = (enum sb_product_id)p;
         const struct sb_product_format *format = sb_product_format(id);
         const struct sb_family_baker *family = sb_family_baker(format->family);
@@ -193,9 +197,11 @@ enum sb_result sb_bake_scene(struct sb_vk *vk, const struct sb_scene *scene, con
     }
     struct sb_device_info device;
     sb_vk_device_info(vk, &device);
+    sb_status("writing the pack");
     res = sb_pack_writer_commit(&writer, scene_json, &device);
 
 cleanup:
+    sb_status(NULL);
     free(scene_json);
     sb_pack_close(old);
     free(old);

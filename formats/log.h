@@ -36,6 +36,25 @@ double sb_now_s(void);
  */
 void sb_progress(const char *what, unsigned done, unsigned total);
 
+/*
+ * What the program is doing now ("sky_visibility (3 of 5 products)"), in
+ * place on stderr until the next status, progress or log line replaces
+ * it; NULL clears it. For steps that may take more than a second and
+ * report nothing else. The same silence as sb_progress.
+ * sb_status_begin shows a step inside the current one ("loading
+ * world.obj", "BVH: 1002528 triangles"); sb_status_end shows the current
+ * one again. They nest four deep.
+ */
+#if defined(__GNUC__)
+__attribute__((format(printf, 1, 2)))
+#endif
+void sb_status(const char *fmt, ...);
+#if defined(__GNUC__)
+__attribute__((format(printf, 1, 2)))
+#endif
+void sb_status_begin(const char *fmt, ...);
+void sb_status_end(void);
+
 #define sb_error(...) sb_log(SB_LOG_ERROR, __VA_ARGS__)
 #define sb_warn(...) sb_log(SB_LOG_WARN, __VA_ARGS__)
 #define sb_info(...) sb_log(SB_LOG_INFO, __VA_ARGS__)

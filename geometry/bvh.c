@@ -627,9 +627,12 @@ enum sb_result sb_bvh_build(const struct sb_mesh *mesh, struct sb_bvh *bvh)
     bvh->nodes = calloc(2 * (size_t)n, sizeof(*bvh->nodes));
     bvh->triangles = calloc(n, sizeof(*bvh->triangles));
     enum sb_result res = SB_ERR_NOMEM;
+    bool begun = false;
     if (!b.prims || !b.scratch || !b.index || !b.scratch_index || !b.chunk_bins || !b.chunks || !task_nodes || !bvh->nodes || !bvh->triangles)
         goto done;
     bvh->triangle_count = n;
+    sb_status_begin("BVH: %u triangles on %d threads", n, sb_parallel_threads());
+    begun = true;
     sb_parallel_for((int)chunks, make_prims, &b);
     if ((res = build_top(&b)))
         goto done;
@@ -655,6 +658,8 @@ enum sb_result sb_bvh_build(const struct sb_mesh *mesh, struct sb_bvh *bvh)
     sb_parallel_for((int)b.task_count, place_task, &b);
     sb_parallel_for((int)chunks, write_triangles, &b);
 done:
+    if (begun)
+        sb_status_end();
     free(b.prims);
     free(b.scratch);
     free(b.index);

@@ -4,15 +4,19 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "log.h"
 #include "scene.h"
 #include "world_file.h"
 
 enum sb_result sb_mesh_load(const char *path, const struct sb_mesh_load_params *params, struct sb_mesh *mesh)
 {
     size_t length = strlen(path);
-    if (length > 5 && !strcmp(path + length - 5, ".json"))
-        return sb_world_file_load(path, params, mesh);
-    return sb_mesh_import(path, params, mesh);
+    const char *name = strrchr(path, '/');
+    sb_status_begin("loading %s", name ? name + 1 : path);
+    enum sb_result res = length > 5 && !strcmp(path + length - 5, ".json") ? sb_world_file_load(path, params, mesh)
+                                                                            : sb_mesh_import(path, params, mesh);
+    sb_status_end();
+    return res;
 }
 
 enum sb_result sb_mesh_load_world(const struct sb_world_params *w, const char *directory, struct sb_mesh *mesh,

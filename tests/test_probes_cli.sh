@@ -53,6 +53,18 @@ check "other probes" test "$(hash)" != "$first"
 check "forced rebake, same bytes" expect_exit 0 "$skybake" bake "$tmp/s.json" -o "$tmp/q" --force -q
 check "deterministic" cmp -s "$tmp/p/sky_visibility.sbprobes" "$tmp/q/sky_visibility.sbprobes"
 
+# On a terminal the steps show what they are doing (script(1) gives the
+# bake one); not on a file, nor with -q.
+check "a bake on a terminal" sh -c "script -qec \"'$skybake' bake '$tmp/s.json' -o '$tmp/tty' --force\" /dev/null >'$tmp/tty.txt'"
+check "shows the world loading" grep -q "loading world.obj" "$tmp/tty.txt"
+check "shows the BVH" grep -q "BVH: 6 triangles on" "$tmp/tty.txt"
+check "shows the product" grep -q "sky_visibility (1 of 1 products)" "$tmp/tty.txt"
+check "shows the writing" grep -q "writing the pack" "$tmp/tty.txt"
+check "a quiet bake on a terminal" sh -c "script -qec \"'$skybake' bake '$tmp/s.json' -o '$tmp/tty' --force -q\" /dev/null >'$tmp/tty.txt'"
+check "shows none of it" sh -c "! grep -q 'BVH:\\|loading\\|products)' '$tmp/tty.txt'"
+check "a bake into a file" expect_exit 0 "$skybake" bake "$tmp/s.json" -o "$tmp/tty" --force
+check "writes none of it" sh -c "! grep -q 'BVH:\\|loading\\|products)' '$tmp/err'"
+
 # The thread count changes no byte: a world of 80,000 triangles (a bumpy
 # grid, more than one thread's share of the BVH build) baked on 1 and on
 # 3 threads gives the same probe files.
