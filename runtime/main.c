@@ -66,7 +66,8 @@ static void usage(FILE *f)
                "  --camera X,Y,Z[,YAW,PITCH[,FOV]]\n"
                "                          metres (y up, origin on the ground) and degrees: yaw\n"
                "                          clockwise from north, pitch above the horizontal,\n"
-               "                          vertical field of view (default 0,2,0,0,3,50)\n"
+               "                          vertical field of view (default 0,2,0,0,3,50; when\n"
+               "                          that cannot see the world, one that frames it)\n"
                "  --world FILE            the world: a skybake world file (.json) or a mesh assimp\n"
                "                          reads (default: the world the pack's probes were baked\n"
                "                          against, else the built-in data/worlds/test.json)\n"
@@ -209,6 +210,7 @@ struct options {
     struct sb_vk_params vk; /* the environment's, then --device and --validate */
     struct sb_renderer_params params;
     struct sb_view view;
+    bool camera_given; /* --camera: else the default, unless it cannot see the world */
     int frames, warmup;
     bool hdr, bench;
     /* Time of day: the sun from sun_path at day_from (one hour), or swept to day_to. */
@@ -458,6 +460,7 @@ static int parse_options(int argc, char **argv, struct options *o)
             ok = parse_doubles(argv[++i], c, 3, 6, &n) && fabs(c[0]) <= 1e7 && fabs(c[2]) <= 1e7 && c[1] > 0.0 &&
                  c[1] <= 1e8;
             if (ok) {
+                o->camera_given = true;
                 memcpy(o->view.camera_m, c, sizeof(o->view.camera_m));
                 if (n >= 5) {
                     o->view.yaw = c[3] * DEG;
@@ -927,6 +930,20 @@ static int run(const struct options *o)
         sb_lut3d_finish(&grade);
         sb_pack_close(&pack);
         return EXIT_USAGE;
+    }
+    /* A newcomer's own model is in the first frame: a default camera that
+     * cannot see the world is moved to frame it. */
+    struct options framed;
+    if (!o->camera_given) {
+        framed = *o;
+        struct sb_view *v = &framed.view;
+        double aspect = (double)(params.width ? params.width : 1280) / (params.height ? params.height : 720);
+        if (sb_world_frame(&world, aspect, v->fov_y > 0 ? v->fov_y : 50.0 * DEG, v->camera_m, &v->yaw, &v->pitch)) {
+            sb_info("the default camera does not see the world: framing it, as --camera %.4g,%.4g,%.4g,%.4g,%.4g,%.4g",
+                    v->camera_m[0], v->camera_m[1], v->camera_m[2], v->yaw / DEG, v->pitch / DEG,
+                    (v->fov_y > 0 ? v->fov_y : 50.0 * DEG) / DEG);
+            o = &framed;
+        }
     }
     if (mkdir(o->out_dir, 0777) != 0 && errno != EEXIST) {
         sb_error("%s: cannot create the output directory: %s", o->out_dir, strerror(errno));

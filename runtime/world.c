@@ -50,6 +50,72 @@ enum sb_result sb_world_from_mesh(const struct sb_mesh *mesh, struct sb_world *w
     return SB_OK;
 }
 
+static double dot3d(const double a[3], const double b[3])
+{
+    return a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
+}
+
+bool sb_world_frame(const struct sb_world *w, double aspect, double fov_y, double camera_m[3], double *yaw,
+                    double *pitch)
+{
+    double lo[3] = {INFINITY, INFINITY, INFINITY}, hi[3] = {-INFINITY, -INFINITY, -INFINITY};
+    for (uint32_t v = w->caster_first_vertex; v < w->vertex_count; v++)
+        for (int i = 0; i < 3; i++) {
+            lo[i] = fmin(lo[i], w->vertices[v].position[i]);
+            hi[i] = fmax(hi[i], w->vertices[v].position[i]);
+        }
+    if (!(lo[0] <= hi[0]))
+        return false;
+    bool inside = true;
+    for (int i = 0; i < 3; i++)
+        inside = inside && camera_m[i] >= lo[i] && camera_m[i] <= hi[i];
+    if (inside)
+        return false;
+    /* The frustum's four sides through the camera, normals inward; the box
+     * is out of view when all its corners lie behind one of them, or behind
+     * the camera. */
+    double tan_v = tan(0.5 * fov_y), tan_h = tan_v * aspect;
+    double f[3] = {sin(*yaw) * cos(*pitch), sin(*pitch), -cos(*yaw) * cos(*pitch)};
+    double r[3] = {cos(*yaw), 0.0, sin(*yaw)};
+    double u[3] = {r[1] * f[2] - r[2] * f[1], r[2] * f[0] - r[0] * f[2], r[0] * f[1] - r[1] * f[0]};
+    double planes[5][3];
+    for (int i = 0; i < 3; i++) {
+        planes[0][i] = f[i] * tan_v - u[i];
+        planes[1][i] = f[i] * tan_v + u[i];
+        planes[2][i] = f[i] * tan_h - r[i];
+        planes[3][i] = f[i] * tan_h + r[i];
+        planes[4][i] = f[i];
+    }
+    bool seen = true;
+    for (int k = 0; k < 5 && seen; k++) {
+        bool all_behind = true;
+        for (int c = 0; c < 8 && all_behind; c++) {
+            double d[3];
+            for (int i = 0; i < 3; i++)
+                d[i] = ((c >> i) & 1 ? hi[i] : lo[i]) - camera_m[i];
+            all_behind = dot3d(planes[k], d) < 0.0;
+        }
+        seen = !all_behind;
+    }
+    if (seen)
+        return false;
+    double centre[3], radius = 0.0;
+    for (int i = 0; i < 3; i++) {
+        centre[i] = 0.5 * (lo[i] + hi[i]);
+        radius += 0.25 * (hi[i] - lo[i]) * (hi[i] - lo[i]);
+    }
+    radius = sqrt(radius);
+    double half = fmin(atan(tan_v), atan(tan_h)), distance = 1.05 * radius / sin(half);
+    double down = 20.0 * M_PI / 180.0;
+    /* to 0.1 mm, so that the position skyview reports reads plainly */
+    camera_m[0] = round(centre[0] * 1e4) / 1e4;
+    camera_m[1] = round(fmax(centre[1] + distance * sin(down), 0.1) * 1e4) / 1e4;
+    camera_m[2] = round((centre[2] + distance * cos(down)) * 1e4) / 1e4;
+    *yaw = 0.0;
+    *pitch = atan2(centre[1] - camera_m[1], camera_m[2] - centre[2]);
+    return true;
+}
+
 static enum sb_result from(enum sb_result res, struct sb_mesh *mesh, struct sb_world *w)
 {
     if (!res)

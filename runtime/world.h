@@ -43,6 +43,19 @@ enum sb_result sb_world_parse(const char *json, size_t size, const char *source,
  * or 0 (receiving only). */
 enum sb_result sb_world_mesh(const struct sb_world *world, bool casters_only, struct sb_mesh *mesh);
 
+/*
+ * A camera that sees the world: when the one given (camera_m, yaw clockwise
+ * from north (-z), pitch above the horizontal, the vertical field of view
+ * fov_y, radians, and the frame's width over its height) cannot see the
+ * world's shadow casters (their box lies wholly outside its frustum and does
+ * not hold it), set camera_m, yaw and pitch to frame them: looking north
+ * and 20 degrees down at their box's centre from where its bounding sphere
+ * fills the narrower field of view, at least 0.1 m above the ground.
+ * Returns whether it did; a world of no caster is left alone.
+ */
+bool sb_world_frame(const struct sb_world *world, double aspect, double fov_y, double camera_m[3], double *yaw,
+                    double *pitch);
+
 /* Free the triangles; accepts a zeroed world. */
 void sb_world_finish(struct sb_world *world);
 

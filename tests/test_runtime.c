@@ -203,6 +203,50 @@ static void test_shadows(struct sb_renderer *r)
 /* A world of many triangles gets at most SB_CASTER_MAX_BOXES boxes, and
  * every caster vertex lies in the box of its triangle's run: triangle t is
  * placed at x = t, so the boxes are disjoint in x and in order. */
+/* A default camera that cannot see the world frames it: every corner of the
+ * casters' box lands in the new view's frustum (projected here, not by the
+ * framing's own planes); one that sees the world, or stands inside it, and
+ * a world of no caster are left alone. */
+static void test_framing(const struct sb_world *test_world)
+{
+    const double fov = 50.0 * M_PI / 180.0, aspect = 16.0 / 9.0;
+    double camera[3] = {0.0, 2.0, 0.0}, yaw = 0.0, pitch = 3.0 * M_PI / 180.0;
+    CHECK(!sb_world_frame(test_world, aspect, fov, camera, &yaw, &pitch) && camera[2] == 0.0 && yaw == 0.0,
+          "the test world, seen from the default camera, is left alone");
+    static const char behind[] =
+        "{\"version\":1,\"ground\":{\"size_m\":1000},\"boxes\":[{\"center_m\":[4,1,30],\"size_m\":[2,2,6]}]}";
+    struct sb_world w;
+    CHECK(sb_world_parse(behind, sizeof(behind) - 1, "behind", &w) == SB_OK, "a box behind the camera");
+    CHECK(sb_world_frame(&w, aspect, fov, camera, &yaw, &pitch), "a box behind the default camera is framed");
+    double tan_v = tan(0.5 * fov), tan_h = tan_v * aspect;
+    double f[3] = {sin(yaw) * cos(pitch), sin(pitch), -cos(yaw) * cos(pitch)};
+    double r[3] = {cos(yaw), 0.0, sin(yaw)};
+    double u[3] = {r[1] * f[2] - r[2] * f[1], r[2] * f[0] - r[0] * f[2], r[0] * f[1] - r[1] * f[0]};
+    int out = 0;
+    for (int c = 0; c < 8; c++) {
+        double p[3] = {c & 1 ? 5 : 3, c & 2 ? 2 : 0, c & 4 ? 33 : 27}, d[3];
+        for (int i = 0; i < 3; i++)
+            d[i] = p[i] - camera[i];
+        double z = d[0] * f[0] + d[1] * f[1] + d[2] * f[2];
+        double x = d[0] * r[0] + d[1] * r[1] + d[2] * r[2], y = d[0] * u[0] + d[1] * u[1] + d[2] * u[2];
+        out += !(z > 0 && fabs(x) <= z * tan_h && fabs(y) <= z * tan_v);
+    }
+    CHECK(out == 0 && camera[1] > 0, "%d of the box's corners are outside the framed view (camera %g,%g,%g)", out,
+          camera[0], camera[1], camera[2]);
+    double again[3] = {camera[0], camera[1], camera[2]}, yaw2 = yaw, pitch2 = pitch;
+    CHECK(!sb_world_frame(&w, aspect, fov, again, &yaw2, &pitch2), "a framed world stays framed");
+    double in[3] = {4.0, 1.0, 30.0};
+    yaw2 = 0.0;
+    pitch2 = 0.0;
+    CHECK(!sb_world_frame(&w, aspect, fov, in, &yaw2, &pitch2) && in[2] == 30.0, "a camera inside is left alone");
+    sb_world_finish(&w);
+    static const char ground[] = "{\"version\":1,\"ground\":{\"size_m\":100}}";
+    CHECK(sb_world_parse(ground, sizeof(ground) - 1, "ground", &w) == SB_OK, "a ground alone");
+    double at[3] = {0.0, 2.0, 500.0};
+    CHECK(!sb_world_frame(&w, aspect, fov, at, &yaw2, &pitch2) && at[2] == 500.0, "a world of no caster is left alone");
+    sb_world_finish(&w);
+}
+
 static void test_caster_boxes_bounded(void)
 {
     const uint32_t triangles = 100003, first = 6;
@@ -1400,6 +1444,7 @@ int main(int argc, char **argv)
         test_specialised_shaders(r, &rp);
         test_traced_scene(&rp);
         test_caster_boxes_bounded();
+        test_framing(&world);
         test_exposure(r);
         test_multiscattering_refined();
         /* Against a reference that reads the sun's transmittance from the

@@ -33,6 +33,16 @@ skyview_abs=$(cd "$(dirname "$skyview")" && pwd)/$(basename "$skyview")
 check "from another directory" sh -c "cd / && '$skyview_abs' '$tmp/pack' -o '$tmp/elsewhere' $small >/dev/null 2>&1"
 check "with the world file named" expect_exit 0 "$skyview" "$tmp/pack" -o "$tmp/named" $small --world "$root/data/worlds/test.json"
 check "the built-in world is data/worlds/test.json" cmp -s "$tmp/elsewhere/frame_0000.png" "$tmp/named/frame_0000.png"
+# A model the default camera cannot see (a box behind it) is framed, and the
+# camera reported; the test world and a given --camera are left alone.
+check "the test world is not framed" sh -c "! grep -q 'framing it' '$tmp/err'"
+printf 'v 3 0 27\nv 5 0 27\nv 5 2 27\nv 3 2 27\nv 3 0 33\nv 5 0 33\nv 5 2 33\nv 3 2 33\nf 1 2 3 4\nf 5 8 7 6\nf 1 5 6 2\nf 4 3 7 8\nf 1 4 8 5\nf 2 6 7 3\n' >"$tmp/behind.obj"
+check "a model behind the default camera" expect_exit 0 "$skyview" "$tmp/pack" -o "$tmp/framed" $small --world "$tmp/behind.obj"
+check "is framed, and the camera said" grep -q "the default camera does not see the world: framing it, as --camera 4," "$tmp/err"
+camera=$(sed -n 's/.*as --camera \([^ ]*\).*/\1/p' "$tmp/err")
+check "that camera given" expect_exit 0 "$skyview" "$tmp/pack" -o "$tmp/given" $small --world "$tmp/behind.obj" --camera "$camera"
+check "frames the same" cmp -s "$tmp/framed/frame_0000.png" "$tmp/given/frame_0000.png"
+check "and is not framed again" sh -c "! grep -q 'framing it' '$tmp/err'"
 check "data/worlds/colonnade.json (docs/fog.md's shafts) loads" expect_exit 0 "$skyview" "$tmp/pack" -o "$tmp/named" $small --world "$root/data/worlds/colonnade.json"
 check "three frames, each tone mapper" expect_exit 0 "$skyview" "$tmp/pack" -o "$tmp/g" $small --frames 3 --tonemap gt
 check "frame_0002.png" test -s "$tmp/g/frame_0002.png"
