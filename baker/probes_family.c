@@ -126,8 +126,8 @@ static enum sb_result plan(const struct sb_scene *scene, const struct sb_mesh *m
     const struct sb_probe_params *p = &scene->probes;
     uint64_t grid = 0;
     if (p->spacing_m > 0) {
-        float lo[3], hi[3];
-        sb_mesh_bounds(mesh, lo, hi);
+        float lo[3], hi[3]; /* what stands on a ground, not the ground */
+        sb_mesh_bounds_casting(mesh, lo, hi);
         for (int k = 0; k < 3 && p->has_bounds; k++) {
             lo[k] = (float)p->bounds_m[0][k];
             hi[k] = (float)p->bounds_m[1][k];

@@ -87,6 +87,18 @@ struct sb_world_params {
         char material[64]; /* a material's name in the file, or "*" */
         double albedo[3];
     } overrides[SB_WORLD_MAX_OVERRIDES];
+    /* "ground": what a mesh file stands on (a world file states its own):
+     * false for none, else a square that receives shadows and casts none
+     * (geometry/mesh.h, sb_mesh_ground). */
+    struct {
+        bool given;      /* the scene gave "ground" (for the normalised form) */
+        bool none;       /* "ground": false */
+        bool object;     /* an object: a ground even under a model that has its own */
+        bool has_height; /* else at the model's lowest point or 0, the lower */
+        double height_m;
+        double size_m;    /* 0: 4 times the model's larger horizontal extent, at least 100 m [0] */
+        double albedo[3]; /* [0.18] */
+    } ground;
 };
 
 /* The scene's "probes": where the sky-visibility probes go. */

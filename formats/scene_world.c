@@ -14,11 +14,45 @@
 #include "log.h"
 #include "scene.h"
 
+/* "ground": true (the default's), false, or {"height_m", "size_m", "albedo"};
+ * a mesh file's alone (a world file states its own). */
+static enum sb_result parse_ground(const cJSON *item, struct sb_world_params *w, const char *source)
+{
+    size_t length = strlen(w->file);
+    if (length > 5 && !strcmp(w->file + length - 5, ".json")) {
+        sb_error("%s: world.ground: %s is a skybake world file, which states its own ground", source, w->file);
+        return SB_ERR_OUT_OF_RANGE;
+    }
+    w->ground.given = true;
+    if (cJSON_IsBool(item)) {
+        w->ground.none = cJSON_IsFalse(item);
+        return SB_OK;
+    }
+    static const char *const keys[] = {"height_m", "size_m", "albedo", NULL};
+    if (!cJSON_IsObject(item)) {
+        sb_error("%s: world.ground: expected true, false or an object (height_m, size_m, albedo)", source);
+        return SB_ERR_WRONG_TYPE;
+    }
+    w->ground.object = true;
+    enum sb_result res = sb_json_only_keys(item, source, "world.ground", keys);
+    const cJSON *v;
+    if (!res && (v = cJSON_GetObjectItemCaseSensitive(item, "height_m"))) {
+        w->ground.has_height = true;
+        res = sb_json_number(v, source, "world.ground.height_m", -1e4, 1e4, &w->ground.height_m);
+    }
+    if (!res && (v = cJSON_GetObjectItemCaseSensitive(item, "size_m")))
+        res = sb_json_number(v, source, "world.ground.size_m", 1, 2e4, &w->ground.size_m);
+    if (!res && (v = cJSON_GetObjectItemCaseSensitive(item, "albedo")))
+        res = sb_json_vec3(v, source, "world.ground.albedo", 0, 1, w->ground.albedo);
+    return res;
+}
+
 enum sb_result sb_world_section_parse(const cJSON *obj, struct sb_scene *scene, const char *source)
 {
-    static const char *const keys[] = {"file", "units_m", "scale", "up", "rotate_deg", "translate_m", "albedo", NULL};
+    static const char *const keys[] = {"file",        "units_m", "scale",  "up", "rotate_deg",
+                                       "translate_m", "albedo",  "ground", NULL};
     struct sb_world_params *w = &scene->world;
-    *w = (struct sb_world_params){.units_m = 1, .scale = 1};
+    *w = (struct sb_world_params){.units_m = 1, .scale = 1, .ground.albedo = {0.18, 0.18, 0.18}};
     scene->has_world = true;
     enum sb_result res = sb_json_only_keys(obj, source, "world", keys);
     if (res)
@@ -69,6 +103,8 @@ enum sb_result sb_world_section_parse(const cJSON *obj, struct sb_scene *scene, 
             w->override_count++;
         }
     }
+    if ((item = cJSON_GetObjectItemCaseSensitive(obj, "ground")))
+        return parse_ground(item, w, source);
     return SB_OK;
 }
 
@@ -88,6 +124,17 @@ cJSON *sb_world_section_json(const struct sb_scene *scene)
         cJSON *albedo = cJSON_AddObjectToObject(o, "albedo");
         for (int i = 0; i < w->override_count; i++)
             cJSON_AddItemToObject(albedo, w->overrides[i].material, cJSON_CreateDoubleArray(w->overrides[i].albedo, 3));
+    }
+    /* only when given, so that older scenes keep their hashes */
+    if (w->ground.none) {
+        cJSON_AddFalseToObject(o, "ground");
+    } else if (w->ground.object) {
+        cJSON *g = cJSON_AddObjectToObject(o, "ground");
+        if (w->ground.has_height)
+            cJSON_AddNumberToObject(g, "height_m", w->ground.height_m);
+        if (w->ground.size_m > 0)
+            cJSON_AddNumberToObject(g, "size_m", w->ground.size_m);
+        cJSON_AddItemToObject(g, "albedo", cJSON_CreateDoubleArray(w->ground.albedo, 3));
     }
     return o;
 }

@@ -12,9 +12,17 @@ enum sb_result sb_mesh_load(const char *path, const struct sb_mesh_load_params *
 {
     size_t length = strlen(path);
     const char *name = strrchr(path, '/');
+    bool world_file = length > 5 && !strcmp(path + length - 5, ".json");
+    if (world_file && params && params->ground) {
+        sb_error("%s: a skybake world file states its own ground (its \"ground\"); the scene's world.ground is for "
+                 "mesh files",
+                 path);
+        return SB_ERR_MESH;
+    }
     sb_status_begin("loading %s", name ? name + 1 : path);
-    enum sb_result res = length > 5 && !strcmp(path + length - 5, ".json") ? sb_world_file_load(path, params, mesh)
-                                                                            : sb_mesh_import(path, params, mesh);
+    enum sb_result res = world_file ? sb_world_file_load(path, params, mesh) : sb_mesh_import(path, params, mesh);
+    if (!res && !world_file && params && params->ground)
+        res = sb_mesh_add_ground(mesh, params->ground, path);
     sb_status_end();
     return res;
 }
@@ -32,10 +40,21 @@ enum sb_result sb_mesh_load_world(const struct sb_world_params *w, const char *d
         overrides[i].material = w->overrides[i].material;
         memcpy(overrides[i].albedo, w->overrides[i].albedo, sizeof(overrides[i].albedo));
     }
+    struct sb_mesh_ground ground = {
+        .unless_own = !w->ground.object,
+        .automatic_height = !w->ground.has_height,
+        .height_m = w->ground.height_m,
+        .size_m = w->ground.size_m,
+        .albedo = {w->ground.albedo[0], w->ground.albedo[1], w->ground.albedo[2]},
+    };
+    size_t length = strlen(path);
+    bool world_file = length > 5 && !strcmp(path + length - 5, ".json");
     struct sb_mesh_load_params load = {
         .transform = {.units_m = w->units_m, .scale = w->scale, .up_z = w->up_z},
         .overrides = overrides,
         .override_count = w->override_count,
+        /* a world file states its own */
+        .ground = w->ground.none || world_file ? NULL : &ground,
     };
     memcpy(load.transform.rotate_deg, w->rotate_deg, sizeof(w->rotate_deg));
     memcpy(load.transform.translate_m, w->translate_m, sizeof(w->translate_m));

@@ -28,13 +28,17 @@
  * not finish within the time limit (SB_ERR_MESH), a
  * non-finite or out-of-extent coordinate (SB_ERR_NUMERIC), counts past the
  * caps (SB_ERR_TOO_LARGE), and a file with no triangle of non-zero area
- * (SB_ERR_MESH). Zero-area triangles are left out and counted.
+ * (SB_ERR_MESH). Zero-area triangles are left out and counted. A mesh file
+ * with params->ground stands on it (sb_mesh_add_ground); a world file with
+ * one is refused (SB_ERR_MESH).
  */
 enum sb_result sb_mesh_load(const char *path, const struct sb_mesh_load_params *params, struct sb_mesh *mesh);
 
 /* Read a scene's world (formats/scene.h: its file, relative to
  * `directory` unless absolute or directory is "", placed and overridden as
- * the scene says); *path_out (may be NULL) gets the path read, absolute. */
+ * the scene says, a mesh file standing on the ground the scene gives it,
+ * by default one at its lowest point or 0, sb_mesh_ground); *path_out (may
+ * be NULL) gets the path read, absolute. */
 struct sb_world_params;
 enum sb_result sb_mesh_load_world(const struct sb_world_params *world, const char *directory, struct sb_mesh *mesh,
                                   char *path_out, size_t path_size);

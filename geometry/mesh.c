@@ -596,6 +596,68 @@ bool sb_mesh_bounds(const struct sb_mesh *mesh, float min[3], float max[3])
     return true;
 }
 
+bool sb_mesh_bounds_casting(const struct sb_mesh *mesh, float min[3], float max[3])
+{
+    bool any = false;
+    for (uint32_t t = 0; t < mesh->triangle_count; t++) {
+        if (!mesh->material_list[mesh->materials[t]].casts_shadows)
+            continue;
+        for (int k = 0; k < 3; k++) {
+            const float *p = &mesh->positions[3 * (size_t)mesh->indices[3 * (size_t)t + k]];
+            for (int i = 0; i < 3; i++) {
+                min[i] = any ? fminf(min[i], p[i]) : p[i];
+                max[i] = any ? fmaxf(max[i], p[i]) : p[i];
+            }
+            any = true;
+        }
+    }
+    return any || sb_mesh_bounds(mesh, min, max);
+}
+
+enum sb_result sb_mesh_add_ground(struct sb_mesh *mesh, const struct sb_mesh_ground *ground, const char *source)
+{
+    float lo[3], hi[3];
+    if (!sb_mesh_bounds(mesh, lo, hi))
+        return SB_OK;
+    if (ground->unless_own) {
+        /* upward faces within a millimetre of the lowest point, against the footprint */
+        double own = 0.0;
+        for (uint32_t t = 0; t < mesh->triangle_count; t++) {
+            const float *p[3];
+            for (int k = 0; k < 3; k++)
+                p[k] = &mesh->positions[3 * (size_t)mesh->indices[3 * (size_t)t + k]];
+            if (fmaxf(p[0][1], fmaxf(p[1][1], p[2][1])) > lo[1] + 1e-3f)
+                continue;
+            /* twice the area projected on the ground, positive facing up */
+            double up = ((double)p[2][0] - p[0][0]) * ((double)p[1][2] - p[0][2]) -
+                        ((double)p[1][0] - p[0][0]) * ((double)p[2][2] - p[0][2]);
+            own += up > 0 ? 0.5 * up : 0.0;
+        }
+        if (own >= 0.5 * ((double)hi[0] - lo[0]) * ((double)hi[2] - lo[2]))
+            return SB_OK;
+    }
+    double size = ground->size_m;
+    if (size <= 0)
+        size = fmax(100.0, 4.0 * fmax((double)hi[0] - lo[0], (double)hi[2] - lo[2]));
+    size = fmin(size, 2.0 * SB_MESH_MAX_EXTENT_M);
+    double y = ground->automatic_height ? fmin(0.0, lo[1]) : ground->height_m;
+    /* centred under the model, within the extent the mesh allows */
+    double c[2] = {0.5 * ((double)lo[0] + hi[0]), 0.5 * ((double)lo[2] + hi[2])}, h = 0.5 * size;
+    for (int i = 0; i < 2; i++)
+        c[i] = fmax(fmin(c[i], SB_MESH_MAX_EXTENT_M - h), -SB_MESH_MAX_EXTENT_M + h);
+    uint32_t material;
+    enum sb_result res = sb_mesh_add_material(mesh, "ground", ground->albedo, &material);
+    if (res)
+        return res;
+    mesh->material_list[material].casts_shadows = false;
+    mesh->material_list[material].roughness = 0.9f;
+    double p[4][3] = {{c[0] - h, y, c[1] - h}, {c[0] + h, y, c[1] - h}, {c[0] + h, y, c[1] + h}, {c[0] - h, y, c[1] + h}};
+    /* counter-clockwise seen from above: facing up */
+    if (!(res = sb_mesh_add_triangle(mesh, p[0], p[2], p[1], material, source)))
+        res = sb_mesh_add_triangle(mesh, p[0], p[3], p[2], material, source);
+    return res;
+}
+
 void sb_mesh_hash(const struct sb_mesh *mesh, char out[33])
 {
     XXH3_state_t *st = XXH3_createState();

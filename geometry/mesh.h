@@ -72,8 +72,23 @@ struct sb_mesh_albedo_override {
     double albedo[3];
 };
 
+/* The ground a model from a mesh file stands on (a skybake world file
+ * states its own): a square, upward, that receives shadows and casts none
+ * (material "ground"), so that the model shades it and the probes see it. */
+struct sb_mesh_ground {
+    bool unless_own;       /* none when the model has a ground of its own: upward faces at its lowest
+                              point covering half its footprint or more */
+    bool automatic_height; /* at the model's lowest point or 0 (the planet's ground), the lower */
+    double height_m;       /* else here */
+    double size_m;         /* its side; 0: 4 times the model's larger horizontal extent, at least 100 m */
+    double albedo[3];      /* linear */
+};
+
 struct sb_mesh_load_params {
     struct sb_mesh_transform transform;
+    /* For a mesh file: the ground it stands on, or NULL for none. A world
+     * file with one is refused (it states its own). */
+    const struct sb_mesh_ground *ground;
     const struct sb_mesh_albedo_override *overrides;
     int override_count;
     /* Albedo of a material whose file gives no base or diffuse colour [0.5]. */
@@ -117,6 +132,14 @@ enum sb_result sb_mesh_add_triangle(struct sb_mesh *mesh, const double a[3], con
 
 /* The bounds of every vertex; false when the mesh is empty. */
 bool sb_mesh_bounds(const struct sb_mesh *mesh, float min[3], float max[3]);
+
+/* The bounds of the triangles that cast shadows (what stands on a ground),
+ * else of every vertex; false when the mesh is empty. */
+bool sb_mesh_bounds_casting(const struct sb_mesh *mesh, float min[3], float max[3]);
+
+/* Add `ground` under everything the mesh holds (sb_mesh_ground);
+ * `source` names the model in messages. */
+enum sb_result sb_mesh_add_ground(struct sb_mesh *mesh, const struct sb_mesh_ground *ground, const char *source);
 
 /* XXH3-128 of the positions, indices, materials and albedos: what a bake
  * that reads the mesh depends on. */

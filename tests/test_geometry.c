@@ -25,6 +25,7 @@
 #include "load.h"
 #include "mesh.h"
 #include "raycast.h"
+#include "scene.h"
 #include "shapes.h"
 
 #define MODELS "/usr/share/assimp/models"
@@ -533,6 +534,94 @@ static void write_file(const char *path, const char *text)
     }
 }
 
+/* A scene's world from a mesh file: `ground_json` ("" for the default) in
+ * its world section, loaded as the baker and skyview load it. */
+static enum sb_result load_scene_world(const char *dir, const char *file, const char *ground_json, struct sb_mesh *m)
+{
+    char json[512];
+    snprintf(json, sizeof(json), "{\"atmosphere\":{\"preset\":\"earth\"},\"world\":{\"file\":\"%s\"%s}}", file,
+             ground_json);
+    struct sb_scene *scene = malloc(sizeof(*scene));
+    enum sb_result res = scene ? sb_scene_parse(json, strlen(json), "ground test", scene) : SB_ERR_NOMEM;
+    if (!res)
+        res = sb_mesh_load_world(&scene->world, dir, m, NULL, 0);
+    free(scene);
+    return res;
+}
+
+/* The ground's two triangles: material "ground" that casts no shadow, facing
+ * up, all at height y, spanning side x side centred on (cx, cz). */
+static bool is_ground(const struct sb_mesh *m, double y, double side, double cx, double cz)
+{
+    if (m->triangle_count < 2)
+        return false;
+    uint32_t g = m->materials[m->triangle_count - 1];
+    bool ok = !strcmp(m->material_list[g].name, "ground") && !m->material_list[g].casts_shadows &&
+              m->materials[m->triangle_count - 2] == g;
+    double lo[2] = {INFINITY, INFINITY}, hi[2] = {-INFINITY, -INFINITY};
+    for (uint32_t t = m->triangle_count - 2; t < m->triangle_count; t++) {
+        const float *p[3];
+        for (int k = 0; k < 3; k++) {
+            p[k] = &m->positions[3 * (size_t)m->indices[3 * (size_t)t + k]];
+            ok = ok && fabs(p[k][1] - y) < 1e-4;
+            lo[0] = fmin(lo[0], p[k][0]), hi[0] = fmax(hi[0], p[k][0]);
+            lo[1] = fmin(lo[1], p[k][2]), hi[1] = fmax(hi[1], p[k][2]);
+        }
+        double up = ((double)p[2][0] - p[0][0]) * (p[1][2] - p[0][2]) - ((double)p[1][0] - p[0][0]) * (p[2][2] - p[0][2]);
+        ok = ok && up > 0;
+    }
+    return ok && fabs(hi[0] - lo[0] - side) < 1e-3 && fabs(hi[1] - lo[1] - side) < 1e-3 &&
+           fabs(0.5 * (lo[0] + hi[0]) - cx) < 1e-3 && fabs(0.5 * (lo[1] + hi[1]) - cz) < 1e-3;
+}
+
+/* A model from a mesh file stands on a ground: at its lowest point or 0,
+ * under it, 4 times its width or 100 m; none under a model with a ground of
+ * its own, none with "ground": false, where and how large the scene says
+ * otherwise; a world file's own is its own. */
+static void test_ground(void)
+{
+    char dir[256], path[300];
+    CHECK(test_temp_dir("skybake-ground", dir, sizeof(dir)), "temporary directory");
+    /* a cube floating from y 1 to 2 over x 30..32, z -5..-3 */
+    snprintf(path, sizeof(path), "%s/cube.obj", dir);
+    write_file(path, "v 30 1 -5\nv 32 1 -5\nv 32 2 -5\nv 30 2 -5\nv 30 1 -3\nv 32 1 -3\nv 32 2 -3\nv 30 2 -3\n"
+                     "f 1 2 3 4\nf 5 8 7 6\nf 1 2 6 5\nf 4 8 7 3\nf 1 5 8 4\nf 2 3 7 6\n");
+    /* a slab from y -3 with its own floor under all of it, and a post */
+    snprintf(path, sizeof(path), "%s/floored.obj", dir);
+    write_file(path, "v -50 -3 -50\nv -50 -3 50\nv 50 -3 50\nv 50 -3 -50\nf 1 2 3\nf 1 3 4\n"
+                     "v 0 -3 0\nv 1 -3 0\nv 0 5 0\nf 5 6 7\n");
+    struct sb_mesh m = {0};
+    CHECK(load_scene_world(dir, "cube.obj", "", &m) == SB_OK && m.triangle_count == 14 &&
+              is_ground(&m, 0.0, 100.0, 31.0, -4.0),
+          "a floating cube stands on a ground at 0, 100 m wide, under it (%u triangles)", m.triangle_count);
+    float lo[3], hi[3];
+    CHECK(sb_mesh_bounds_casting(&m, lo, hi) && lo[0] == 30.0f && hi[2] == -3.0f && lo[1] == 1.0f,
+          "the casters' bounds leave the ground out");
+    sb_mesh_finish(&m);
+    CHECK(load_scene_world(dir, "cube.obj", ",\"ground\":false", &m) == SB_OK && m.triangle_count == 12,
+          "\"ground\": false: none");
+    sb_mesh_finish(&m);
+    CHECK(load_scene_world(dir, "cube.obj", ",\"ground\":{\"height_m\":-2,\"size_m\":50,\"albedo\":[0.5,0.4,0.3]}",
+                           &m) == SB_OK &&
+              is_ground(&m, -2.0, 50.0, 31.0, -4.0) &&
+              fabsf(m.material_list[m.materials[12]].albedo[1] - 0.4f) < 1e-6f,
+          "the ground the scene gives: its height, size and albedo");
+    sb_mesh_finish(&m);
+    CHECK(load_scene_world(dir, "floored.obj", "", &m) == SB_OK && m.triangle_count == 3,
+          "a model with a floor of its own at its lowest point stands on that (%u triangles)", m.triangle_count);
+    sb_mesh_finish(&m);
+    CHECK(load_scene_world(dir, "floored.obj", ",\"ground\":{}", &m) == SB_OK && m.triangle_count == 5 &&
+              is_ground(&m, -3.0, 400.0, 0.0, 0.0),
+          "a ground asked for goes under it anyway, at its lowest point");
+    sb_mesh_finish(&m);
+    struct sb_scene *scene = malloc(sizeof(*scene));
+    static const char world_file[] =
+        "{\"atmosphere\":{\"preset\":\"earth\"},\"world\":{\"file\":\"w.json\",\"ground\":false}}";
+    CHECK(scene && sb_scene_parse(world_file, sizeof(world_file) - 1, "ground test", scene) == SB_ERR_OUT_OF_RANGE,
+          "a world file with world.ground is a scene error");
+    free(scene);
+}
+
 static void test_hostile(void)
 {
     char dir[256], path[300];
@@ -679,6 +768,7 @@ int main(void)
     sb_log_set_level(SB_LOG_WARN);
     test_loading();
     test_world_file();
+    test_ground();
     test_hostile();
     test_coincident();
 

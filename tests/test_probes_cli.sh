@@ -140,15 +140,17 @@ check "a world beyond 10 km is refused" expect_exit 1 "$skybake" bake "$tmp/fars
 check "naming the world file" grep -q "far.json: .*10000 m" "$tmp/err"
 check "the tolerance is refused for probes" sh -c "printf '{\"atmosphere\":{\"preset\":\"earth\"},\"products\":[\"sky_visibility\"],\"world\":{\"file\":\"w.obj\"},\"tolerance\":{\"sky_visibility\":0.01}}' >'$tmp/tol.json'; '$skybake' bake '$tmp/tol.json' -o '$tmp/n' 2>/dev/null; test \$? = 2"
 
-# The grid over given bounds instead of the world's (a world too wide for
-# a grid: the test world's 20 km ground), a skybake world file as the world.
+# The grid over given bounds instead of the world's casters (the test
+# world's boxes and pillars span 100 m: too wide for a grid 5 cm apart; its
+# 20 km ground is no caster), a skybake world file as the world.
 cat >"$tmp/outdoor.json" <<EOF
 {"version":1,"atmosphere":{"preset":"earth"},"products":["sky_visibility"],
- "world":{"file":"$root/data/worlds/test.json"},"probes":{"spacing_m":4,"rays":256}}
+ "world":{"file":"$root/data/worlds/test.json"},"probes":{"spacing_m":0.05,"rays":256}}
 EOF
-check "the test world's bounds need probes.bounds_m" expect_exit 1 "$skybake" bake "$tmp/outdoor.json" -o "$tmp/o"
+check "the test world's casters 5 cm apart need probes.bounds_m" expect_exit 1 "$skybake" bake "$tmp/outdoor.json" -o "$tmp/o"
 check "it says to give bounds" grep -q "give probes.bounds_m" "$tmp/err"
-sed -i 's/"rays":256/"rays":256,"bounds_m":[[-8,0.5,-30],[8,8.5,-14]]/' "$tmp/outdoor.json"
+check "it names the casters' width along z, not the ground's" grep -q "probes along z (the world is 10[0-9].[0-9] m across" "$tmp/err"
+sed -i 's/"spacing_m":0.05,"rays":256/"spacing_m":4,"rays":256,"bounds_m":[[-8,0.5,-30],[8,8.5,-14]]/' "$tmp/outdoor.json"
 check "a grid over the scene's bounds" expect_exit 0 "$skybake" bake "$tmp/outdoor.json" -o "$tmp/o"
 check "5 x 3 x 5 probes" expect_exit 0 "$skybake" info "$tmp/o"
 check "info shows that grid" grep -q '"grid":\[5,3,5\]' "$tmp/out"
