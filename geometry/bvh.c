@@ -337,7 +337,7 @@ struct builder {
     uint32_t *index, *scratch_index; /* each triangle's in the mesh, moved with prims */
     struct sb_bvh *bvh;
     struct task *tasks;
-    uint32_t task_count, *task_order;
+    uint32_t task_count, *task_order, top_nodes;
     /* the range being split on every thread */
     const struct range *range;
     struct binning binning;
@@ -624,8 +624,8 @@ enum sb_result sb_bvh_build(const struct sb_mesh *mesh, struct sb_bvh *bvh)
     b.chunks = malloc(chunks * sizeof(*b.chunks));
     /* the tasks' own nodes: a task of c triangles has at most 2c - 1 */
     struct sb_bvh_node *task_nodes = malloc(2 * (size_t)n * sizeof(*task_nodes));
-    bvh->nodes = calloc(2 * (size_t)n, sizeof(*bvh->nodes));
-    bvh->triangles = calloc(n, sizeof(*bvh->triangles));
+    bvh->nodes = malloc(2 * (size_t)n * sizeof(*bvh->nodes));
+    bvh->triangles = malloc(n * sizeof(*bvh->triangles));
     enum sb_result res = SB_ERR_NOMEM;
     bool begun = false;
     if (!b.prims || !b.scratch || !b.index || !b.scratch_index || !b.chunk_bins || !b.chunks || !task_nodes || !bvh->nodes || !bvh->triangles)
@@ -633,9 +633,12 @@ enum sb_result sb_bvh_build(const struct sb_mesh *mesh, struct sb_bvh *bvh)
     bvh->triangle_count = n;
     sb_status_begin("BVH: %u triangles on %d threads", n, sb_parallel_threads());
     begun = true;
+    double t0 = sb_now_s();
     sb_parallel_for((int)chunks, make_prims, &b);
+    double t1 = sb_now_s();
     if ((res = build_top(&b)))
         goto done;
+    b.top_nodes = bvh->node_count;
     for (uint32_t i = 0; i < b.task_count; i++)
         b.tasks[i].nodes = &task_nodes[2 * (size_t)b.tasks[i].range.begin];
     /* the largest tasks first, so that no thread is left with one at the end */
@@ -647,7 +650,9 @@ enum sb_result sb_bvh_build(const struct sb_mesh *mesh, struct sb_bvh *bvh)
     for (uint32_t i = 0; i < b.task_count; i++)
         b.task_order[i] = i;
     qsort_r(b.task_order, b.task_count, sizeof(*b.task_order), larger_task_first, b.tasks);
+    double t2 = sb_now_s();
     sb_parallel_for((int)b.task_count, run_task, &b);
+    double t3 = sb_now_s();
     for (uint32_t i = 0; i < b.task_count; i++) {
         struct task *t = &b.tasks[i];
         t->base = bvh->node_count;
@@ -657,6 +662,10 @@ enum sb_result sb_bvh_build(const struct sb_mesh *mesh, struct sb_bvh *bvh)
     }
     sb_parallel_for((int)b.task_count, place_task, &b);
     sb_parallel_for((int)chunks, write_triangles, &b);
+    sb_debug("BVH: %u triangles on %d threads: boxes %.1f ms, top levels %.1f ms (%u nodes), %u tasks %.1f ms, "
+             "layout %.1f ms",
+             n, sb_parallel_threads(), 1e3 * (t1 - t0), 1e3 * (t2 - t1), b.top_nodes, b.task_count, 1e3 * (t3 - t2),
+             1e3 * (sb_now_s() - t3));
 done:
     if (begun)
         sb_status_end();
