@@ -14,13 +14,12 @@
 /* SAH costs relative to one triangle test. */
 #define BVH_COST_TRAVERSAL 1.0
 #define BVH_COST_TRIANGLE 1.0
-/* A range of at most this many triangles is built whole by one thread (a
- * task); larger ones are split with every thread binning and partitioning
- * chunks of BVH_CHUNK. Both are fixed, not taken from the thread count, so
- * that the bytes are the same on any number of threads. */
-#ifndef BVH_TASK_PRIMS /* (a bench may try others) */
-#define BVH_TASK_PRIMS 65536
-#endif
+/* Ranges larger than a task (n / (2 x threads), at least BVH_TASK_MIN;
+ * on one thread the whole mesh) are split with every thread binning and
+ * partitioning chunks of BVH_CHUNK; each smaller one is built whole by one
+ * thread. Every partition is stable and the layout is the one-thread
+ * build's, so the bytes do not depend on how the work was shared. */
+#define BVH_TASK_MIN 8192
 #define BVH_CHUNK 16384
 
 /* min and max for the build's finite values: one instruction each, where
@@ -232,8 +231,8 @@ static void range_bounds(const struct prim *prims, uint32_t begin, uint32_t end,
  * Split `r` into its children's ranges, partitioning in place by swaps
  * (one thread): false when it stays a leaf.
  */
-static bool split_serial(struct prim *prims, uint32_t *index, const struct range *r, struct range *left,
-                         struct range *right)
+static bool split_serial(struct prim *prims, uint32_t *index, struct prim *scratch, uint32_t *scratch_index,
+                         const struct range *r, struct range *left, struct range *right)
 {
     uint32_t count = r->end - r->begin;
     if (count <= 1 || r->depth >= SB_BVH_MAX_DEPTH)
@@ -245,27 +244,31 @@ static bool split_serial(struct prim *prims, uint32_t *index, const struct range
     bool must = count > SB_BVH_MAX_LEAF;
     uint32_t mid;
     if (best_split(&b, &m, count, box_area(&r->box), must, &s)) {
+        /* stable: the left ones aside in scratch (the range's own part of
+         * it), the right ones moved up in place, then both where they go */
         struct box lc, rc;
         box_empty(&lc);
         box_empty(&rc);
-        uint32_t i = r->begin, j = r->end;
-        while (i < j) {
+        uint32_t l = r->begin, w = r->begin;
+        for (uint32_t i = r->begin; i < r->end; i++) {
             float c[4];
             prim_centroid(&prims[i], c);
             if (bin_of(&m, s.axis, c[s.axis]) < s.bin) {
                 box_grow_point(&lc, c);
-                i++;
+                scratch[l] = prims[i];
+                scratch_index[l++] = index[i];
             } else {
                 box_grow_point(&rc, c);
-                struct prim t = prims[i];
-                uint32_t ti = index[i];
-                prims[i] = prims[--j];
-                index[i] = index[j];
-                prims[j] = t;
-                index[j] = ti;
+                prims[w] = prims[i];
+                index[w++] = index[i];
             }
         }
-        mid = i;
+        uint32_t lefts = l - r->begin, rights = w - r->begin;
+        memmove(&prims[r->begin + lefts], &prims[r->begin], rights * sizeof(*prims));
+        memmove(&index[r->begin + lefts], &index[r->begin], rights * sizeof(*index));
+        memcpy(&prims[r->begin], &scratch[r->begin], lefts * sizeof(*prims));
+        memcpy(&index[r->begin], &scratch_index[r->begin], lefts * sizeof(*index));
+        mid = r->begin + lefts;
         left->box = s.left;
         right->box = s.right;
         left->centroids = lc;
@@ -294,14 +297,16 @@ static void set_node(struct sb_bvh_node *node, const struct box *box, uint32_t f
 }
 
 /* A range built whole by one thread into nodes of its own (nodes[0] its
- * root, children indices local), placed after the top nodes at `base`. */
+ * root, children indices local); its root goes where the top levels put
+ * it, the rest from `base` on. */
 struct task {
     struct range range;
     struct sb_bvh_node *nodes;
-    uint32_t node_count, depth, max_leaf, base;
+    uint32_t node_count, depth, max_leaf, root, base;
 };
 
-static void build_task(struct prim *prims, uint32_t *index, struct task *t)
+static void build_task(struct prim *prims, uint32_t *index, struct prim *scratch, uint32_t *scratch_index,
+                       struct task *t)
 {
     /* One range per level at most waits on the stack, plus the one popped. */
     struct range stack[(SB_BVH_MAX_DEPTH + 2) * 2];
@@ -313,7 +318,7 @@ static void build_task(struct prim *prims, uint32_t *index, struct task *t)
         struct range r = stack[--top], left, right;
         if (r.depth > t->depth)
             t->depth = r.depth;
-        if (!split_serial(prims, index, &r, &left, &right)) {
+        if (!split_serial(prims, index, scratch, scratch_index, &r, &left, &right)) {
             set_node(&t->nodes[r.node], &r.box, r.begin, r.end - r.begin);
             if (r.end - r.begin > t->max_leaf)
                 t->max_leaf = r.end - r.begin;
@@ -336,8 +341,16 @@ struct builder {
     struct prim *prims, *scratch;
     uint32_t *index, *scratch_index; /* each triangle's in the mesh, moved with prims */
     struct sb_bvh *bvh;
+    uint32_t task_prims; /* the largest range a task */
     struct task *tasks;
-    uint32_t task_count, *task_order, top_nodes;
+    uint32_t task_count, *task_order;
+    /* The top levels, split on every thread: their nodes (children at
+     * these indices, not yet the final ones), and each node popped from
+     * the stack in order: a split, or a task (its index). */
+    struct sb_bvh_node *top;
+    uint32_t top_count, top_capacity;
+    int32_t *events;
+    uint32_t event_count, event_capacity;
     /* the range being split on every thread */
     const struct range *range;
     struct binning binning;
@@ -522,7 +535,7 @@ static int larger_task_first(const void *a, const void *b, void *user)
 static void run_task(void *user, int index)
 {
     struct builder *b = user;
-    build_task(b->prims, b->index, &b->tasks[b->task_order[index]]);
+    build_task(b->prims, b->index, b->scratch, b->scratch_index, &b->tasks[b->task_order[index]]);
 }
 
 /* A task's nodes into their places: its root where the top level left it,
@@ -535,7 +548,7 @@ static void place_task(void *user, int index)
         struct sb_bvh_node n = t->nodes[i];
         if (!n.count)
             n.first = t->base + n.first - 1;
-        b->bvh->nodes[i ? t->base + i - 1 : t->range.node] = n;
+        b->bvh->nodes[i ? t->base + i - 1 : t->root] = n;
     }
 }
 
@@ -562,13 +575,28 @@ static void write_triangles(void *user, int chunk)
     }
 }
 
-/* The top levels, split on every thread, until the ranges are tasks. */
+/* Room for one more of `count` items of `size` in *array. */
+static bool grow(void **array, uint32_t count, uint32_t *capacity, size_t size)
+{
+    if (count < *capacity)
+        return true;
+    uint32_t more = *capacity ? 2 * *capacity : 64;
+    void *grown = realloc(*array, more * size);
+    if (!grown)
+        return false;
+    *array = grown;
+    *capacity = more;
+    return true;
+}
+
+/* The top levels, split on every thread, until the ranges are tasks, in
+ * the order the one-thread build pops them. */
 static enum sb_result build_top(struct builder *b)
 {
     struct sb_bvh *bvh = b->bvh;
     struct range stack[(SB_BVH_MAX_DEPTH + 2) * 2];
     int top = 0;
-    uint32_t capacity = 0;
+    uint32_t task_capacity = 0;
     struct range root = {.node = 0, .begin = 0, .end = bvh->triangle_count};
     b->range = &root;
     b->chunk_count = (bvh->triangle_count + BVH_CHUNK - 1) / BVH_CHUNK;
@@ -580,29 +608,69 @@ static enum sb_result build_top(struct builder *b)
         box_grow(&root.centroids, &b->chunk_bins[c].box[1][0]);
     }
     stack[top++] = root;
-    bvh->node_count = 1;
+    b->top_count = 1;
+    if (!grow((void **)&b->top, 0, &b->top_capacity, sizeof(*b->top)))
+        return SB_ERR_NOMEM;
     while (top) {
         struct range r = stack[--top], left, right;
-        if (r.depth > bvh->depth)
-            bvh->depth = r.depth;
-        if (r.end - r.begin <= BVH_TASK_PRIMS || !split_parallel(b, &r, &left, &right)) {
-            if (b->task_count == capacity) {
-                capacity = capacity ? 2 * capacity : 64;
-                struct task *grown = realloc(b->tasks, capacity * sizeof(*grown));
-                if (!grown)
-                    return SB_ERR_NOMEM;
-                b->tasks = grown;
-            }
+        if (!grow((void **)&b->events, b->event_count, &b->event_capacity, sizeof(*b->events)))
+            return SB_ERR_NOMEM;
+        if (r.end - r.begin <= b->task_prims || !split_parallel(b, &r, &left, &right)) {
+            if (!grow((void **)&b->tasks, b->task_count, &task_capacity, sizeof(*b->tasks)))
+                return SB_ERR_NOMEM;
+            b->events[b->event_count++] = (int32_t)b->task_count;
             b->tasks[b->task_count++] = (struct task){.range = r};
             continue;
         }
-        left.node = bvh->node_count;
-        right.node = bvh->node_count + 1;
-        bvh->node_count += 2;
-        set_node(&bvh->nodes[r.node], &r.box, left.node, 0);
+        if (r.depth > bvh->depth)
+            bvh->depth = r.depth;
+        if (!grow((void **)&b->top, b->top_count + 1, &b->top_capacity, sizeof(*b->top)))
+            return SB_ERR_NOMEM;
+        left.node = b->top_count;
+        right.node = b->top_count + 1;
+        b->top_count += 2;
+        set_node(&b->top[r.node], &r.box, left.node, 0);
+        b->events[b->event_count++] = -1 - (int32_t)r.node;
         stack[top++] = right;
         stack[top++] = left;
     }
+    return SB_OK;
+}
+
+/* Where every node goes, as the one-thread build lays them out: a split
+ * node's children side by side at the next free place, a task's subtree
+ * whole from the next free place on; then the top nodes written there. */
+static enum sb_result lay_out(struct builder *b)
+{
+    uint32_t *place = malloc(b->top_count * sizeof(*place)), next = 1;
+    if (!place)
+        return SB_ERR_NOMEM;
+    place[0] = 0;
+    for (uint32_t e = 0; e < b->event_count; e++) {
+        if (b->events[e] < 0) {
+            uint32_t first = b->top[-1 - b->events[e]].first;
+            place[first] = next;
+            place[first + 1] = next + 1;
+            next += 2;
+        } else {
+            struct task *t = &b->tasks[b->events[e]];
+            t->base = next;
+            next += t->node_count - 1;
+        }
+    }
+    for (uint32_t e = 0; e < b->event_count; e++) {
+        if (b->events[e] < 0) {
+            uint32_t node = (uint32_t)(-1 - b->events[e]);
+            struct sb_bvh_node n = b->top[node];
+            n.first = place[n.first];
+            b->bvh->nodes[place[node]] = n;
+        } else {
+            struct task *t = &b->tasks[b->events[e]];
+            t->root = place[t->range.node];
+        }
+    }
+    b->bvh->node_count = next;
+    free(place);
     return SB_OK;
 }
 
@@ -615,7 +683,10 @@ enum sb_result sb_bvh_build(const struct sb_mesh *mesh, struct sb_bvh *bvh)
         return SB_ERR_MESH;
     }
     uint32_t chunks = (n + BVH_CHUNK - 1) / BVH_CHUNK;
+    int threads = sb_parallel_threads();
     struct builder b = {.mesh = mesh, .bvh = bvh};
+    b.task_prims = threads <= 1 ? n : n / (2 * (uint32_t)threads) > BVH_TASK_MIN ? n / (2 * (uint32_t)threads)
+                                                                                : BVH_TASK_MIN;
     b.prims = malloc(n * sizeof(*b.prims));
     b.scratch = malloc(n * sizeof(*b.scratch));
     b.index = malloc(n * sizeof(*b.index));
@@ -638,7 +709,6 @@ enum sb_result sb_bvh_build(const struct sb_mesh *mesh, struct sb_bvh *bvh)
     double t1 = sb_now_s();
     if ((res = build_top(&b)))
         goto done;
-    b.top_nodes = bvh->node_count;
     for (uint32_t i = 0; i < b.task_count; i++)
         b.tasks[i].nodes = &task_nodes[2 * (size_t)b.tasks[i].range.begin];
     /* the largest tasks first, so that no thread is left with one at the end */
@@ -654,17 +724,17 @@ enum sb_result sb_bvh_build(const struct sb_mesh *mesh, struct sb_bvh *bvh)
     sb_parallel_for((int)b.task_count, run_task, &b);
     double t3 = sb_now_s();
     for (uint32_t i = 0; i < b.task_count; i++) {
-        struct task *t = &b.tasks[i];
-        t->base = bvh->node_count;
-        bvh->node_count += t->node_count - 1;
+        const struct task *t = &b.tasks[i];
         bvh->depth = t->depth > bvh->depth ? t->depth : bvh->depth;
         bvh->max_leaf = t->max_leaf > bvh->max_leaf ? t->max_leaf : bvh->max_leaf;
     }
+    if ((res = lay_out(&b)))
+        goto done;
     sb_parallel_for((int)b.task_count, place_task, &b);
     sb_parallel_for((int)chunks, write_triangles, &b);
     sb_debug("BVH: %u triangles on %d threads: boxes %.1f ms, top levels %.1f ms (%u nodes), %u tasks %.1f ms, "
              "layout %.1f ms",
-             n, sb_parallel_threads(), 1e3 * (t1 - t0), 1e3 * (t2 - t1), b.top_nodes, b.task_count, 1e3 * (t3 - t2),
+             n, threads, 1e3 * (t1 - t0), 1e3 * (t2 - t1), b.top_count, b.task_count, 1e3 * (t3 - t2),
              1e3 * (sb_now_s() - t3));
 done:
     if (begun)
@@ -677,6 +747,8 @@ done:
     free(b.chunks);
     free(b.tasks);
     free(b.task_order);
+    free(b.top);
+    free(b.events);
     free(task_nodes);
     if (res)
         sb_bvh_finish(bvh);

@@ -19,9 +19,10 @@
 /* The builder's recipe, in the bake keys of every product that traces the
  * BVH: bump it whenever the bytes built for some mesh change (the splits,
  * the order, the layout), since a hit between coincident triangles
- * follows them. 2: built on every thread, stable partitions above 8192
- * triangles, as many bins as triangles below 32. */
-#define SB_BVH_VERSION 2
+ * follows them. 3: every partition stable, laid out as on one thread
+ * (2: built on every thread, stable partitions above 8192 triangles, as
+ * many bins as triangles below 32). */
+#define SB_BVH_VERSION 3
 
 /* One node, 32 bytes (two vec4s in GLSL). count 0: an interior node whose
  * children are nodes first and first + 1; else a leaf of `count` triangles
