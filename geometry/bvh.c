@@ -21,6 +21,8 @@
  * build's, so the bytes do not depend on how the work was shared. */
 #define BVH_TASK_MIN 8192
 #define BVH_CHUNK 16384
+/* Ranges of at most this many chunks are split one thread each, many at once. */
+#define BVH_CHUNKS_SHARED 16
 
 /* min and max for the build's finite values: one instruction each, where
  * fminf and fmaxf's NaN rules cost a call. */
@@ -344,13 +346,18 @@ struct builder {
     uint32_t task_prims; /* the largest range a task */
     struct task *tasks;
     uint32_t task_count, *task_order;
-    /* The top levels, split on every thread: their nodes (children at
-     * these indices, not yet the final ones), and each node popped from
-     * the stack in order: a split, or a task (its index). */
+    /* The top levels: their nodes (children at these indices, not yet the
+     * final ones), and each one's task (-1: split). */
     struct sb_bvh_node *top;
-    uint32_t top_count, top_capacity;
-    int32_t *events;
-    uint32_t event_count, event_capacity;
+    int32_t *top_task;
+    uint32_t top_count, top_capacity, task_capacity;
+    /* ranges being split one thread each, and what each became */
+    struct range *frontier, *frontier_next;
+    struct {
+        struct range left, right;
+        bool split;
+    } *split_out;
+    uint32_t frontier_count;
     /* the range being split on every thread */
     const struct range *range;
     struct binning binning;
@@ -589,14 +596,58 @@ static bool grow(void **array, uint32_t count, uint32_t *capacity, size_t size)
     return true;
 }
 
-/* The top levels, split on every thread, until the ranges are tasks, in
- * the order the one-thread build pops them. */
+/* A top node: a task's root, or room for a split's children. */
+static enum sb_result add_task(struct builder *b, const struct range *r)
+{
+    if (!grow((void **)&b->tasks, b->task_count, &b->task_capacity, sizeof(*b->tasks)))
+        return SB_ERR_NOMEM;
+    b->top_task[r->node] = (int32_t)b->task_count;
+    b->tasks[b->task_count++] = (struct task){.range = *r};
+    return SB_OK;
+}
+
+/* Children for top node `r`, split into left and right. */
+static enum sb_result add_split(struct builder *b, const struct range *r, struct range *left, struct range *right)
+{
+    if (b->top_count + 2 > b->top_capacity) {
+        uint32_t more = 2 * b->top_capacity;
+        struct sb_bvh_node *top = realloc(b->top, more * sizeof(*top));
+        if (top)
+            b->top = top;
+        int32_t *task = top ? realloc(b->top_task, more * sizeof(*task)) : NULL;
+        if (!task)
+            return SB_ERR_NOMEM;
+        b->top_task = task;
+        b->top_capacity = more;
+    }
+    left->node = b->top_count;
+    right->node = b->top_count + 1;
+    b->top_count += 2;
+    set_node(&b->top[r->node], &r->box, left->node, 0);
+    b->top_task[r->node] = -1;
+    if (r->depth > b->bvh->depth)
+        b->bvh->depth = r->depth;
+    return SB_OK;
+}
+
+static void split_one(void *user, int i)
+{
+    struct builder *b = user;
+    b->split_out[i].split = split_serial(b->prims, b->index, b->scratch, b->scratch_index, &b->frontier[i],
+                                         &b->split_out[i].left, &b->split_out[i].right);
+}
+
+/*
+ * The top levels, until every range is a task: ranges over
+ * BVH_CHUNKS_SHARED chunks one at a time, each by every thread; then the
+ * rest level by level, each range by one thread, many at once. The order
+ * they are split in changes nothing: lay_out places the nodes.
+ */
 static enum sb_result build_top(struct builder *b)
 {
     struct sb_bvh *bvh = b->bvh;
     struct range stack[(SB_BVH_MAX_DEPTH + 2) * 2];
     int top = 0;
-    uint32_t task_capacity = 0;
     struct range root = {.node = 0, .begin = 0, .end = bvh->triangle_count};
     b->range = &root;
     b->chunk_count = (bvh->triangle_count + BVH_CHUNK - 1) / BVH_CHUNK;
@@ -607,67 +658,95 @@ static enum sb_result build_top(struct builder *b)
         box_grow(&root.box, &b->chunk_bins[c].box[0][0]);
         box_grow(&root.centroids, &b->chunk_bins[c].box[1][0]);
     }
-    stack[top++] = root;
-    b->top_count = 1;
-    if (!grow((void **)&b->top, 0, &b->top_capacity, sizeof(*b->top)))
+    b->top = malloc(64 * sizeof(*b->top));
+    b->top_task = malloc(64 * sizeof(*b->top_task));
+    /* each range there holds over task_prims triangles, none twice */
+    size_t most = bvh->triangle_count / b->task_prims + 1;
+    b->frontier = malloc(most * sizeof(*b->frontier));
+    b->frontier_next = malloc(most * sizeof(*b->frontier_next));
+    b->split_out = malloc(most * sizeof(*b->split_out));
+    if (!b->top || !b->top_task || !b->frontier || !b->frontier_next || !b->split_out)
         return SB_ERR_NOMEM;
-    while (top) {
+    b->top_capacity = 64;
+    b->top_count = 1;
+    enum sb_result res = SB_OK;
+    stack[top++] = root;
+    while (top && !res) {
         struct range r = stack[--top], left, right;
-        if (!grow((void **)&b->events, b->event_count, &b->event_capacity, sizeof(*b->events)))
-            return SB_ERR_NOMEM;
-        if (r.end - r.begin <= b->task_prims || !split_parallel(b, &r, &left, &right)) {
-            if (!grow((void **)&b->tasks, b->task_count, &task_capacity, sizeof(*b->tasks)))
-                return SB_ERR_NOMEM;
-            b->events[b->event_count++] = (int32_t)b->task_count;
-            b->tasks[b->task_count++] = (struct task){.range = r};
-            continue;
+        uint32_t count = r.end - r.begin;
+        if (count <= b->task_prims)
+            res = add_task(b, &r);
+        else if (count <= BVH_CHUNKS_SHARED * BVH_CHUNK)
+            b->frontier[b->frontier_count++] = r;
+        else if (!split_parallel(b, &r, &left, &right))
+            res = add_task(b, &r); /* the depth limit: a leaf */
+        else if (!(res = add_split(b, &r, &left, &right))) {
+            stack[top++] = right;
+            stack[top++] = left;
         }
-        if (r.depth > bvh->depth)
-            bvh->depth = r.depth;
-        if (!grow((void **)&b->top, b->top_count + 1, &b->top_capacity, sizeof(*b->top)))
-            return SB_ERR_NOMEM;
-        left.node = b->top_count;
-        right.node = b->top_count + 1;
-        b->top_count += 2;
-        set_node(&b->top[r.node], &r.box, left.node, 0);
-        b->events[b->event_count++] = -1 - (int32_t)r.node;
-        stack[top++] = right;
-        stack[top++] = left;
     }
-    return SB_OK;
+    while (b->frontier_count && !res) {
+        sb_parallel_for((int)b->frontier_count, split_one, b);
+        uint32_t next = 0;
+        for (uint32_t i = 0; i < b->frontier_count && !res; i++) {
+            struct range r = b->frontier[i], left = b->split_out[i].left, right = b->split_out[i].right;
+            if (!b->split_out[i].split) {
+                res = add_task(b, &r);
+                continue;
+            }
+            if ((res = add_split(b, &r, &left, &right)))
+                break;
+            const struct range *children[2] = {&left, &right};
+            for (int c = 0; c < 2 && !res; c++) {
+                if (children[c]->end - children[c]->begin <= b->task_prims)
+                    res = add_task(b, children[c]);
+                else
+                    b->frontier_next[next++] = *children[c];
+            }
+        }
+        struct range *swap = b->frontier;
+        b->frontier = b->frontier_next;
+        b->frontier_next = swap;
+        b->frontier_count = next;
+    }
+    return res;
 }
 
-/* Where every node goes, as the one-thread build lays them out: a split
- * node's children side by side at the next free place, a task's subtree
- * whole from the next free place on; then the top nodes written there. */
+/* Where every node goes, as the one-thread build lays them out (its stack,
+ * the right child pushed first): a split node's children side by side at
+ * the next free place, a task's subtree whole from the next free place on;
+ * then the top nodes written there. */
 static enum sb_result lay_out(struct builder *b)
 {
     uint32_t *place = malloc(b->top_count * sizeof(*place)), next = 1;
+    uint32_t stack[(SB_BVH_MAX_DEPTH + 2) * 2];
+    int top = 0;
     if (!place)
         return SB_ERR_NOMEM;
     place[0] = 0;
-    for (uint32_t e = 0; e < b->event_count; e++) {
-        if (b->events[e] < 0) {
-            uint32_t first = b->top[-1 - b->events[e]].first;
-            place[first] = next;
-            place[first + 1] = next + 1;
-            next += 2;
-        } else {
-            struct task *t = &b->tasks[b->events[e]];
+    stack[top++] = 0;
+    while (top) {
+        uint32_t node = stack[--top];
+        if (b->top_task[node] >= 0) {
+            struct task *t = &b->tasks[b->top_task[node]];
+            t->root = place[node];
             t->base = next;
             next += t->node_count - 1;
+            continue;
         }
+        struct sb_bvh_node n = b->top[node];
+        place[n.first] = next;
+        place[n.first + 1] = next + 1;
+        next += 2;
+        stack[top++] = n.first + 1;
+        stack[top++] = n.first;
     }
-    for (uint32_t e = 0; e < b->event_count; e++) {
-        if (b->events[e] < 0) {
-            uint32_t node = (uint32_t)(-1 - b->events[e]);
-            struct sb_bvh_node n = b->top[node];
-            n.first = place[n.first];
-            b->bvh->nodes[place[node]] = n;
-        } else {
-            struct task *t = &b->tasks[b->events[e]];
-            t->root = place[t->range.node];
-        }
+    for (uint32_t node = 0; node < b->top_count; node++) {
+        if (b->top_task[node] >= 0)
+            continue;
+        struct sb_bvh_node n = b->top[node];
+        n.first = place[n.first];
+        b->bvh->nodes[place[node]] = n;
     }
     b->bvh->node_count = next;
     free(place);
@@ -748,7 +827,10 @@ done:
     free(b.tasks);
     free(b.task_order);
     free(b.top);
-    free(b.events);
+    free(b.top_task);
+    free(b.frontier);
+    free(b.frontier_next);
+    free(b.split_out);
     free(task_nodes);
     if (res)
         sb_bvh_finish(bvh);

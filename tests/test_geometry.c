@@ -793,12 +793,13 @@ int main(void)
     test_bvh_structure("well", &well);
     test_bvh_structure("room", &room);
     test_bvh_structure("soup", &soup);
-    /* Hills of 80,000 triangles: more than one thread's share of the build
-     * (BVH_TASK_PRIMS), so the top levels are split by every thread. */
+    /* Hills of 288,800 triangles: on 3 and 8 threads the top ranges are split
+     * by every thread at once (over 16 chunks of 16,384), the next ones one
+     * thread each, many at once, and the rest are tasks. */
     struct sb_mesh hills = {0};
     sb_mesh_add_material(&hills, "hills", grey, &mat);
-    for (int j = 0; j < 200; j++)
-        for (int i = 0; i < 200; i++) {
+    for (int j = 0; j < 380; j++)
+        for (int i = 0; i < 380; i++) {
             double p[4][3];
             for (int k = 0; k < 4; k++) {
                 double x = i + (k & 1), z = j + (k >> 1);
