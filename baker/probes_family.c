@@ -138,9 +138,10 @@ static enum sb_result plan(const struct sb_scene *scene, const struct sb_mesh *m
             double n = floor(extent / p->spacing_m) + 1;
             if (n > SB_PROBES_MAX_GRID) {
                 sb_error("probes: %.0f probes along %c (the %s %.1f m across with a %g m margin); at most %d: raise "
-                         "probes.spacing_m%s",
+                         "probes.spacing_m%s%s",
                          n, "xyz"[k], p -> has_bounds ? "bounds are" : "world is", (double)hi[k] - lo[k], p->margin_m,
-                         SB_PROBES_MAX_GRID, p->has_bounds ? "" : " or give probes.bounds_m");
+                         SB_PROBES_MAX_GRID, p->has_bounds ? "" : " or give probes.bounds_m",
+                         p->has_bounds ? "" : " (a model in millimetres or centimetres: set world.units_m)");
                 return SB_ERR_TOO_LARGE;
             }
             layout->grid[k] = (uint32_t)n;
@@ -150,8 +151,15 @@ static enum sb_result plan(const struct sb_scene *scene, const struct sb_mesh *m
         }
     }
     if (grid + (uint64_t)p->explicit_count > SB_PROBES_MAX_COUNT) {
-        sb_error("probes: %llu probes; at most %u: raise probes.spacing_m",
-                 (unsigned long long)(grid + p->explicit_count), SB_PROBES_MAX_COUNT);
+        /* a model in millimetres is the usual reason a world is this large */
+        sb_error("probes: %llu probes (a grid of %u x %u x %u, %g m apart, over the %s); at most %u: raise "
+                 "probes.spacing_m%s%s",
+                 (unsigned long long)(grid + p->explicit_count), layout->grid[0], layout->grid[1], layout->grid[2],
+                 p->spacing_m, p->has_bounds ? "bounds" : "world's shadow casters", SB_PROBES_MAX_COUNT,
+                 p->has_bounds ? "" : ", give probes.bounds_m",
+                 scene->has_world && !p->has_bounds
+                     ? ", or, for a model in millimetres or centimetres, set world.units_m (0.001, 0.01)"
+                     : "");
         return SB_ERR_TOO_LARGE;
     }
     *grid_out = grid;
