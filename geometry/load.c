@@ -8,11 +8,16 @@
 #include "scene.h"
 #include "world_file.h"
 
-enum sb_result sb_mesh_load(const char *path, const struct sb_mesh_load_params *params, struct sb_mesh *mesh)
+bool sb_mesh_is_world_file(const char *path)
 {
     size_t length = strlen(path);
+    return length > 5 && !strcmp(path + length - 5, ".json");
+}
+
+enum sb_result sb_mesh_load(const char *path, const struct sb_mesh_load_params *params, struct sb_mesh *mesh)
+{
     const char *name = strrchr(path, '/');
-    bool world_file = length > 5 && !strcmp(path + length - 5, ".json");
+    bool world_file = sb_mesh_is_world_file(path);
     if (world_file && params && params->ground) {
         sb_error("%s: a skybake world file states its own ground (its \"ground\"); the scene's world.ground is for "
                  "mesh files",
@@ -47,14 +52,12 @@ enum sb_result sb_mesh_load_world(const struct sb_world_params *w, const char *d
         .size_m = w->ground.size_m,
         .albedo = {w->ground.albedo[0], w->ground.albedo[1], w->ground.albedo[2]},
     };
-    size_t length = strlen(path);
-    bool world_file = length > 5 && !strcmp(path + length - 5, ".json");
     struct sb_mesh_load_params load = {
         .transform = {.units_m = w->units_m, .scale = w->scale, .up_z = w->up_z},
         .overrides = overrides,
         .override_count = w->override_count,
         /* a world file states its own */
-        .ground = w->ground.none || world_file ? NULL : &ground,
+        .ground = w->ground.none || sb_mesh_is_world_file(path) ? NULL : &ground,
     };
     memcpy(load.transform.rotate_deg, w->rotate_deg, sizeof(w->rotate_deg));
     memcpy(load.transform.translate_m, w->translate_m, sizeof(w->translate_m));

@@ -6,6 +6,7 @@
 #ifndef SB_GEOMETRY_LOAD_H
 #define SB_GEOMETRY_LOAD_H
 
+#include <stdbool.h>
 #include <stddef.h>
 
 #include "mesh.h"
@@ -33,6 +34,10 @@
  * one is refused (SB_ERR_MESH).
  */
 enum sb_result sb_mesh_load(const char *path, const struct sb_mesh_load_params *params, struct sb_mesh *mesh);
+
+/* Whether sb_mesh_load reads `path` as a skybake world file (its name ends
+ * in .json) rather than through assimp. */
+bool sb_mesh_is_world_file(const char *path);
 
 /* Read a scene's world (formats/scene.h: its file, relative to
  * `directory` unless absolute or directory is "", placed and overridden as

@@ -867,10 +867,8 @@ static enum sb_result load_world(const struct options *o, const struct sb_pack *
         /* a mesh file stands on a ground, as a scene's world does by default */
         static const struct sb_mesh_ground ground = {
             .unless_own = true, .automatic_height = true, .albedo = {0.18, 0.18, 0.18}};
-        size_t length = strlen(o->world);
-        bool world_file = length > 5 && !strcmp(o->world + length - 5, ".json");
         struct sb_mesh_load_params load = {.transform = {.units_m = 1, .scale = 1},
-                                           .ground = world_file ? NULL : &ground};
+                                           .ground = sb_mesh_is_world_file(o->world) ? NULL : &ground};
         res = sb_world_load(o->world, &load, world);
     } else if (baked_path[0]) {
         struct sb_world_params *wp = malloc(sizeof(*wp));
