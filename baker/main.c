@@ -152,8 +152,9 @@ static void print_json(const char *out_dir, const struct sb_vk *vk, const struct
     sb_json_emit(stdout, root);
 }
 
-/* The options bake and bench share; returns false for an unknown one. */
-static bool common_option(int argc, char **argv, int *i, struct sb_vk_params *vk_params, bool *json)
+/* The options the commands share: 1 when argv[*i] was one (and its value
+ * taken), 0 when it is not, -1 when its value is refused (said why). */
+static int common_option(int argc, char **argv, int *i, struct sb_vk_params *vk_params, bool *json)
 {
     const char *a = argv[*i];
     if (!strcmp(a, "--device") && *i + 1 < argc)
@@ -168,7 +169,7 @@ static bool common_option(int argc, char **argv, int *i, struct sb_vk_params *vk
         if (*end || end == argv[*i] || n < 1 || n > SB_PARALLEL_MAX_THREADS) {
             fprintf(stderr, "skybake: --threads: '%s' is not a count from 1 to %d\n", argv[*i],
                     SB_PARALLEL_MAX_THREADS);
-            return false;
+            return -1;
         }
         sb_parallel_set_threads((int)n);
     } else if (!strcmp(a, "-q") || !strcmp(a, "--quiet"))
@@ -176,8 +177,8 @@ static bool common_option(int argc, char **argv, int *i, struct sb_vk_params *vk
     else if (!strcmp(a, "-v") || !strcmp(a, "--verbose"))
         sb_log_set_level(SB_LOG_DEBUG);
     else
-        return false;
-    return true;
+        return 0;
+    return 1;
 }
 
 static int cmd_bake(int argc, char **argv)
@@ -188,7 +189,10 @@ static int cmd_bake(int argc, char **argv)
     bool json = false;
     for (int i = 0; i < argc; i++) {
         const char *a = argv[i];
-        if (common_option(argc, argv, &i, &params, &json))
+        int common = common_option(argc, argv, &i, &params, &json);
+        if (common < 0)
+            return EXIT_USAGE;
+        if (common)
             continue;
         if ((!strcmp(a, "-o") || !strcmp(a, "--output")) && i + 1 < argc)
             out_dir = argv[++i];
@@ -249,7 +253,10 @@ static int cmd_bench(int argc, char **argv)
     for (int i = 0; i < argc; i++) {
         const char *a = argv[i];
         enum sb_bench_sweep sweep;
-        if (common_option(argc, argv, &i, &vk_params, &json))
+        int common = common_option(argc, argv, &i, &vk_params, &json);
+        if (common < 0)
+            return EXIT_USAGE;
+        if (common)
             continue;
         if ((!strcmp(a, "-o") || !strcmp(a, "--output")) && i + 1 < argc) {
             out_dir = argv[++i];
@@ -364,7 +371,10 @@ static int cmd_sky_error(int argc, char **argv)
     for (int i = 0; i < argc; i++) {
         const char *a = argv[i];
         double v;
-        if (common_option(argc, argv, &i, &vk_params, &json))
+        int common = common_option(argc, argv, &i, &vk_params, &json);
+        if (common < 0)
+            return EXIT_USAGE;
+        if (common)
             continue;
         if (!strcmp(a, "--paths") && i + 1 < argc) {
             if (!parse_number(argv[++i], 32, 1e8, &v) || v != floor(v)) {
@@ -445,7 +455,10 @@ static bool pack_args(int argc, char **argv, const char *command, const char **d
     struct sb_vk_params unused = {0};
     for (int i = 0; i < argc; i++) {
         const char *a = argv[i];
-        if (common_option(argc, argv, &i, &unused, json))
+        int common = common_option(argc, argv, &i, &unused, json);
+        if (common < 0)
+            return false;
+        if (common)
             continue;
         if (tolerance && (!strcmp(a, "--tol") || !strcmp(a, "--floor")) && i + 1 < argc) {
             double *out = !strcmp(a, "--tol") ? tolerance : floor;

@@ -79,6 +79,7 @@ check "the same visibility on 1 and 3 threads" cmp -s "$tmp/t1/sky_visibility.sb
 check "the same bounce on 1 and 3 threads" cmp -s "$tmp/t1/sky_bounce.sbprobes" "$tmp/t3/sky_bounce.sbprobes"
 check "--threads 0 is refused" expect_exit 2 "$skybake" bake "$tmp/grid.json" -o "$tmp/t0" --threads 0
 check "naming the option" grep -q -- "--threads: '0'" "$tmp/err"
+check "not as an unknown option" sh -c "! grep -q 'unknown or incomplete' '$tmp/err'"
 check "and nothing was written" test ! -e "$tmp/t0"
 
 # The bounce: a product of its own over the same probes. Asking for it
