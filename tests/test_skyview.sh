@@ -35,6 +35,7 @@ check "with the world file named" expect_exit 0 "$skyview" "$tmp/pack" -o "$tmp/
 check "the built-in world is data/worlds/test.json" cmp -s "$tmp/elsewhere/frame_0000.png" "$tmp/named/frame_0000.png"
 # A model the default camera cannot see (a box behind it) is framed, and the
 # camera reported; the test world and a given --camera are left alone.
+# ($tmp/err is the run with the test world named, above)
 check "the test world is not framed" sh -c "! grep -q 'framing it' '$tmp/err'"
 printf 'v 3 0 27\nv 5 0 27\nv 5 2 27\nv 3 2 27\nv 3 0 33\nv 5 0 33\nv 5 2 33\nv 3 2 33\nf 1 2 3 4\nf 5 8 7 6\nf 1 5 6 2\nf 4 3 7 8\nf 1 4 8 5\nf 2 6 7 3\n' >"$tmp/behind.obj"
 check "a model behind the default camera" expect_exit 0 "$skyview" "$tmp/pack" -o "$tmp/framed" $small --world "$tmp/behind.obj"
