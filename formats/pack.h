@@ -123,7 +123,7 @@ struct sb_pack {
  * pack holds no file the manifest does not list. Every problem is logged
  * naming the pack, the artifact and the reason; the first one's code is
  * returned, and *pack is then empty. A pack is untrusted input whatever its
- * hashes say (docs/pack.md): its VDB files are parsed in a forked child
+ * hashes say (docs/pack.md): its VDB files are parsed in a helper
  * process (vdb.h, sandbox.h), so the caller sees a child come and go.
  */
 enum sb_result sb_pack_open(const char *dir, struct sb_pack *pack);

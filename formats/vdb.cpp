@@ -5,8 +5,9 @@
 // it with write(2), so that a full disk or a file size limit is reported
 // with the system's reason (std::ofstream would lose it), and the random
 // UUID OpenVDB puts in the header can be replaced with one derived from the
-// content. The reader checks each grid's shape in its metadata before it
-// reads the grid.
+// content. The reader checks the file's structure in the caller, then
+// OpenVDB parses it in a helper program (read_vdb.c, sandbox.h), which
+// checks each grid's shape in its metadata before it reads the grid.
 #include <openvdb/io/Archive.h>
 #include <openvdb/io/File.h>
 #include <openvdb/openvdb.h>
@@ -26,6 +27,7 @@
 extern "C" {
 #include "io.h"
 #include "log.h"
+#include "read_vdb.h"
 #include "sandbox.h"
 #include "vdb.h"
 }
@@ -241,6 +243,56 @@ openvdb::FloatGrid::Ptr channel_grid(const sb_image *v, uint32_t c)
     return grid;
 }
 
+} // namespace
+
+extern "C" enum sb_result sb_vdb_write(const char *path, const struct sb_image *volume,
+                                       const struct sb_attribute *attributes, int attribute_count)
+{
+    int64_t bad = sb_image_find_not_half(volume);
+    if (bad >= 0) {
+        sb_error("%s: value %lld (%.9g) is not a binary16 value, which the file stores; round first", path,
+                 static_cast<long long>(bad), double(volume->data[bad]));
+        return SB_ERR_NUMERIC;
+    }
+    std::string bytes;
+    try {
+        openvdb::initialize();
+        openvdb::GridCPtrVec grids;
+        openvdb::MetaMap file_meta;
+        for (int a = 0; a < attribute_count; a++)
+            file_meta.insertMeta(attributes[a].name, openvdb::StringMetadata(attributes[a].value));
+        for (uint32_t c = 0; c < volume->channel_count; c++) {
+            openvdb::FloatGrid::Ptr grid = channel_grid(volume, c);
+            grid->setName(volume->channel_names[c]);
+            grid->setGridClass(openvdb::GRID_FOG_VOLUME);
+            grid->setSaveFloatAsHalf(true);
+            grid->setTransform(texture_transform(volume->width, volume->height, volume->depth));
+            for (int a = 0; a < attribute_count; a++)
+                grid->insertMeta(attributes[a].name, openvdb::StringMetadata(attributes[a].value));
+            grids.push_back(grid);
+        }
+        std::ostringstream os(std::ios_base::out | std::ios_base::binary);
+        BufferWriter writer;
+        writer.setCompression(openvdb::io::COMPRESS_BLOSC | openvdb::io::COMPRESS_ACTIVE_MASK);
+        writer.write_to(os, grids, file_meta);
+        bytes = os.str();
+    } catch (const std::exception &e) {
+        sb_error("%s: OpenVDB cannot write the volume: %s", path, e.what());
+        return SB_ERR_VDB;
+    }
+    if (!looks_like_uuid(bytes, kUuidOffset)) {
+        sb_error("%s: OpenVDB wrote a header this build does not know (no UUID at byte %zu)", path, kUuidOffset);
+        return SB_ERR_VDB;
+    }
+    bytes.replace(kUuidOffset, kUuidSize, uuid_from(volume, attributes, attribute_count));
+    return write_bytes(path, bytes);
+}
+
+namespace
+{
+
+// ---- in the helper program (read_vdb.c): OpenVDB parses ------------------------------------
+
 std::string meta_string(const openvdb::MetaMap &meta, const char *name)
 {
     openvdb::StringMetadata::ConstPtr s = meta.getMetadata<openvdb::StringMetadata>(name);
@@ -297,56 +349,8 @@ enum sb_result read_channel(openvdb::io::File &file, const char *path, uint32_t 
     return SB_OK;
 }
 
-} // namespace
-
-extern "C" enum sb_result sb_vdb_write(const char *path, const struct sb_image *volume,
-                                       const struct sb_attribute *attributes, int attribute_count)
-{
-    int64_t bad = sb_image_find_not_half(volume);
-    if (bad >= 0) {
-        sb_error("%s: value %lld (%.9g) is not a binary16 value, which the file stores; round first", path,
-                 static_cast<long long>(bad), double(volume->data[bad]));
-        return SB_ERR_NUMERIC;
-    }
-    std::string bytes;
-    try {
-        openvdb::initialize();
-        openvdb::GridCPtrVec grids;
-        openvdb::MetaMap file_meta;
-        for (int a = 0; a < attribute_count; a++)
-            file_meta.insertMeta(attributes[a].name, openvdb::StringMetadata(attributes[a].value));
-        for (uint32_t c = 0; c < volume->channel_count; c++) {
-            openvdb::FloatGrid::Ptr grid = channel_grid(volume, c);
-            grid->setName(volume->channel_names[c]);
-            grid->setGridClass(openvdb::GRID_FOG_VOLUME);
-            grid->setSaveFloatAsHalf(true);
-            grid->setTransform(texture_transform(volume->width, volume->height, volume->depth));
-            for (int a = 0; a < attribute_count; a++)
-                grid->insertMeta(attributes[a].name, openvdb::StringMetadata(attributes[a].value));
-            grids.push_back(grid);
-        }
-        std::ostringstream os(std::ios_base::out | std::ios_base::binary);
-        BufferWriter writer;
-        writer.setCompression(openvdb::io::COMPRESS_BLOSC | openvdb::io::COMPRESS_ACTIVE_MASK);
-        writer.write_to(os, grids, file_meta);
-        bytes = os.str();
-    } catch (const std::exception &e) {
-        sb_error("%s: OpenVDB cannot write the volume: %s", path, e.what());
-        return SB_ERR_VDB;
-    }
-    if (!looks_like_uuid(bytes, kUuidOffset)) {
-        sb_error("%s: OpenVDB wrote a header this build does not know (no UUID at byte %zu)", path, kUuidOffset);
-        return SB_ERR_VDB;
-    }
-    bytes.replace(kUuidOffset, kUuidSize, uuid_from(volume, attributes, attribute_count));
-    return write_bytes(path, bytes);
-}
-
-namespace
-{
-
-// In the sandboxed child: the grids of the file OpenVDB opens at `file`
-// (the parent's descriptor, as /proc/self/fd/N), errors naming `path`.
+// The grids of the file OpenVDB opens at `file` (the parent's descriptor,
+// as /proc/self/fd/N), errors naming `path`.
 enum sb_result read_grids(const char *path, const char *file_name, const char *channel_order, uint64_t max_voxels,
                           sb_image *volume, sb_attribute *attributes, int *attribute_count)
 {
@@ -417,38 +421,29 @@ enum sb_result read_grids(const char *path, const char *file_name, const char *c
     return res;
 }
 
-constexpr uint32_t kAnswerMagic = 0x534b4256; // "SKBV"
+} // namespace
 
-struct Answer {
-    uint32_t magic;
-    int32_t result;
-    uint32_t width, height, depth, channel_count;
-    int32_t attribute_count;
-    char message[512];
-};
-
-struct ReadJob {
-    const char *path, *channel_order;
-    int fd;
-    uint64_t max_voxels;
-};
-
-int read_child(int out, void *user)
+// The helper's side of sb_vdb_read (read_vdb.h).
+extern "C" int sb_vdb_read_task(int out, const void *request, size_t size)
 {
-    const ReadJob *job = static_cast<const ReadJob *>(user);
-    Answer a = {};
-    a.magic = kAnswerMagic;
+    sb_read_vdb_request job = {};
+    if (size != sizeof(job))
+        return 2;
+    std::memcpy(&job, request, sizeof(job));
+    job.path[sizeof(job.path) - 1] = '\0';
+    job.channel_order[sizeof(job.channel_order) - 1] = '\0';
+    sb_read_vdb_answer a = {};
+    a.magic = SB_READ_VDB_MAGIC;
     sb_sandbox_capture_log(a.message, sizeof(a.message));
     char file_name[64];
-    std::snprintf(file_name, sizeof(file_name), "/proc/self/fd/%d", job->fd);
+    std::snprintf(file_name, sizeof(file_name), "/proc/self/fd/%d", SB_SANDBOX_FILE_FD);
     sb_image volume = {};
     sb_attribute attributes[SB_FILE_MAX_ATTRIBUTES] = {};
     int attribute_count = 0;
-    // One thread: the TBB of a forked process may hold workers that are
-    // not there any more.
+    // One thread: the CPU-time limit then bounds the wall time too.
     tbb::task_arena arena(1);
     arena.execute([&] {
-        a.result = read_grids(job->path, file_name, job->channel_order, job->max_voxels, &volume, attributes,
+        a.result = read_grids(job.path, file_name, job.channel_order, job.max_voxels, &volume, attributes,
                               &attribute_count);
     });
     if (!a.result) {
@@ -462,10 +457,12 @@ int read_child(int out, void *user)
     if (!a.result && ok)
         ok = sb_write_all(out, attributes, sizeof(attributes)) &&
              sb_write_all(out, volume.data, sb_image_float_count(&volume) * sizeof(float));
+    sb_image_finish(&volume);
     return ok ? 0 : 1;
 }
 
-} // namespace
+
+// ---- in the caller ---------------------------------------------------------------------------
 
 extern "C" enum sb_result sb_vdb_read(const char *path, const char *channel_order, uint64_t max_voxels,
                                       struct sb_image *volume, struct sb_attribute *attributes, int *attribute_count)
@@ -498,22 +495,30 @@ extern "C" enum sb_result sb_vdb_read(const char *path, const char *channel_orde
         close(fd);
         return code;
     }
-    // OpenVDB in a child: the grids' contents are still OpenVDB's to parse.
+    // OpenVDB in its helper: the grids' contents are still OpenVDB's to parse.
     // Memory for its tree and our copy: three times the volume, and room
     // for OpenVDB's own buffers.
-    ReadJob job = {path, channel_order, fd, max_voxels};
+    sb_read_vdb_request job = {};
+    job.max_voxels = max_voxels;
+    if (std::snprintf(job.path, sizeof(job.path), "%s", path) >= int(sizeof(job.path)) ||
+        std::snprintf(job.channel_order, sizeof(job.channel_order), "%s", channel_order) >=
+            int(sizeof(job.channel_order))) {
+        sb_error("%s: the path or the channel list is too long to read it", path);
+        close(fd);
+        return SB_ERR_IO;
+    }
     sb_sandbox_limits limits = {};
     limits.cpu_seconds = 60;
     limits.address_space_bytes =
         (128ull << 20) + 3 * std::min(max_voxels, kDefaultMaxVoxels) * channels * sizeof(float);
     sb_sandbox box;
-    enum sb_result res = sb_sandbox_start(&box, &limits, read_child, &job);
-    close(fd); // the child has its copy
+    enum sb_result res = sb_sandbox_start(&box, &limits, SB_READ_VDB_HELPER, &job, sizeof(job), fd);
+    close(fd); // the helper has its copy
     if (res)
         return res;
-    Answer a;
+    sb_read_vdb_answer a;
     char why[160];
-    if (!sb_sandbox_read(&box, &a, sizeof(a)) || a.magic != kAnswerMagic) {
+    if (!sb_sandbox_read(&box, &a, sizeof(a)) || a.magic != SB_READ_VDB_MAGIC) {
         sb_sandbox_finish(&box, why, sizeof(why));
         sb_error("%s: OpenVDB did not finish reading it: its process %s", path, why);
         return SB_ERR_VDB;

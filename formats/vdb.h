@@ -56,8 +56,9 @@ enum sb_result sb_vdb_write(const char *path, const struct sb_image *volume, con
  *
  * OpenVDB's reader is not hardened against hostile files, so the file's
  * layout is checked first (header, metadata, each grid's offsets within the
- * file) and OpenVDB parses the grids in a child process under CPU-time,
- * memory and wall-clock limits (sandbox.h): a crafted file gets SB_ERR_VDB,
+ * file) and OpenVDB parses the grids in a helper process under CPU-time,
+ * memory and wall-clock limits (sandbox.h; the program skybake-read-vdb,
+ * installed beside the library in libexecdir/skybake): a crafted file gets SB_ERR_VDB,
  * never a crash or a hang of the caller.
  */
 enum sb_result sb_vdb_read(const char *path, const char *channel_order, uint64_t max_voxels, struct sb_image *volume,

@@ -18,6 +18,7 @@
 
 #include "io.h"
 #include "log.h"
+#include "import_mesh.h"
 #include "sandbox.h"
 
 /* Node trees deeper than this are refused (a file can make them cyclic). */
@@ -318,7 +319,7 @@ static enum sb_result add_materials(struct importer *im)
 }
 
 /*
- * assimp's file system in the child: regular files only, opened without
+ * assimp's file system in the helper: regular files only, opened without
  * blocking first, so that a FIFO or a device named by the file (an OBJ's
  * mtllib, a glTF's buffer) is refused at once instead of stalling the
  * import until its deadline.
@@ -397,7 +398,7 @@ static void file_close(struct aiFileIO *io, struct aiFile *f)
     }
 }
 
-/* The import itself, into a fresh mesh, in the importing child: the
+/* The import itself, into a fresh mesh, in the helper: the
  * file's materials, then every instanced triangle. */
 static enum sb_result import(const char *path, const struct sb_mesh_load_params *params, struct sb_mesh *mesh)
 {
@@ -426,36 +427,40 @@ done:
     return res;
 }
 
-/* ---- the importing child --------------------------------------------------------------- */
+/* ---- the helper's side and the caller's --------------------------------------------------- */
 
 /*
  * assimp is not hardened: on this machine a PLY header claiming 10^11
- * vertices made it loop for ever, and a reader can crash. So a sandboxed
- * child process imports (formats/sandbox.h) and sends the mesh back; the
- * parent checks every count against the caps.
+ * vertices made it loop for ever, and a reader can crash. So it reads only
+ * in a helper program (import_mesh.c, formats/sandbox.h), which sends the
+ * mesh back; the parent checks every count against the caps.
  */
 #define IMPORT_ADDRESS_SPACE (16ull << 30)
-#define IMPORT_MAGIC 0x534b424d /* "SKBM" */
 
-struct import_header {
-    uint32_t magic;
-    int32_t result;
-    uint32_t vertex_count, triangle_count, material_count, dropped_degenerate;
-    char message[512];
-};
-
-struct import_job {
-    const char *path;
-    const struct sb_mesh_load_params *params;
-};
-
-static int import_child(int fd, void *user)
+int sb_mesh_import_task(int fd, const void *request, size_t size)
 {
-    const struct import_job *job = user;
-    struct import_header h = {.magic = IMPORT_MAGIC};
+    struct sb_import_mesh_request job;
+    if (size != sizeof(job))
+        return 2;
+    memcpy(&job, request, sizeof(job));
+    job.path[sizeof(job.path) - 1] = '\0';
+    struct sb_mesh_albedo_override overrides[SB_WORLD_MAX_OVERRIDES];
+    int override_count = job.override_count >= 0 && job.override_count <= SB_WORLD_MAX_OVERRIDES ? job.override_count : 0;
+    for (int o = 0; o < override_count; o++) {
+        job.overrides[o].material[sizeof(job.overrides[o].material) - 1] = '\0';
+        overrides[o].material = job.overrides[o].material;
+        memcpy(overrides[o].albedo, job.overrides[o].albedo, sizeof(overrides[o].albedo));
+    }
+    struct sb_mesh_load_params params = {
+        .transform = job.transform,
+        .overrides = overrides,
+        .override_count = override_count,
+        .default_albedo = job.default_albedo,
+    };
+    struct sb_import_mesh_answer h = {.magic = SB_IMPORT_MESH_MAGIC};
     sb_sandbox_capture_log(h.message, sizeof(h.message));
     struct sb_mesh mesh = {0};
-    h.result = import(job->path, job->params, &mesh);
+    h.result = import(job.path, &params, &mesh);
     if (!h.result) {
         h.vertex_count = mesh.vertex_count;
         h.triangle_count = mesh.triangle_count;
@@ -467,15 +472,16 @@ static int import_child(int fd, void *user)
         ok = sb_write_all(fd, mesh.material_list, (size_t)mesh.material_count * sizeof(*mesh.material_list)) &&
              sb_write_all(fd, mesh.positions, (size_t)mesh.vertex_count * 3 * sizeof(float)) &&
              sb_write_all(fd, mesh.materials, (size_t)mesh.triangle_count * sizeof(uint32_t));
+    sb_mesh_finish(&mesh);
     return ok ? 0 : 1;
 }
 
-/* Append what the child sent: the materials, then the triangles through
+/* Append what the helper sent: the materials, then the triangles through
  * the checks every triangle meets. */
 static enum sb_result receive(struct sb_sandbox *box, const char *path, struct sb_mesh *mesh)
 {
-    struct import_header h;
-    if (!sb_sandbox_read(box, &h, sizeof(h)) || h.magic != IMPORT_MAGIC) {
+    struct sb_import_mesh_answer h;
+    if (!sb_sandbox_read(box, &h, sizeof(h)) || h.magic != SB_IMPORT_MESH_MAGIC) {
         char why[160];
         sb_sandbox_finish(box, why, sizeof(why));
         sb_error("%s: assimp did not finish reading it: its process %s", path, why);
@@ -512,7 +518,7 @@ static enum sb_result receive(struct sb_sandbox *box, const char *path, struct s
         uint32_t index;
         materials[m].name[sizeof(materials[m].name) - 1] = '\0';
         res = sb_mesh_add_material(mesh, materials[m].name, albedo, &index);
-        if (!res) { /* the child's values, checked again */
+        if (!res) { /* the helper's values, checked again */
             struct sb_mesh_material *to = &mesh->material_list[index];
             to->roughness = isfinite(materials[m].roughness) ? fminf(fmaxf(materials[m].roughness, 0.0f), 1.0f) : 0.5f;
             to->metallic = isfinite(materials[m].metallic) ? fminf(fmaxf(materials[m].metallic, 0.0f), 1.0f) : 0.0f;
@@ -562,11 +568,27 @@ enum sb_result sb_mesh_import(const char *path, const struct sb_mesh_load_params
     struct sb_sandbox_limits limits = {
         .cpu_seconds = seconds,
         .address_space_bytes = IMPORT_ADDRESS_SPACE,
-        .wall_seconds = seconds + 30, /* covers a child that sleeps; a busy one meets its CPU limit first */
+        .wall_seconds = seconds + 30, /* covers a helper that sleeps; a busy one meets its CPU limit first */
     };
-    struct import_job job = {.path = path, .params = params};
+    struct sb_import_mesh_request job = {
+        .transform = params->transform,
+        .default_albedo = params->default_albedo,
+        .override_count = params->override_count,
+    };
+    bool fits = snprintf(job.path, sizeof(job.path), "%s", path) < (int)sizeof(job.path) &&
+                params->override_count >= 0 && params->override_count <= SB_WORLD_MAX_OVERRIDES;
+    for (int o = 0; fits && o < params->override_count; o++) {
+        fits = snprintf(job.overrides[o].material, sizeof(job.overrides[o].material), "%s",
+                        params->overrides[o].material) < (int)sizeof(job.overrides[o].material);
+        memcpy(job.overrides[o].albedo, params->overrides[o].albedo, sizeof(job.overrides[o].albedo));
+    }
+    if (!fits) {
+        sb_error("%s: the path, or the albedo overrides (at most %d, names under 64 bytes), too long to import it",
+                 path, SB_WORLD_MAX_OVERRIDES);
+        return SB_ERR_TOO_LARGE;
+    }
     struct sb_sandbox box;
-    enum sb_result res = sb_sandbox_start(&box, &limits, import_child, &job);
+    enum sb_result res = sb_sandbox_start(&box, &limits, SB_IMPORT_MESH_HELPER, &job, sizeof(job), -1);
     if (res)
         return res;
     res = receive(&box, path, mesh);

@@ -28,9 +28,9 @@
 /* Coordinates beyond this many metres from the origin (after the
  * transform) are refused: fp32 steps there are 1 mm. */
 #define SB_MESH_MAX_EXTENT_M 1.0e4
-/* assimp imports in a child process (it is not hardened against hostile
+/* assimp imports in a helper process (it is not hardened against hostile
  * files: one made it loop for ever here) under this CPU-time limit, 16 GiB
- * of address space beyond the caller's, and a wall-clock deadline 30 s past
+ * of address space beyond the helper's own, and a wall-clock deadline 30 s past
  * the CPU limit (formats/sandbox.h); files the mesh names (an OBJ's mtllib,
  * a glTF's buffers) must be regular files. */
 #define SB_MESH_IMPORT_SECONDS 300

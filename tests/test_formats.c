@@ -3,10 +3,13 @@
 #include <cJSON.h>
 #include <fcntl.h>
 #include <math.h>
+#include <pthread.h>
 #include <signal.h>
+#include <stdatomic.h>
 #include <stdlib.h>
 #include <string.h>
 #include <sys/stat.h>
+#include <sys/wait.h>
 #include <time.h>
 #include <unistd.h>
 #include <xxhash.h>
@@ -1351,9 +1354,12 @@ static double seconds_now(void)
     return ts.tv_sec + ts.tv_nsec * 1e-9;
 }
 
-static int child_answers(int fd, void *user)
+/* ---- the sandbox: this program is its own helper (main) -------------------------------- */
+
+static pthread_mutex_t held_by_the_caller = PTHREAD_MUTEX_INITIALIZER;
+
+static int answer(int fd)
 {
-    (void)user;
     uint32_t answer[2] = {7, 11};
     return write(fd, answer, sizeof(answer)) == (ssize_t)sizeof(answer) ? 0 : 1;
 }
@@ -1370,50 +1376,57 @@ static void hold_pipe_a_while(void)
     _exit(0);
 }
 
-/* Exits at once with status 0 and nothing sent, while a grandchild of its
- * own keeps the pipe's write end open for 10 s: the case where the parent
- * never sees the pipe's end and must notice the exit itself. */
-static int child_leaves_writer(int fd, void *user)
+/* The helper's tasks, by the request's name. */
+static int sandbox_task(int fd, const void *request, size_t size)
 {
-    (void)fd;
-    (void)user;
-    if (fork() == 0)
-        hold_pipe_a_while();
-    return 0;
+    char name[32] = {0};
+    memcpy(name, request, size < sizeof(name) - 1 ? size : sizeof(name) - 1);
+    if (!strcmp(name, "answers"))
+        return answer(fd);
+    if (!strcmp(name, "locks")) {
+        /* a lock the caller's threads take all the time: a fork of the
+         * caller could hold it for ever, a new program never does */
+        pthread_mutex_lock(&held_by_the_caller);
+        pthread_mutex_unlock(&held_by_the_caller);
+        return answer(fd);
+    }
+    if (!strcmp(name, "leaves-writer") || !strcmp(name, "sends-half")) {
+        /* exits at once with nothing (or half) sent, while a grandchild of
+         * its own keeps the pipe's write end open for 10 s: the case where
+         * the parent never sees the pipe's end and must notice the exit */
+        if (fork() == 0)
+            hold_pipe_a_while();
+        uint32_t half = 7;
+        return name[0] == 's' && write(fd, &half, sizeof(half)) != (ssize_t)sizeof(half);
+    }
+    if (!strcmp(name, "spins")) {
+        volatile uint64_t n = 0;
+        while (n != UINT64_MAX)
+            n++;
+    }
+    if (!strcmp(name, "sleeps"))
+        sleep(60);
+    if (!strcmp(name, "crashes"))
+        raise(SIGSEGV);
+    return 3;
 }
 
-static int child_sends_half(int fd, void *user)
+static enum sb_result start_task(struct sb_sandbox *box, const struct sb_sandbox_limits *limits, const char *task)
 {
-    (void)user;
-    uint32_t half = 7;
-    if (fork() == 0)
-        hold_pipe_a_while();
-    return write(fd, &half, sizeof(half)) == (ssize_t)sizeof(half) ? 0 : 1;
+    return sb_sandbox_start(box, limits, "/proc/self/exe", task, strlen(task), -1);
 }
 
-static int child_spins(int fd, void *user)
-{
-    (void)fd;
-    volatile uint64_t *n = user;
-    while (*n != UINT64_MAX)
-        (*n)++;
-    return 0;
-}
+static atomic_bool stop_locking;
 
-static int child_sleeps(int fd, void *user)
+static void *lock_all_the_time(void *unused)
 {
-    (void)fd;
-    (void)user;
-    sleep(60);
-    return 0;
-}
-
-static int child_crashes(int fd, void *user)
-{
-    (void)fd;
-    (void)user;
-    raise(SIGSEGV);
-    return 0;
+    (void)unused;
+    while (!atomic_load(&stop_locking)) {
+        pthread_mutex_lock(&held_by_the_caller);
+        free(malloc(64));
+        pthread_mutex_unlock(&held_by_the_caller);
+    }
+    return NULL;
 }
 
 static void test_sandbox(void)
@@ -1421,50 +1434,85 @@ static void test_sandbox(void)
     struct sb_sandbox box;
     uint32_t got[2] = {0};
     char why[160];
-    CHECK(sb_sandbox_start(&box, NULL, child_answers, NULL) == SB_OK, "start");
+    CHECK(start_task(&box, NULL, "answers") == SB_OK, "start");
     CHECK(sb_sandbox_read(&box, got, sizeof(got)) && got[0] == 7 && got[1] == 11, "the answer arrives");
-    sb_sandbox_finish(&box, why, sizeof(why)); /* with `why`, it waits for the child's own exit */
-    CHECK(box.reaped && WIFEXITED(box.status) && WEXITSTATUS(box.status) == 0, "the child is reaped: %s", why);
+    sb_sandbox_finish(&box, why, sizeof(why)); /* with `why`, it waits for the helper's own exit */
+    CHECK(box.reaped && WIFEXITED(box.status) && WEXITSTATUS(box.status) == 0, "the helper is reaped: %s", why);
 
-    /* The mesh importer's hang in CI: a child that exits with status 0 but
+    /* The static example's hang in CI: a forked child waited for ever on a
+     * lock (AddressSanitizer's allocator's) that a thread of the caller (a
+     * library's thread pool) held at the fork. The helper is a new program:
+     * it answers however busy the caller's threads are with their locks. */
+    pthread_t threads[3];
+    atomic_store(&stop_locking, false);
+    for (int i = 0; i < 3; i++)
+        pthread_create(&threads[i], NULL, lock_all_the_time, NULL);
+    int answered = 0;
+    double t0 = seconds_now();
+    for (int i = 0; i < 40; i++) {
+        struct sb_sandbox_limits limits = {.wall_seconds = 10};
+        if (start_task(&box, &limits, "locks") == SB_OK && sb_sandbox_read(&box, got, sizeof(got)))
+            answered++;
+        sb_sandbox_finish(&box, NULL, 0);
+    }
+    atomic_store(&stop_locking, true);
+    for (int i = 0; i < 3; i++)
+        pthread_join(threads[i], NULL);
+    CHECK(answered == 40, "with the caller's threads taking locks, %d of 40 helpers answered (%.1f s)", answered,
+          seconds_now() - t0);
+
+    /* The mesh importer's hang in CI: a helper that exits with status 0 but
      * sends nothing, the pipe still held open elsewhere. The default
-     * deadline is 60 s; the read must return as soon as the child is gone. */
+     * deadline is 60 s; the read must return as soon as the helper is gone. */
     static const struct {
-        const char *name;
-        sb_sandbox_fn fn;
-        size_t size;
+        const char *task;
         const char *why;
     } gone[] = {
-        {"exits without an answer", child_leaves_writer, sizeof(got), "exited before sending its whole answer"},
-        {"exits half way", child_sends_half, sizeof(got), "exited before sending its whole answer"},
-        {"crashes", child_crashes, sizeof(got), "crashed"},
+        {"leaves-writer", "exited before sending its whole answer"},
+        {"sends-half", "exited before sending its whole answer"},
+        {"crashes", "crashed"},
     };
     for (size_t i = 0; i < sizeof(gone) / sizeof(gone[0]); i++) {
-        double t0 = seconds_now();
-        CHECK(sb_sandbox_start(&box, NULL, gone[i].fn, NULL) == SB_OK, "start");
-        bool read = sb_sandbox_read(&box, got, gone[i].size);
+        t0 = seconds_now();
+        CHECK(start_task(&box, NULL, gone[i].task) == SB_OK, "start");
+        bool read = sb_sandbox_read(&box, got, sizeof(got));
         double took = seconds_now() - t0;
         sb_sandbox_finish(&box, why, sizeof(why));
-        CHECK(!read, "a child that %s: the read fails", gone[i].name);
-        CHECK(took < 5.0, "a child that %s: the parent returns in %.2f s, not at its deadline", gone[i].name, took);
-        CHECK(strstr(why, gone[i].why), "a child that %s: \"%s\"", gone[i].name, why);
+        CHECK(!read, "a helper that %s: the read fails", gone[i].task);
+        CHECK(took < 5.0, "a helper that %s: the parent returns in %.2f s, not at its deadline", gone[i].task, took);
+        CHECK(strstr(why, gone[i].why), "a helper that %s: \"%s\"", gone[i].task, why);
     }
 
-    uint64_t spins = 0;
-    double t0 = seconds_now();
-    CHECK(sb_sandbox_start(&box, &(struct sb_sandbox_limits){.cpu_seconds = 1}, child_spins, &spins) == SB_OK, "start");
-    CHECK(!sb_sandbox_read(&box, got, sizeof(got)), "a child that spins: no answer");
+    t0 = seconds_now();
+    CHECK(start_task(&box, &(struct sb_sandbox_limits){.cpu_seconds = 1}, "spins") == SB_OK, "start");
+    CHECK(!sb_sandbox_read(&box, got, sizeof(got)), "a helper that spins: no answer");
     sb_sandbox_finish(&box, why, sizeof(why));
-    CHECK(strstr(why, "1 s of CPU time") && seconds_now() - t0 < 15, "a child that spins: \"%s\" after %.1f s", why,
+    CHECK(strstr(why, "1 s of CPU time") && seconds_now() - t0 < 15, "a helper that spins: \"%s\" after %.1f s", why,
           seconds_now() - t0);
 
     t0 = seconds_now();
-    CHECK(sb_sandbox_start(&box, &(struct sb_sandbox_limits){.wall_seconds = 1}, child_sleeps, NULL) == SB_OK, "start");
-    CHECK(!sb_sandbox_read(&box, got, sizeof(got)), "a child that sleeps: no answer");
+    CHECK(start_task(&box, &(struct sb_sandbox_limits){.wall_seconds = 1}, "sleeps") == SB_OK, "start");
+    CHECK(!sb_sandbox_read(&box, got, sizeof(got)), "a helper that sleeps: no answer");
     sb_sandbox_finish(&box, why, sizeof(why));
-    CHECK(strstr(why, "within 1 s") && seconds_now() - t0 < 5, "a child that sleeps: \"%s\" after %.1f s", why,
+    CHECK(strstr(why, "within 1 s") && seconds_now() - t0 < 5, "a helper that sleeps: \"%s\" after %.1f s", why,
           seconds_now() - t0);
     sb_sandbox_finish(&box, why, sizeof(why)); /* twice is harmless */
+
+    /* A helper that is not there, or of another build, is an error naming it. */
+    CHECK(sb_sandbox_start(&box, NULL, "/nonexistent/skybake-helper", "answers", 7, -1) == SB_ERR_IO,
+          "a missing helper is refused");
+    int status = -1;
+    pid_t pid = fork();
+    if (pid == 0) {
+        int null = open("/dev/null", O_WRONLY);
+        dup2(null, 2);
+        char *argv[] = {"/proc/self/exe", "skybake-sandbox-1/0.0", "1", "1", NULL};
+        execv(argv[0], argv);
+        _exit(127);
+    }
+    waitpid(pid, &status, 0);
+    CHECK(WIFEXITED(status) && WEXITSTATUS(status) == 2, "a helper started by another build refuses (status %d)",
+          status);
 }
 
 /* Every reader of a named file refuses a FIFO (which blocks an ordinary
@@ -1508,8 +1556,10 @@ static void test_fifos(void)
     rmdir(dir);
 }
 
-int main(void)
+int main(int argc, char **argv)
 {
+    if (argc > 1) /* started by test_sandbox as its helper */
+        return sb_sandbox_main(argc, argv, sandbox_task);
     if (!getenv("SKYBAKE_TEST_VERBOSE"))
         sb_log_set_sink(quiet, NULL);
     test_result_codes();

@@ -30,8 +30,14 @@ printf '{"atmosphere":{"preset":"earth"},"products":["transmittance","cloud_deta
 check "bake a pack" expect_exit 0 "$skybake" bake "$tmp/t.json" -o "$tmp/pack" -q
 hash=$(sed -n 's/.*"content_hash":[[:space:]]*"\([0-9a-f]*\)".*/\1/p' "$tmp/pack/manifest.json" | head -n 1)
 volume_hash=$(sed -n 's/.*"content_hash":[[:space:]]*"\([0-9a-f]*\)".*/\1/p' "$tmp/pack/manifest.json" | tail -n 1)
+# The static example lies outside the build tree, with nothing beside it:
+# it finds the VDB helper only where SKYBAKE_LIBEXEC_DIR says (the shared
+# one finds it beside the library), and says so when it cannot.
+check "the static example without the helper fails" expect_exit 1 "$tmp/example_static" "$tmp/pack"
+check "naming the helper and SKYBAKE_LIBEXEC_DIR" grep -q "cannot find the helper program skybake-read-vdb.*SKYBAKE_LIBEXEC_DIR" "$tmp/err"
 for kind in shared static; do
-    check "the $kind example loads the pack" expect_exit 0 env LD_LIBRARY_PATH="$build/formats" "$tmp/example_$kind" "$tmp/pack"
+    check "the $kind example loads the pack" expect_exit 0 env LD_LIBRARY_PATH="$build/formats" \
+        SKYBAKE_LIBEXEC_DIR="$([ $kind = static ] && echo "$build/formats")" "$tmp/example_$kind" "$tmp/pack"
     check "the $kind example reads the transmittance" grep -q "^transmittance 256x64x1 x3 first value 0\.[0-9]* hash $hash" "$tmp/out"
     check "the $kind example reads the volume (OpenVDB)" grep -q "^cloud_detail 16x16x16 x3 first value 0\.[0-9]* hash $volume_hash" "$tmp/out"
 done
