@@ -1,18 +1,17 @@
 #include "embree_ref.h"
 
 #include <pthread.h>
+#include <stdlib.h>
 #include <string.h>
 #include <unistd.h>
 
 #include "bench.h"
 #include "log.h"
 
-/* A scene of the mesh, built at `quality`; its build's wall time in *ms. */
-static bool create(const struct sb_mesh *mesh, enum RTCBuildQuality quality, struct sb_embree *e, double *ms)
+/* A scene of the mesh on e->device, built at `quality`; its build's wall
+ * time in *ms. */
+static bool create_scene(const struct sb_mesh *mesh, enum RTCBuildQuality quality, struct sb_embree *e, double *ms)
 {
-    e->device = rtcNewDevice(NULL);
-    if (!e->device)
-        return false;
     e->scene = rtcNewScene(e->device);
     rtcSetSceneFlags(e->scene, RTC_SCENE_FLAG_ROBUST);
     rtcSetSceneBuildQuality(e->scene, quality);
@@ -33,6 +32,14 @@ static bool create(const struct sb_mesh *mesh, enum RTCBuildQuality quality, str
     return true;
 }
 
+/* A device and a scene of the mesh. */
+static bool create(const struct sb_mesh *mesh, enum RTCBuildQuality quality, struct sb_embree *e, double *ms)
+{
+    memset(e, 0, sizeof(*e));
+    e->device = rtcNewDevice(NULL);
+    return e->device && create_scene(mesh, quality, e, ms);
+}
+
 bool sb_embree_create(const struct sb_mesh *mesh, struct sb_embree *e)
 {
     double ms;
@@ -48,8 +55,54 @@ double sb_embree_build_ms(const struct sb_mesh *mesh, enum RTCBuildQuality quali
     return ms;
 }
 
+bool sb_embree_create_instanced(const struct sb_mesh *const *meshes, uint32_t mesh_count,
+                                const struct sb_bvh_instance *instances, uint32_t instance_count, struct sb_embree *e)
+{
+    memset(e, 0, sizeof(*e));
+    e->device = rtcNewDevice(NULL);
+    e->triangle_base = malloc(instance_count * sizeof(*e->triangle_base));
+    uint32_t *mesh_base = malloc((mesh_count + 1) * sizeof(*mesh_base));
+    RTCScene *scenes = calloc(mesh_count, sizeof(*scenes));
+    bool ok = e->device && e->triangle_base && mesh_base && scenes;
+    for (uint32_t m = 0; ok && m < mesh_count; m++) {
+        mesh_base[m + 1] = (m ? mesh_base[m] : 0) + meshes[m]->triangle_count;
+        double ms;
+        struct sb_embree one = {.device = e->device};
+        ok = create_scene(meshes[m], RTC_BUILD_QUALITY_MEDIUM, &one, &ms);
+        scenes[m] = one.scene;
+    }
+    if (ok) {
+        mesh_base[0] = 0;
+        e->scene = rtcNewScene(e->device);
+        rtcSetSceneFlags(e->scene, RTC_SCENE_FLAG_ROBUST);
+        for (uint32_t i = 0; i < instance_count; i++) {
+            RTCGeometry g = rtcNewGeometry(e->device, RTC_GEOMETRY_TYPE_INSTANCE);
+            rtcSetGeometryInstancedScene(g, scenes[instances[i].mesh]);
+            float m[12];
+            for (int r = 0; r < 3; r++)
+                for (int c = 0; c < 4; c++)
+                    m[4 * r + c] = (float)instances[i].to_world[r][c];
+            rtcSetGeometryTransform(g, 0, RTC_FORMAT_FLOAT3X4_ROW_MAJOR, m);
+            rtcCommitGeometry(g);
+            rtcAttachGeometryByID(e->scene, g, i);
+            rtcReleaseGeometry(g);
+            e->triangle_base[i] = mesh_base[instances[i].mesh];
+        }
+        rtcCommitScene(e->scene);
+    }
+    for (uint32_t m = 0; scenes && m < mesh_count; m++)
+        if (scenes[m])
+            rtcReleaseScene(scenes[m]); /* the instances hold them */
+    free(scenes);
+    free(mesh_base);
+    if (!ok && e->device)
+        sb_embree_destroy(e);
+    return ok;
+}
+
 void sb_embree_destroy(struct sb_embree *e)
 {
+    free(e->triangle_base);
     rtcReleaseScene(e->scene);
     rtcReleaseDevice(e->device);
 }
@@ -81,11 +134,17 @@ static void *sb_embree_worker(void *arg)
         rh.hit.geomID = RTC_INVALID_GEOMETRY_ID;
         rtcIntersect1(job->e->scene, &ctx, &rh);
         float *h = &job->hits[4 * (size_t)i];
-        uint32_t tri = rh.hit.geomID == RTC_INVALID_GEOMETRY_ID ? SB_BVH_MISS : rh.hit.primID;
+        bool missed = rh.hit.geomID == RTC_INVALID_GEOMETRY_ID;
+        uint32_t instance = rh.hit.instID[0];
+        uint32_t tri = missed                                   ? SB_BVH_MISS
+                       : instance == RTC_INVALID_GEOMETRY_ID ? rh.hit.primID
+                                                               : job->e->triangle_base[instance] + rh.hit.primID;
+        if (missed || instance == RTC_INVALID_GEOMETRY_ID)
+            instance = SB_BVH_NO_INSTANCE;
         h[0] = rh.ray.tfar;
         memcpy(&h[1], &tri, sizeof(tri));
-        h[2] = rh.hit.u;
-        h[3] = rh.hit.v;
+        memcpy(&h[2], &instance, sizeof(instance));
+        h[3] = 0.0f;
     }
     return NULL;
 }

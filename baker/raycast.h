@@ -31,7 +31,8 @@ void sb_raycaster_destroy(struct sb_raycaster **raycaster);
  * Cast `count` rays: rays[8 i ..] = origin (m), tmin, direction (any
  * length; t is in its units), tmax. hits[4 i ..] = t, the triangle's bits
  * (SB_BVH_MISS, or the mesh's triangle index | SB_BVH_BACK_FACE on a back
- * face, as a uint32_t), u, v. `any`: stop at the first hit found. *gpu_ms
+ * face, as a uint32_t), the instance's index (SB_BVH_NO_INSTANCE in a
+ * one-level BVH, as a uint32_t), 0. `any`: stop at the first hit found. *gpu_ms
  * (may be NULL) gets the kernels' GPU time.
  */
 enum sb_result sb_raycaster_cast(struct sb_raycaster *raycaster, const float *rays, uint32_t count, bool any,

@@ -234,7 +234,7 @@ static void range_bounds(const struct prim *prims, uint32_t begin, uint32_t end,
  * (one thread): false when it stays a leaf.
  */
 static bool split_serial(struct prim *prims, uint32_t *index, struct prim *scratch, uint32_t *scratch_index,
-                         const struct range *r, struct range *left, struct range *right)
+                         const struct range *r, uint32_t max_leaf, struct range *left, struct range *right)
 {
     uint32_t count = r->end - r->begin;
     if (count <= 1 || r->depth >= SB_BVH_MAX_DEPTH)
@@ -243,7 +243,7 @@ static bool split_serial(struct prim *prims, uint32_t *index, struct prim *scrat
     struct bins b;
     bins_fill(&b, &m, prims, r->begin, r->end);
     struct split s;
-    bool must = count > SB_BVH_MAX_LEAF;
+    bool must = count > max_leaf;
     uint32_t mid;
     if (best_split(&b, &m, count, box_area(&r->box), must, &s)) {
         /* stable: the left ones aside in scratch (the range's own part of
@@ -320,7 +320,7 @@ static void build_task(struct prim *prims, uint32_t *index, struct prim *scratch
         struct range r = stack[--top], left, right;
         if (r.depth > t->depth)
             t->depth = r.depth;
-        if (!split_serial(prims, index, scratch, scratch_index, &r, &left, &right)) {
+        if (!split_serial(prims, index, scratch, scratch_index, &r, SB_BVH_MAX_LEAF, &left, &right)) {
             set_node(&t->nodes[r.node], &r.box, r.begin, r.end - r.begin);
             if (r.end - r.begin > t->max_leaf)
                 t->max_leaf = r.end - r.begin;
@@ -633,7 +633,7 @@ static enum sb_result add_split(struct builder *b, const struct range *r, struct
 static void split_one(void *user, int i)
 {
     struct builder *b = user;
-    b->split_out[i].split = split_serial(b->prims, b->index, b->scratch, b->scratch_index, &b->frontier[i],
+    b->split_out[i].split = split_serial(b->prims, b->index, b->scratch, b->scratch_index, &b->frontier[i], SB_BVH_MAX_LEAF,
                                          &b->split_out[i].left, &b->split_out[i].right);
 }
 
@@ -837,6 +837,213 @@ done:
     return res;
 }
 
+/* ---- two levels: a BVH a mesh, a top level over the instances ------------------------------ */
+
+/* The inverse of an affine 3 x 4 (rows); false when not finite or singular. */
+static bool invert_affine(const double m[3][4], double out[3][4])
+{
+    double det = m[0][0] * (m[1][1] * m[2][2] - m[1][2] * m[2][1]) -
+                 m[0][1] * (m[1][0] * m[2][2] - m[1][2] * m[2][0]) +
+                 m[0][2] * (m[1][0] * m[2][1] - m[1][1] * m[2][0]);
+    double scale = 0.0;
+    for (int r = 0; r < 3; r++)
+        for (int c = 0; c < 4; c++) {
+            if (!isfinite(m[r][c]))
+                return false;
+            if (c < 3)
+                scale = fmax(scale, fabs(m[r][c]));
+        }
+    if (!isfinite(det) || fabs(det) <= 1e-12 * scale * scale * scale)
+        return false;
+    double inv[3][3];
+    for (int r = 0; r < 3; r++)
+        for (int c = 0; c < 3; c++) {
+            int r1 = (c + 1) % 3, r2 = (c + 2) % 3, c1 = (r + 1) % 3, c2 = (r + 2) % 3;
+            inv[r][c] = (m[r1][c1] * m[r2][c2] - m[r1][c2] * m[r2][c1]) / det;
+        }
+    for (int r = 0; r < 3; r++) {
+        for (int c = 0; c < 3; c++)
+            out[r][c] = inv[r][c];
+        out[r][3] = -(inv[r][0] * m[0][3] + inv[r][1] * m[1][3] + inv[r][2] * m[2][3]);
+    }
+    return true;
+}
+
+/* The world box of a mesh's root box placed by `to_world`, padded as a
+ * triangle's (make_prims). */
+static void instance_box(const struct sb_bvh_node *root, const double to_world[3][4], struct box *box)
+{
+    box_empty(box);
+    for (int corner = 0; corner < 8; corner++) {
+        double p[3] = {corner & 1 ? root->max[0] : root->min[0], corner & 2 ? root->max[1] : root->min[1],
+                       corner & 4 ? root->max[2] : root->min[2]};
+        float w[4] = {0};
+        for (int r = 0; r < 3; r++)
+            w[r] = (float)(to_world[r][0] * p[0] + to_world[r][1] * p[1] + to_world[r][2] * p[2] + to_world[r][3]);
+        box_grow_point(box, w);
+    }
+    for (int i = 0; i < 3; i++) {
+        float pad = 1e-6f * (max_f(fabsf(box->min[i]), fabsf(box->max[i])) + (box->max[i] - box->min[i]));
+        box->min[i] -= pad;
+        box->max[i] += pad;
+    }
+}
+
+/* The top level over `n` instance boxes (serial: the meshes' builds take
+ * the threads): one instance a leaf (first: its index, for now), split by
+ * SAH, or halved in order where SAH finds nothing or the depth left would
+ * not hold the rest halved. */
+static uint32_t build_instance_top(struct prim *prims, uint32_t *index, struct prim *scratch, uint32_t *scratch_index,
+                                   uint32_t n, struct sb_bvh_node *nodes, uint32_t *depth)
+{
+    struct range stack[(SB_BVH_MAX_DEPTH + 2) * 2];
+    int top = 0;
+    stack[top].begin = 0;
+    stack[top].end = n;
+    stack[top].depth = 0;
+    stack[top].node = 0;
+    range_bounds(prims, 0, n, &stack[top].box, &stack[top].centroids);
+    top++;
+    uint32_t node_count = 1;
+    *depth = 0;
+    while (top) {
+        struct range r = stack[--top], left, right;
+        uint32_t count = r.end - r.begin;
+        *depth = r.depth > *depth ? r.depth : *depth;
+        if (count == 1) {
+            set_node(&nodes[r.node], &r.box, index[r.begin], SB_BVH_INSTANCE_LEAF);
+            continue;
+        }
+        uint32_t levels = 0; /* to halve `count` down to ones */
+        while ((1u << levels) < count)
+            levels++;
+        if (r.depth + levels >= SB_BVH_MAX_DEPTH ||
+            !split_serial(prims, index, scratch, scratch_index, &r, 1, &left, &right)) {
+            uint32_t mid = r.begin + count / 2;
+            left = right = r;
+            left.end = right.begin = mid;
+            range_bounds(prims, left.begin, left.end, &left.box, &left.centroids);
+            range_bounds(prims, right.begin, right.end, &right.box, &right.centroids);
+            left.depth = right.depth = r.depth + 1;
+        }
+        left.node = node_count;
+        right.node = node_count + 1;
+        node_count += 2;
+        set_node(&nodes[r.node], &r.box, left.node, 0);
+        stack[top++] = right;
+        stack[top++] = left;
+    }
+    return node_count;
+}
+
+enum sb_result sb_bvh_build_instanced(const struct sb_mesh *const *meshes, uint32_t mesh_count,
+                                      const struct sb_bvh_instance *instances, uint32_t instance_count,
+                                      struct sb_bvh *bvh)
+{
+    memset(bvh, 0, sizeof(*bvh));
+    if (!instance_count || instance_count > SB_BVH_MISS / 4) {
+        sb_error("BVH: %u instances (1 to %u)", instance_count, SB_BVH_MISS / 4);
+        return instance_count ? SB_ERR_TOO_LARGE : SB_ERR_MESH;
+    }
+    for (uint32_t i = 0; i < instance_count; i++) {
+        double inverse[3][4];
+        if (instances[i].mesh >= mesh_count || !invert_affine(instances[i].to_world, inverse)) {
+            sb_error("BVH: instance %u: %s", i,
+                     instances[i].mesh >= mesh_count ? "of no mesh" : "its transform is not finite and invertible");
+            return SB_ERR_MESH;
+        }
+    }
+    struct sb_bvh *blas = calloc(mesh_count, sizeof(*blas));
+    uint32_t *node_base = calloc(mesh_count, sizeof(*node_base));
+    struct prim *prims = malloc(2 * (size_t)instance_count * sizeof(*prims));
+    uint32_t *index = malloc(2 * (size_t)instance_count * sizeof(*index));
+    struct sb_bvh_node *top = malloc(2 * (size_t)instance_count * sizeof(*top));
+    enum sb_result res = blas && node_base && prims && index && top ? SB_OK : SB_ERR_NOMEM;
+    uint64_t triangles = 0, nodes = 0, materials = 0;
+    for (uint32_t m = 0; m < mesh_count && !res; m++) {
+        res = sb_bvh_build(meshes[m], &blas[m]);
+        triangles += blas[m].triangle_count;
+        nodes += blas[m].node_count;
+        materials += meshes[m]->material_count;
+    }
+    uint32_t top_count = 0, top_depth = 0;
+    if (!res) {
+        for (uint32_t i = 0; i < instance_count; i++) {
+            instance_box(&blas[instances[i].mesh].nodes[0], instances[i].to_world, &prims[i].box);
+            index[i] = i;
+        }
+        top_count = build_instance_top(prims, index, prims + instance_count, index + instance_count, instance_count,
+                                       top, &top_depth);
+        nodes += top_count + 2 * (uint64_t)instance_count;
+        if (triangles >= SB_BVH_BACK_FACE || nodes >= SB_BVH_BACK_FACE || materials >= SB_BVH_BACK_FACE) {
+            sb_error("BVH: %llu triangles, %llu nodes: past 2^31", (unsigned long long)triangles,
+                     (unsigned long long)nodes);
+            res = SB_ERR_TOO_LARGE;
+        }
+    }
+    if (!res) {
+        bvh->nodes = malloc(nodes * sizeof(*bvh->nodes));
+        bvh->triangles = malloc(triangles * sizeof(*bvh->triangles));
+        if (!bvh->nodes || !bvh->triangles)
+            res = SB_ERR_NOMEM;
+    }
+    if (!res) {
+        bvh->node_count = (uint32_t)nodes;
+        bvh->triangle_count = (uint32_t)triangles;
+        bvh->instance_count = instance_count;
+        /* the top level, its leaves pointing at the records */
+        for (uint32_t k = 0; k < top_count; k++) {
+            bvh->nodes[k] = top[k];
+            if (top[k].count == SB_BVH_INSTANCE_LEAF)
+                bvh->nodes[k].first = top_count + 2 * top[k].first;
+        }
+        /* each mesh's nodes and triangles, offset */
+        uint32_t next_node = top_count + 2 * instance_count, next_triangle = 0, next_material = 0;
+        for (uint32_t m = 0; m < mesh_count; m++) {
+            node_base[m] = next_node;
+            for (uint32_t k = 0; k < blas[m].node_count; k++) {
+                struct sb_bvh_node n = blas[m].nodes[k];
+                n.first += n.count ? next_triangle : next_node;
+                bvh->nodes[next_node + k] = n;
+            }
+            for (uint32_t k = 0; k < blas[m].triangle_count; k++) {
+                struct sb_bvh_triangle t = blas[m].triangles[k];
+                t.triangle += next_triangle;
+                t.material += next_material;
+                bvh->triangles[next_triangle + k] = t;
+            }
+            next_node += blas[m].node_count;
+            next_triangle += blas[m].triangle_count;
+            next_material += meshes[m]->material_count;
+            bvh->depth = blas[m].depth > bvh->depth ? blas[m].depth : bvh->depth;
+            bvh->max_leaf = blas[m].max_leaf > bvh->max_leaf ? blas[m].max_leaf : bvh->max_leaf;
+        }
+        bvh->depth += top_depth + 1;
+        /* the records */
+        for (uint32_t i = 0; i < instance_count; i++) {
+            double inverse[3][4];
+            invert_affine(instances[i].to_world, inverse);
+            struct sb_bvh_instance_record rec = {.root = node_base[instances[i].mesh], .instance = i};
+            for (int r = 0; r < 3; r++)
+                for (int c = 0; c < 4; c++)
+                    rec.to_object[r][c] = (float)inverse[r][c];
+            memcpy(&bvh->nodes[top_count + 2 * i], &rec, sizeof(rec));
+        }
+    }
+    for (uint32_t m = 0; blas && m < mesh_count; m++)
+        sb_bvh_finish(&blas[m]);
+    free(blas);
+    free(node_base);
+    free(prims);
+    free(index);
+    free(top);
+    if (res)
+        sb_bvh_finish(bvh);
+    return res;
+}
+
+_Static_assert(sizeof(struct sb_bvh_instance_record) == 2 * sizeof(struct sb_bvh_node), "a record is two nodes");
+
 void sb_bvh_finish(struct sb_bvh *bvh)
 {
     free(bvh->nodes);
@@ -912,14 +1119,27 @@ static bool hit_box(const struct sb_bvh_node *n, const float o[3], const float i
     return t0 <= t1;
 }
 
-bool sb_bvh_intersect(const struct sb_bvh *bvh, const float o[3], const float d[3], float tmin, float tmax, bool any,
-                      struct sb_hit *hit)
+static void inverse_direction(const float d[3], float inv_d[3])
 {
-    float inv_d[3];
     for (int i = 0; i < 3; i++) /* a zero component: a huge but finite slope keeps the slabs NaN-free */
         inv_d[i] = 1.0f / (fabsf(d[i]) > 1e-30f ? d[i] : copysignf(1e-30f, d[i]));
+}
+
+/* The stack entry that ends an instance's subtree: back to the world's ray. */
+#define LEAVE_INSTANCE SB_BVH_MISS
+
+bool sb_bvh_intersect(const struct sb_bvh *bvh, const float world_o[3], const float world_d[3], float tmin, float tmax,
+                      bool any, struct sb_hit *hit)
+{
+    float o[3], d[3], inv_d[3];
+    memcpy(o, world_o, sizeof(o));
+    memcpy(d, world_d, sizeof(d));
+    inverse_direction(d, inv_d);
     hit->triangle = SB_BVH_MISS;
-    uint32_t stack[SB_BVH_MAX_DEPTH + 1];
+    hit->instance = SB_BVH_NO_INSTANCE;
+    uint32_t instance = SB_BVH_NO_INSTANCE;
+    /* the top level's path, the instance's end, the mesh's path */
+    uint32_t stack[2 * SB_BVH_MAX_DEPTH + 3];
     int top = 0;
     uint32_t node = 0;
     float t_enter;
@@ -927,12 +1147,28 @@ bool sb_bvh_intersect(const struct sb_bvh *bvh, const float o[3], const float d[
         return false;
     for (;;) {
         const struct sb_bvh_node *n = &bvh->nodes[node];
+        if (n->count == SB_BVH_INSTANCE_LEAF) {
+            /* Into the mesh's space: an affine map keeps t. */
+            struct sb_bvh_instance_record rec;
+            memcpy(&rec, &bvh->nodes[n->first], sizeof(rec));
+            for (int r = 0; r < 3; r++) {
+                const float *m = rec.to_object[r];
+                o[r] = m[0] * world_o[0] + m[1] * world_o[1] + m[2] * world_o[2] + m[3];
+                d[r] = m[0] * world_d[0] + m[1] * world_d[1] + m[2] * world_d[2];
+            }
+            inverse_direction(d, inv_d);
+            instance = rec.instance;
+            stack[top++] = LEAVE_INSTANCE;
+            node = rec.root;
+            continue;
+        }
         if (n->count) {
             for (uint32_t i = n->first; i < n->first + n->count; i++) {
                 struct sb_hit h;
                 if (hit_triangle(&bvh->triangles[i], o, d, tmin, tmax, &h)) {
                     tmax = h.t;
                     h.triangle = bvh->triangles[i].triangle;
+                    h.instance = instance;
                     *hit = h;
                     if (any)
                         return true;
@@ -953,9 +1189,16 @@ bool sb_bvh_intersect(const struct sb_bvh *bvh, const float o[3], const float d[
                 continue;
             }
         }
-        if (!top)
-            break;
-        node = stack[--top];
+        for (;;) {
+            if (!top)
+                return hit->triangle != SB_BVH_MISS;
+            node = stack[--top];
+            if (node != LEAVE_INSTANCE)
+                break;
+            memcpy(o, world_o, sizeof(o));
+            memcpy(d, world_d, sizeof(d));
+            inverse_direction(d, inv_d);
+            instance = SB_BVH_NO_INSTANCE;
+        }
     }
-    return hit->triangle != SB_BVH_MISS;
 }

@@ -264,10 +264,16 @@ struct sb_noise_push {
 #define SB_BVH_MAX_DEPTH 40
 #define SB_BVH_MISS 0xffffffffu
 #define SB_BVH_BACK_FACE 0x80000000u /* set in a hit's triangle when the ray met its back */
+/* Two levels (a world of instances): a top-level leaf whose count is
+ * SB_BVH_INSTANCE_LEAF holds one instance, its record at node `first`: two
+ * nodes, the world-to-object rows (three vec4s), then its mesh's root node,
+ * the instance's index and two zeros (as uints). */
+#define SB_BVH_INSTANCE_LEAF 0x80000000u
+#define SB_BVH_NO_INSTANCE 0xffffffffu
 #define SB_RAYCAST_BINDING_NODES 0
 #define SB_RAYCAST_BINDING_TRIANGLES 1
 #define SB_RAYCAST_BINDING_RAYS 2 /* two vec4s a ray: origin, tmin; direction, tmax */
-#define SB_RAYCAST_BINDING_HITS 3 /* one vec4 a ray: t, triangle | SB_BVH_BACK_FACE (bits), u, v */
+#define SB_RAYCAST_BINDING_HITS 3 /* one vec4 a ray: t, triangle | SB_BVH_BACK_FACE, instance (bits), 0 */
 #define SB_RAYCAST_BINDING_COUNT 4
 #define SB_RAYCAST_WORKGROUP 64
 

@@ -39,7 +39,7 @@ vec3 sky(float h, vec3 d)
 vec3 surface(vec3 origin, vec3 d, BvhHit hit)
 {
     vec4 e1 = bvh_triangles[3 * hit.slot + 1], e2 = bvh_triangles[3 * hit.slot + 2];
-    vec3 n = normalize(cross(e1.xyz, e2.xyz));
+    vec3 n = normalize(bvh_world_normal(cross(e1.xyz, e2.xyz), hit.instance));
     if (dot(n, d) > 0.0)
         n = -n; // the side the probe sees
     vec3 rho = albedo[floatBitsToUint(e1.w)].rgb;

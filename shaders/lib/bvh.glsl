@@ -5,12 +5,16 @@
 //   bvh_nodes[]: two vec4s a node (min, first; max, count),
 //   bvh_triangles[]: three vec4s a triangle (v0, triangle; e1, material; e2, -),
 // and then includes this file. With BVH_ANY_HIT_MATERIAL_0_PASSES defined,
-// an any-hit trace goes through the triangles of material 0.
+// an any-hit trace goes through the triangles of material 0. A BVH of two
+// levels (instances, geometry/bvh.h) is traced by the same loop: at an
+// instance's leaf the ray goes into the mesh's space (an affine map keeps
+// t), and a marker on the stack brings it back.
 
 struct BvhHit {
     float t;
     uint triangle; // SB_BVH_MISS when none; | SB_BVH_BACK_FACE on a back face
     vec2 uv;
+    uint instance; // the instance's record (a node index), SB_BVH_NO_INSTANCE when none
 #ifdef BVH_HIT_SLOT
     uint slot; // the triangle's place in bvh_triangles[] (kernels that define BVH_HIT_SLOT)
 #endif
@@ -59,20 +63,40 @@ bool bvh_hit_triangle(uint i, vec3 o, vec3 d, float tmin, float tmax, bool any_h
     return true;
 }
 
+vec3 bvh_inverse_direction(vec3 d)
+{
+    // a zero component: a huge but finite slope keeps the slabs NaN-free
+    vec3 tiny = vec3(lessThan(d, vec3(0.0))) * -2e-30 + 1e-30;
+    return 1.0 / mix(d, tiny, lessThanEqual(abs(d), vec3(1e-30)));
+}
+
+// The geometric normal of a triangle in world space (unnormalised; its
+// sense the triangle's winding): object space through the instance's
+// world-to-object rows, transposed.
+vec3 bvh_world_normal(vec3 n, uint instance)
+{
+    if (instance == SB_BVH_NO_INSTANCE)
+        return n;
+    return n.x * bvh_nodes[2 * instance].xyz + n.y * bvh_nodes[2 * instance + 1].xyz +
+           n.z * bvh_nodes[2 * instance + 2].xyz;
+}
+
 // The closest hit in (tmin, tmax), or any when `any_hit`.
-BvhHit bvh_trace(vec3 o, vec3 d, float tmin, float tmax, bool any_hit)
+BvhHit bvh_trace(vec3 world_o, vec3 world_d, float tmin, float tmax, bool any_hit)
 {
     BvhHit hit;
     hit.t = tmax;
     hit.triangle = SB_BVH_MISS;
     hit.uv = vec2(0.0);
+    hit.instance = SB_BVH_NO_INSTANCE;
 #ifdef BVH_HIT_SLOT
     hit.slot = 0u;
 #endif
-    // a zero component: a huge but finite slope keeps the slabs NaN-free
-    vec3 tiny = vec3(lessThan(d, vec3(0.0))) * -2e-30 + 1e-30;
-    vec3 inv_d = 1.0 / mix(d, tiny, lessThanEqual(abs(d), vec3(1e-30)));
-    uint stack[SB_BVH_MAX_DEPTH + 1];
+    vec3 o = world_o, d = world_d;
+    vec3 inv_d = bvh_inverse_direction(d);
+    uint instance = SB_BVH_NO_INSTANCE;
+    // the top level's path, the instance's end (SB_BVH_MISS), the mesh's path
+    uint stack[2 * SB_BVH_MAX_DEPTH + 3];
     int top = 0;
     uint node = 0u;
     float ta, tb;
@@ -81,10 +105,23 @@ BvhHit bvh_trace(vec3 o, vec3 d, float tmin, float tmax, bool any_hit)
     for (;;) {
         uint first = floatBitsToUint(bvh_nodes[2 * node].w);
         uint count = floatBitsToUint(bvh_nodes[2 * node + 1].w);
+        if (count == SB_BVH_INSTANCE_LEAF) {
+            vec4 r0 = bvh_nodes[2 * first], r1 = bvh_nodes[2 * first + 1], r2 = bvh_nodes[2 * first + 2];
+            o = vec3(dot(r0.xyz, world_o), dot(r1.xyz, world_o), dot(r2.xyz, world_o)) + vec3(r0.w, r1.w, r2.w);
+            d = vec3(dot(r0.xyz, world_d), dot(r1.xyz, world_d), dot(r2.xyz, world_d));
+            inv_d = bvh_inverse_direction(d);
+            instance = first;
+            stack[top++] = SB_BVH_MISS;
+            node = floatBitsToUint(bvh_nodes[2 * first + 3].x);
+            continue;
+        }
         if (count != 0u) {
             for (uint i = first; i < first + count; i++) {
-                if (bvh_hit_triangle(i, o, d, tmin, hit.t, any_hit, hit) && any_hit)
-                    return hit;
+                if (bvh_hit_triangle(i, o, d, tmin, hit.t, any_hit, hit)) {
+                    hit.instance = instance;
+                    if (any_hit)
+                        return hit;
+                }
             }
         } else {
             bool a = bvh_hit_box(first, o, inv_d, tmin, hit.t, ta);
@@ -100,9 +137,17 @@ BvhHit bvh_trace(vec3 o, vec3 d, float tmin, float tmax, bool any_hit)
                 continue;
             }
         }
-        if (top == 0)
-            break;
-        node = stack[--top];
+        for (;;) {
+            if (top == 0)
+                return hit;
+            node = stack[--top];
+            if (node != SB_BVH_MISS)
+                break;
+            o = world_o;
+            d = world_d;
+            inv_d = bvh_inverse_direction(d);
+            instance = SB_BVH_NO_INSTANCE;
+        }
     }
     return hit;
 }
