@@ -108,16 +108,23 @@ enum sb_result sb_mesh_add_triangle(struct sb_mesh *mesh, const double a[3], con
         return SB_ERR_TOO_LARGE;
     }
     enum sb_result res;
+    size_t triangles_before = mesh->capacity_triangles;
     if ((res = grow((void **)&mesh->positions, &mesh->capacity_vertices, (size_t)mesh->vertex_count + 3,
                     3 * sizeof(float))) ||
         (res = grow((void **)&mesh->indices, &mesh->capacity_triangles, (size_t)mesh->triangle_count + 1,
                     3 * sizeof(uint32_t))))
         return res;
-    /* materials[] shares the triangles' capacity */
-    uint32_t *materials = realloc(mesh->materials, mesh->capacity_triangles * sizeof(uint32_t));
-    if (!materials)
-        return SB_ERR_NOMEM;
-    mesh->materials = materials;
+    /* materials[] shares the triangles' capacity: grown with it, not at
+     * every triangle (a realloc to the same size copies the whole array
+     * under AddressSanitizer, which made loading quadratic there) */
+    if (mesh->capacity_triangles != triangles_before || !mesh->materials) {
+        uint32_t *materials = realloc(mesh->materials, mesh->capacity_triangles * sizeof(uint32_t));
+        if (!materials) {
+            mesh->capacity_triangles = triangles_before; /* grown again, both, next time */
+            return SB_ERR_NOMEM;
+        }
+        mesh->materials = materials;
+    }
     for (int k = 0; k < 3; k++) {
         memcpy(&mesh->positions[3 * (size_t)(mesh->vertex_count + k)], f[k], sizeof(f[k]));
         mesh->indices[3 * (size_t)mesh->triangle_count + k] = mesh->vertex_count + k;
