@@ -118,8 +118,9 @@ static enum sb_result capture(struct sb_vk *vk, const struct sb_atmosphere_param
     cp.sun[0] = cos(el) * sin(az);
     cp.sun[1] = sin(el);
     cp.sun[2] = -cos(el) * cos(az);
-    struct sb_capture_inputs sky = {.atmosphere = atm, .mesh = &mesh},
-                             world = {.atmosphere = atm, .rc = rc, .mesh = &mesh};
+    struct sb_capture_inputs sky = {.atmosphere = atm},
+                             world = {.atmosphere = atm, .rc = rc, .materials = mesh.material_list,
+                                      .material_count = mesh.material_count};
     if (!res && !(res = sb_reflection_capture(vk, &sky, &cp, level0, NULL))) {
         sb_reflection_sh(level0, n, 0, cp.sky_sh);
         res = sb_reflection_capture(vk, &world, &cp, level0, ms);

@@ -20,6 +20,7 @@
 #include "json.h"
 #include "load.h"
 #include "log.h"
+#include "level.h"
 #include "mesh.h"
 #include "parallel.h"
 #include "raycast.h"
@@ -37,14 +38,14 @@ static const double push_steps[] = {0.25, 0.5};
 /* The world as read for this bake: the key's input and the bake's; its
  * BVH on the device, built by the first product baked. */
 struct probes_state {
-    struct sb_mesh mesh;
+    struct sb_level level;
     char mesh_hash[SB_HASH_HEX_SIZE];
     char path[640]; /* the world's file, absolute */
     struct sb_bvh bvh;
     struct sb_raycaster *rc;
 };
 
-static enum sb_result plan(const struct sb_scene *scene, const struct sb_mesh *mesh, struct sb_probe_layout *layout,
+static enum sb_result plan(const struct sb_scene *scene, const struct sb_level *level, struct sb_probe_layout *layout,
                            uint64_t *grid_out);
 
 static enum sb_result probes_create(struct sb_vk *vk, const struct sb_scene *scene, void **out)
@@ -52,17 +53,17 @@ static enum sb_result probes_create(struct sb_vk *vk, const struct sb_scene *sce
     struct probes_state *st = calloc(1, sizeof(*st));
     if (!st)
         return SB_ERR_NOMEM;
-    enum sb_result res = sb_mesh_load_world(&scene->world, scene->directory, &st->mesh, st->path, sizeof(st->path));
+    enum sb_result res = sb_level_load(&scene->world, scene->directory, &st->level, st->path, sizeof(st->path));
     struct sb_probe_layout layout = {0};
     uint64_t grid;
     if (!res)
-        res = plan(scene, &st->mesh, &layout, &grid);
+        res = plan(scene, &st->level, &layout, &grid);
     if (res) {
-        sb_mesh_finish(&st->mesh); /* a failed load leaves what it had allocated */
+        sb_level_finish(&st->level);
         free(st);
         return res;
     }
-    sb_mesh_hash(&st->mesh, st->mesh_hash);
+    sb_level_hash(&st->level, st->mesh_hash);
     *out = st;
     return SB_OK;
 }
@@ -73,7 +74,7 @@ static void probes_destroy(void **state)
     if (st) {
         sb_raycaster_destroy(&st->rc);
         sb_bvh_finish(&st->bvh);
-        sb_mesh_finish(&st->mesh);
+        sb_level_finish(&st->level);
     }
     free(st);
     *state = NULL;
@@ -112,7 +113,7 @@ static uint32_t probes_depends_on(enum sb_product_id id)
 static enum sb_result raycaster(struct probes_state *st, struct sb_vk *vk)
 {
     enum sb_result res = SB_OK;
-    if (!st->rc && !(res = sb_bvh_build(&st->mesh, &st->bvh)))
+    if (!st->rc && !(res = sb_level_build_bvh(&st->level, &st->bvh)))
         res = sb_raycaster_create(vk, &st->bvh, &st->rc);
     return res;
 }
@@ -120,14 +121,14 @@ static enum sb_result raycaster(struct probes_state *st, struct sb_vk *vk)
 /* The grid over the world's bounds (or the scene's), centred on them, and
  * its size checked against the caps: from the scene and its world alone,
  * so that probes_create refuses a grid before any product is baked. */
-static enum sb_result plan(const struct sb_scene *scene, const struct sb_mesh *mesh, struct sb_probe_layout *layout,
+static enum sb_result plan(const struct sb_scene *scene, const struct sb_level *level, struct sb_probe_layout *layout,
                            uint64_t *grid_out)
 {
     const struct sb_probe_params *p = &scene->probes;
     uint64_t grid = 0;
     if (p->spacing_m > 0) {
         float lo[3], hi[3]; /* what stands on a ground, not the ground */
-        sb_mesh_bounds_casting(mesh, lo, hi);
+        sb_level_bounds_casting(level, lo, hi);
         for (int k = 0; k < 3 && p->has_bounds; k++) {
             lo[k] = (float)p->bounds_m[0][k];
             hi[k] = (float)p->bounds_m[1][k];
@@ -166,12 +167,12 @@ static enum sb_result plan(const struct sb_scene *scene, const struct sb_mesh *m
     return SB_OK;
 }
 
-static enum sb_result place(const struct sb_scene *scene, const struct sb_mesh *mesh, struct sb_probe_layout *layout,
+static enum sb_result place(const struct sb_scene *scene, const struct sb_level *level, struct sb_probe_layout *layout,
                             float **positions, uint32_t *count)
 {
     const struct sb_probe_params *p = &scene->probes;
     uint64_t grid;
-    enum sb_result res = plan(scene, mesh, layout, &grid);
+    enum sb_result res = plan(scene, level, layout, &grid);
     if (res)
         return res;
     layout->explicit_count = (uint32_t)p->explicit_count;
@@ -289,8 +290,8 @@ static enum sb_result bake_visibility(struct probes_state *st, const struct sb_s
     struct sb_probe_layout *layout = &a->probes;
     memset(layout, 0, sizeof(*layout));
     enum sb_result res;
-    const struct sb_mesh *mesh = &st->mesh;
-    if ((res = place(scene, mesh, layout, &positions, &count)))
+    const struct sb_level *level = &st->level;
+    if ((res = place(scene, level, layout, &positions, &count)))
         goto done;
     offsets = calloc((size_t)count * 3, sizeof(float));
     valid = calloc(count, sizeof(float));
@@ -347,13 +348,13 @@ static enum sb_result bake_visibility(struct probes_state *st, const struct sb_s
     free(job.sh);
     a->gpu_ms = gpu_ms;
     snprintf(a->settings_json, sizeof(a->settings_json),
-             "{\"rays\":%u,\"grid\":[%u,%u,%u],\"spacing_m\":%.9g,\"explicit\":%u,\"triangles\":%u,"
+             "{\"rays\":%u,\"grid\":[%u,%u,%u],\"spacing_m\":%.9g,\"explicit\":%u,\"triangles\":%llu,"
              "\"inside\":%u,\"pushed_out\":%u,\"invalid\":%u,\"deringed\":%u,\"lowest_before_dering\":%.6g}",
              layout->ray_count, layout->grid[0], layout->grid[1], layout->grid[2], (double)layout->spacing_m[0],
-             layout->explicit_count, mesh->triangle_count, inside, pushed, inside - pushed, deringed, lowest);
+             layout->explicit_count, (unsigned long long)level->placed_triangles, inside, pushed, inside - pushed, deringed, lowest);
     sb_artifact_set_world(a, st->mesh_hash, st->path);
-    sb_info("sky_visibility: %u probes over %u triangles; %u inside geometry, %u pushed out; %u deringed", count,
-            mesh->triangle_count, inside, pushed, deringed);
+    sb_info("sky_visibility: %u probes over %llu triangles; %u inside geometry, %u pushed out; %u deringed", count,
+            (unsigned long long)level->placed_triangles, inside, pushed, deringed);
 done:
     if (res)
         sb_image_finish(image);
@@ -373,7 +374,7 @@ static enum sb_result bake_bounce(struct probes_state *st, const struct sb_scene
     uint32_t count = 0;
     struct sb_probe_layout *layout = &a->probes;
     memset(layout, 0, sizeof(*layout));
-    enum sb_result res = place(scene, &st->mesh, layout, &positions, &count);
+    enum sb_result res = place(scene, &st->level, layout, &positions, &count);
     if (!res && (visibility->width != count || visibility->channel_count != SB_SKY_VISIBILITY_CHANNEL_COUNT)) {
         sb_error("sky_bounce: sky_visibility holds %u probes, the scene places %u", visibility->width, count);
         res = SB_ERR_BAD_IMAGE;
@@ -395,7 +396,7 @@ static enum sb_result bake_bounce(struct probes_state *st, const struct sb_scene
     }
     struct sb_sky_bounce_params params = {.ray_count = scene->probes.bounce_rays,
                                           .secondary = scene->probes.bounce_secondary};
-    if ((res = sb_sky_bounce_bake(st->rc, &st->mesh, positions, valid, count, &params, out, &a->gpu_ms)) ||
+    if ((res = sb_sky_bounce_bake(st->rc, st->level.materials, st->level.material_count, positions, valid, count, &params, out, &a->gpu_ms)) ||
         (res = sb_image_init(image, count, 1, SB_SKY_BOUNCE_CHANNEL_COUNT)))
         goto done;
     sb_image_set_channel_names(image, SB_SKY_BOUNCE_CHANNELS);

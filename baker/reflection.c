@@ -62,7 +62,7 @@ enum sb_result sb_reflection_capture(struct sb_vk *vk, const struct sb_capture_i
         .push_size = sizeof(pc),
         .name = "reflection capture",
     };
-    uint32_t materials = in->rc && in->mesh->material_count ? in->mesh->material_count : 1;
+    uint32_t materials = in->rc && in->material_count ? in->material_count : 1;
     enum sb_result res;
     if ((res = sb_buffer_create(vk, (VkDeviceSize)6 * n * n * 4 * sizeof(float), "reflection capture", &result)) ||
         (res = sb_buffer_create(vk, (VkDeviceSize)materials * 4 * sizeof(float), "albedo", &albedo)) ||
@@ -71,8 +71,8 @@ enum sb_result sb_reflection_capture(struct sb_vk *vk, const struct sb_capture_i
         (res = pipeline_for(vk, in->kernels ? &in->kernels->capture : NULL, &pp, &temp, &pipeline)))
         goto done;
     float *a = albedo.mapped;
-    for (uint32_t m = 0; in->rc && m < in->mesh->material_count; m++)
-        memcpy(&a[4 * (size_t)m], in->mesh->material_list[m].albedo, 3 * sizeof(float));
+    for (uint32_t m = 0; in->rc && m < in->material_count; m++)
+        memcpy(&a[4 * (size_t)m], in->materials[m].albedo, 3 * sizeof(float));
     float *s = sky.mapped;
     for (int k = 0; k < SB_PROBE_SH; k++)
         for (int c = 0; c < 3; c++)

@@ -39,7 +39,8 @@ void sb_reflection_kernels_destroy(struct sb_vk *vk, struct sb_reflection_kernel
 struct sb_capture_inputs {
     struct sb_atmosphere_baker *atmosphere;
     struct sb_raycaster *rc;
-    const struct sb_mesh *mesh;
+    const struct sb_mesh_material *materials; /* what the BVH's triangles' materials index */
+    uint32_t material_count;
     struct sb_reflection_kernels *kernels; /* may be NULL: made for the call */
 };
 

@@ -5,7 +5,8 @@
 #include "log.h"
 #include "probe_bounce.spv.h"
 
-enum sb_result sb_sky_bounce_bake(struct sb_raycaster *rc, const struct sb_mesh *mesh, const float *positions,
+enum sb_result sb_sky_bounce_bake(struct sb_raycaster *rc, const struct sb_mesh_material *materials,
+                                  uint32_t material_count, const float *positions,
                                   const float *valid, uint32_t probe_count, const struct sb_sky_bounce_params *params,
                                   float *out, double *gpu_ms)
 {
@@ -20,7 +21,7 @@ enum sb_result sb_sky_bounce_bake(struct sb_raycaster *rc, const struct sb_mesh 
     if (gpu_ms)
         *gpu_ms = 0;
     if (pc.ray_count % SB_PROBE_THREADS || pc.ray_count > SB_PROBE_MAX_RAYS || pc.secondary > SB_PROBE_MAX_RAYS / 2 ||
-        !probe_count || !mesh->material_count) {
+        !probe_count || !material_count) {
         sb_error("sky bounce: %u rays and %u from each hit for %u probes (rays: a multiple of %u up to %u)",
                  pc.ray_count, pc.secondary, probe_count, SB_PROBE_THREADS, SB_PROBE_MAX_RAYS);
         return SB_ERR_OUT_OF_RANGE;
@@ -37,12 +38,12 @@ enum sb_result sb_sky_bounce_bake(struct sb_raycaster *rc, const struct sb_mesh 
     };
     enum sb_result res;
     if ((res = sb_probe_buffers_create(vk, positions, valid, probe_count, SB_BOUNCE_FLOATS, &probes, &results)) ||
-        (res = sb_buffer_create(vk, (VkDeviceSize)mesh->material_count * 4 * sizeof(float), "albedo", &albedo)) ||
+        (res = sb_buffer_create(vk, (VkDeviceSize)material_count * 4 * sizeof(float), "albedo", &albedo)) ||
         (res = sb_pipeline_create(vk, &pp, &pipeline)))
         goto done;
     float *a = albedo.mapped;
-    for (uint32_t m = 0; m < mesh->material_count; m++) {
-        memcpy(&a[4 * (size_t)m], mesh->material_list[m].albedo, 3 * sizeof(float));
+    for (uint32_t m = 0; m < material_count; m++) {
+        memcpy(&a[4 * (size_t)m], materials[m].albedo, 3 * sizeof(float));
         a[4 * (size_t)m + 3] = 0;
     }
     const struct sb_buffer *bindings[SB_BOUNCE_BINDING_COUNT] = {

@@ -25,12 +25,13 @@ struct sb_sky_bounce_params {
 
 /*
  * Bake probe_count probes at positions (xyz in m each; valid[i] 0 gives the
- * probe zeros) against the raycaster's BVH, whose triangles' materials index
- * mesh's material list (their albedos), into out[SB_BOUNCE_FLOATS *
- * probe_count] (config.h: m, then k, then rgb). *gpu_ms (may be NULL) gets
- * the GPU time.
+ * probe zeros) against the raycaster's BVH into out[SB_BOUNCE_FLOATS *
+ * probe_count] (config.h: m, then k, then rgb). The triangles' materials
+ * index `materials` (their albedos; a level's, or a mesh's material_list).
+ * *gpu_ms (may be NULL) gets the GPU time.
  */
-enum sb_result sb_sky_bounce_bake(struct sb_raycaster *raycaster, const struct sb_mesh *mesh, const float *positions,
+enum sb_result sb_sky_bounce_bake(struct sb_raycaster *raycaster, const struct sb_mesh_material *materials,
+                                  uint32_t material_count, const float *positions,
                                   const float *valid, uint32_t probe_count, const struct sb_sky_bounce_params *params,
                                   float *out, double *gpu_ms);
 

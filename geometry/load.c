@@ -25,7 +25,7 @@ enum sb_result sb_mesh_load(const char *path, const struct sb_mesh_load_params *
         return SB_ERR_MESH;
     }
     sb_status_begin("loading %s", name ? name + 1 : path);
-    enum sb_result res = world_file ? sb_world_file_load(path, params, mesh) : sb_mesh_import(path, params, mesh);
+    enum sb_result res = world_file ? sb_world_file_load(path, params, mesh, NULL) : sb_mesh_import(path, params, mesh);
     if (!res && !world_file && params && params->ground)
         res = sb_mesh_add_ground(mesh, params->ground, path);
     sb_status_end();

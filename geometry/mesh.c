@@ -199,6 +199,14 @@ static void transform_point(const struct mat4 *m, const struct aiVector3D *p, do
         out[i] = m->m[i][0] * p->x + m->m[i][1] * p->y + m->m[i][2] * p->z + m->m[i][3];
 }
 
+void sb_mesh_transform_matrix(const struct sb_mesh_transform *t, double out[3][4])
+{
+    struct mat4 m = mat_world(t);
+    for (int r = 0; r < 3; r++)
+        for (int c = 0; c < 4; c++)
+            out[r][c] = m.m[r][c];
+}
+
 void sb_mesh_transform_point(const struct sb_mesh_transform *t, const double p[3], double out[3])
 {
     struct mat4 m = mat_world(t);

@@ -116,6 +116,9 @@ struct sb_mesh_load_params {
  */
 enum sb_result sb_mesh_import(const char *path, const struct sb_mesh_load_params *params, struct sb_mesh *mesh);
 
+/* The transform as rows of an affine 3 x 4 (file units to world metres). */
+void sb_mesh_transform_matrix(const struct sb_mesh_transform *t, double out[3][4]);
+
 /* Where the transform takes point p (file units) in world metres. */
 void sb_mesh_transform_point(const struct sb_mesh_transform *t, const double p[3], double out[3]);
 

@@ -30,11 +30,13 @@ struct pillar {
 };
 
 struct world {
+    bool no_ground;       /* "ground": false */
     double ground_size_m; /* the ground plane is this wide, centred on the origin */
     struct material ground;
     int box_count, pillar_count;
     struct box boxes[SB_WORLD_FILE_MAX_OBJECTS];
     struct pillar pillars[SB_WORLD_FILE_MAX_OBJECTS];
+    struct sb_world_file_refs refs;
 };
 
 /* ---- Parsing ------------------------------------------------------------------- */
@@ -99,6 +101,43 @@ static enum sb_result vec3(const struct reader *rd, const cJSON *obj, const char
     return SB_OK;
 }
 
+/* An array of n numbers in [lo, hi]. */
+static enum sb_result numbers(const struct reader *rd, const cJSON *obj, const char *key, int n, double lo, double hi,
+                              const double *fallback, double *out)
+{
+    const cJSON *item = cJSON_GetObjectItemCaseSensitive(obj, key);
+    if (!item && fallback) {
+        memcpy(out, fallback, (size_t)n * sizeof(double));
+        return SB_OK;
+    }
+    if (!item || !cJSON_IsArray(item) || cJSON_GetArraySize(item) != n) {
+        sb_error("%s: %s%s: %s an array of %d numbers", rd->source, rd->path, key, item ? "expected" : "missing:", n);
+        return item ? SB_ERR_WRONG_TYPE : SB_ERR_MISSING_FIELD;
+    }
+    for (int i = 0; i < n; i++) {
+        const cJSON *v = cJSON_GetArrayItem(item, i);
+        if (!cJSON_IsNumber(v) || !(v->valuedouble >= lo && v->valuedouble <= hi)) {
+            sb_error("%s: %s%s[%d]: expected a number in [%g, %g]", rd->source, rd->path, key, i, lo, hi);
+            return cJSON_IsNumber(v) ? SB_ERR_OUT_OF_RANGE : SB_ERR_WRONG_TYPE;
+        }
+        out[i] = v->valuedouble;
+    }
+    return SB_OK;
+}
+
+static enum sb_result boolean(const struct reader *rd, const cJSON *obj, const char *key, bool *out)
+{
+    const cJSON *item = cJSON_GetObjectItemCaseSensitive(obj, key);
+    if (!item)
+        return SB_OK;
+    if (!cJSON_IsBool(item)) {
+        sb_error("%s: %s%s: expected true or false", rd->source, rd->path, key);
+        return SB_ERR_WRONG_TYPE;
+    }
+    *out = cJSON_IsTrue(item);
+    return SB_OK;
+}
+
 /* Every key of `obj` must be one of `keys` (NULL-terminated). */
 static enum sb_result known_keys(const struct reader *rd, const cJSON *obj, const char *const *keys)
 {
@@ -136,7 +175,8 @@ static enum sb_result material(const struct reader *rd, const cJSON *obj, struct
     return res;
 }
 
-static enum sb_result array(const struct reader *rd, const cJSON *root, const char *key, const cJSON **out, int *count)
+static enum sb_result array(const struct reader *rd, const cJSON *root, const char *key, int max, const cJSON **out,
+                            int *count)
 {
     *out = cJSON_GetObjectItemCaseSensitive(root, key);
     *count = 0;
@@ -147,8 +187,8 @@ static enum sb_result array(const struct reader *rd, const cJSON *root, const ch
         return SB_ERR_WRONG_TYPE;
     }
     *count = cJSON_GetArraySize(*out);
-    if (*count > SB_WORLD_FILE_MAX_OBJECTS) {
-        sb_error("%s: %s: %d entries; at most %d", rd->source, key, *count, SB_WORLD_FILE_MAX_OBJECTS);
+    if (*count > max) {
+        sb_error("%s: %s: %d entries; at most %d", rd->source, key, *count, max);
         return SB_ERR_OUT_OF_RANGE;
     }
     return SB_OK;
@@ -157,13 +197,15 @@ static enum sb_result array(const struct reader *rd, const cJSON *root, const ch
 static enum sb_result parse(const cJSON *root, const char *source, struct world *w)
 {
     struct reader rd = {.source = source};
-    static const char *const root_keys[] = {"version", "ground", "boxes", "pillars", NULL};
+    static const char *const root_keys[] = {"version", "ground", "boxes", "pillars", "instances", "scatter", NULL};
     enum sb_result res = known_keys(&rd, root, root_keys);
     double version = 0;
     if (!res)
         res = number(&rd, root, "version", 1, 1, NAN, &version);
     const cJSON *ground = res ? NULL : cJSON_GetObjectItemCaseSensitive(root, "ground");
-    if (!res && ground) {
+    if (!res && cJSON_IsFalse(ground)) {
+        w->no_ground = true;
+    } else if (!res && ground) {
         static const char *const keys[] = {"size_m", MATERIAL_KEYS, NULL};
         snprintf(rd.path, sizeof(rd.path), "ground.");
         res = known_keys(&rd, ground, keys);
@@ -179,7 +221,7 @@ static enum sb_result parse(const cJSON *root, const char *source, struct world 
     const cJSON *list, *item;
     int n = 0;
     if (!res)
-        res = array(&rd, root, "boxes", &list, &n);
+        res = array(&rd, root, "boxes", SB_WORLD_FILE_MAX_OBJECTS, &list, &n);
     w->box_count = res ? 0 : n;
     for (int i = 0; i < w->box_count && !res; i++) {
         static const char *const keys[] = {"center_m", "size_m", MATERIAL_KEYS, NULL};
@@ -195,7 +237,7 @@ static enum sb_result parse(const cJSON *root, const char *source, struct world 
             res = material(&rd, item, &b->material);
     }
     if (!res)
-        res = array(&rd, root, "pillars", &list, &n);
+        res = array(&rd, root, "pillars", SB_WORLD_FILE_MAX_OBJECTS, &list, &n);
     w->pillar_count = res ? 0 : n;
     for (int i = 0; i < w->pillar_count && !res; i++) {
         static const char *const keys[] = {"base_m", "radius_m", "height_m", "sides", MATERIAL_KEYS, NULL};
@@ -219,6 +261,81 @@ static enum sb_result parse(const cJSON *root, const char *source, struct world 
         p->sides = (int)sides;
         if (!res)
             res = material(&rd, item, &p->material);
+    }
+    int instance_count = 0, scatter_count = 0;
+    const cJSON *instances = NULL, *scatters = NULL;
+    if (!res)
+        res = array(&rd, root, "instances", SB_WORLD_FILE_MAX_REFS, &instances, &instance_count);
+    if (!res)
+        res = array(&rd, root, "scatter", SB_WORLD_FILE_MAX_REFS, &scatters, &scatter_count);
+    if (!res && instance_count + scatter_count > SB_WORLD_FILE_MAX_REFS) {
+        sb_error("%s: instances and scatter: %d entries; at most %d", source, instance_count + scatter_count,
+                 SB_WORLD_FILE_MAX_REFS);
+        res = SB_ERR_OUT_OF_RANGE;
+    }
+    if (!res && instance_count + scatter_count) {
+        w->refs.refs = calloc((size_t)(instance_count + scatter_count), sizeof(*w->refs.refs));
+        if (!w->refs.refs)
+            res = SB_ERR_NOMEM;
+    }
+    for (int i = 0; i < instance_count + scatter_count && !res; i++) {
+        bool scatter = i >= instance_count;
+        struct sb_world_file_ref *r = &w->refs.refs[w->refs.count++];
+        item = cJSON_GetArrayItem(scatter ? scatters : instances, scatter ? i - instance_count : i);
+        snprintf(rd.path, sizeof(rd.path), "%s[%d].", scatter ? "scatter" : "instances", scatter ? i - instance_count : i);
+        static const char *const instance_keys[] = {"file", "translate_m", "rotate_deg", "scale", "units_m", "up_z", NULL};
+        static const char *const scatter_keys[] = {"file", "count", "seed", "area_m", "scale", "units_m", "up_z", NULL};
+        res = known_keys(&rd, item, scatter ? scatter_keys : instance_keys);
+        const cJSON *file = res ? NULL : cJSON_GetObjectItemCaseSensitive(item, "file");
+        if (!res && (!cJSON_IsString(file) || !file->valuestring[0] || strlen(file->valuestring) >= sizeof(r->file))) {
+            sb_error("%s: %sfile: %s", source, rd.path,
+                     file ? "expected a path of 1 to 1023 bytes" : "missing: the mesh or world file to place");
+            res = file ? SB_ERR_WRONG_TYPE : SB_ERR_MISSING_FIELD;
+        }
+        if (!res)
+            snprintf(r->file, sizeof(r->file), "%s", file->valuestring);
+        static const double zero[3] = {0, 0, 0};
+        r->scatter = scatter;
+        if (!res)
+            res = number(&rd, item, "units_m", 1e-6, 1e6, 1.0, &r->transform.units_m);
+        if (!res)
+            res = boolean(&rd, item, "up_z", &r->transform.up_z);
+        if (!res && !scatter) {
+            res = vec3(&rd, item, "translate_m", -SB_MESH_MAX_EXTENT_M, SB_MESH_MAX_EXTENT_M, zero,
+                       r->transform.translate_m);
+            if (!res)
+                res = vec3(&rd, item, "rotate_deg", -360, 360, zero, r->transform.rotate_deg);
+            if (!res)
+                res = number(&rd, item, "scale", 1e-6, 1e6, 1.0, &r->transform.scale);
+        } else if (!res) {
+            double count = 0, seed = 0;
+            static const double one[2] = {1, 1};
+            res = number(&rd, item, "count", 1, SB_WORLD_FILE_MAX_SCATTER, NAN, &count);
+            if (!res && count != floor(count)) {
+                sb_error("%s: %scount: expected a whole number", source, rd.path);
+                res = SB_ERR_OUT_OF_RANGE;
+            }
+            if (!res)
+                res = number(&rd, item, "seed", 0, 4294967295.0, 1, &seed);
+            if (!res && seed != floor(seed)) {
+                sb_error("%s: %sseed: expected a whole number", source, rd.path);
+                res = SB_ERR_OUT_OF_RANGE;
+            }
+            if (!res)
+                res = numbers(&rd, item, "area_m", 4, -SB_MESH_MAX_EXTENT_M, SB_MESH_MAX_EXTENT_M, NULL, r->area_m);
+            if (!res && !(r->area_m[2] > r->area_m[0] && r->area_m[3] > r->area_m[1])) {
+                sb_error("%s: %sarea_m: expected [x0, z0, x1, z1] with x1 > x0 and z1 > z0", source, rd.path);
+                res = SB_ERR_OUT_OF_RANGE;
+            }
+            if (!res)
+                res = numbers(&rd, item, "scale", 2, 1e-6, 1e6, one, r->scale_range);
+            if (!res && r->scale_range[1] < r->scale_range[0]) {
+                sb_error("%s: %sscale: expected [smallest, largest]", source, rd.path);
+                res = SB_ERR_OUT_OF_RANGE;
+            }
+            r->count = (uint32_t)count;
+            r->seed = (uint64_t)seed;
+        }
     }
     return res;
 }
@@ -312,8 +429,10 @@ static enum sb_result build(const struct world *w, const char *source, const str
     struct builder b = {.mesh = mesh, .params = params, .source = source};
     double h = 0.5 * w->ground_size_m;
     double g[4][3] = {{-h, 0, h}, {h, 0, h}, {h, 0, -h}, {-h, 0, -h}};
-    begin(&b, "ground", &w->ground, false);
-    quad(&b, g[0], g[1], g[2], g[3]);
+    if (!w->no_ground) {
+        begin(&b, "ground", &w->ground, false);
+        quad(&b, g[0], g[1], g[2], g[3]);
+    }
     char name[32];
     for (int i = 0; i < w->box_count; i++) {
         snprintf(name, sizeof(name), "boxes[%d]", i);
@@ -328,18 +447,26 @@ static enum sb_result build(const struct world *w, const char *source, const str
     return b.res;
 }
 
-/* A parsed root (deleted here) to triangles; *mesh as it was on failure. */
+/* A parsed root (deleted here) to triangles and places; *mesh as it was
+ * and *refs empty on failure. */
 static enum sb_result from_root(enum sb_result res, cJSON *root, const char *source,
-                                const struct sb_mesh_load_params *params, struct sb_mesh *mesh)
+                                const struct sb_mesh_load_params *params, struct sb_mesh *mesh,
+                                struct sb_world_file_refs *refs)
 {
     static const struct sb_mesh_load_params defaults = {0};
     params = params ? params : &defaults;
+    if (refs)
+        memset(refs, 0, sizeof(*refs));
     struct world *w = res ? NULL : calloc(1, sizeof(*w));
     if (!res && !w)
         res = SB_ERR_NOMEM;
     if (!res)
         res = parse(root, source, w);
     cJSON_Delete(root);
+    if (!res && w->refs.count && !refs) {
+        sb_error("%s: places other files (instances, scatter): read it as a scene's world, not as one mesh", source);
+        res = SB_ERR_MESH;
+    }
     struct sb_mesh before = *mesh;
     if (!res)
         res = build(w, source, params, mesh);
@@ -349,19 +476,25 @@ static enum sb_result from_root(enum sb_result res, cJSON *root, const char *sou
         mesh->material_count = before.material_count;
         mesh->dropped_degenerate = before.dropped_degenerate;
     }
+    if (w && !res && refs)
+        *refs = w->refs;
+    else if (w)
+        free(w->refs.refs);
     free(w);
     return res;
 }
 
-enum sb_result sb_world_file_load(const char *path, const struct sb_mesh_load_params *params, struct sb_mesh *mesh)
+enum sb_result sb_world_file_load(const char *path, const struct sb_mesh_load_params *params, struct sb_mesh *mesh,
+                                  struct sb_world_file_refs *refs)
 {
     cJSON *root = NULL;
     enum sb_result res = sb_json_load(AT_FDCWD, path, path, SB_WORLD_FILE_MAX_BYTES, true, &root);
-    return from_root(res, root, path, params, mesh);
+    return from_root(res, root, path, params, mesh, refs);
 }
 
 enum sb_result sb_world_file_parse(const char *json, size_t size, const char *source,
-                                   const struct sb_mesh_load_params *params, struct sb_mesh *mesh)
+                                   const struct sb_mesh_load_params *params, struct sb_mesh *mesh,
+                                   struct sb_world_file_refs *refs)
 {
     cJSON *root = NULL;
     enum sb_result res = SB_OK;
@@ -371,5 +504,5 @@ enum sb_result sb_world_file_parse(const char *json, size_t size, const char *so
     }
     if (!res)
         res = sb_json_parse(json, size, source, &root);
-    return from_root(res, root, source, params, mesh);
+    return from_root(res, root, source, params, mesh, refs);
 }

@@ -21,6 +21,7 @@
 #include "default_world.h"
 #include "exr.h"
 #include "io.h"
+#include "level.h"
 #include "load.h"
 #include "log.h"
 #include "lut3d.h"
@@ -863,26 +864,26 @@ static enum sb_result load_world(const struct options *o, const struct sb_pack *
             snprintf(baked_path, sizeof(baked_path), "%s", a->world_path);
     }
     enum sb_result res;
-    if (o->world) {
-        /* a mesh file stands on a ground, as a scene's world does by default */
-        static const struct sb_mesh_ground ground = {
-            .unless_own = true, .automatic_height = true, .albedo = {0.18, 0.18, 0.18}};
-        struct sb_mesh_load_params load = {.transform = {.units_m = 1, .scale = 1},
-                                           .ground = sb_mesh_is_world_file(o->world) ? NULL : &ground};
-        res = sb_world_load(o->world, &load, world);
-    } else if (baked_path[0]) {
-        struct sb_world_params *wp = malloc(sizeof(*wp));
+    if (o->world || baked_path[0]) {
+        /* --world: a mesh file stands on a ground, as a scene's world does by default */
+        struct sb_world_params *wp = calloc(1, sizeof(*wp));
         if (!wp)
             return SB_ERR_NOMEM;
-        *wp = pack->scene->world;
-        snprintf(wp->file, sizeof(wp->file), "%s", baked_path);
-        struct sb_mesh mesh = {0};
-        res = sb_mesh_load_world(wp, "", &mesh, NULL, 0);
+        if (o->world) {
+            wp->units_m = wp->scale = 1;
+            for (int i = 0; i < 3; i++)
+                wp->ground.albedo[i] = 0.18;
+        } else {
+            *wp = pack->scene->world;
+        }
+        snprintf(wp->file, sizeof(wp->file), "%s", o->world ? o->world : baked_path);
+        struct sb_level level;
+        res = sb_level_load(wp, "", &level, NULL, 0);
         if (!res)
-            res = sb_world_from_mesh(&mesh, world);
-        sb_mesh_finish(&mesh);
+            res = sb_world_from_level(&level, world);
+        sb_level_finish(&level);
         free(wp);
-        if (res)
+        if (res && !o->world)
             sb_error("%s: the world its probes were baked against cannot be read; name one with --world", o->pack);
     } else {
         res = sb_world_parse(sb_default_world_json, strlen(sb_default_world_json),

@@ -4,6 +4,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "level.h"
 #include "load.h"
 #include "world_file.h"
 
@@ -126,6 +127,16 @@ static enum sb_result from(enum sb_result res, struct sb_mesh *mesh, struct sb_w
     return res;
 }
 
+enum sb_result sb_world_from_level(const struct sb_level *level, struct sb_world *w)
+{
+    memset(w, 0, sizeof(*w));
+    struct sb_mesh mesh = {0};
+    enum sb_result res = from(sb_level_flatten(level, &mesh), &mesh, w);
+    if (!res)
+        sb_level_hash(level, w->mesh_hash);
+    return res;
+}
+
 enum sb_result sb_world_load(const char *path, const struct sb_mesh_load_params *params, struct sb_world *w)
 {
     memset(w, 0, sizeof(*w));
@@ -137,7 +148,7 @@ enum sb_result sb_world_parse(const char *json, size_t size, const char *source,
 {
     memset(w, 0, sizeof(*w));
     struct sb_mesh mesh = {0};
-    return from(sb_world_file_parse(json, size, source, NULL, &mesh), &mesh, w);
+    return from(sb_world_file_parse(json, size, source, NULL, &mesh, NULL), &mesh, w);
 }
 
 void sb_world_finish(struct sb_world *w)

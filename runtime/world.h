@@ -22,12 +22,17 @@ struct sb_world {
     /* Triangles of materials that cast no shadow (a ground) come first:
      * they receive shadows but are not drawn into the shadow maps. */
     uint32_t caster_first_vertex;
-    char mesh_hash[33]; /* sb_mesh_hash of the mesh it was made from */
+    char mesh_hash[33]; /* sb_mesh_hash of the mesh it was made from (sb_level_hash of a level) */
 };
 
 /* The world of a mesh: flat shading (each triangle's own normal, from its
  * winding), the triangle's material. */
 enum sb_result sb_world_from_mesh(const struct sb_mesh *mesh, struct sb_world *world);
+
+/* The world of a level (geometry/level.h), its instances placed into one
+ * list of triangles for now (sb_level_flatten), named by the level's hash. */
+struct sb_level;
+enum sb_result sb_world_from_level(const struct sb_level *level, struct sb_world *world);
 
 /* Read a mesh file (sb_mesh_load: a world file or any format assimp reads)
  * with params (NULL: as the file is) and make its world. On failure the

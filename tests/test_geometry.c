@@ -21,6 +21,7 @@
 #include "embree_ref.h"
 #include "harness_vk.h"
 #include "json.h"
+#include "level.h"
 #include "log.h"
 #include "load.h"
 #include "mesh.h"
@@ -970,6 +971,244 @@ static void test_coincident(void)
     sb_mesh_finish(&m);
 }
 
+/* ---- levels: world files that place files --------------------------------------------------- */
+
+/* What the log said while capturing (warnings and errors). */
+struct captured {
+    char text[2048];
+};
+
+static void capture_sink(void *user, enum sb_log_level level, const char *message)
+{
+    struct captured *c = user;
+    size_t n = strlen(c->text);
+    if (level <= SB_LOG_WARN && n < sizeof(c->text) - 1)
+        snprintf(c->text + n, sizeof(c->text) - n, "%s\n", message);
+}
+
+static void capture_begin(struct captured *c)
+{
+    c->text[0] = '\0';
+    sb_log_set_sink(capture_sink, c);
+}
+
+static void capture_end(void)
+{
+    sb_log_set_sink(NULL, NULL);
+}
+
+/* A level from a scene whose world is `file` in `dir`. */
+static enum sb_result load_level(const char *dir, const char *file, struct sb_level *level)
+{
+    char json[512];
+    snprintf(json, sizeof(json), "{\"atmosphere\":{\"preset\":\"earth\"},\"world\":{\"file\":\"%s\"}}", file);
+    struct sb_scene *scene = malloc(sizeof(*scene));
+    enum sb_result res = scene ? sb_scene_parse(json, strlen(json), "level test", scene) : SB_ERR_NOMEM;
+    if (!res)
+        res = sb_level_load(&scene->world, dir, level, NULL, 0);
+    else
+        memset(level, 0, sizeof(*level));
+    free(scene);
+    return res;
+}
+
+/* The centre of the nth run of triangles of material `name` in a
+ * flattened level (a copy's triangles lie together). */
+static bool material_centre(const struct sb_mesh *m, const char *name, uint32_t nth, double centre[3])
+{
+    double lo[3] = {INFINITY, INFINITY, INFINITY}, hi[3] = {-INFINITY, -INFINITY, -INFINITY};
+    uint32_t runs = 0;
+    bool in_run = false;
+    for (uint32_t t = 0; t < m->triangle_count; t++) {
+        bool match = !strcmp(m->material_list[m->materials[t]].name, name);
+        runs += match && !in_run;
+        in_run = match;
+        if (!match || runs != nth + 1)
+            continue;
+        for (int k = 0; k < 3; k++)
+            for (int i = 0; i < 3; i++) {
+                double v = m->positions[3 * (size_t)m->indices[3 * (size_t)t + k] + i];
+                lo[i] = fmin(lo[i], v);
+                hi[i] = fmax(hi[i], v);
+            }
+    }
+    for (int i = 0; i < 3; i++)
+        centre[i] = 0.5 * (lo[i] + hi[i]);
+    return isfinite(lo[0]);
+}
+
+/*
+ * A world file that places a world file (a box of its own and an OBJ
+ * cube) twice and scatters the cube: each file read once, the copies where
+ * the transforms compose to, the scatter on the ground, the same BVH bytes
+ * on 1 and 3 threads; and every way such files can be wrong refused
+ * before anything is allocated for it, naming the file.
+ */
+static void test_levels(void)
+{
+    char dir[256], path[400];
+    CHECK(test_temp_dir("skybake-level", dir, sizeof(dir)), "temporary directory");
+    snprintf(path, sizeof(path), "%s/cube.obj", dir);
+    write_file(path, "v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nv 0 0 1\nv 1 0 1\nv 1 1 1\nv 0 1 1\n"
+                     "f 1 4 3 2\nf 5 6 7 8\nf 1 2 6 5\nf 4 8 7 3\nf 1 5 8 4\nf 2 3 7 6\n");
+    snprintf(path, sizeof(path), "%s/house.json", dir);
+    write_file(path, "{\"version\": 1, \"ground\": false, \"boxes\": [{\"center_m\": [2, 1, 0], \"size_m\": [1, 2, 1]}],"
+                     " \"instances\": [{\"file\": \"cube.obj\", \"translate_m\": [0, 0, 5]}]}");
+    snprintf(path, sizeof(path), "%s/world.json", dir);
+    write_file(path, "{\"version\": 1, \"ground\": {\"size_m\": 400},"
+                     " \"instances\": [{\"file\": \"house.json\", \"translate_m\": [30, 0, 0], \"rotate_deg\": [0, 90, 0]},"
+                     "  {\"file\": \"house.json\", \"translate_m\": [-30, 0, 10], \"scale\": 2}],"
+                     " \"scatter\": [{\"file\": \"cube.obj\", \"count\": 40, \"seed\": 7, \"area_m\": [-50, -50, 50, 50],"
+                     "  \"scale\": [0.5, 1.5]}]}");
+    struct sb_level level;
+    enum sb_result res = load_level(dir, "world.json", &level);
+    CHECK(res == SB_OK, "a level: %s", sb_result_name(res));
+    /* meshes: the ground, the house's box, the cube (read once for 42 copies) */
+    CHECK(level.mesh_count == 3 && level.instance_count == 1 + 2 * 2 + 40,
+          "a level: %u meshes, %u instances (3 and 45)", level.mesh_count, level.instance_count);
+    CHECK(level.placed_triangles == 2 + 2 * 12 + 2 * 12 + 40 * 12, "a level: %llu placed triangles",
+          (unsigned long long)level.placed_triangles);
+    struct sb_mesh flat = {0};
+    CHECK(!res && sb_level_flatten(&level, &flat) == SB_OK && flat.triangle_count == level.placed_triangles,
+          "flattened: %u triangles", flat.triangle_count);
+    /* the house's box (2, 1, 0) turned 90 degrees about y: (0, 1, -2); then moved (30, 0, 0) */
+    double c[3], c2[3];
+    CHECK(material_centre(&flat, "boxes[0]", 0, c) && fabs(c[0] - 30) < 1e-4 && fabs(c[1] - 1) < 1e-4 &&
+              fabs(c[2] + 2) < 1e-4,
+          "the first house's box at (%g, %g, %g), expected (30, 1, -2)", c[0], c[1], c[2]);
+    /* the second: scaled 2, moved (-30, 0, 10): (-26, 2, 10) */
+    CHECK(material_centre(&flat, "boxes[0]", 1, c2) && fabs(c2[0] + 26) < 1e-4 && fabs(c2[1] - 2) < 1e-4 &&
+              fabs(c2[2] - 10) < 1e-4,
+          "the second house's box at (%g, %g, %g), expected (-26, 2, 10)", c2[0], c2[1], c2[2]);
+    /* every scattered cube stands on the ground (y 0) */
+    struct sb_bvh bvh = {0}, again = {0};
+    float lo[3], hi[3];
+    CHECK(sb_level_bounds_casting(&level, lo, hi) && lo[1] > -1e-4f, "the level's casters from y %g", lo[1]);
+    sb_parallel_set_threads(1);
+    CHECK(sb_level_build_bvh(&level, &bvh) == SB_OK, "the level's BVH");
+    sb_parallel_set_threads(3);
+    CHECK(sb_level_build_bvh(&level, &again) == SB_OK, "the level's BVH, 3 threads");
+    sb_parallel_set_threads(0);
+    char h1[33], h2[33];
+    sb_bvh_hash(&bvh, h1);
+    sb_bvh_hash(&again, h2);
+    CHECK(!strcmp(h1, h2) && bvh.instance_count == level.instance_count, "the level's BVH on 1 and 3 threads: %s, %s",
+          h1, h2);
+    /* rays straight down agree with the flattened copy's */
+    struct sb_bvh flat_bvh = {0};
+    CHECK(sb_bvh_build(&flat, &flat_bvh) == SB_OK, "the flattened BVH");
+    uint32_t differ = 0;
+    for (int i = 0; i < 4000 && flat_bvh.nodes; i++) {
+        float o[3] = {(float)(-60 + 120 * uniform()), 50.0f, (float)(-60 + 120 * uniform())}, d[3] = {0, -1, 0};
+        struct sb_hit a, b;
+        sb_bvh_intersect(&bvh, o, d, 0, 1e30f, false, &a);
+        sb_bvh_intersect(&flat_bvh, o, d, 0, 1e30f, false, &b);
+        differ += (a.triangle == SB_BVH_MISS) != (b.triangle == SB_BVH_MISS) || fabsf(a.t - b.t) > 1e-3f;
+    }
+    CHECK(differ == 0, "rays down: %u of 4000 differ between the level and its flattened copy", differ);
+    sb_bvh_finish(&flat_bvh);
+    sb_bvh_finish(&bvh);
+    sb_bvh_finish(&again);
+    sb_mesh_finish(&flat);
+    char hash[33];
+    sb_level_hash(&level, hash);
+    sb_level_finish(&level);
+
+    /* a world that places nothing: one mesh, hashed as before */
+    snprintf(path, sizeof(path), "%s/plain.json", dir);
+    write_file(path, "{\"version\": 1, \"boxes\": [{\"center_m\": [0, 1, 0], \"size_m\": [1, 2, 1]}]}");
+    struct sb_mesh plain = {0};
+    CHECK(load_level(dir, "plain.json", &level) == SB_OK && level.instance_count == 0 && level.mesh_count == 1,
+          "a world file that places nothing is one mesh");
+    CHECK(load_scene_world(dir, "plain.json", "", &plain) == SB_OK, "the same read as a mesh");
+    char a[33], b[33];
+    sb_level_hash(&level, a);
+    sb_mesh_hash(&plain, b);
+    CHECK(!strcmp(a, b), "its level hash is its mesh's (%s, %s)", a, b);
+    sb_mesh_finish(&plain);
+    sb_level_finish(&level);
+
+    /* refused, naming the file: a cycle, itself, too deep, too many, missing, wrong */
+    static const struct {
+        const char *name, *text, *says;
+        enum sb_result want;
+    } bad[] = {
+        {"self.json", "{\"version\": 1, \"instances\": [{\"file\": \"self.json\"}]}", "places itself", SB_ERR_MESH},
+        {"a.json", "{\"version\": 1, \"instances\": [{\"file\": \"b.json\"}]}", "places itself", SB_ERR_MESH},
+        {"missing.json", "{\"version\": 1, \"instances\": [{\"file\": \"nowhere.obj\"}]}", "nowhere.obj", SB_ERR_IO},
+        {"many.json",
+         "{\"version\": 1, \"scatter\": [{\"file\": \"cube.obj\", \"count\": 1048576, \"area_m\": [0, 0, 1, 1]},"
+         "{\"file\": \"cube.obj\", \"count\": 1048576, \"area_m\": [0, 0, 1, 1]},"
+         "{\"file\": \"cube.obj\", \"count\": 1048576, \"area_m\": [0, 0, 1, 1]},"
+         "{\"file\": \"cube.obj\", \"count\": 1048576, \"area_m\": [0, 0, 1, 1]},"
+         "{\"file\": \"cube.obj\", \"count\": 1048576, \"area_m\": [0, 0, 1, 1]}]}",
+         "over the cap", SB_ERR_TOO_LARGE},
+        {"nested.json", "{\"version\": 1, \"instances\": [{\"file\": \"thousand.json\"}, {\"file\": \"thousand.json\"},"
+                        "{\"file\": \"thousand.json\"}, {\"file\": \"thousand.json\"}, {\"file\": \"thousand.json\"}]}",
+         "over the cap", SB_ERR_TOO_LARGE},
+        {"nofile.json", "{\"version\": 1, \"instances\": [{\"translate_m\": [0, 0, 0]}]}", "file: missing",
+         SB_ERR_MISSING_FIELD},
+        {"key.json", "{\"version\": 1, \"instances\": [{\"file\": \"cube.obj\", \"skew\": 1}]}", "skew",
+         SB_ERR_UNKNOWN_KEY},
+        {"area.json", "{\"version\": 1, \"scatter\": [{\"file\": \"cube.obj\", \"count\": 3, \"area_m\": [1, 0, 0, 1]}]}",
+         "area_m", SB_ERR_OUT_OF_RANGE},
+    };
+    snprintf(path, sizeof(path), "%s/b.json", dir);
+    write_file(path, "{\"version\": 1, \"ground\": false, \"instances\": [{\"file\": \"a.json\"}]}");
+    /* 5 x 1000 x 1000 cubes, none of the files large */
+    snprintf(path, sizeof(path), "%s/kilo.json", dir);
+    write_file(path, "{\"version\": 1, \"ground\": false, \"scatter\": [{\"file\": \"cube.obj\", \"count\": 1000,"
+                     " \"area_m\": [0, 0, 1, 1]}], \"boxes\": [{\"center_m\": [0, 0, 0], \"size_m\": [1, 1, 1]}]}");
+    char *thousand = malloc(64 * 1024);
+    if (thousand) {
+        size_t n = (size_t)snprintf(thousand, 64 * 1024, "{\"version\": 1, \"ground\": false, \"instances\": [");
+        for (int i = 0; i < 1000; i++)
+            n += (size_t)snprintf(thousand + n, 64 * 1024 - n, "%s{\"file\": \"kilo.json\"}", i ? ", " : "");
+        snprintf(thousand + n, 64 * 1024 - n, "]}");
+        snprintf(path, sizeof(path), "%s/thousand.json", dir);
+        write_file(path, thousand);
+        free(thousand);
+    }
+    /* ten files deep */
+    for (int i = 0; i < 10; i++) {
+        char text[256];
+        snprintf(path, sizeof(path), "%s/deep%d.json", dir, i);
+        snprintf(text, sizeof(text), "{\"version\": 1, \"ground\": false, \"instances\": [{\"file\": \"%s\"}]}",
+                 i < 9 ? "" : "cube.obj");
+        if (i < 9)
+            snprintf(text, sizeof(text),
+                     "{\"version\": 1, \"ground\": false, \"instances\": [{\"file\": \"deep%d.json\"}]}", i + 1);
+        write_file(path, text);
+    }
+    struct captured log = {0};
+    for (size_t i = 0; i < sizeof(bad) / sizeof(bad[0]); i++) {
+        snprintf(path, sizeof(path), "%s/%s", dir, bad[i].name);
+        write_file(path, bad[i].text);
+        capture_begin(&log);
+        res = load_level(dir, bad[i].name, &level);
+        capture_end();
+        CHECK(res == bad[i].want && strstr(log.text, bad[i].says) && level.mesh_count == 0,
+              "%s: %s, expected %s, saying \"%s\": %s", bad[i].name, sb_result_name(res),
+              sb_result_name(bad[i].want), bad[i].says, log.text);
+    }
+    capture_begin(&log);
+    res = load_level(dir, "deep0.json", &level);
+    capture_end();
+    CHECK(res == SB_ERR_TOO_LARGE && strstr(log.text, "more than 8 deep"), "ten files deep: %s: %s",
+          sb_result_name(res), log.text);
+    /* a world file that places files is not one mesh */
+    struct sb_mesh one = {0};
+    snprintf(path, sizeof(path), "%s/world.json", dir);
+    capture_begin(&log);
+    res = sb_mesh_load(path, NULL, &one);
+    capture_end();
+    CHECK(res == SB_ERR_MESH && strstr(log.text, "scene's world"), "a level read as one mesh: %s: %s",
+          sb_result_name(res), log.text);
+    sb_mesh_finish(&one);
+    (void)hash;
+    test_remove_dir(dir);
+}
+
 int main(void)
 {
     sb_log_set_level(SB_LOG_WARN);
@@ -978,6 +1217,7 @@ int main(void)
     test_ground();
     test_hostile();
     test_coincident();
+    test_levels();
 
     struct sb_mesh house = {0}, well = {0}, room = {0}, soup = {0};
     uint32_t mat;

@@ -77,6 +77,24 @@ check "bake the grid on 1 thread" expect_exit 0 "$skybake" bake "$tmp/grid.json"
 check "bake the grid on 3 threads" expect_exit 0 "$skybake" bake "$tmp/grid.json" -o "$tmp/t3" --threads 3 -q
 check "the same visibility on 1 and 3 threads" cmp -s "$tmp/t1/sky_visibility.sbprobes" "$tmp/t3/sky_visibility.sbprobes"
 check "the same bounce on 1 and 3 threads" cmp -s "$tmp/t1/sky_bounce.sbprobes" "$tmp/t3/sky_bounce.sbprobes"
+# A level: the grid placed twice, a world file of a cube placed in turn,
+# and 30 cubes scattered over the grid; on 1 and 3 threads, the same files.
+printf 'v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nv 0 0 1\nv 1 0 1\nv 1 1 1\nv 0 1 1\nf 1 4 3 2\nf 5 6 7 8\nf 1 2 6 5\nf 4 8 7 3\nf 1 5 8 4\nf 2 3 7 6\n' >"$tmp/cube.obj"
+printf '{"version":1,"ground":false,"boxes":[{"center_m":[0,2,0],"size_m":[4,4,4]}],"instances":[{"file":"cube.obj","translate_m":[3,0,0]}]}' >"$tmp/hut.json"
+printf '{"version":1,"ground":false,"instances":[{"file":"grid.obj"},{"file":"grid.obj","translate_m":[200,0,0],"rotate_deg":[0,90,0]},{"file":"hut.json","translate_m":[10,0.5,10]},{"file":"hut.json","translate_m":[-20,0.5,5],"scale":1.5}],"scatter":[{"file":"cube.obj","count":30,"seed":5,"area_m":[-90,-90,90,90],"scale":[1,3]}]}' >"$tmp/village.json"
+printf '{"version":1,"name":"village","atmosphere":{"preset":"earth"},"products":["sky_visibility","sky_bounce"],"world":{"file":"village.json"},"probes":{"spacing_m":40,"rays":256,"bounce_rays":64,"bounce_secondary":8}}' >"$tmp/village-scene.json"
+check "bake a level on 1 thread" expect_exit 0 "$skybake" bake "$tmp/village-scene.json" -o "$tmp/v1" --threads 1
+# the grid, the hut's box, the cube: 80,024 triangles, placed 2 + 2 x 2 + 30 times
+check "it says what it placed" grep -q "village.json: 3 meshes (80024 triangles) placed 36 times: 160408 triangles" "$tmp/err"
+check "bake it on 3 threads" expect_exit 0 "$skybake" bake "$tmp/village-scene.json" -o "$tmp/v3" --threads 3 -q
+check "the same visibility on 1 and 3 threads" cmp -s "$tmp/v1/sky_visibility.sbprobes" "$tmp/v3/sky_visibility.sbprobes"
+check "the same bounce on 1 and 3 threads" cmp -s "$tmp/v1/sky_bounce.sbprobes" "$tmp/v3/sky_bounce.sbprobes"
+check "the manifest counts the placed triangles" grep -q '"triangles":[[:space:]]*160408' "$tmp/v1/manifest.json"
+printf '{"version":1,"instances":[{"file":"nowhere.obj"}]}' >"$tmp/broken.json"
+printf '{"version":1,"name":"broken","atmosphere":{"preset":"earth"},"products":["sky_visibility"],"world":{"file":"broken.json"}}' >"$tmp/broken-scene.json"
+check "a level placing a missing file is refused" expect_exit 1 "$skybake" bake "$tmp/broken-scene.json" -o "$tmp/vb"
+check "naming the world file, the field and the file" grep -q "broken.json: instances: cannot read .*nowhere.obj" "$tmp/err"
+check "and nothing was written" test ! -e "$tmp/vb"
 check "--threads 0 is refused" expect_exit 2 "$skybake" bake "$tmp/grid.json" -o "$tmp/t0" --threads 0
 check "naming the option" grep -q -- "--threads: '0'" "$tmp/err"
 check "not as an unknown option" sh -c "! grep -q 'unknown or incomplete' '$tmp/err'"

@@ -224,8 +224,9 @@ int main(void)
     cp.sun[1] = sin(el);
     cp.sun[2] = -cos(el) * cos(az);
     float *sky = malloc((size_t)6 * N * N * 4 * sizeof(float)), *again = malloc((size_t)6 * N * N * 4 * sizeof(float));
-    struct sb_capture_inputs sky_in = {.atmosphere = atm, .mesh = &mesh};
-    struct sb_capture_inputs world_in = {.atmosphere = atm, .rc = rc, .mesh = &mesh};
+    struct sb_capture_inputs sky_in = {.atmosphere = atm};
+    struct sb_capture_inputs world_in = {
+        .atmosphere = atm, .rc = rc, .materials = mesh.material_list, .material_count = mesh.material_count};
     CHECK(sb_reflection_capture(vk, &sky_in, &cp, sky, NULL) == SB_OK, "sky capture");
     sb_reflection_sh(sky, N, 0, cp.sky_sh);
     CHECK(sb_reflection_capture(vk, &world_in, &cp, level0, NULL) == SB_OK, "world capture");

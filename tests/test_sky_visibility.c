@@ -426,7 +426,7 @@ static bool bake_bounce(struct scene *s, const float *positions, uint32_t count,
                         float *out)
 {
     struct sb_sky_bounce_params p = {.ray_count = rays, .secondary = secondary};
-    enum sb_result res = sb_sky_bounce_bake(s->rc, &s->mesh, positions, NULL, count, &p, out, NULL);
+    enum sb_result res = sb_sky_bounce_bake(s->rc, s->mesh.material_list, s->mesh.material_count, positions, NULL, count, &p, out, NULL);
     CHECK(res == SB_OK, "%s: bounce: %s", s->name, sb_result_name(res));
     return res == SB_OK;
 }

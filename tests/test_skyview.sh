@@ -44,6 +44,14 @@ camera=$(sed -n 's/.*as --camera \([^ ]*\).*/\1/p' "$tmp/err")
 check "that camera given" expect_exit 0 "$skyview" "$tmp/pack" -o "$tmp/given" $small --world "$tmp/behind.obj" --camera "$camera"
 check "frames the same" cmp -s "$tmp/framed/frame_0000.png" "$tmp/given/frame_0000.png"
 check "and is not framed again" sh -c "! grep -q 'framing it' '$tmp/err'"
+# A level (a world file placing another) draws exactly what the same
+# triangles written out in one world file draw.
+printf '{"version":1,"ground":false,"boxes":[{"center_m":[0,1,0],"size_m":[2,2,2],"albedo":[0.8,0.3,0.2]}]}' >"$tmp/hut.json"
+printf '{"version":1,"instances":[{"file":"hut.json","translate_m":[4,0,-30]},{"file":"hut.json","translate_m":[-6,0,-24]}]}' >"$tmp/level.json"
+printf '{"version":1,"boxes":[{"center_m":[4,1,-30],"size_m":[2,2,2],"albedo":[0.8,0.3,0.2]},{"center_m":[-6,1,-24],"size_m":[2,2,2],"albedo":[0.8,0.3,0.2]}]}' >"$tmp/flat.json"
+check "a level" expect_exit 0 "$skyview" "$tmp/pack" -o "$tmp/level" $small --world "$tmp/level.json"
+check "its triangles in one world file" expect_exit 0 "$skyview" "$tmp/pack" -o "$tmp/flat" $small --world "$tmp/flat.json"
+check "draw the same frame" cmp -s "$tmp/level/frame_0000.png" "$tmp/flat/frame_0000.png"
 check "data/worlds/colonnade.json (docs/fog.md's shafts) loads" expect_exit 0 "$skyview" "$tmp/pack" -o "$tmp/named" $small --world "$root/data/worlds/colonnade.json"
 check "three frames, each tone mapper" expect_exit 0 "$skyview" "$tmp/pack" -o "$tmp/g" $small --frames 3 --tonemap gt
 check "frame_0002.png" test -s "$tmp/g/frame_0002.png"
