@@ -299,16 +299,9 @@ enum sb_result sb_level_load(const struct sb_world_params *w, const char *direct
 {
     memset(level, 0, sizeof(*level));
     char path[2100];
-    if (w->file[0] == '/' || !directory[0])
-        snprintf(path, sizeof(path), "%s", w->file);
-    else
-        snprintf(path, sizeof(path), "%s/%s", directory, w->file);
+    sb_world_path(w, directory, path, sizeof(path));
     struct sb_mesh_albedo_override overrides[SB_WORLD_MAX_OVERRIDES];
-    for (int i = 0; i < w->override_count; i++) {
-        overrides[i].material = w->overrides[i].material;
-        memcpy(overrides[i].albedo, w->overrides[i].albedo, sizeof(overrides[i].albedo));
-    }
-    struct sb_mesh_load_params import = {.overrides = overrides, .override_count = w->override_count};
+    struct sb_mesh_load_params import = {.overrides = overrides, .override_count = sb_world_overrides(w, overrides)};
     struct loader ld = {.level = level, .import = &import};
     struct sb_mesh top = {0};
     struct sb_world_file_refs refs = {0};

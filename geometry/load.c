@@ -32,19 +32,30 @@ enum sb_result sb_mesh_load(const char *path, const struct sb_mesh_load_params *
     return res;
 }
 
+void sb_world_path(const struct sb_world_params *w, const char *directory, char *path, size_t size)
+{
+    if (w->file[0] == '/' || !directory[0])
+        snprintf(path, size, "%s", w->file);
+    else
+        snprintf(path, size, "%s/%s", directory, w->file);
+}
+
+int sb_world_overrides(const struct sb_world_params *w, struct sb_mesh_albedo_override *out)
+{
+    for (int i = 0; i < w->override_count; i++) {
+        out[i].material = w->overrides[i].material;
+        memcpy(out[i].albedo, w->overrides[i].albedo, sizeof(out[i].albedo));
+    }
+    return w->override_count;
+}
+
 enum sb_result sb_mesh_load_world(const struct sb_world_params *w, const char *directory, struct sb_mesh *mesh,
                                   char *path_out, size_t path_size)
 {
     char path[2100];
-    if (w->file[0] == '/' || !directory[0])
-        snprintf(path, sizeof(path), "%s", w->file);
-    else
-        snprintf(path, sizeof(path), "%s/%s", directory, w->file);
+    sb_world_path(w, directory, path, sizeof(path));
     struct sb_mesh_albedo_override overrides[SB_WORLD_MAX_OVERRIDES];
-    for (int i = 0; i < w->override_count; i++) {
-        overrides[i].material = w->overrides[i].material;
-        memcpy(overrides[i].albedo, w->overrides[i].albedo, sizeof(overrides[i].albedo));
-    }
+    sb_world_overrides(w, overrides);
     struct sb_mesh_ground ground = {
         .unless_own = !w->ground.object,
         .automatic_height = !w->ground.has_height,

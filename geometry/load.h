@@ -39,12 +39,20 @@ enum sb_result sb_mesh_load(const char *path, const struct sb_mesh_load_params *
  * in .json) rather than through assimp. */
 bool sb_mesh_is_world_file(const char *path);
 
+/* The path of a scene's world file: relative to `directory` unless
+ * absolute or directory is "". */
+struct sb_world_params;
+void sb_world_path(const struct sb_world_params *world, const char *directory, char *path, size_t size);
+
+/* The scene's albedo overrides as mesh.h's (pointing into *world), into
+ * out[SB_WORLD_MAX_OVERRIDES]; returns their count. */
+int sb_world_overrides(const struct sb_world_params *world, struct sb_mesh_albedo_override *out);
+
 /* Read a scene's world (formats/scene.h: its file, relative to
  * `directory` unless absolute or directory is "", placed and overridden as
  * the scene says, a mesh file standing on the ground the scene gives it,
  * by default one at its lowest point or 0, sb_mesh_ground); *path_out (may
  * be NULL) gets the path read, absolute. */
-struct sb_world_params;
 enum sb_result sb_mesh_load_world(const struct sb_world_params *world, const char *directory, struct sb_mesh *mesh,
                                   char *path_out, size_t path_size);
 
