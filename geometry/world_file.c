@@ -29,8 +29,19 @@ struct pillar {
     struct material material;
 };
 
+/* Rolling hills: a square heightfield of cells x cells quads centred on
+ * the origin, heights from seeded value noise (4 octaves). */
+struct terrain {
+    double size_m, height_m;
+    int cells;
+    uint32_t seed;
+    struct material material;
+};
+
 struct world {
     bool no_ground;       /* "ground": false */
+    bool has_terrain;
+    struct terrain terrain;
     double ground_size_m; /* the ground plane is this wide, centred on the origin */
     struct material ground;
     int box_count, pillar_count;
@@ -197,7 +208,8 @@ static enum sb_result array(const struct reader *rd, const cJSON *root, const ch
 static enum sb_result parse(const cJSON *root, const char *source, struct world *w)
 {
     struct reader rd = {.source = source};
-    static const char *const root_keys[] = {"version", "ground", "boxes", "pillars", "instances", "scatter", NULL};
+    static const char *const root_keys[] = {"version", "ground", "terrain", "boxes", "pillars", "instances", "scatter",
+                                            NULL};
     enum sb_result res = known_keys(&rd, root, root_keys);
     double version = 0;
     if (!res)
@@ -217,6 +229,31 @@ static enum sb_result parse(const cJSON *root, const char *source, struct world 
     } else if (!res) {
         w->ground_size_m = 2.0 * SB_MESH_MAX_EXTENT_M;
         res = material(&rd, root, &w->ground); /* defaults */
+    }
+    const cJSON *terrain = res ? NULL : cJSON_GetObjectItemCaseSensitive(root, "terrain");
+    if (!res && terrain) {
+        static const char *const keys[] = {"size_m", "cells", "height_m", "seed", MATERIAL_KEYS, NULL};
+        struct terrain *t = &w->terrain;
+        double cells = 0, seed = 0;
+        snprintf(rd.path, sizeof(rd.path), "terrain.");
+        w->has_terrain = true;
+        res = known_keys(&rd, terrain, keys);
+        if (!res)
+            res = number(&rd, terrain, "size_m", 1.0, 2.0 * SB_MESH_MAX_EXTENT_M, NAN, &t->size_m);
+        if (!res)
+            res = number(&rd, terrain, "cells", 1, SB_WORLD_FILE_MAX_TERRAIN_CELLS, NAN, &cells);
+        if (!res)
+            res = number(&rd, terrain, "height_m", 0.0, 1e3, 10.0, &t->height_m);
+        if (!res)
+            res = number(&rd, terrain, "seed", 0, 4294967295.0, 1, &seed);
+        if (!res && (cells != floor(cells) || seed != floor(seed))) {
+            sb_error("%s: terrain: cells and seed are whole numbers", source);
+            res = SB_ERR_OUT_OF_RANGE;
+        }
+        if (!res)
+            res = material(&rd, terrain, &t->material);
+        t->cells = (int)cells;
+        t->seed = (uint32_t)seed;
     }
     const cJSON *list, *item;
     int n = 0;
@@ -423,6 +460,50 @@ static void pillar(struct builder *b, const struct pillar *x)
     }
 }
 
+static double lattice(uint32_t seed, int64_t i, int64_t j)
+{
+    uint64_t h = seed * 0x9e3779b97f4a7c15ull ^ (uint64_t)i * 0xbf58476d1ce4e5b9ull ^ (uint64_t)j * 0x94d049bb133111ebull;
+    h ^= h >> 31;
+    h *= 0xd6e8feb86659fd93ull;
+    h ^= h >> 32;
+    return (double)(h >> 11) * 0x1.0p-52 - 1.0; /* [-1, 1) */
+}
+
+/* Value noise, smoothly interpolated, four octaves: in about [-1, 1]. */
+static double hills(uint32_t seed, double x, double z)
+{
+    double sum = 0, amplitude = 0.5333;
+    for (int o = 0; o < 4; o++, x *= 2, z *= 2, amplitude *= 0.5) {
+        double fx = floor(x), fz = floor(z), u = x - fx, v = z - fz;
+        u = u * u * (3 - 2 * u);
+        v = v * v * (3 - 2 * v);
+        int64_t i = (int64_t)fx, j = (int64_t)fz;
+        double a = lattice(seed + (uint32_t)o, i, j), b = lattice(seed + (uint32_t)o, i + 1, j);
+        double c = lattice(seed + (uint32_t)o, i, j + 1), d = lattice(seed + (uint32_t)o, i + 1, j + 1);
+        sum += amplitude * ((a + (b - a) * u) * (1 - v) + (c + (d - c) * u) * v);
+    }
+    return sum;
+}
+
+static void terrain(struct builder *b, const struct terrain *t)
+{
+    int n = t->cells;
+    double step = t->size_m / n, half = 0.5 * t->size_m, scale = 4.0 / t->size_m; /* four hills across */
+    for (int j = 0; j < n && !b->res; j++)
+        for (int i = 0; i < n && !b->res; i++) {
+            double p[4][3];
+            for (int k = 0; k < 4; k++) {
+                double x = -half + (i + (k & 1)) * step, z = -half + (j + (k >> 1)) * step;
+                p[k][0] = x;
+                p[k][1] = t->height_m * hills(t->seed, (x + half) * scale, (z + half) * scale);
+                p[k][2] = z;
+            }
+            /* counter-clockwise seen from above */
+            triangle(b, p[0], p[2], p[1]);
+            triangle(b, p[1], p[2], p[3]);
+        }
+}
+
 static enum sb_result build(const struct world *w, const char *source, const struct sb_mesh_load_params *params,
                             struct sb_mesh *mesh)
 {
@@ -432,6 +513,10 @@ static enum sb_result build(const struct world *w, const char *source, const str
     if (!w->no_ground) {
         begin(&b, "ground", &w->ground, false);
         quad(&b, g[0], g[1], g[2], g[3]);
+    }
+    if (w->has_terrain) {
+        begin(&b, "terrain", &w->terrain.material, true);
+        terrain(&b, &w->terrain);
     }
     char name[32];
     for (int i = 0; i < w->box_count; i++) {

@@ -20,6 +20,7 @@
 #define SB_WORLD_FILE_MAX_BYTES (1 << 20)
 #define SB_WORLD_FILE_MAX_OBJECTS 256 /* boxes, and pillars */
 #define SB_WORLD_FILE_MAX_REFS 16384  /* instances and scatters */
+#define SB_WORLD_FILE_MAX_TERRAIN_CELLS 2048 /* a side: 8 Mi triangles */
 #define SB_WORLD_FILE_MAX_SCATTER (1u << 20) /* copies one scatter places */
 
 /* A file a world file places (its "instances" and "scatter"): a mesh file

@@ -1114,6 +1114,35 @@ static void test_levels(void)
     sb_level_hash(&level, hash);
     sb_level_finish(&level);
 
+    /* terrain: cells x cells quads, within its height, facing up, the same for a seed */
+    char terrain_hash[2][33];
+    for (int k = 0; k < 2; k++) {
+        snprintf(path, sizeof(path), "%s/terrain%d.json", dir, k);
+        char text[256];
+        snprintf(text, sizeof(text),
+                 "{\"version\": 1, \"ground\": false, \"terrain\": {\"size_m\": 400, \"cells\": 50, "
+                 "\"height_m\": 12, \"seed\": %d}}",
+                 k ? 8 : 7);
+        write_file(path, text);
+        struct sb_mesh t = {0};
+        CHECK(sb_mesh_load(path, NULL, &t) == SB_OK && t.triangle_count == 2 * 50 * 50, "terrain: %u triangles",
+              t.triangle_count);
+        float tlo[3], thi[3];
+        uint32_t down = 0;
+        for (uint32_t i = 0; i < t.triangle_count; i++) {
+            const float *p0 = &t.positions[9 * (size_t)i], *p1 = p0 + 3, *p2 = p0 + 6;
+            double e1[3] = {p1[0] - p0[0], p1[1] - p0[1], p1[2] - p0[2]}, e2[3] = {p2[0] - p0[0], p2[1] - p0[1], p2[2] - p0[2]};
+            down += e1[2] * e2[0] - e1[0] * e2[2] <= 0; /* the normal's y */
+        }
+        CHECK(sb_mesh_bounds(&t, tlo, thi) && tlo[0] == -200 && thi[2] == 200 && tlo[1] >= -12 && thi[1] <= 12 &&
+                  thi[1] - tlo[1] > 6 && down == 0,
+              "terrain: x %g..%g, y %g..%g (hills within 12 m), %u triangles facing down", tlo[0], thi[0], tlo[1],
+              thi[1], down);
+        sb_mesh_hash(&t, terrain_hash[k]);
+        sb_mesh_finish(&t);
+    }
+    CHECK(strcmp(terrain_hash[0], terrain_hash[1]) != 0, "terrain: another seed, other hills");
+
     /* a world that places nothing: one mesh, hashed as before */
     snprintf(path, sizeof(path), "%s/plain.json", dir);
     write_file(path, "{\"version\": 1, \"boxes\": [{\"center_m\": [0, 1, 0], \"size_m\": [1, 2, 1]}]}");
