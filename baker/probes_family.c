@@ -38,7 +38,7 @@ static const double push_steps[] = {0.25, 0.5};
 /* The world as read for this bake: the key's input and the bake's; its
  * BVH on the device, built by the first product baked. */
 struct probes_state {
-    struct sb_level level;
+    const struct sb_level *level;
     char mesh_hash[SB_HASH_HEX_SIZE];
     char path[640]; /* the world's file, absolute */
     struct sb_bvh bvh;
@@ -53,17 +53,17 @@ static enum sb_result probes_create(struct sb_vk *vk, const struct sb_scene *sce
     struct probes_state *st = calloc(1, sizeof(*st));
     if (!st)
         return SB_ERR_NOMEM;
-    enum sb_result res = sb_level_load(&scene->world, scene->directory, &st->level, st->path, sizeof(st->path));
+    enum sb_result res = sb_level_acquire(&scene->world, scene->directory, &st->level, st->path, sizeof(st->path));
     struct sb_probe_layout layout = {0};
     uint64_t grid;
     if (!res)
-        res = plan(scene, &st->level, &layout, &grid);
+        res = plan(scene, st->level, &layout, &grid);
     if (res) {
-        sb_level_finish(&st->level);
+        sb_level_release(&st->level);
         free(st);
         return res;
     }
-    sb_level_hash(&st->level, st->mesh_hash);
+    sb_level_hash(st->level, st->mesh_hash);
     *out = st;
     return SB_OK;
 }
@@ -74,7 +74,7 @@ static void probes_destroy(void **state)
     if (st) {
         sb_raycaster_destroy(&st->rc);
         sb_bvh_finish(&st->bvh);
-        sb_level_finish(&st->level);
+        sb_level_release(&st->level);
     }
     free(st);
     *state = NULL;
@@ -113,7 +113,7 @@ static uint32_t probes_depends_on(enum sb_product_id id)
 static enum sb_result raycaster(struct probes_state *st, struct sb_vk *vk)
 {
     enum sb_result res = SB_OK;
-    if (!st->rc && !(res = sb_level_build_bvh(&st->level, &st->bvh)))
+    if (!st->rc && !(res = sb_level_build_bvh(st->level, &st->bvh)))
         res = sb_raycaster_create(vk, &st->bvh, &st->rc);
     return res;
 }
@@ -199,7 +199,8 @@ static enum sb_result place(const struct sb_scene *scene, const struct sb_level 
  * move each to the first that is free; flag the rest invalid.
  */
 static enum sb_result push_out(struct sb_raycaster *rc, const struct sb_scene *scene, float *positions, float *offsets,
-                               float *valid, const float *results, uint32_t count, uint32_t *inside, uint32_t *pushed)
+                               float *valid, const float *results, uint32_t count, uint32_t *inside, uint32_t *pushed,
+                               double *gpu_ms)
 {
     const int per = 26 * (int)(sizeof(push_steps) / sizeof(push_steps[0]));
     double unit = scene->probes.spacing_m > 0 ? scene->probes.spacing_m : 1.0;
@@ -240,7 +241,7 @@ static enum sb_result push_out(struct sb_raycaster *rc, const struct sb_scene *s
             }
     }
     struct sb_sky_visibility_params quick = {.ray_count = PUSH_RAYS};
-    if ((res = sb_sky_visibility_bake(rc, candidates, n * per, &quick, trial, NULL)))
+    if ((res = sb_sky_visibility_bake(rc, candidates, n * per, &quick, trial, gpu_ms)))
         goto done;
     for (uint32_t j = 0; j < n; j++)
         for (int c = 0; c < per; c++) {
@@ -290,7 +291,7 @@ static enum sb_result bake_visibility(struct probes_state *st, const struct sb_s
     struct sb_probe_layout *layout = &a->probes;
     memset(layout, 0, sizeof(*layout));
     enum sb_result res;
-    const struct sb_level *level = &st->level;
+    const struct sb_level *level = st->level;
     if ((res = place(scene, level, layout, &positions, &count)))
         goto done;
     offsets = calloc((size_t)count * 3, sizeof(float));
@@ -305,8 +306,9 @@ static enum sb_result bake_visibility(struct probes_state *st, const struct sb_s
     if ((res = sb_sky_visibility_bake(rc, positions, count, &params, results, &ms)))
         goto done;
     gpu_ms += ms;
-    if ((res = push_out(rc, scene, positions, offsets, valid, results, count, &inside, &pushed)))
+    if ((res = push_out(rc, scene, positions, offsets, valid, results, count, &inside, &pushed, &ms)))
         goto done;
+    gpu_ms += inside ? ms : 0; /* every candidate place of every probe inside */
     if (pushed && (res = sb_sky_visibility_bake(rc, positions, count, &params, results, &ms)))
         goto done;
     gpu_ms += pushed ? ms : 0;
@@ -374,7 +376,7 @@ static enum sb_result bake_bounce(struct probes_state *st, const struct sb_scene
     uint32_t count = 0;
     struct sb_probe_layout *layout = &a->probes;
     memset(layout, 0, sizeof(*layout));
-    enum sb_result res = place(scene, &st->level, layout, &positions, &count);
+    enum sb_result res = place(scene, st->level, layout, &positions, &count);
     if (!res && (visibility->width != count || visibility->channel_count != SB_SKY_VISIBILITY_CHANNEL_COUNT)) {
         sb_error("sky_bounce: sky_visibility holds %u probes, the scene places %u", visibility->width, count);
         res = SB_ERR_BAD_IMAGE;
@@ -396,7 +398,7 @@ static enum sb_result bake_bounce(struct probes_state *st, const struct sb_scene
     }
     struct sb_sky_bounce_params params = {.ray_count = scene->probes.bounce_rays,
                                           .secondary = scene->probes.bounce_secondary};
-    if ((res = sb_sky_bounce_bake(st->rc, st->level.materials, st->level.material_count, positions, valid, count, &params, out, &a->gpu_ms)) ||
+    if ((res = sb_sky_bounce_bake(st->rc, st->level->materials, st->level->material_count, positions, valid, count, &params, out, &a->gpu_ms)) ||
         (res = sb_image_init(image, count, 1, SB_SKY_BOUNCE_CHANNEL_COUNT)))
         goto done;
     sb_image_set_channel_names(image, SB_SKY_BOUNCE_CHANNELS);

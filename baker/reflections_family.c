@@ -32,7 +32,7 @@
 
 struct reflection_state {
     bool has_world;
-    struct sb_level level;
+    const struct sb_level *level;
     char mesh_hash[SB_HASH_HEX_SIZE];
     char path[640]; /* the world's file, absolute */
     struct sb_bvh bvh;
@@ -57,11 +57,11 @@ static enum sb_result reflection_create(struct sb_vk *vk, const struct sb_scene 
         sb_warn("reflections.probes: the scene has no world, so every cube sees the sky alone");
     if (!wants_cubes(scene) || !scene->has_world)
         return SB_OK;
-    enum sb_result res = sb_level_load(&scene->world, scene->directory, &st->level, st->path, sizeof(st->path));
+    enum sb_result res = sb_level_acquire(&scene->world, scene->directory, &st->level, st->path, sizeof(st->path));
     if (res)
         return res;
     st->has_world = true;
-    sb_level_hash(&st->level, st->mesh_hash);
+    sb_level_hash(st->level, st->mesh_hash);
     return SB_OK;
 }
 
@@ -74,7 +74,7 @@ static void reflection_destroy(void **state)
         sb_atmosphere_baker_destroy(&st->atmosphere);
         sb_raycaster_destroy(&st->rc);
         sb_bvh_finish(&st->bvh);
-        sb_level_finish(&st->level);
+        sb_level_release(&st->level);
     }
     free(st);
     *state = NULL;
@@ -153,7 +153,7 @@ static enum sb_result bake_cubes(struct reflection_state *st, struct sb_vk *vk, 
         for (size_t i = 0; i < sizeof(inputs) / sizeof(inputs[0]) && !res; i++)
             res = sb_atmosphere_adopt(st->atmosphere, inputs[i], &baked[inputs[i]]);
     }
-    if (!res && st->has_world && !st->rc && !(res = sb_level_build_bvh(&st->level, &st->bvh)))
+    if (!res && st->has_world && !st->rc && !(res = sb_level_build_bvh(st->level, &st->bvh)))
         res = sb_raycaster_create(vk, &st->bvh, &st->rc);
     if (res)
         return res;
@@ -179,8 +179,8 @@ static enum sb_result bake_cubes(struct reflection_state *st, struct sb_vk *vk, 
         struct sb_capture_inputs in = {
             .atmosphere = st->atmosphere,
             .rc = i ? st->rc : NULL,
-            .materials = st->level.materials,
-            .material_count = st->level.material_count,
+            .materials = st->level->materials,
+            .material_count = st->level->material_count,
             .kernels = &st->kernels,
         };
         double t1 = 1e3 * sb_now_s();

@@ -3,6 +3,7 @@
 #include <errno.h>
 #include <limits.h>
 #include <math.h>
+#include <pthread.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -82,11 +83,11 @@ static double uniform(uint64_t *state)
 static enum sb_result resolve(struct loader *ld, const char *path, uint32_t depth, const char *named_by,
                               uint32_t *out);
 
-/* A world file's scatter: each copy dropped onto the file's own triangles
- * and what its first `instances` children (its "instances" list) place,
- * their own triangles, from 10 km up. */
-static enum sb_result scatter(struct loader *ld, const struct unique *u, uint32_t instances,
-                              const struct sb_world_file_ref *r, const char *source, struct child *out)
+/* What a world file's scatters land on: its own triangles and what its
+ * first `instances` children (its "instances" list) place, their own
+ * triangles, as one BVH (built once for all its scatters). */
+static enum sb_result landing(struct loader *ld, const struct unique *u, uint32_t instances, const char *source,
+                              struct sb_bvh *bvh)
 {
     const struct sb_level *l = ld->level;
     const struct sb_mesh **meshes = malloc((instances + 1) * sizeof(*meshes));
@@ -105,16 +106,24 @@ static enum sb_result scatter(struct loader *ld, const struct unique *u, uint32_
         placed[placed_count].mesh = k;
         memcpy(placed[placed_count++].to_world, c == 0 ? identity : u->children[c - 1].local, sizeof(identity));
     }
-    struct sb_bvh bvh = {0};
     if (!res && !placed_count) {
         sb_error("%s: scatter: nothing to land on (the file has no triangles of its own and no instances)", source);
         res = SB_ERR_MESH;
     }
     if (!res)
-        res = sb_bvh_build_instanced(meshes, mesh_count, placed, placed_count, &bvh);
+        res = sb_bvh_build_instanced(meshes, mesh_count, placed, placed_count, bvh);
+    free(meshes);
+    free(placed);
+    return res;
+}
+
+/* A scatter's copies, each dropped from 10 km up onto `surface`. */
+static void scatter(const struct sb_bvh *surface, const struct sb_world_file_ref *r, const char *source,
+                    struct child *out)
+{
     uint64_t state = r->seed * 0x2545f4914f6cdd1dull + 1;
     uint32_t missed = 0;
-    for (uint32_t i = 0; i < r->count && !res; i++) {
+    for (uint32_t i = 0; i < r->count; i++) {
         double x = r->area_m[0] + uniform(&state) * (r->area_m[2] - r->area_m[0]);
         double z = r->area_m[1] + uniform(&state) * (r->area_m[3] - r->area_m[1]);
         double yaw = 360.0 * uniform(&state);
@@ -122,7 +131,7 @@ static enum sb_result scatter(struct loader *ld, const struct unique *u, uint32_
         float o[3] = {(float)x, (float)SB_MESH_MAX_EXTENT_M, (float)z}, d[3] = {0, -1, 0};
         struct sb_hit hit;
         double y = 0.0;
-        if (sb_bvh_intersect(&bvh, o, d, 0.0f, (float)(2 * SB_MESH_MAX_EXTENT_M), false, &hit))
+        if (sb_bvh_intersect(surface, o, d, 0.0f, (float)(2 * SB_MESH_MAX_EXTENT_M), false, &hit))
             y = SB_MESH_MAX_EXTENT_M - hit.t;
         else
             missed++;
@@ -138,10 +147,6 @@ static enum sb_result scatter(struct loader *ld, const struct unique *u, uint32_
     if (missed)
         sb_warn("%s: scatter of %s: %u of %u copies found nothing below them and stand at y = 0", source, r->file,
                 missed, r->count);
-    sb_bvh_finish(&bvh);
-    free(meshes);
-    free(placed);
-    return res;
 }
 
 /* Read a world file's own triangles and what it places. */
@@ -171,6 +176,7 @@ static enum sb_result read_world_file(struct loader *ld, uint32_t self, uint32_t
     *strrchr(dir, '/') = '\0';
     /* the instances first: the scatters land on them */
     uint32_t n = 0, instances = 0;
+    struct sb_bvh surface = {0};
     for (int pass = 0; pass < 2 && !res; pass++) {
         if (pass == 1)
             instances = n;
@@ -192,13 +198,17 @@ static enum sb_result read_world_file(struct loader *ld, uint32_t self, uint32_t
                 children[n].unique = unique;
                 sb_mesh_transform_matrix(&r->transform, children[n++].local);
             } else {
-                res = scatter(ld, u, instances, r, path, &children[n]);
+                if (!surface.nodes)
+                    res = landing(ld, u, instances, path, &surface);
+                if (!res)
+                    scatter(&surface, r, path, &children[n]);
                 for (uint32_t k = 0; k < r->count && !res; k++)
                     children[n + k].unique = unique;
                 n += r->count;
             }
         }
     }
+    sb_bvh_finish(&surface);
     struct unique *u = &ld->uniques[self];
     u->children = children;
     u->child_count = res ? 0 : n;
@@ -531,4 +541,68 @@ enum sb_result sb_level_flatten(const struct sb_level *level, struct sb_mesh *me
     if (res)
         sb_mesh_finish(mesh);
     return res;
+}
+
+/* ---- shared while held ---------------------------------------------------------------------- */
+
+static struct {
+    pthread_mutex_t lock;
+    struct sb_level level;
+    struct sb_world_params world;
+    char directory[1024], path[PATH_MAX];
+    int holders;
+} shared = {.lock = PTHREAD_MUTEX_INITIALIZER};
+
+enum sb_result sb_level_acquire(const struct sb_world_params *world, const char *directory,
+                                const struct sb_level **level, char *path_out, size_t path_size)
+{
+    *level = NULL;
+    pthread_mutex_lock(&shared.lock);
+    enum sb_result res = SB_OK;
+    bool same = shared.holders && !memcmp(&shared.world, world, sizeof(*world)) &&
+                !strcmp(shared.directory, directory);
+    if (!same && shared.holders) {
+        /* another world while one is held: read alone, not shared */
+        pthread_mutex_unlock(&shared.lock);
+        struct sb_level *own = malloc(sizeof(*own));
+        if (!own)
+            return SB_ERR_NOMEM;
+        if ((res = sb_level_load(world, directory, own, path_out, path_size)))
+            free(own);
+        else
+            *level = own;
+        return res;
+    }
+    if (!same) {
+        res = sb_level_load(world, directory, &shared.level, shared.path, sizeof(shared.path));
+        if (!res) {
+            memcpy(&shared.world, world, sizeof(*world));
+            snprintf(shared.directory, sizeof(shared.directory), "%s", directory);
+        }
+    }
+    if (!res) {
+        shared.holders++;
+        *level = &shared.level;
+        if (path_out)
+            snprintf(path_out, path_size, "%s", shared.path);
+    }
+    pthread_mutex_unlock(&shared.lock);
+    return res;
+}
+
+void sb_level_release(const struct sb_level **level)
+{
+    if (!*level)
+        return;
+    pthread_mutex_lock(&shared.lock);
+    if (*level == &shared.level) {
+        if (--shared.holders == 0)
+            sb_level_finish(&shared.level);
+    } else {
+        struct sb_level *own = (struct sb_level *)*level;
+        sb_level_finish(own);
+        free(own);
+    }
+    pthread_mutex_unlock(&shared.lock);
+    *level = NULL;
 }

@@ -51,6 +51,17 @@ enum sb_result sb_level_load(const struct sb_world_params *world, const char *di
 /* Free and zero; accepts a zeroed level. */
 void sb_level_finish(struct sb_level *level);
 
+/*
+ * The same level shared while held: the first acquire reads it (as
+ * sb_level_load), later ones of the same world (the same parameters and
+ * directory) while it is held get it again, so the families of one bake
+ * read a level once. Release with sb_level_release, which frees it when no
+ * holder is left and sets *level to NULL. Thread-safe.
+ */
+enum sb_result sb_level_acquire(const struct sb_world_params *world, const char *directory,
+                                const struct sb_level **level, char *path_out, size_t path_size);
+void sb_level_release(const struct sb_level **level);
+
 /* The BVH: one level over meshes[0], or two. */
 enum sb_result sb_level_build_bvh(const struct sb_level *level, struct sb_bvh *bvh);
 

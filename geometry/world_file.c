@@ -382,6 +382,7 @@ static enum sb_result parse(const cJSON *root, const char *source, struct world 
 struct builder {
     struct sb_mesh *mesh;
     const struct sb_mesh_load_params *params;
+    double to_world[3][4]; /* params' transform, made once */
     const char *source;
     uint32_t material;
     enum sb_result res;
@@ -413,8 +414,10 @@ static void triangle(struct builder *b, const double p0[3], const double p1[3], 
         return;
     double q[3][3];
     const double *p[3] = {p0, p1, p2};
+    const double(*m)[4] = b->to_world;
     for (int k = 0; k < 3; k++)
-        sb_mesh_transform_point(&b->params->transform, p[k], q[k]);
+        for (int i = 0; i < 3; i++)
+            q[k][i] = m[i][0] * p[k][0] + m[i][1] * p[k][1] + m[i][2] * p[k][2] + m[i][3];
     b->res = sb_mesh_add_triangle(b->mesh, q[0], q[1], q[2], b->material, b->source);
 }
 
@@ -508,6 +511,7 @@ static enum sb_result build(const struct world *w, const char *source, const str
                             struct sb_mesh *mesh)
 {
     struct builder b = {.mesh = mesh, .params = params, .source = source};
+    sb_mesh_transform_matrix(&params->transform, b.to_world);
     double h = 0.5 * w->ground_size_m;
     double g[4][3] = {{-h, 0, h}, {h, 0, h}, {h, 0, -h}, {-h, 0, -h}};
     if (!w->no_ground) {
