@@ -67,8 +67,9 @@ static void usage(FILE *f)
                "  --camera X,Y,Z[,YAW,PITCH[,FOV]]\n"
                "                          metres (y up, origin on the ground) and degrees: yaw\n"
                "                          clockwise from north, pitch above the horizontal,\n"
-               "                          vertical field of view (default 0,2,0,0,3,50; when\n"
-               "                          that cannot see the world, one that frames it)\n"
+               "                          vertical field of view (default 0,2,0,0,3,50; under\n"
+               "                          the world's surface, lifted onto it; when that cannot\n"
+               "                          see the world, one that frames it)\n"
                "  --world FILE            the world: a skybake world file (.json) or a mesh assimp\n"
                "                          reads (default: the world the pack's probes were baked\n"
                "                          against, else the built-in data/worlds/test.json)\n"
@@ -944,6 +945,14 @@ static int run(const struct options *o)
         framed = *o;
         struct sb_view *v = &framed.view;
         double aspect = (double)(params.width ? params.width : 1280) / (params.height ? params.height : 720);
+        double surface;
+        if (sb_world_lift(&world, 1.7, v->camera_m, &surface)) {
+            sb_info("the default camera is under the world's surface (at %.4g m there): lifted onto it, as --camera "
+                    "%.4g,%.4g,%.4g,%.4g,%.4g,%.4g",
+                    surface, v->camera_m[0], v->camera_m[1], v->camera_m[2], v->yaw / DEG, v->pitch / DEG,
+                    (v->fov_y > 0 ? v->fov_y : 50.0 * DEG) / DEG);
+            o = &framed;
+        }
         if (sb_world_frame(&world, aspect, v->fov_y > 0 ? v->fov_y : 50.0 * DEG, v->camera_m, &v->yaw, &v->pitch)) {
             sb_info("the default camera does not see the world: framing it, as --camera %.4g,%.4g,%.4g,%.4g,%.4g,%.4g",
                     v->camera_m[0], v->camera_m[1], v->camera_m[2], v->yaw / DEG, v->pitch / DEG,

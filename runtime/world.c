@@ -56,6 +56,35 @@ static double dot3d(const double a[3], const double b[3])
     return a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
 }
 
+bool sb_world_lift(const struct sb_world *w, double eye_m, double camera_m[3], double *surface_m)
+{
+    bool below = false, above = false;
+    double highest = -INFINITY, x = camera_m[0], z = camera_m[2];
+    for (uint32_t v = 0; v + 2 < w->vertex_count; v += 3) {
+        const float *a = w->vertices[v].position, *b = w->vertices[v + 1].position, *c = w->vertices[v + 2].position;
+        if (!(w->vertices[v].normal[1] > 0.0f))
+            continue; /* upward faces only */
+        /* barycentrics of (x, z) in the triangle's projection */
+        double d = ((double)b[2] - c[2]) * ((double)a[0] - c[0]) + ((double)c[0] - b[0]) * ((double)a[2] - c[2]);
+        if (d == 0.0)
+            continue;
+        double l1 = (((double)b[2] - c[2]) * (x - c[0]) + ((double)c[0] - b[0]) * (z - c[2])) / d;
+        double l2 = (((double)c[2] - a[2]) * (x - c[0]) + ((double)a[0] - c[0]) * (z - c[2])) / d;
+        double l3 = 1.0 - l1 - l2;
+        if (l1 < 0 || l2 < 0 || l3 < 0)
+            continue;
+        double y = l1 * a[1] + l2 * b[1] + l3 * c[1];
+        below = below || y <= camera_m[1];
+        above = above || y > camera_m[1];
+        highest = fmax(highest, y);
+    }
+    if (below || !above)
+        return false;
+    *surface_m = highest;
+    camera_m[1] = round((highest + eye_m) * 1e4) / 1e4;
+    return true;
+}
+
 bool sb_world_frame(const struct sb_world *w, double aspect, double fov_y, double camera_m[3], double *yaw,
                     double *pitch)
 {

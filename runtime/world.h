@@ -61,6 +61,14 @@ enum sb_result sb_world_mesh(const struct sb_world *world, bool casters_only, st
 bool sb_world_frame(const struct sb_world *world, double aspect, double fov_y, double camera_m[3], double *yaw,
                     double *pitch);
 
+/*
+ * A camera under the world's surface (a terrain whose hills rise above
+ * it): when an upward face lies above camera_m and none below it (straight
+ * up and down), lift it to `eye_m` above the highest upward face there and
+ * return true (*surface_m gets that face's height); else leave it.
+ */
+bool sb_world_lift(const struct sb_world *world, double eye_m, double camera_m[3], double *surface_m);
+
 /* Free the triangles; accepts a zeroed world. */
 void sb_world_finish(struct sb_world *world);
 

@@ -37,6 +37,12 @@ check "the built-in world is data/worlds/test.json" cmp -s "$tmp/elsewhere/frame
 # camera reported; the test world and a given --camera are left alone.
 # ($tmp/err is the run with the test world named, above)
 check "the test world is not framed" sh -c "! grep -q 'framing it' '$tmp/err'"
+check "nor lifted" sh -c "! grep -q 'lifted onto it' '$tmp/err'"
+# Hills rising over the default camera (3.8 m at the origin, seed 5): it
+# stands on them, 1.7 m up, and says so.
+printf '{"version":1,"ground":false,"terrain":{"size_m":400,"cells":80,"height_m":20,"seed":5}}' >"$tmp/hills.json"
+check "a camera under hills" expect_exit 0 "$skyview" "$tmp/pack" -o "$tmp/hills" $small --world "$tmp/hills.json"
+check "is lifted onto them, and the camera said" grep -q "under the world's surface (at 3.811 m there): lifted onto it, as --camera 0,5.511,0," "$tmp/err"
 printf 'v 3 0 27\nv 5 0 27\nv 5 2 27\nv 3 2 27\nv 3 0 33\nv 5 0 33\nv 5 2 33\nv 3 2 33\nf 1 2 3 4\nf 5 8 7 6\nf 1 5 6 2\nf 4 3 7 8\nf 1 4 8 5\nf 2 6 7 3\n' >"$tmp/behind.obj"
 check "a model behind the default camera" expect_exit 0 "$skyview" "$tmp/pack" -o "$tmp/framed" $small --world "$tmp/behind.obj"
 check "is framed, and the camera said" grep -q "the default camera does not see the world: framing it, as --camera 4," "$tmp/err"
