@@ -4,7 +4,9 @@
  * other, through formats/sandbox.h: the request, then the answer's header;
  * after a header with result 0 come material_count struct sb_mesh_material,
  * 3 x vertex_count floats (positions, world metres, three per triangle)
- * and triangle_count material indices. Both sides are of one build (the
+ * and triangle_count material indices, then, for a file kept as parts
+ * (mesh.h's sb_mesh_parts), part_count (first, count) pairs of uint32_t
+ * and placement_count struct sb_mesh_placement. Both sides are of one build (the
  * sandbox checks), so the structs go as bytes.
  */
 #ifndef SB_IMPORT_MESH_H
@@ -27,6 +29,7 @@ struct sb_import_mesh_request {
         char material[64];
         double albedo[3];
     } overrides[SB_WORLD_MAX_OVERRIDES];
+    int32_t keep_parts; /* sb_mesh_import_parts */
     char path[4096];
 };
 
@@ -34,6 +37,7 @@ struct sb_import_mesh_answer {
     uint32_t magic;
     int32_t result;
     uint32_t vertex_count, triangle_count, material_count, dropped_degenerate;
+    uint32_t part_count, placement_count; /* parts: then part_count (first, count) pairs and the placements */
     char message[512]; /* the first warning or error the helper logged */
 };
 

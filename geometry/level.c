@@ -67,6 +67,75 @@ static enum sb_result add_mesh(struct loader *ld, struct sb_mesh *mesh, int32_t 
     return SB_OK;
 }
 
+/* A new unique entry named `path` (no mesh, no children yet). */
+static enum sb_result new_unique(struct loader *ld, const char *path, uint32_t *index)
+{
+    if (ld->unique_count == ld->unique_capacity) {
+        uint32_t n = ld->unique_capacity ? 2 * ld->unique_capacity : 16;
+        struct unique *u = realloc(ld->uniques, n * sizeof(*u));
+        if (!u)
+            return SB_ERR_NOMEM;
+        ld->uniques = u;
+        ld->unique_capacity = n;
+    }
+    *index = ld->unique_count++;
+    struct unique *u = &ld->uniques[*index];
+    memset(u, 0, sizeof(*u));
+    snprintf(u->path, sizeof(u->path), "%s", path);
+    u->mesh = -1;
+    return SB_OK;
+}
+
+/* A mesh file whose nodes place a mesh more than once (mesh.h's parts):
+ * each part a mesh of its own (every material kept, so that the indices
+ * hold) and an entry "path#k" placed as the file's children. */
+static enum sb_result add_parts(struct loader *ld, uint32_t self, const struct sb_mesh *mesh,
+                                const struct sb_mesh_parts *parts)
+{
+    struct child *children = calloc(parts->placement_count, sizeof(*children));
+    uint32_t *part_unique = calloc(parts->part_count, sizeof(*part_unique));
+    enum sb_result res = children && part_unique ? SB_OK : SB_ERR_NOMEM;
+    for (uint32_t k = 0; k < parts->part_count && !res; k++) {
+        struct sb_mesh part = {0};
+        for (uint32_t m = 0; m < mesh->material_count && !res; m++) {
+            const struct sb_mesh_material *from = &mesh->material_list[m];
+            double albedo[3] = {from->albedo[0], from->albedo[1], from->albedo[2]};
+            uint32_t index;
+            if (!(res = sb_mesh_add_material(&part, from->name, albedo, &index)))
+                part.material_list[index] = *from;
+        }
+        for (uint32_t t = parts->first[k]; t < parts->first[k] + parts->count[k] && !res; t++) {
+            double p[3][3];
+            for (int v = 0; v < 3; v++)
+                for (int i = 0; i < 3; i++)
+                    p[v][i] = mesh->positions[3 * (size_t)mesh->indices[3 * (size_t)t + v] + i];
+            res = sb_mesh_add_triangle(&part, p[0], p[1], p[2], mesh->materials[t], ld->uniques[self].path);
+        }
+        char name[PATH_MAX + 16];
+        snprintf(name, sizeof(name), "%s#%u", ld->uniques[self].path, k);
+        int32_t mesh_index = -1;
+        if (!res && !(res = add_mesh(ld, &part, &mesh_index)) && !(res = new_unique(ld, name, &part_unique[k]))) {
+            struct unique *u = &ld->uniques[part_unique[k]];
+            u->mesh = mesh_index;
+            u->instances = 1;
+            u->triangles = ld->level->meshes[mesh_index].triangle_count;
+        }
+        sb_mesh_finish(&part);
+    }
+    for (uint32_t i = 0; i < parts->placement_count && !res; i++) {
+        children[i].unique = part_unique[parts->placements[i].part];
+        memcpy(children[i].local, parts->placements[i].to_world, sizeof(children[i].local));
+    }
+    free(part_unique);
+    if (res) {
+        free(children);
+        return res;
+    }
+    ld->uniques[self].children = children;
+    ld->uniques[self].child_count = parts->placement_count;
+    return SB_OK;
+}
+
 static uint64_t splitmix(uint64_t *state)
 {
     uint64_t z = (*state += 0x9e3779b97f4a7c15ull);
@@ -239,32 +308,27 @@ static enum sb_result resolve(struct loader *ld, const char *path, uint32_t dept
         sb_error("%s: %s: world files nest more than %d deep", named_by, canonical, SB_LEVEL_MAX_DEPTH);
         return SB_ERR_TOO_LARGE;
     }
-    if (ld->unique_count == ld->unique_capacity) {
-        uint32_t n = ld->unique_capacity ? 2 * ld->unique_capacity : 16;
-        struct unique *u = realloc(ld->uniques, n * sizeof(*u));
-        if (!u)
-            return SB_ERR_NOMEM;
-        ld->uniques = u;
-        ld->unique_capacity = n;
-    }
-    uint32_t self = ld->unique_count++;
+    uint32_t self;
+    enum sb_result res = new_unique(ld, canonical, &self);
+    if (res)
+        return res;
     struct unique *u = &ld->uniques[self];
-    memset(u, 0, sizeof(*u));
-    snprintf(u->path, sizeof(u->path), "%s", canonical);
-    u->mesh = -1;
     u->resolving = true;
-    enum sb_result res;
     if (sb_mesh_is_world_file(canonical)) {
         res = read_world_file(ld, self, depth);
     } else {
         struct sb_mesh mesh = {0};
+        struct sb_mesh_parts parts;
         const char *name = strrchr(canonical, '/');
         sb_status_begin("loading %s", name ? name + 1 : canonical);
-        res = sb_mesh_import(canonical, ld->import, &mesh);
+        res = sb_mesh_import_parts(canonical, ld->import, &mesh, &parts);
         sb_status_end();
-        if (!res)
+        if (!res && !parts.part_count)
             res = add_mesh(ld, &mesh, &ld->uniques[self].mesh);
+        else if (!res)
+            res = add_parts(ld, self, &mesh, &parts);
         sb_mesh_finish(&mesh);
+        sb_mesh_parts_finish(&parts);
     }
     u = &ld->uniques[self];
     u->resolving = false;

@@ -223,6 +223,11 @@ struct importer {
     struct sb_mesh *mesh;
     uint32_t *material_map; /* the file's material -> the mesh's */
     uint64_t triangles;     /* counted before anything is added */
+    /* kept as parts (sb_mesh_import_parts): each file mesh's part, -1 none */
+    struct sb_mesh_parts *parts;
+    int32_t *part_of;
+    uint32_t *uses;   /* how many times the node tree places each file mesh */
+    bool single_only; /* add_node: only the meshes placed once */
 };
 
 /* Count the triangles the node tree instances, refusing deep trees and
@@ -257,7 +262,7 @@ static enum sb_result add_node(struct importer *im, const struct aiNode *node, c
     struct mat4 m = mat_mul(parent, &local);
     for (unsigned i = 0; i < node->mNumMeshes; i++) {
         const struct aiMesh *am = im->scene->mMeshes[node->mMeshes[i]];
-        if (!(am->mPrimitiveTypes & aiPrimitiveType_TRIANGLE))
+        if (!(am->mPrimitiveTypes & aiPrimitiveType_TRIANGLE) || (im->single_only && im->uses[node->mMeshes[i]] != 1))
             continue;
         uint32_t material = im->material_map[am->mMaterialIndex < im->scene->mNumMaterials ? am->mMaterialIndex : 0];
         for (unsigned f = 0; f < am->mNumFaces; f++) {
@@ -284,6 +289,101 @@ static enum sb_result add_node(struct importer *im, const struct aiNode *node, c
             return res;
     }
     return SB_OK;
+}
+
+/* How many times the node tree places each mesh (count_node has checked the tree). */
+static void count_uses(struct importer *im, const struct aiNode *node)
+{
+    for (unsigned i = 0; i < node->mNumMeshes; i++)
+        im->uses[node->mMeshes[i]]++;
+    for (unsigned c = 0; c < node->mNumChildren; c++)
+        count_uses(im, node->mChildren[c]);
+}
+
+/* Every placement of a part, the nodes' transforms under `parent`. */
+static enum sb_result place_parts(struct importer *im, const struct aiNode *node, const struct mat4 *parent)
+{
+    struct mat4 local = mat_from_ai(&node->mTransformation);
+    struct mat4 m = mat_mul(parent, &local);
+    struct sb_mesh_parts *parts = im->parts;
+    for (unsigned i = 0; i < node->mNumMeshes; i++) {
+        int32_t part = im->part_of[node->mMeshes[i]];
+        if (part < 0)
+            continue;
+        if (parts->placement_count >= SB_MESH_MAX_PLACEMENTS) {
+            sb_error("%s: more than %u placements of its meshes", im->path, SB_MESH_MAX_PLACEMENTS);
+            return SB_ERR_TOO_LARGE;
+        }
+        if ((parts->placement_count & (parts->placement_count - 1)) == 0) { /* grown at powers of two */
+            size_t n = parts->placement_count ? 2 * (size_t)parts->placement_count : 16;
+            struct sb_mesh_placement *p = realloc(parts->placements, n * sizeof(*p));
+            if (!p)
+                return SB_ERR_NOMEM;
+            parts->placements = p;
+        }
+        struct sb_mesh_placement *out = &parts->placements[parts->placement_count++];
+        memset(out, 0, sizeof(*out));
+        out->part = (uint32_t)part;
+        for (int r = 0; r < 3; r++)
+            for (int c = 0; c < 4; c++)
+                out->to_world[r][c] = m.m[r][c];
+    }
+    for (unsigned c = 0; c < node->mNumChildren; c++) {
+        enum sb_result res = place_parts(im, node->mChildren[c], &m);
+        if (res)
+            return res;
+    }
+    return SB_OK;
+}
+
+/* The parts: first the meshes placed once, in the file's space (their
+ * nodes' transforms applied), as one part placed once; then each mesh
+ * placed more than once, in its own space, a part placed where its nodes
+ * put it. */
+static enum sb_result add_parts(struct importer *im)
+{
+    const struct aiScene *scene = im->scene;
+    struct sb_mesh_parts *parts = im->parts;
+    parts->first = calloc(scene->mNumMeshes + 2, sizeof(uint32_t));
+    parts->count = calloc(scene->mNumMeshes + 2, sizeof(uint32_t));
+    if (!parts->first || !parts->count)
+        return SB_ERR_NOMEM;
+    static const struct mat4 identity = {{{1, 0, 0, 0}, {0, 1, 0, 0}, {0, 0, 1, 0}, {0, 0, 0, 1}}};
+    struct mat4 world = mat_world(&im->params->transform);
+    im->single_only = true;
+    enum sb_result merged = add_node(im, scene->mRootNode, &identity);
+    im->single_only = false;
+    if (merged)
+        return merged;
+    if (im->mesh->triangle_count) {
+        parts->count[parts->part_count++] = im->mesh->triangle_count;
+        parts->placements = calloc(16, sizeof(*parts->placements));
+        if (!parts->placements)
+            return SB_ERR_NOMEM;
+        parts->placement_count = 1;
+        for (int r = 0; r < 3; r++)
+            for (int c = 0; c < 4; c++)
+                parts->placements[0].to_world[r][c] = world.m[r][c];
+    }
+    for (unsigned i = 0; i < scene->mNumMeshes; i++) {
+        im->part_of[i] = -1;
+        const struct aiMesh *am = scene->mMeshes[i];
+        if (im->uses[i] < 2 || !(am->mPrimitiveTypes & aiPrimitiveType_TRIANGLE))
+            continue;
+        uint32_t before = im->mesh->triangle_count;
+        struct aiNode one = {.mTransformation = {1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1},
+                             .mNumMeshes = 1,
+                             .mMeshes = &i};
+        enum sb_result res = add_node(im, &one, &identity);
+        if (res)
+            return res;
+        if (im->mesh->triangle_count == before)
+            continue; /* nothing but zero-area triangles */
+        im->part_of[i] = (int32_t)parts->part_count;
+        parts->first[parts->part_count] = before;
+        parts->count[parts->part_count++] = im->mesh->triangle_count - before;
+    }
+    return place_parts(im, scene->mRootNode, &world);
 }
 
 static enum sb_result add_materials(struct importer *im)
@@ -415,7 +515,8 @@ static void file_close(struct aiFileIO *io, struct aiFile *f)
 
 /* The import itself, into a fresh mesh, in the helper: the
  * file's materials, then every instanced triangle. */
-static enum sb_result import(const char *path, const struct sb_mesh_load_params *params, struct sb_mesh *mesh)
+static enum sb_result import(const char *path, const struct sb_mesh_load_params *params, struct sb_mesh *mesh,
+                             struct sb_mesh_parts *parts)
 {
     struct importer im = {.path = path, .params = params, .mesh = mesh};
     struct aiFileIO io = {.OpenProc = file_open, .CloseProc = file_close, .UserData = (aiUserData)path};
@@ -429,8 +530,32 @@ static enum sb_result import(const char *path, const struct sb_mesh_load_params 
     }
     if ((res = count_node(&im, im.scene->mRootNode, 0)) || (res = add_materials(&im)))
         goto done;
-    struct mat4 world = mat_world(&params->transform);
-    if ((res = add_node(&im, im.scene->mRootNode, &world)))
+    bool reused = false;
+    if (parts) {
+        im.uses = calloc(im.scene->mNumMeshes + 1, sizeof(uint32_t));
+        im.part_of = calloc(im.scene->mNumMeshes + 1, sizeof(int32_t));
+        if (!im.uses || !im.part_of) {
+            res = SB_ERR_NOMEM;
+            goto done;
+        }
+        count_uses(&im, im.scene->mRootNode);
+        /* parts when the reuse saves a fifth of the triangles or more: a
+         * copy costs a top-level leaf and a moved ray */
+        uint64_t unique = 0, placed = 0;
+        for (unsigned i = 0; i < im.scene->mNumMeshes; i++) {
+            unique += im.uses[i] ? im.scene->mMeshes[i]->mNumFaces : 0;
+            placed += (uint64_t)im.uses[i] * im.scene->mMeshes[i]->mNumFaces;
+        }
+        reused = 4 * placed >= 5 * unique && placed > unique;
+    }
+    if (reused) {
+        im.parts = parts;
+        res = add_parts(&im);
+    } else {
+        struct mat4 world = mat_world(&params->transform);
+        res = add_node(&im, im.scene->mRootNode, &world);
+    }
+    if (res)
         goto done;
     if (!mesh->triangle_count) {
         sb_error("%s: no triangle of non-zero area (%u left out as degenerate)", path, mesh->dropped_degenerate);
@@ -438,6 +563,8 @@ static enum sb_result import(const char *path, const struct sb_mesh_load_params 
     }
 done:
     free(im.material_map);
+    free(im.uses);
+    free(im.part_of);
     aiReleaseImport(im.scene);
     return res;
 }
@@ -475,26 +602,89 @@ int sb_mesh_import_task(int fd, const void *request, size_t size)
     struct sb_import_mesh_answer h = {.magic = SB_IMPORT_MESH_MAGIC};
     sb_sandbox_capture_log(h.message, sizeof(h.message));
     struct sb_mesh mesh = {0};
-    h.result = import(job.path, &params, &mesh);
+    struct sb_mesh_parts parts = {0};
+    h.result = import(job.path, &params, &mesh, job.keep_parts ? &parts : NULL);
     if (!h.result) {
         h.vertex_count = mesh.vertex_count;
         h.triangle_count = mesh.triangle_count;
         h.material_count = mesh.material_count;
         h.dropped_degenerate = mesh.dropped_degenerate;
+        h.part_count = parts.part_count;
+        h.placement_count = parts.placement_count;
     }
     bool ok = sb_write_all(fd, &h, sizeof(h));
     if (!h.result && ok)
         ok = sb_write_all(fd, mesh.material_list, (size_t)mesh.material_count * sizeof(*mesh.material_list)) &&
              sb_write_all(fd, mesh.positions, (size_t)mesh.vertex_count * 3 * sizeof(float)) &&
              sb_write_all(fd, mesh.materials, (size_t)mesh.triangle_count * sizeof(uint32_t));
+    for (uint32_t k = 0; !h.result && ok && k < parts.part_count; k++)
+        ok = sb_write_all(fd, &parts.first[k], sizeof(uint32_t)) && sb_write_all(fd, &parts.count[k], sizeof(uint32_t));
+    if (!h.result && ok && parts.placement_count)
+        ok = sb_write_all(fd, parts.placements, parts.placement_count * sizeof(*parts.placements));
     sb_mesh_finish(&mesh);
+    sb_mesh_parts_finish(&parts);
     return ok ? 0 : 1;
+}
+
+/* A file kept as parts: its ranges of the triangles just received (from
+ * `base` on) and its placements, each checked. */
+static enum sb_result receive_parts(struct sb_sandbox *box, const char *path, const struct sb_import_mesh_answer *h,
+                                    uint32_t base, struct sb_mesh_parts *parts)
+{
+    if (!parts || h->part_count > h->triangle_count || !h->part_count || !h->placement_count ||
+        h->placement_count > SB_MESH_MAX_PLACEMENTS) {
+        sb_error("%s: %u parts placed %u times: not what was asked (at most %u placements)", path, h->part_count,
+                 h->placement_count, SB_MESH_MAX_PLACEMENTS);
+        return SB_ERR_MESH;
+    }
+    parts->first = malloc(h->part_count * sizeof(uint32_t));
+    parts->count = malloc(h->part_count * sizeof(uint32_t));
+    parts->placements = malloc(h->placement_count * sizeof(*parts->placements));
+    if (!parts->first || !parts->count || !parts->placements)
+        return SB_ERR_NOMEM;
+    uint32_t next = 0;
+    bool read = true;
+    for (uint32_t k = 0; k < h->part_count && read; k++) {
+        read = sb_sandbox_read(box, &parts->first[k], sizeof(uint32_t)) &&
+               sb_sandbox_read(box, &parts->count[k], sizeof(uint32_t));
+        /* consecutive, non-empty, covering every triangle */
+        if (read && (parts->first[k] != next || !parts->count[k] || parts->count[k] > h->triangle_count - next)) {
+            sb_error("%s: part %u: triangles %u + %u of %u, expected from %u", path, k, parts->first[k],
+                     parts->count[k], h->triangle_count, next);
+            return SB_ERR_MESH;
+        }
+        next += read ? parts->count[k] : 0;
+        parts->first[k] += base;
+    }
+    read = read && next == h->triangle_count &&
+           sb_sandbox_read(box, parts->placements, h->placement_count * sizeof(*parts->placements));
+    if (!read) {
+        char why[160];
+        sb_sandbox_finish(box, why, sizeof(why));
+        sb_error("%s: the import's parts stopped half way: its process %s", path, why);
+        return SB_ERR_MESH;
+    }
+    for (uint32_t i = 0; i < h->placement_count; i++) {
+        bool finite = parts->placements[i].part < h->part_count;
+        for (int r = 0; r < 3 && finite; r++)
+            for (int c = 0; c < 4; c++)
+                finite = finite && isfinite(parts->placements[i].to_world[r][c]);
+        if (!finite) {
+            sb_error("%s: placement %u: of no part, or not finite", path, i);
+            return SB_ERR_MESH;
+        }
+    }
+    parts->part_count = h->part_count;
+    parts->placement_count = h->placement_count;
+    return SB_OK;
 }
 
 /* Append what the helper sent: the materials, then the triangles through
  * the checks every triangle meets. */
-static enum sb_result receive(struct sb_sandbox *box, const char *path, struct sb_mesh *mesh)
+static enum sb_result receive(struct sb_sandbox *box, const char *path, struct sb_mesh *mesh,
+                              struct sb_mesh_parts *parts)
 {
+    uint32_t triangles_before = mesh->triangle_count;
     struct sb_import_mesh_answer h;
     if (!sb_sandbox_read(box, &h, sizeof(h)) || h.magic != SB_IMPORT_MESH_MAGIC) {
         char why[160];
@@ -556,12 +746,35 @@ static enum sb_result receive(struct sb_sandbox *box, const char *path, struct s
     free(materials);
     free(positions);
     free(triangle_materials);
+    if (!res && (h.part_count || h.placement_count) && mesh->triangle_count - triangles_before != h.triangle_count) {
+        sb_error("%s: %u of its parts' triangles became zero-area in fp32", path,
+                 h.triangle_count - (mesh->triangle_count - triangles_before));
+        res = SB_ERR_MESH;
+    }
+    if (!res && (h.part_count || h.placement_count))
+        res = receive_parts(box, path, &h, triangles_before, parts);
     return res;
+}
+
+void sb_mesh_parts_finish(struct sb_mesh_parts *parts)
+{
+    free(parts->first);
+    free(parts->count);
+    free(parts->placements);
+    memset(parts, 0, sizeof(*parts));
 }
 
 enum sb_result sb_mesh_import(const char *path, const struct sb_mesh_load_params *params, struct sb_mesh *mesh)
 {
+    return sb_mesh_import_parts(path, params, mesh, NULL);
+}
+
+enum sb_result sb_mesh_import_parts(const char *path, const struct sb_mesh_load_params *params, struct sb_mesh *mesh,
+                                    struct sb_mesh_parts *parts)
+{
     static const struct sb_mesh_load_params defaults = {0};
+    if (parts)
+        memset(parts, 0, sizeof(*parts));
     params = params ? params : &defaults;
     struct stat st;
     if (stat(path, &st) != 0) {
@@ -589,6 +802,7 @@ enum sb_result sb_mesh_import(const char *path, const struct sb_mesh_load_params
         .transform = params->transform,
         .default_albedo = params->default_albedo,
         .override_count = params->override_count,
+        .keep_parts = parts != NULL,
     };
     bool fits = snprintf(job.path, sizeof(job.path), "%s", path) < (int)sizeof(job.path) &&
                 params->override_count >= 0 && params->override_count <= SB_WORLD_MAX_OVERRIDES;
@@ -606,8 +820,10 @@ enum sb_result sb_mesh_import(const char *path, const struct sb_mesh_load_params
     enum sb_result res = sb_sandbox_start(&box, &limits, SB_IMPORT_MESH_HELPER, &job, sizeof(job), -1);
     if (res)
         return res;
-    res = receive(&box, path, mesh);
+    res = receive(&box, path, mesh, parts);
     sb_sandbox_finish(&box, NULL, 0);
+    if (res && parts)
+        sb_mesh_parts_finish(parts);
     if (res) {
         mesh->vertex_count = before.vertex_count;
         mesh->triangle_count = before.triangle_count;

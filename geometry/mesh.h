@@ -97,6 +97,22 @@ struct sb_mesh_load_params {
     unsigned time_limit_s;
 };
 
+/* A file whose nodes place one mesh more than once, kept as its parts
+ * (sb_mesh_import_parts): part k is triangles [first[k], first[k] +
+ * count[k]) of the mesh, in its own space; each placement puts a part in
+ * the world. */
+#define SB_MESH_MAX_PLACEMENTS (1u << 20)
+struct sb_mesh_placement {
+    uint32_t part;
+    uint32_t pad;
+    double to_world[3][4];
+};
+struct sb_mesh_parts {
+    uint32_t part_count, placement_count;
+    uint32_t *first, *count;               /* owned */
+    struct sb_mesh_placement *placements; /* owned */
+};
+
 /*
  * Append the triangles of the mesh file at `path`, read through assimp, to
  * *mesh (which may hold triangles already, or be zeroed). Every triangle of
@@ -115,6 +131,22 @@ struct sb_mesh_load_params {
  * (SB_ERR_MESH). Zero-area triangles are left out and counted.
  */
 enum sb_result sb_mesh_import(const char *path, const struct sb_mesh_load_params *params, struct sb_mesh *mesh);
+
+/*
+ * As sb_mesh_import, but a file whose node tree places some mesh more than
+ * once (a glTF's wheels), saving a fifth of its triangles or more, comes
+ * as parts into an empty *mesh: the meshes placed once as one part, in the
+ * file's space, then each mesh placed more than once as a part, in its own
+ * space; every placement of a part (the nodes' transforms and params'
+ * placement) in *parts. Any other file comes as sb_mesh_import reads it,
+ * parts->part_count 0 (a copy costs a top-level leaf and a moved ray: the
+ * IFC house's few reused meshes are not worth it).
+ * At most SB_MESH_MAX_PLACEMENTS placements. Free parts with
+ * sb_mesh_parts_finish.
+ */
+enum sb_result sb_mesh_import_parts(const char *path, const struct sb_mesh_load_params *params, struct sb_mesh *mesh,
+                                    struct sb_mesh_parts *parts);
+void sb_mesh_parts_finish(struct sb_mesh_parts *parts);
 
 /* The transform as rows of an affine 3 x 4 (file units to world metres). */
 void sb_mesh_transform_matrix(const struct sb_mesh_transform *t, double out[3][4]);

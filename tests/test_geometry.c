@@ -1114,6 +1114,35 @@ static void test_levels(void)
     sb_level_hash(&level, hash);
     sb_level_finish(&level);
 
+    /* a glTF whose nodes place its wheels twice: parts, the wheels once,
+     * the copies where the flat import puts them */
+    snprintf(path, sizeof(path), "%s/truck.json", dir);
+    write_file(path, "{\"version\": 1, \"ground\": false, \"instances\": [{\"file\": \"" MODELS
+                     "/glTF/CesiumMilkTruck/CesiumMilkTruck.gltf\", \"translate_m\": [3, 0, -2]}]}");
+    struct sb_mesh truck = {0}, placed = {0};
+    CHECK(sb_mesh_load(MODELS "/glTF/CesiumMilkTruck/CesiumMilkTruck.gltf",
+                       &(struct sb_mesh_load_params){.transform = {.translate_m = {3, 0, -2}}}, &truck) == SB_OK,
+          "the milk truck, flat");
+    res = load_level(dir, "truck.json", &level);
+    uint32_t unique = 0;
+    for (uint32_t m = 0; m < level.mesh_count; m++)
+        unique += level.meshes[m].triangle_count;
+    CHECK(res == SB_OK && level.instance_count > level.mesh_count && unique < level.placed_triangles &&
+              level.placed_triangles == truck.triangle_count,
+          "the milk truck as parts: %u meshes (%u triangles) placed %u times, %llu triangles (flat: %u)",
+          level.mesh_count, unique, level.instance_count, (unsigned long long)level.placed_triangles,
+          truck.triangle_count);
+    float flo[3], fhi[3], plo[3], phi[3];
+    CHECK(!res && sb_level_flatten(&level, &placed) == SB_OK && sb_mesh_bounds(&placed, plo, phi) &&
+              sb_mesh_bounds(&truck, flo, fhi) && fabsf(plo[0] - flo[0]) < 1e-4f && fabsf(phi[0] - fhi[0]) < 1e-4f &&
+              fabsf(plo[1] - flo[1]) < 1e-4f && fabsf(phi[1] - fhi[1]) < 1e-4f && fabsf(plo[2] - flo[2]) < 1e-4f &&
+              fabsf(phi[2] - fhi[2]) < 1e-4f,
+          "the truck's parts placed where the flat import puts them: (%g %g %g)-(%g %g %g) against (%g %g %g)-(%g %g %g)",
+          plo[0], plo[1], plo[2], phi[0], phi[1], phi[2], flo[0], flo[1], flo[2], fhi[0], fhi[1], fhi[2]);
+    sb_mesh_finish(&truck);
+    sb_mesh_finish(&placed);
+    sb_level_finish(&level);
+
     /* terrain: cells x cells quads, within its height, facing up, the same for a seed */
     char terrain_hash[2][33];
     for (int k = 0; k < 2; k++) {

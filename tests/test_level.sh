@@ -24,8 +24,8 @@ cat >"$tmp/village.json" <<EOF
                  "probes": [{"position_m": [0, 20, 0], "box_m": [[-60, -10, -60], [60, 40, 60]]}]}}
 EOF
 check "the small level bakes every product" expect_exit 0 "$skybake" bake "$tmp/village.json" -o "$tmp/pack"
-check "reading 4 meshes placed 64 times" grep -q "village-small.json: 4 meshes (.*) placed 64 times" "$tmp/err"
-check "read once for the probes and the reflections" sh -c "[ \$(grep -c 'placed 64 times' '$tmp/err') -eq 1 ]"
+check "reading 5 meshes placed 104 times" grep -q "village-small.json: 5 meshes (.*) placed 104 times" "$tmp/err"
+check "read once for the probes and the reflections" sh -c "[ \$(grep -c 'placed 104 times' '$tmp/err') -eq 1 ]"
 check "every product in the pack" sh -c "[ \$(grep -c '\"content_hash\"' '$tmp/pack/manifest.json') -eq 13 ]"
 check "it verifies" expect_exit 0 "$skybake" verify "$tmp/pack"
 check "the same bytes again (reusing nothing)" expect_exit 0 "$skybake" bake "$tmp/village.json" -o "$tmp/again" --force -q
