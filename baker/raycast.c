@@ -5,6 +5,7 @@
 
 #include "log.h"
 #include "raycast.spv.h"
+#include "raycast_instanced.spv.h"
 
 enum sb_result sb_raycaster_create(struct sb_vk *vk, const struct sb_bvh *bvh, struct sb_raycaster **out)
 {
@@ -21,9 +22,10 @@ enum sb_result sb_raycaster_create(struct sb_vk *vk, const struct sb_bvh *bvh, s
         goto fail;
     memcpy(rc->nodes.mapped, bvh->nodes, node_bytes);
     memcpy(rc->triangles.mapped, bvh->triangles, triangle_bytes);
+    rc->instanced = bvh->instance_count > 0;
     const struct sb_pipeline_params params = {
-        .spirv = sb_spv_raycast,
-        .spirv_size = sizeof(sb_spv_raycast),
+        .spirv = rc->instanced ? sb_spv_raycast_instanced : sb_spv_raycast,
+        .spirv_size = rc->instanced ? sizeof(sb_spv_raycast_instanced) : sizeof(sb_spv_raycast),
         .binding_count = SB_RAYCAST_BINDING_COUNT,
         .push_size = sizeof(struct sb_raycast_push),
         .name = "raycast",
@@ -114,4 +116,13 @@ enum sb_result sb_probe_buffers_create(struct sb_vk *vk, const float *positions,
         p[4 * (size_t)i + 3] = valid ? valid[i] : 1.0f;
     }
     return SB_OK;
+}
+
+void sb_kernel_code_hash(const void *one_level, size_t one_size, const void *instanced, size_t instanced_size,
+                         char out[33])
+{
+    char both[2 * 33];
+    sb_hash_bytes(one_level, one_size, both);
+    sb_hash_bytes(instanced, instanced_size, both + 32);
+    sb_hash_bytes(both, 64, out);
 }

@@ -17,12 +17,19 @@
 struct sb_raycaster {
     struct sb_vk *vk;
     struct sb_buffer nodes, triangles; /* the BVH, as bvh.glsl reads it */
+    bool instanced;                    /* two levels: the kernels built with BVH_INSTANCES */
     struct sb_pipeline pipeline;
     struct sb_buffer rays, hits; /* sized for the last cast */
     uint32_t capacity;
 };
 
-/* Upload `bvh` (which may be freed afterwards). */
+/* A kernel's code hash for bake keys: both its builds (one level, and
+ * BVH_INSTANCES), so that a change to either rebakes. */
+void sb_kernel_code_hash(const void *one_level, size_t one_size, const void *instanced, size_t instanced_size,
+                         char out[33]);
+
+/* Upload `bvh` (which may be freed afterwards); its kernels are the
+ * two-level builds when it has instances. */
 enum sb_result sb_raycaster_create(struct sb_vk *vk, const struct sb_bvh *bvh, struct sb_raycaster **raycaster);
 /* Free; accepts a pointer to NULL and sets it to NULL. */
 void sb_raycaster_destroy(struct sb_raycaster **raycaster);

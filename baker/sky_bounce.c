@@ -4,6 +4,7 @@
 
 #include "log.h"
 #include "probe_bounce.spv.h"
+#include "probe_bounce_instanced.spv.h"
 
 enum sb_result sb_sky_bounce_bake(struct sb_raycaster *rc, const struct sb_mesh_material *materials,
                                   uint32_t material_count, const float *positions,
@@ -30,8 +31,8 @@ enum sb_result sb_sky_bounce_bake(struct sb_raycaster *rc, const struct sb_mesh_
     struct sb_buffer probes = {0}, results = {0}, albedo = {0};
     struct sb_pipeline pipeline = {0};
     const struct sb_pipeline_params pp = {
-        .spirv = sb_spv_probe_bounce,
-        .spirv_size = sizeof(sb_spv_probe_bounce),
+        .spirv = rc->instanced ? sb_spv_probe_bounce_instanced : sb_spv_probe_bounce,
+        .spirv_size = rc->instanced ? sizeof(sb_spv_probe_bounce_instanced) : sizeof(sb_spv_probe_bounce),
         .binding_count = SB_BOUNCE_BINDING_COUNT,
         .push_size = sizeof(pc),
         .name = "sky bounce",
@@ -63,5 +64,6 @@ done:
 
 void sb_sky_bounce_code_hash(char out[33])
 {
-    sb_hash_bytes(sb_spv_probe_bounce, sizeof(sb_spv_probe_bounce), out);
+    sb_kernel_code_hash(sb_spv_probe_bounce, sizeof(sb_spv_probe_bounce), sb_spv_probe_bounce_instanced,
+                        sizeof(sb_spv_probe_bounce_instanced), out);
 }

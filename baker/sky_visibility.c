@@ -7,6 +7,7 @@
 #include "log.h"
 #include "sh.h"
 #include "sky_visibility.spv.h"
+#include "sky_visibility_instanced.spv.h"
 
 /* Morton code of two 16-bit coordinates. */
 static uint32_t morton2(uint32_t x, uint32_t y)
@@ -77,8 +78,8 @@ enum sb_result sb_sky_visibility_bake(struct sb_raycaster *rc, const float *posi
     struct sb_buffer probes = {0}, results = {0}, order = {0};
     struct sb_pipeline pipeline = {0};
     const struct sb_pipeline_params pp = {
-        .spirv = sb_spv_sky_visibility,
-        .spirv_size = sizeof(sb_spv_sky_visibility),
+        .spirv = rc->instanced ? sb_spv_sky_visibility_instanced : sb_spv_sky_visibility,
+        .spirv_size = rc->instanced ? sizeof(sb_spv_sky_visibility_instanced) : sizeof(sb_spv_sky_visibility),
         .binding_count = SB_PROBE_BINDING_COUNT,
         .push_size = sizeof(pc),
         .name = "sky visibility",
@@ -108,7 +109,8 @@ done:
 
 void sb_sky_visibility_code_hash(char out[33])
 {
-    sb_hash_bytes(sb_spv_sky_visibility, sizeof(sb_spv_sky_visibility), out);
+    sb_kernel_code_hash(sb_spv_sky_visibility, sizeof(sb_spv_sky_visibility), sb_spv_sky_visibility_instanced,
+                        sizeof(sb_spv_sky_visibility_instanced), out);
 }
 
 void sb_probe_rays(const float position[3], uint32_t n, float tmin, float *rays)

@@ -45,7 +45,11 @@ void main()
         if (hit.triangle == SB_BVH_MISS)
             continue;
         vec4 e1 = bvh_triangles[3 * hit.slot + 1], e2 = bvh_triangles[3 * hit.slot + 2];
+#ifdef BVH_INSTANCES
         vec3 n = normalize(bvh_world_normal(cross(e1.xyz, e2.xyz), hit.instance));
+#else
+        vec3 n = normalize(cross(e1.xyz, e2.xyz));
+#endif
         if (dot(n, w) > 0.0)
             n = -n; // the side the probe sees
         vec3 rho = albedo[floatBitsToUint(e1.w)].rgb;

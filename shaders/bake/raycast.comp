@@ -20,6 +20,10 @@ void main()
         return;
     vec4 a = rays[2 * i], b = rays[2 * i + 1];
     BvhHit hit = bvh_trace(a.xyz, b.xyz, a.w, b.w, pc.any_hit != 0u);
+#ifdef BVH_INSTANCES
     uint instance = hit.instance == SB_BVH_NO_INSTANCE ? hit.instance : floatBitsToUint(bvh_nodes[2 * hit.instance + 3].y);
+#else
+    uint instance = SB_BVH_NO_INSTANCE;
+#endif
     hits[i] = vec4(hit.t, uintBitsToFloat(hit.triangle), uintBitsToFloat(instance), 0.0);
 }
