@@ -1,26 +1,25 @@
 // Ray casts against skybake's BVH (geometry/bvh.h): the GPU twin of
-// sb_bvh_intersect. Two builds of each kernel that traces: without
-// BVH_INSTANCES, one level, the traversal as it always was (its SPIR-V, its
-// speed on lavapipe, its bake hashes); with it, one or two levels
-// (instances), the longer loop below. The baker picks by the BVH.
-#ifdef BVH_INSTANCES
-// Ray casts against skybake's BVH (geometry/bvh.h): the GPU twin of
 // sb_bvh_intersect, the same traversal (nearer child first, one stack entry
 // a level) and the same fp32 Möller-Trumbore test of both faces. A kernel
 // that includes this declares the node and triangle buffers as
 //   bvh_nodes[]: two vec4s a node (min, first; max, count),
 //   bvh_triangles[]: three vec4s a triangle (v0, triangle; e1, material; e2, -),
 // and then includes this file. With BVH_ANY_HIT_MATERIAL_0_PASSES defined,
-// an any-hit trace goes through the triangles of material 0. A BVH of two
-// levels (instances, geometry/bvh.h) is traced by the same loop: at an
-// instance's leaf the ray goes into the mesh's space (an affine map keeps
-// t), and a marker on the stack brings it back.
+// an any-hit trace goes through the triangles of material 0.
+//
+// Two builds of each kernel that traces (the baker picks by the BVH):
+// without BVH_INSTANCES, one level, the traversal as it always was (its
+// SPIR-V, its speed on lavapipe, its bake hashes); with it, one or two
+// levels (instances): at an instance's leaf the ray goes into the mesh's
+// space (an affine map keeps t), and a marker on the stack brings it back.
 
 struct BvhHit {
     float t;
     uint triangle; // SB_BVH_MISS when none; | SB_BVH_BACK_FACE on a back face
     vec2 uv;
+#ifdef BVH_INSTANCES
     uint instance; // the instance's record (a node index), SB_BVH_NO_INSTANCE when none
+#endif
 #ifdef BVH_HIT_SLOT
     uint slot; // the triangle's place in bvh_triangles[] (kernels that define BVH_HIT_SLOT)
 #endif
@@ -69,6 +68,7 @@ bool bvh_hit_triangle(uint i, vec3 o, vec3 d, float tmin, float tmax, bool any_h
     return true;
 }
 
+#ifdef BVH_INSTANCES
 vec3 bvh_inverse_direction(vec3 d)
 {
     // a zero component: a huge but finite slope keeps the slabs NaN-free
@@ -157,69 +157,7 @@ BvhHit bvh_trace(vec3 world_o, vec3 world_d, float tmin, float tmax, bool any_hi
     }
     return hit;
 }
-
 #else // one level
-// Ray casts against skybake's BVH (geometry/bvh.h): the GPU twin of
-// sb_bvh_intersect, the same traversal (nearer child first, one stack entry
-// a level) and the same fp32 Möller-Trumbore test of both faces. A kernel
-// that includes this declares the node and triangle buffers as
-//   bvh_nodes[]: two vec4s a node (min, first; max, count),
-//   bvh_triangles[]: three vec4s a triangle (v0, triangle; e1, material; e2, -),
-// and then includes this file. With BVH_ANY_HIT_MATERIAL_0_PASSES defined,
-// an any-hit trace goes through the triangles of material 0.
-
-struct BvhHit {
-    float t;
-    uint triangle; // SB_BVH_MISS when none; | SB_BVH_BACK_FACE on a back face
-    vec2 uv;
-#ifdef BVH_HIT_SLOT
-    uint slot; // the triangle's place in bvh_triangles[] (kernels that define BVH_HIT_SLOT)
-#endif
-};
-
-bool bvh_hit_box(uint node, vec3 o, vec3 inv_d, float tmin, float tmax, out float t_enter)
-{
-    vec3 a = (bvh_nodes[2 * node].xyz - o) * inv_d;
-    vec3 b = (bvh_nodes[2 * node + 1].xyz - o) * inv_d;
-    vec3 lo = min(a, b), hi = max(a, b);
-    float t0 = max(tmin, max(lo.x, max(lo.y, lo.z)));
-    float t1 = min(tmax, min(hi.x, min(hi.y, hi.z)));
-    t_enter = t0;
-    return t0 <= t1;
-}
-
-bool bvh_hit_triangle(uint i, vec3 o, vec3 d, float tmin, float tmax, bool any_hit, inout BvhHit hit)
-{
-    vec4 v0 = bvh_triangles[3 * i], e1 = bvh_triangles[3 * i + 1], e2 = bvh_triangles[3 * i + 2];
-#ifdef BVH_ANY_HIT_MATERIAL_0_PASSES
-    if (any_hit && floatBitsToUint(e1.w) == 0u)
-        return false;
-#endif
-    vec3 p = cross(d, e2.xyz);
-    float det = dot(e1.xyz, p);
-    if (det == 0.0)
-        return false;
-    float inv = 1.0 / det;
-    vec3 s = o - v0.xyz;
-    float u = dot(s, p) * inv;
-    if (u < 0.0 || u > 1.0)
-        return false;
-    vec3 q = cross(s, e1.xyz);
-    float v = dot(d, q) * inv;
-    if (v < 0.0 || u + v > 1.0)
-        return false;
-    float t = dot(e2.xyz, q) * inv;
-    if (!(t > tmin && t < tmax))
-        return false;
-    hit.t = t;
-    hit.uv = vec2(u, v);
-#ifdef BVH_HIT_SLOT
-    hit.slot = i;
-#endif
-    hit.triangle = floatBitsToUint(v0.w) | (det < 0.0 ? SB_BVH_BACK_FACE : 0u);
-    return true;
-}
-
 // The closest hit in (tmin, tmax), or any when `any_hit`.
 BvhHit bvh_trace(vec3 o, vec3 d, float tmin, float tmax, bool any_hit)
 {
@@ -267,5 +205,4 @@ BvhHit bvh_trace(vec3 o, vec3 d, float tmin, float tmax, bool any_hit)
     }
     return hit;
 }
-
 #endif
