@@ -1110,8 +1110,13 @@ static void test_levels(void)
     sb_bvh_finish(&bvh);
     sb_bvh_finish(&again);
     sb_mesh_finish(&flat);
-    char hash[33];
+    char hash[33], again_hash[33];
     sb_level_hash(&level, hash);
+    sb_level_finish(&level);
+    /* read again: the same scatter, the same hash */
+    CHECK(load_level(dir, "world.json", &level) == SB_OK, "the level again");
+    sb_level_hash(&level, again_hash);
+    CHECK(!strcmp(hash, again_hash), "the level read twice hashes the same (%s, %s)", hash, again_hash);
     sb_level_finish(&level);
 
     /* a glTF whose nodes place its wheels twice: parts, the wheels once,
@@ -1263,7 +1268,6 @@ static void test_levels(void)
     CHECK(res == SB_ERR_MESH && strstr(log.text, "scene's world"), "a level read as one mesh: %s: %s",
           sb_result_name(res), log.text);
     sb_mesh_finish(&one);
-    (void)hash;
     test_remove_dir(dir);
 }
 
