@@ -132,13 +132,15 @@ static enum sb_result bench_one(struct sb_vk *vk, const char *name, struct sb_me
         res = SB_ERR_NOMEM;
         goto done;
     }
+    struct sb_surfaces surfaces = {0};
+    res = sb_surfaces_create(vk, mesh, 1, &surfaces);
     for (int k = repeat >= 3 ? -1 : 0; k < repeat && !res; k++) {
         double ms, bms = 0;
         res = sb_warm_up(vk, k <= 0 ? SB_WARM_UP_MS : SB_KEEP_WARM_MS);
         if (!res)
             res = sb_sky_visibility_bake(rc, positions, count, &params, out, &ms);
         if (!res)
-            res = sb_sky_bounce_bake(rc, mesh->material_list, mesh->material_count, positions, NULL, count, &bounce, bounced, &bms);
+            res = sb_sky_bounce_bake(rc, &surfaces, positions, NULL, count, &bounce, bounced, &bms);
         if (k >= 0) {
             times[k] = ms;
             bounce_times[k] = bms;
@@ -153,6 +155,7 @@ static enum sb_result bench_one(struct sb_vk *vk, const char *name, struct sb_me
     free(times);
     free(bounce_times);
     free(bounced);
+    sb_surfaces_destroy(vk, &surfaces);
     if (res)
         goto done;
     row->rays = (uint64_t)count * rays_per_probe;

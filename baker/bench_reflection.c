@@ -111,20 +111,22 @@ static enum sb_result capture(struct sb_vk *vk, const struct sb_atmosphere_param
         res = sb_atmosphere_bake(atm, inputs[i], NULL, &lut, NULL, NULL);
         sb_image_finish(&lut);
     }
-    if (!res && !(res = sb_bench_terrain(257, &mesh)) && !(res = sb_bvh_build(&mesh, &bvh)))
-        res = sb_raycaster_create(vk, &bvh, &rc);
+    struct sb_surfaces surfaces = {0};
+    if (!res && !(res = sb_bench_terrain(257, &mesh)) && !(res = sb_bvh_build(&mesh, &bvh)) &&
+        !(res = sb_raycaster_create(vk, &bvh, &rc)))
+        res = sb_surfaces_create(vk, &mesh, 1, &surfaces);
     struct sb_capture_params cp = {.origin_m = {0, 23, 0}, .altitude_km = 0.023, .face_size = n, .ambient_rays = 32};
     double el = 30 * M_PI / 180, az = 150 * M_PI / 180;
     cp.sun[0] = cos(el) * sin(az);
     cp.sun[1] = sin(el);
     cp.sun[2] = -cos(el) * cos(az);
     struct sb_capture_inputs sky = {.atmosphere = atm},
-                             world = {.atmosphere = atm, .rc = rc, .materials = mesh.material_list,
-                                      .material_count = mesh.material_count};
+                             world = {.atmosphere = atm, .rc = rc, .surfaces = &surfaces};
     if (!res && !(res = sb_reflection_capture(vk, &sky, &cp, level0, NULL))) {
         sb_reflection_sh(level0, n, 0, cp.sky_sh);
         res = sb_reflection_capture(vk, &world, &cp, level0, ms);
     }
+    sb_surfaces_destroy(vk, &surfaces);
     sb_raycaster_destroy(&rc);
     sb_bvh_finish(&bvh);
     sb_mesh_finish(&mesh);

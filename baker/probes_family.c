@@ -43,6 +43,7 @@ struct probes_state {
     char path[640]; /* the world's file, absolute */
     struct sb_bvh bvh;
     struct sb_raycaster *rc;
+    struct sb_surfaces surfaces; /* the bounce's, made with rc */
 };
 
 static enum sb_result plan(const struct sb_scene *scene, const struct sb_level *level, struct sb_probe_layout *layout,
@@ -72,6 +73,8 @@ static void probes_destroy(void **state)
 {
     struct probes_state *st = *state;
     if (st) {
+        if (st->rc)
+            sb_surfaces_destroy(st->rc->vk, &st->surfaces);
         sb_raycaster_destroy(&st->rc);
         sb_bvh_finish(&st->bvh);
         sb_level_release(&st->level);
@@ -398,7 +401,9 @@ static enum sb_result bake_bounce(struct probes_state *st, const struct sb_scene
     }
     struct sb_sky_bounce_params params = {.ray_count = scene->probes.bounce_rays,
                                           .secondary = scene->probes.bounce_secondary};
-    if ((res = sb_sky_bounce_bake(st->rc, st->level->materials, st->level->material_count, positions, valid, count, &params, out, &a->gpu_ms)) ||
+    if (!st->surfaces.material_count && (res = sb_surfaces_create_level(st->rc->vk, st->level, &st->surfaces)))
+        goto done;
+    if ((res = sb_sky_bounce_bake(st->rc, &st->surfaces, positions, valid, count, &params, out, &a->gpu_ms)) ||
         (res = sb_image_init(image, count, 1, SB_SKY_BOUNCE_CHANNEL_COUNT)))
         goto done;
     sb_image_set_channel_names(image, SB_SKY_BOUNCE_CHANNELS);

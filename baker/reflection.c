@@ -53,7 +53,7 @@ enum sb_result sb_reflection_capture(struct sb_vk *vk, const struct sb_capture_i
         .ambient_rays = p->ambient_rays,
         .tmin_m = 1e-4f,
     };
-    struct sb_buffer result = {0}, albedo = {0}, sky = {0}, dummy = {0};
+    struct sb_buffer result = {0}, sky = {0}, dummy = {0};
     struct sb_pipeline temp = {0}, *pipeline = NULL;
     const struct sb_pipeline_params pp = {
         .spirv = sb_spv_reflection_capture,
@@ -62,17 +62,12 @@ enum sb_result sb_reflection_capture(struct sb_vk *vk, const struct sb_capture_i
         .push_size = sizeof(pc),
         .name = "reflection capture",
     };
-    uint32_t materials = in->rc && in->material_count ? in->material_count : 1;
     enum sb_result res;
     if ((res = sb_buffer_create(vk, (VkDeviceSize)6 * n * n * 4 * sizeof(float), "reflection capture", &result)) ||
-        (res = sb_buffer_create(vk, (VkDeviceSize)materials * 4 * sizeof(float), "albedo", &albedo)) ||
         (res = sb_buffer_create(vk, SB_PROBE_SH * 4 * sizeof(float), "sky sh", &sky)) ||
         (res = sb_buffer_create(vk, 64, "no world", &dummy)) ||
         (res = pipeline_for(vk, in->kernels ? &in->kernels->capture : NULL, &pp, &temp, &pipeline)))
         goto done;
-    float *a = albedo.mapped;
-    for (uint32_t m = 0; in->rc && m < in->material_count; m++)
-        memcpy(&a[4 * (size_t)m], in->materials[m].albedo, 3 * sizeof(float));
     float *s = sky.mapped;
     for (int k = 0; k < SB_PROBE_SH; k++)
         for (int c = 0; c < 3; c++)
@@ -81,9 +76,10 @@ enum sb_result sb_reflection_capture(struct sb_vk *vk, const struct sb_capture_i
         [SB_CAPTURE_BINDING_OUT] = &result,
         [SB_CAPTURE_BINDING_NODES] = in->rc ? &in->rc->nodes : &dummy,
         [SB_CAPTURE_BINDING_TRIANGLES] = in->rc ? &in->rc->triangles : &dummy,
-        [SB_CAPTURE_BINDING_ALBEDO] = &albedo,
         [SB_CAPTURE_BINDING_SKY_SH] = &sky,
     };
+    for (int b = 0; b < SB_SURFACE_BINDING_COUNT; b++)
+        bindings[SB_CAPTURE_BINDING_SURFACE + b] = in->rc ? &in->surfaces->buffers[b] : &dummy;
     sb_atmosphere_bind_inputs(in->atmosphere, bindings);
     sb_pipeline_bind(vk, pipeline, bindings);
     double ms = 0;
@@ -95,7 +91,6 @@ enum sb_result sb_reflection_capture(struct sb_vk *vk, const struct sb_capture_i
 done:
     sb_pipeline_destroy(vk, &temp);
     sb_buffer_destroy(vk, &result);
-    sb_buffer_destroy(vk, &albedo);
     sb_buffer_destroy(vk, &sky);
     sb_buffer_destroy(vk, &dummy);
     return res;
@@ -212,8 +207,9 @@ void sb_reflection_sh(const float *level0, uint32_t n, int irradiance, double sh
 
 void sb_reflection_code_hash(char out[33])
 {
-    char text[2 * 33 + 16];
+    char text[3 * 33 + 16];
     sb_hash_bytes(sb_spv_reflection_capture, sizeof(sb_spv_reflection_capture), text);
     sb_hash_bytes(sb_spv_reflection_prefilter, sizeof(sb_spv_reflection_prefilter), text + 32);
-    sb_hash_bytes(text, 64, out);
+    sb_surfaces_code_hash(text + 64);
+    sb_hash_bytes(text, 96, out);
 }

@@ -14,6 +14,7 @@
 #include "compute.h"
 #include "mesh.h"
 #include "raycast.h"
+#include "surfaces.h"
 
 /* The perceptual roughness mip `level` of `levels` holds: Filament's
  * mapping, level / (levels - 1) = r (2 - r), which spends more levels on
@@ -39,8 +40,7 @@ void sb_reflection_kernels_destroy(struct sb_vk *vk, struct sb_reflection_kernel
 struct sb_capture_inputs {
     struct sb_atmosphere_baker *atmosphere;
     struct sb_raycaster *rc;
-    const struct sb_mesh_material *materials; /* what the BVH's triangles' materials index */
-    uint32_t material_count;
+    const struct sb_surfaces *surfaces; /* what the BVH's triangles are (with rc) */
     struct sb_reflection_kernels *kernels; /* may be NULL: made for the call */
 };
 

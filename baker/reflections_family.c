@@ -37,6 +37,7 @@ struct reflection_state {
     char path[640]; /* the world's file, absolute */
     struct sb_bvh bvh;
     struct sb_raycaster *rc;
+    struct sb_surfaces surfaces; /* made with rc */
     struct sb_atmosphere_baker *atmosphere;
     struct sb_reflection_kernels kernels;
     struct sb_vk *vk; /* the kernels' */
@@ -72,6 +73,8 @@ static void reflection_destroy(void **state)
         if (st->vk)
             sb_reflection_kernels_destroy(st->vk, &st->kernels);
         sb_atmosphere_baker_destroy(&st->atmosphere);
+        if (st->rc)
+            sb_surfaces_destroy(st->rc->vk, &st->surfaces);
         sb_raycaster_destroy(&st->rc);
         sb_bvh_finish(&st->bvh);
         sb_level_release(&st->level);
@@ -153,8 +156,9 @@ static enum sb_result bake_cubes(struct reflection_state *st, struct sb_vk *vk, 
         for (size_t i = 0; i < sizeof(inputs) / sizeof(inputs[0]) && !res; i++)
             res = sb_atmosphere_adopt(st->atmosphere, inputs[i], &baked[inputs[i]]);
     }
-    if (!res && st->has_world && !st->rc && !(res = sb_level_build_bvh(st->level, &st->bvh)))
-        res = sb_raycaster_create(vk, &st->bvh, &st->rc);
+    if (!res && st->has_world && !st->rc && !(res = sb_level_build_bvh(st->level, &st->bvh)) &&
+        !(res = sb_raycaster_create(vk, &st->bvh, &st->rc)))
+        res = sb_surfaces_create_level(vk, st->level, &st->surfaces);
     if (res)
         return res;
     sb_debug("reflection_cubes: the atmosphere's LUTs and the BVH on the device in %.1f ms", 1e3 * sb_now_s() - t0);
@@ -179,8 +183,7 @@ static enum sb_result bake_cubes(struct reflection_state *st, struct sb_vk *vk, 
         struct sb_capture_inputs in = {
             .atmosphere = st->atmosphere,
             .rc = i ? st->rc : NULL,
-            .materials = st->level->materials,
-            .material_count = st->level->material_count,
+            .surfaces = &st->surfaces,
             .kernels = &st->kernels,
         };
         double t1 = 1e3 * sb_now_s();

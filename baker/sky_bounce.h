@@ -16,6 +16,7 @@
 
 #include "mesh.h"
 #include "raycast.h"
+#include "surfaces.h"
 
 struct sb_sky_bounce_params {
     uint32_t ray_count; /* rays a probe, a multiple of SB_PROBE_THREADS [256] */
@@ -26,16 +27,16 @@ struct sb_sky_bounce_params {
 /*
  * Bake probe_count probes at positions (xyz in m each; valid[i] 0 gives the
  * probe zeros) against the raycaster's BVH into out[SB_BOUNCE_FLOATS *
- * probe_count] (config.h: m, then k, then rgb). The triangles' materials
- * index `materials` (their albedos; a level's, or a mesh's material_list).
+ * probe_count] (config.h: m, then k, then rgb). `surfaces` are what the
+ * BVH's triangles are (their albedos and textures: the same meshes'). A
+ * hit's albedo is its texture's at the ray cone's footprint (surface.glsl).
  * *gpu_ms (may be NULL) gets the GPU time.
  */
-enum sb_result sb_sky_bounce_bake(struct sb_raycaster *raycaster, const struct sb_mesh_material *materials,
-                                  uint32_t material_count, const float *positions,
-                                  const float *valid, uint32_t probe_count, const struct sb_sky_bounce_params *params,
+enum sb_result sb_sky_bounce_bake(struct sb_raycaster *raycaster, const struct sb_surfaces *surfaces,
+                                  const float *positions, const float *valid, uint32_t probe_count, const struct sb_sky_bounce_params *params,
                                   float *out, double *gpu_ms);
 
-/* XXH3-128 of the kernel's SPIR-V, for bake keys. */
+/* XXH3-128 of the kernel's SPIR-V (and the texture mips'), for bake keys. */
 void sb_sky_bounce_code_hash(char out[33]);
 
 #endif

@@ -97,19 +97,22 @@ static enum sb_result add_parts(struct loader *ld, uint32_t self, const struct s
     enum sb_result res = children && part_unique ? SB_OK : SB_ERR_NOMEM;
     for (uint32_t k = 0; k < parts->part_count && !res; k++) {
         struct sb_mesh part = {0};
-        for (uint32_t m = 0; m < mesh->material_count && !res; m++) {
-            const struct sb_mesh_material *from = &mesh->material_list[m];
-            double albedo[3] = {from->albedo[0], from->albedo[1], from->albedo[2]};
-            uint32_t index;
-            if (!(res = sb_mesh_add_material(&part, from->name, albedo, &index)))
-                part.material_list[index] = *from;
-        }
+        uint32_t texture_base = 0;
+        res = sb_mesh_copy_textures(&part, mesh, &texture_base);
+        for (uint32_t m = 0; m < mesh->material_count && !res; m++)
+            res = sb_mesh_copy_material(&part, &mesh->material_list[m], texture_base, &(uint32_t){0});
         for (uint32_t t = parts->first[k]; t < parts->first[k] + parts->count[k] && !res; t++) {
             double p[3][3];
-            for (int v = 0; v < 3; v++)
+            float uv[3][2];
+            for (int v = 0; v < 3; v++) {
+                uint32_t vertex = mesh->indices[3 * (size_t)t + v];
                 for (int i = 0; i < 3; i++)
-                    p[v][i] = mesh->positions[3 * (size_t)mesh->indices[3 * (size_t)t + v] + i];
-            res = sb_mesh_add_triangle(&part, p[0], p[1], p[2], mesh->materials[t], ld->uniques[self].path);
+                    p[v][i] = mesh->positions[3 * (size_t)vertex + i];
+                for (int i = 0; i < 2 && mesh->uvs; i++)
+                    uv[v][i] = mesh->uvs[2 * (size_t)vertex + i];
+            }
+            res = sb_mesh_add_triangle_uv(&part, p[0], p[1], p[2], mesh->uvs ? uv : NULL, mesh->materials[t],
+                                          ld->uniques[self].path);
         }
         char name[PATH_MAX + 16];
         snprintf(name, sizeof(name), "%s#%u", ld->uniques[self].path, k);
@@ -462,13 +465,25 @@ enum sb_result sb_level_load(const struct sb_world_params *w, const char *direct
         sb_error("%s: %llu unique triangles: past 2^31", path, (unsigned long long)unique_triangles);
         res = SB_ERR_TOO_LARGE;
     }
+    uint64_t textures = 0;
+    for (uint32_t m = 0; m < level->mesh_count; m++)
+        textures += level->meshes[m].texture_count;
     level->materials = res ? NULL : malloc((materials ? materials : 1) * sizeof(*level->materials));
-    if (!res && !level->materials)
+    level->textures = res ? NULL : malloc((textures ? textures : 1) * sizeof(*level->textures));
+    if (!res && (!level->materials || !level->textures))
         res = SB_ERR_NOMEM;
     for (uint32_t m = 0; m < level->mesh_count && !res; m++) {
-        memcpy(&level->materials[level->material_count], level->meshes[m].material_list,
-               level->meshes[m].material_count * sizeof(*level->materials));
-        level->material_count += level->meshes[m].material_count;
+        const struct sb_mesh *mesh = &level->meshes[m];
+        for (uint32_t k = 0; k < mesh->material_count; k++) {
+            struct sb_mesh_material *to = &level->materials[level->material_count + k];
+            *to = mesh->material_list[k];
+            for (int slot = 0; slot < SB_TEXTURE_SLOT_COUNT; slot++)
+                to->textures[slot] += to->textures[slot] < 0 ? 0 : (int32_t)level->texture_count;
+        }
+        for (uint32_t k = 0; k < mesh->texture_count; k++)
+            level->textures[level->texture_count + k] = &mesh->texture_list[k];
+        level->material_count += mesh->material_count;
+        level->texture_count += mesh->texture_count;
     }
     if (!res && !level->instance_count)
         level->placed_triangles = level->meshes[0].triangle_count;
@@ -493,6 +508,7 @@ void sb_level_finish(struct sb_level *level)
     free(level->meshes);
     free(level->instances);
     free(level->materials);
+    free(level->textures);
     memset(level, 0, sizeof(*level));
 }
 
@@ -573,15 +589,13 @@ enum sb_result sb_level_flatten(const struct sb_level *level, struct sb_mesh *me
         return SB_ERR_NOMEM;
     for (uint32_t m = 0; m < level->mesh_count && !res; m++) {
         material_base[m] = first_material;
+        uint32_t texture_base = 0;
+        res = sb_mesh_copy_textures(mesh, &level->meshes[m], &texture_base);
         for (uint32_t k = 0; k < level->meshes[m].material_count && !res; k++) {
-            const struct sb_mesh_material *from = &level->meshes[m].material_list[k];
-            double albedo[3] = {from->albedo[0], from->albedo[1], from->albedo[2]};
             uint32_t index;
-            res = sb_mesh_add_material(mesh, from->name, albedo, &index);
-            if (!res) {
-                mesh->material_list[index] = *from;
+            res = sb_mesh_copy_material(mesh, &level->meshes[m].material_list[k], texture_base, &index);
+            if (!res)
                 first_material = index + 1;
-            }
         }
     }
     uint32_t count = level->instance_count ? level->instance_count : 1;
@@ -590,15 +604,19 @@ enum sb_result sb_level_flatten(const struct sb_level *level, struct sb_mesh *me
         const struct sb_mesh *from = &level->meshes[in ? in->mesh : 0];
         for (uint32_t t = 0; t < from->triangle_count && !res; t++) {
             double p[3][3];
+            float uv[3][2];
             for (int k = 0; k < 3; k++) {
-                const float *v = &from->positions[3 * (size_t)from->indices[3 * (size_t)t + k]];
+                uint32_t vertex = from->indices[3 * (size_t)t + k];
+                for (int c = 0; c < 2 && from->uvs; c++)
+                    uv[k][c] = from->uvs[2 * (size_t)vertex + c];
+                const float *v = &from->positions[3 * (size_t)vertex];
                 for (int r = 0; r < 3; r++)
                     p[k][r] = in ? in->to_world[r][0] * v[0] + in->to_world[r][1] * v[1] + in->to_world[r][2] * v[2] +
                                        in->to_world[r][3]
                                  : v[r];
             }
-            res = sb_mesh_add_triangle(mesh, p[0], p[1], p[2], material_base[in ? in->mesh : 0] + from->materials[t],
-                                       "the world");
+            res = sb_mesh_add_triangle_uv(mesh, p[0], p[1], p[2], from->uvs ? uv : NULL,
+                                          material_base[in ? in->mesh : 0] + from->materials[t], "the world");
         }
     }
     free(material_base);

@@ -34,6 +34,10 @@ struct sb_level {
     /* every mesh's materials in turn, as the BVH numbers them (owned) */
     struct sb_mesh_material *materials;
     uint32_t material_count;
+    /* every mesh's textures in turn, as the materials above number them
+     * (the array owned, the textures the meshes') */
+    const struct sb_mesh_texture **textures;
+    uint32_t texture_count;
 };
 
 struct sb_world_params;

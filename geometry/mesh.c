@@ -56,7 +56,65 @@ enum sb_result sb_mesh_add_material(struct sb_mesh *mesh, const char *name, cons
         m->albedo[c] = (float)fmin(fmax(isfinite(albedo[c]) ? albedo[c] : 0.0, 0.0), 1.0);
     m->roughness = 0.5f;
     m->casts_shadows = true;
+    for (int k = 0; k < SB_TEXTURE_SLOT_COUNT; k++)
+        m->textures[k] = -1;
     *index = mesh->material_count++;
+    return SB_OK;
+}
+
+enum sb_result sb_mesh_add_texture(struct sb_mesh *mesh, struct sb_mesh_texture *texture, uint32_t *index)
+{
+    size_t bytes = sb_texture_bytes(texture);
+    for (uint32_t k = 0; k < mesh->texture_count; k++)
+        bytes += sb_texture_bytes(&mesh->texture_list[k]);
+    enum sb_result res = SB_OK;
+    if (mesh->texture_count >= SB_MESH_MAX_TEXTURES || bytes > SB_MESH_MAX_TEXEL_BYTES) {
+        sb_error("%s: more than %u images or %llu MiB of texels", texture->name, SB_MESH_MAX_TEXTURES,
+                 SB_MESH_MAX_TEXEL_BYTES >> 20);
+        res = SB_ERR_TOO_LARGE;
+    } else {
+        res = grow((void **)&mesh->texture_list, &mesh->capacity_textures, mesh->texture_count + 1,
+                   sizeof(*mesh->texture_list));
+    }
+    if (res) {
+        free(texture->rgba);
+        texture->rgba = NULL;
+        return res;
+    }
+    mesh->texture_list[mesh->texture_count] = *texture;
+    texture->rgba = NULL;
+    *index = mesh->texture_count++;
+    return SB_OK;
+}
+
+enum sb_result sb_mesh_copy_textures(struct sb_mesh *to, const struct sb_mesh *from, uint32_t *base)
+{
+    *base = to->texture_count;
+    for (uint32_t k = 0; k < from->texture_count; k++) {
+        struct sb_mesh_texture copy = from->texture_list[k];
+        copy.rgba = malloc(sb_texture_bytes(&copy));
+        if (!copy.rgba)
+            return SB_ERR_NOMEM;
+        memcpy(copy.rgba, from->texture_list[k].rgba, sb_texture_bytes(&copy));
+        uint32_t index;
+        enum sb_result res = sb_mesh_add_texture(to, &copy, &index);
+        if (res)
+            return res;
+    }
+    return SB_OK;
+}
+
+enum sb_result sb_mesh_copy_material(struct sb_mesh *to, const struct sb_mesh_material *from, uint32_t texture_base,
+                                     uint32_t *index)
+{
+    double albedo[3] = {from->albedo[0], from->albedo[1], from->albedo[2]};
+    enum sb_result res = sb_mesh_add_material(to, from->name, albedo, index);
+    if (res)
+        return res;
+    struct sb_mesh_material *m = &to->material_list[*index];
+    *m = *from;
+    for (int k = 0; k < SB_TEXTURE_SLOT_COUNT; k++)
+        m->textures[k] = from->textures[k] < 0 ? -1 : from->textures[k] + (int32_t)texture_base;
     return SB_OK;
 }
 
@@ -83,6 +141,12 @@ static double doubled_area(const float *a, const float *b, const float *c)
 enum sb_result sb_mesh_add_triangle(struct sb_mesh *mesh, const double a[3], const double b[3], const double c[3],
                                     uint32_t material, const char *source)
 {
+    return sb_mesh_add_triangle_uv(mesh, a, b, c, NULL, material, source);
+}
+
+enum sb_result sb_mesh_add_triangle_uv(struct sb_mesh *mesh, const double a[3], const double b[3], const double c[3],
+                                       const float uv[3][2], uint32_t material, const char *source)
+{
     const double *v[3] = {a, b, c};
     for (int k = 0; k < 3; k++)
         if (!coordinate_ok(v[k])) {
@@ -108,7 +172,7 @@ enum sb_result sb_mesh_add_triangle(struct sb_mesh *mesh, const double a[3], con
         return SB_ERR_TOO_LARGE;
     }
     enum sb_result res;
-    size_t triangles_before = mesh->capacity_triangles;
+    size_t triangles_before = mesh->capacity_triangles, vertices_before = mesh->capacity_vertices;
     if ((res = grow((void **)&mesh->positions, &mesh->capacity_vertices, (size_t)mesh->vertex_count + 3,
                     3 * sizeof(float))) ||
         (res = grow((void **)&mesh->indices, &mesh->capacity_triangles, (size_t)mesh->triangle_count + 1,
@@ -125,6 +189,20 @@ enum sb_result sb_mesh_add_triangle(struct sb_mesh *mesh, const double a[3], con
         }
         mesh->materials = materials;
     }
+    /* uvs[], once a triangle has them, shares the vertices' capacity */
+    if ((mesh->uvs && mesh->capacity_vertices != vertices_before) || (uv && !mesh->uvs)) {
+        float *uvs = realloc(mesh->uvs, mesh->capacity_vertices * 2 * sizeof(float));
+        if (!uvs) {
+            mesh->capacity_vertices = vertices_before;
+            return SB_ERR_NOMEM;
+        }
+        if (!mesh->uvs)
+            memset(uvs, 0, (size_t)mesh->vertex_count * 2 * sizeof(float));
+        mesh->uvs = uvs;
+    }
+    for (int k = 0; k < 3 && mesh->uvs; k++)
+        for (int i = 0; i < 2; i++)
+            mesh->uvs[2 * (size_t)(mesh->vertex_count + k) + i] = uv && isfinite(uv[k][i]) ? uv[k][i] : 0.0f;
     for (int k = 0; k < 3; k++) {
         memcpy(&mesh->positions[3 * (size_t)(mesh->vertex_count + k)], f[k], sizeof(f[k]));
         mesh->indices[3 * (size_t)mesh->triangle_count + k] = mesh->vertex_count + k;
@@ -228,6 +306,13 @@ struct importer {
     int32_t *part_of;
     uint32_t *uses;   /* how many times the node tree places each file mesh */
     bool single_only; /* add_node: only the meshes placed once */
+    /* the images read so far, by their name in the file and encoding */
+    uint32_t image_count;
+    struct {
+        char name[SB_TEXTURE_NAME_MAX];
+        bool srgb;
+        uint32_t index;
+    } images[SB_MESH_MAX_TEXTURES];
 };
 
 /* Count the triangles the node tree instances, refusing deep trees and
@@ -270,6 +355,8 @@ static enum sb_result add_node(struct importer *im, const struct aiNode *node, c
             if (face->mNumIndices != 3)
                 continue; /* points and lines */
             double p[3][3];
+            float uv[3][2];
+            const struct aiVector3D *coords = am->mNumUVComponents[0] >= 2 ? am->mTextureCoords[0] : NULL;
             for (int k = 0; k < 3; k++) {
                 if (face->mIndices[k] >= am->mNumVertices) {
                     sb_error("%s: mesh \"%s\" face %u: vertex %u of %u", im->path, am->mName.data, f, face->mIndices[k],
@@ -277,8 +364,12 @@ static enum sb_result add_node(struct importer *im, const struct aiNode *node, c
                     return SB_ERR_MESH;
                 }
                 transform_point(&m, &am->mVertices[face->mIndices[k]], p[k]);
+                if (coords) {
+                    uv[k][0] = (float)coords[face->mIndices[k]].x;
+                    uv[k][1] = (float)coords[face->mIndices[k]].y;
+                }
             }
-            enum sb_result res = sb_mesh_add_triangle(im->mesh, p[0], p[1], p[2], material, im->path);
+            enum sb_result res = sb_mesh_add_triangle_uv(im->mesh, p[0], p[1], p[2], coords ? uv : NULL, material, im->path);
             if (res)
                 return res;
         }
@@ -386,6 +477,109 @@ static enum sb_result add_parts(struct importer *im)
     return place_parts(im, scene->mRootNode, &world);
 }
 
+/* The image `name` of the file (a path beside it, or "*N", its N-th
+ * embedded image) decoded once for each encoding; its index in *index. */
+static enum sb_result add_image(struct importer *im, const char *name, bool srgb, const enum aiTextureMapMode mode[2],
+                                uint32_t *index)
+{
+    if (strlen(name) >= SB_TEXTURE_NAME_MAX) {
+        sb_error("%s: image %.64s...: a name of %zu bytes; at most %d", im->path, name, strlen(name),
+                 SB_TEXTURE_NAME_MAX - 1);
+        return SB_ERR_MESH;
+    }
+    for (uint32_t k = 0; k < im->image_count; k++)
+        if (im->images[k].srgb == srgb && !strcmp(im->images[k].name, name)) {
+            *index = im->images[k].index;
+            return SB_OK;
+        }
+    if (im->image_count >= SB_MESH_MAX_TEXTURES) {
+        sb_error("%s: more than %u images", im->path, SB_MESH_MAX_TEXTURES);
+        return SB_ERR_TOO_LARGE;
+    }
+    struct sb_mesh_texture t = {.srgb = srgb};
+    enum sb_result res;
+    if (name[0] == '*') {
+        char *end;
+        unsigned long n = strtoul(name + 1, &end, 10);
+        snprintf(t.name, sizeof(t.name), "%.*s", SB_TEXTURE_NAME_MAX - 1, name);
+        if (*end || end == name + 1 || n >= im->scene->mNumTextures || !im->scene->mTextures[n]) {
+            sb_error("%s: image %s: the file embeds %u images", im->path, name, im->scene->mNumTextures);
+            return SB_ERR_MESH;
+        }
+        const struct aiTexture *at = im->scene->mTextures[n];
+        if (at->mHeight == 0) { /* a PNG or JPEG file's bytes */
+            res = sb_texture_decode(at->pcData, at->mWidth, im->path, &t);
+        } else if (!at->mWidth || at->mWidth > SB_TEXTURE_MAX_SIDE || at->mHeight > SB_TEXTURE_MAX_SIDE) {
+            sb_error("%s: image %s: %u x %u texels; images are read up to %u x %u", im->path, name, at->mWidth,
+                     at->mHeight, SB_TEXTURE_MAX_SIDE, SB_TEXTURE_MAX_SIDE);
+            res = SB_ERR_TOO_LARGE;
+        } else { /* texels as assimp holds them: b, g, r, a */
+            t.width = at->mWidth;
+            t.height = at->mHeight;
+            t.rgba = malloc(sb_texture_bytes(&t));
+            res = t.rgba ? SB_OK : SB_ERR_NOMEM;
+            for (size_t i = 0; !res && i < (size_t)t.width * t.height; i++) {
+                const struct aiTexel *x = &at->pcData[i];
+                uint8_t *o = &t.rgba[4 * i];
+                o[0] = x->r, o[1] = x->g, o[2] = x->b, o[3] = x->a;
+            }
+        }
+    } else {
+        res = sb_texture_read(im->path, name, &t);
+    }
+    if (res) {
+        free(t.rgba);
+        return res;
+    }
+    for (int axis = 0; axis < 2; axis++)
+        t.wrap[axis] = mode[axis] == aiTextureMapMode_Clamp || mode[axis] == aiTextureMapMode_Decal ? SB_TEXTURE_CLAMP
+                       : mode[axis] == aiTextureMapMode_Mirror                                    ? SB_TEXTURE_MIRROR
+                                                                                                  : SB_TEXTURE_REPEAT;
+    if ((res = sb_mesh_add_texture(im->mesh, &t, index)))
+        return res;
+    snprintf(im->images[im->image_count].name, sizeof(im->images[0].name), "%.*s", SB_TEXTURE_NAME_MAX - 1, name);
+    im->images[im->image_count].srgb = srgb;
+    im->images[im->image_count++].index = *index;
+    return SB_OK;
+}
+
+/* The material's images, glTF's maps as assimp names them. */
+static enum sb_result add_textures(struct importer *im, const struct aiMaterial *mat, struct sb_mesh_material *out)
+{
+    static const struct {
+        enum aiTextureType types[2];
+        bool srgb;
+    } slots[SB_TEXTURE_SLOT_COUNT] = {
+        [SB_TEXTURE_BASE_COLOR] = {{aiTextureType_BASE_COLOR, aiTextureType_DIFFUSE}, true},
+        [SB_TEXTURE_NORMAL] = {{aiTextureType_NORMALS, aiTextureType_NORMALS}, false},
+        /* glTF's metallicRoughnessTexture (AI_MATKEY_GLTF_PBRMETALLICROUGHNESS_METALLICROUGHNESS_TEXTURE) */
+        [SB_TEXTURE_METALLIC_ROUGHNESS] = {{aiTextureType_UNKNOWN, aiTextureType_UNKNOWN}, false},
+        [SB_TEXTURE_EMISSIVE] = {{aiTextureType_EMISSIVE, aiTextureType_EMISSIVE}, true},
+    };
+    for (int slot = 0; slot < SB_TEXTURE_SLOT_COUNT; slot++)
+        for (int k = 0; k < 2 && out->textures[slot] < 0; k++) {
+            struct aiString name = {0};
+            enum aiTextureMapMode mode[2] = {aiTextureMapMode_Wrap, aiTextureMapMode_Wrap};
+            if (aiGetMaterialTextureCount(mat, slots[slot].types[k]) == 0 ||
+                aiGetMaterialTexture(mat, slots[slot].types[k], 0, &name, NULL, NULL, NULL, NULL, mode, NULL) !=
+                    aiReturn_SUCCESS ||
+                !name.length)
+                continue;
+            uint32_t index;
+            enum sb_result res = add_image(im, name.data, slots[slot].srgb, mode, &index);
+            if (res)
+                return res;
+            out->textures[slot] = (int32_t)index;
+        }
+    struct aiColor4D emissive;
+    if (aiGetMaterialColor(mat, AI_MATKEY_COLOR_EMISSIVE, &emissive) == aiReturn_SUCCESS) {
+        float e[3] = {emissive.r, emissive.g, emissive.b};
+        for (int c = 0; c < 3; c++)
+            out->emissive[c] = isfinite(e[c]) ? fminf(fmaxf(e[c], 0.0f), 1e6f) : 0.0f;
+    }
+    return SB_OK;
+}
+
 static enum sb_result add_materials(struct importer *im)
 {
     const struct sb_mesh_load_params *params = im->params;
@@ -429,6 +623,8 @@ static enum sb_result add_materials(struct importer *im)
             out->roughness = fminf(fmaxf((float)value, 0.0f), 1.0f);
         if (mat && aiGetMaterialFloat(mat, AI_MATKEY_METALLIC_FACTOR, &value) == aiReturn_SUCCESS && isfinite(value))
             out->metallic = fminf(fmaxf((float)value, 0.0f), 1.0f);
+        if (mat && (res = add_textures(im, mat, out)))
+            return res;
     }
     return SB_OK;
 }
@@ -611,12 +807,18 @@ int sb_mesh_import_task(int fd, const void *request, size_t size)
         h.dropped_degenerate = mesh.dropped_degenerate;
         h.part_count = parts.part_count;
         h.placement_count = parts.placement_count;
+        h.has_uvs = mesh.uvs != NULL;
+        h.texture_count = mesh.texture_count;
     }
     bool ok = sb_write_all(fd, &h, sizeof(h));
     if (!h.result && ok)
         ok = sb_write_all(fd, mesh.material_list, (size_t)mesh.material_count * sizeof(*mesh.material_list)) &&
              sb_write_all(fd, mesh.positions, (size_t)mesh.vertex_count * 3 * sizeof(float)) &&
-             sb_write_all(fd, mesh.materials, (size_t)mesh.triangle_count * sizeof(uint32_t));
+             sb_write_all(fd, mesh.materials, (size_t)mesh.triangle_count * sizeof(uint32_t)) &&
+             (!mesh.uvs || sb_write_all(fd, mesh.uvs, (size_t)mesh.vertex_count * 2 * sizeof(float)));
+    for (uint32_t k = 0; !h.result && ok && k < mesh.texture_count; k++)
+        ok = sb_write_all(fd, &mesh.texture_list[k], sizeof(mesh.texture_list[k])) &&
+             sb_write_all(fd, mesh.texture_list[k].rgba, sb_texture_bytes(&mesh.texture_list[k]));
     for (uint32_t k = 0; !h.result && ok && k < parts.part_count; k++)
         ok = sb_write_all(fd, &parts.first[k], sizeof(uint32_t)) && sb_write_all(fd, &parts.count[k], sizeof(uint32_t));
     if (!h.result && ok && parts.placement_count)
@@ -705,13 +907,51 @@ static enum sb_result receive(struct sb_sandbox *box, const char *path, struct s
                  h.triangle_count, h.material_count, SB_MESH_MAX_TRIANGLES, SB_MESH_MAX_MATERIALS);
         return SB_ERR_TOO_LARGE;
     }
+    if (h.texture_count > SB_MESH_MAX_TEXTURES || h.has_uvs > 1) {
+        sb_error("%s: %u images; at most %u", path, h.texture_count, SB_MESH_MAX_TEXTURES);
+        return SB_ERR_TOO_LARGE;
+    }
     struct sb_mesh_material *materials = malloc((h.material_count + 1) * sizeof(*materials));
     float *positions = malloc((size_t)h.vertex_count * 3 * sizeof(float) + 1);
     uint32_t *triangle_materials = malloc((size_t)h.triangle_count * sizeof(uint32_t) + 1);
-    enum sb_result res = materials && positions && triangle_materials ? SB_OK : SB_ERR_NOMEM;
-    if (!res && !(sb_sandbox_read(box, materials, h.material_count * sizeof(*materials)) &&
-                  sb_sandbox_read(box, positions, (size_t)h.vertex_count * 3 * sizeof(float)) &&
-                  sb_sandbox_read(box, triangle_materials, (size_t)h.triangle_count * sizeof(uint32_t)))) {
+    float *uvs = h.has_uvs ? malloc((size_t)h.vertex_count * 2 * sizeof(float) + 1) : NULL;
+    enum sb_result res = materials && positions && triangle_materials && (uvs || !h.has_uvs) ? SB_OK : SB_ERR_NOMEM;
+    bool read = !res && sb_sandbox_read(box, materials, h.material_count * sizeof(*materials)) &&
+                sb_sandbox_read(box, positions, (size_t)h.vertex_count * 3 * sizeof(float)) &&
+                sb_sandbox_read(box, triangle_materials, (size_t)h.triangle_count * sizeof(uint32_t)) &&
+                (!uvs || sb_sandbox_read(box, uvs, (size_t)h.vertex_count * 2 * sizeof(float)));
+    /* the images, each checked before its texels are allocated */
+    uint32_t texture_base = mesh->texture_count;
+    size_t texel_bytes = 0;
+    for (uint32_t k = 0; k < h.texture_count && read && !res; k++) {
+        struct sb_mesh_texture t;
+        read = sb_sandbox_read(box, &t, sizeof(t));
+        if (!read)
+            break;
+        t.name[sizeof(t.name) - 1] = '\0';
+        texel_bytes += (size_t)4 * (t.width <= SB_TEXTURE_MAX_SIDE ? t.width : 0) *
+                       (t.height <= SB_TEXTURE_MAX_SIDE ? t.height : 0);
+        if (!t.width || !t.height || t.width > SB_TEXTURE_MAX_SIDE || t.height > SB_TEXTURE_MAX_SIDE ||
+            texel_bytes > SB_MESH_MAX_TEXEL_BYTES || t.wrap[0] > SB_TEXTURE_MIRROR || t.wrap[1] > SB_TEXTURE_MIRROR ||
+            t.srgb > 1) {
+            sb_error("%s: image %s: %u x %u texels, past the caps (%u a side, %llu MiB in all)", path, t.name, t.width,
+                     t.height, SB_TEXTURE_MAX_SIDE, SB_MESH_MAX_TEXEL_BYTES >> 20);
+            res = SB_ERR_TOO_LARGE;
+            break;
+        }
+        t.rgba = malloc(sb_texture_bytes(&t));
+        if (!t.rgba) {
+            res = SB_ERR_NOMEM;
+            break;
+        }
+        read = sb_sandbox_read(box, t.rgba, sb_texture_bytes(&t));
+        uint32_t index;
+        if (!read)
+            free(t.rgba);
+        else
+            res = sb_mesh_add_texture(mesh, &t, &index);
+    }
+    if (!res && !read) {
         char why[160];
         sb_sandbox_finish(box, why, sizeof(why));
         sb_error("%s: the import stopped half way: its process %s", path, why);
@@ -719,15 +959,24 @@ static enum sb_result receive(struct sb_sandbox *box, const char *path, struct s
     }
     uint32_t first = mesh->material_count;
     for (uint32_t m = 0; m < h.material_count && !res; m++) {
-        double albedo[3] = {materials[m].albedo[0], materials[m].albedo[1], materials[m].albedo[2]};
-        uint32_t index;
         materials[m].name[sizeof(materials[m].name) - 1] = '\0';
-        res = sb_mesh_add_material(mesh, materials[m].name, albedo, &index);
-        if (!res) { /* the helper's values, checked again */
-            struct sb_mesh_material *to = &mesh->material_list[index];
-            to->roughness = isfinite(materials[m].roughness) ? fminf(fmaxf(materials[m].roughness, 0.0f), 1.0f) : 0.5f;
-            to->metallic = isfinite(materials[m].metallic) ? fminf(fmaxf(materials[m].metallic, 0.0f), 1.0f) : 0.0f;
+        /* the helper's values, checked again */
+        struct sb_mesh_material *from = &materials[m];
+        for (int c = 0; c < 3; c++) {
+            from->albedo[c] = isfinite(from->albedo[c]) ? fminf(fmaxf(from->albedo[c], 0.0f), 1.0f) : 0.0f;
+            from->emissive[c] = isfinite(from->emissive[c]) ? fminf(fmaxf(from->emissive[c], 0.0f), 1e6f) : 0.0f;
         }
+        from->roughness = isfinite(from->roughness) ? fminf(fmaxf(from->roughness, 0.0f), 1.0f) : 0.5f;
+        from->metallic = isfinite(from->metallic) ? fminf(fmaxf(from->metallic, 0.0f), 1.0f) : 0.0f;
+        from->casts_shadows = true;
+        for (int k = 0; k < SB_TEXTURE_SLOT_COUNT; k++)
+            if (from->textures[k] < -1 || from->textures[k] >= (int32_t)h.texture_count) {
+                sb_error("%s: material %s: image %d of %u", path, from->name, from->textures[k], h.texture_count);
+                res = SB_ERR_MESH;
+            }
+        uint32_t index;
+        if (!res)
+            res = sb_mesh_copy_material(mesh, from, texture_base, &index);
     }
     uint32_t dropped = mesh->dropped_degenerate;
     for (uint32_t t = 0; t < h.triangle_count && !res; t++) {
@@ -740,12 +989,14 @@ static enum sb_result receive(struct sb_sandbox *box, const char *path, struct s
             res = SB_ERR_MESH;
             break;
         }
-        res = sb_mesh_add_triangle(mesh, p[0], p[1], p[2], first + triangle_materials[t], path);
+        res = sb_mesh_add_triangle_uv(mesh, p[0], p[1], p[2], uvs ? (const float(*)[2]) & uvs[6 * (size_t)t] : NULL,
+                                      first + triangle_materials[t], path);
     }
     mesh->dropped_degenerate = dropped + h.dropped_degenerate;
     free(materials);
     free(positions);
     free(triangle_materials);
+    free(uvs);
     if (!res && (h.part_count || h.placement_count) && mesh->triangle_count - triangles_before != h.triangle_count) {
         sb_error("%s: %u of its parts' triangles became zero-area in fp32", path,
                  h.triangle_count - (mesh->triangle_count - triangles_before));
@@ -829,6 +1080,13 @@ enum sb_result sb_mesh_import_parts(const char *path, const struct sb_mesh_load_
         mesh->triangle_count = before.triangle_count;
         mesh->material_count = before.material_count;
         mesh->dropped_degenerate = before.dropped_degenerate;
+        for (uint32_t k = before.texture_count; k < mesh->texture_count; k++)
+            free(mesh->texture_list[k].rgba);
+        mesh->texture_count = before.texture_count;
+        if (!before.uvs) {
+            free(mesh->uvs);
+            mesh->uvs = NULL;
+        }
     } else if (mesh->dropped_degenerate > before.dropped_degenerate) {
         sb_info("%s: %u zero-area triangles left out", path, mesh->dropped_degenerate - before.dropped_degenerate);
     }
@@ -923,6 +1181,17 @@ void sb_mesh_hash(const struct sb_mesh *mesh, char out[33])
     XXH3_128bits_update(st, mesh->materials, (size_t)mesh->triangle_count * sizeof(uint32_t));
     for (uint32_t m = 0; m < mesh->material_count; m++)
         XXH3_128bits_update(st, mesh->material_list[m].albedo, sizeof(mesh->material_list[m].albedo));
+    /* what only a textured mesh has (an untextured one hashes as before) */
+    if (mesh->uvs)
+        XXH3_128bits_update(st, mesh->uvs, (size_t)mesh->vertex_count * 2 * sizeof(float));
+    for (uint32_t m = 0; m < mesh->material_count && mesh->texture_count; m++)
+        XXH3_128bits_update(st, mesh->material_list[m].textures, sizeof(mesh->material_list[m].textures));
+    for (uint32_t k = 0; k < mesh->texture_count; k++) {
+        const struct sb_mesh_texture *t = &mesh->texture_list[k];
+        uint32_t header[5] = {t->width, t->height, t->wrap[0], t->wrap[1], t->srgb};
+        XXH3_128bits_update(st, header, sizeof(header));
+        XXH3_128bits_update(st, t->rgba, sb_texture_bytes(t));
+    }
     XXH128_hash_t h = XXH3_128bits_digest(st);
     XXH3_freeState(st);
     snprintf(out, 33, "%016llx%016llx", (unsigned long long)h.high64, (unsigned long long)h.low64);
@@ -930,6 +1199,10 @@ void sb_mesh_hash(const struct sb_mesh *mesh, char out[33])
 
 void sb_mesh_finish(struct sb_mesh *mesh)
 {
+    for (uint32_t k = 0; k < mesh->texture_count; k++)
+        free(mesh->texture_list[k].rgba);
+    free(mesh->texture_list);
+    free(mesh->uvs);
     free(mesh->positions);
     free(mesh->indices);
     free(mesh->materials);

@@ -17,6 +17,7 @@
 #include <stdint.h>
 
 #include "result.h"
+#include "texture.h"
 
 /* Caps: a mesh file larger than this is refused before it is read. */
 #define SB_MESH_MAX_FILE_BYTES (512ull << 20)
@@ -41,6 +42,11 @@ struct sb_mesh_material {
     float roughness;    /* perceptual, [0, 1]: for the runtime's shading [0.5] */
     float metallic;     /* [0, 1] [0] */
     bool casts_shadows; /* false: receives only (a ground plane) [true] */
+    float emissive[3];  /* linear radiance factor [0] */
+    /* The images the material reads (texture.h's slots): indices in the
+     * mesh's texture_list, -1 none [-1]. The base colour's multiplies
+     * albedo, as glTF's baseColorTexture does its factor. */
+    int32_t textures[SB_TEXTURE_SLOT_COUNT];
 };
 
 struct sb_mesh {
@@ -50,7 +56,13 @@ struct sb_mesh {
     uint32_t *materials;                    /* owned: one per triangle, < material_count */
     struct sb_mesh_material *material_list; /* owned */
     uint32_t dropped_degenerate;            /* zero-area triangles left out on loading */
-    size_t capacity_vertices, capacity_triangles, capacity_materials;
+    /* Texture coordinates, 2 a vertex (u right, v up from the image's last
+     * row, as OpenGL has them; assimp turns glTF's over),
+     * or NULL when no triangle has them (0, 0 for those without). */
+    float *uvs;
+    uint32_t texture_count;
+    struct sb_mesh_texture *texture_list; /* owned, each with its texels */
+    size_t capacity_vertices, capacity_triangles, capacity_materials, capacity_textures;
 };
 
 /* How a file's coordinates become world coordinates: p_world = translate +
@@ -164,6 +176,25 @@ enum sb_result sb_mesh_add_material(struct sb_mesh *mesh, const char *name, cons
  * messages. */
 enum sb_result sb_mesh_add_triangle(struct sb_mesh *mesh, const double a[3], const double b[3], const double c[3],
                                     uint32_t material, const char *source);
+
+/* As sb_mesh_add_triangle, with the vertices' texture coordinates (uv[k]
+ * for vertex k; NULL: none, read as 0). */
+enum sb_result sb_mesh_add_triangle_uv(struct sb_mesh *mesh, const double a[3], const double b[3], const double c[3],
+                                       const float uv[3][2], uint32_t material, const char *source);
+
+/* Add a texture, taking its texels (texture->rgba then belongs to the
+ * mesh, also on failure); its index in *index. Refuses more than
+ * SB_MESH_MAX_TEXTURES or SB_MESH_MAX_TEXEL_BYTES in all. */
+enum sb_result sb_mesh_add_texture(struct sb_mesh *mesh, struct sb_mesh_texture *texture, uint32_t *index);
+
+/* Copy every texture of `from` into `to` (texels too); *base gets the
+ * index of the first copy, the offset for the materials' indices. */
+enum sb_result sb_mesh_copy_textures(struct sb_mesh *to, const struct sb_mesh *from, uint32_t *base);
+
+/* Copy material `from` into `to` (after sb_mesh_copy_textures, whose base
+ * offsets its textures); its index in *index. */
+enum sb_result sb_mesh_copy_material(struct sb_mesh *to, const struct sb_mesh_material *from, uint32_t texture_base,
+                                     uint32_t *index);
 
 /* The bounds of every vertex; false when the mesh is empty. */
 bool sb_mesh_bounds(const struct sb_mesh *mesh, float min[3], float max[3]);

@@ -304,6 +304,32 @@ struct sb_raycast_push {
 #define SB_SH_COSINE_FACTORS 3.141592653589793, 2.0943951023931953, 0.7853981633974483
 #define SB_VISIBILITY_FLOATS 12 /* sh[9], back-face fraction, hit fraction, mean hit distance (m) */
 
+/* What the baker's rays see of the surfaces they hit (surface.glsl,
+ * baker/surfaces.h): four bindings from a kernel's first, in this order:
+ * one (albedo, base-colour texture + 1) a material, three vec2 a triangle
+ * (its vertices' texture coordinates), one uvec4 a texture, and every
+ * texture's mips (one RGBA8 uint a texel). Wrap modes as
+ * geometry/texture.h's enum sb_texture_wrap. */
+#define SB_SURFACE_MATERIALS 0
+#define SB_SURFACE_UVS 1
+#define SB_SURFACE_TEXTURES 2
+#define SB_SURFACE_TEXELS 3
+#define SB_SURFACE_BINDING_COUNT 4
+#define SB_SURFACE_WRAP_REPEAT 0
+#define SB_SURFACE_WRAP_CLAMP 1
+#define SB_SURFACE_WRAP_MIRROR 2
+
+/* The textures' mips (texture_mips.comp): one dispatch a level, z the
+ * texture; level `level` from level - 1. */
+#define SB_TEXTURE_MIPS_BINDING_TEXTURES 0
+#define SB_TEXTURE_MIPS_BINDING_TEXELS 1
+#define SB_TEXTURE_MIPS_BINDING_COUNT 2
+
+struct sb_texture_mips_push {
+    SB_UINT level;
+    SB_UINT texture_count;
+};
+
 /* The one-bounce transfer at probes (probe_bounce.comp, baker/sky_bounce.h):
  * one workgroup a probe; each of ray_count rays (spherical Fibonacci) that
  * hits a surface casts, from the hit, the directions of a 2 x secondary
@@ -312,9 +338,10 @@ struct sb_raycast_push {
  * times the order-1 SH of the ray's direction, 4 pi / ray_count, is summed
  * into SB_BOUNCE_FLOATS a probe (m < 4, k < 9, rgb). Bindings: the raycast
  * kernel's nodes and triangles; rays: one vec4 a probe (position m, 1 when
- * valid); hits: the output; albedo: one vec4 a material. */
-#define SB_BOUNCE_BINDING_ALBEDO 4
-#define SB_BOUNCE_BINDING_COUNT 5
+ * valid); hits: the output; from SB_BOUNCE_BINDING_SURFACE the surfaces'
+ * four (surface.glsl). */
+#define SB_BOUNCE_BINDING_SURFACE 4
+#define SB_BOUNCE_BINDING_COUNT (SB_BOUNCE_BINDING_SURFACE + SB_SURFACE_BINDING_COUNT)
 #define SB_BOUNCE_SH 4 /* order 1 at the probe */
 #define SB_BOUNCE_FLOATS (SB_BOUNCE_SH * SB_PROBE_SH * 3)
 
@@ -370,9 +397,9 @@ struct sb_probe_push {
 #define SB_CAPTURE_BINDING_OUT 4       /* rgb radiance; w: 1 where the ray met a back face */
 #define SB_CAPTURE_BINDING_NODES 5     /* the BVH (bvh.glsl) */
 #define SB_CAPTURE_BINDING_TRIANGLES 6
-#define SB_CAPTURE_BINDING_ALBEDO 7    /* one vec4 a material */
-#define SB_CAPTURE_BINDING_SKY_SH 8    /* 9 vec4: the sky's radiance in order-2 SH, rgb */
-#define SB_CAPTURE_BINDING_COUNT 9
+#define SB_CAPTURE_BINDING_SKY_SH 7    /* 9 vec4: the sky's radiance in order-2 SH, rgb */
+#define SB_CAPTURE_BINDING_SURFACE 8   /* the surfaces' four (surface.glsl) */
+#define SB_CAPTURE_BINDING_COUNT (SB_CAPTURE_BINDING_SURFACE + SB_SURFACE_BINDING_COUNT)
 
 struct sb_capture_push {
     SB_VEC4(origin_m);      /* the probe; w: its altitude, km */

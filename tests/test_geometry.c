@@ -18,8 +18,10 @@
 
 #include "bvh.h"
 #include "parallel.h"
+#include "pngfile.h"
 #include "embree_ref.h"
 #include "harness_vk.h"
+#include "io.h"
 #include "json.h"
 #include "level.h"
 #include "log.h"
@@ -997,6 +999,167 @@ static void capture_end(void)
     sb_log_set_sink(NULL, NULL);
 }
 
+/* ---- textures ---------------------------------------------------------------------------- */
+
+static uint32_t crc32_of(const uint8_t *p, size_t n)
+{
+    uint32_t c = 0xffffffffu;
+    for (size_t i = 0; i < n; i++) {
+        c ^= p[i];
+        for (int k = 0; k < 8; k++)
+            c = c >> 1 ^ (0xedb88320u & (0u - (c & 1)));
+    }
+    return ~c;
+}
+
+/* A PNG of a signature, an IHDR and an empty IDAT: what a decoder reads
+ * before any texel. */
+static void write_png_header(const char *path, uint32_t width, uint32_t height, uint8_t colour_type)
+{
+    uint8_t b[33 + 12] = {0x89, 'P', 'N', 'G', '\r', '\n', 0x1a, '\n', 0, 0, 0, 13, 'I', 'H', 'D', 'R'};
+    for (int i = 0; i < 4; i++) {
+        b[16 + i] = (uint8_t)(width >> (24 - 8 * i));
+        b[20 + i] = (uint8_t)(height >> (24 - 8 * i));
+    }
+    b[24] = 8; /* bit depth */
+    b[25] = colour_type;
+    uint32_t crc = crc32_of(b + 12, 17);
+    for (int i = 0; i < 4; i++)
+        b[29 + i] = (uint8_t)(crc >> (24 - 8 * i));
+    memcpy(b + 37, "IDAT", 4);
+    crc = crc32_of(b + 37, 4);
+    for (int i = 0; i < 4; i++)
+        b[41 + i] = (uint8_t)(crc >> (24 - 8 * i));
+    FILE *f = fopen(path, "wb");
+    fwrite(b, 1, sizeof(b), f);
+    fclose(f);
+}
+
+/* A glTF of one triangle with texture coordinates, its material's base
+ * colour the image `uri`. */
+static void write_textured_gltf(const char *dir, const char *name, const char *uri)
+{
+    char path[512];
+    const float data[15] = {0, 0, 0, 1, 0, 0, 0, 0, -1, /* positions */
+                            0.25f, 0.25f, 0.75f, 0.25f, 0.25f, 1.0f};
+    snprintf(path, sizeof(path), "%s/tri.bin", dir);
+    FILE *f = fopen(path, "wb");
+    fwrite(data, 1, sizeof(data), f);
+    fclose(f);
+    char text[2048];
+    snprintf(text, sizeof(text),
+             "{\"asset\": {\"version\": \"2.0\"}, \"buffers\": [{\"uri\": \"tri.bin\", \"byteLength\": 60}], "
+             "\"bufferViews\": [{\"buffer\": 0, \"byteLength\": 36}, {\"buffer\": 0, \"byteOffset\": 36, "
+             "\"byteLength\": 24}], \"accessors\": [{\"bufferView\": 0, \"componentType\": 5126, \"count\": 3, "
+             "\"type\": \"VEC3\", \"min\": [0, 0, -1], \"max\": [1, 0, 0]}, {\"bufferView\": 1, "
+             "\"componentType\": 5126, \"count\": 3, \"type\": \"VEC2\"}], \"images\": [{\"uri\": \"%s\"}], "
+             "\"textures\": [{\"source\": 0}], \"materials\": [{\"name\": \"painted\", \"pbrMetallicRoughness\": "
+             "{\"baseColorTexture\": {\"index\": 0}}}], \"meshes\": [{\"primitives\": [{\"attributes\": "
+             "{\"POSITION\": 0, \"TEXCOORD_0\": 1}, \"material\": 0}]}], \"nodes\": [{\"mesh\": 0}], "
+             "\"scenes\": [{\"nodes\": [0]}], \"scene\": 0}",
+             uri);
+    snprintf(path, sizeof(path), "%s/%s", dir, name);
+    write_file(path, text);
+}
+
+/* Images a model names: decoded with the texture coordinates, and hostile
+ * ones (truncated, huge, of no layout PNG has, not an image, outside the
+ * model's folder) refused, naming the model and the image, the mesh left
+ * as it was. */
+static void test_textures(void)
+{
+    char dir[256], sub[300], path[600], model[600];
+    CHECK(test_temp_dir("skybake-textures", dir, sizeof(dir)), "temporary directory");
+    snprintf(sub, sizeof(sub), "%s/model", dir);
+    CHECK(mkdir(sub, 0700) == 0, "a model folder");
+    /* 4 x 2 texels: red, green, blue, white; then grey */
+    uint8_t rgba[4 * 8] = {255, 0, 0, 255, 0, 255, 0, 255, 0, 0, 255, 255, 255, 255, 255, 255};
+    for (int i = 16; i < 32; i++)
+        rgba[i] = i % 4 == 3 ? 255 : 128;
+    snprintf(path, sizeof(path), "%s/good.png", sub);
+    CHECK(sb_png_write(path, 4, 2, rgba) == SB_OK, "a PNG");
+    snprintf(model, sizeof(model), "%s/good.gltf", sub);
+    write_textured_gltf(sub, "good.gltf", "good.png");
+    struct sb_mesh m = {0};
+    enum sb_result res = sb_mesh_load(model, NULL, &m);
+    CHECK(res == SB_OK && m.texture_count == 1 && m.uvs, "a textured glTF: %s, %u textures", sb_result_name(res),
+          m.texture_count);
+    if (!res && m.texture_count == 1 && m.uvs) {
+        const struct sb_mesh_texture *t = &m.texture_list[0];
+        CHECK(t->width == 4 && t->height == 2 && t->srgb && !memcmp(t->rgba, rgba, sizeof(rgba)),
+              "the image's texels, as written (%u x %u)", t->width, t->height);
+        CHECK(m.material_list[0].textures[SB_TEXTURE_BASE_COLOR] == 0, "the material's base colour texture");
+        /* glTF's v runs down the image; the mesh's up (assimp turns it) */
+        CHECK(m.uvs[0] == 0.25f && m.uvs[1] == 0.75f && m.uvs[5] == 0.0f, "texture coordinates (%g, %g) (%g)",
+              m.uvs[0], m.uvs[1], m.uvs[5]);
+    }
+    char before[33], after[33];
+    sb_mesh_hash(&m, before);
+
+    /* a valid image, then broken copies of it */
+    char *good = NULL;
+    size_t good_size = 0;
+    sb_read_file(AT_FDCWD, path, "good.png", 1 << 20, false, &good, &good_size);
+    snprintf(path, sizeof(path), "%s/outside.png", dir);
+    sb_png_write(path, 4, 2, rgba);
+    free(good);
+    /* cut inside its texels: the header reads, the texels end early */
+    uint8_t *noise = malloc(4 * 64 * 64);
+    for (int i = 0; i < 4 * 64 * 64; i++)
+        noise[i] = (uint8_t)(i * 2654435761u >> 24);
+    snprintf(path, sizeof(path), "%s/noise.png", sub);
+    sb_png_write(path, 64, 64, noise);
+    free(noise);
+    sb_read_file(AT_FDCWD, path, "noise.png", 1 << 20, false, &good, &good_size);
+    snprintf(path, sizeof(path), "%s/truncated.png", sub);
+    FILE *f = fopen(path, "wb");
+    fwrite(good, 1, good_size * 3 / 4, f);
+    fclose(f);
+    free(good);
+    snprintf(path, sizeof(path), "%s/huge.png", sub);
+    write_png_header(path, 65535, 65535, 6);
+    snprintf(path, sizeof(path), "%s/layout.png", sub);
+    write_png_header(path, 4, 4, 5); /* colour type 5: no such channel layout */
+    snprintf(path, sizeof(path), "%s/text.png", sub);
+    write_file(path, "not an image at all");
+    char target[600];
+    snprintf(target, sizeof(target), "%s/outside.png", dir);
+    snprintf(path, sizeof(path), "%s/link.png", sub);
+    CHECK(symlink(target, path) == 0, "a link out of the folder");
+    static const struct {
+        const char *uri;
+        enum sb_result want;
+        const char *says;
+    } cases[] = {
+        {"truncated.png", SB_ERR_IO, "libpng cannot read it"},
+        {"huge.png", SB_ERR_TOO_LARGE, "65535 x 65535 texels"},
+        {"layout.png", SB_ERR_IO, "libpng cannot read it"},
+        {"text.png", SB_ERR_IO, "neither PNG nor JPEG"},
+        {"../outside.png", SB_ERR_UNSAFE_PATH, "outside the model's folder"},
+        {"link.png", SB_ERR_UNSAFE_PATH, "outside the model's folder"},
+        {"/etc/passwd", SB_ERR_UNSAFE_PATH, "outside the model's folder"},
+        {"missing.png", SB_ERR_IO, "missing.png"},
+    };
+    for (size_t i = 0; i < sizeof(cases) / sizeof(cases[0]); i++) {
+        write_textured_gltf(sub, "hostile.gltf", cases[i].uri);
+        snprintf(model, sizeof(model), "%s/hostile.gltf", sub);
+        struct captured log;
+        capture_begin(&log);
+        res = sb_mesh_load(model, &(struct sb_mesh_load_params){.time_limit_s = 20}, &m);
+        capture_end();
+        sb_mesh_hash(&m, after);
+        CHECK(res == cases[i].want && strstr(log.text, model) && strstr(log.text, cases[i].uri) &&
+                  strstr(log.text, cases[i].says),
+              "%s: %s, expected %s saying \"%s\", naming the model and the image: %s", cases[i].uri,
+              sb_result_name(res), sb_result_name(cases[i].want), cases[i].says, log.text);
+        CHECK(!strcmp(before, after) && m.texture_count == 1, "%s: the mesh changed on failure", cases[i].uri);
+    }
+    sb_mesh_finish(&m);
+    char rm[700];
+    snprintf(rm, sizeof(rm), "rm -rf '%s'", dir);
+    CHECK(system(rm) == 0, "removing %s", dir);
+}
+
 /* A level from a scene whose world is `file` in `dir`. */
 static enum sb_result load_level(const char *dir, const char *file, struct sb_level *level)
 {
@@ -1280,6 +1443,7 @@ int main(void)
     test_hostile();
     test_coincident();
     test_levels();
+    test_textures();
 
     struct sb_mesh house = {0}, well = {0}, room = {0}, soup = {0};
     uint32_t mat;

@@ -216,7 +216,10 @@ int main(void)
     struct sb_bvh bvh = {0};
     struct sb_raycaster *rc = NULL;
     CHECK(sb_mesh_load(SOURCE_ROOT "/data/worlds/test.json", NULL, &mesh) == SB_OK, "test world");
-    CHECK(sb_bvh_build(&mesh, &bvh) == SB_OK && sb_raycaster_create(vk, &bvh, &rc) == SB_OK, "bvh");
+    struct sb_surfaces surfaces = {0};
+    CHECK(sb_bvh_build(&mesh, &bvh) == SB_OK && sb_raycaster_create(vk, &bvh, &rc) == SB_OK &&
+              sb_surfaces_create(vk, &mesh, 1, &surfaces) == SB_OK,
+          "bvh");
     struct sb_capture_params cp = {
         .origin_m = {0, 1.5f, -20}, .altitude_km = 1.5e-3, .face_size = N, .ambient_rays = 32};
     double el = 30 * M_PI / 180, az = 150 * M_PI / 180;
@@ -226,7 +229,7 @@ int main(void)
     float *sky = malloc((size_t)6 * N * N * 4 * sizeof(float)), *again = malloc((size_t)6 * N * N * 4 * sizeof(float));
     struct sb_capture_inputs sky_in = {.atmosphere = atm};
     struct sb_capture_inputs world_in = {
-        .atmosphere = atm, .rc = rc, .materials = mesh.material_list, .material_count = mesh.material_count};
+        .atmosphere = atm, .rc = rc, .surfaces = &surfaces};
     CHECK(sb_reflection_capture(vk, &sky_in, &cp, sky, NULL) == SB_OK, "sky capture");
     sb_reflection_sh(sky, N, 0, cp.sky_sh);
     CHECK(sb_reflection_capture(vk, &world_in, &cp, level0, NULL) == SB_OK, "world capture");
@@ -274,6 +277,7 @@ int main(void)
     free(level0);
     for (int i = 0; i < 3; i++)
         sb_image_finish(&luts[i]);
+    sb_surfaces_destroy(vk, &surfaces);
     sb_raycaster_destroy(&rc);
     sb_bvh_finish(&bvh);
     sb_mesh_finish(&mesh);

@@ -50,6 +50,7 @@ struct scene {
     struct sb_mesh mesh;
     struct sb_bvh bvh;
     struct sb_raycaster *rc;
+    struct sb_surfaces surfaces;
 };
 
 static bool scene_ready(struct sb_vk *vk, struct scene *s)
@@ -57,12 +58,16 @@ static bool scene_ready(struct sb_vk *vk, struct scene *s)
     enum sb_result res = sb_bvh_build(&s->mesh, &s->bvh);
     if (!res)
         res = sb_raycaster_create(vk, &s->bvh, &s->rc);
+    if (!res)
+        res = sb_surfaces_create(vk, &s->mesh, 1, &s->surfaces);
     CHECK(res == SB_OK, "%s: BVH and raycaster: %s", s->name, sb_result_name(res));
     return res == SB_OK;
 }
 
 static void scene_finish(struct scene *s)
 {
+    if (s->rc)
+        sb_surfaces_destroy(s->rc->vk, &s->surfaces);
     sb_raycaster_destroy(&s->rc);
     sb_bvh_finish(&s->bvh);
     sb_mesh_finish(&s->mesh);
@@ -426,7 +431,7 @@ static bool bake_bounce(struct scene *s, const float *positions, uint32_t count,
                         float *out)
 {
     struct sb_sky_bounce_params p = {.ray_count = rays, .secondary = secondary};
-    enum sb_result res = sb_sky_bounce_bake(s->rc, s->mesh.material_list, s->mesh.material_count, positions, NULL, count, &p, out, NULL);
+    enum sb_result res = sb_sky_bounce_bake(s->rc, &s->surfaces, positions, NULL, count, &p, out, NULL);
     CHECK(res == SB_OK, "%s: bounce: %s", s->name, sb_result_name(res));
     return res == SB_OK;
 }
@@ -618,6 +623,97 @@ static void test_bounce(struct sb_vk *vk)
     scene_finish(&house);
 }
 
+/* A square floor [-h, h]^2 at y = 0, facing up, in two triangles per half
+ * (x < 0, x > 0), each half its material; texture coordinates u = (x + h)
+ * / 2h, v = (z + h) / 2h. */
+static void split_floor(struct sb_mesh *mesh, double h, uint32_t left, uint32_t right)
+{
+    for (int half = 0; half < 2; half++) {
+        double x0 = half ? 0 : -h, x1 = half ? h : 0;
+        double p[4][3] = {{x0, 0, -h}, {x1, 0, -h}, {x1, 0, h}, {x0, 0, h}};
+        float uv[4][2];
+        for (int k = 0; k < 4; k++) {
+            uv[k][0] = (float)((p[k][0] + h) / (2 * h));
+            uv[k][1] = (float)((p[k][2] + h) / (2 * h));
+        }
+        const int tris[2][3] = {{0, 2, 1}, {0, 3, 2}}; /* counter-clockwise from above */
+        for (int t = 0; t < 2; t++) {
+            float tuv[3][2];
+            for (int k = 0; k < 3; k++)
+                memcpy(tuv[k], uv[tris[t][k]], sizeof(tuv[k]));
+            sb_mesh_add_triangle_uv(mesh, p[tris[t][0]], p[tris[t][1]], p[tris[t][2]], tuv, half ? right : left,
+                                    "floor");
+        }
+    }
+}
+
+/* The bounce reads the albedo at the hit from its texture: a floor textured
+ * half black, half white bounces as the same floor made of a black and a
+ * white half (the bounce is linear in the albedo; only the rays whose
+ * footprint straddles the seam can differ), and unlike a uniformly grey
+ * floor of the same mean. */
+static void test_textured_bounce(struct sb_vk *vk)
+{
+    const double h = 20.0, black[3] = {0, 0, 0}, white[3] = {1, 1, 1}, grey[3] = {0.5, 0.5, 0.5};
+    static float textured[4 * SB_BOUNCE_FLOATS], split[4 * SB_BOUNCE_FLOATS], flat[4 * SB_BOUNCE_FLOATS],
+        bright[4 * SB_BOUNCE_FLOATS];
+    const float positions[4 * 3] = {-3.0f, 1.0f, 0.5f, 2.0f, 1.5f, -1.0f, 0.3f, 4.0f, 0.2f, 0.0f, 0.7f, 6.0f};
+    struct scene scenes[4] = {{.name = "textured floor"}, {.name = "split floor"}, {.name = "grey floor"},
+                              {.name = "white floor"}};
+    float *outs[4] = {textured, split, flat, bright};
+    uint32_t m0, m1;
+    /* 256 x 256 sRGB texels, black where u < 1/2 */
+    struct sb_mesh_texture t = {.name = "half", .width = 256, .height = 256, .srgb = 1,
+                                .wrap = {SB_TEXTURE_CLAMP, SB_TEXTURE_CLAMP}};
+    t.rgba = malloc(sb_texture_bytes(&t));
+    for (uint32_t y = 0; y < t.height; y++)
+        for (uint32_t x = 0; x < t.width; x++) {
+            uint8_t *o = &t.rgba[4 * ((size_t)y * t.width + x)];
+            o[0] = o[1] = o[2] = x < t.width / 2 ? 0 : 255;
+            o[3] = 255;
+        }
+    uint32_t texture;
+    sb_mesh_add_texture(&scenes[0].mesh, &t, &texture);
+    sb_mesh_add_material(&scenes[0].mesh, "textured", white, &m0);
+    scenes[0].mesh.material_list[m0].textures[SB_TEXTURE_BASE_COLOR] = (int32_t)texture;
+    split_floor(&scenes[0].mesh, h, m0, m0);
+    sb_mesh_add_material(&scenes[1].mesh, "black", black, &m0);
+    sb_mesh_add_material(&scenes[1].mesh, "white", white, &m1);
+    split_floor(&scenes[1].mesh, h, m0, m1);
+    sb_mesh_add_material(&scenes[2].mesh, "grey", grey, &m0);
+    split_floor(&scenes[2].mesh, h, m0, m0);
+    sb_mesh_add_material(&scenes[3].mesh, "white", white, &m0);
+    split_floor(&scenes[3].mesh, h, m0, m0);
+    bool ok = true;
+    for (int i = 0; i < 4; i++)
+        ok = ok && scene_ready(vk, &scenes[i]) && bake_bounce(&scenes[i], positions, 4, 256, 64, outs[i]);
+    if (ok) {
+        double seam = 0, from_grey = 0, peak = 0, below = 0;
+        for (int i = 0; i < 4 * SB_BOUNCE_FLOATS; i++) {
+            seam = fmax(seam, fabs((double)textured[i] - split[i]));
+            from_grey = fmax(from_grey, fabs((double)textured[i] - flat[i]));
+            peak = fmax(peak, fabs((double)bright[i]));
+        }
+        /* the textured floor's DC (m = 0, k = 0) within the black (0) and
+         * white floors' */
+        for (int p = 0; p < 4; p++)
+            for (int c = 0; c < 3; c++) {
+                double dc = textured[p * SB_BOUNCE_FLOATS + c], top = bright[p * SB_BOUNCE_FLOATS + c];
+                below += dc < 0 || dc > top;
+            }
+        printf("bounce over a floor textured half black, half white: within %.2e of a floor made of a black and a "
+               "white half, %.2e from a grey one (largest coefficient of a white floor %.3f)\n",
+               seam, from_grey, peak);
+        /* the seam: a ray's footprint across it filters the two halves */
+        CHECK(seam <= 0.02 * peak, "textured floor: %g from the split floor (of %g)", seam, peak);
+        CHECK(from_grey >= 10 * seam && from_grey >= 0.05 * peak, "textured floor: only %g from a grey floor",
+              from_grey);
+        CHECK(below == 0, "textured floor: a DC outside the black and white floors'");
+    }
+    for (int i = 0; i < 4; i++)
+        scene_finish(&scenes[i]);
+}
+
 /* Deringing on closed forms: a narrow cone rings negative; after, the
  * minimum is 0 within the bisection and c0 (the mean) is untouched. */
 static void test_dering(void)
@@ -706,6 +802,7 @@ int main(void)
         test_analytic(vk);
         test_house(vk);
         test_bounce(vk);
+        test_textured_bounce(vk);
         CHECK(sb_vk_validation_messages(vk) == 0, "validation messages");
         sb_vk_destroy(&vk);
     }

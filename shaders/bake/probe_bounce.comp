@@ -1,6 +1,7 @@
 #version 450
 // The one-bounce transfer at probes (config.h, sb_bounce_push): for each
-// of a probe's rays that hits a surface (albedo rho, normal n turned toward
+// of a probe's rays that hits a surface (albedo rho, textured at the ray
+// cone's footprint: surface.glsl; normal n turned toward
 // the probe), the order-2 SH g_k of (n.l) V(l) over the directions l that
 // leave the surface (V: 1 where a ray from the hit escapes the geometry),
 // by a spherical Fibonacci set of 2 x secondary directions of which the
@@ -17,12 +18,13 @@ layout(std430, binding = SB_RAYCAST_BINDING_NODES) readonly buffer Nodes { vec4 
 layout(std430, binding = SB_RAYCAST_BINDING_TRIANGLES) readonly buffer Triangles { vec4 bvh_triangles[]; };
 layout(std430, binding = SB_RAYCAST_BINDING_RAYS) readonly buffer Probes { vec4 probes[]; };
 layout(std430, binding = SB_RAYCAST_BINDING_HITS) writeonly buffer Out { float results[]; };
-layout(std430, binding = SB_BOUNCE_BINDING_ALBEDO) readonly buffer Albedo { vec4 albedo[]; };
 layout(push_constant) uniform Push { sb_bounce_push pc; };
 
 #define BVH_HIT_SLOT
 #include "bvh.glsl"
 #include "sh.glsl"
+#define SURFACE_BINDING SB_BOUNCE_BINDING_SURFACE
+#include "surface.glsl"
 
 shared float partial[SB_PROBE_SH * 3][SB_PROBE_THREADS];
 
@@ -39,6 +41,7 @@ void main()
         for (int k = 0; k < SB_PROBE_SH; k++)
             acc[m][k] = vec3(0.0);
     uint sphere = 2u * pc.secondary;
+    float spread = sqrt(12.566370614359172 / float(pc.ray_count)); // a ray's cone, radians
     for (uint r = lane; r < pc.ray_count && valid; r += SB_PROBE_THREADS) {
         vec3 w = probe_direction(r, pc.ray_count);
         BvhHit hit = bvh_trace(origin, w, pc.tmin_m, 1e30, false);
@@ -52,7 +55,7 @@ void main()
 #endif
         if (dot(n, w) > 0.0)
             n = -n; // the side the probe sees
-        vec3 rho = albedo[floatBitsToUint(e1.w)].rgb;
+        vec3 rho = surface_albedo(hit, hit.t * spread, abs(dot(n, w)));
         vec3 x = origin + w * hit.t;
         float eps = 1e-4 + 2e-6 * max(abs(x.x), max(abs(x.y), abs(x.z)));
         vec3 from = x + n * eps;

@@ -4,7 +4,7 @@
 // see the sky (sky_radiance: single scattering with the baked sun
 // transmittance, multiple scattering, the lit planet below the horizon;
 // the sun's disk is left out, a runtime adds it analytically). Rays that
-// hit a surface see it Lambertian: albedo / pi times the sun's irradiance
+// hit a surface see it Lambertian (its albedo textured: surface.glsl): albedo / pi times the sun's irradiance
 // through the atmosphere (the transmittance LUT at the point's altitude,
 // a shadow ray) plus the sky's, over a spherical Fibonacci set from the
 // point (the sky's order-2 SH where a ray escapes, nothing where it is
@@ -21,7 +21,6 @@ layout(local_size_x = SB_WORKGROUP_X, local_size_y = SB_WORKGROUP_Y) in;
 layout(std430, binding = SB_CAPTURE_BINDING_OUT) writeonly buffer Out { vec4 radiance[]; };
 layout(std430, binding = SB_CAPTURE_BINDING_NODES) readonly buffer Nodes { vec4 bvh_nodes[]; };
 layout(std430, binding = SB_CAPTURE_BINDING_TRIANGLES) readonly buffer Triangles { vec4 bvh_triangles[]; };
-layout(std430, binding = SB_CAPTURE_BINDING_ALBEDO) readonly buffer Albedo { vec4 albedo[]; };
 layout(std430, binding = SB_CAPTURE_BINDING_SKY_SH) readonly buffer SkySh { vec4 sky_sh[SB_PROBE_SH]; };
 layout(push_constant) uniform Push { sb_capture_push pc; };
 
@@ -29,6 +28,8 @@ layout(push_constant) uniform Push { sb_capture_push pc; };
 #include "bvh.glsl"
 #include "cube.glsl"
 #include "sh.glsl"
+#define SURFACE_BINDING SB_CAPTURE_BINDING_SURFACE
+#include "surface.glsl"
 
 vec3 sky(float h, vec3 d)
 {
@@ -42,7 +43,8 @@ vec3 surface(vec3 origin, vec3 d, BvhHit hit)
     vec3 n = normalize(bvh_world_normal(cross(e1.xyz, e2.xyz), hit.instance));
     if (dot(n, d) > 0.0)
         n = -n; // the side the probe sees
-    vec3 rho = albedo[floatBitsToUint(e1.w)].rgb;
+    // a texel's cone: 2 / n radians across at a face's centre
+    vec3 rho = surface_albedo(hit, hit.t * 2.0 / float(pc.face_size), abs(dot(n, d)));
     vec3 x = origin + d * hit.t;
     float eps = 1e-4 + 2e-6 * max(abs(x.x), max(abs(x.y), abs(x.z)));
     vec3 from = x + n * eps;

@@ -1,0 +1,47 @@
+/*
+ * What the baker's rays see of the surfaces they hit (shaders/lib/
+ * surface.glsl): each material's albedo and base-colour texture, each
+ * triangle's texture coordinates, and every texture with its mips, built
+ * on the device (texture_mips.comp) from the texels the mesh import
+ * decoded (geometry/texture.h). The bounce (sky_bounce.h) and the
+ * reflection capture (reflection.h) bind them.
+ */
+#ifndef SB_BAKER_SURFACES_H
+#define SB_BAKER_SURFACES_H
+
+#include <stdint.h>
+
+#include "compute.h"
+#include "level.h"
+#include "mesh.h"
+
+struct sb_surfaces {
+    struct sb_buffer buffers[SB_SURFACE_BINDING_COUNT]; /* config.h's SB_SURFACE_* order */
+    uint32_t material_count, texture_count;
+    uint64_t texel_count; /* every level of every texture */
+    double gpu_ms;        /* the mips' */
+};
+
+/*
+ * The surfaces of `meshes` taken in turn, as a BVH over them numbers their
+ * triangles and materials (bvh.h: one mesh, or a level's meshes). Every
+ * texture is uploaded with its mips (the kernels read the base colour's);
+ * a world without textures costs buffers of one element. *surfaces zeroed on failure.
+ */
+enum sb_result sb_surfaces_create(struct sb_vk *vk, const struct sb_mesh *meshes, uint32_t mesh_count,
+                                  struct sb_surfaces *surfaces);
+
+/* A level's (sb_level's meshes). */
+static inline enum sb_result sb_surfaces_create_level(struct sb_vk *vk, const struct sb_level *level,
+                                                      struct sb_surfaces *surfaces)
+{
+    return sb_surfaces_create(vk, level->meshes, level->mesh_count, surfaces);
+}
+
+/* Free; accepts a zeroed one. */
+void sb_surfaces_destroy(struct sb_vk *vk, struct sb_surfaces *surfaces);
+
+/* The mips kernel's code, for the bake keys of what samples textures. */
+void sb_surfaces_code_hash(char out[33]);
+
+#endif
