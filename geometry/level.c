@@ -176,7 +176,8 @@ static enum sb_result landing(struct loader *ld, const struct unique *u, uint32_
         if (k == mesh_count)
             meshes[mesh_count++] = &l->meshes[m];
         placed[placed_count].mesh = k;
-        memcpy(placed[placed_count++].to_world, c == 0 ? identity : u->children[c - 1].local, sizeof(identity));
+        const void *to_world = c == 0 ? (const void *)identity : (const void *)u->children[c - 1].local;
+        memcpy(placed[placed_count++].to_world, to_world, sizeof(identity));
     }
     if (!res && !placed_count) {
         sb_error("%s: scatter: nothing to land on (the file has no triangles of its own and no instances)", source);
