@@ -78,8 +78,11 @@ enum sb_result sb_reflection_capture(struct sb_vk *vk, const struct sb_capture_i
         [SB_CAPTURE_BINDING_TRIANGLES] = in->rc ? &in->rc->triangles : &dummy,
         [SB_CAPTURE_BINDING_SKY_SH] = &sky,
     };
-    for (int b = 0; b < SB_SURFACE_BINDING_COUNT; b++)
-        bindings[SB_CAPTURE_BINDING_SURFACE + b] = in->rc ? &in->surfaces->buffers[b] : &dummy;
+    if (in->rc)
+        sb_surfaces_bindings(in->surfaces, &bindings[SB_CAPTURE_BINDING_SURFACE]);
+    else
+        for (int b = 0; b < SB_SURFACE_BINDING_COUNT; b++)
+            bindings[SB_CAPTURE_BINDING_SURFACE + b] = &dummy;
     sb_atmosphere_bind_inputs(in->atmosphere, bindings);
     sb_pipeline_bind(vk, pipeline, bindings);
     double ms = 0;

@@ -46,8 +46,7 @@ enum sb_result sb_sky_bounce_bake(struct sb_raycaster *rc, const struct sb_surfa
         [SB_RAYCAST_BINDING_RAYS] = &probes,
         [SB_RAYCAST_BINDING_HITS] = &results,
     };
-    for (int b = 0; b < SB_SURFACE_BINDING_COUNT; b++)
-        bindings[SB_BOUNCE_BINDING_SURFACE + b] = &surfaces->buffers[b];
+    sb_surfaces_bindings(surfaces, &bindings[SB_BOUNCE_BINDING_SURFACE]);
     sb_pipeline_bind(vk, &pipeline, bindings);
     res = sb_probe_kernel_run(vk, &pipeline, &pc, probe_count, &results, out, gpu_ms);
 done:

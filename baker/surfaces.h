@@ -3,7 +3,7 @@
  * surface.glsl): each material's albedo and base-colour texture, each
  * triangle's texture coordinates, and every texture with its mips, built
  * on the device (texture_mips.comp) from the texels the mesh import
- * decoded (geometry/texture.h). The bounce (sky_bounce.h) and the
+ * decoded (geometry/mesh_texture.h). The bounce (sky_bounce.h) and the
  * reflection capture (reflection.h) bind them.
  */
 #ifndef SB_BAKER_SURFACES_H
@@ -14,13 +14,16 @@
 #include "compute.h"
 #include "level.h"
 #include "mesh.h"
+#include "texels.h"
 
 struct sb_surfaces {
-    struct sb_buffer buffers[SB_SURFACE_BINDING_COUNT]; /* config.h's SB_SURFACE_* order */
-    uint32_t material_count, texture_count;
-    uint64_t texel_count; /* every level of every texture */
-    double gpu_ms;        /* the mips' */
+    struct sb_buffer materials, uvs; /* config.h's SB_SURFACE_MATERIALS and SB_SURFACE_UVS */
+    struct sb_texel_set textures;    /* SB_SURFACE_TEXTURES and SB_SURFACE_TEXELS (vulkan/texels.h) */
+    uint32_t material_count;
 };
+
+/* The four buffers in config.h's SB_SURFACE_* order, for a kernel's bindings. */
+void sb_surfaces_bindings(const struct sb_surfaces *surfaces, const struct sb_buffer *out[SB_SURFACE_BINDING_COUNT]);
 
 /*
  * The surfaces of `meshes` taken in turn, as a BVH over them numbers their

@@ -5,7 +5,8 @@
  * after a header with result 0 come material_count struct sb_mesh_material,
  * 3 x vertex_count floats (positions, world metres, three per triangle)
  * and triangle_count material indices, 2 x vertex_count floats of texture
- * coordinates when has_uvs, texture_count struct sb_mesh_texture each
+ * coordinates when has_uvs, 4 x vertex_count of tangents when
+ * has_tangents, texture_count struct sb_mesh_texture each
  * followed by its texels (4 x width x height bytes), then, for a file kept as parts
  * (mesh.h's sb_mesh_parts), part_count (first, count) pairs of uint32_t
  * and placement_count struct sb_mesh_placement. Both sides are of one build (the
@@ -40,7 +41,7 @@ struct sb_import_mesh_answer {
     int32_t result;
     uint32_t vertex_count, triangle_count, material_count, dropped_degenerate;
     uint32_t part_count, placement_count; /* parts: then part_count (first, count) pairs and the placements */
-    uint32_t has_uvs, texture_count;
+    uint32_t has_uvs, has_tangents, texture_count;
     char message[512]; /* the first warning or error the helper logged */
 };
 

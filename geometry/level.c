@@ -103,16 +103,19 @@ static enum sb_result add_parts(struct loader *ld, uint32_t self, const struct s
             res = sb_mesh_copy_material(&part, &mesh->material_list[m], texture_base, &(uint32_t){0});
         for (uint32_t t = parts->first[k]; t < parts->first[k] + parts->count[k] && !res; t++) {
             double p[3][3];
-            float uv[3][2];
+            float uv[3][2], tangent[3][4];
             for (int v = 0; v < 3; v++) {
                 uint32_t vertex = mesh->indices[3 * (size_t)t + v];
                 for (int i = 0; i < 3; i++)
                     p[v][i] = mesh->positions[3 * (size_t)vertex + i];
                 for (int i = 0; i < 2 && mesh->uvs; i++)
                     uv[v][i] = mesh->uvs[2 * (size_t)vertex + i];
+                for (int i = 0; i < 4 && mesh->tangents; i++)
+                    tangent[v][i] = mesh->tangents[4 * (size_t)vertex + i];
             }
-            res = sb_mesh_add_triangle_uv(&part, p[0], p[1], p[2], mesh->uvs ? uv : NULL, mesh->materials[t],
-                                          ld->uniques[self].path);
+            res = sb_mesh_add_textured_triangle(&part, p[0], p[1], p[2], mesh->uvs ? uv : NULL,
+                                                mesh->tangents ? tangent : NULL, mesh->materials[t],
+                                                ld->uniques[self].path);
         }
         char name[PATH_MAX + 16];
         snprintf(name, sizeof(name), "%s#%u", ld->uniques[self].path, k);
@@ -575,6 +578,22 @@ bool sb_level_bounds_casting(const struct sb_level *level, float min[3], float m
     return any;
 }
 
+/* A tangent placed by an instance (NULL: in place): its direction by the
+ * linear part, its handedness flipped by a mirror. */
+static void place_tangent(const struct sb_bvh_instance *in, const float t[4], float out[4])
+{
+    if (!in) {
+        memcpy(out, t, 4 * sizeof(float));
+        return;
+    }
+    const double(*m)[4] = in->to_world;
+    for (int r = 0; r < 3; r++)
+        out[r] = (float)(m[r][0] * t[0] + m[r][1] * t[1] + m[r][2] * t[2]);
+    double det = m[0][0] * (m[1][1] * m[2][2] - m[1][2] * m[2][1]) - m[0][1] * (m[1][0] * m[2][2] - m[1][2] * m[2][0]) +
+                 m[0][2] * (m[1][0] * m[2][1] - m[1][1] * m[2][0]);
+    out[3] = det < 0 ? -t[3] : t[3];
+}
+
 enum sb_result sb_level_flatten(const struct sb_level *level, struct sb_mesh *mesh)
 {
     memset(mesh, 0, sizeof(*mesh));
@@ -605,19 +624,22 @@ enum sb_result sb_level_flatten(const struct sb_level *level, struct sb_mesh *me
         const struct sb_mesh *from = &level->meshes[in ? in->mesh : 0];
         for (uint32_t t = 0; t < from->triangle_count && !res; t++) {
             double p[3][3];
-            float uv[3][2];
+            float uv[3][2], tangent[3][4];
             for (int k = 0; k < 3; k++) {
                 uint32_t vertex = from->indices[3 * (size_t)t + k];
                 for (int c = 0; c < 2 && from->uvs; c++)
                     uv[k][c] = from->uvs[2 * (size_t)vertex + c];
+                if (from->tangents)
+                    place_tangent(in, &from->tangents[4 * (size_t)vertex], tangent[k]);
                 const float *v = &from->positions[3 * (size_t)vertex];
                 for (int r = 0; r < 3; r++)
                     p[k][r] = in ? in->to_world[r][0] * v[0] + in->to_world[r][1] * v[1] + in->to_world[r][2] * v[2] +
                                        in->to_world[r][3]
                                  : v[r];
             }
-            res = sb_mesh_add_triangle_uv(mesh, p[0], p[1], p[2], from->uvs ? uv : NULL,
-                                          material_base[in ? in->mesh : 0] + from->materials[t], "the world");
+            res = sb_mesh_add_textured_triangle(mesh, p[0], p[1], p[2], from->uvs ? uv : NULL,
+                                                from->tangents ? tangent : NULL,
+                                                material_base[in ? in->mesh : 0] + from->materials[t], "the world");
         }
     }
     free(material_base);

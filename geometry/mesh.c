@@ -138,14 +138,32 @@ static double doubled_area(const float *a, const float *b, const float *c)
     return sqrt(n[0] * n[0] + n[1] * n[1] + n[2] * n[2]);
 }
 
+/* A per-vertex array (`components` floats a vertex) that exists once some
+ * triangle has it: made (zeros for the vertices before) when `given`,
+ * grown with the positions' capacity. */
+static enum sb_result grow_attribute(struct sb_mesh *mesh, float **array, size_t components, bool given,
+                                     size_t vertices_before)
+{
+    if (!(*array && mesh->capacity_vertices != vertices_before) && !(given && !*array))
+        return SB_OK;
+    float *grown = realloc(*array, mesh->capacity_vertices * components * sizeof(float));
+    if (!grown)
+        return SB_ERR_NOMEM;
+    if (!*array)
+        memset(grown, 0, (size_t)mesh->vertex_count * components * sizeof(float));
+    *array = grown;
+    return SB_OK;
+}
+
 enum sb_result sb_mesh_add_triangle(struct sb_mesh *mesh, const double a[3], const double b[3], const double c[3],
                                     uint32_t material, const char *source)
 {
-    return sb_mesh_add_triangle_uv(mesh, a, b, c, NULL, material, source);
+    return sb_mesh_add_textured_triangle(mesh, a, b, c, NULL, NULL, material, source);
 }
 
-enum sb_result sb_mesh_add_triangle_uv(struct sb_mesh *mesh, const double a[3], const double b[3], const double c[3],
-                                       const float uv[3][2], uint32_t material, const char *source)
+enum sb_result sb_mesh_add_textured_triangle(struct sb_mesh *mesh, const double a[3], const double b[3],
+                                             const double c[3], const float uv[3][2], const float tangent[3][4],
+                                             uint32_t material, const char *source)
 {
     const double *v[3] = {a, b, c};
     for (int k = 0; k < 3; k++)
@@ -189,20 +207,24 @@ enum sb_result sb_mesh_add_triangle_uv(struct sb_mesh *mesh, const double a[3], 
         }
         mesh->materials = materials;
     }
-    /* uvs[], once a triangle has them, shares the vertices' capacity */
-    if ((mesh->uvs && mesh->capacity_vertices != vertices_before) || (uv && !mesh->uvs)) {
-        float *uvs = realloc(mesh->uvs, mesh->capacity_vertices * 2 * sizeof(float));
-        if (!uvs) {
-            mesh->capacity_vertices = vertices_before;
-            return SB_ERR_NOMEM;
-        }
-        if (!mesh->uvs)
-            memset(uvs, 0, (size_t)mesh->vertex_count * 2 * sizeof(float));
-        mesh->uvs = uvs;
+    /* uvs[] and tangents[], once a triangle has them, share the vertices' capacity */
+    if ((res = grow_attribute(mesh, &mesh->uvs, 2, uv != NULL, vertices_before)) ||
+        (res = grow_attribute(mesh, &mesh->tangents, 4, tangent != NULL, vertices_before))) {
+        mesh->capacity_vertices = vertices_before; /* every array grown again next time */
+        return res;
     }
     for (int k = 0; k < 3 && mesh->uvs; k++)
         for (int i = 0; i < 2; i++)
             mesh->uvs[2 * (size_t)(mesh->vertex_count + k) + i] = uv && isfinite(uv[k][i]) ? uv[k][i] : 0.0f;
+    for (int k = 0; k < 3 && mesh->tangents; k++) {
+        float *t = &mesh->tangents[4 * (size_t)(mesh->vertex_count + k)];
+        double length = 0;
+        for (int i = 0; i < 3; i++)
+            length += tangent && isfinite(tangent[k][i]) ? (double)tangent[k][i] * tangent[k][i] : 0.0;
+        for (int i = 0; i < 3; i++) /* unit, or 0 where there is none */
+            t[i] = length > 1e-24 && isfinite(length) ? (float)(tangent[k][i] / sqrt(length)) : 0.0f;
+        t[3] = tangent && tangent[k][3] < 0 ? -1.0f : 1.0f;
+    }
     for (int k = 0; k < 3; k++) {
         memcpy(&mesh->positions[3 * (size_t)(mesh->vertex_count + k)], f[k], sizeof(f[k]));
         mesh->indices[3 * (size_t)mesh->triangle_count + k] = mesh->vertex_count + k;
@@ -341,6 +363,21 @@ static enum sb_result count_node(struct importer *im, const struct aiNode *node,
     return res;
 }
 
+/* Vertex v's tangent in the world (m's linear part) and its handedness:
+ * the sign of (n x t) . b in the file, flipped by a mirroring m. */
+static void world_tangent(const struct mat4 *m, const struct aiMesh *am, unsigned v, float out[4])
+{
+    const struct aiVector3D *t = &am->mTangents[v], *b = &am->mBitangents[v], *n = &am->mNormals[v];
+    for (int i = 0; i < 3; i++)
+        out[i] = (float)(m->m[i][0] * t->x + m->m[i][1] * t->y + m->m[i][2] * t->z);
+    double nxt[3] = {n->y * t->z - n->z * t->y, n->z * t->x - n->x * t->z, n->x * t->y - n->y * t->x};
+    double det = m->m[0][0] * (m->m[1][1] * m->m[2][2] - m->m[1][2] * m->m[2][1]) -
+                 m->m[0][1] * (m->m[1][0] * m->m[2][2] - m->m[1][2] * m->m[2][0]) +
+                 m->m[0][2] * (m->m[1][0] * m->m[2][1] - m->m[1][1] * m->m[2][0]);
+    double hand = nxt[0] * b->x + nxt[1] * b->y + nxt[2] * b->z;
+    out[3] = (hand < 0) != (det < 0) ? -1.0f : 1.0f;
+}
+
 static enum sb_result add_node(struct importer *im, const struct aiNode *node, const struct mat4 *parent)
 {
     struct mat4 local = mat_from_ai(&node->mTransformation);
@@ -350,12 +387,15 @@ static enum sb_result add_node(struct importer *im, const struct aiNode *node, c
         if (!(am->mPrimitiveTypes & aiPrimitiveType_TRIANGLE) || (im->single_only && im->uses[node->mMeshes[i]] != 1))
             continue;
         uint32_t material = im->material_map[am->mMaterialIndex < im->scene->mNumMaterials ? am->mMaterialIndex : 0];
+        /* tangents where a normal map needs them (assimp's, from the texture coordinates) */
+        bool tangents = am->mTangents && am->mBitangents && am->mNormals && am->mTextureCoords[0] &&
+                        im->mesh->material_list[material].textures[SB_TEXTURE_NORMAL] >= 0;
         for (unsigned f = 0; f < am->mNumFaces; f++) {
             const struct aiFace *face = &am->mFaces[f];
             if (face->mNumIndices != 3)
                 continue; /* points and lines */
             double p[3][3];
-            float uv[3][2];
+            float uv[3][2], tangent[3][4];
             const struct aiVector3D *coords = am->mNumUVComponents[0] >= 2 ? am->mTextureCoords[0] : NULL;
             for (int k = 0; k < 3; k++) {
                 if (face->mIndices[k] >= am->mNumVertices) {
@@ -368,8 +408,11 @@ static enum sb_result add_node(struct importer *im, const struct aiNode *node, c
                     uv[k][0] = (float)coords[face->mIndices[k]].x;
                     uv[k][1] = (float)coords[face->mIndices[k]].y;
                 }
+                if (tangents)
+                    world_tangent(&m, am, face->mIndices[k], tangent[k]);
             }
-            enum sb_result res = sb_mesh_add_triangle_uv(im->mesh, p[0], p[1], p[2], coords ? uv : NULL, material, im->path);
+            enum sb_result res = sb_mesh_add_textured_triangle(im->mesh, p[0], p[1], p[2], coords ? uv : NULL,
+                                                               tangents ? tangent : NULL, material, im->path);
             if (res)
                 return res;
         }
@@ -717,7 +760,10 @@ static enum sb_result import(const char *path, const struct sb_mesh_load_params 
     struct importer im = {.path = path, .params = params, .mesh = mesh};
     struct aiFileIO io = {.OpenProc = file_open, .CloseProc = file_close, .UserData = (aiUserData)path};
     im.scene =
-        aiImportFileEx(path, aiProcess_Triangulate | aiProcess_SortByPType | aiProcess_ValidateDataStructure, &io);
+        aiImportFileEx(path,
+                       aiProcess_Triangulate | aiProcess_SortByPType | aiProcess_ValidateDataStructure |
+                           aiProcess_CalcTangentSpace,
+                       &io);
     enum sb_result res = SB_OK;
     if (!im.scene || !im.scene->mRootNode || (im.scene->mFlags & AI_SCENE_FLAGS_INCOMPLETE)) {
         sb_error("%s: assimp cannot read it: %s", path, im.scene ? "the scene is incomplete" : aiGetErrorString());
@@ -808,6 +854,7 @@ int sb_mesh_import_task(int fd, const void *request, size_t size)
         h.part_count = parts.part_count;
         h.placement_count = parts.placement_count;
         h.has_uvs = mesh.uvs != NULL;
+        h.has_tangents = mesh.tangents != NULL;
         h.texture_count = mesh.texture_count;
     }
     bool ok = sb_write_all(fd, &h, sizeof(h));
@@ -815,7 +862,8 @@ int sb_mesh_import_task(int fd, const void *request, size_t size)
         ok = sb_write_all(fd, mesh.material_list, (size_t)mesh.material_count * sizeof(*mesh.material_list)) &&
              sb_write_all(fd, mesh.positions, (size_t)mesh.vertex_count * 3 * sizeof(float)) &&
              sb_write_all(fd, mesh.materials, (size_t)mesh.triangle_count * sizeof(uint32_t)) &&
-             (!mesh.uvs || sb_write_all(fd, mesh.uvs, (size_t)mesh.vertex_count * 2 * sizeof(float)));
+             (!mesh.uvs || sb_write_all(fd, mesh.uvs, (size_t)mesh.vertex_count * 2 * sizeof(float))) &&
+             (!mesh.tangents || sb_write_all(fd, mesh.tangents, (size_t)mesh.vertex_count * 4 * sizeof(float)));
     for (uint32_t k = 0; !h.result && ok && k < mesh.texture_count; k++)
         ok = sb_write_all(fd, &mesh.texture_list[k], sizeof(mesh.texture_list[k])) &&
              sb_write_all(fd, mesh.texture_list[k].rgba, sb_texture_bytes(&mesh.texture_list[k]));
@@ -907,7 +955,7 @@ static enum sb_result receive(struct sb_sandbox *box, const char *path, struct s
                  h.triangle_count, h.material_count, SB_MESH_MAX_TRIANGLES, SB_MESH_MAX_MATERIALS);
         return SB_ERR_TOO_LARGE;
     }
-    if (h.texture_count > SB_MESH_MAX_TEXTURES || h.has_uvs > 1) {
+    if (h.texture_count > SB_MESH_MAX_TEXTURES || h.has_uvs > 1 || h.has_tangents > 1) {
         sb_error("%s: %u images; at most %u", path, h.texture_count, SB_MESH_MAX_TEXTURES);
         return SB_ERR_TOO_LARGE;
     }
@@ -915,11 +963,16 @@ static enum sb_result receive(struct sb_sandbox *box, const char *path, struct s
     float *positions = malloc((size_t)h.vertex_count * 3 * sizeof(float) + 1);
     uint32_t *triangle_materials = malloc((size_t)h.triangle_count * sizeof(uint32_t) + 1);
     float *uvs = h.has_uvs ? malloc((size_t)h.vertex_count * 2 * sizeof(float) + 1) : NULL;
-    enum sb_result res = materials && positions && triangle_materials && (uvs || !h.has_uvs) ? SB_OK : SB_ERR_NOMEM;
+    float *tangents = h.has_tangents ? malloc((size_t)h.vertex_count * 4 * sizeof(float) + 1) : NULL;
+    enum sb_result res = materials && positions && triangle_materials && (uvs || !h.has_uvs) &&
+                                 (tangents || !h.has_tangents)
+                             ? SB_OK
+                             : SB_ERR_NOMEM;
     bool read = !res && sb_sandbox_read(box, materials, h.material_count * sizeof(*materials)) &&
                 sb_sandbox_read(box, positions, (size_t)h.vertex_count * 3 * sizeof(float)) &&
                 sb_sandbox_read(box, triangle_materials, (size_t)h.triangle_count * sizeof(uint32_t)) &&
-                (!uvs || sb_sandbox_read(box, uvs, (size_t)h.vertex_count * 2 * sizeof(float)));
+                (!uvs || sb_sandbox_read(box, uvs, (size_t)h.vertex_count * 2 * sizeof(float))) &&
+                (!tangents || sb_sandbox_read(box, tangents, (size_t)h.vertex_count * 4 * sizeof(float)));
     /* the images, each checked before its texels are allocated */
     uint32_t texture_base = mesh->texture_count;
     size_t texel_bytes = 0;
@@ -989,14 +1042,17 @@ static enum sb_result receive(struct sb_sandbox *box, const char *path, struct s
             res = SB_ERR_MESH;
             break;
         }
-        res = sb_mesh_add_triangle_uv(mesh, p[0], p[1], p[2], uvs ? (const float(*)[2]) & uvs[6 * (size_t)t] : NULL,
-                                      first + triangle_materials[t], path);
+        res = sb_mesh_add_textured_triangle(mesh, p[0], p[1], p[2],
+                                            uvs ? (const float(*)[2]) & uvs[6 * (size_t)t] : NULL,
+                                            tangents ? (const float(*)[4]) & tangents[12 * (size_t)t] : NULL,
+                                            first + triangle_materials[t], path);
     }
     mesh->dropped_degenerate = dropped + h.dropped_degenerate;
     free(materials);
     free(positions);
     free(triangle_materials);
     free(uvs);
+    free(tangents);
     if (!res && (h.part_count || h.placement_count) && mesh->triangle_count - triangles_before != h.triangle_count) {
         sb_error("%s: %u of its parts' triangles became zero-area in fp32", path,
                  h.triangle_count - (mesh->triangle_count - triangles_before));
@@ -1086,6 +1142,10 @@ enum sb_result sb_mesh_import_parts(const char *path, const struct sb_mesh_load_
         if (!before.uvs) {
             free(mesh->uvs);
             mesh->uvs = NULL;
+        }
+        if (!before.tangents) {
+            free(mesh->tangents);
+            mesh->tangents = NULL;
         }
     } else if (mesh->dropped_degenerate > before.dropped_degenerate) {
         sb_info("%s: %u zero-area triangles left out", path, mesh->dropped_degenerate - before.dropped_degenerate);
@@ -1184,6 +1244,8 @@ void sb_mesh_hash(const struct sb_mesh *mesh, char out[33])
     /* what only a textured mesh has (an untextured one hashes as before) */
     if (mesh->uvs)
         XXH3_128bits_update(st, mesh->uvs, (size_t)mesh->vertex_count * 2 * sizeof(float));
+    if (mesh->tangents)
+        XXH3_128bits_update(st, mesh->tangents, (size_t)mesh->vertex_count * 4 * sizeof(float));
     for (uint32_t m = 0; m < mesh->material_count && mesh->texture_count; m++)
         XXH3_128bits_update(st, mesh->material_list[m].textures, sizeof(mesh->material_list[m].textures));
     for (uint32_t k = 0; k < mesh->texture_count; k++) {
@@ -1203,6 +1265,7 @@ void sb_mesh_finish(struct sb_mesh *mesh)
         free(mesh->texture_list[k].rgba);
     free(mesh->texture_list);
     free(mesh->uvs);
+    free(mesh->tangents);
     free(mesh->positions);
     free(mesh->indices);
     free(mesh->materials);

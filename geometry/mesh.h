@@ -17,7 +17,7 @@
 #include <stdint.h>
 
 #include "result.h"
-#include "texture.h"
+#include "mesh_texture.h"
 
 /* Caps: a mesh file larger than this is refused before it is read. */
 #define SB_MESH_MAX_FILE_BYTES (512ull << 20)
@@ -43,7 +43,7 @@ struct sb_mesh_material {
     float metallic;     /* [0, 1] [0] */
     bool casts_shadows; /* false: receives only (a ground plane) [true] */
     float emissive[3];  /* linear radiance factor [0] */
-    /* The images the material reads (texture.h's slots): indices in the
+    /* The images the material reads (mesh_texture.h's slots): indices in the
      * mesh's texture_list, -1 none [-1]. The base colour's multiplies
      * albedo, as glTF's baseColorTexture does its factor. */
     int32_t textures[SB_TEXTURE_SLOT_COUNT];
@@ -60,6 +60,10 @@ struct sb_mesh {
      * row, as OpenGL has them; assimp turns glTF's over),
      * or NULL when no triangle has them (0, 0 for those without). */
     float *uvs;
+    /* Tangents, 4 a vertex: the unit direction of increasing u (world), w
+     * +1 or -1, the handedness of (normal, tangent, bitangent) (glTF's);
+     * or NULL when no triangle has them (0, 0, 0, 1 for those without). */
+    float *tangents;
     uint32_t texture_count;
     struct sb_mesh_texture *texture_list; /* owned, each with its texels */
     size_t capacity_vertices, capacity_triangles, capacity_materials, capacity_textures;
@@ -178,9 +182,11 @@ enum sb_result sb_mesh_add_triangle(struct sb_mesh *mesh, const double a[3], con
                                     uint32_t material, const char *source);
 
 /* As sb_mesh_add_triangle, with the vertices' texture coordinates (uv[k]
- * for vertex k; NULL: none, read as 0). */
-enum sb_result sb_mesh_add_triangle_uv(struct sb_mesh *mesh, const double a[3], const double b[3], const double c[3],
-                                       const float uv[3][2], uint32_t material, const char *source);
+ * for vertex k; NULL: none, read as 0) and tangents (tangent[k]: a
+ * direction, normalised here, and the handedness's sign; NULL: none). */
+enum sb_result sb_mesh_add_textured_triangle(struct sb_mesh *mesh, const double a[3], const double b[3],
+                                             const double c[3], const float uv[3][2], const float tangent[3][4],
+                                             uint32_t material, const char *source);
 
 /* Add a texture, taking its texels (texture->rgba then belongs to the
  * mesh, also on failure); its index in *index. Refuses more than

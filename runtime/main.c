@@ -77,6 +77,8 @@ static void usage(FILE *f)
                "                          sky-visibility probes\n"
                "  --no-reflections        the sky model's ambient specular, ignoring the pack's\n"
                "                          reflection probes\n"
+               "  --no-textures           the world's materials without their images (their\n"
+               "                          colours and factors alone)\n"
                "  --no-fog                leave out the scene's fog\n"
                "  --fog-tile PX           a froxel's width and height in pixels (default 8)\n"
                "  --fog-slices N          froxel slices, 2 to 256 (default 64)\n"
@@ -530,6 +532,8 @@ static int parse_options(int argc, char **argv, struct options *o)
             o->params.no_probes = true;
         else if (!strcmp(a, "--no-reflections"))
             o->params.no_reflections = true;
+        else if (!strcmp(a, "--no-textures"))
+            o->params.no_textures = true;
         else if (!strcmp(a, "--no-fog"))
             o->params.no_fog = true;
         else if (!strcmp(a, "--fog-tile") && next) {
@@ -939,7 +943,7 @@ static int run(const struct options *o)
         return EXIT_USAGE;
     }
     /* A newcomer's own model is in the first frame: a default camera that
-     * cannot see the world is moved to frame it. */
+     * cannot see the world, or stands inside a model, is moved to frame it. */
     struct options framed;
     if (!o->camera_given) {
         framed = *o;
@@ -954,7 +958,8 @@ static int run(const struct options *o)
             o = &framed;
         }
         if (sb_world_frame(&world, aspect, v->fov_y > 0 ? v->fov_y : 50.0 * DEG, v->camera_m, &v->yaw, &v->pitch)) {
-            sb_info("the default camera does not see the world: framing it, as --camera %.4g,%.4g,%.4g,%.4g,%.4g,%.4g",
+            sb_info("the default camera does not show the world (out of its view, or inside a model): framing it, as "
+                    "--camera %.4g,%.4g,%.4g,%.4g,%.4g,%.4g",
                     v->camera_m[0], v->camera_m[1], v->camera_m[2], v->yaw / DEG, v->pitch / DEG,
                     (v->fov_y > 0 ? v->fov_y : 50.0 * DEG) / DEG);
             o = &framed;

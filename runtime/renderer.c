@@ -35,6 +35,8 @@ static void add_resources(struct sb_renderer *r)
         {"frame", &r->frame},
         {"vertices", &r->vertices},
         {"exposure", &r->exposure},
+        {"texture records", &r->textures.records},
+        {"texels", &r->textures.texels},
     };
     for (size_t i = 0; i < sizeof(buffers) / sizeof(buffers[0]); i++)
         sb_graph_buffer(r, buffers[i].name, buffers[i].buffer);
@@ -48,6 +50,33 @@ static void add_resources(struct sb_renderer *r)
     sb_graph_image(r, "depth", &r->depth);
     r->hdr_id = sb_graph_image(r, "hdr", &r->hdr);
     r->ldr_id = sb_graph_image(r, "ldr", &r->ldr);
+}
+
+/* The world's textures, their mips made on the device (vulkan/texels.h). */
+static enum sb_result upload_textures(struct sb_renderer *r, const struct sb_world *world)
+{
+    if (r->params.no_textures) { /* none, and no vertex names one */
+        struct sb_vertex_gpu *v = r->vertices.mapped;
+        for (uint32_t i = 0; i < world->vertex_count; i++) {
+            v[i].uv[2] = v[i].uv[3] = 0.0f;
+            v[i].tangent[3] = 0.0f;
+        }
+        return sb_texel_set_create(r->vk, NULL, 0, &r->textures);
+    }
+    struct sb_texel_image *images = calloc(world->texture_count + 1, sizeof(*images));
+    if (!images)
+        return SB_ERR_NOMEM;
+    for (uint32_t k = 0; k < world->texture_count; k++) {
+        const struct sb_mesh_texture *t = &world->textures[k];
+        images[k] = (struct sb_texel_image){.width = t->width, .height = t->height, .wrap = {t->wrap[0], t->wrap[1]},
+                                            .srgb = t->srgb != 0, .rgba = t->rgba};
+    }
+    enum sb_result res = sb_texel_set_create(r->vk, images, world->texture_count, &r->textures);
+    free(images);
+    if (!res && world->texture_count)
+        sb_info("world: %u textures, %.1f MiB with their mips (%.2f ms on the device)", world->texture_count,
+                r->textures.texel_count * 4.0 / (1 << 20), r->textures.gpu_ms);
+    return res;
 }
 
 /* Whether the scene pass traces (passes/scene.c): on a GPU by default. */
@@ -186,6 +215,8 @@ enum sb_result sb_renderer_create(struct sb_vk *vk, const struct sb_pack *pack, 
     res = sb_renderer_upload(r, world->vertices, world->vertex_count * sizeof(struct sb_vertex_gpu), "world",
                              &r->vertices);
     if (!res)
+        res = upload_textures(r, world);
+    if (!res)
         res = sb_renderer_upload(r, NULL, sizeof(struct sb_frame_gpu), "frame constants", &r->frame);
     if (!res)
         res = sb_renderer_upload(r, NULL, SB_HISTOGRAM_BINS * sizeof(uint32_t) + sizeof(struct sb_exposure_gpu),
@@ -305,6 +336,7 @@ void sb_renderer_destroy(struct sb_renderer **pr)
                                    &r->read_sky_view, &r->bvh_nodes, &r->bvh_triangles};
     for (size_t i = 0; i < sizeof(buffers) / sizeof(buffers[0]); i++)
         sb_buffer_destroy(vk, buffers[i]);
+    sb_texel_set_destroy(vk, &r->textures);
     free(r);
     *pr = NULL;
 }

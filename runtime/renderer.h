@@ -51,6 +51,7 @@ struct sb_renderer_params {
     double bloom_strength;           /* 0: 0.15; negative: no bloom */
     bool no_probes;                  /* light the world with the sky alone even if the pack has probes */
     bool no_reflections;             /* leave the pack's reflection probes unread (the sky model's specular) */
+    bool no_textures;                /* the world's materials without their textures (their factors alone) */
     bool no_fog;                     /* leave out the scene's fog */
     uint32_t fog_tile_px;            /* a froxel's width and height in pixels; 0: 8 */
     uint32_t fog_slices;             /* froxel slices, [2, 256]; 0: 64 */

@@ -18,6 +18,7 @@
 #include "graph.h"
 #include "renderer.h"
 #include "shadows.h"
+#include "texels.h"
 #include "texture.h"
 #include "transform.h"
 #include "view_gpu.h"
@@ -59,6 +60,7 @@ struct sb_renderer {
                                                                             LUT; the refined and lookup forms */
     struct sb_buffer frame, vertices, exposure;                          /* "frame", "vertices", "exposure" */
     struct sb_buffer bvh_nodes, bvh_triangles;         /* "bvh nodes", "bvh triangles": the world's BVH when traced */
+    struct sb_texel_set textures;                      /* "texture records", "texels": the world's textures */
     struct sb_texture hdr, depth, ldr;                 /* "hdr", "depth", "ldr": the frame */
     VkSampler linear, nearest, shadow_compare, repeat; /* repeat: linear, wrapping (tileable noise) */
 

@@ -14,8 +14,20 @@ enum sb_result sb_world_from_mesh(const struct sb_mesh *mesh, struct sb_world *w
     if ((uint64_t)mesh->triangle_count * 3 > UINT32_MAX)
         return SB_ERR_TOO_LARGE;
     w->vertices = calloc((size_t)mesh->triangle_count * 3 + 1, sizeof(*w->vertices));
-    if (!w->vertices)
+    w->textures = calloc(mesh->texture_count + 1, sizeof(*w->textures));
+    if (!w->vertices || !w->textures) {
+        sb_world_finish(w);
         return SB_ERR_NOMEM;
+    }
+    for (uint32_t k = 0; k < mesh->texture_count; k++, w->texture_count++) {
+        w->textures[k] = mesh->texture_list[k];
+        w->textures[k].rgba = malloc(sb_texture_bytes(&w->textures[k]));
+        if (!w->textures[k].rgba) {
+            sb_world_finish(w);
+            return SB_ERR_NOMEM;
+        }
+        memcpy(w->textures[k].rgba, mesh->texture_list[k].rgba, sb_texture_bytes(&w->textures[k]));
+    }
     /* two passes: the triangles that cast no shadow, then the casters, each in the mesh's order */
     for (int casters = 0; casters <= 1; casters++) {
         if (casters)
@@ -34,8 +46,13 @@ enum sb_result sb_world_from_mesh(const struct sb_mesh *mesh, struct sb_world *w
             }
             double n[3] = {e1[1] * e2[2] - e1[2] * e2[1], e1[2] * e2[0] - e1[0] * e2[2], e1[0] * e2[1] - e1[1] * e2[0]};
             double len = sqrt(n[0] * n[0] + n[1] * n[1] + n[2] * n[2]);
+            /* a texture the vertices name where they have coordinates */
+            int32_t base = mesh->uvs ? m->textures[SB_TEXTURE_BASE_COLOR] : -1;
+            int32_t mr = mesh->uvs ? m->textures[SB_TEXTURE_METALLIC_ROUGHNESS] : -1;
+            int32_t normal = mesh->uvs && mesh->tangents ? m->textures[SB_TEXTURE_NORMAL] : -1;
             for (int k = 0; k < 3; k++) {
                 struct sb_vertex_gpu *v = &w->vertices[w->vertex_count++];
+                uint32_t vertex = mesh->indices[3 * (size_t)t + k];
                 for (int i = 0; i < 3; i++) {
                     v->position[i] = p[k][i];
                     v->normal[i] = len > 0 ? (float)(n[i] / len) : (i == 1);
@@ -44,6 +61,17 @@ enum sb_result sb_world_from_mesh(const struct sb_mesh *mesh, struct sb_world *w
                 v->position[3] = m->metallic;
                 v->normal[3] = m->roughness;
                 v->albedo[3] = 1.0f;
+                if (mesh->uvs) {
+                    v->uv[0] = mesh->uvs[2 * (size_t)vertex];
+                    v->uv[1] = mesh->uvs[2 * (size_t)vertex + 1];
+                }
+                v->uv[2] = (float)(base + 1);
+                v->uv[3] = (float)(mr + 1);
+                if (normal >= 0) {
+                    const float *tangent = &mesh->tangents[4 * (size_t)vertex];
+                    memcpy(v->tangent, tangent, 3 * sizeof(float));
+                    v->tangent[3] = (float)(normal + 1) * (tangent[3] < 0 ? -1.0f : 1.0f);
+                }
             }
         }
     }
@@ -85,6 +113,29 @@ bool sb_world_lift(const struct sb_world *w, double eye_m, double camera_m[3], d
     return true;
 }
 
+/* Look north and 20 degrees down at the box's centre from where its
+ * bounding sphere fills the narrower field of view. */
+static bool frame_box(const double lo[3], const double hi[3], double aspect, double fov_y, double camera_m[3],
+                      double *yaw, double *pitch)
+{
+    double tan_v = tan(0.5 * fov_y), tan_h = tan_v * aspect;
+    double centre[3], radius = 0.0;
+    for (int i = 0; i < 3; i++) {
+        centre[i] = 0.5 * (lo[i] + hi[i]);
+        radius += 0.25 * (hi[i] - lo[i]) * (hi[i] - lo[i]);
+    }
+    radius = sqrt(radius);
+    double half = fmin(atan(tan_v), atan(tan_h)), distance = 1.05 * radius / sin(half);
+    double down = 20.0 * M_PI / 180.0;
+    /* to 0.1 mm, so that the position skyview reports reads plainly */
+    camera_m[0] = round(centre[0] * 1e4) / 1e4;
+    camera_m[1] = round(fmax(centre[1] + distance * sin(down), 0.1) * 1e4) / 1e4;
+    camera_m[2] = round((centre[2] + distance * cos(down)) * 1e4) / 1e4;
+    *yaw = 0.0;
+    *pitch = atan2(centre[1] - camera_m[1], camera_m[2] - centre[2]);
+    return true;
+}
+
 bool sb_world_frame(const struct sb_world *w, double aspect, double fov_y, double camera_m[3], double *yaw,
                     double *pitch)
 {
@@ -99,8 +150,12 @@ bool sb_world_frame(const struct sb_world *w, double aspect, double fov_y, doubl
     bool inside = true;
     for (int i = 0; i < 3; i++)
         inside = inside && camera_m[i] >= lo[i] && camera_m[i] <= hi[i];
-    if (inside)
+    /* inside a level's box, the camera stands in it; inside a model's, in
+     * the model (a truck's cab, a house's walls), which it does not show */
+    if (inside && fmax(hi[0] - lo[0], hi[2] - lo[2]) > SB_WORLD_MODEL_M)
         return false;
+    if (inside)
+        return frame_box(lo, hi, aspect, fov_y, camera_m, yaw, pitch);
     /* The frustum's four sides through the camera, normals inward; the box
      * is out of view when all its corners lie behind one of them, or behind
      * the camera. */
@@ -129,21 +184,7 @@ bool sb_world_frame(const struct sb_world *w, double aspect, double fov_y, doubl
     }
     if (seen)
         return false;
-    double centre[3], radius = 0.0;
-    for (int i = 0; i < 3; i++) {
-        centre[i] = 0.5 * (lo[i] + hi[i]);
-        radius += 0.25 * (hi[i] - lo[i]) * (hi[i] - lo[i]);
-    }
-    radius = sqrt(radius);
-    double half = fmin(atan(tan_v), atan(tan_h)), distance = 1.05 * radius / sin(half);
-    double down = 20.0 * M_PI / 180.0;
-    /* to 0.1 mm, so that the position skyview reports reads plainly */
-    camera_m[0] = round(centre[0] * 1e4) / 1e4;
-    camera_m[1] = round(fmax(centre[1] + distance * sin(down), 0.1) * 1e4) / 1e4;
-    camera_m[2] = round((centre[2] + distance * cos(down)) * 1e4) / 1e4;
-    *yaw = 0.0;
-    *pitch = atan2(centre[1] - camera_m[1], camera_m[2] - centre[2]);
-    return true;
+    return frame_box(lo, hi, aspect, fov_y, camera_m, yaw, pitch);
 }
 
 static enum sb_result from(enum sb_result res, struct sb_mesh *mesh, struct sb_world *w)
@@ -182,6 +223,9 @@ enum sb_result sb_world_parse(const char *json, size_t size, const char *source,
 
 void sb_world_finish(struct sb_world *w)
 {
+    for (uint32_t k = 0; k < w->texture_count; k++)
+        free(w->textures[k].rgba);
+    free(w->textures);
     free(w->vertices);
     memset(w, 0, sizeof(*w));
 }

@@ -23,10 +23,14 @@ struct sb_world {
      * they receive shadows but are not drawn into the shadow maps. */
     uint32_t caster_first_vertex;
     char mesh_hash[33]; /* sb_mesh_hash of the mesh it was made from (sb_level_hash of a level) */
+    /* the images the vertices' texture indices name (owned, with their texels) */
+    struct sb_mesh_texture *textures;
+    uint32_t texture_count;
 };
 
 /* The world of a mesh: flat shading (each triangle's own normal, from its
- * winding), the triangle's material. */
+ * winding), the triangle's material, its textures (copied) and the
+ * vertices' texture coordinates and tangents. */
 enum sb_result sb_world_from_mesh(const struct sb_mesh *mesh, struct sb_world *world);
 
 /* The world of a level (geometry/level.h), its instances placed into one
@@ -48,12 +52,16 @@ enum sb_result sb_world_parse(const char *json, size_t size, const char *source,
  * or 0 (receiving only). */
 enum sb_result sb_world_mesh(const struct sb_world *world, bool casters_only, struct sb_mesh *mesh);
 
+/* A world whose casters span at most this (x or z) is a model: a camera
+ * inside its box is inside the model, and is moved out to frame it. */
+#define SB_WORLD_MODEL_M 50.0
+
 /*
  * A camera that sees the world: when the one given (camera_m, yaw clockwise
  * from north (-z), pitch above the horizontal, the vertical field of view
  * fov_y, radians, and the frame's width over its height) cannot see the
  * world's shadow casters (their box lies wholly outside its frustum and does
- * not hold it), set camera_m, yaw and pitch to frame them: looking north
+ * not hold it, or holds it but is a model's, SB_WORLD_MODEL_M), set camera_m, yaw and pitch to frame them: looking north
  * and 20 degrees down at their box's centre from where its bounding sphere
  * fills the narrower field of view, at least 0.1 m above the ground.
  * Returns whether it did; a world of no caster is left alone.

@@ -309,7 +309,7 @@ struct sb_raycast_push {
  * one (albedo, base-colour texture + 1) a material, three vec2 a triangle
  * (its vertices' texture coordinates), one uvec4 a texture, and every
  * texture's mips (one RGBA8 uint a texel). Wrap modes as
- * geometry/texture.h's enum sb_texture_wrap. */
+ * geometry/mesh_texture.h's enum sb_texture_wrap. */
 #define SB_SURFACE_MATERIALS 0
 #define SB_SURFACE_UVS 1
 #define SB_SURFACE_TEXTURES 2

@@ -235,10 +235,22 @@ static void test_framing(const struct sb_world *test_world)
           camera[0], camera[1], camera[2]);
     double again[3] = {camera[0], camera[1], camera[2]}, yaw2 = yaw, pitch2 = pitch;
     CHECK(!sb_world_frame(&w, aspect, fov, again, &yaw2, &pitch2), "a framed world stays framed");
+    /* inside a model's box (its casters span under SB_WORLD_MODEL_M): the
+     * frame would show its inside, so it is framed from outside, as from
+     * behind; inside a level's, the camera stands in the level */
     double in[3] = {4.0, 1.0, 30.0};
     yaw2 = 0.0;
     pitch2 = 0.0;
-    CHECK(!sb_world_frame(&w, aspect, fov, in, &yaw2, &pitch2) && in[2] == 30.0, "a camera inside is left alone");
+    CHECK(sb_world_frame(&w, aspect, fov, in, &yaw2, &pitch2) && in[0] == camera[0] && in[1] == camera[1] &&
+              in[2] == camera[2],
+          "a camera inside a model is framed as from behind (%g,%g,%g)", in[0], in[1], in[2]);
+    sb_world_finish(&w);
+    static const char level[] = "{\"version\":1,\"boxes\":[{\"center_m\":[0,1,30],\"size_m\":[2,2,6]},"
+                                "{\"center_m\":[60,1,-30],\"size_m\":[2,2,6]}]}";
+    CHECK(sb_world_parse(level, sizeof(level) - 1, "level", &w) == SB_OK, "two boxes 85 m apart");
+    double among[3] = {30.0, 1.0, 0.0};
+    CHECK(!sb_world_frame(&w, aspect, fov, among, &yaw2, &pitch2) && among[0] == 30.0,
+          "a camera inside a level's box is left alone");
     sb_world_finish(&w);
     static const char ground[] = "{\"version\":1,\"ground\":{\"size_m\":100}}";
     CHECK(sb_world_parse(ground, sizeof(ground) - 1, "ground", &w) == SB_OK, "a ground alone");
@@ -1417,6 +1429,131 @@ static void test_fog(const char *dir)
     sb_world_finish(&w);
 }
 
+/* ---- textures (world.h, material.glsl) ---------------------------------------------------- */
+
+/* A 40 m floor at y = 0 facing up, u along +x, v along -z, tangents +x;
+ * its one material `albedo`, reading `base` and `normal` (-1: none). */
+static void textured_floor(struct sb_mesh *mesh, double albedo, int32_t base, int32_t normal)
+{
+    const double h = 20.0, a[3] = {albedo, albedo, albedo};
+    uint32_t m;
+    sb_mesh_add_material(mesh, "floor", a, &m);
+    mesh->material_list[m].textures[SB_TEXTURE_BASE_COLOR] = base;
+    mesh->material_list[m].textures[SB_TEXTURE_NORMAL] = normal;
+    double p[4][3] = {{-h, 0, h}, {h, 0, h}, {h, 0, -h}, {-h, 0, -h}};
+    const float uv[4][2] = {{0, 0}, {1, 0}, {1, 1}, {0, 1}};
+    const int tris[2][3] = {{0, 1, 2}, {0, 2, 3}}; /* counter-clockwise from above */
+    for (int t = 0; t < 2; t++) {
+        float tuv[3][2], tangent[3][4];
+        for (int k = 0; k < 3; k++) {
+            memcpy(tuv[k], uv[tris[t][k]], sizeof(tuv[k]));
+            const float x[4] = {1, 0, 0, 1};
+            memcpy(tangent[k], x, sizeof(x));
+        }
+        sb_mesh_add_textured_triangle(mesh, p[tris[t][0]], p[tris[t][1]], p[tris[t][2]], tuv, tangent, m, "floor");
+    }
+}
+
+/* A size x size texture of one texel value, or of two halves (u < 1/2: `left`). */
+static uint32_t add_texture(struct sb_mesh *mesh, uint32_t size, const uint8_t left[4], const uint8_t right[4],
+                            bool srgb)
+{
+    struct sb_mesh_texture t = {.name = "test", .width = size, .height = size, .srgb = srgb};
+    t.rgba = malloc(sb_texture_bytes(&t));
+    for (uint32_t y = 0; y < size; y++)
+        for (uint32_t x = 0; x < size; x++)
+            memcpy(&t.rgba[4 * ((size_t)y * size + x)], x < size / 2 ? left : right, 4);
+    uint32_t index = 0;
+    sb_mesh_add_texture(mesh, &t, &index);
+    return index;
+}
+
+/* The floor seen from 8 m straight down, raster (k 0) and traced (1): the
+ * mean luminance of the frame's left and right thirds. */
+static bool floor_thirds(const struct sb_mesh *mesh, const struct sb_renderer_params *rp, bool no_textures,
+                         double thirds[2][2])
+{
+    struct sb_world w;
+    if (sb_world_from_mesh(mesh, &w) != SB_OK)
+        return false;
+    struct sb_view v = base_view();
+    v.camera_m[1] = 8.0;
+    v.pitch = -89.9 * DEG;
+    v.sun_azimuth = 90.0 * DEG; /* from the east (+x) */
+    v.sun_elevation = 30.0 * DEG;
+    bool ok = true;
+    for (int k = 0; k < 2 && ok; k++) {
+        struct sb_renderer_params p = *rp;
+        p.scene = k ? SB_SCENE_TRACED : SB_SCENE_RASTER;
+        p.no_textures = no_textures;
+        struct sb_renderer *r = NULL;
+        ok = sb_renderer_create(vk, &pack, &w, &p, &r) == SB_OK && render(r, &v);
+        float *rgb = ok ? frame_rgb(r) : NULL;
+        for (int side = 0; side < 2 && rgb; side++) {
+            double sum = 0;
+            int n = 0;
+            for (int y = H / 4; y < 3 * H / 4; y++)
+                for (int x = side ? 2 * W / 3 : 0; x < (side ? W : W / 3); x++, n++)
+                    sum += luminance(pixel(rgb, x, y));
+            thirds[k][side] = sum / n;
+        }
+        free(rgb);
+        sb_renderer_destroy(&r);
+    }
+    sb_world_finish(&w);
+    return ok;
+}
+
+/* A floor textured black where x < 0 and white where x > 0 draws dark and
+ * bright halves, raster and traced alike, the white as the floor without
+ * its texture; a normal map tilting the floor 30 degrees toward the sun (+u,
+ * the tangent) brightens it as the sun's cosine says, and tilted away
+ * darkens it: the tangent frame's orientation. */
+static void test_textures(const struct sb_renderer_params *rp)
+{
+    const uint8_t black[4] = {0, 0, 0, 255}, white[4] = {255, 255, 255, 255};
+    struct sb_mesh halves = {0};
+    textured_floor(&halves, 1.0, (int32_t)add_texture(&halves, 64, black, white, true), -1);
+    double with[2][2], without[2][2];
+    if (floor_thirds(&halves, rp, false, with) && floor_thirds(&halves, rp, true, without)) {
+        for (int k = 0; k < 2; k++) {
+            printf("textured floor, %s: left (black) %.4g, right (white) %.4g; without textures %.4g, %.4g\n",
+                   k ? "traced" : "raster", with[k][0], with[k][1], without[k][0], without[k][1]);
+            /* black: the sky's specular and the air's light alone */
+            CHECK(with[k][1] > 5 * with[k][0], "%s: the texture's halves (%g, %g)", k ? "traced" : "raster",
+                  with[k][0], with[k][1]);
+            /* white texels are the material's own albedo (1): the floor without its texture */
+            CHECK(fabs(with[k][1] - without[k][1]) < 1e-3 * without[k][1] && with[k][0] < 0.05 * without[k][0],
+                  "%s: white texels as the untextured floor, black far darker (%g, %g; %g, %g)",
+                  k ? "traced" : "raster", with[k][0], with[k][1], without[k][0], without[k][1]);
+        }
+        CHECK(fabs(with[0][0] - with[1][0]) < 0.02 * with[0][1] && fabs(with[0][1] - with[1][1]) < 0.02 * with[0][1],
+              "raster and traced textures agree (%g, %g; %g, %g)", with[0][0], with[0][1], with[1][0], with[1][1]);
+    }
+    sb_mesh_finish(&halves);
+
+    /* tangent-space normals (x, y, z) * 0.5 + 0.5: 30 degrees toward +u, and away */
+    double lit[3][2][2];
+    for (int tilt = 0; tilt < 3; tilt++) {
+        double a = (tilt - 1) * 30.0 * DEG;
+        uint8_t n[4] = {(uint8_t)lround(255 * (0.5 + 0.5 * sin(a))), 128, (uint8_t)lround(255 * (0.5 + 0.5 * cos(a))),
+                        255};
+        struct sb_mesh bumped = {0};
+        textured_floor(&bumped, 0.5, -1, (int32_t)add_texture(&bumped, 16, n, n, false));
+        CHECK(floor_thirds(&bumped, rp, false, lit[tilt]), "a normal-mapped floor");
+        sb_mesh_finish(&bumped);
+    }
+    for (int k = 0; k < 2; k++) {
+        double away = lit[0][k][1], flat = lit[1][k][1], toward = lit[2][k][1];
+        printf("normal map, %s: floor tilted 30 degrees from the sun %.4g, flat %.4g, toward %.4g\n",
+               k ? "traced" : "raster", away, flat, toward);
+        /* the sun's term goes as its cosine: 0.87 and 0.00 against 0.5 flat
+         * (the sky's light moves less) */
+        CHECK(toward > 1.3 * flat && away < 0.7 * flat, "%s: the normal map's tilt (%g, %g, %g)",
+              k ? "traced" : "raster", away, flat, toward);
+    }
+}
+
 int main(int argc, char **argv)
 {
     /* The world file; argv[1] overrides the source tree's (for runs elsewhere). */
@@ -1443,6 +1580,7 @@ int main(int argc, char **argv)
         test_shadow_boxes(r, &rp);
         test_specialised_shaders(r, &rp);
         test_traced_scene(&rp);
+        test_textures(&rp);
         test_caster_boxes_bounded();
         test_framing(&world);
         test_exposure(r);

@@ -641,8 +641,8 @@ static void split_floor(struct sb_mesh *mesh, double h, uint32_t left, uint32_t 
             float tuv[3][2];
             for (int k = 0; k < 3; k++)
                 memcpy(tuv[k], uv[tris[t][k]], sizeof(tuv[k]));
-            sb_mesh_add_triangle_uv(mesh, p[tris[t][0]], p[tris[t][1]], p[tris[t][2]], tuv, half ? right : left,
-                                    "floor");
+            sb_mesh_add_textured_triangle(mesh, p[tris[t][0]], p[tris[t][1]], p[tris[t][2]], tuv, NULL,
+                                          half ? right : left, "floor");
         }
     }
 }

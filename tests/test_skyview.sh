@@ -45,11 +45,16 @@ check "a camera under hills" expect_exit 0 "$skyview" "$tmp/pack" -o "$tmp/hills
 check "is lifted onto them, and the camera said" grep -q "under the world's surface (at 3.811 m there): lifted onto it, as --camera 0,5.511,0," "$tmp/err"
 printf 'v 3 0 27\nv 5 0 27\nv 5 2 27\nv 3 2 27\nv 3 0 33\nv 5 0 33\nv 5 2 33\nv 3 2 33\nf 1 2 3 4\nf 5 8 7 6\nf 1 5 6 2\nf 4 3 7 8\nf 1 4 8 5\nf 2 6 7 3\n' >"$tmp/behind.obj"
 check "a model behind the default camera" expect_exit 0 "$skyview" "$tmp/pack" -o "$tmp/framed" $small --world "$tmp/behind.obj"
-check "is framed, and the camera said" grep -q "the default camera does not see the world: framing it, as --camera 4," "$tmp/err"
+check "is framed, and the camera said" grep -q "the default camera does not show the world (out of its view, or inside a model): framing it, as --camera 4," "$tmp/err"
 camera=$(sed -n 's/.*as --camera \([^ ]*\).*/\1/p' "$tmp/err")
 check "that camera given" expect_exit 0 "$skyview" "$tmp/pack" -o "$tmp/given" $small --world "$tmp/behind.obj" --camera "$camera"
 check "frames the same" cmp -s "$tmp/framed/frame_0000.png" "$tmp/given/frame_0000.png"
 check "and is not framed again" sh -c "! grep -q 'framing it' '$tmp/err'"
+# A model around the default camera (a van, 6 m long, the camera in its
+# cab): the frame would show its inside; it is framed from outside.
+printf 'v -3 0 -1\nv 3 0 -1\nv 3 2.5 -1\nv -3 2.5 -1\nv -3 0 1\nv 3 0 1\nv 3 2.5 1\nv -3 2.5 1\nf 1 2 3 4\nf 5 8 7 6\nf 1 5 6 2\nf 4 3 7 8\nf 1 4 8 5\nf 2 6 7 3\n' >"$tmp/van.obj"
+check "a model around the default camera" expect_exit 0 "$skyview" "$tmp/pack" -o "$tmp/van" $small --world "$tmp/van.obj"
+check "is framed from outside" grep -q "inside a model): framing it, as --camera 0,[0-9.]*,[1-9]" "$tmp/err"
 # A level (a world file placing another) draws exactly what the same
 # triangles written out in one world file draw.
 printf '{"version":1,"ground":false,"boxes":[{"center_m":[0,1,0],"size_m":[2,2,2],"albedo":[0.8,0.3,0.2]}]}' >"$tmp/hut.json"

@@ -188,6 +188,8 @@ static enum sb_result scene_create(struct sb_renderer *r)
         return res;
     sb_pass_read_atmosphere(r);
     sb_pass_use(r, SB_VIEW_BINDING_VERTICES, sb_pass_find(r, "vertices"), SB_USE_LOAD);
+    sb_pass_use(r, SB_VIEW_BINDING_TEXTURES, sb_pass_find(r, "texture records"), SB_USE_LOAD);
+    sb_pass_use(r, SB_VIEW_BINDING_TEXELS, sb_pass_find(r, "texels"), SB_USE_LOAD);
     sb_pass_sample(r, SB_VIEW_BINDING_AERIAL, sb_pass_find(r, "aerial"), NULL);
     sb_pass_sample(r, SB_VIEW_BINDING_AERIAL_T, sb_pass_find(r, "aerial transmittance"), NULL);
     sb_pass_use(r, SB_VIEW_BINDING_PROBES, sb_pass_find(r, "probes"), SB_USE_LOAD);

@@ -6,16 +6,29 @@
 #include "view_gpu.h"
 #include "scene_shading.glsl"
 #include "shadows.glsl"
+#include "material.glsl"
 
 layout(location = 0) in vec3 in_offset;
 layout(location = 1) in vec3 in_normal;
 layout(location = 2) in vec3 in_albedo;
 layout(location = 3) in vec2 in_metallic_roughness;
+layout(location = 4) in vec2 in_uv;
+layout(location = 5) flat in vec2 in_images;
+layout(location = 6) in vec3 in_tangent;
+layout(location = 7) flat in float in_normal_map;
 layout(location = 0) out vec4 out_color;
 
 void main()
 {
     vec3 n = normalize(in_normal);
-    out_color = scene_shade(in_offset, n, in_albedo, in_metallic_roughness, gl_FragCoord.xy / vec2(frame.size.xy),
+    /* the footprint from the derivatives, taken where every fragment of the quad runs */
+    float footprint = max(length(dFdx(in_uv)), length(dFdy(in_uv)));
+    vec3 albedo = in_albedo;
+    vec2 metallic_roughness = in_metallic_roughness;
+    vec3 shading_n = n;
+    if (in_images != vec2(0.0) || in_normal_map != 0.0)
+        material_textures(in_uv, footprint, in_images, vec4(in_tangent, in_normal_map), albedo, metallic_roughness,
+                          shading_n);
+    out_color = scene_shade(in_offset, shading_n, albedo, metallic_roughness, gl_FragCoord.xy / vec2(frame.size.xy),
                             sun_visibility(in_offset, n, true));
 }

@@ -10,6 +10,10 @@ layout(location = 0) out vec3 out_offset; /* from the camera, m */
 layout(location = 1) out vec3 out_normal;
 layout(location = 2) out vec3 out_albedo;
 layout(location = 3) out vec2 out_metallic_roughness;
+layout(location = 4) out vec2 out_uv;
+layout(location = 5) flat out vec2 out_images; /* the base colour's and metallic-roughness's texture + 1 */
+layout(location = 6) out vec3 out_tangent;
+layout(location = 7) flat out float out_normal_map; /* +-(the normal map's texture + 1) */
 
 void main()
 {
@@ -18,5 +22,9 @@ void main()
     out_normal = v.normal.xyz;
     out_albedo = v.albedo.rgb;
     out_metallic_roughness = vec2(v.position.w, v.normal.w);
+    out_uv = v.uv.xy;
+    out_images = v.uv.zw;
+    out_tangent = v.tangent.xyz;
+    out_normal_map = v.tangent.w;
     gl_Position = frame.view_proj * vec4(out_offset, 1.0);
 }

@@ -13,6 +13,7 @@
 #include "scene_shading.glsl"
 #include "shadows.glsl"
 #include "world.glsl"
+#include "material.glsl"
 
 layout(local_size_x = SB_WORKGROUP_X, local_size_y = SB_WORKGROUP_Y) in;
 layout(set = 0, binding = SB_VIEW_BINDING_HDR, rgba16f) uniform writeonly image2D hdr;
@@ -40,5 +41,25 @@ void main()
     imageStore(depth_out, pixel, vec4(clip.z / clip.w));
     /* a face turned from the sun gets none of it, shadowed or not */
     float visibility = dot(n, frame.sun_direction.xyz) > 0.0 ? sun_visibility(offset, n, true) : 0.0;
-    imageStore(hdr, pixel, scene_shade(offset, n, v.albedo.rgb, vec2(v.position.w, v.normal.w), uv, visibility));
+    vec3 albedo = v.albedo.rgb, shading_n = n;
+    vec2 metallic_roughness = vec2(v.position.w, v.normal.w);
+    if (v.uv.zw != vec2(0.0) || v.tangent.w != 0.0) {
+        uint first = 3u * (hit.triangle & ~SB_BVH_BACK_FACE);
+        sb_vertex_gpu b = vertices[first + 1u], c = vertices[first + 2u];
+        vec3 w = vec3(1.0 - hit.uv.x - hit.uv.y, hit.uv);
+        vec2 tex = w.x * v.uv.xy + w.y * b.uv.xy + w.z * c.uv.xy;
+        vec3 tangent = w.x * v.tangent.xyz + w.y * b.tangent.xyz + w.z * c.tangent.xyz;
+        /* the pixel's ray cone (its angle the pixel's) met the surface: its
+         * width over the cosine, in texture coordinates by the triangle's
+         * texture area over its area */
+        vec2 du = b.uv.xy - v.uv.xy, dv = c.uv.xy - v.uv.xy;
+        float area_uv = abs(du.x * dv.y - du.y * dv.x);
+        float area_m = length(cross(b.position.xyz - v.position.xyz, c.position.xyz - v.position.xyz));
+        float pixel = length(view_ray(uv + vec2(0.0, 1.0 / float(frame.size.y))) - d); /* radians a pixel */
+        float width_m = hit.t * pixel / max(abs(dot(d, n)), 0.05);
+        float footprint = width_m * sqrt(area_uv / max(area_m, 1e-20));
+        material_textures(tex, footprint, v.uv.zw, vec4(tangent, v.tangent.w), albedo, metallic_roughness,
+                          shading_n);
+    }
+    imageStore(hdr, pixel, scene_shade(offset, shading_n, albedo, metallic_roughness, uv, visibility));
 }

@@ -34,6 +34,8 @@
 #define SB_VIEW_BINDING_BVH_NODES 43        /* the world's BVH (geometry/bvh.h) when traced: its nodes */
 #define SB_VIEW_BINDING_BVH_TRIANGLES 44    /* its triangles; material 1: casts shadows, 0: does not */
 #define SB_VIEW_BINDING_DEPTH_OUT 45        /* image2D r32f: the traced scene's depth, written */
+#define SB_VIEW_BINDING_TEXTURES 51         /* the world's textures (vulkan/texels.h): a record an image */
+#define SB_VIEW_BINDING_TEXELS 52           /* and their texels, with their mips */
 /* A shadow ray's reach: past any two points of a world (4 x SB_MESH_MAX_EXTENT_M, geometry/mesh.h). */
 #define SB_TRACE_FAR_M 4.0e4
 
@@ -79,6 +81,10 @@ struct sb_vertex_gpu {
     SB_VEC4(position); /* xyz: m, world; w: metallic */
     SB_VEC4(normal);   /* xyz: unit normal; w: perceptual roughness */
     SB_VEC4(albedo);   /* rgb: base colour, linear; w: unused */
+    SB_VEC4(uv);       /* xy: texture coordinates (u right, v up); z: the base colour's texture + 1,
+                          w: the metallic-roughness's (0: none; SB_VIEW_BINDING_TEXTURES) */
+    SB_VEC4(tangent);  /* xyz: unit, along u, world; w: +-(the normal map's texture + 1), the sign
+                          the bitangent's handedness (0: none) */
 };
 
 /* Per-frame constants (std430). */

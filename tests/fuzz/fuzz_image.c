@@ -1,5 +1,5 @@
 /*
- * libFuzzer entry point: an image a model names (geometry/texture.h),
+ * libFuzzer entry point: an image a model names (geometry/mesh_texture.h),
  * decoded by libpng or libjpeg-turbo as the mesh import's helper does. Any
  * input is refused with a code of the closed set or decoded into texels
  * whose size is within the caps, never a crash.
@@ -8,7 +8,7 @@
 #include <string.h>
 
 #include "fuzz.h"
-#include "texture.h"
+#include "mesh_texture.h"
 
 int LLVMFuzzerTestOneInput(const unsigned char *data, size_t size)
 {

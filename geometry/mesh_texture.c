@@ -1,4 +1,4 @@
-#include "texture.h"
+#include "mesh_texture.h"
 
 #include <errno.h>
 #include <fcntl.h>
@@ -13,14 +13,6 @@
 
 #include "io.h"
 #include "log.h"
-
-uint32_t sb_texture_levels(uint32_t width, uint32_t height)
-{
-    uint32_t levels = 1;
-    for (uint32_t side = width > height ? width : height; side > 1; side >>= 1)
-        levels++;
-    return levels;
-}
 
 static enum sb_result check_size(uint32_t width, uint32_t height, const char *model, const char *name)
 {

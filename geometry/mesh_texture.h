@@ -12,8 +12,8 @@
  * folder (no absolute path, no ".." or link leading out of it) and be a
  * regular file.
  */
-#ifndef SB_GEOMETRY_TEXTURE_H
-#define SB_GEOMETRY_TEXTURE_H
+#ifndef SB_GEOMETRY_MESH_TEXTURE_H
+#define SB_GEOMETRY_MESH_TEXTURE_H
 
 #include <stdbool.h>
 #include <stddef.h>
@@ -70,11 +70,10 @@ enum sb_result sb_texture_decode(const void *bytes, size_t size, const char *mod
  */
 enum sb_result sb_texture_read(const char *model_path, const char *image, struct sb_mesh_texture *texture);
 
-/* The texel bytes of a texture, and the number of mip levels down to 1 x 1. */
+/* The texel bytes of a texture. */
 static inline size_t sb_texture_bytes(const struct sb_mesh_texture *t)
 {
     return (size_t)4 * t->width * t->height;
 }
-uint32_t sb_texture_levels(uint32_t width, uint32_t height);
 
 #endif
