@@ -253,6 +253,81 @@ int main(void)
         finite &= isfinite(level0[t]) && level0[t] >= 0;
     CHECK(finite, "the capture holds a negative or non-finite value");
 
+    /* The capture reads a surface's albedo from its texture: over a floor
+     * black where x < 0 and white where x > 0, the -y face is black (0)
+     * where it sees the black half and, where it sees the white half, the
+     * same floor untextured (albedo 1) bit for bit; near the seam, where a
+     * texel's footprint spans both, in between. */
+    {
+        struct sb_mesh floors[2] = {{0}, {0}};
+        struct sb_mesh_texture t = {.name = "halves", .width = 64, .height = 64, .srgb = 1};
+        t.rgba = malloc(sb_texture_bytes(&t));
+        for (uint32_t i = 0; i < 64 * 64; i++)
+            for (int c = 0; c < 4; c++)
+                t.rgba[4 * i + c] = c == 3 || i % 64 >= 32 ? 255 : 0;
+        for (int f = 0; f < 2; f++) {
+            uint32_t m, tex;
+            sb_mesh_add_material(&floors[f], "floor", (double[3]){1, 1, 1}, &m);
+            if (f == 0) {
+                sb_mesh_add_texture(&floors[0], &t, &tex);
+                floors[0].material_list[m].textures[SB_TEXTURE_BASE_COLOR] = (int32_t)tex;
+            }
+            double p[4][3] = {{-20, 0, 20}, {20, 0, 20}, {20, 0, -20}, {-20, 0, -20}};
+            const float uv[4][2] = {{0, 0}, {1, 0}, {1, 1}, {0, 1}};
+            const int tris[2][3] = {{0, 1, 2}, {0, 2, 3}};
+            for (int k = 0; k < 2; k++) {
+                float tuv[3][2];
+                for (int j = 0; j < 3; j++)
+                    memcpy(tuv[j], uv[tris[k][j]], sizeof(tuv[j]));
+                sb_mesh_add_textured_triangle(&floors[f], p[tris[k][0]], p[tris[k][1]], p[tris[k][2]], tuv, NULL, m,
+                                              "floor");
+            }
+        }
+        float *seen[2] = {malloc((size_t)6 * N * N * 4 * sizeof(float)), malloc((size_t)6 * N * N * 4 * sizeof(float))};
+        struct sb_capture_params over = cp;
+        over.origin_m[0] = 0;
+        over.origin_m[2] = 0;
+        for (int f = 0; f < 2; f++) {
+            struct sb_bvh fb = {0};
+            struct sb_raycaster *frc = NULL;
+            struct sb_surfaces fs = {0};
+            CHECK(sb_bvh_build(&floors[f], &fb) == SB_OK && sb_raycaster_create(vk, &fb, &frc) == SB_OK &&
+                      sb_surfaces_create(vk, &floors[f], 1, &fs) == SB_OK,
+                  "floor %d", f);
+            struct sb_capture_inputs in = {.atmosphere = atm, .rc = frc, .surfaces = &fs};
+            CHECK(sb_reflection_capture(vk, &in, &over, seen[f], NULL) == SB_OK, "capture over floor %d", f);
+            sb_surfaces_destroy(vk, &fs);
+            sb_raycaster_destroy(&frc);
+            sb_bvh_finish(&fb);
+            sb_mesh_finish(&floors[f]);
+        }
+        int black = 0, white = 0, between = 0, wrong = 0;
+        for (uint32_t y = 0; y < N; y++)
+            for (uint32_t x = 0; x < N; x++) {
+                double d[3];
+                sb_cube_texel_direction(3, N, x, y, d); /* -y */
+                double at_x = 1.5 * d[0] / -d[1];      /* where the ray meets the floor */
+                const float *a = &seen[0][4 * (3 * N * N + y * N + x)], *b = &seen[1][4 * (3 * N * N + y * N + x)];
+                if (at_x < -0.5) { /* a texel (0.625 m) from the seam: bilinear reaches it no further */
+                    black++;
+                    wrong += a[0] != 0 || a[1] != 0 || a[2] != 0;
+                } else if (at_x > 0.5) {
+                    white++;
+                    wrong += memcmp(a, b, 3 * sizeof(float)) != 0;
+                } else {
+                    between++;
+                    wrong += !(a[1] >= 0 && a[1] <= b[1]);
+                }
+            }
+        printf("capture over a floor textured half black, half white: %d texels black, %d as the untextured floor, "
+               "%d at the seam within them; %d otherwise\n",
+               black, white, between, wrong);
+        CHECK(wrong == 0 && black > N * N / 4 && white > N * N / 4, "the capture's textured floor: %d texels wrong",
+              wrong);
+        free(seen[0]);
+        free(seen[1]);
+    }
+
     chain = prefilter(vk, level0, samples);
     float *chain2 = prefilter(vk, level0, samples);
     CHECK(!memcmp(chain, chain2, sb_cube_level_offset(N, LEVELS) * 4 * sizeof(float)), "two prefilters differ");
