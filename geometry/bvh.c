@@ -179,24 +179,35 @@ static bool best_split(const struct bins *b, const struct binning *m, uint32_t c
         /* right-to-left sweep of areas and counts, then left to right */
         double right_area[BVH_BINS];
         uint32_t right_count[BVH_BINS];
+        /* an empty bin leaves the sweep's box, so its area, as it was:
+         * the areas are taken only where a bin adds triangles (most bins of
+         * a small node are empty) */
         struct box acc;
         box_empty(&acc);
         uint32_t n = 0;
+        double area = 0.0; /* of the empty box */
         for (int k = m->count - 1; k > 0; k--) {
-            box_grow(&acc, &b->box[axis][k]);
-            n += b->count[axis][k];
-            right_area[k] = box_area(&acc);
+            if (b->count[axis][k]) {
+                box_grow(&acc, &b->box[axis][k]);
+                n += b->count[axis][k];
+                area = box_area(&acc);
+            }
+            right_area[k] = area;
             right_count[k] = n;
         }
         box_empty(&acc);
         n = 0;
+        area = 0.0;
         for (int k = 1; k < m->count; k++) {
-            box_grow(&acc, &b->box[axis][k - 1]);
-            n += b->count[axis][k - 1];
+            if (b->count[axis][k - 1]) {
+                box_grow(&acc, &b->box[axis][k - 1]);
+                n += b->count[axis][k - 1];
+                area = box_area(&acc);
+            }
             if (!n || !right_count[k])
                 continue;
             double cost = BVH_COST_TRAVERSAL + BVH_COST_TRIANGLE *
-                                                   (box_area(&acc) * n + right_area[k] * right_count[k]) /
+                                                   (area * n + right_area[k] * right_count[k]) /
                                                    fmax(parent_area, DBL_MIN);
             if (cost < best) {
                 best = cost;
