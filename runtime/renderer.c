@@ -37,6 +37,7 @@ static void add_resources(struct sb_renderer *r)
         {"exposure", &r->exposure},
         {"texture records", &r->textures.records},
         {"texels", &r->textures.texels},
+        {"instances", &r->instances},
     };
     for (size_t i = 0; i < sizeof(buffers) / sizeof(buffers[0]); i++)
         sb_graph_buffer(r, buffers[i].name, buffers[i].buffer);
@@ -89,26 +90,114 @@ static bool scene_traced(const struct sb_renderer_params *params, const struct s
     return params->scene == SB_SCENE_TRACED;
 }
 
+/* An instanced world's BVH: one a mesh (its vertices in its own space),
+ * a top level over its instances, in the world's order (the traced
+ * kernels read an instance's sb_instance_gpu by the index its record holds). */
+static enum sb_result build_instanced_bvh(const struct sb_world *world, struct sb_bvh *bvh)
+{
+    struct sb_mesh *meshes = calloc(world->mesh_count, sizeof(*meshes));
+    const struct sb_mesh **list = calloc(world->mesh_count, sizeof(*list));
+    struct sb_bvh_instance *instances = calloc(world->instance_count, sizeof(*instances));
+    enum sb_result res = meshes && list && instances ? SB_OK : SB_ERR_NOMEM;
+    for (uint32_t m = 0; m < world->mesh_count && !res; m++) {
+        const struct sb_world_mesh_range *range = &world->meshes[m];
+        struct sb_mesh *mesh = &meshes[m];
+        uint32_t n = (range->end_vertex - range->first_vertex) / 3;
+        mesh->positions = malloc((size_t)n * 9 * sizeof(float) + 1);
+        mesh->indices = malloc((size_t)n * 3 * sizeof(uint32_t) + 1);
+        mesh->materials = malloc((size_t)n * sizeof(uint32_t) + 1);
+        mesh->material_list = calloc(2, sizeof(*mesh->material_list));
+        if (!mesh->positions || !mesh->indices || !mesh->materials || !mesh->material_list) {
+            res = SB_ERR_NOMEM;
+            break;
+        }
+        for (uint32_t v = 0; v < 3 * n; v++) {
+            memcpy(&mesh->positions[3 * (size_t)v], world->vertices[range->first_vertex + v].position,
+                   3 * sizeof(float));
+            mesh->indices[v] = v;
+        }
+        for (uint32_t t = 0; t < n; t++) /* 1: casts shadows (shadows.glsl) */
+            mesh->materials[t] = range->first_vertex + 3 * t >= range->caster_first_vertex;
+        mesh->material_list[1].casts_shadows = true;
+        mesh->vertex_count = 3 * n;
+        mesh->triangle_count = n;
+        mesh->material_count = 2;
+        list[m] = mesh;
+    }
+    for (uint32_t i = 0; i < world->instance_count && !res; i++) {
+        instances[i].mesh = world->instance_mesh[i];
+        for (int r = 0; r < 3; r++)
+            for (int c = 0; c < 4; c++)
+                instances[i].to_world[r][c] = world->instances[i].to_world[r][c];
+    }
+    if (!res)
+        res = sb_bvh_build_instanced(list, world->mesh_count, instances, world->instance_count, bvh);
+    for (uint32_t m = 0; meshes && m < world->mesh_count; m++)
+        sb_mesh_finish(&meshes[m]);
+    free(meshes);
+    free(list);
+    free(instances);
+    return res;
+}
+
 /* The world's BVH (geometry/bvh.h), which the traced scene and the fog's shadow rays walk. */
 static enum sb_result upload_bvh(struct sb_renderer *r, const struct sb_world *world)
 {
-    struct sb_mesh mesh;
     struct sb_bvh bvh = {0};
-    enum sb_result res = sb_world_mesh(world, false, &mesh);
-    if (res)
-        return res;
-    res = sb_bvh_build(&mesh, &bvh);
-    sb_mesh_finish(&mesh);
+    enum sb_result res;
+    if (world->instance_count) {
+        res = build_instanced_bvh(world, &bvh);
+    } else {
+        struct sb_mesh mesh;
+        res = sb_world_mesh(world, false, &mesh);
+        if (res)
+            return res;
+        res = sb_bvh_build(&mesh, &bvh);
+        sb_mesh_finish(&mesh);
+    }
     if (!res)
         res = sb_renderer_upload(r, bvh.nodes, bvh.node_count * sizeof(*bvh.nodes), "world BVH nodes", &r->bvh_nodes);
     if (!res)
         res = sb_renderer_upload(r, bvh.triangles, bvh.triangle_count * sizeof(*bvh.triangles), "world BVH triangles",
                                  &r->bvh_triangles);
-    if (!res)
+    if (!res && bvh.instance_count)
+        sb_info("scene traced: %u triangles placed %u times, a BVH of two levels, %u nodes", bvh.triangle_count,
+                bvh.instance_count, bvh.node_count);
+    else if (!res)
         sb_info("scene traced: %u triangles, a BVH of %u nodes, %u deep", bvh.triangle_count, bvh.node_count,
                 bvh.depth);
     sb_bvh_finish(&bvh);
     return res;
+}
+
+/* An instanced world's instances and its draws, a mesh each; else one
+ * zero instance (every pass's set binds the buffer). */
+static enum sb_result upload_instances(struct sb_renderer *r, const struct sb_world *world)
+{
+    enum sb_result res = sb_renderer_upload(r, world->instances,
+                                            (world->instance_count ? world->instance_count : 1) *
+                                                sizeof(struct sb_instance_gpu),
+                                            "instances", &r->instances);
+    if (res || !world->instance_count)
+        return res;
+    r->draw_groups = calloc(world->mesh_count, sizeof(*r->draw_groups));
+    if (!r->draw_groups)
+        return SB_ERR_NOMEM;
+    for (uint32_t i = 0; i < world->instance_count;) { /* sorted by mesh */
+        uint32_t m = world->instance_mesh[i], end = i;
+        while (end < world->instance_count && world->instance_mesh[end] == m)
+            end++;
+        const struct sb_world_mesh_range *range = &world->meshes[m];
+        r->draw_groups[r->draw_group_count++] = (struct sb_draw_group){
+            .first_vertex = range->first_vertex,
+            .caster_first_vertex = range->caster_first_vertex,
+            .end_vertex = range->end_vertex,
+            .first_instance = i,
+            .instance_count = end - i,
+        };
+        i = end;
+    }
+    return SB_OK;
 }
 
 /* The frame's targets and the samplers. */
@@ -197,14 +286,33 @@ enum sb_result sb_renderer_create(struct sb_vk *vk, const struct sb_pack *pack, 
         r->world_min_m[i] = world->vertex_count ? INFINITY : 0.0;
         r->world_max_m[i] = world->vertex_count ? -INFINITY : 0.0;
     }
-    for (uint32_t v = 0; v < world->vertex_count; v++)
-        for (int i = 0; i < 3; i++) {
-            r->world_min_m[i] = fmin(r->world_min_m[i], world->vertices[v].position[i]);
-            r->world_max_m[i] = fmax(r->world_max_m[i], world->vertices[v].position[i]);
+    bool failed = false;
+    if (world->instance_count) {
+        /* every instance's box, which also bounds its casters for the cascades */
+        r->caster_boxes = calloc(world->instance_count, sizeof(*r->caster_boxes));
+        failed = !r->caster_boxes;
+        for (uint32_t i = 0; i < world->instance_count && !failed; i++) {
+            double box[2][3];
+            if (sb_world_instance_box(world, i, false, box))
+                for (int k = 0; k < 3; k++) {
+                    r->world_min_m[k] = fmin(r->world_min_m[k], box[0][k]);
+                    r->world_max_m[k] = fmax(r->world_max_m[k], box[1][k]);
+                }
+            if (sb_world_instance_box(world, i, true, box)) {
+                struct sb_caster_box *c = &r->caster_boxes[r->caster_box_count++];
+                memcpy(c->min, box[0], sizeof(c->min));
+                memcpy(c->max, box[1], sizeof(c->max));
+            }
         }
-    bool failed;
-    r->caster_box_count =
-        sb_caster_boxes(world->vertices, world->caster_first_vertex, world->vertex_count, &r->caster_boxes, &failed);
+    } else {
+        for (uint32_t v = 0; v < world->vertex_count; v++)
+            for (int i = 0; i < 3; i++) {
+                r->world_min_m[i] = fmin(r->world_min_m[i], world->vertices[v].position[i]);
+                r->world_max_m[i] = fmax(r->world_max_m[i], world->vertices[v].position[i]);
+            }
+        r->caster_box_count = sb_caster_boxes(world->vertices, world->caster_first_vertex, world->vertex_count,
+                                              &r->caster_boxes, &failed);
+    }
     if (failed) {
         res = SB_ERR_NOMEM;
         goto cleanup;
@@ -216,6 +324,8 @@ enum sb_result sb_renderer_create(struct sb_vk *vk, const struct sb_pack *pack, 
                              &r->vertices);
     if (!res)
         res = upload_textures(r, world);
+    if (!res)
+        res = upload_instances(r, world);
     if (!res)
         res = sb_renderer_upload(r, NULL, sizeof(struct sb_frame_gpu), "frame constants", &r->frame);
     if (!res)
@@ -333,10 +443,11 @@ void sb_renderer_destroy(struct sb_renderer **pr)
     sb_renderer_release(r, NULL, 0, textures, sizeof(textures) / sizeof(textures[0]));
     struct sb_buffer *buffers[] = {&r->atmosphere,    &r->frame,     &r->vertices,     &r->exposure,
                                    &r->read_ldr,      &r->read_hdr,  &r->read_post,    &r->post_input,
-                                   &r->read_sky_view, &r->bvh_nodes, &r->bvh_triangles};
+                                   &r->read_sky_view, &r->bvh_nodes, &r->bvh_triangles, &r->instances};
     for (size_t i = 0; i < sizeof(buffers) / sizeof(buffers[0]); i++)
         sb_buffer_destroy(vk, buffers[i]);
     sb_texel_set_destroy(vk, &r->textures);
+    free(r->draw_groups);
     free(r);
     *pr = NULL;
 }

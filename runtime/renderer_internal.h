@@ -61,6 +61,13 @@ struct sb_renderer {
     struct sb_buffer frame, vertices, exposure;                          /* "frame", "vertices", "exposure" */
     struct sb_buffer bvh_nodes, bvh_triangles;         /* "bvh nodes", "bvh triangles": the world's BVH when traced */
     struct sb_texel_set textures;                      /* "texture records", "texels": the world's textures */
+    struct sb_buffer instances;                        /* "instances": sb_instance_gpu[] (one zero when none) */
+    /* An instanced world's draws, a mesh each: its vertices in its own
+     * space and its instances [first_instance, + instance_count). */
+    struct sb_draw_group {
+        uint32_t first_vertex, caster_first_vertex, end_vertex, first_instance, instance_count;
+    } *draw_groups;
+    uint32_t draw_group_count; /* 0: the world in place, drawn as one list */
     struct sb_texture hdr, depth, ldr;                 /* "hdr", "depth", "ldr": the frame */
     VkSampler linear, nearest, shadow_compare, repeat; /* repeat: linear, wrapping (tileable noise) */
 

@@ -6,32 +6,31 @@
 
 #include "level.h"
 #include "load.h"
+#include "log.h"
 #include "world_file.h"
 
-enum sb_result sb_world_from_mesh(const struct sb_mesh *mesh, struct sb_world *w)
+/* Copy the mesh's textures after the world's. */
+static enum sb_result append_textures(struct sb_world *w, const struct sb_mesh *mesh)
 {
-    memset(w, 0, sizeof(*w));
-    if ((uint64_t)mesh->triangle_count * 3 > UINT32_MAX)
-        return SB_ERR_TOO_LARGE;
-    w->vertices = calloc((size_t)mesh->triangle_count * 3 + 1, sizeof(*w->vertices));
-    w->textures = calloc(mesh->texture_count + 1, sizeof(*w->textures));
-    if (!w->vertices || !w->textures) {
-        sb_world_finish(w);
-        return SB_ERR_NOMEM;
-    }
     for (uint32_t k = 0; k < mesh->texture_count; k++, w->texture_count++) {
-        w->textures[k] = mesh->texture_list[k];
-        w->textures[k].rgba = malloc(sb_texture_bytes(&w->textures[k]));
-        if (!w->textures[k].rgba) {
-            sb_world_finish(w);
+        struct sb_mesh_texture *t = &w->textures[w->texture_count];
+        *t = mesh->texture_list[k];
+        t->rgba = malloc(sb_texture_bytes(t));
+        if (!t->rgba)
             return SB_ERR_NOMEM;
-        }
-        memcpy(w->textures[k].rgba, mesh->texture_list[k].rgba, sb_texture_bytes(&w->textures[k]));
+        memcpy(t->rgba, mesh->texture_list[k].rgba, sb_texture_bytes(t));
     }
-    /* two passes: the triangles that cast no shadow, then the casters, each in the mesh's order */
+    return SB_OK;
+}
+
+/* Append the mesh's triangles as vertices, in two passes: those that cast
+ * no shadow, then the casters (from *caster_first), each in the mesh's
+ * order; its texture indices from texture_base. */
+static void append_mesh(struct sb_world *w, const struct sb_mesh *mesh, uint32_t texture_base, uint32_t *caster_first)
+{
     for (int casters = 0; casters <= 1; casters++) {
         if (casters)
-            w->caster_first_vertex = w->vertex_count;
+            *caster_first = w->vertex_count;
         for (uint32_t t = 0; t < mesh->triangle_count; t++) {
             const struct sb_mesh_material *m = &mesh->material_list[mesh->materials[t]];
             if (m->casts_shadows != (casters == 1))
@@ -47,9 +46,15 @@ enum sb_result sb_world_from_mesh(const struct sb_mesh *mesh, struct sb_world *w
             double n[3] = {e1[1] * e2[2] - e1[2] * e2[1], e1[2] * e2[0] - e1[0] * e2[2], e1[0] * e2[1] - e1[1] * e2[0]};
             double len = sqrt(n[0] * n[0] + n[1] * n[1] + n[2] * n[2]);
             /* a texture the vertices name where they have coordinates */
-            int32_t base = mesh->uvs ? m->textures[SB_TEXTURE_BASE_COLOR] : -1;
-            int32_t mr = mesh->uvs ? m->textures[SB_TEXTURE_METALLIC_ROUGHNESS] : -1;
-            int32_t normal = mesh->uvs && mesh->tangents ? m->textures[SB_TEXTURE_NORMAL] : -1;
+            int32_t base = mesh->uvs && m->textures[SB_TEXTURE_BASE_COLOR] >= 0
+                               ? m->textures[SB_TEXTURE_BASE_COLOR] + (int32_t)texture_base
+                               : -1;
+            int32_t mr = mesh->uvs && m->textures[SB_TEXTURE_METALLIC_ROUGHNESS] >= 0
+                             ? m->textures[SB_TEXTURE_METALLIC_ROUGHNESS] + (int32_t)texture_base
+                             : -1;
+            int32_t normal = mesh->uvs && mesh->tangents && m->textures[SB_TEXTURE_NORMAL] >= 0
+                                 ? m->textures[SB_TEXTURE_NORMAL] + (int32_t)texture_base
+                                 : -1;
             for (int k = 0; k < 3; k++) {
                 struct sb_vertex_gpu *v = &w->vertices[w->vertex_count++];
                 uint32_t vertex = mesh->indices[3 * (size_t)t + k];
@@ -75,8 +80,126 @@ enum sb_result sb_world_from_mesh(const struct sb_mesh *mesh, struct sb_world *w
             }
         }
     }
+}
+
+static enum sb_result from(enum sb_result res, struct sb_mesh *mesh, struct sb_world *w);
+
+enum sb_result sb_world_from_mesh(const struct sb_mesh *mesh, struct sb_world *w)
+{
+    memset(w, 0, sizeof(*w));
+    if ((uint64_t)mesh->triangle_count * 3 > UINT32_MAX)
+        return SB_ERR_TOO_LARGE;
+    w->vertices = calloc((size_t)mesh->triangle_count * 3 + 1, sizeof(*w->vertices));
+    w->textures = calloc(mesh->texture_count + 1, sizeof(*w->textures));
+    enum sb_result res = w->vertices && w->textures ? append_textures(w, mesh) : SB_ERR_NOMEM;
+    if (res) {
+        sb_world_finish(w);
+        return res;
+    }
+    append_mesh(w, mesh, 0, &w->caster_first_vertex);
     sb_mesh_hash(mesh, w->mesh_hash);
     return SB_OK;
+}
+
+void sb_world_place(const struct sb_world *w, uint32_t instance, const float p[3], double out[3])
+{
+    const struct sb_instance_gpu *in = &w->instances[instance];
+    for (int r = 0; r < 3; r++)
+        out[r] = (double)in->to_world[r][0] * p[0] + (double)in->to_world[r][1] * p[1] +
+                 (double)in->to_world[r][2] * p[2] + in->to_world[r][3];
+}
+
+/* The level's meshes once, each in its own space, and its instances,
+ * sorted by mesh (a draw a mesh), each with its normals' matrix. */
+static enum sb_result from_instanced_level(const struct sb_level *level, struct sb_world *w)
+{
+    uint64_t vertices = 0;
+    uint32_t textures = 0;
+    for (uint32_t m = 0; m < level->mesh_count; m++) {
+        vertices += 3ull * level->meshes[m].triangle_count;
+        textures += level->meshes[m].texture_count;
+    }
+    if (vertices > UINT32_MAX) {
+        sb_error("the world's meshes hold %llu vertices: at most 2^32", (unsigned long long)vertices);
+        return SB_ERR_TOO_LARGE;
+    }
+    w->vertices = calloc(vertices + 1, sizeof(*w->vertices));
+    w->textures = calloc(textures + 1, sizeof(*w->textures));
+    w->meshes = calloc(level->mesh_count, sizeof(*w->meshes));
+    w->instances = calloc(level->instance_count, sizeof(*w->instances));
+    w->instance_mesh = calloc(level->instance_count, sizeof(*w->instance_mesh));
+    uint32_t *first = calloc(level->mesh_count + 1, sizeof(*first));
+    enum sb_result res = w->vertices && w->textures && w->meshes && w->instances && w->instance_mesh && first
+                             ? SB_OK
+                             : SB_ERR_NOMEM;
+    for (uint32_t m = 0; m < level->mesh_count && !res; m++) {
+        struct sb_world_mesh_range *range = &w->meshes[w->mesh_count++];
+        uint32_t texture_base = w->texture_count;
+        if ((res = append_textures(w, &level->meshes[m])))
+            break;
+        range->first_vertex = w->vertex_count;
+        append_mesh(w, &level->meshes[m], texture_base, &range->caster_first_vertex);
+        range->end_vertex = w->vertex_count;
+        for (int i = 0; i < 3; i++) {
+            range->caster_min[i] = range->min[i] = INFINITY;
+            range->caster_max[i] = range->max[i] = -INFINITY;
+        }
+        for (uint32_t v = range->first_vertex; v < range->end_vertex; v++)
+            for (int i = 0; i < 3; i++) {
+                float x = w->vertices[v].position[i];
+                range->min[i] = fminf(range->min[i], x);
+                range->max[i] = fmaxf(range->max[i], x);
+                if (v >= range->caster_first_vertex) {
+                    range->caster_min[i] = fminf(range->caster_min[i], x);
+                    range->caster_max[i] = fmaxf(range->caster_max[i], x);
+                }
+            }
+    }
+    /* a counting sort by mesh: each mesh's instances in the level's order */
+    for (uint32_t i = 0; i < level->instance_count && !res; i++)
+        first[level->instances[i].mesh + 1]++;
+    for (uint32_t m = 0; m < level->mesh_count && !res; m++)
+        first[m + 1] += first[m];
+    for (uint32_t i = 0; i < level->instance_count && !res; i++) {
+        const struct sb_bvh_instance *in = &level->instances[i];
+        uint32_t at = first[in->mesh]++;
+        struct sb_instance_gpu *out = &w->instances[at];
+        const double(*a)[4] = in->to_world;
+        /* the normals': the inverse transpose of the linear part, its cofactors over the determinant */
+        double c[3][3];
+        for (int r = 0; r < 3; r++)
+            for (int k = 0; k < 3; k++)
+                c[r][k] = a[(r + 1) % 3][(k + 1) % 3] * a[(r + 2) % 3][(k + 2) % 3] -
+                          a[(r + 1) % 3][(k + 2) % 3] * a[(r + 2) % 3][(k + 1) % 3];
+        double det = a[0][0] * c[0][0] + a[0][1] * c[0][1] + a[0][2] * c[0][2];
+        for (int r = 0; r < 3; r++) {
+            for (int k = 0; k < 4; k++)
+                out->to_world[r][k] = (float)a[r][k];
+            for (int k = 0; k < 3; k++)
+                out->normal[r][k] = (float)(c[r][k] / det);
+        }
+        w->instance_mesh[at] = in->mesh;
+    }
+    w->instance_count = res ? 0 : level->instance_count;
+    free(first);
+    return res;
+}
+
+enum sb_result sb_world_from_level(const struct sb_level *level, struct sb_world *w)
+{
+    memset(w, 0, sizeof(*w));
+    enum sb_result res;
+    if (level->instance_count) {
+        res = from_instanced_level(level, w);
+        if (res)
+            sb_world_finish(w);
+    } else {
+        struct sb_mesh mesh = {0};
+        res = from(sb_level_flatten(level, &mesh), &mesh, w);
+    }
+    if (!res)
+        sb_level_hash(level, w->mesh_hash);
+    return res;
 }
 
 static double dot3d(const double a[3], const double b[3])
@@ -84,27 +207,99 @@ static double dot3d(const double a[3], const double b[3])
     return a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
 }
 
+/* Where the upward triangle (a, b, c) lies over (x, z): its height there
+ * into *y, false when it does not. */
+static bool height_over(const double a[3], const double b[3], const double c[3], double x, double z, double *y)
+{
+    /* barycentrics of (x, z) in the triangle's projection */
+    double d = (b[2] - c[2]) * (a[0] - c[0]) + (c[0] - b[0]) * (a[2] - c[2]);
+    if (d == 0.0)
+        return false;
+    double l1 = ((b[2] - c[2]) * (x - c[0]) + (c[0] - b[0]) * (z - c[2])) / d;
+    double l2 = ((c[2] - a[2]) * (x - c[0]) + (a[0] - c[0]) * (z - c[2])) / d;
+    double l3 = 1.0 - l1 - l2;
+    if (l1 < 0 || l2 < 0 || l3 < 0)
+        return false;
+    *y = l1 * a[1] + l2 * b[1] + l3 * c[1];
+    return true;
+}
+
+void sb_world_caster_bounds(const struct sb_world *w, double lo[3], double hi[3])
+{
+    if (!w->instance_count) {
+        for (uint32_t v = w->caster_first_vertex; v < w->vertex_count; v++)
+            for (int i = 0; i < 3; i++) {
+                lo[i] = fmin(lo[i], w->vertices[v].position[i]);
+                hi[i] = fmax(hi[i], w->vertices[v].position[i]);
+            }
+        return;
+    }
+    for (uint32_t i = 0; i < w->instance_count; i++) {
+        double box[2][3];
+        if (sb_world_instance_box(w, i, true, box))
+            for (int k = 0; k < 3; k++) {
+                lo[k] = fmin(lo[k], box[0][k]);
+                hi[k] = fmax(hi[k], box[1][k]);
+            }
+    }
+}
+
+bool sb_world_instance_box(const struct sb_world *w, uint32_t i, bool casters, double box[2][3])
+{
+    const struct sb_world_mesh_range *range = &w->meshes[w->instance_mesh[i]];
+    const float *lo = casters ? range->caster_min : range->min, *hi = casters ? range->caster_max : range->max;
+    if (!(lo[0] <= hi[0]))
+        return false;
+    for (int k = 0; k < 3; k++) {
+        box[0][k] = INFINITY;
+        box[1][k] = -INFINITY;
+    }
+    for (int corner = 0; corner < 8; corner++) {
+        float p[3];
+        double q[3];
+        for (int k = 0; k < 3; k++)
+            p[k] = (corner >> k) & 1 ? hi[k] : lo[k];
+        sb_world_place(w, i, p, q);
+        for (int k = 0; k < 3; k++) {
+            box[0][k] = fmin(box[0][k], q[k]);
+            box[1][k] = fmax(box[1][k], q[k]);
+        }
+    }
+    return true;
+}
+
 bool sb_world_lift(const struct sb_world *w, double eye_m, double camera_m[3], double *surface_m)
 {
     bool below = false, above = false;
     double highest = -INFINITY, x = camera_m[0], z = camera_m[2];
-    for (uint32_t v = 0; v + 2 < w->vertex_count; v += 3) {
-        const float *a = w->vertices[v].position, *b = w->vertices[v + 1].position, *c = w->vertices[v + 2].position;
-        if (!(w->vertices[v].normal[1] > 0.0f))
-            continue; /* upward faces only */
-        /* barycentrics of (x, z) in the triangle's projection */
-        double d = ((double)b[2] - c[2]) * ((double)a[0] - c[0]) + ((double)c[0] - b[0]) * ((double)a[2] - c[2]);
-        if (d == 0.0)
-            continue;
-        double l1 = (((double)b[2] - c[2]) * (x - c[0]) + ((double)c[0] - b[0]) * (z - c[2])) / d;
-        double l2 = (((double)c[2] - a[2]) * (x - c[0]) + ((double)a[0] - c[0]) * (z - c[2])) / d;
-        double l3 = 1.0 - l1 - l2;
-        if (l1 < 0 || l2 < 0 || l3 < 0)
-            continue;
-        double y = l1 * a[1] + l2 * b[1] + l3 * c[1];
-        below = below || y <= camera_m[1];
-        above = above || y > camera_m[1];
-        highest = fmax(highest, y);
+    uint32_t copies = w->instance_count ? w->instance_count : 1;
+    for (uint32_t i = 0; i < copies; i++) {
+        const struct sb_world_mesh_range *range = w->instance_count ? &w->meshes[w->instance_mesh[i]] : NULL;
+        uint32_t first = range ? range->first_vertex : 0, end = range ? range->end_vertex : w->vertex_count;
+        for (uint32_t v = first; v + 2 < end; v += 3) {
+            const struct sb_vertex_gpu *t = &w->vertices[v];
+            double p[3][3];
+            float up = t->normal[1];
+            if (range) { /* upward in the world: the normal's matrix's second row */
+                const float *n = w->instances[i].normal[1];
+                up = n[0] * t->normal[0] + n[1] * t->normal[1] + n[2] * t->normal[2];
+            }
+            if (!(up > 0.0f))
+                continue; /* upward faces only */
+            for (int k = 0; k < 3; k++) {
+                if (range)
+                    sb_world_place(w, i, t[k].position, p[k]);
+                else
+                    for (int c = 0; c < 3; c++)
+                        p[k][c] = t[k].position[c];
+            }
+            double y;
+            if (!height_over(p[0], p[1], p[2], x, z, &y))
+                continue;
+            below = below || y <= camera_m[1];
+            above = above || y > camera_m[1];
+            highest = fmax(highest, y);
+        }
     }
     if (below || !above)
         return false;
@@ -140,11 +335,7 @@ bool sb_world_frame(const struct sb_world *w, double aspect, double fov_y, doubl
                     double *pitch)
 {
     double lo[3] = {INFINITY, INFINITY, INFINITY}, hi[3] = {-INFINITY, -INFINITY, -INFINITY};
-    for (uint32_t v = w->caster_first_vertex; v < w->vertex_count; v++)
-        for (int i = 0; i < 3; i++) {
-            lo[i] = fmin(lo[i], w->vertices[v].position[i]);
-            hi[i] = fmax(hi[i], w->vertices[v].position[i]);
-        }
+    sb_world_caster_bounds(w, lo, hi);
     if (!(lo[0] <= hi[0]))
         return false;
     bool inside = true;
@@ -197,16 +388,6 @@ static enum sb_result from(enum sb_result res, struct sb_mesh *mesh, struct sb_w
     return res;
 }
 
-enum sb_result sb_world_from_level(const struct sb_level *level, struct sb_world *w)
-{
-    memset(w, 0, sizeof(*w));
-    struct sb_mesh mesh = {0};
-    enum sb_result res = from(sb_level_flatten(level, &mesh), &mesh, w);
-    if (!res)
-        sb_level_hash(level, w->mesh_hash);
-    return res;
-}
-
 enum sb_result sb_world_load(const char *path, const struct sb_mesh_load_params *params, struct sb_world *w)
 {
     memset(w, 0, sizeof(*w));
@@ -223,6 +404,9 @@ enum sb_result sb_world_parse(const char *json, size_t size, const char *source,
 
 void sb_world_finish(struct sb_world *w)
 {
+    free(w->meshes);
+    free(w->instances);
+    free(w->instance_mesh);
     for (uint32_t k = 0; k < w->texture_count; k++)
         free(w->textures[k].rgba);
     free(w->textures);
@@ -233,8 +417,20 @@ void sb_world_finish(struct sb_world *w)
 enum sb_result sb_world_mesh(const struct sb_world *world, bool casters_only, struct sb_mesh *mesh)
 {
     memset(mesh, 0, sizeof(*mesh));
-    uint32_t first = casters_only ? world->caster_first_vertex : 0;
-    uint32_t n = (world->vertex_count - first) / 3;
+    /* the triangles placed: (copy, first vertex, end) runs */
+    uint32_t copies = world->instance_count ? world->instance_count : 1;
+    uint64_t n = 0;
+    for (uint32_t i = 0; i < copies; i++) {
+        const struct sb_world_mesh_range *r = world->instance_count ? &world->meshes[world->instance_mesh[i]] : NULL;
+        uint32_t first = r ? (casters_only ? r->caster_first_vertex : r->first_vertex)
+                           : (casters_only ? world->caster_first_vertex : 0);
+        n += ((r ? r->end_vertex : world->vertex_count) - first) / 3;
+    }
+    if (n > SB_MESH_MAX_TRIANGLES) {
+        sb_error("the world places %llu triangles: as one mesh, at most %u", (unsigned long long)n,
+                 SB_MESH_MAX_TRIANGLES);
+        return SB_ERR_TOO_LARGE;
+    }
     mesh->positions = malloc((size_t)n * 9 * sizeof(float) + 1);
     mesh->indices = malloc((size_t)n * 3 * sizeof(uint32_t) + 1);
     mesh->materials = malloc((size_t)n * sizeof(uint32_t) + 1);
@@ -243,15 +439,30 @@ enum sb_result sb_world_mesh(const struct sb_world *world, bool casters_only, st
         sb_mesh_finish(mesh);
         return SB_ERR_NOMEM;
     }
-    for (uint32_t v = 0; v < 3 * n; v++) {
-        memcpy(&mesh->positions[3 * (size_t)v], world->vertices[first + v].position, 3 * sizeof(float));
-        mesh->indices[v] = v;
+    uint32_t out = 0;
+    for (uint32_t i = 0; i < copies; i++) {
+        const struct sb_world_mesh_range *r = world->instance_count ? &world->meshes[world->instance_mesh[i]] : NULL;
+        uint32_t casters = r ? r->caster_first_vertex : world->caster_first_vertex;
+        uint32_t first = casters_only ? casters : r ? r->first_vertex : 0;
+        uint32_t end = r ? r->end_vertex : world->vertex_count;
+        for (uint32_t v = first; v < end; v++, out++) {
+            float *p = &mesh->positions[3 * (size_t)out];
+            if (r) {
+                double q[3];
+                sb_world_place(world, i, world->vertices[v].position, q);
+                for (int k = 0; k < 3; k++)
+                    p[k] = (float)q[k];
+            } else {
+                memcpy(p, world->vertices[v].position, 3 * sizeof(float));
+            }
+            mesh->indices[out] = out;
+            if (out % 3 == 0)
+                mesh->materials[out / 3] = v >= casters;
+        }
     }
-    for (uint32_t t = 0; t < n; t++)
-        mesh->materials[t] = first + 3 * t >= world->caster_first_vertex;
     mesh->material_list[1].casts_shadows = true;
-    mesh->vertex_count = 3 * n;
-    mesh->triangle_count = n;
+    mesh->vertex_count = 3 * (uint32_t)n;
+    mesh->triangle_count = (uint32_t)n;
     mesh->material_count = 2;
     return SB_OK;
 }

@@ -16,6 +16,14 @@
 #include "result.h"
 #include "view_gpu.h"
 
+/* A mesh of an instanced world: vertices [first_vertex, end_vertex) in its
+ * own space, those from caster_first_vertex on casting shadows. */
+struct sb_world_mesh_range {
+    uint32_t first_vertex, caster_first_vertex, end_vertex;
+    float caster_min[3], caster_max[3]; /* the casters' box, the mesh's space (empty: min > max) */
+    float min[3], max[3];               /* every vertex's */
+};
+
 struct sb_world {
     struct sb_vertex_gpu *vertices; /* owned: vertex_count, a triangle list */
     uint32_t vertex_count;
@@ -26,15 +34,34 @@ struct sb_world {
     /* the images the vertices' texture indices name (owned, with their texels) */
     struct sb_mesh_texture *textures;
     uint32_t texture_count;
+    /* An instanced world (a level that places meshes): the vertices are
+     * its meshes' in turn, each in its own space, and instances (sorted by
+     * mesh) place them; caster_first_vertex is then unused. instance_count
+     * 0: the vertices are the world, in place. */
+    uint32_t mesh_count, instance_count;
+    struct sb_world_mesh_range *meshes;   /* owned */
+    struct sb_instance_gpu *instances;    /* owned */
+    uint32_t *instance_mesh;              /* owned: each instance's mesh */
 };
+
+/* Instance i's map of a point of its mesh to the world (fp64 from the fp32 rows). */
+void sb_world_place(const struct sb_world *world, uint32_t instance, const float p[3], double out[3]);
+
+/* The box of instance i's casters (or of all its mesh) in the world: its
+ * mesh's box placed; false when there is none. */
+bool sb_world_instance_box(const struct sb_world *world, uint32_t instance, bool casters, double box[2][3]);
+
+/* Grow lo and hi by the world's casters (every instance's). */
+void sb_world_caster_bounds(const struct sb_world *world, double lo[3], double hi[3]);
 
 /* The world of a mesh: flat shading (each triangle's own normal, from its
  * winding), the triangle's material, its textures (copied) and the
  * vertices' texture coordinates and tangents. */
 enum sb_result sb_world_from_mesh(const struct sb_mesh *mesh, struct sb_world *world);
 
-/* The world of a level (geometry/level.h), its instances placed into one
- * list of triangles for now (sb_level_flatten), named by the level's hash. */
+/* The world of a level (geometry/level.h), named by the level's hash: one
+ * that places nothing as sb_world_from_mesh makes it; else instanced, its
+ * meshes once and its instances. */
 struct sb_level;
 enum sb_result sb_world_from_level(const struct sb_level *level, struct sb_world *world);
 

@@ -18,6 +18,7 @@
 #include "harness_view.h"
 #include "harness_vk.h"
 #include "json.h"
+#include "level.h"
 #include "log.h"
 #include "pack.h"
 #include "parallel.h"
@@ -1554,6 +1555,87 @@ static void test_textures(const struct sb_renderer_params *rp)
     }
 }
 
+/* An instanced world (a level: meshes once, placed by instances, runtime/
+ * world.h) draws what the same level flattened into one list draws:
+ * rotated, scaled and mirrored copies, raster and traced. The two differ
+ * only in where fp32 rounds each vertex's placement, so the frames agree
+ * but at a few pixels along edges. */
+static void test_instanced_world(const char *dir, const struct sb_renderer_params *rp)
+{
+    char hut[512], level_path[512];
+    snprintf(hut, sizeof(hut), "%s/hut.json", dir);
+    snprintf(level_path, sizeof(level_path), "%s/huts.json", dir);
+    FILE *f = fopen(hut, "w");
+    fputs("{\"version\":1,\"ground\":false,\"boxes\":[{\"center_m\":[0,1,0],\"size_m\":[2,2,3],"
+          "\"albedo\":[0.8,0.3,0.2]},{\"center_m\":[0,2.5,0],\"size_m\":[1,1,1],\"albedo\":[0.2,0.5,0.8]}]}",
+          f);
+    fclose(f);
+    f = fopen(level_path, "w");
+    fputs("{\"version\":1,\"ground\":{\"size_m\":200},\"instances\":["
+          "{\"file\":\"hut.json\",\"translate_m\":[4,0,-30]},"
+          "{\"file\":\"hut.json\",\"translate_m\":[-6,0,-24],\"rotate_deg\":[0,37,0],\"scale\":1.5},"
+          "{\"file\":\"hut.json\",\"translate_m\":[9,0,-20],\"rotate_deg\":[0,-70,0],\"scale\":0.7},"
+          "{\"file\":\"hut.json\",\"translate_m\":[-2,0,-16],\"rotate_deg\":[0,200,0]}]}",
+          f);
+    fclose(f);
+    struct sb_world_params wp = {.units_m = 1, .scale = 1};
+    snprintf(wp.file, sizeof(wp.file), "%s", level_path);
+    struct sb_level level;
+    struct sb_mesh flat_mesh = {0};
+    struct sb_world instanced = {0}, flat = {0};
+    bool ok = sb_level_load(&wp, "", &level, NULL, 0) == SB_OK;
+    ok = ok && sb_world_from_level(&level, &instanced) == SB_OK && sb_level_flatten(&level, &flat_mesh) == SB_OK &&
+         sb_world_from_mesh(&flat_mesh, &flat) == SB_OK;
+    CHECK(ok && instanced.instance_count == 5 && instanced.mesh_count == 2 && !flat.instance_count,
+          "a level of 4 huts and its own ground: 5 instances (%u)", instanced.instance_count);
+    if (ok) {
+        double lo[2][3], hi[2][3];
+        for (int k = 0; k < 3; k++)
+            lo[0][k] = lo[1][k] = INFINITY, hi[0][k] = hi[1][k] = -INFINITY;
+        sb_world_caster_bounds(&instanced, lo[0], hi[0]);
+        sb_world_caster_bounds(&flat, lo[1], hi[1]);
+        double worst = 0;
+        for (int k = 0; k < 3; k++)
+            worst = fmax(worst, fmax(fabs(lo[0][k] - lo[1][k]), fabs(hi[0][k] - hi[1][k])));
+        CHECK(worst < 1e-5, "the casters' bounds, instanced and flat: %g m apart", worst);
+    }
+    struct sb_view v = base_view();
+    v.camera_m[1] = 6.0;
+    v.pitch = -12.0 * DEG;
+    for (int k = 0; k < 2 && ok; k++) {
+        struct sb_renderer_params p = *rp;
+        p.scene = k ? SB_SCENE_TRACED : SB_SCENE_RASTER;
+        struct sb_renderer *ri = NULL, *rf = NULL;
+        ok = sb_renderer_create(vk, &pack, &instanced, &p, &ri) == SB_OK &&
+             sb_renderer_create(vk, &pack, &flat, &p, &rf) == SB_OK;
+        CHECK(ok, "renderers for the instanced and flat worlds");
+        float *a = ok && render(ri, &v) ? frame_rgb(ri) : NULL, *b = ok && render(rf, &v) ? frame_rgb(rf) : NULL;
+        if (a && b) {
+            int differ = 0, lit = 0;
+            for (int i = 0; i < W * H; i++) {
+                double la = luminance(a + 3 * i), lb = luminance(b + 3 * i);
+                lit += lb > 0;
+                differ += fabs(la - lb) > 1e-3 * fmax(la, lb) + 1e-6;
+            }
+            printf("instanced world, %s: %d of %d pixels differ from the flattened world's by over 1e-3\n",
+                   k ? "traced" : "raster", differ, W * H);
+            CHECK(lit > W * H / 2 && differ <= W * H / 100, "%s: %d pixels differ (of %d lit)", k ? "traced" : "raster",
+                  differ, lit);
+        }
+        free(a);
+        free(b);
+        sb_renderer_destroy(&ri);
+        sb_renderer_destroy(&rf);
+    }
+    sb_world_finish(&instanced);
+    sb_world_finish(&flat);
+    sb_mesh_finish(&flat_mesh);
+    if (ok)
+        sb_level_finish(&level);
+    remove(hut);
+    remove(level_path);
+}
+
 int main(int argc, char **argv)
 {
     /* The world file; argv[1] overrides the source tree's (for runs elsewhere). */
@@ -1581,6 +1663,7 @@ int main(int argc, char **argv)
         test_specialised_shaders(r, &rp);
         test_traced_scene(&rp);
         test_textures(&rp);
+        test_instanced_world(dir, &rp);
         test_caster_boxes_bounded();
         test_framing(&world);
         test_exposure(r);

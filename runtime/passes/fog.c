@@ -20,6 +20,7 @@
 
 #include "fog_inject.spv.h"
 #include "fog_inject_traced.spv.h"
+#include "fog_inject_traced_instanced.spv.h"
 #include "fog_integrate.spv.h"
 
 #define FROXEL_FORMAT VK_FORMAT_R16G16B16A16_SFLOAT
@@ -112,8 +113,12 @@ static enum sb_result fog_create(struct sb_renderer *r)
     if (r->scene_traced) {
         sb_pass_use(r, SB_VIEW_BINDING_BVH_NODES, sb_pass_find(r, "bvh nodes"), SB_USE_LOAD);
         sb_pass_use(r, SB_VIEW_BINDING_BVH_TRIANGLES, sb_pass_find(r, "bvh triangles"), SB_USE_LOAD);
-        res = sb_renderer_kernel(r, sb_spv_fog_inject_traced, sizeof(sb_spv_fog_inject_traced),
-                                 "fog inject (shadow rays)", &f->inject);
+        if (r->draw_group_count) /* an instanced world: its BVH's two levels */
+            res = sb_renderer_kernel(r, sb_spv_fog_inject_traced_instanced, sizeof(sb_spv_fog_inject_traced_instanced),
+                                     "fog inject (shadow rays, instances)", &f->inject);
+        else
+            res = sb_renderer_kernel(r, sb_spv_fog_inject_traced, sizeof(sb_spv_fog_inject_traced),
+                                     "fog inject (shadow rays)", &f->inject);
     } else {
         sb_pass_sample(r, SB_VIEW_BINDING_SHADOW, sb_pass_find(r, "shadow cascades"), r->shadow_compare);
         res = sb_renderer_kernel(r, sb_spv_fog_inject, sizeof(sb_spv_fog_inject), "fog inject", &f->inject);

@@ -23,22 +23,44 @@ struct probes {
     VkPipeline sky_kernel, light_kernel;
 };
 
-/* The world's mean albedo, weighted by area: the bounce model's surfaces. */
+/* The world's mean albedo, weighted by area: the bounce model's surfaces.
+ * An instanced world's triangles count once a copy, by their placed area
+ * (cross(M a, M b) = det(M) M^-T cross(a, b): the normals' matrix). */
 static void mean_albedo(const struct sb_world *world, float out[3])
 {
     double sum[3] = {0, 0, 0}, area = 0;
-    for (uint32_t v = 0; v + 2 < world->vertex_count; v += 3) {
-        const struct sb_vertex_gpu *t = &world->vertices[v];
-        double e1[3], e2[3];
-        for (int i = 0; i < 3; i++) {
-            e1[i] = (double)t[1].position[i] - t[0].position[i];
-            e2[i] = (double)t[2].position[i] - t[0].position[i];
+    uint32_t copies = world->instance_count ? world->instance_count : 1;
+    for (uint32_t i = 0; i < copies; i++) {
+        const struct sb_world_mesh_range *range = world->instance_count ? &world->meshes[world->instance_mesh[i]] : NULL;
+        const struct sb_instance_gpu *in = range ? &world->instances[i] : NULL;
+        double det = 1.0;
+        if (in) {
+            const float(*m)[4] = in->to_world;
+            det = fabs((double)m[0][0] * ((double)m[1][1] * m[2][2] - (double)m[1][2] * m[2][1]) -
+                       (double)m[0][1] * ((double)m[1][0] * m[2][2] - (double)m[1][2] * m[2][0]) +
+                       (double)m[0][2] * ((double)m[1][0] * m[2][1] - (double)m[1][1] * m[2][0]));
         }
-        double n[3] = {e1[1] * e2[2] - e1[2] * e2[1], e1[2] * e2[0] - e1[0] * e2[2], e1[0] * e2[1] - e1[1] * e2[0]};
-        double a = 0.5 * sqrt(n[0] * n[0] + n[1] * n[1] + n[2] * n[2]);
-        for (int i = 0; i < 3; i++)
-            sum[i] += a * t[0].albedo[i];
-        area += a;
+        uint32_t first = range ? range->first_vertex : 0, end = range ? range->end_vertex : world->vertex_count;
+        for (uint32_t v = first; v + 2 < end; v += 3) {
+            const struct sb_vertex_gpu *t = &world->vertices[v];
+            double e1[3], e2[3];
+            for (int k = 0; k < 3; k++) {
+                e1[k] = (double)t[1].position[k] - t[0].position[k];
+                e2[k] = (double)t[2].position[k] - t[0].position[k];
+            }
+            double n[3] = {e1[1] * e2[2] - e1[2] * e2[1], e1[2] * e2[0] - e1[0] * e2[2],
+                           e1[0] * e2[1] - e1[1] * e2[0]};
+            if (in) {
+                double placed[3];
+                for (int r = 0; r < 3; r++)
+                    placed[r] = det * (in->normal[r][0] * n[0] + in->normal[r][1] * n[1] + in->normal[r][2] * n[2]);
+                memcpy(n, placed, sizeof(n));
+            }
+            double a = 0.5 * sqrt(n[0] * n[0] + n[1] * n[1] + n[2] * n[2]);
+            for (int k = 0; k < 3; k++)
+                sum[k] += a * t[0].albedo[k];
+            area += a;
+        }
     }
     for (int i = 0; i < 3; i++)
         out[i] = area > 0 ? (float)(sum[i] / area) : 0.0f;

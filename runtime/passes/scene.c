@@ -39,8 +39,11 @@
 #include "scene_frag.spv.h"
 #include "scene_frag_volume.spv.h"
 #include "scene_trace.spv.h"
+#include "scene_trace_instanced.spv.h"
 #include "scene_trace_volume.spv.h"
+#include "scene_trace_volume_instanced.spv.h"
 #include "scene_vert.spv.h"
+#include "scene_vert_instanced.spv.h"
 
 struct scene {
     struct sb_buffer reflections, cubes; /* sb_reflections_gpu, its probes and the DFG; the cubes */
@@ -133,6 +136,15 @@ static enum sb_result create_traced(struct sb_renderer *r, struct scene *s)
     sb_pass_use(r, SB_VIEW_BINDING_DEPTH_OUT, sb_pass_find(r, "depth"), SB_USE_OVERWRITE);
     sb_pass_use(r, SB_VIEW_BINDING_BVH_NODES, sb_pass_find(r, "bvh nodes"), SB_USE_LOAD);
     sb_pass_use(r, SB_VIEW_BINDING_BVH_TRIANGLES, sb_pass_find(r, "bvh triangles"), SB_USE_LOAD);
+    if (r->draw_group_count) { /* an instanced world: its BVH's two levels, its vertices placed */
+        enum sb_result res = sb_renderer_kernel(r, sb_spv_scene_trace_instanced, sizeof(sb_spv_scene_trace_instanced),
+                                                "scene traced (instances)", &s->traced[0]);
+        if (!res)
+            res = sb_renderer_kernel(r, sb_spv_scene_trace_volume_instanced,
+                                     sizeof(sb_spv_scene_trace_volume_instanced),
+                                     "scene traced (instances, aerial volume only)", &s->traced[1]);
+        return res;
+    }
     enum sb_result res =
         sb_renderer_kernel(r, sb_spv_scene_trace, sizeof(sb_spv_scene_trace), "scene traced", &s->traced[0]);
     if (!res)
@@ -157,8 +169,8 @@ static enum sb_result create_raster(struct sb_renderer *r, struct scene *s)
         .mapEntryCount = 2, .pMapEntries = entries, .dataSize = sizeof(has), .pData = has};
     struct sb_graphics_pipeline_params params = {
         .fragment_specialization = &specialization,
-        .vertex_spirv = sb_spv_scene_vert,
-        .vertex_size = sizeof(sb_spv_scene_vert),
+        .vertex_spirv = r->draw_group_count ? sb_spv_scene_vert_instanced : sb_spv_scene_vert,
+        .vertex_size = r->draw_group_count ? sizeof(sb_spv_scene_vert_instanced) : sizeof(sb_spv_scene_vert),
         .fragment_spirv = sb_spv_scene_frag,
         .fragment_size = sizeof(sb_spv_scene_frag),
         .color_format = SB_HDR_FORMAT,
@@ -190,6 +202,8 @@ static enum sb_result scene_create(struct sb_renderer *r)
     sb_pass_use(r, SB_VIEW_BINDING_VERTICES, sb_pass_find(r, "vertices"), SB_USE_LOAD);
     sb_pass_use(r, SB_VIEW_BINDING_TEXTURES, sb_pass_find(r, "texture records"), SB_USE_LOAD);
     sb_pass_use(r, SB_VIEW_BINDING_TEXELS, sb_pass_find(r, "texels"), SB_USE_LOAD);
+    if (r->draw_group_count)
+        sb_pass_use(r, SB_VIEW_BINDING_INSTANCES, sb_pass_find(r, "instances"), SB_USE_LOAD);
     sb_pass_sample(r, SB_VIEW_BINDING_AERIAL, sb_pass_find(r, "aerial"), NULL);
     sb_pass_sample(r, SB_VIEW_BINDING_AERIAL_T, sb_pass_find(r, "aerial transmittance"), NULL);
     sb_pass_use(r, SB_VIEW_BINDING_PROBES, sb_pass_find(r, "probes"), SB_USE_LOAD);
@@ -246,7 +260,12 @@ static void scene_record(struct sb_renderer *r)
     vkCmdBeginRendering(r->cmd, &info);
     sb_renderer_viewport(r, r->width, r->height);
     sb_renderer_bind_graphics(r, s->raster[r->aerial_volume_only ? 1 : 0], NULL);
-    vkCmdDraw(r->cmd, r->vertex_count, 1, 0, 0);
+    if (!r->draw_group_count)
+        vkCmdDraw(r->cmd, r->vertex_count, 1, 0, 0);
+    for (uint32_t g = 0; g < r->draw_group_count; g++) { /* a mesh, every instance of it */
+        const struct sb_draw_group *d = &r->draw_groups[g];
+        vkCmdDraw(r->cmd, d->end_vertex - d->first_vertex, d->instance_count, d->first_vertex, d->first_instance);
+    }
     vkCmdEndRendering(r->cmd);
 }
 

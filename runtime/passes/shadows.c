@@ -12,6 +12,7 @@
 #include "renderer_internal.h"
 
 #include "shadow_vert.spv.h"
+#include "shadow_vert_instanced.spv.h"
 
 /* The cascades' depth: 16 bits resolve 1 cm over the largest cascade's
  * depth range (two radii of 238 m and the 200 m caster margin), far under
@@ -40,10 +41,12 @@ static enum sb_result shadows_create(struct sb_renderer *r)
         return res;
     sb_pass_use(r, SB_VIEW_BINDING_FRAME, sb_pass_find(r, "frame"), SB_USE_LOAD);
     sb_pass_use(r, SB_VIEW_BINDING_VERTICES, sb_pass_find(r, "vertices"), SB_USE_LOAD);
+    if (r->draw_group_count)
+        sb_pass_use(r, SB_VIEW_BINDING_INSTANCES, sb_pass_find(r, "instances"), SB_USE_LOAD);
     sb_pass_use(r, SB_NO_BINDING, sb_graph_image(r, "shadow cascades", &s->maps), SB_USE_DEPTH_TARGET);
     struct sb_graphics_pipeline_params params = {
-        .vertex_spirv = sb_spv_shadow_vert,
-        .vertex_size = sizeof(sb_spv_shadow_vert),
+        .vertex_spirv = r->draw_group_count ? sb_spv_shadow_vert_instanced : sb_spv_shadow_vert,
+        .vertex_size = r->draw_group_count ? sizeof(sb_spv_shadow_vert_instanced) : sizeof(sb_spv_shadow_vert),
         .depth_format = SHADOW_FORMAT,
         .depth_compare = VK_COMPARE_OP_LESS,
         .depth_clamp = true, /* casters behind the near plane still cast ("pancaking") */
@@ -97,7 +100,14 @@ static void shadows_record(struct sb_renderer *r)
         vkCmdSetScissor(r->cmd, 0, 1, &area);
         struct sb_view_push push = {.cascade = c};
         vkCmdPushConstants(r->cmd, layout, VK_SHADER_STAGE_ALL, 0, sizeof(push), &push);
-        vkCmdDraw(r->cmd, r->vertex_count - r->caster_first_vertex, 1, r->caster_first_vertex, 0);
+        if (!r->draw_group_count)
+            vkCmdDraw(r->cmd, r->vertex_count - r->caster_first_vertex, 1, r->caster_first_vertex, 0);
+        for (uint32_t g = 0; g < r->draw_group_count; g++) { /* a mesh's casters, every instance of it */
+            const struct sb_draw_group *d = &r->draw_groups[g];
+            if (d->end_vertex > d->caster_first_vertex)
+                vkCmdDraw(r->cmd, d->end_vertex - d->caster_first_vertex, d->instance_count, d->caster_first_vertex,
+                          d->first_instance);
+        }
         vkCmdEndRendering(r->cmd);
     }
 }

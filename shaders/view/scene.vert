@@ -1,5 +1,6 @@
 #version 450
-/* The world seen from the camera. */
+/* The world seen from the camera; with SB_INSTANCED, instance
+ * gl_InstanceIndex of an instanced world's mesh. */
 #extension GL_GOOGLE_include_directive : require
 #include "view_gpu.h"
 
@@ -18,13 +19,19 @@ layout(location = 7) flat out float out_normal_map; /* +-(the normal map's textu
 void main()
 {
     sb_vertex_gpu v = vertices[gl_VertexIndex];
+#ifdef SB_INSTANCED
+    out_offset = instance_point(gl_InstanceIndex, v.position.xyz) - frame.camera_m.xyz;
+    out_normal = normalize(instance_normal(gl_InstanceIndex, v.normal.xyz));
+    out_tangent = instance_direction(gl_InstanceIndex, v.tangent.xyz);
+#else
     out_offset = vertex_offset(v);
     out_normal = v.normal.xyz;
+    out_tangent = v.tangent.xyz;
+#endif
     out_albedo = v.albedo.rgb;
     out_metallic_roughness = vec2(v.position.w, v.normal.w);
     out_uv = v.uv.xy;
     out_images = v.uv.zw;
-    out_tangent = v.tangent.xyz;
     out_normal_map = v.tangent.w;
     gl_Position = frame.view_proj * vec4(out_offset, 1.0);
 }

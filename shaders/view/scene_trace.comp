@@ -7,7 +7,8 @@
  * fills those), and the depth as the rasteriser's reverse-Z projection
  * would (0 for the sky). For GPUs whose rasteriser is their weak part
  * (runtime/passes/scene.c). Built with SB_AERIAL_VOLUME_ONLY too, as
- * scene.frag is. */
+ * scene.frag is, and for an instanced world with SB_INSTANCED and
+ * BVH_INSTANCES (its BVH's two levels, its vertices placed by instances). */
 #extension GL_GOOGLE_include_directive : require
 #include "view_gpu.h"
 #include "scene_shading.glsl"
@@ -36,7 +37,13 @@ void main()
     }
     sb_vertex_gpu v = vertices[3u * (hit.triangle & ~SB_BVH_BACK_FACE)];
     vec3 offset = d * hit.t;
+#ifdef SB_INSTANCED
+    /* the instance the BVH's record names (bvh.h), its normals' matrix */
+    uint instance = hit.instance == SB_BVH_NO_INSTANCE ? 0u : floatBitsToUint(bvh_nodes[2u * hit.instance + 3u].y);
+    vec3 n = normalize(instance_normal(instance, v.normal.xyz));
+#else
     vec3 n = v.normal.xyz;
+#endif
     vec4 clip = frame.view_proj * vec4(offset, 1.0);
     imageStore(depth_out, pixel, vec4(clip.z / clip.w));
     /* a face turned from the sun gets none of it, shadowed or not */
@@ -49,12 +56,19 @@ void main()
         vec3 w = vec3(1.0 - hit.uv.x - hit.uv.y, hit.uv);
         vec2 tex = w.x * v.uv.xy + w.y * b.uv.xy + w.z * c.uv.xy;
         vec3 tangent = w.x * v.tangent.xyz + w.y * b.tangent.xyz + w.z * c.tangent.xyz;
+        vec3 pa = v.position.xyz, pb = b.position.xyz, pc = c.position.xyz;
+#ifdef SB_INSTANCED
+        tangent = instance_direction(instance, tangent);
+        pa = instance_point(instance, pa);
+        pb = instance_point(instance, pb);
+        pc = instance_point(instance, pc);
+#endif
         /* the pixel's ray cone (its angle the pixel's) met the surface: its
          * width over the cosine, in texture coordinates by the triangle's
          * texture area over its area */
         vec2 du = b.uv.xy - v.uv.xy, dv = c.uv.xy - v.uv.xy;
         float area_uv = abs(du.x * dv.y - du.y * dv.x);
-        float area_m = length(cross(b.position.xyz - v.position.xyz, c.position.xyz - v.position.xyz));
+        float area_m = length(cross(pb - pa, pc - pa));
         float pixel = length(view_ray(uv + vec2(0.0, 1.0 / float(frame.size.y))) - d); /* radians a pixel */
         float width_m = hit.t * pixel / max(abs(dot(d, n)), 0.05);
         float footprint = width_m * sqrt(area_uv / max(area_m, 1e-20));

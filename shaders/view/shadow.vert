@@ -1,5 +1,6 @@
 #version 450
-/* Depth of the world from the sun, into one cascade (pc.cascade). */
+/* Depth of the world from the sun, into one cascade (pc.cascade); with
+ * SB_INSTANCED, of instance gl_InstanceIndex of an instanced world's mesh. */
 #extension GL_GOOGLE_include_directive : require
 #include "view_gpu.h"
 
@@ -12,5 +13,10 @@ layout(push_constant) uniform ViewPush {
 void main()
 {
     sb_vertex_gpu v = vertices[gl_VertexIndex];
-    gl_Position = frame.shadow_view_proj[pc.cascade] * vec4(vertex_offset(v), 1.0);
+#ifdef SB_INSTANCED
+    vec3 offset = instance_point(gl_InstanceIndex, v.position.xyz) - frame.camera_m.xyz;
+#else
+    vec3 offset = vertex_offset(v);
+#endif
+    gl_Position = frame.shadow_view_proj[pc.cascade] * vec4(offset, 1.0);
 }

@@ -36,6 +36,7 @@
 #define SB_VIEW_BINDING_DEPTH_OUT 45        /* image2D r32f: the traced scene's depth, written */
 #define SB_VIEW_BINDING_TEXTURES 51         /* the world's textures (vulkan/texels.h): a record an image */
 #define SB_VIEW_BINDING_TEXELS 52           /* and their texels, with their mips */
+#define SB_VIEW_BINDING_INSTANCES 53        /* struct sb_instance_gpu[]: an instanced world's placed copies */
 /* A shadow ray's reach: past any two points of a world (4 x SB_MESH_MAX_EXTENT_M, geometry/mesh.h). */
 #define SB_TRACE_FAR_M 4.0e4
 
@@ -85,6 +86,16 @@ struct sb_vertex_gpu {
                           w: the metallic-roughness's (0: none; SB_VIEW_BINDING_TEXTURES) */
     SB_VEC4(tangent);  /* xyz: unit, along u, world; w: +-(the normal map's texture + 1), the sign
                           the bitangent's handedness (0: none) */
+};
+
+/* A placed copy of one of an instanced world's meshes (runtime/world.h):
+ * rows of the affine map from the mesh's space to the world's (m), and of
+ * its normals' (the inverse transpose of its linear part). The raster path
+ * draws instance gl_InstanceIndex; the traced path reads the one its BVH
+ * record names (bvh.h: instances in this order). */
+struct sb_instance_gpu {
+    SB_VEC4(to_world[3]);
+    SB_VEC4(normal[3]);
 };
 
 /* Per-frame constants (std430). */
