@@ -38,6 +38,7 @@ static void add_resources(struct sb_renderer *r)
         {"texture records", &r->textures.records},
         {"texels", &r->textures.texels},
         {"instances", &r->instances},
+        {"visible instances", &r->visible},
     };
     for (size_t i = 0; i < sizeof(buffers) / sizeof(buffers[0]); i++)
         sb_graph_buffer(r, buffers[i].name, buffers[i].buffer);
@@ -174,15 +175,26 @@ static enum sb_result upload_bvh(struct sb_renderer *r, const struct sb_world *w
  * zero instance (every pass's set binds the buffer). */
 static enum sb_result upload_instances(struct sb_renderer *r, const struct sb_world *world)
 {
-    enum sb_result res = sb_renderer_upload(r, world->instances,
-                                            (world->instance_count ? world->instance_count : 1) *
-                                                sizeof(struct sb_instance_gpu),
-                                            "instances", &r->instances);
+    uint32_t n = world->instance_count ? world->instance_count : 1;
+    enum sb_result res = sb_renderer_upload(r, world->instances, n * sizeof(struct sb_instance_gpu), "instances",
+                                            &r->instances);
+    if (!res)
+        res = sb_renderer_upload(r, NULL, (size_t)(1 + SB_CASCADES) * n * sizeof(uint32_t), "visible instances",
+                                 &r->visible);
     if (res || !world->instance_count)
         return res;
     r->draw_groups = calloc(world->mesh_count, sizeof(*r->draw_groups));
-    if (!r->draw_groups)
+    r->visible_ranges = calloc((size_t)(1 + SB_CASCADES) * world->mesh_count, sizeof(*r->visible_ranges));
+    r->instance_boxes = calloc(n, sizeof(*r->instance_boxes));
+    r->caster_instance_boxes = calloc(n, sizeof(*r->caster_instance_boxes));
+    if (!r->draw_groups || !r->visible_ranges || !r->instance_boxes || !r->caster_instance_boxes)
         return SB_ERR_NOMEM;
+    for (uint32_t i = 0; i < n; i++) {
+        if (!sb_world_instance_box(world, i, false, r->instance_boxes[i]))
+            r->instance_boxes[i][0][0] = INFINITY; /* empty: never drawn */
+        if (!sb_world_instance_box(world, i, true, r->caster_instance_boxes[i]))
+            r->caster_instance_boxes[i][0][0] = INFINITY;
+    }
     for (uint32_t i = 0; i < world->instance_count;) { /* sorted by mesh */
         uint32_t m = world->instance_mesh[i], end = i;
         while (end < world->instance_count && world->instance_mesh[end] == m)
@@ -443,16 +455,70 @@ void sb_renderer_destroy(struct sb_renderer **pr)
     sb_renderer_release(r, NULL, 0, textures, sizeof(textures) / sizeof(textures[0]));
     struct sb_buffer *buffers[] = {&r->atmosphere,    &r->frame,     &r->vertices,     &r->exposure,
                                    &r->read_ldr,      &r->read_hdr,  &r->read_post,    &r->post_input,
-                                   &r->read_sky_view, &r->bvh_nodes, &r->bvh_triangles, &r->instances};
+                                   &r->read_sky_view, &r->bvh_nodes, &r->bvh_triangles, &r->instances,
+                                   &r->visible};
     for (size_t i = 0; i < sizeof(buffers) / sizeof(buffers[0]); i++)
         sb_buffer_destroy(vk, buffers[i]);
     sb_texel_set_destroy(vk, &r->textures);
     free(r->draw_groups);
+    free(r->visible_ranges);
+    free(r->instance_boxes);
+    free(r->caster_instance_boxes);
     free(r);
     *pr = NULL;
 }
 
 /* ---- A frame ------------------------------------------------------------------- */
+
+/* Whether a world box lies wholly outside a camera-relative clip space:
+ * all its corners past one side (x or y beyond +-w; with `near`, w below
+ * it: behind the perspective's near plane; an orthographic cascade's depth
+ * is not tested, a caster behind it still shadows). */
+static bool box_outside(const struct sb_mat4 *view_proj, const double camera_m[3], const double box[2][3], double near)
+{
+    if (!(box[0][0] <= box[1][0]))
+        return true;
+    int out[5] = {0, 0, 0, 0, 0};
+    for (int corner = 0; corner < 8; corner++) {
+        double p[3], clip[4];
+        for (int k = 0; k < 3; k++)
+            p[k] = box[(corner >> k) & 1][k] - camera_m[k];
+        for (int row = 0; row < 4; row++)
+            clip[row] = view_proj->m[row] * p[0] + view_proj->m[4 + row] * p[1] + view_proj->m[8 + row] * p[2] +
+                        view_proj->m[12 + row];
+        out[0] += clip[0] < -clip[3];
+        out[1] += clip[0] > clip[3];
+        out[2] += clip[1] < -clip[3];
+        out[3] += clip[1] > clip[3];
+        out[4] += near > 0 && clip[3] < near;
+    }
+    for (int k = 0; k < 5; k++)
+        if (out[k] == 8)
+            return true;
+    return false;
+}
+
+/* This frame's lists of the instances each raster draw draws: those whose
+ * box the frame can see, and for each cascade those whose casters' box
+ * falls on its map (runtime/passes/scene.c and shadows.c draw them). */
+static void cull_instances(struct sb_renderer *r, const struct sb_cascades *cascades)
+{
+    uint32_t *visible = r->visible.mapped, at = 0;
+    for (int list = 0; list <= SB_CASCADES; list++)
+        for (uint32_t g = 0; g < r->draw_group_count; g++) {
+            const struct sb_draw_group *d = &r->draw_groups[g];
+            struct sb_visible_range *range = &r->visible_ranges[list * r->draw_group_count + g];
+            range->first = at;
+            for (uint32_t i = d->first_instance; i < d->first_instance + d->instance_count; i++) {
+                bool out = list == 0 ? box_outside(&r->view_proj, r->camera_m, r->instance_boxes[i], SB_NEAR_M)
+                                     : box_outside(&cascades->view_proj[list - 1], r->camera_m,
+                                                   r->caster_instance_boxes[i], 0.0);
+                if (!out)
+                    visible[at++] = i;
+            }
+            range->count = at - range->first;
+        }
+}
 
 static void store4(float dst[4], double x, double y, double z, double w)
 {
@@ -496,6 +562,8 @@ static void fill_frame(struct sb_renderer *r, const struct sb_view *v, struct sb
     };
     struct sb_cascades cascades;
     sb_cascades_compute(&cp, v->camera_m, forward, sun, &cascades);
+    if (r->draw_group_count)
+        cull_instances(r, &cascades);
     for (int c = 0; c < SB_CASCADES; c++) {
         sb_mat4_store(&cascades.view_proj[c], f->shadow_view_proj[c]);
         f->cascade_ends[c] = (float)cascades.ends_m[c];

@@ -68,6 +68,15 @@ struct sb_renderer {
         uint32_t first_vertex, caster_first_vertex, end_vertex, first_instance, instance_count;
     } *draw_groups;
     uint32_t draw_group_count; /* 0: the world in place, drawn as one list */
+    /* This frame's cull of an instanced world: each list (the frame, then
+     * each cascade) holds, a group after another, the instances a draw
+     * draws; "visible instances", written by the host before each submit. */
+    struct sb_buffer visible;
+    struct sb_visible_range {
+        uint32_t first, count; /* in the visible buffer */
+    } *visible_ranges;         /* [(1 + SB_CASCADES) x draw_group_count] */
+    double (*instance_boxes)[2][3]; /* each instance's box in the world, and its casters' */
+    double (*caster_instance_boxes)[2][3];
     struct sb_texture hdr, depth, ldr;                 /* "hdr", "depth", "ldr": the frame */
     VkSampler linear, nearest, shadow_compare, repeat; /* repeat: linear, wrapping (tileable noise) */
 

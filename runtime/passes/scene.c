@@ -202,8 +202,11 @@ static enum sb_result scene_create(struct sb_renderer *r)
     sb_pass_use(r, SB_VIEW_BINDING_VERTICES, sb_pass_find(r, "vertices"), SB_USE_LOAD);
     sb_pass_use(r, SB_VIEW_BINDING_TEXTURES, sb_pass_find(r, "texture records"), SB_USE_LOAD);
     sb_pass_use(r, SB_VIEW_BINDING_TEXELS, sb_pass_find(r, "texels"), SB_USE_LOAD);
-    if (r->draw_group_count)
+    if (r->draw_group_count) {
         sb_pass_use(r, SB_VIEW_BINDING_INSTANCES, sb_pass_find(r, "instances"), SB_USE_LOAD);
+        if (!r->scene_traced)
+            sb_pass_use(r, SB_VIEW_BINDING_VISIBLE, sb_pass_find(r, "visible instances"), SB_USE_LOAD);
+    }
     sb_pass_sample(r, SB_VIEW_BINDING_AERIAL, sb_pass_find(r, "aerial"), NULL);
     sb_pass_sample(r, SB_VIEW_BINDING_AERIAL_T, sb_pass_find(r, "aerial transmittance"), NULL);
     sb_pass_use(r, SB_VIEW_BINDING_PROBES, sb_pass_find(r, "probes"), SB_USE_LOAD);
@@ -262,9 +265,11 @@ static void scene_record(struct sb_renderer *r)
     sb_renderer_bind_graphics(r, s->raster[r->aerial_volume_only ? 1 : 0], NULL);
     if (!r->draw_group_count)
         vkCmdDraw(r->cmd, r->vertex_count, 1, 0, 0);
-    for (uint32_t g = 0; g < r->draw_group_count; g++) { /* a mesh, every instance of it */
+    for (uint32_t g = 0; g < r->draw_group_count; g++) { /* a mesh, every instance of it the frame sees */
         const struct sb_draw_group *d = &r->draw_groups[g];
-        vkCmdDraw(r->cmd, d->end_vertex - d->first_vertex, d->instance_count, d->first_vertex, d->first_instance);
+        const struct sb_visible_range *v = &r->visible_ranges[g];
+        if (v->count)
+            vkCmdDraw(r->cmd, d->end_vertex - d->first_vertex, v->count, d->first_vertex, v->first);
     }
     vkCmdEndRendering(r->cmd);
 }

@@ -41,8 +41,10 @@ static enum sb_result shadows_create(struct sb_renderer *r)
         return res;
     sb_pass_use(r, SB_VIEW_BINDING_FRAME, sb_pass_find(r, "frame"), SB_USE_LOAD);
     sb_pass_use(r, SB_VIEW_BINDING_VERTICES, sb_pass_find(r, "vertices"), SB_USE_LOAD);
-    if (r->draw_group_count)
+    if (r->draw_group_count) {
         sb_pass_use(r, SB_VIEW_BINDING_INSTANCES, sb_pass_find(r, "instances"), SB_USE_LOAD);
+        sb_pass_use(r, SB_VIEW_BINDING_VISIBLE, sb_pass_find(r, "visible instances"), SB_USE_LOAD);
+    }
     sb_pass_use(r, SB_NO_BINDING, sb_graph_image(r, "shadow cascades", &s->maps), SB_USE_DEPTH_TARGET);
     struct sb_graphics_pipeline_params params = {
         .vertex_spirv = r->draw_group_count ? sb_spv_shadow_vert_instanced : sb_spv_shadow_vert,
@@ -102,11 +104,11 @@ static void shadows_record(struct sb_renderer *r)
         vkCmdPushConstants(r->cmd, layout, VK_SHADER_STAGE_ALL, 0, sizeof(push), &push);
         if (!r->draw_group_count)
             vkCmdDraw(r->cmd, r->vertex_count - r->caster_first_vertex, 1, r->caster_first_vertex, 0);
-        for (uint32_t g = 0; g < r->draw_group_count; g++) { /* a mesh's casters, every instance of it */
+        for (uint32_t g = 0; g < r->draw_group_count; g++) { /* a mesh's casters, every instance on the map */
             const struct sb_draw_group *d = &r->draw_groups[g];
-            if (d->end_vertex > d->caster_first_vertex)
-                vkCmdDraw(r->cmd, d->end_vertex - d->caster_first_vertex, d->instance_count, d->caster_first_vertex,
-                          d->first_instance);
+            const struct sb_visible_range *v = &r->visible_ranges[(1 + c) * r->draw_group_count + g];
+            if (d->end_vertex > d->caster_first_vertex && v->count)
+                vkCmdDraw(r->cmd, d->end_vertex - d->caster_first_vertex, v->count, d->caster_first_vertex, v->first);
         }
         vkCmdEndRendering(r->cmd);
     }

@@ -20,9 +20,9 @@ void main()
 {
     sb_vertex_gpu v = vertices[gl_VertexIndex];
 #ifdef SB_INSTANCED
-    out_offset = instance_point(gl_InstanceIndex, v.position.xyz) - frame.camera_m.xyz;
-    out_normal = normalize(instance_normal(gl_InstanceIndex, v.normal.xyz));
-    out_tangent = instance_direction(gl_InstanceIndex, v.tangent.xyz);
+    out_offset = instance_point(visible_instances[gl_InstanceIndex], v.position.xyz) - frame.camera_m.xyz;
+    out_normal = normalize(instance_normal(visible_instances[gl_InstanceIndex], v.normal.xyz));
+    out_tangent = instance_direction(visible_instances[gl_InstanceIndex], v.tangent.xyz);
 #else
     out_offset = vertex_offset(v);
     out_normal = v.normal.xyz;

@@ -1,6 +1,7 @@
 #version 450
 /* Depth of the world from the sun, into one cascade (pc.cascade); with
- * SB_INSTANCED, of instance gl_InstanceIndex of an instanced world's mesh. */
+ * SB_INSTANCED, of instance visible_instances[gl_InstanceIndex] of an instanced
+ * world's mesh. */
 #extension GL_GOOGLE_include_directive : require
 #include "view_gpu.h"
 
@@ -14,7 +15,7 @@ void main()
 {
     sb_vertex_gpu v = vertices[gl_VertexIndex];
 #ifdef SB_INSTANCED
-    vec3 offset = instance_point(gl_InstanceIndex, v.position.xyz) - frame.camera_m.xyz;
+    vec3 offset = instance_point(visible_instances[gl_InstanceIndex], v.position.xyz) - frame.camera_m.xyz;
 #else
     vec3 offset = vertex_offset(v);
 #endif

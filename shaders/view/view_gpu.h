@@ -37,6 +37,7 @@
 #define SB_VIEW_BINDING_TEXTURES 51         /* the world's textures (vulkan/texels.h): a record an image */
 #define SB_VIEW_BINDING_TEXELS 52           /* and their texels, with their mips */
 #define SB_VIEW_BINDING_INSTANCES 53        /* struct sb_instance_gpu[]: an instanced world's placed copies */
+#define SB_VIEW_BINDING_VISIBLE 54          /* uint[]: the instances each raster draw draws (this frame's cull) */
 /* A shadow ray's reach: past any two points of a world (4 x SB_MESH_MAX_EXTENT_M, geometry/mesh.h). */
 #define SB_TRACE_FAR_M 4.0e4
 
@@ -91,8 +92,9 @@ struct sb_vertex_gpu {
 /* A placed copy of one of an instanced world's meshes (runtime/world.h):
  * rows of the affine map from the mesh's space to the world's (m), and of
  * its normals' (the inverse transpose of its linear part). The raster path
- * draws instance gl_InstanceIndex; the traced path reads the one its BVH
- * record names (bvh.h: instances in this order). */
+ * draws instance visible[gl_InstanceIndex] (the frame's cull writes the
+ * list); the traced path reads the one its BVH record names (bvh.h:
+ * instances in this order). */
 struct sb_instance_gpu {
     SB_VEC4(to_world[3]);
     SB_VEC4(normal[3]);

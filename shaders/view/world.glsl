@@ -23,6 +23,12 @@ layout(std430, set = 0, binding = SB_VIEW_BINDING_INSTANCES) readonly buffer Ins
     sb_instance_gpu instances[];
 };
 
+/* The raster draws': the instance drawn as gl_InstanceIndex, from the
+ * frame's cull (runtime/renderer.c). */
+layout(std430, set = 0, binding = SB_VIEW_BINDING_VISIBLE) readonly buffer VisibleBuffer {
+    uint visible_instances[];
+};
+
 vec3 instance_point(uint i, vec3 p)
 {
     vec4 h = vec4(p, 1.0);
