@@ -452,9 +452,27 @@ enum sb_result sb_level_load(const struct sb_world_params *w, const char *direct
         free(refs.refs);
         sb_mesh_finish(&top);
     } else {
-        res = sb_mesh_load_world(w, directory, &top, NULL, 0);
-        if (!res)
+        /* a mesh file: one mesh, or parts when its nodes reuse meshes (a
+         * glTF's wheels), placed where the scene puts it, on its ground */
+        struct sb_mesh_parts parts;
+        res = sb_mesh_load_world_parts(w, directory, &top, &parts, NULL, 0);
+        if (!res && !parts.part_count) {
             res = add_mesh(&ld, &top, &(int32_t){0});
+        } else if (!res) {
+            char canonical[PATH_MAX];
+            if (!realpath(path, canonical)) {
+                sb_error("%s: %s", path, strerror(errno));
+                res = SB_ERR_IO;
+            } else if ((res = new_unique(&ld, canonical, &(uint32_t){0})) ||
+                       (res = add_parts(&ld, 0, &top, &parts))) {
+                /* nothing placed */
+            } else if (!(level->instances = calloc(parts.placement_count, sizeof(*level->instances)))) {
+                res = SB_ERR_NOMEM;
+            } else {
+                place(&ld, 0, identity);
+            }
+        }
+        sb_mesh_parts_finish(&parts);
         sb_mesh_finish(&top);
     }
     for (uint32_t i = 0; i < ld.unique_count; i++)
@@ -554,27 +572,41 @@ void sb_level_hash(const struct sb_level *level, char out[33])
     snprintf(out, 33, "%016llx%016llx", (unsigned long long)h.high64, (unsigned long long)h.low64);
 }
 
+/* Grow lo, hi by instance `in`'s triangles (those that cast shadows, or
+ * all), placed vertex by vertex, as the flattened level would hold them
+ * (a box's corners placed would grow a turned part's box); false when it
+ * adds none. */
+static bool grow_placed(const struct sb_mesh *mesh, const struct sb_bvh_instance *in, bool casters, bool any,
+                        float lo[3], float hi[3])
+{
+    bool added = false;
+    for (uint32_t t = 0; t < mesh->triangle_count; t++) {
+        if (casters && !mesh->material_list[mesh->materials[t]].casts_shadows)
+            continue;
+        for (int k = 0; k < 3; k++) {
+            const float *p = &mesh->positions[3 * (size_t)mesh->indices[3 * (size_t)t + k]];
+            for (int r = 0; r < 3; r++) {
+                float w = (float)(in->to_world[r][0] * p[0] + in->to_world[r][1] * p[1] + in->to_world[r][2] * p[2] +
+                                  in->to_world[r][3]);
+                lo[r] = any || added ? fminf(lo[r], w) : w;
+                hi[r] = any || added ? fmaxf(hi[r], w) : w;
+            }
+            added = true;
+        }
+    }
+    return added;
+}
+
 bool sb_level_bounds_casting(const struct sb_level *level, float min[3], float max[3])
 {
     if (!level->instance_count)
         return sb_mesh_bounds_casting(&level->meshes[0], min, max);
+    /* the casters (a mesh file's ground, a part of its own, casts
+     * nothing), else every triangle, as sb_mesh_bounds_casting */
     bool any = false;
-    for (uint32_t i = 0; i < level->instance_count; i++) {
-        const struct sb_bvh_instance *in = &level->instances[i];
-        float lo[3], hi[3];
-        if (!sb_mesh_bounds_casting(&level->meshes[in->mesh], lo, hi))
-            continue;
-        for (int corner = 0; corner < 8; corner++) {
-            double p[3] = {corner & 1 ? hi[0] : lo[0], corner & 2 ? hi[1] : lo[1], corner & 4 ? hi[2] : lo[2]};
-            for (int r = 0; r < 3; r++) {
-                float w = (float)(in->to_world[r][0] * p[0] + in->to_world[r][1] * p[1] + in->to_world[r][2] * p[2] +
-                                  in->to_world[r][3]);
-                min[r] = any ? fminf(min[r], w) : w;
-                max[r] = any ? fmaxf(max[r], w) : w;
-            }
-            any = true;
-        }
-    }
+    for (int casters = 1; casters >= 0 && !any; casters--)
+        for (uint32_t i = 0; i < level->instance_count; i++)
+            any |= grow_placed(&level->meshes[level->instances[i].mesh], &level->instances[i], casters, any, min, max);
     return any;
 }
 

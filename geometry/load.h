@@ -56,4 +56,14 @@ int sb_world_overrides(const struct sb_world_params *world, struct sb_mesh_albed
 enum sb_result sb_mesh_load_world(const struct sb_world_params *world, const char *directory, struct sb_mesh *mesh,
                                   char *path_out, size_t path_size);
 
+/* As sb_mesh_load_world, but a mesh file whose nodes reuse meshes comes as
+ * parts (mesh.h's sb_mesh_import_parts), placed where the scene puts the
+ * file; its ground, found from the placed parts, is one more part placed
+ * once (identity). Any other file as sb_mesh_load_world reads it,
+ * parts->part_count 0. Free parts with sb_mesh_parts_finish. */
+struct sb_mesh_parts;
+enum sb_result sb_mesh_load_world_parts(const struct sb_world_params *world, const char *directory,
+                                        struct sb_mesh *mesh, struct sb_mesh_parts *parts, char *path_out,
+                                        size_t path_size);
+
 #endif

@@ -1311,6 +1311,35 @@ static void test_levels(void)
     sb_mesh_finish(&placed);
     sb_level_finish(&level);
 
+    /* the same glTF named as a scene's world, with its automatic ground:
+     * parts and the ground one more, whose casters' box (the probes'
+     * grid) is the flat import's exactly, as is its ground */
+    {
+        struct sb_mesh whole = {0};
+        struct sb_world_params wp = {.units_m = 1, .scale = 1};
+        snprintf(wp.file, sizeof(wp.file), "%s", MODELS "/glTF/CesiumMilkTruck/CesiumMilkTruck.gltf");
+        res = sb_level_load(&wp, "", &level, NULL, 0);
+        enum sb_result whole_res = sb_mesh_load_world(&wp, "", &whole, NULL, 0);
+        float llo[3], lhi[3], mlo[3], mhi[3];
+        CHECK(!res && !whole_res && level.instance_count == level.mesh_count + 1 &&
+                  level.placed_triangles == whole.triangle_count && sb_level_bounds_casting(&level, llo, lhi) &&
+                  sb_mesh_bounds_casting(&whole, mlo, mhi) && !memcmp(llo, mlo, sizeof(llo)) &&
+                  !memcmp(lhi, mhi, sizeof(lhi)),
+              "the milk truck as a world: %u meshes placed %u times, %llu triangles (flat %u); casters' box "
+              "(%g %g %g)-(%g %g %g) against (%g %g %g)-(%g %g %g)",
+              level.mesh_count, level.instance_count, (unsigned long long)level.placed_triangles, whole.triangle_count,
+              llo[0], llo[1], llo[2], lhi[0], lhi[1], lhi[2], mlo[0], mlo[1], mlo[2], mhi[0], mhi[1], mhi[2]);
+        float glo[3], ghi[3], plo2[3], phi2[3];
+        struct sb_mesh placed_world = {0};
+        CHECK(!res && sb_level_flatten(&level, &placed_world) == SB_OK && sb_mesh_bounds(&placed_world, plo2, phi2) &&
+                  sb_mesh_bounds(&whole, glo, ghi) && !memcmp(plo2, glo, sizeof(glo)) && !memcmp(phi2, ghi, sizeof(ghi)),
+              "its ground where the flat import puts it: (%g %g %g)-(%g %g %g) against (%g %g %g)-(%g %g %g)", plo2[0],
+              plo2[1], plo2[2], phi2[0], phi2[1], phi2[2], glo[0], glo[1], glo[2], ghi[0], ghi[1], ghi[2]);
+        sb_mesh_finish(&placed_world);
+        sb_mesh_finish(&whole);
+        sb_level_finish(&level);
+    }
+
     /* terrain: cells x cells quads, within its height, facing up, the same for a seed */
     char terrain_hash[2][33];
     for (int k = 0; k < 2; k++) {
