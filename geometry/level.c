@@ -375,6 +375,8 @@ static void place(struct loader *ld, uint32_t unique, const double to_world[3][4
     }
 }
 
+static bool casting_bounds(const struct sb_level *level, float min[3], float max[3]);
+
 enum sb_result sb_level_load(const struct sb_world_params *w, const char *directory, struct sb_level *level,
                              char *path_out, size_t path_size)
 {
@@ -509,6 +511,8 @@ enum sb_result sb_level_load(const struct sb_world_params *w, const char *direct
     }
     if (!res && !level->instance_count)
         level->placed_triangles = level->meshes[0].triangle_count;
+    if (!res)
+        level->has_casting_bounds = casting_bounds(level, level->casting_min, level->casting_max);
     if (!res && path_out) {
         char *absolute = realpath(path, NULL);
         snprintf(path_out, path_size, "%s", absolute ? absolute : path);
@@ -598,6 +602,14 @@ static bool grow_placed(const struct sb_mesh *mesh, const struct sb_bvh_instance
 }
 
 bool sb_level_bounds_casting(const struct sb_level *level, float min[3], float max[3])
+{
+    memcpy(min, level->casting_min, sizeof(level->casting_min));
+    memcpy(max, level->casting_max, sizeof(level->casting_max));
+    return level->has_casting_bounds;
+}
+
+/* The bounds sb_level_bounds_casting returns, found once as the level is read. */
+static bool casting_bounds(const struct sb_level *level, float min[3], float max[3])
 {
     if (!level->instance_count)
         return sb_mesh_bounds_casting(&level->meshes[0], min, max);

@@ -38,6 +38,9 @@ struct sb_level {
      * (the array owned, the textures the meshes') */
     const struct sb_mesh_texture **textures;
     uint32_t texture_count;
+    /* sb_level_bounds_casting's, found once as the level is read */
+    float casting_min[3], casting_max[3];
+    bool has_casting_bounds;
 };
 
 struct sb_world_params;
@@ -73,7 +76,8 @@ enum sb_result sb_level_build_bvh(const struct sb_level *level, struct sb_bvh *b
  * places nothing; else of every mesh's hash and every instance. */
 void sb_level_hash(const struct sb_level *level, char out[33]);
 
-/* The bounds of what casts shadows, placed (sb_mesh_bounds_casting). */
+/* The bounds of what casts shadows, placed vertex by vertex, else of
+ * everything (sb_mesh_bounds_casting); false for an empty level. */
 bool sb_level_bounds_casting(const struct sb_level *level, float min[3], float max[3]);
 
 /* Every instance's triangles placed into one mesh (for a renderer that
