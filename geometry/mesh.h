@@ -213,7 +213,9 @@ bool sb_mesh_bounds_casting(const struct sb_mesh *mesh, float min[3], float max[
  * `source` names the model in messages. */
 enum sb_result sb_mesh_add_ground(struct sb_mesh *mesh, const struct sb_mesh_ground *ground, const char *source);
 
-/* XXH3-128 of the positions, indices, materials and albedos: what a bake
+/* XXH3-128 of the positions, indices, materials and albedos, and where
+ * the mesh has them its texture coordinates, tangents, materials' textures
+ * and texels (an untextured mesh hashes as before textures): what a bake
  * that reads the mesh depends on. */
 void sb_mesh_hash(const struct sb_mesh *mesh, char out[33]);
 

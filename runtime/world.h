@@ -76,7 +76,8 @@ enum sb_result sb_world_parse(const char *json, size_t size, const char *source,
 /* The world's triangles as a mesh (for a BVH, or Embree): triangle t is
  * vertices 3t to 3t + 2 of all of them, or of those from
  * caster_first_vertex on with casters_only; material 1 (casting shadows)
- * or 0 (receiving only). */
+ * or 0 (receiving only). An instanced world's are placed, instance after
+ * instance (at most SB_MESH_MAX_TRIANGLES: the tests' flattened copy). */
 enum sb_result sb_world_mesh(const struct sb_world *world, bool casters_only, struct sb_mesh *mesh);
 
 /* A world whose casters span at most this (x or z) is a model: a camera
