@@ -1528,7 +1528,10 @@ static void test_textures(const struct sb_renderer_params *rp)
                   "%s: white texels as the untextured floor, black far darker (%g, %g; %g, %g)",
                   k ? "traced" : "raster", with[k][0], with[k][1], without[k][0], without[k][1]);
         }
-        CHECK(fabs(with[0][0] - with[1][0]) < 0.02 * with[0][1] && fabs(with[0][1] - with[1][1]) < 0.02 * with[0][1],
+        /* the outer thirds lie texels from the seam, where either level of
+         * detail reads one colour; the two paths differ in the last bits of
+         * each point's position only (the floor casts nothing) */
+        CHECK(fabs(with[0][0] - with[1][0]) < 1e-3 * with[0][1] && fabs(with[0][1] - with[1][1]) < 1e-3 * with[0][1],
               "raster and traced textures agree (%g, %g; %g, %g)", with[0][0], with[0][1], with[1][0], with[1][1]);
     }
     sb_mesh_finish(&halves);
