@@ -5,6 +5,7 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <sys/mman.h>
 #include <xxhash.h>
 
 #include "log.h"
@@ -14,15 +15,40 @@
 /* SAH costs relative to one triangle test. */
 #define BVH_COST_TRAVERSAL 1.0
 #define BVH_COST_TRIANGLE 1.0
-/* Ranges larger than a task (n / (2 x threads), at least BVH_TASK_MIN;
- * on one thread the whole mesh) are split with every thread binning and
- * partitioning chunks of BVH_CHUNK; each smaller one is built whole by one
+/* Ranges larger than twice a task (a task: n / (2 x threads), at least
+ * BVH_TASK_MIN; on one thread the whole mesh) are split with every thread
+ * binning and partitioning chunks of theirs (BVH_SPLIT_CHUNKS a thread, of
+ * at least BVH_SPLIT_CHUNK_MIN triangles); those between one and two tasks
+ * one thread each, many at once; each smaller one is built whole by one
  * thread. Every partition is stable and the layout is the one-thread
  * build's, so the bytes do not depend on how the work was shared. */
 #define BVH_TASK_MIN 8192
+#define BVH_SPLIT_CHUNKS 4
+#define BVH_SPLIT_CHUNK_MIN 2048
+/* The chunks of the steps that go over every triangle once. */
 #define BVH_CHUNK 16384
-/* Ranges of at most this many chunks are split one thread each, many at once. */
-#define BVH_CHUNKS_SHARED 16
+
+/*
+ * The build's large arrays (a million triangles: some 200 MB touched once)
+ * on 2 MiB pages where the kernel grants them on request (Linux's
+ * transparent huge pages in "madvise" mode, Debian's default): a 4 KiB
+ * page a fault was a fifth of the one-thread build. free() releases them.
+ */
+#define BVH_HUGE_PAGE ((size_t)2 << 20)
+
+static void *big_alloc(size_t bytes)
+{
+#ifdef MADV_HUGEPAGE
+    if (bytes >= BVH_HUGE_PAGE) {
+        size_t rounded = (bytes + BVH_HUGE_PAGE - 1) & ~(BVH_HUGE_PAGE - 1);
+        void *p = aligned_alloc(BVH_HUGE_PAGE, rounded);
+        if (p)
+            madvise(p, rounded, MADV_HUGEPAGE); /* advice: refused, it is 4 KiB pages */
+        return p;
+    }
+#endif
+    return malloc(bytes);
+}
 
 /* min and max for the build's finite values: one instruction each, where
  * fminf and fmaxf's NaN rules cost a call. */
@@ -87,11 +113,20 @@ static inline void prim_centroid(const struct prim *p, float c[4])
         c[i] = p->box.min[i] + p->box.max[i];
 }
 
-/* A node to split: the triangles prims[begin, end), their box and their
- * (doubled) centroids' box. */
+/* A node to split: the triangles [begin, end) of one of the two arrays a
+ * partition goes between (side), their box and their (doubled) centroids'
+ * box. */
 struct range {
-    uint32_t node, begin, end, depth;
+    uint32_t node, begin, end, depth, side;
     struct box box, centroids;
+};
+
+/* The triangles and their indices, and the arrays a split partitions them
+ * into: a range's children are on the side its triangles are not, so that
+ * each level moves a triangle once. */
+struct sides {
+    struct prim *prims[2];
+    uint32_t *index[2];
 };
 
 /* Binned counts and boxes along the three axes. */
@@ -172,6 +207,7 @@ static bool best_split(const struct bins *b, const struct binning *m, uint32_t c
                        struct split *out)
 {
     double best = must ? INFINITY : BVH_COST_TRIANGLE * count;
+    double area_scale = fmax(parent_area, DBL_MIN);
     bool found = false;
     for (int axis = 0; axis < 3; axis++) {
         if (!(m->scale[axis] > 0))
@@ -207,8 +243,7 @@ static bool best_split(const struct bins *b, const struct binning *m, uint32_t c
             if (!n || !right_count[k])
                 continue;
             double cost = BVH_COST_TRAVERSAL + BVH_COST_TRIANGLE *
-                                                   (area * n + right_area[k] * right_count[k]) /
-                                                   fmax(parent_area, DBL_MIN);
+                                                   (area * n + right_area[k] * right_count[k]) / area_scale;
             if (cost < best) {
                 best = cost;
                 out->axis = axis;
@@ -241,15 +276,19 @@ static void range_bounds(const struct prim *prims, uint32_t begin, uint32_t end,
 }
 
 /*
- * Split `r` into its children's ranges, partitioning in place by swaps
- * (one thread): false when it stays a leaf.
+ * Split `r` into its children's ranges, partitioned stably onto the other
+ * side (one thread): false when it stays a leaf.
  */
-static bool split_serial(struct prim *prims, uint32_t *index, struct prim *scratch, uint32_t *scratch_index,
-                         const struct range *r, uint32_t max_leaf, struct range *left, struct range *right)
+static bool split_serial(const struct sides *sides, const struct range *r, uint32_t max_leaf, struct range *left,
+                         struct range *right)
 {
     uint32_t count = r->end - r->begin;
     if (count <= 1 || r->depth >= SB_BVH_MAX_DEPTH)
         return false;
+    const struct prim *prims = sides->prims[r->side];
+    const uint32_t *index = sides->index[r->side];
+    struct prim *to = sides->prims[!r->side];
+    uint32_t *to_index = sides->index[!r->side];
     struct binning m = binning_of(&r->centroids, count);
     struct bins b;
     bins_fill(&b, &m, prims, r->begin, r->end);
@@ -257,31 +296,27 @@ static bool split_serial(struct prim *prims, uint32_t *index, struct prim *scrat
     bool must = count > max_leaf;
     uint32_t mid;
     if (best_split(&b, &m, count, box_area(&r->box), must, &s)) {
-        /* stable: the left ones aside in scratch (the range's own part of
-         * it), the right ones moved up in place, then both where they go */
+        uint32_t lefts = 0;
+        for (int k = 0; k < s.bin; k++)
+            lefts += b.count[s.axis][k];
         struct box lc, rc;
         box_empty(&lc);
         box_empty(&rc);
-        uint32_t l = r->begin, w = r->begin;
+        mid = r->begin + lefts;
+        uint32_t l = r->begin, w = mid;
         for (uint32_t i = r->begin; i < r->end; i++) {
             float c[4];
             prim_centroid(&prims[i], c);
             if (bin_of(&m, s.axis, c[s.axis]) < s.bin) {
                 box_grow_point(&lc, c);
-                scratch[l] = prims[i];
-                scratch_index[l++] = index[i];
+                to[l] = prims[i];
+                to_index[l++] = index[i];
             } else {
                 box_grow_point(&rc, c);
-                prims[w] = prims[i];
-                index[w++] = index[i];
+                to[w] = prims[i];
+                to_index[w++] = index[i];
             }
         }
-        uint32_t lefts = l - r->begin, rights = w - r->begin;
-        memmove(&prims[r->begin + lefts], &prims[r->begin], rights * sizeof(*prims));
-        memmove(&index[r->begin + lefts], &index[r->begin], rights * sizeof(*index));
-        memcpy(&prims[r->begin], &scratch[r->begin], lefts * sizeof(*prims));
-        memcpy(&index[r->begin], &scratch_index[r->begin], lefts * sizeof(*index));
-        mid = r->begin + lefts;
         left->box = s.left;
         right->box = s.right;
         left->centroids = lc;
@@ -289,6 +324,8 @@ static bool split_serial(struct prim *prims, uint32_t *index, struct prim *scrat
     } else if (must) {
         /* Coincident centroids: halve in the order they lie. */
         mid = r->begin + count / 2;
+        memcpy(&to[r->begin], &prims[r->begin], count * sizeof(*prims));
+        memcpy(&to_index[r->begin], &index[r->begin], count * sizeof(*index));
         range_bounds(prims, r->begin, mid, &left->box, &left->centroids);
         range_bounds(prims, mid, r->end, &right->box, &right->centroids);
     } else {
@@ -298,6 +335,7 @@ static bool split_serial(struct prim *prims, uint32_t *index, struct prim *scrat
     left->end = right->begin = mid;
     right->end = r->end;
     left->depth = right->depth = r->depth + 1;
+    left->side = right->side = !r->side;
     return true;
 }
 
@@ -318,8 +356,7 @@ struct task {
     uint32_t node_count, depth, max_leaf, root, base;
 };
 
-static void build_task(struct prim *prims, uint32_t *index, struct prim *scratch, uint32_t *scratch_index,
-                       struct task *t)
+static void build_task(const struct sides *sides, struct task *t)
 {
     /* One range per level at most waits on the stack, plus the one popped. */
     struct range stack[(SB_BVH_MAX_DEPTH + 2) * 2];
@@ -331,7 +368,10 @@ static void build_task(struct prim *prims, uint32_t *index, struct prim *scratch
         struct range r = stack[--top], left, right;
         if (r.depth > t->depth)
             t->depth = r.depth;
-        if (!split_serial(prims, index, scratch, scratch_index, &r, SB_BVH_MAX_LEAF, &left, &right)) {
+        if (!split_serial(sides, &r, SB_BVH_MAX_LEAF, &left, &right)) {
+            /* the leaf's indices where write_triangles reads them */
+            if (r.side)
+                memcpy(&sides->index[0][r.begin], &sides->index[1][r.begin], (r.end - r.begin) * sizeof(uint32_t));
             set_node(&t->nodes[r.node], &r.box, r.begin, r.end - r.begin);
             if (r.end - r.begin > t->max_leaf)
                 t->max_leaf = r.end - r.begin;
@@ -353,6 +393,7 @@ struct builder {
     const struct sb_mesh *mesh;
     struct prim *prims, *scratch;
     uint32_t *index, *scratch_index; /* each triangle's in the mesh, moved with prims */
+    struct sides sides; /* prims and index, scratch and scratch_index */
     struct sb_bvh *bvh;
     uint32_t task_prims; /* the largest range a task */
     struct task *tasks;
@@ -369,8 +410,9 @@ struct builder {
         bool split;
     } *split_out;
     uint32_t frontier_count;
-    /* the range being split on every thread */
+    /* the range being split on every thread, in chunks of `chunk` */
     const struct range *range;
+    uint32_t chunk, parallel_prims;
     struct binning binning;
     struct split split;
     uint32_t chunk_count;
@@ -383,12 +425,12 @@ struct builder {
 
 static uint32_t chunk_begin(const struct builder *b, uint32_t chunk)
 {
-    return b->range->begin + chunk * BVH_CHUNK;
+    return b->range->begin + chunk * b->chunk;
 }
 
 static uint32_t chunk_end(const struct builder *b, uint32_t chunk)
 {
-    uint32_t end = chunk_begin(b, chunk) + BVH_CHUNK;
+    uint32_t end = chunk_begin(b, chunk) + b->chunk;
     return end < b->range->end ? end : b->range->end;
 }
 
@@ -430,14 +472,14 @@ static void chunk_bounds(void *user, int chunk)
     struct builder *b = user;
     struct bins *out = &b->chunk_bins[chunk];
     /* the box in box[0][0], the centroids' in box[1][0] */
-    range_bounds(b->prims, chunk_begin(b, (uint32_t)chunk), chunk_end(b, (uint32_t)chunk), &out->box[0][0],
-                 &out->box[1][0]);
+    range_bounds(b->sides.prims[b->range->side], chunk_begin(b, (uint32_t)chunk), chunk_end(b, (uint32_t)chunk),
+                 &out->box[0][0], &out->box[1][0]);
 }
 
 static void chunk_bin(void *user, int chunk)
 {
     struct builder *b = user;
-    bins_fill(&b->chunk_bins[chunk], &b->binning, b->prims, chunk_begin(b, (uint32_t)chunk),
+    bins_fill(&b->chunk_bins[chunk], &b->binning, b->sides.prims[b->range->side], chunk_begin(b, (uint32_t)chunk),
               chunk_end(b, (uint32_t)chunk));
 }
 
@@ -450,43 +492,42 @@ static bool goes_left(const struct builder *b, const struct prim *p, float c[4])
 static void chunk_count(void *user, int chunk)
 {
     struct builder *b = user;
+    const struct prim *prims = b->sides.prims[b->range->side];
     uint32_t left = 0, begin = chunk_begin(b, (uint32_t)chunk), end = chunk_end(b, (uint32_t)chunk);
     for (uint32_t i = begin; i < end; i++) {
         float c[4];
-        left += goes_left(b, &b->prims[i], c);
+        left += goes_left(b, &prims[i], c);
     }
     b->chunks[chunk].left = left;
     b->chunks[chunk].right = end - begin - left;
 }
 
-/* Stable: each chunk's triangles go to the places the counts gave it. */
+/* Stable: each chunk's triangles go to the places the counts gave it, on
+ * the other side. */
 static void chunk_scatter(void *user, int chunk)
 {
     struct builder *b = user;
+    uint32_t side = b->range->side;
+    const struct prim *prims = b->sides.prims[side];
+    const uint32_t *index = b->sides.index[side];
+    struct prim *to = b->sides.prims[!side];
+    uint32_t *to_index = b->sides.index[!side];
     uint32_t l = b->chunks[chunk].left, r = b->chunks[chunk].right;
     struct box *lc = &b->chunks[chunk].left_centroids, *rc = &b->chunks[chunk].right_centroids;
     box_empty(lc);
     box_empty(rc);
     for (uint32_t i = chunk_begin(b, (uint32_t)chunk); i < chunk_end(b, (uint32_t)chunk); i++) {
         float c[4];
-        if (goes_left(b, &b->prims[i], c)) {
-            b->scratch_index[l] = b->index[i];
-            b->scratch[l++] = b->prims[i];
+        if (goes_left(b, &prims[i], c)) {
+            to_index[l] = index[i];
+            to[l++] = prims[i];
             box_grow_point(lc, c);
         } else {
-            b->scratch_index[r] = b->index[i];
-            b->scratch[r++] = b->prims[i];
+            to_index[r] = index[i];
+            to[r++] = prims[i];
             box_grow_point(rc, c);
         }
     }
-}
-
-static void chunk_copy_back(void *user, int chunk)
-{
-    struct builder *b = user;
-    uint32_t begin = chunk_begin(b, (uint32_t)chunk), end = chunk_end(b, (uint32_t)chunk);
-    memcpy(&b->prims[begin], &b->scratch[begin], (end - begin) * sizeof(*b->prims));
-    memcpy(&b->index[begin], &b->scratch_index[begin], (end - begin) * sizeof(*b->index));
 }
 
 /* Split a range too large for one thread: binned and partitioned (stably)
@@ -496,9 +537,12 @@ static bool split_parallel(struct builder *b, const struct range *r, struct rang
 {
     if (r->depth >= SB_BVH_MAX_DEPTH)
         return false;
+    uint32_t count = r->end - r->begin, chunks = BVH_SPLIT_CHUNKS * (uint32_t)sb_parallel_threads();
     b->range = r;
-    b->binning = binning_of(&r->centroids, r->end - r->begin);
-    b->chunk_count = (r->end - r->begin + BVH_CHUNK - 1) / BVH_CHUNK;
+    b->binning = binning_of(&r->centroids, count);
+    b->chunk = (count + chunks - 1) / chunks;
+    b->chunk = b->chunk > BVH_SPLIT_CHUNK_MIN ? b->chunk : BVH_SPLIT_CHUNK_MIN;
+    b->chunk_count = (count + b->chunk - 1) / b->chunk;
     sb_parallel_for((int)b->chunk_count, chunk_bin, b);
     struct bins all;
     bins_empty(&all, &b->binning);
@@ -519,8 +563,8 @@ static bool split_parallel(struct builder *b, const struct range *r, struct rang
             rr += nr;
         }
         sb_parallel_for((int)b->chunk_count, chunk_scatter, b);
-        sb_parallel_for((int)b->chunk_count, chunk_copy_back, b);
         mid = r->begin + total_left;
+        left->side = right->side = !r->side;
         left->box = b->split.left;
         right->box = b->split.right;
         box_empty(&left->centroids);
@@ -532,8 +576,9 @@ static bool split_parallel(struct builder *b, const struct range *r, struct rang
     } else {
         /* Coincident centroids: halve in the order they lie. */
         mid = r->begin + (r->end - r->begin) / 2;
-        range_bounds(b->prims, r->begin, mid, &left->box, &left->centroids);
-        range_bounds(b->prims, mid, r->end, &right->box, &right->centroids);
+        range_bounds(b->sides.prims[r->side], r->begin, mid, &left->box, &left->centroids);
+        range_bounds(b->sides.prims[r->side], mid, r->end, &right->box, &right->centroids);
+        left->side = right->side = r->side;
     }
     left->begin = r->begin;
     left->end = right->begin = mid;
@@ -553,7 +598,7 @@ static int larger_task_first(const void *a, const void *b, void *user)
 static void run_task(void *user, int index)
 {
     struct builder *b = user;
-    build_task(b->prims, b->index, b->scratch, b->scratch_index, &b->tasks[b->task_order[index]]);
+    build_task(&b->sides, &b->tasks[b->task_order[index]]);
 }
 
 /* A task's nodes into their places: its root where the top level left it,
@@ -644,13 +689,13 @@ static enum sb_result add_split(struct builder *b, const struct range *r, struct
 static void split_one(void *user, int i)
 {
     struct builder *b = user;
-    b->split_out[i].split = split_serial(b->prims, b->index, b->scratch, b->scratch_index, &b->frontier[i], SB_BVH_MAX_LEAF,
+    b->split_out[i].split = split_serial(&b->sides, &b->frontier[i], SB_BVH_MAX_LEAF,
                                          &b->split_out[i].left, &b->split_out[i].right);
 }
 
 /*
- * The top levels, until every range is a task: ranges over
- * BVH_CHUNKS_SHARED chunks one at a time, each by every thread; then the
+ * The top levels, until every range is a task: ranges over two tasks one
+ * at a time, each by every thread (fewer of them than threads); then the
  * rest level by level, each range by one thread, many at once. The order
  * they are split in changes nothing: lay_out places the nodes.
  */
@@ -661,6 +706,7 @@ static enum sb_result build_top(struct builder *b)
     int top = 0;
     struct range root = {.node = 0, .begin = 0, .end = bvh->triangle_count};
     b->range = &root;
+    b->chunk = BVH_CHUNK;
     b->chunk_count = (bvh->triangle_count + BVH_CHUNK - 1) / BVH_CHUNK;
     sb_parallel_for((int)b->chunk_count, chunk_bounds, b);
     box_empty(&root.box);
@@ -687,7 +733,7 @@ static enum sb_result build_top(struct builder *b)
         uint32_t count = r.end - r.begin;
         if (count <= b->task_prims)
             res = add_task(b, &r);
-        else if (count <= BVH_CHUNKS_SHARED * BVH_CHUNK)
+        else if (count <= b->parallel_prims)
             b->frontier[b->frontier_count++] = r;
         else if (!split_parallel(b, &r, &left, &right))
             res = add_task(b, &r); /* the depth limit: a leaf */
@@ -777,16 +823,20 @@ enum sb_result sb_bvh_build(const struct sb_mesh *mesh, struct sb_bvh *bvh)
     struct builder b = {.mesh = mesh, .bvh = bvh};
     b.task_prims = threads <= 1 ? n : n / (2 * (uint32_t)threads) > BVH_TASK_MIN ? n / (2 * (uint32_t)threads)
                                                                                 : BVH_TASK_MIN;
-    b.prims = malloc(n * sizeof(*b.prims));
-    b.scratch = malloc(n * sizeof(*b.scratch));
-    b.index = malloc(n * sizeof(*b.index));
-    b.scratch_index = malloc(n * sizeof(*b.scratch_index));
-    b.chunk_bins = malloc(chunks * sizeof(*b.chunk_bins));
-    b.chunks = malloc(chunks * sizeof(*b.chunks));
+    b.parallel_prims = b.task_prims > UINT32_MAX / 2 ? UINT32_MAX : 2 * b.task_prims;
+    b.prims = big_alloc(n * sizeof(*b.prims));
+    b.scratch = big_alloc(n * sizeof(*b.scratch));
+    b.index = big_alloc(n * sizeof(*b.index));
+    b.scratch_index = big_alloc(n * sizeof(*b.scratch_index));
+    b.sides = (struct sides){{b.prims, b.scratch}, {b.index, b.scratch_index}};
+    /* the most chunks of a pass: the whole mesh's, or a split's */
+    uint32_t split_chunks = BVH_SPLIT_CHUNKS * (uint32_t)threads;
+    b.chunk_bins = malloc((chunks > split_chunks ? chunks : split_chunks) * sizeof(*b.chunk_bins));
+    b.chunks = malloc((chunks > split_chunks ? chunks : split_chunks) * sizeof(*b.chunks));
     /* the tasks' own nodes: a task of c triangles has at most 2c - 1 */
-    struct sb_bvh_node *task_nodes = malloc(2 * (size_t)n * sizeof(*task_nodes));
-    bvh->nodes = malloc(2 * (size_t)n * sizeof(*bvh->nodes));
-    bvh->triangles = malloc(n * sizeof(*bvh->triangles));
+    struct sb_bvh_node *task_nodes = big_alloc(2 * (size_t)n * sizeof(*task_nodes));
+    bvh->nodes = big_alloc(2 * (size_t)n * sizeof(*bvh->nodes));
+    bvh->triangles = big_alloc(n * sizeof(*bvh->triangles));
     enum sb_result res = SB_ERR_NOMEM;
     bool begun = false;
     if (!b.prims || !b.scratch || !b.index || !b.scratch_index || !b.chunk_bins || !b.chunks || !task_nodes || !bvh->nodes || !bvh->triangles)
@@ -904,8 +954,7 @@ static void instance_box(const struct sb_bvh_node *root, const double to_world[3
  * the threads): one instance a leaf (first: its index, for now), split by
  * SAH, or halved in order where SAH finds nothing or the depth left would
  * not hold the rest halved. */
-static uint32_t build_instance_top(struct prim *prims, uint32_t *index, struct prim *scratch, uint32_t *scratch_index,
-                                   uint32_t n, struct sb_bvh_node *nodes, uint32_t *depth)
+static uint32_t build_instance_top(const struct sides *sides, uint32_t n, struct sb_bvh_node *nodes, uint32_t *depth)
 {
     struct range stack[(SB_BVH_MAX_DEPTH + 2) * 2];
     int top = 0;
@@ -913,7 +962,8 @@ static uint32_t build_instance_top(struct prim *prims, uint32_t *index, struct p
     stack[top].end = n;
     stack[top].depth = 0;
     stack[top].node = 0;
-    range_bounds(prims, 0, n, &stack[top].box, &stack[top].centroids);
+    stack[top].side = 0;
+    range_bounds(sides->prims[0], 0, n, &stack[top].box, &stack[top].centroids);
     top++;
     uint32_t node_count = 1;
     *depth = 0;
@@ -922,19 +972,19 @@ static uint32_t build_instance_top(struct prim *prims, uint32_t *index, struct p
         uint32_t count = r.end - r.begin;
         *depth = r.depth > *depth ? r.depth : *depth;
         if (count == 1) {
-            set_node(&nodes[r.node], &r.box, index[r.begin], SB_BVH_INSTANCE_LEAF);
+            set_node(&nodes[r.node], &r.box, sides->index[r.side][r.begin], SB_BVH_INSTANCE_LEAF);
             continue;
         }
         uint32_t levels = 0; /* to halve `count` down to ones */
         while ((1u << levels) < count)
             levels++;
         if (r.depth + levels >= SB_BVH_MAX_DEPTH ||
-            !split_serial(prims, index, scratch, scratch_index, &r, 1, &left, &right)) {
+            !split_serial(sides, &r, 1, &left, &right)) {
             uint32_t mid = r.begin + count / 2;
             left = right = r;
             left.end = right.begin = mid;
-            range_bounds(prims, left.begin, left.end, &left.box, &left.centroids);
-            range_bounds(prims, right.begin, right.end, &right.box, &right.centroids);
+            range_bounds(sides->prims[r.side], left.begin, left.end, &left.box, &left.centroids);
+            range_bounds(sides->prims[r.side], right.begin, right.end, &right.box, &right.centroids);
             left.depth = right.depth = r.depth + 1;
         }
         left.node = node_count;
@@ -983,8 +1033,8 @@ enum sb_result sb_bvh_build_instanced(const struct sb_mesh *const *meshes, uint3
             instance_box(&blas[instances[i].mesh].nodes[0], instances[i].to_world, &prims[i].box);
             index[i] = i;
         }
-        top_count = build_instance_top(prims, index, prims + instance_count, index + instance_count, instance_count,
-                                       top, &top_depth);
+        struct sides sides = {{prims, prims + instance_count}, {index, index + instance_count}};
+        top_count = build_instance_top(&sides, instance_count, top, &top_depth);
         nodes += top_count + 2 * (uint64_t)instance_count;
         if (triangles >= SB_BVH_BACK_FACE || nodes >= SB_BVH_BACK_FACE || materials >= SB_BVH_BACK_FACE) {
             sb_error("BVH: %llu triangles, %llu nodes: past 2^31", (unsigned long long)triangles,
@@ -993,8 +1043,8 @@ enum sb_result sb_bvh_build_instanced(const struct sb_mesh *const *meshes, uint3
         }
     }
     if (!res) {
-        bvh->nodes = malloc(nodes * sizeof(*bvh->nodes));
-        bvh->triangles = malloc(triangles * sizeof(*bvh->triangles));
+        bvh->nodes = big_alloc(nodes * sizeof(*bvh->nodes));
+        bvh->triangles = big_alloc(triangles * sizeof(*bvh->triangles));
         if (!bvh->nodes || !bvh->triangles)
             res = SB_ERR_NOMEM;
     }
