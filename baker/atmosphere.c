@@ -357,6 +357,26 @@ void sb_atmosphere_baker_destroy(struct sb_atmosphere_baker **pb)
  * pass on a GPU), the partial sums kept
  * in the scratch buffer; *gpu_ms sums the passes.
  */
+static struct sb_pipeline_params kernel_params(const struct spirv *kernel, const char *name)
+{
+    return (struct sb_pipeline_params){
+        .spirv = kernel->words,
+        .spirv_size = kernel->size,
+        .binding_count = SB_BINDING_COUNT,
+        .push_size = sizeof(struct sb_bake_push),
+        .name = name,
+    };
+}
+
+/* The kernel that bakes product `id` with settings `s` (resolved). */
+static const struct spirv *product_kernel(const struct sb_atmosphere_baker *b, enum sb_product_id id,
+                                          const struct sb_atmosphere_settings *s)
+{
+    if (id == SB_PRODUCT_TRANSMITTANCE)
+        return &transmittance_shaders[s->quadrature == SB_QUADRATURE_GAUSS_LEGENDRE ? s->samples : 0];
+    return is_anchor(id, s) ? &anchor_shaders[id] : &scattering_shaders[b->kernels][id];
+}
+
 static enum sb_result run(struct sb_atmosphere_baker *b, const struct spirv *kernel, const char *name,
                           struct sb_buffer *output, uint32_t width, uint32_t height, uint64_t directions,
                           bool group_per_texel, const struct sb_atmosphere_settings *s, double *gpu_ms)
@@ -398,13 +418,7 @@ static enum sb_result run(struct sb_atmosphere_baker *b, const struct spirv *ker
     }
 
     struct sb_pipeline pipeline = {0};
-    struct sb_pipeline_params pp = {
-        .spirv = kernel->words,
-        .spirv_size = kernel->size,
-        .binding_count = SB_BINDING_COUNT,
-        .push_size = sizeof(struct sb_bake_push),
-        .name = name,
-    };
+    struct sb_pipeline_params pp = kernel_params(kernel, name);
     if ((res = sb_pipeline_create(b->vk, &pp, &pipeline)))
         return res;
     const struct sb_buffer *bindings[SB_BINDING_COUNT] = {
@@ -497,6 +511,23 @@ static enum sb_result make_lookup(struct sb_atmosphere_baker *b, enum sb_product
     return res;
 }
 
+uint32_t sb_atmosphere_kernels(const struct sb_atmosphere_baker *b, enum sb_product_id id,
+                               const struct sb_atmosphere_settings *settings,
+                               struct sb_pipeline_params out[SB_ATMOSPHERE_KERNELS_MAX])
+{
+    const struct sb_atmosphere_product *prod = sb_atmosphere_product(id);
+    struct sb_atmosphere_settings s = resolve_settings(id, settings);
+    uint32_t n = 0;
+    out[n++] = kernel_params(product_kernel(b, id, &s), sb_product_name(id));
+    if (prod->workgroup_per_texel && !is_anchor(id, &s)) {
+        out[n++] = kernel_params(&sun_columns_shader, "sun columns");
+        out[n++] = kernel_params(&sun_columns_ghosts_shader, "sun columns' ghosts");
+        if (prod->rings)
+            out[n++] = kernel_params(&sun_rings_shader, "sun rings");
+    }
+    return n;
+}
+
 enum sb_result sb_atmosphere_bake(struct sb_atmosphere_baker *b, enum sb_product_id id,
                                   const struct sb_atmosphere_settings *settings, struct sb_image *image,
                                   struct sb_atmosphere_settings *used, double *gpu_ms)
@@ -527,10 +558,7 @@ enum sb_result sb_atmosphere_bake(struct sb_atmosphere_baker *b, enum sb_product
         goto cleanup;
 
     bool anchor = is_anchor(id, &s);
-    const struct spirv *shader =
-        id == SB_PRODUCT_TRANSMITTANCE
-            ? &transmittance_shaders[s.quadrature == SB_QUADRATURE_GAUSS_LEGENDRE ? s.samples : 0]
-            : (anchor ? &anchor_shaders[id] : &scattering_shaders[b->kernels][id]);
+    const struct spirv *shader = product_kernel(b, id, &s);
     bool cap = id == SB_PRODUCT_IRRADIANCE_GROUND || (id == SB_PRODUCT_IRRADIANCE_SKY && b->sky_cap);
     uint64_t directions = prod->workgroup_per_texel && !anchor ? sphere_directions(&s, cap, prod->rings) : 0;
     /* The sun table is built afresh by every multiscattering bake, the

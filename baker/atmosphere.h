@@ -123,6 +123,13 @@ enum sb_result sb_atmosphere_bake(struct sb_atmosphere_baker *baker, enum sb_pro
                                   const struct sb_atmosphere_settings *settings, struct sb_image *image,
                                   struct sb_atmosphere_settings *used, double *gpu_ms);
 
+/* The kernels sb_atmosphere_bake makes for `id` with `settings` (NULL:
+ * the defaults), the sun's tables' included; returns their count. */
+#define SB_ATMOSPHERE_KERNELS_MAX 4
+uint32_t sb_atmosphere_kernels(const struct sb_atmosphere_baker *baker, enum sb_product_id id,
+                               const struct sb_atmosphere_settings *settings,
+                               struct sb_pipeline_params out[SB_ATMOSPHERE_KERNELS_MAX]);
+
 /* The buffers a kernel including atmosphere.glsl reads at bindings 0 to
  * 3 (config.h, SB_BINDING_*): the parameters and the LUTs this baker has
  * baked or adopted (a 16-byte unused buffer in the slot of each it has

@@ -170,6 +170,16 @@ static enum sb_result atmosphere_adopt(void *state, enum sb_product_id id, const
     return sb_atmosphere_adopt(state, id, image);
 }
 
+static uint32_t atmosphere_kernels(void *state, const struct sb_scene *scene, enum sb_product_id id,
+                                   struct sb_pipeline_params out[SB_FAMILY_KERNELS_MAX])
+{
+    _Static_assert(SB_ATMOSPHERE_KERNELS_MAX <= SB_FAMILY_KERNELS_MAX, "room for the atmosphere's kernels");
+    /* to a tolerance, the candidates bake cheapest first: the first's */
+    struct sb_atmosphere_settings candidates[SB_ATMOSPHERE_MAX_CANDIDATES];
+    bool first = scene->tolerance[id] > 0 && sb_atmosphere_candidates(id, candidates) > 0;
+    return sb_atmosphere_kernels(state, id, first ? &candidates[0] : NULL, out);
+}
+
 const struct sb_family_baker sb_atmosphere_family = {
     .depends_on = atmosphere_depends_on,
     .key = atmosphere_key,
@@ -177,4 +187,5 @@ const struct sb_family_baker sb_atmosphere_family = {
     .destroy = atmosphere_destroy,
     .bake = atmosphere_bake,
     .adopt = atmosphere_adopt,
+    .kernels = atmosphere_kernels,
 };

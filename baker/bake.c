@@ -8,6 +8,7 @@
 
 #include "family.h"
 #include "log.h"
+#include "parallel.h"
 #include "skybake_version.h"
 
 static uint32_t depends_on(enum sb_product_id id)
@@ -50,6 +51,31 @@ void sb_bake_keys(const struct sb_scene *scene, uint32_t mask, void *const state
             if (inputs & (1u << d))
                 sb_key_add(&key, " input %s=%s", sb_product_name((enum sb_product_id)d), out[d]);
         sb_hash_bytes(key.text, key.length < sizeof(key.text) ? key.length : sizeof(key.text) - 1, out[p]);
+    }
+}
+
+/* Whether product `id` of the previous pack `old` (NULL: none) is reused. */
+static bool reusable(const struct sb_pack *old, enum sb_product_id id, const char *key)
+{
+    return old && old->present[id] && !strcmp(old->artifacts[id].key, key);
+}
+
+/* Every kernel the products to bake make, compiled at once on every core. */
+static void prepare_kernels(struct sb_vk *vk, const struct sb_scene *scene, uint32_t mask, const struct sb_pack *old,
+                            const char keys[SB_PRODUCT_COUNT][SB_HASH_HEX_SIZE], void *states[SB_FAMILY_COUNT])
+{
+    struct sb_pipeline_params params[SB_PRODUCT_COUNT * SB_FAMILY_KERNELS_MAX];
+    uint32_t count = 0;
+    for (int p = 0; p < SB_PRODUCT_COUNT; p++) {
+        enum sb_product_id id = (enum sb_product_id)p;
+        enum sb_family f = sb_product_format(id)->family;
+        const struct sb_family_baker *family = sb_family_baker(f);
+        if ((mask & (1u << p)) && family->kernels && !reusable(old, id, keys[p]))
+            count += family->kernels(states[f], scene, id, &params[count]);
+    }
+    if (count) {
+        sb_status("compiling %u kernels", count);
+        sb_pipelines_prepare(vk, params, count, sb_parallel_threads());
     }
 }
 
@@ -142,6 +168,7 @@ enum sb_result sb_bake_scene(struct sb_vk *vk, const struct sb_scene *scene, con
 
     char keys[SB_PRODUCT_COUNT][SB_HASH_HEX_SIZE];
     sb_bake_keys(scene, mask, states, keys);
+    prepare_kernels(vk, scene, mask, reuse ? old : NULL, keys, states);
     int total = 0, done = 0;
     for (int p = 0; p < SB_PRODUCT_COUNT; p++)
         total += (mask >> p) & 1;
@@ -158,7 +185,7 @@ enum sb_result sb_bake_scene(struct sb_vk *vk, const struct sb_scene *scene, con
         snprintf(a->parameterization, sizeof(a->parameterization), "%s", format->parameterization);
         memcpy(a->key, keys[p], SB_HASH_HEX_SIZE);
 
-        if (reuse && old->present[p] && !strcmp(old->artifacts[p].key, keys[p])) {
+        if (reuse && reusable(old, id, keys[p])) {
             /* Verified when the old pack was opened; the writer hashes it again. */
             const struct sb_artifact *was = &old->artifacts[p];
             snprintf(a->settings_json, sizeof(a->settings_json), "%s", was->settings_json);
@@ -202,6 +229,7 @@ enum sb_result sb_bake_scene(struct sb_vk *vk, const struct sb_scene *scene, con
 
 cleanup:
     sb_status(NULL);
+    sb_pipelines_release(vk);
     free(scene_json);
     sb_pack_close(old);
     free(old);

@@ -111,6 +111,17 @@ void sb_cloud_code_hash(char out[SB_HASH_HEX_SIZE])
     sb_hash_bytes(sb_spv_clouds, sizeof(sb_spv_clouds), out);
 }
 
+struct sb_pipeline_params sb_cloud_kernel(enum sb_product_id product)
+{
+    return (struct sb_pipeline_params){
+        .spirv = sb_spv_clouds,
+        .spirv_size = sizeof(sb_spv_clouds),
+        .binding_count = 1,
+        .push_size = sizeof(struct sb_noise_push),
+        .name = sb_product_name(product),
+    };
+}
+
 enum sb_result sb_cloud_bake(struct sb_vk *vk, enum sb_product_id product, const struct sb_cloud_params *params,
                              struct sb_image *image, double *gpu_ms)
 {
@@ -120,15 +131,10 @@ enum sb_result sb_cloud_bake(struct sb_vk *vk, enum sb_product_id product, const
     uint64_t values = (uint64_t)pc.size_x * pc.size_y * pc.size_z * pc.channel_count;
     struct sb_buffer out = {0};
     struct sb_pipeline pipeline = {0};
+    const struct sb_pipeline_params pp = sb_cloud_kernel(product);
     enum sb_result res = sb_buffer_create(vk, values * sizeof(float), sb_product_name(product), &out);
     if (!res)
-        res = sb_pipeline_create(vk,
-                                 &(struct sb_pipeline_params){.spirv = sb_spv_clouds,
-                                                              .spirv_size = sizeof(sb_spv_clouds),
-                                                              .binding_count = 1,
-                                                              .push_size = sizeof(pc),
-                                                              .name = sb_product_name(product)},
-                                 &pipeline);
+        res = sb_pipeline_create(vk, &pp, &pipeline);
     if (!res) {
         const struct sb_buffer *bindings[1] = {&out};
         sb_pipeline_bind(vk, &pipeline, bindings);

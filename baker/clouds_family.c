@@ -39,7 +39,15 @@ static enum sb_result clouds_bake(void *state, struct sb_vk *vk, const struct sb
     return res;
 }
 
+static uint32_t clouds_kernels(void *state, const struct sb_scene *scene, enum sb_product_id id,
+                               struct sb_pipeline_params out[SB_FAMILY_KERNELS_MAX])
+{
+    out[0] = sb_cloud_kernel(id);
+    return 1;
+}
+
 const struct sb_family_baker sb_clouds_family = {
     .key = clouds_key,
     .bake = clouds_bake,
+    .kernels = clouds_kernels,
 };

@@ -5,18 +5,23 @@
 #include "dfg.spv.h"
 #include "log.h"
 
+struct sb_pipeline_params sb_dfg_kernel(void)
+{
+    return (struct sb_pipeline_params){
+        .spirv = sb_spv_dfg,
+        .spirv_size = sizeof(sb_spv_dfg),
+        .binding_count = SB_DFG_BINDING_COUNT,
+        .push_size = sizeof(struct sb_dfg_push),
+        .name = "dfg",
+    };
+}
+
 enum sb_result sb_dfg_bake(struct sb_vk *vk, struct sb_image *image, double *gpu_ms)
 {
     struct sb_dfg_push pc = {.size = SB_DFG_SIZE, .samples_side = SB_DFG_SAMPLES_SIDE};
     struct sb_buffer out = {0};
     struct sb_pipeline pipeline = {0};
-    const struct sb_pipeline_params pp = {
-        .spirv = sb_spv_dfg,
-        .spirv_size = sizeof(sb_spv_dfg),
-        .binding_count = SB_DFG_BINDING_COUNT,
-        .push_size = sizeof(pc),
-        .name = "dfg",
-    };
+    const struct sb_pipeline_params pp = sb_dfg_kernel();
     double ms = 0;
     enum sb_result res;
     if ((res = sb_image_init(image, SB_DFG_SIZE, SB_DFG_SIZE, 2)) ||

@@ -11,12 +11,15 @@
 #ifndef SB_BAKER_DFG_H
 #define SB_BAKER_DFG_H
 
+#include "compute.h"
 #include "config.h"
 #include "context.h"
 #include "image.h"
 
 /* Bake the LUT into *image (SB_DFG_SIZE^2, channels "dfg.x,dfg.y"). */
 enum sb_result sb_dfg_bake(struct sb_vk *vk, struct sb_image *image, double *gpu_ms);
+/* The kernel sb_dfg_bake makes. */
+struct sb_pipeline_params sb_dfg_kernel(void);
 
 /* XXH3-128 of the kernel's SPIR-V, for bake keys. */
 void sb_dfg_code_hash(char out[33]);

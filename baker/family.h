@@ -12,11 +12,15 @@
 #include <stddef.h>
 #include <stdint.h>
 
+#include "compute.h"
 #include "context.h"
 #include "image.h"
 #include "key.h"
 #include "pack.h"
 #include "scene.h"
+
+/* The most kernels a product's bake makes (sb_family_baker.kernels). */
+#define SB_FAMILY_KERNELS_MAX 8
 
 struct sb_family_baker {
     /* The products `id` reads (bit mask of sb_product_id, all of lower ids
@@ -43,6 +47,13 @@ struct sb_family_baker {
     /* A product reused from an older pack, for the family's later bakes
      * that read it; NULL when they read baked[] only. */
     enum sb_result (*adopt)(void *state, enum sb_product_id id, const struct sb_image *image);
+    /* The kernels bake() makes for `id`, at most SB_FAMILY_KERNELS_MAX;
+     * returns their count. bake.c compiles every product's at once, on
+     * every core, before the first bake (sb_pipelines_prepare): a driver's
+     * first compile of a kernel takes up to a second. NULL: none listed
+     * (each compiles when made); one left out compiles when made. */
+    uint32_t (*kernels)(void *state, const struct sb_scene *scene, enum sb_product_id id,
+                        struct sb_pipeline_params out[SB_FAMILY_KERNELS_MAX]);
 };
 
 /* The baker of `family` (< SB_FAMILY_COUNT). */

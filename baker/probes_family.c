@@ -437,10 +437,21 @@ static enum sb_result probes_bake(void *state, struct sb_vk *vk, const struct sb
                                        : bake_visibility(st, scene, image, a);
 }
 
+static uint32_t probes_kernels(void *state, const struct sb_scene *scene, enum sb_product_id id,
+                               struct sb_pipeline_params out[SB_FAMILY_KERNELS_MAX])
+{
+    const struct probes_state *st = state;
+    bool instanced = st->level->instance_count > 0;
+    uint32_t n = sb_surfaces_level_kernels(st->level, id == SB_PRODUCT_SKY_BOUNCE, out);
+    out[n++] = id == SB_PRODUCT_SKY_BOUNCE ? sb_sky_bounce_kernel(instanced) : sb_sky_visibility_kernel(instanced);
+    return n;
+}
+
 const struct sb_family_baker sb_probes_family = {
     .depends_on = probes_depends_on,
     .key = probes_key,
     .create = probes_create,
     .destroy = probes_destroy,
     .bake = probes_bake,
+    .kernels = probes_kernels,
 };

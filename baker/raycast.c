@@ -7,6 +7,17 @@
 #include "raycast.spv.h"
 #include "raycast_instanced.spv.h"
 
+struct sb_pipeline_params sb_raycast_kernel(bool instanced)
+{
+    return (struct sb_pipeline_params){
+        .spirv = instanced ? sb_spv_raycast_instanced : sb_spv_raycast,
+        .spirv_size = instanced ? sizeof(sb_spv_raycast_instanced) : sizeof(sb_spv_raycast),
+        .binding_count = SB_RAYCAST_BINDING_COUNT,
+        .push_size = sizeof(struct sb_raycast_push),
+        .name = "raycast",
+    };
+}
+
 enum sb_result sb_raycaster_create(struct sb_vk *vk, const struct sb_bvh *bvh, struct sb_raycaster **out)
 {
     *out = NULL;
@@ -23,13 +34,7 @@ enum sb_result sb_raycaster_create(struct sb_vk *vk, const struct sb_bvh *bvh, s
     memcpy(rc->nodes.mapped, bvh->nodes, node_bytes);
     memcpy(rc->triangles.mapped, bvh->triangles, triangle_bytes);
     rc->instanced = bvh->instance_count > 0;
-    const struct sb_pipeline_params params = {
-        .spirv = rc->instanced ? sb_spv_raycast_instanced : sb_spv_raycast,
-        .spirv_size = rc->instanced ? sizeof(sb_spv_raycast_instanced) : sizeof(sb_spv_raycast),
-        .binding_count = SB_RAYCAST_BINDING_COUNT,
-        .push_size = sizeof(struct sb_raycast_push),
-        .name = "raycast",
-    };
+    const struct sb_pipeline_params params = sb_raycast_kernel(rc->instanced);
     if ((res = sb_pipeline_create(vk, &params, &rc->pipeline)))
         goto fail;
     *out = rc;

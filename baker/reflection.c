@@ -32,6 +32,28 @@ void sb_reflection_kernels_destroy(struct sb_vk *vk, struct sb_reflection_kernel
     sb_pipeline_destroy(vk, &k->prefilter);
 }
 
+struct sb_pipeline_params sb_reflection_capture_kernel(void)
+{
+    return (struct sb_pipeline_params){
+        .spirv = sb_spv_reflection_capture,
+        .spirv_size = sizeof(sb_spv_reflection_capture),
+        .binding_count = SB_CAPTURE_BINDING_COUNT,
+        .push_size = sizeof(struct sb_capture_push),
+        .name = "reflection capture",
+    };
+}
+
+struct sb_pipeline_params sb_reflection_prefilter_kernel(void)
+{
+    return (struct sb_pipeline_params){
+        .spirv = sb_spv_reflection_prefilter,
+        .spirv_size = sizeof(sb_spv_reflection_prefilter),
+        .binding_count = SB_PREFILTER_BINDING_COUNT,
+        .push_size = sizeof(struct sb_prefilter_push),
+        .name = "reflection prefilter",
+    };
+}
+
 /* The cached pipeline (made on first use) or, without a cache, `temp`. */
 static enum sb_result pipeline_for(struct sb_vk *vk, struct sb_pipeline *cached, const struct sb_pipeline_params *pp,
                                    struct sb_pipeline *temp, struct sb_pipeline **use)
@@ -55,13 +77,7 @@ enum sb_result sb_reflection_capture(struct sb_vk *vk, const struct sb_capture_i
     };
     struct sb_buffer result = {0}, sky = {0}, dummy = {0};
     struct sb_pipeline temp = {0}, *pipeline = NULL;
-    const struct sb_pipeline_params pp = {
-        .spirv = sb_spv_reflection_capture,
-        .spirv_size = sizeof(sb_spv_reflection_capture),
-        .binding_count = SB_CAPTURE_BINDING_COUNT,
-        .push_size = sizeof(pc),
-        .name = "reflection capture",
-    };
+    const struct sb_pipeline_params pp = sb_reflection_capture_kernel();
     enum sb_result res;
     if ((res = sb_buffer_create(vk, (VkDeviceSize)6 * n * n * 4 * sizeof(float), "reflection capture", &result)) ||
         (res = sb_buffer_create(vk, SB_PROBE_SH * 4 * sizeof(float), "sky sh", &sky)) ||
@@ -111,13 +127,7 @@ enum sb_result sb_reflection_prefilter(struct sb_vk *vk, const float *level0, ui
     uint64_t texels = sb_cube_level_offset(n, levels);
     struct sb_buffer source = {0}, result = {0};
     struct sb_pipeline temp = {0}, *pipeline = NULL;
-    const struct sb_pipeline_params pp = {
-        .spirv = sb_spv_reflection_prefilter,
-        .spirv_size = sizeof(sb_spv_reflection_prefilter),
-        .binding_count = SB_PREFILTER_BINDING_COUNT,
-        .push_size = sizeof(struct sb_prefilter_push),
-        .name = "reflection prefilter",
-    };
+    const struct sb_pipeline_params pp = sb_reflection_prefilter_kernel();
     enum sb_result res;
     if ((res = sb_buffer_create(vk, texels * 4 * sizeof(float), "prefilter source", &source)) ||
         (res = sb_buffer_create(vk, texels * 4 * sizeof(float), "prefiltered", &result)) ||

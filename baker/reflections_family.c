@@ -300,10 +300,27 @@ static enum sb_result reflection_bake(void *state, struct sb_vk *vk, const struc
     return res;
 }
 
+static uint32_t reflection_kernels(void *state, const struct sb_scene *scene, enum sb_product_id id,
+                                   struct sb_pipeline_params out[SB_FAMILY_KERNELS_MAX])
+{
+    const struct reflection_state *st = state;
+    uint32_t n = 0;
+    if (id == SB_PRODUCT_DFG)
+        out[n++] = sb_dfg_kernel();
+    if (id != SB_PRODUCT_REFLECTION_CUBES)
+        return n;
+    if (st->has_world)
+        n += sb_surfaces_level_kernels(st->level, true, out);
+    out[n++] = sb_reflection_capture_kernel();
+    out[n++] = sb_reflection_prefilter_kernel();
+    return n;
+}
+
 const struct sb_family_baker sb_reflections_family = {
     .depends_on = reflection_depends_on,
     .key = reflection_key,
     .create = reflection_create,
     .destroy = reflection_destroy,
     .bake = reflection_bake,
+    .kernels = reflection_kernels,
 };

@@ -6,6 +6,17 @@
 #include "probe_bounce.spv.h"
 #include "probe_bounce_instanced.spv.h"
 
+struct sb_pipeline_params sb_sky_bounce_kernel(bool instanced)
+{
+    return (struct sb_pipeline_params){
+        .spirv = instanced ? sb_spv_probe_bounce_instanced : sb_spv_probe_bounce,
+        .spirv_size = instanced ? sizeof(sb_spv_probe_bounce_instanced) : sizeof(sb_spv_probe_bounce),
+        .binding_count = SB_BOUNCE_BINDING_COUNT,
+        .push_size = sizeof(struct sb_bounce_push),
+        .name = "sky bounce",
+    };
+}
+
 enum sb_result sb_sky_bounce_bake(struct sb_raycaster *rc, const struct sb_surfaces *surfaces, const float *positions,
                                   const float *valid, uint32_t probe_count, const struct sb_sky_bounce_params *params,
                                   float *out, double *gpu_ms)
@@ -29,13 +40,7 @@ enum sb_result sb_sky_bounce_bake(struct sb_raycaster *rc, const struct sb_surfa
     struct sb_vk *vk = rc->vk;
     struct sb_buffer probes = {0}, results = {0};
     struct sb_pipeline pipeline = {0};
-    const struct sb_pipeline_params pp = {
-        .spirv = rc->instanced ? sb_spv_probe_bounce_instanced : sb_spv_probe_bounce,
-        .spirv_size = rc->instanced ? sizeof(sb_spv_probe_bounce_instanced) : sizeof(sb_spv_probe_bounce),
-        .binding_count = SB_BOUNCE_BINDING_COUNT,
-        .push_size = sizeof(pc),
-        .name = "sky bounce",
-    };
+    const struct sb_pipeline_params pp = sb_sky_bounce_kernel(rc->instanced);
     enum sb_result res;
     if ((res = sb_probe_buffers_create(vk, positions, valid, probe_count, SB_BOUNCE_FLOATS, &probes, &results)) ||
         (res = sb_pipeline_create(vk, &pp, &pipeline)))

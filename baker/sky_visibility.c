@@ -56,6 +56,17 @@ void sb_probe_ray_order(uint32_t n, uint32_t *order)
     free(k);
 }
 
+struct sb_pipeline_params sb_sky_visibility_kernel(bool instanced)
+{
+    return (struct sb_pipeline_params){
+        .spirv = instanced ? sb_spv_sky_visibility_instanced : sb_spv_sky_visibility,
+        .spirv_size = instanced ? sizeof(sb_spv_sky_visibility_instanced) : sizeof(sb_spv_sky_visibility),
+        .binding_count = SB_PROBE_BINDING_COUNT,
+        .push_size = sizeof(struct sb_probe_push),
+        .name = "sky visibility",
+    };
+}
+
 enum sb_result sb_sky_visibility_bake(struct sb_raycaster *rc, const float *positions, uint32_t probe_count,
                                       const struct sb_sky_visibility_params *params, float *out, double *gpu_ms)
 {
@@ -77,13 +88,7 @@ enum sb_result sb_sky_visibility_bake(struct sb_raycaster *rc, const float *posi
     struct sb_vk *vk = rc->vk;
     struct sb_buffer probes = {0}, results = {0}, order = {0};
     struct sb_pipeline pipeline = {0};
-    const struct sb_pipeline_params pp = {
-        .spirv = rc->instanced ? sb_spv_sky_visibility_instanced : sb_spv_sky_visibility,
-        .spirv_size = rc->instanced ? sizeof(sb_spv_sky_visibility_instanced) : sizeof(sb_spv_sky_visibility),
-        .binding_count = SB_PROBE_BINDING_COUNT,
-        .push_size = sizeof(pc),
-        .name = "sky visibility",
-    };
+    const struct sb_pipeline_params pp = sb_sky_visibility_kernel(rc->instanced);
     enum sb_result res;
     if ((res = sb_probe_buffers_create(vk, positions, NULL, probe_count, SB_VISIBILITY_FLOATS, &probes, &results)) ||
         (res = sb_buffer_create(vk, (VkDeviceSize)pc.ray_count * sizeof(uint32_t), "probe ray order", &order)) ||

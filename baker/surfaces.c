@@ -5,6 +5,7 @@
 
 #include "config.h"
 #include "log.h"
+#include "raycast.h"
 
 _Static_assert(SB_SURFACE_WRAP_REPEAT == SB_TEXTURE_REPEAT && SB_SURFACE_WRAP_CLAMP == SB_TEXTURE_CLAMP &&
                    SB_SURFACE_WRAP_MIRROR == SB_TEXTURE_MIRROR,
@@ -89,4 +90,18 @@ enum sb_result sb_surfaces_create(struct sb_vk *vk, const struct sb_mesh *meshes
         texture += mesh->texture_count;
     }
     return SB_OK;
+}
+
+uint32_t sb_surfaces_level_kernels(const struct sb_level *level, bool surfaces, struct sb_pipeline_params out[2])
+{
+    uint32_t n = 0;
+    out[n++] = sb_raycast_kernel(level->instance_count > 0);
+    bool textured = false;
+    if (!surfaces)
+        return n;
+    for (uint32_t m = 0; m < level->mesh_count && !textured; m++)
+        textured = level->meshes[m].texture_count > 0;
+    if (textured)
+        out[n++] = sb_texel_mips_kernel();
+    return n;
 }

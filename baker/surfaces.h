@@ -41,6 +41,11 @@ static inline enum sb_result sb_surfaces_create_level(struct sb_vk *vk, const st
     return sb_surfaces_create(vk, level->meshes, level->mesh_count, surfaces);
 }
 
+/* The kernels a bake against `level` makes for its rays and, with
+ * `surfaces`, its surfaces: the raycaster's (sb_raycaster_create) and, for
+ * a level with textures, the mips'; returns their count (at most 2). */
+uint32_t sb_surfaces_level_kernels(const struct sb_level *level, bool surfaces, struct sb_pipeline_params out[2]);
+
 /* Free; accepts a zeroed one. */
 void sb_surfaces_destroy(struct sb_vk *vk, struct sb_surfaces *surfaces);
 

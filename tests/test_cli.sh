@@ -320,6 +320,23 @@ for bad in '--paths 8' '--paths x' '--paths 100.5' '--sun 91' '--sun' '--seed -1
     check "sky-error refuses $bad" expect_exit 2 "$skybake" sky-error "$scene" $bad
 done
 
+# Every kernel a bake makes is compiled ahead, all at once (family.h's
+# kernels): none listed in vain, and each family's largest made from those.
+# The milk truck's scene bakes every family but the clouds'; earth-clouds'
+# has them.
+for s in milk-truck earth-clouds; do
+    check "$s bakes with -v" expect_exit 0 "$skybake" bake "$root/data/scenes/$s.json" -o "$tmp/kernels-$s" -v
+    cp "$tmp/err" "$tmp/kernels-$s.log"
+    check "$s: its kernels compiled ahead" grep -Eq "pipelines: [0-9]+ kernels compiled ahead" "$tmp/kernels-$s.log"
+    check "$s: none of them in vain" test -z "$(grep "compiled ahead were not used" "$tmp/kernels-$s.log")"
+done
+for k in irradiance_sky multiscattering "sky visibility" "sky bounce" "reflection capture" "texture mips" dfg; do
+    check "milk truck: $k made from the one compiled ahead" grep -q "pipeline $k: compiled ahead" \
+        "$tmp/kernels-milk-truck.log"
+done
+check "clouds: cloud_shape made from the one compiled ahead" grep -q "pipeline cloud_shape: compiled ahead" \
+    "$tmp/kernels-earth-clouds.log"
+
 echo "cli: $checks checks, $fails failed"
 echo "$((checks - fails)) passed, $fails failed"
 [ "$fails" = 0 ]

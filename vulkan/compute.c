@@ -1,6 +1,9 @@
 #include "compute.h"
 
 #include <math.h>
+#include <pthread.h>
+#include <stdatomic.h>
+#include <stdlib.h>
 #include <string.h>
 
 #include "log.h"
@@ -108,18 +111,15 @@ void sb_buffer_destroy(struct sb_vk *vk, struct sb_buffer *b)
     memset(b, 0, sizeof(*b));
 }
 
-enum sb_result sb_pipeline_create(struct sb_vk *vk, const struct sb_pipeline_params *params, struct sb_pipeline *p)
+/* A kernel's descriptor set layout (storage buffers 0..binding_count-1)
+ * and pipeline layout. */
+static enum sb_result create_layouts(struct sb_vk *vk, const struct sb_pipeline_params *params,
+                                     VkDescriptorSetLayout *set_layout, VkPipelineLayout *layout)
 {
     enum sb_result res = SB_OK;
-    memset(p, 0, sizeof(*p));
-    p->binding_count = params->binding_count;
-    p->push_size = params->push_size;
-
     VkDescriptorSetLayoutBinding bindings[16];
-    if (params->binding_count > 16) {
-        res = SB_ERR_OUT_OF_RANGE;
-        goto cleanup;
-    }
+    if (params->binding_count > 16)
+        return SB_ERR_OUT_OF_RANGE;
     for (uint32_t i = 0; i < params->binding_count; i++)
         bindings[i] = (VkDescriptorSetLayoutBinding){
             .binding = i,
@@ -132,18 +132,139 @@ enum sb_result sb_pipeline_create(struct sb_vk *vk, const struct sb_pipeline_par
         .bindingCount = params->binding_count,
         .pBindings = bindings,
     };
-    VK(vkCreateDescriptorSetLayout(vk->device, &set_info, NULL, &p->set_layout));
+    VK(vkCreateDescriptorSetLayout(vk->device, &set_info, NULL, set_layout));
     VkPushConstantRange range = {.stageFlags = VK_SHADER_STAGE_COMPUTE_BIT, .size = params->push_size};
     VkPipelineLayoutCreateInfo layout_info = {
         .sType = VK_STRUCTURE_TYPE_PIPELINE_LAYOUT_CREATE_INFO,
         .setLayoutCount = 1,
-        .pSetLayouts = &p->set_layout,
+        .pSetLayouts = set_layout,
         .pushConstantRangeCount = params->push_size ? 1 : 0,
         .pPushConstantRanges = &range,
     };
-    VK(vkCreatePipelineLayout(vk->device, &layout_info, NULL, &p->layout));
-    if ((res =
-             sb_compute_pipeline_create(vk, p->layout, params->spirv, params->spirv_size, params->name, &p->pipeline)))
+    VK(vkCreatePipelineLayout(vk->device, &layout_info, NULL, layout));
+cleanup:
+    return res;
+}
+
+/* Compile threads at most (a driver's compiler seldom scales further). */
+#define SB_PREPARE_THREADS_MAX 32
+
+/* A kernel compiled ahead (sb_pipelines_prepare), until taken. */
+struct sb_prepared_pipeline {
+    struct sb_pipeline_params params;
+    VkDescriptorSetLayout set_layout;
+    VkPipelineLayout layout;
+    VkPipeline pipeline;
+};
+
+static bool same_kernel(const struct sb_pipeline_params *a, const struct sb_pipeline_params *b)
+{
+    return a->spirv == b->spirv && a->spirv_size == b->spirv_size && a->binding_count == b->binding_count &&
+           a->push_size == b->push_size;
+}
+
+/* Take the prepared pipeline of `params`' kernel into `p`: false when none was. */
+static bool take_prepared(struct sb_vk *vk, const struct sb_pipeline_params *params, struct sb_pipeline *p)
+{
+    for (uint32_t i = 0; i < vk->prepared_count; i++) {
+        struct sb_prepared_pipeline *k = &vk->prepared[i];
+        if (!k->pipeline || !same_kernel(&k->params, params))
+            continue;
+        p->set_layout = k->set_layout;
+        p->layout = k->layout;
+        p->pipeline = k->pipeline;
+        *k = vk->prepared[--vk->prepared_count];
+        sb_compute_pipeline_named(vk, p->pipeline, params->name);
+        sb_debug("pipeline %s: compiled ahead", params->name);
+        return true;
+    }
+    return false;
+}
+
+struct prepare_job {
+    struct sb_vk *vk;
+    atomic_uint next;
+};
+
+static void *prepare_thread(void *user)
+{
+    struct prepare_job *job = user;
+    struct sb_vk *vk = job->vk;
+    for (uint32_t i; (i = atomic_fetch_add(&job->next, 1)) < vk->prepared_count;) {
+        struct sb_prepared_pipeline *k = &vk->prepared[i];
+        if (create_layouts(vk, &k->params, &k->set_layout, &k->layout) ||
+            sb_compute_pipeline_compile(vk, k->layout, k->params.spirv, k->params.spirv_size, &k->pipeline))
+            k->pipeline = VK_NULL_HANDLE; /* sb_pipeline_create compiles it again */
+    }
+    return NULL;
+}
+
+void sb_pipelines_prepare(struct sb_vk *vk, const struct sb_pipeline_params *params, uint32_t count, int threads)
+{
+    sb_pipelines_release(vk);
+    vk->prepared = calloc(count ? count : 1, sizeof(*vk->prepared));
+    if (!vk->prepared)
+        return; /* each compiles when created */
+    for (uint32_t i = 0; i < count; i++) {
+        bool listed = false;
+        for (uint32_t j = 0; j < vk->prepared_count && !listed; j++)
+            listed = same_kernel(&vk->prepared[j].params, &params[i]);
+        if (!listed)
+            vk->prepared[vk->prepared_count++].params = params[i];
+    }
+    double t0 = sb_now_s();
+    struct prepare_job job = {.vk = vk};
+    pthread_t pool[SB_PREPARE_THREADS_MAX];
+    int started = 0;
+    threads = threads < 1 ? 1 : threads > SB_PREPARE_THREADS_MAX ? SB_PREPARE_THREADS_MAX : threads;
+    for (int t = 1; t < threads && (uint32_t)t < vk->prepared_count; t++)
+        if (!pthread_create(&pool[started], NULL, prepare_thread, &job))
+            started++;
+    prepare_thread(&job);
+    for (int t = 0; t < started; t++)
+        pthread_join(pool[t], NULL);
+    /* what failed goes, so that sb_pipeline_create compiles it itself */
+    for (uint32_t i = 0; i < vk->prepared_count;) {
+        struct sb_prepared_pipeline *k = &vk->prepared[i];
+        if (k->pipeline) {
+            i++;
+            continue;
+        }
+        if (k->layout)
+            vkDestroyPipelineLayout(vk->device, k->layout, NULL);
+        if (k->set_layout)
+            vkDestroyDescriptorSetLayout(vk->device, k->set_layout, NULL);
+        *k = vk->prepared[--vk->prepared_count];
+    }
+    sb_debug("pipelines: %u kernels compiled ahead on %d threads in %.1f ms", vk->prepared_count, started + 1,
+             1e3 * (sb_now_s() - t0));
+}
+
+void sb_pipelines_release(struct sb_vk *vk)
+{
+    if (vk->prepared_count)
+        sb_debug("pipelines: %u kernels compiled ahead were not used", vk->prepared_count);
+    for (uint32_t i = 0; i < vk->prepared_count; i++) {
+        struct sb_prepared_pipeline *k = &vk->prepared[i];
+        vkDestroyPipeline(vk->device, k->pipeline, NULL);
+        vkDestroyPipelineLayout(vk->device, k->layout, NULL);
+        vkDestroyDescriptorSetLayout(vk->device, k->set_layout, NULL);
+    }
+    free(vk->prepared);
+    vk->prepared = NULL;
+    vk->prepared_count = 0;
+}
+
+enum sb_result sb_pipeline_create(struct sb_vk *vk, const struct sb_pipeline_params *params, struct sb_pipeline *p)
+{
+    enum sb_result res = SB_OK;
+    memset(p, 0, sizeof(*p));
+    p->binding_count = params->binding_count;
+    p->push_size = params->push_size;
+    if (!take_prepared(vk, params, p) &&
+        ((res = create_layouts(vk, params, &p->set_layout, &p->layout)) ||
+         (res = sb_compute_pipeline_create(vk, p->layout, params->spirv, params->spirv_size, params->name,
+                                           &p->pipeline))))
         goto cleanup;
 
     VkDescriptorPoolSize pool_size = {

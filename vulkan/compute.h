@@ -58,6 +58,20 @@ enum sb_result sb_pipeline_create(struct sb_vk *vk, const struct sb_pipeline_par
                                   struct sb_pipeline *pipeline);
 void sb_pipeline_destroy(struct sb_vk *vk, struct sb_pipeline *pipeline);
 
+/*
+ * Compile kernels ahead, on up to `threads` threads at once: a driver's
+ * first compile of a large kernel takes up to a second, and a bake creates
+ * its kernels one after another. sb_pipeline_create then takes a prepared
+ * pipeline (the same SPIR-V words, size, bindings and push size) instead of
+ * compiling it, once; a kernel listed twice is compiled once, and what is
+ * never taken is freed with the context. A kernel that fails to compile
+ * here is compiled again by sb_pipeline_create.
+ */
+void sb_pipelines_prepare(struct sb_vk *vk, const struct sb_pipeline_params *params, uint32_t count, int threads);
+
+/* Free the prepared pipelines nothing took (sb_vk_destroy does). */
+void sb_pipelines_release(struct sb_vk *vk);
+
 /* Point binding i at buffers[i] for every binding of the pipeline. */
 void sb_pipeline_bind(struct sb_vk *vk, struct sb_pipeline *pipeline, const struct sb_buffer *const *buffers);
 

@@ -5,6 +5,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "compute.h"
 #include "log.h"
 
 #define VALIDATION_LAYER "VK_LAYER_KHRONOS_validation"
@@ -377,6 +378,7 @@ void sb_vk_destroy(struct sb_vk **pvk)
         return;
     if (vk->device) {
         vkDeviceWaitIdle(vk->device);
+        sb_pipelines_release(vk);
         if (vk->command_pool)
             vkDestroyCommandPool(vk->device, vk->command_pool, NULL);
         vkDestroyDevice(vk->device, NULL);

@@ -63,6 +63,8 @@ struct sb_vk {
     double timestamp_period_ns;
     unsigned validation_messages;
     PFN_vkSetDebugUtilsObjectNameEXT set_object_name;
+    struct sb_prepared_pipeline *prepared; /* sb_pipelines_prepare's, until taken */
+    uint32_t prepared_count;
 };
 
 /*

@@ -68,8 +68,8 @@ static void log_statistics(struct sb_vk *vk, VkPipeline pipeline, const char *na
     }
 }
 
-enum sb_result sb_compute_pipeline_create(struct sb_vk *vk, VkPipelineLayout layout, const uint32_t *spirv,
-                                          size_t spirv_size, const char *name, VkPipeline *pipeline)
+enum sb_result sb_compute_pipeline_compile(struct sb_vk *vk, VkPipelineLayout layout, const uint32_t *spirv,
+                                           size_t spirv_size, VkPipeline *pipeline)
 {
     VkShaderModule module = VK_NULL_HANDLE;
     *pipeline = VK_NULL_HANDLE;
@@ -89,12 +89,28 @@ enum sb_result sb_compute_pipeline_create(struct sb_vk *vk, VkPipelineLayout lay
         .flags = vk->statistics ? VK_PIPELINE_CREATE_CAPTURE_STATISTICS_BIT_KHR : 0,
     };
     VK(vkCreateComputePipelines(vk->device, VK_NULL_HANDLE, 1, &info, NULL, pipeline));
-    sb_vk_name(vk, VK_OBJECT_TYPE_PIPELINE, (uint64_t)*pipeline, name);
-    if (vk->statistics)
-        log_statistics(vk, *pipeline, name);
 cleanup:
     vkDestroyShaderModule(vk->device, module, NULL);
     return res;
+}
+
+void sb_compute_pipeline_named(struct sb_vk *vk, VkPipeline pipeline, const char *name)
+{
+    sb_vk_name(vk, VK_OBJECT_TYPE_PIPELINE, (uint64_t)pipeline, name);
+    if (vk->statistics)
+        log_statistics(vk, pipeline, name);
+}
+
+enum sb_result sb_compute_pipeline_create(struct sb_vk *vk, VkPipelineLayout layout, const uint32_t *spirv,
+                                          size_t spirv_size, const char *name, VkPipeline *pipeline)
+{
+    double t0 = sb_now_s();
+    enum sb_result res = sb_compute_pipeline_compile(vk, layout, spirv, spirv_size, pipeline);
+    if (res)
+        return res;
+    sb_debug("pipeline %s: compiled in %.1f ms", name, 1e3 * (sb_now_s() - t0));
+    sb_compute_pipeline_named(vk, *pipeline, name);
+    return SB_OK;
 }
 
 enum sb_result sb_graphics_pipeline_create(struct sb_vk *vk, const struct sb_graphics_pipeline_params *p,

@@ -34,17 +34,22 @@ static uint64_t chain_texels(uint32_t w, uint32_t h)
     return n;
 }
 
-/* Every level below the first, one dispatch a level over all images. */
-static enum sb_result make_mips(struct sb_vk *vk, struct sb_texel_set *s, uint32_t max_levels, uint32_t max_side)
+struct sb_pipeline_params sb_texel_mips_kernel(void)
 {
-    struct sb_pipeline pipeline = {0};
-    const struct sb_pipeline_params pp = {
+    return (struct sb_pipeline_params){
         .spirv = sb_spv_texture_mips,
         .spirv_size = sizeof(sb_spv_texture_mips),
         .binding_count = SB_TEXTURE_MIPS_BINDING_COUNT,
         .push_size = sizeof(struct sb_texture_mips_push),
         .name = "texture mips",
     };
+}
+
+/* Every level below the first, one dispatch a level over all images. */
+static enum sb_result make_mips(struct sb_vk *vk, struct sb_texel_set *s, uint32_t max_levels, uint32_t max_side)
+{
+    struct sb_pipeline pipeline = {0};
+    const struct sb_pipeline_params pp = sb_texel_mips_kernel();
     enum sb_result res = sb_pipeline_create(vk, &pp, &pipeline);
     if (res)
         return res;
