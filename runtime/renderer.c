@@ -38,6 +38,7 @@ static void add_resources(struct sb_renderer *r)
         {"texture records", &r->textures.records},
         {"texels", &r->textures.texels},
         {"instances", &r->instances},
+        {"emissive", &r->emissive},
         {"visible instances", &r->visible},
     };
     for (size_t i = 0; i < sizeof(buffers) / sizeof(buffers[0]); i++)
@@ -78,6 +79,21 @@ static enum sb_result upload_textures(struct sb_renderer *r, const struct sb_wor
     if (!res && world->texture_count)
         sb_info("world: %u textures, %.1f MiB with their mips (%.2f ms on the device)", world->texture_count,
                 r->textures.texel_count * 4.0 / (1 << 20), r->textures.gpu_ms);
+    return res;
+}
+
+/* The world's emitting materials (one zero record when none); with
+ * --no-textures, without their textures. */
+static enum sb_result upload_emissive(struct sb_renderer *r, const struct sb_world *world)
+{
+    uint32_t n = world->emissive_count ? world->emissive_count : 1;
+    enum sb_result res = sb_renderer_upload(r, world->emissive, n * sizeof(struct sb_emissive_gpu), "emissive",
+                                            &r->emissive);
+    struct sb_emissive_gpu *e = r->emissive.mapped;
+    if (!res && !world->emissive_count)
+        memset(e, 0, sizeof(*e));
+    for (uint32_t i = 0; !res && r->params.no_textures && i < world->emissive_count; i++)
+        e[i].radiance[3] = 0.0f;
     return res;
 }
 
@@ -337,6 +353,8 @@ enum sb_result sb_renderer_create(struct sb_vk *vk, const struct sb_pack *pack, 
     if (!res)
         res = upload_textures(r, world);
     if (!res)
+        res = upload_emissive(r, world);
+    if (!res)
         res = upload_instances(r, world);
     if (!res)
         res = sb_renderer_upload(r, NULL, sizeof(struct sb_frame_gpu), "frame constants", &r->frame);
@@ -456,7 +474,7 @@ void sb_renderer_destroy(struct sb_renderer **pr)
     struct sb_buffer *buffers[] = {&r->atmosphere,    &r->frame,     &r->vertices,     &r->exposure,
                                    &r->read_ldr,      &r->read_hdr,  &r->read_post,    &r->post_input,
                                    &r->read_sky_view, &r->bvh_nodes, &r->bvh_triangles, &r->instances,
-                                   &r->visible};
+                                   &r->visible,       &r->emissive};
     for (size_t i = 0; i < sizeof(buffers) / sizeof(buffers[0]); i++)
         sb_buffer_destroy(vk, buffers[i]);
     sb_texel_set_destroy(vk, &r->textures);

@@ -62,6 +62,7 @@ struct sb_renderer {
     struct sb_buffer bvh_nodes, bvh_triangles;         /* "bvh nodes", "bvh triangles": the world's BVH when traced */
     struct sb_texel_set textures;                      /* "texture records", "texels": the world's textures */
     struct sb_buffer instances;                        /* "instances": sb_instance_gpu[] (one zero when none) */
+    struct sb_buffer emissive;                         /* "emissive": sb_emissive_gpu[] (one zero when none) */
     /* An instanced world's draws, a mesh each: its vertices in its own
      * space and its instances [first_instance, + instance_count). */
     struct sb_draw_group {

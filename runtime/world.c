@@ -23,10 +23,35 @@ static enum sb_result append_textures(struct sb_world *w, const struct sb_mesh *
     return SB_OK;
 }
 
+/* A record after the world's for each of the mesh's materials that emits
+ * light: emission[material] its index + 1, 0 for those that do not. */
+static enum sb_result append_emissive(struct sb_world *w, const struct sb_mesh *mesh, uint32_t texture_base,
+                                      uint32_t *emission)
+{
+    for (uint32_t k = 0; k < mesh->material_count; k++) {
+        const struct sb_mesh_material *m = &mesh->material_list[k];
+        emission[k] = 0;
+        if (!(m->emissive[0] > 0 || m->emissive[1] > 0 || m->emissive[2] > 0))
+            continue;
+        struct sb_emissive_gpu *grown = realloc(w->emissive, (w->emissive_count + 1) * sizeof(*grown));
+        if (!grown)
+            return SB_ERR_NOMEM;
+        w->emissive = grown;
+        struct sb_emissive_gpu *e = &w->emissive[w->emissive_count++];
+        memcpy(e->radiance, m->emissive, sizeof(m->emissive));
+        int32_t texture = mesh->uvs ? m->textures[SB_TEXTURE_EMISSIVE] : -1;
+        e->radiance[3] = texture >= 0 ? (float)(texture + (int32_t)texture_base + 1) : 0.0f;
+        emission[k] = w->emissive_count;
+    }
+    return SB_OK;
+}
+
 /* Append the mesh's triangles as vertices, in two passes: those that cast
  * no shadow, then the casters (from *caster_first), each in the mesh's
- * order; its texture indices from texture_base. */
-static void append_mesh(struct sb_world *w, const struct sb_mesh *mesh, uint32_t texture_base, uint32_t *caster_first)
+ * order; its texture indices from texture_base, its emitting materials'
+ * records from emission[] (append_emissive). */
+static void append_mesh(struct sb_world *w, const struct sb_mesh *mesh, uint32_t texture_base,
+                        const uint32_t *emission, uint32_t *caster_first)
 {
     for (int casters = 0; casters <= 1; casters++) {
         if (casters)
@@ -65,7 +90,7 @@ static void append_mesh(struct sb_world *w, const struct sb_mesh *mesh, uint32_t
                 }
                 v->position[3] = m->metallic;
                 v->normal[3] = m->roughness;
-                v->albedo[3] = 1.0f;
+                v->albedo[3] = (float)emission[mesh->materials[t]];
                 if (mesh->uvs) {
                     v->uv[0] = mesh->uvs[2 * (size_t)vertex];
                     v->uv[1] = mesh->uvs[2 * (size_t)vertex + 1];
@@ -96,7 +121,15 @@ enum sb_result sb_world_from_mesh(const struct sb_mesh *mesh, struct sb_world *w
         sb_world_finish(w);
         return res;
     }
-    append_mesh(w, mesh, 0, &w->caster_first_vertex);
+    uint32_t *emission = malloc((mesh->material_count + 1) * sizeof(*emission));
+    res = emission ? append_emissive(w, mesh, 0, emission) : SB_ERR_NOMEM;
+    if (!res)
+        append_mesh(w, mesh, 0, emission, &w->caster_first_vertex);
+    free(emission);
+    if (res) {
+        sb_world_finish(w);
+        return res;
+    }
     sb_mesh_hash(mesh, w->mesh_hash);
     return SB_OK;
 }
@@ -137,8 +170,15 @@ static enum sb_result from_instanced_level(const struct sb_level *level, struct 
         uint32_t texture_base = w->texture_count;
         if ((res = append_textures(w, &level->meshes[m])))
             break;
+        uint32_t *emission = malloc((level->meshes[m].material_count + 1) * sizeof(*emission));
+        res = emission ? append_emissive(w, &level->meshes[m], texture_base, emission) : SB_ERR_NOMEM;
+        if (res) {
+            free(emission);
+            break;
+        }
         range->first_vertex = w->vertex_count;
-        append_mesh(w, &level->meshes[m], texture_base, &range->caster_first_vertex);
+        append_mesh(w, &level->meshes[m], texture_base, emission, &range->caster_first_vertex);
+        free(emission);
         range->end_vertex = w->vertex_count;
         for (int i = 0; i < 3; i++) {
             range->caster_min[i] = range->min[i] = INFINITY;
@@ -410,6 +450,7 @@ void sb_world_finish(struct sb_world *w)
     for (uint32_t k = 0; k < w->texture_count; k++)
         free(w->textures[k].rgba);
     free(w->textures);
+    free(w->emissive);
     free(w->vertices);
     memset(w, 0, sizeof(*w));
 }

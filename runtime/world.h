@@ -34,6 +34,9 @@ struct sb_world {
     /* the images the vertices' texture indices name (owned, with their texels) */
     struct sb_mesh_texture *textures;
     uint32_t texture_count;
+    /* the emitting materials the vertices' albedo[3] name (owned) */
+    struct sb_emissive_gpu *emissive;
+    uint32_t emissive_count;
     /* An instanced world (a level that places meshes): the vertices are
      * its meshes' in turn, each in its own space, and instances (sorted by
      * mesh) place them; caster_first_vertex is then unused. instance_count

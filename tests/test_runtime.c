@@ -1558,6 +1558,49 @@ static void test_textures(const struct sb_renderer_params *rp)
     }
 }
 
+/* A floor that emits (glTF's emissive factor, here on black, so that the
+ * light it reflects stays that of the floor without it) adds that radiance,
+ * times the air's transmittance over 8 m, to every pixel of it, raster and
+ * traced; an emissive texture black and white by halves (sRGB) leaves the
+ * black half as it was; --no-textures drops the texture and keeps the
+ * factor. */
+static void test_emissive(const struct sb_renderer_params *rp)
+{
+    const uint8_t black[4] = {0, 0, 0, 255}, white[4] = {255, 255, 255, 255};
+    const float e = 0.25f;
+    struct sb_mesh dark = {0}, lit = {0}, halves = {0};
+    textured_floor(&dark, 0.0, -1, -1);
+    textured_floor(&lit, 0.0, -1, -1);
+    textured_floor(&halves, 0.0, -1, -1);
+    int32_t texture = (int32_t)add_texture(&halves, 64, black, white, true);
+    for (int c = 0; c < 3; c++)
+        lit.material_list[0].emissive[c] = halves.material_list[0].emissive[c] = e;
+    halves.material_list[0].textures[SB_TEXTURE_EMISSIVE] = texture;
+    double d[2][2], l[2][2], h[2][2], dropped[2][2];
+    bool drawn = floor_thirds(&dark, rp, false, d) && floor_thirds(&lit, rp, false, l) &&
+                 floor_thirds(&halves, rp, false, h) && floor_thirds(&halves, rp, true, dropped);
+    CHECK(drawn, "the emitting floors draw");
+    if (!drawn)
+        goto done;
+    for (int k = 0; k < 2; k++) {
+        const char *path = k ? "traced" : "raster";
+        printf("emissive floor (%g), %s: %.4g and %.4g over %.4g and %.4g; textured by halves %.4g, %.4g\n", e, path,
+               l[k][0], l[k][1], d[k][0], d[k][1], h[k][0], h[k][1]);
+        for (int side = 0; side < 2; side++) {
+            CHECK(fabs(l[k][side] - d[k][side] - e) < 0.01 * e, "%s: the floor's emission added (%g over %g)", path,
+                  l[k][side], d[k][side]);
+            CHECK(fabs(dropped[k][side] - l[k][side]) < 1e-3 * e, "%s: without textures, the factor (%g, %g)", path,
+                  dropped[k][side], l[k][side]);
+        }
+        CHECK(fabs(h[k][0] - d[k][0]) < 1e-3 * e && fabs(h[k][1] - l[k][1]) < 1e-3 * e,
+              "%s: the texture's black half emits nothing, its white half the factor (%g, %g)", path, h[k][0], h[k][1]);
+    }
+done:
+    sb_mesh_finish(&dark);
+    sb_mesh_finish(&lit);
+    sb_mesh_finish(&halves);
+}
+
 /* An instanced world (a level: meshes once, placed by instances, runtime/
  * world.h) draws what the same level flattened into one list draws:
  * rotated, scaled and mirrored copies, raster and traced. The two differ
@@ -1677,6 +1720,7 @@ int main(int argc, char **argv)
         test_specialised_shaders(r, &rp);
         test_traced_scene(&rp);
         test_textures(&rp);
+        test_emissive(&rp);
         test_instanced_world(dir, &rp);
         test_caster_boxes_bounded();
         test_framing(&world);

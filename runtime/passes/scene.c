@@ -202,6 +202,7 @@ static enum sb_result scene_create(struct sb_renderer *r)
     sb_pass_use(r, SB_VIEW_BINDING_VERTICES, sb_pass_find(r, "vertices"), SB_USE_LOAD);
     sb_pass_use(r, SB_VIEW_BINDING_TEXTURES, sb_pass_find(r, "texture records"), SB_USE_LOAD);
     sb_pass_use(r, SB_VIEW_BINDING_TEXELS, sb_pass_find(r, "texels"), SB_USE_LOAD);
+    sb_pass_use(r, SB_VIEW_BINDING_EMISSIVE, sb_pass_find(r, "emissive"), SB_USE_LOAD);
     if (r->draw_group_count) {
         sb_pass_use(r, SB_VIEW_BINDING_INSTANCES, sb_pass_find(r, "instances"), SB_USE_LOAD);
         if (!r->scene_traced)

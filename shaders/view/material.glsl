@@ -2,9 +2,10 @@
  * world's images as the mesh import decoded them) change it: glTF's base
  * colour (times the vertex's albedo), metallic-roughness (roughness times
  * G, metallic times B) and tangent-space normal map (+y up the image: the
- * bitangent is cross(n, t) times the handedness). Each image read at the
- * level of the pixel's footprint, given in texture-coordinate units (the
- * raster's from the derivatives, the traced path's from its ray cone). */
+ * bitangent is cross(n, t) times the handedness); and what it emits (the
+ * emissive factor times its texture). Each image read at the level of the
+ * pixel's footprint, given in texture-coordinate units (the raster's from
+ * the derivatives, the traced path's from its ray cone). */
 #ifndef SB_MATERIAL_GLSL
 #define SB_MATERIAL_GLSL
 
@@ -13,6 +14,10 @@
 #define TEXELS_BINDING_RECORDS SB_VIEW_BINDING_TEXTURES
 #define TEXELS_BINDING_DATA SB_VIEW_BINDING_TEXELS
 #include "texels.glsl"
+
+layout(std430, set = 0, binding = SB_VIEW_BINDING_EMISSIVE) readonly buffer EmissiveBuffer {
+    sb_emissive_gpu emissive_records[];
+};
 
 /* The level of image `image` where the footprint spans `footprint_uv`. */
 float material_lod(uint image, float footprint_uv)
@@ -45,6 +50,21 @@ void material_textures(vec2 uv, float footprint_uv, vec2 images, vec4 tangent, i
                 n = normalize(bent);
         }
     }
+}
+
+/* The radiance a point emits: `record` is its vertex's albedo.w (the
+ * emission's record + 1, 0: none). */
+vec3 material_emitted(float record, vec2 uv, float footprint_uv)
+{
+    uint e = uint(record + 0.5);
+    if (e == 0u)
+        return vec3(0.0);
+    vec4 r = emissive_records[e - 1u].radiance;
+    uint image = uint(r.w + 0.5);
+    vec3 emitted = r.rgb;
+    if (image != 0u)
+        emitted *= texels_sample(image - 1u, uv, material_lod(image - 1u, footprint_uv)).rgb;
+    return emitted;
 }
 
 #endif

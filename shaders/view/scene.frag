@@ -16,6 +16,7 @@ layout(location = 4) in vec2 in_uv;
 layout(location = 5) flat in vec2 in_images;
 layout(location = 6) in vec3 in_tangent;
 layout(location = 7) flat in float in_normal_map;
+layout(location = 8) flat in float in_emission;
 layout(location = 0) out vec4 out_color;
 
 void main()
@@ -29,6 +30,7 @@ void main()
     if (in_images != vec2(0.0) || in_normal_map != 0.0)
         material_textures(in_uv, footprint, in_images, vec4(in_tangent, in_normal_map), albedo, metallic_roughness,
                           shading_n);
-    out_color = scene_shade(in_offset, shading_n, albedo, metallic_roughness, gl_FragCoord.xy / vec2(frame.size.xy),
-                            sun_visibility(in_offset, n, true));
+    vec3 emitted = material_emitted(in_emission, in_uv, footprint);
+    out_color = scene_shade(in_offset, shading_n, albedo, metallic_roughness, emitted,
+                            gl_FragCoord.xy / vec2(frame.size.xy), sun_visibility(in_offset, n, true));
 }

@@ -15,6 +15,7 @@ layout(location = 4) out vec2 out_uv;
 layout(location = 5) flat out vec2 out_images; /* the base colour's and metallic-roughness's texture + 1 */
 layout(location = 6) out vec3 out_tangent;
 layout(location = 7) flat out float out_normal_map; /* +-(the normal map's texture + 1) */
+layout(location = 8) flat out float out_emission;   /* the emission's record + 1 (0: none) */
 
 void main()
 {
@@ -33,5 +34,6 @@ void main()
     out_uv = v.uv.xy;
     out_images = v.uv.zw;
     out_normal_map = v.tangent.w;
+    out_emission = v.albedo.w;
     gl_Position = frame.view_proj * vec4(out_offset, 1.0);
 }

@@ -44,7 +44,8 @@ layout(constant_id = 1) const bool SB_SCENE_REFLECTIONS = true; /* reflections.i
  * normal n, linear albedo, (metallic, perceptual roughness), where the
  * point is in the frame (0 to 1: the aerial perspective volume's uv) and
  * the sun's visibility there. */
-vec4 scene_shade(vec3 offset, vec3 n, vec3 albedo, vec2 metallic_roughness, vec2 screen_uv, float visibility)
+vec4 scene_shade(vec3 offset, vec3 n, vec3 albedo, vec2 metallic_roughness, vec3 emitted, vec2 screen_uv,
+                 float visibility)
 {
     vec3 v = -normalize(offset);
     vec3 l = frame.sun_direction.xyz;
@@ -113,7 +114,7 @@ vec4 scene_shade(vec3 offset, vec3 n, vec3 albedo, vec2 metallic_roughness, vec2
     }
     if (frame.size.w == SB_DEBUG_ENV_SPECULAR)
         return vec4(fp16_safe(specular * frame.aerial.y), 1.0);
-    color += diffuse_color / PI * e_n + specular;
+    color += diffuse_color / PI * e_n + specular + emitted;
 
     vec3 inscatter, transmittance;
     aerial_perspective(screen_uv, offset, inscatter, transmittance);

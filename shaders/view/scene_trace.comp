@@ -50,7 +50,8 @@ void main()
     float visibility = dot(n, frame.sun_direction.xyz) > 0.0 ? sun_visibility(offset, n, true) : 0.0;
     vec3 albedo = v.albedo.rgb, shading_n = n;
     vec2 metallic_roughness = vec2(v.position.w, v.normal.w);
-    if (v.uv.zw != vec2(0.0) || v.tangent.w != 0.0) {
+    vec3 emitted = vec3(0.0);
+    if (v.uv.zw != vec2(0.0) || v.tangent.w != 0.0 || v.albedo.w != 0.0) {
         uint first = 3u * (hit.triangle & ~SB_BVH_BACK_FACE);
         sb_vertex_gpu b = vertices[first + 1u], c = vertices[first + 2u];
         vec3 w = vec3(1.0 - hit.uv.x - hit.uv.y, hit.uv);
@@ -74,6 +75,7 @@ void main()
         float footprint = width_m * sqrt(area_uv / max(area_m, 1e-20));
         material_textures(tex, footprint, v.uv.zw, vec4(tangent, v.tangent.w), albedo, metallic_roughness,
                           shading_n);
+        emitted = material_emitted(v.albedo.w, tex, footprint);
     }
-    imageStore(hdr, pixel, scene_shade(offset, shading_n, albedo, metallic_roughness, uv, visibility));
+    imageStore(hdr, pixel, scene_shade(offset, shading_n, albedo, metallic_roughness, emitted, uv, visibility));
 }

@@ -38,6 +38,7 @@
 #define SB_VIEW_BINDING_TEXELS 52           /* and their texels, with their mips */
 #define SB_VIEW_BINDING_INSTANCES 53        /* struct sb_instance_gpu[]: an instanced world's placed copies */
 #define SB_VIEW_BINDING_VISIBLE 54          /* uint[]: the instances each raster draw draws (this frame's cull) */
+#define SB_VIEW_BINDING_EMISSIVE 55         /* struct sb_emissive_gpu[]: the world's materials that emit */
 /* A shadow ray's reach: past any two points of a world (4 x SB_MESH_MAX_EXTENT_M, geometry/mesh.h). */
 #define SB_TRACE_FAR_M 4.0e4
 
@@ -82,11 +83,19 @@ _Static_assert(2 * SB_SHADOW_CLEAR_MARGIN_TEXELS >= 2 * SB_SHADOW_RECT_MARGIN_TE
 struct sb_vertex_gpu {
     SB_VEC4(position); /* xyz: m, world; w: metallic */
     SB_VEC4(normal);   /* xyz: unit normal; w: perceptual roughness */
-    SB_VEC4(albedo);   /* rgb: base colour, linear; w: unused */
+    SB_VEC4(albedo);   /* rgb: base colour, linear; w: its material's emission + 1 (0: none;
+                          SB_VIEW_BINDING_EMISSIVE) */
     SB_VEC4(uv);       /* xy: texture coordinates (u right, v up); z: the base colour's texture + 1,
                           w: the metallic-roughness's (0: none; SB_VIEW_BINDING_TEXTURES) */
     SB_VEC4(tangent);  /* xyz: unit, along u, world; w: +-(the normal map's texture + 1), the sign
                           the bitangent's handedness (0: none) */
+};
+
+/* What a material emits: glTF's emissive factor (linear radiance, in the
+ * frame's units: 1 shines as a white surface lit by a sun of irradiance
+ * pi), times its emissive texture's rgb (sRGB) where it has one. */
+struct sb_emissive_gpu {
+    SB_VEC4(radiance); /* rgb: the factor; w: the emissive texture + 1 (0: none) */
 };
 
 /* A placed copy of one of an instanced world's meshes (runtime/world.h):
