@@ -616,7 +616,12 @@ static enum sb_result add_textures(struct importer *im, const struct aiMaterial 
         }
     struct aiColor4D emissive;
     if (aiGetMaterialColor(mat, AI_MATKEY_COLOR_EMISSIVE, &emissive) == aiReturn_SUCCESS) {
-        float e[3] = {emissive.r, emissive.g, emissive.b};
+        /* KHR_materials_emissive_strength multiplies the factor */
+        ai_real strength = 1;
+        if (aiGetMaterialFloat(mat, AI_MATKEY_EMISSIVE_INTENSITY, &strength) != aiReturn_SUCCESS ||
+            !(strength >= 0 && strength < 1e6))
+            strength = 1;
+        float e[3] = {emissive.r * strength, emissive.g * strength, emissive.b * strength};
         for (int c = 0; c < 3; c++)
             out->emissive[c] = isfinite(e[c]) ? fminf(fmaxf(e[c], 0.0f), 1e6f) : 0.0f;
     }
