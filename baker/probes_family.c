@@ -295,8 +295,10 @@ static enum sb_result bake_visibility(struct probes_state *st, const struct sb_s
     memset(layout, 0, sizeof(*layout));
     enum sb_result res;
     const struct sb_level *level = st->level;
+    double placed = sb_now_s();
     if ((res = place(scene, level, layout, &positions, &count)))
         goto done;
+    sb_debug("sky_visibility: %u probes placed in %.1f ms", count, 1e3 * (sb_now_s() - placed));
     offsets = calloc((size_t)count * 3, sizeof(float));
     valid = calloc(count, sizeof(float));
     results = malloc((size_t)count * SB_VISIBILITY_FLOATS * sizeof(float));
@@ -305,16 +307,22 @@ static enum sb_result bake_visibility(struct probes_state *st, const struct sb_s
         goto done;
     }
     struct sb_sky_visibility_params params = {.ray_count = scene->probes.rays};
-    double ms = 0;
+    double ms = 0, t0 = sb_now_s(), t1, t2;
     if ((res = sb_sky_visibility_bake(rc, positions, count, &params, results, &ms)))
         goto done;
     gpu_ms += ms;
+    t1 = sb_now_s();
     if ((res = push_out(rc, scene, positions, offsets, valid, results, count, &inside, &pushed, &ms)))
         goto done;
     gpu_ms += inside ? ms : 0; /* every candidate place of every probe inside */
+    t2 = sb_now_s();
     if (pushed && (res = sb_sky_visibility_bake(rc, positions, count, &params, results, &ms)))
         goto done;
     gpu_ms += pushed ? ms : 0;
+    sb_debug("sky_visibility: %u probes cast in %.1f ms, %u inside tried at %u places each in %.1f ms, cast again "
+             "in %.1f ms",
+             count, 1e3 * (t1 - t0), inside, 26 * (unsigned)(sizeof(push_steps) / sizeof(push_steps[0])),
+             1e3 * (t2 - t1), 1e3 * (sb_now_s() - t2));
     if ((res = sb_image_init(image, count, 1, SB_SKY_VISIBILITY_CHANNEL_COUNT)))
         goto done;
     sb_image_set_channel_names(image, SB_SKY_VISIBILITY_CHANNELS);
@@ -329,7 +337,9 @@ static enum sb_result bake_visibility(struct probes_state *st, const struct sb_s
         res = SB_ERR_NOMEM;
         goto done;
     }
+    double dering_t0 = sb_now_s();
     sb_parallel_for((int)count, dering_one, &job);
+    sb_debug("sky_visibility: deringing in %.1f ms", 1e3 * (sb_now_s() - dering_t0));
     for (uint32_t i = 0; i < count; i++) {
         float *o = &image->data[(size_t)i * SB_SKY_VISIBILITY_CHANNEL_COUNT];
         const float *r = &results[(size_t)i * SB_VISIBILITY_FLOATS];
@@ -430,9 +440,13 @@ static enum sb_result probes_bake(void *state, struct sb_vk *vk, const struct sb
                                   struct sb_artifact *a)
 {
     struct probes_state *st = state;
+    double t0 = sb_now_s();
+    bool had = st->rc != NULL;
     enum sb_result res = raycaster(st, vk);
     if (res)
         return res;
+    if (!had)
+        sb_debug("probes: the BVH built and on the device in %.1f ms", 1e3 * (sb_now_s() - t0));
     return id == SB_PRODUCT_SKY_BOUNCE ? bake_bounce(st, scene, &baked[SB_PRODUCT_SKY_VISIBILITY], image, a)
                                        : bake_visibility(st, scene, image, a);
 }

@@ -86,6 +86,7 @@ enum sb_result sb_sky_visibility_bake(struct sb_raycaster *rc, const float *posi
         return SB_ERR_OUT_OF_RANGE;
     }
     struct sb_vk *vk = rc->vk;
+    double start = sb_now_s();
     struct sb_buffer probes = {0}, results = {0}, order = {0};
     struct sb_pipeline pipeline = {0};
     const struct sb_pipeline_params pp = sb_sky_visibility_kernel(rc->instanced);
@@ -103,7 +104,10 @@ enum sb_result sb_sky_visibility_bake(struct sb_raycaster *rc, const float *posi
         [SB_RAYCAST_BINDING_HITS] = &results,
     };
     sb_pipeline_bind(vk, &pipeline, bindings);
+    double t0 = sb_now_s();
     res = sb_probe_kernel_run(vk, &pipeline, &pc, probe_count, &results, out, gpu_ms);
+    sb_debug("sky visibility: %u probes x %u rays: buffers %.1f ms, run and read back %.1f ms", probe_count,
+             pc.ray_count, 1e3 * (t0 - start), 1e3 * (sb_now_s() - t0));
 done:
     sb_pipeline_destroy(vk, &pipeline);
     sb_buffer_destroy(vk, &results);

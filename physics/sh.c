@@ -2,6 +2,7 @@
 #include "physics.h"
 
 #include <math.h>
+#include <stdbool.h>
 #include <pthread.h>
 #include <string.h>
 
@@ -86,14 +87,34 @@ static void make_test_directions(void)
     }
 }
 
+/* The reconstruction at test direction i: sb_sh9_eval's sum, in its order. */
+static inline double test_value(const double c[SB_PROBE_SH], uint32_t i)
+{
+    double v = 0;
+    for (int k = 0; k < SB_PROBE_SH; k++)
+        v += c[k] * test_basis[i][k];
+    return v;
+}
+
+/* Whether the reconstruction is negative at a test direction: the same
+ * answer as sb_sh9_min(c) < 0, found from *hint on (the direction where the
+ * last call found one, which mostly still is), stopping at the first. */
+static bool has_negative(const double c[SB_PROBE_SH], uint32_t *hint)
+{
+    for (uint32_t n = 0, i = *hint; n < SB_SH_TEST_DIRECTIONS; n++, i = i + 1 < SB_SH_TEST_DIRECTIONS ? i + 1 : 0)
+        if (test_value(c, i) < 0.0) {
+            *hint = i;
+            return true;
+        }
+    return false;
+}
+
 double sb_sh9_min(const double c[SB_PROBE_SH], double where[3])
 {
     pthread_once(&test_once, make_test_directions);
     double lowest = INFINITY;
     for (uint32_t i = 0; i < SB_SH_TEST_DIRECTIONS; i++) {
-        double v = 0; /* sb_sh9_eval's sum, in its order */
-        for (int k = 0; k < SB_PROBE_SH; k++)
-            v += c[k] * test_basis[i][k];
+        double v = test_value(c, i);
         if (v < lowest) {
             lowest = v;
             if (where)
@@ -127,10 +148,11 @@ double sb_sh9_dering(double c[SB_PROBE_SH], double *min_before)
     if (lowest >= 0.0)
         return 0.0;
     double lo = 0.0, hi = 2.0, w[SB_PROBE_SH];
+    uint32_t hint = 0;
     for (int it = 0; it < 20; it++) {
         double mid = 0.5 * (lo + hi);
         window(c, mid, w);
-        if (sb_sh9_min(w, NULL) >= 0.0)
+        if (!has_negative(w, &hint))
             hi = mid;
         else
             lo = mid;
