@@ -74,11 +74,11 @@ void sb_cloud_recipe_json(const struct sb_noise_push *push, char *out, size_t si
  * x-fastest order, their channels interleaved, into out. Thread-safe. */
 void sb_cloud_ref(const struct sb_noise_push *push, uint64_t first, uint64_t count, float *out);
 
-/* Bake a cloud product on the device into *image (fp32, as computed; 2D
- * products have depth 1), named as the pack names its channels. */
 /* The kernel sb_cloud_bake makes for `product`. */
 struct sb_pipeline_params sb_cloud_kernel(enum sb_product_id product);
 
+/* Bake a cloud product on the device into *image (fp32, as computed; 2D
+ * products have depth 1), named as the pack names its channels. */
 enum sb_result sb_cloud_bake(struct sb_vk *vk, enum sb_product_id product, const struct sb_cloud_params *params,
                              struct sb_image *image, double *gpu_ms);
 

@@ -33,6 +33,7 @@ void sb_kernel_code_hash(const void *one_level, size_t one_size, const void *ins
 enum sb_result sb_raycaster_create(struct sb_vk *vk, const struct sb_bvh *bvh, struct sb_raycaster **raycaster);
 /* The kernel sb_raycaster_create makes, for a BVH of instances or not. */
 struct sb_pipeline_params sb_raycast_kernel(bool instanced);
+
 /* Free; accepts a pointer to NULL and sets it to NULL. */
 void sb_raycaster_destroy(struct sb_raycaster **raycaster);
 

@@ -53,12 +53,12 @@ struct sb_capture_params {
     double sky_sh[9][3];   /* the sky's radiance, order-2 SH: what surfaces are lit by */
 };
 
-/* Level 0 of a probe's cube, one rgba texel each (rgb radiance; a = 1
- * where the ray met a back face), 6 n^2 texels into out. */
 /* The kernels sb_reflection_capture and sb_reflection_prefilter make. */
 struct sb_pipeline_params sb_reflection_capture_kernel(void);
 struct sb_pipeline_params sb_reflection_prefilter_kernel(void);
 
+/* Level 0 of a probe's cube, one rgba texel each (rgb radiance; a = 1
+ * where the ray met a back face), 6 n^2 texels into out. */
 enum sb_result sb_reflection_capture(struct sb_vk *vk, const struct sb_capture_inputs *in,
                                      const struct sb_capture_params *params, float *out, double *gpu_ms);
 

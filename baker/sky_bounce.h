@@ -24,6 +24,9 @@ struct sb_sky_bounce_params {
     float tmin_m;       /* rays start this far from the probe [1e-4] */
 };
 
+/* The kernel sb_sky_bounce_bake makes, for a BVH of instances or not. */
+struct sb_pipeline_params sb_sky_bounce_kernel(bool instanced);
+
 /*
  * Bake probe_count probes at positions (xyz in m each; valid[i] 0 gives the
  * probe zeros) against the raycaster's BVH into out[SB_BOUNCE_FLOATS *
@@ -32,9 +35,6 @@ struct sb_sky_bounce_params {
  * hit's albedo is its texture's at the ray cone's footprint (surface.glsl).
  * *gpu_ms (may be NULL) gets the GPU time.
  */
-/* The kernel sb_sky_bounce_bake makes, for a BVH of instances or not. */
-struct sb_pipeline_params sb_sky_bounce_kernel(bool instanced);
-
 enum sb_result sb_sky_bounce_bake(struct sb_raycaster *raycaster, const struct sb_surfaces *surfaces,
                                   const float *positions, const float *valid, uint32_t probe_count, const struct sb_sky_bounce_params *params,
                                   float *out, double *gpu_ms);

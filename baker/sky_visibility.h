@@ -20,6 +20,9 @@ struct sb_sky_visibility_params {
     float tmax_m;       /* a ray reaching this far sees the sky [1e30: the geometry's own extent] */
 };
 
+/* The kernel sb_sky_visibility_bake makes, for a BVH of instances or not. */
+struct sb_pipeline_params sb_sky_visibility_kernel(bool instanced);
+
 /*
  * Bake probe_count probes at positions (xyz in m each) against the
  * raycaster's BVH into out[SB_VISIBILITY_FLOATS * probe_count] (config.h): the
@@ -28,9 +31,6 @@ struct sb_sky_visibility_params {
  * The coefficients are as projected (not deringed: sb_sh9_dering).
  * *gpu_ms (may be NULL) gets the GPU time.
  */
-/* The kernel sb_sky_visibility_bake makes, for a BVH of instances or not. */
-struct sb_pipeline_params sb_sky_visibility_kernel(bool instanced);
-
 enum sb_result sb_sky_visibility_bake(struct sb_raycaster *raycaster, const float *positions, uint32_t probe_count,
                                       const struct sb_sky_visibility_params *params, float *out, double *gpu_ms);
 

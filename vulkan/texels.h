@@ -35,12 +35,12 @@ struct sb_texel_set {
 /* The levels of a width x height image down to 1 x 1. */
 uint32_t sb_texel_levels(uint32_t width, uint32_t height);
 
-/* Upload `count` images (none: buffers of one element) and build their
- * mips. Refuses past 2^29 texels with their mips (SB_ERR_TOO_LARGE).
- * *set zeroed on failure. */
 /* The kernel sb_texel_set_create makes the mips with. */
 struct sb_pipeline_params sb_texel_mips_kernel(void);
 
+/* Upload `count` images (none: buffers of one element) and build their
+ * mips. Refuses past 2^29 texels with their mips (SB_ERR_TOO_LARGE).
+ * *set zeroed on failure. */
 enum sb_result sb_texel_set_create(struct sb_vk *vk, const struct sb_texel_image *images, uint32_t count,
                                    struct sb_texel_set *set);
 
