@@ -100,6 +100,8 @@ static void probes_key(void *state, const struct sb_scene *scene, enum sb_produc
     }
     for (int i = 0; i < p->explicit_count; i++)
         sb_key_add3(key, "at", p->positions_m[i]);
+    for (int l = 0; l < p->layer_count; l++) /* none: the keys of uniform grids as they were */
+        sb_key_add(key, " layer=%a", p->layers_m[l]);
     sb_sky_visibility_code_hash(code);
     sb_key_add(key, " code %s", code);
     if (id == SB_PRODUCT_SKY_BOUNCE) { /* and the visibility's key, as its input */
@@ -138,6 +140,19 @@ static enum sb_result plan(const struct sb_scene *scene, const struct sb_level *
         }
         grid = 1;
         for (int k = 0; k < 3; k++) {
+            if (k == 1 && p->layer_count) {
+                /* layers over the surface: the y origin 0, the y spacing
+                 * the distance over the top layer a runtime fades over */
+                int n = p->layer_count;
+                layout->grid[1] = (uint32_t)n;
+                layout->origin_m[1] = 0;
+                layout->spacing_m[1] = (float)(n > 1 ? p->layers_m[n - 1] - p->layers_m[n - 2] : p->layers_m[0]);
+                layout->layer_count = (uint32_t)n;
+                for (int l = 0; l < n; l++)
+                    layout->layers_m[l] = (float)p->layers_m[l];
+                grid *= (uint64_t)n;
+                continue;
+            }
             double extent = (double)hi[k] - lo[k] + 2 * p->margin_m;
             double n = floor(extent / p->spacing_m) + 1;
             if (n > SB_PROBES_MAX_GRID) {
@@ -170,9 +185,52 @@ static enum sb_result plan(const struct sb_scene *scene, const struct sb_level *
     return SB_OK;
 }
 
-static enum sb_result place(const struct sb_scene *scene, const struct sb_level *level, struct sb_probe_layout *layout,
-                            float **positions, uint32_t *count)
+/* The surface under each column of a grid of layers: where a ray straight
+ * down from over the world first meets it (the world's bottom where it
+ * meets none), into ground[column] (x fastest). */
+static enum sb_result column_surfaces(const struct probes_state *st, const struct sb_probe_layout *layout,
+                                      float *ground)
 {
+    uint32_t columns = layout->grid[0] * layout->grid[2];
+    float *rays = malloc((size_t)columns * 8 * sizeof(float)), *hits = malloc((size_t)columns * 4 * sizeof(float));
+    enum sb_result res = rays && hits ? SB_OK : SB_ERR_NOMEM;
+    const struct sb_bvh_node *root = &st->bvh.nodes[0];
+    float top = root->max[1] + 1.0f;
+    for (uint32_t c = 0; c < columns && !res; c++) {
+        float *r = &rays[8 * (size_t)c];
+        r[0] = layout->origin_m[0] + (float)(c % layout->grid[0]) * layout->spacing_m[0];
+        r[1] = top;
+        r[2] = layout->origin_m[2] + (float)(c / layout->grid[0]) * layout->spacing_m[2];
+        r[3] = 0.0f;
+        r[4] = 0.0f;
+        r[5] = -1.0f;
+        r[6] = 0.0f;
+        r[7] = 1e30f;
+    }
+    double ms = 0;
+    if (!res)
+        res = sb_raycaster_cast(st->rc, rays, columns, false, hits, &ms);
+    uint32_t missed = 0;
+    for (uint32_t c = 0; c < columns && !res; c++) {
+        uint32_t triangle;
+        memcpy(&triangle, &hits[4 * (size_t)c + 1], sizeof(triangle));
+        missed += triangle == SB_BVH_MISS;
+        ground[c] = triangle == SB_BVH_MISS ? root->min[1] : top - hits[4 * (size_t)c];
+    }
+    if (!res)
+        sb_debug("probes: %u columns' surfaces found (%.3f ms on the device), %u over nothing", columns, ms, missed);
+    free(rays);
+    free(hits);
+    return res;
+}
+
+/* Where the probes go. A grid of layers needs the raycaster (st->rc) to
+ * find its columns' surfaces; without it (the bounce, which takes the
+ * visibility's positions) its layers stand over y 0. */
+static enum sb_result place(const struct probes_state *st, const struct sb_scene *scene,
+                            struct sb_probe_layout *layout, float **positions, uint32_t *count, bool surfaces)
+{
+    const struct sb_level *level = st->level;
     const struct sb_probe_params *p = &scene->probes;
     uint64_t grid;
     enum sb_result res = plan(scene, level, layout, &grid);
@@ -184,12 +242,25 @@ static enum sb_result place(const struct sb_scene *scene, const struct sb_level 
     *positions = malloc((size_t)*count * 3 * sizeof(float));
     if (!*positions)
         return SB_ERR_NOMEM;
+    float *ground = NULL;
+    if (layout->layer_count && grid) {
+        ground = calloc((size_t)layout->grid[0] * layout->grid[2], sizeof(*ground));
+        if (!ground)
+            return SB_ERR_NOMEM;
+        if (surfaces && (res = column_surfaces(st, layout, ground))) {
+            free(ground);
+            return res;
+        }
+    }
     for (uint32_t i = 0; i < grid; i++) {
         uint32_t c[3] = {i % layout->grid[0], i / layout->grid[0] % layout->grid[1],
                          i / layout->grid[0] / layout->grid[1]};
         for (int k = 0; k < 3; k++)
             (*positions)[3 * (size_t)i + k] = (float)(layout->origin_m[k] + (double)c[k] * layout->spacing_m[k]);
+        if (ground)
+            (*positions)[3 * (size_t)i + 1] = ground[c[0] + layout->grid[0] * c[2]] + layout->layers_m[c[1]];
     }
+    free(ground);
     for (int e = 0; e < p->explicit_count; e++)
         for (int k = 0; k < 3; k++)
             (*positions)[3 * (grid + e) + k] = (float)p->positions_m[e][k];
@@ -296,7 +367,7 @@ static enum sb_result bake_visibility(struct probes_state *st, const struct sb_s
     enum sb_result res;
     const struct sb_level *level = st->level;
     double placed = sb_now_s();
-    if ((res = place(scene, level, layout, &positions, &count)))
+    if ((res = place(st, scene, layout, &positions, &count, true)))
         goto done;
     sb_debug("sky_visibility: %u probes placed in %.1f ms", count, 1e3 * (sb_now_s() - placed));
     offsets = calloc((size_t)count * 3, sizeof(float));
@@ -367,6 +438,14 @@ static enum sb_result bake_visibility(struct probes_state *st, const struct sb_s
              "\"inside\":%u,\"pushed_out\":%u,\"invalid\":%u,\"deringed\":%u,\"lowest_before_dering\":%.6g}",
              layout->ray_count, layout->grid[0], layout->grid[1], layout->grid[2], (double)layout->spacing_m[0],
              layout->explicit_count, (unsigned long long)level->placed_triangles, inside, pushed, inside - pushed, deringed, lowest);
+    if (layout->layer_count) { /* the layers' heights, after the rest (none: as it was) */
+        size_t len = strlen(a->settings_json);
+        int n = snprintf(a->settings_json + len - 1, sizeof(a->settings_json) - (len - 1), ",\"layers_m\":[");
+        for (uint32_t l = 0; l < layout->layer_count && n > 0; l++)
+            n += snprintf(a->settings_json + len - 1 + n, sizeof(a->settings_json) - (len - 1) - (size_t)n, "%s%.9g",
+                          l ? "," : "", (double)layout->layers_m[l]);
+        snprintf(a->settings_json + len - 1 + n, sizeof(a->settings_json) - (len - 1) - (size_t)n, "]}");
+    }
     sb_artifact_set_world(a, st->mesh_hash, st->path);
     sb_info("sky_visibility: %u probes over %llu triangles; %u inside geometry, %u pushed out; %u deringed", count,
             (unsigned long long)level->placed_triangles, inside, pushed, deringed);
@@ -389,7 +468,7 @@ static enum sb_result bake_bounce(struct probes_state *st, const struct sb_scene
     uint32_t count = 0;
     struct sb_probe_layout *layout = &a->probes;
     memset(layout, 0, sizeof(*layout));
-    enum sb_result res = place(scene, st->level, layout, &positions, &count);
+    enum sb_result res = place(st, scene, layout, &positions, &count, false);
     if (!res && (visibility->width != count || visibility->channel_count != SB_SKY_VISIBILITY_CHANNEL_COUNT)) {
         sb_error("sky_bounce: sky_visibility holds %u probes, the scene places %u", visibility->width, count);
         res = SB_ERR_BAD_IMAGE;

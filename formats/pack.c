@@ -729,6 +729,11 @@ static enum sb_result read_artifact_image(const char *dir, int dir_fd, struct sb
                      a->key);
             res = SB_ERR_HASH_MISMATCH;
         }
+        if (!res && a->probes.layer_count && pack->format_version < 7) {
+            sb_error("%s: %s: a grid in layers, which format version %d cannot hold (7 and later)", path, name,
+                     pack->format_version);
+            res = SB_ERR_PROBES;
+        }
     } else {
         res = format->storage == SB_STORAGE_VDB_HALF
                   ? sb_vdb_read(path, format->channel_names, texels, image, NULL, NULL)

@@ -83,21 +83,23 @@ static void channel_range(const char *name, double *lo, double *hi)
     }
 }
 
-static size_t file_size(uint32_t probes, uint32_t channels)
+static size_t file_size(uint32_t header, uint32_t probes, uint32_t channels)
 {
-    return SB_PROBES_HEADER_BYTES + (size_t)probes * channels * 4 + 8;
+    return header + (size_t)probes * channels * 4 + 8;
 }
 
 enum sb_result sb_probes_write(const char *path, const struct sb_probe_layout *layout, const struct sb_image *image)
 {
-    size_t size = file_size(image->width, image->channel_count);
+    /* without layers, version 1: the files are what they were */
+    uint32_t header = layout->layer_count ? SB_PROBES_HEADER_BYTES : SB_PROBES_HEADER_BYTES_V1;
+    size_t size = file_size(header, image->width, image->channel_count);
     uint8_t *bytes = calloc(1, size);
     if (!bytes)
         return SB_ERR_NOMEM;
     memcpy(bytes, magic, 8);
-    put_u32(bytes + 8, SB_PROBES_VERSION);
+    put_u32(bytes + 8, layout->layer_count ? 2 : 1);
     put_u32(bytes + 12, BYTE_ORDER_MARK);
-    put_u32(bytes + 16, SB_PROBES_HEADER_BYTES);
+    put_u32(bytes + 16, header);
     put_u32(bytes + 20, image->channel_count);
     put_u32(bytes + 24, image->width);
     for (int i = 0; i < 3; i++) {
@@ -108,7 +110,12 @@ enum sb_result sb_probes_write(const char *path, const struct sb_probe_layout *l
     put_u32(bytes + 40, layout->explicit_count);
     put_u32(bytes + 68, layout->ray_count);
     memcpy(bytes + 72, layout->key, strnlen(layout->key, 32));
-    uint8_t *p = bytes + SB_PROBES_HEADER_BYTES;
+    if (layout->layer_count) {
+        put_u32(bytes + 104, layout->layer_count);
+        for (uint32_t l = 0; l < layout->layer_count; l++)
+            put_f32(bytes + 108 + 4 * l, layout->layers_m[l]);
+    }
+    uint8_t *p = bytes + header;
     for (uint64_t i = 0; i < (uint64_t)image->width * image->channel_count; i++, p += 4)
         put_f32(p, image->data[i]);
     put_u64(p, XXH3_64bits(bytes, size - 8));
@@ -139,14 +146,25 @@ enum sb_result sb_probes_parse(const void *data, size_t size, const char *source
                  BYTE_ORDER_MARK);
         return SB_ERR_PROBES;
     }
-    if (size < SB_PROBES_HEADER_BYTES + 8) {
+    if (size < SB_PROBES_HEADER_BYTES_V1 + 8) {
         sb_error("%s: %zu bytes, shorter than the header and checksum", source, size);
         return SB_ERR_BAD_IMAGE;
     }
     uint32_t header = get_u32(b + 16), channels = get_u32(b + 20), count = get_u32(b + 24);
     uint32_t grid[3] = {get_u32(b + 28), get_u32(b + 32), get_u32(b + 36)}, explicit_count = get_u32(b + 40);
-    if (header != SB_PROBES_HEADER_BYTES) {
-        sb_error("%s: header of %u bytes, version 1 has %d", source, header, SB_PROBES_HEADER_BYTES);
+    uint32_t expect_header = version == 1 ? SB_PROBES_HEADER_BYTES_V1 : SB_PROBES_HEADER_BYTES;
+    if (header != expect_header) {
+        sb_error("%s: header of %u bytes, version %u has %u", source, header, version, expect_header);
+        return SB_ERR_PROBES;
+    }
+    if (size < header + 8) {
+        sb_error("%s: %zu bytes, shorter than the header and checksum", source, size);
+        return SB_ERR_BAD_IMAGE;
+    }
+    uint32_t layers = version == 1 ? 0 : get_u32(b + 104);
+    if (version > 1 && (layers < 1 || layers > SB_PROBES_MAX_LAYERS || layers != grid[1])) {
+        sb_error("%s: %u layers in a grid %u high: 1 to %d, the grid's y", source, layers, grid[1],
+                 SB_PROBES_MAX_LAYERS);
         return SB_ERR_PROBES;
     }
     struct sb_image names = {0};
@@ -173,20 +191,31 @@ enum sb_result sb_probes_parse(const void *data, size_t size, const char *source
                  max_probes < SB_PROBES_MAX_COUNT ? max_probes : SB_PROBES_MAX_COUNT);
         return SB_ERR_PROBES;
     }
-    if (size != file_size(count, channels)) {
+    if (size != file_size(header, count, channels)) {
         sb_error("%s: %zu bytes, %u probes of %u channels take %zu", source, size, count, channels,
-                 file_size(count, channels));
+                 file_size(header, count, channels));
         return SB_ERR_BAD_IMAGE;
     }
     if (get_u64(b + size - 8) != XXH3_64bits(b, size - 8)) {
         sb_error("%s: the checksum does not match: the file was changed or corrupted", source);
         return SB_ERR_HASH_MISMATCH;
     }
-    for (int i = 104; i < SB_PROBES_HEADER_BYTES; i++)
+    for (uint32_t i = version == 1 ? 104 : 108 + 4 * layers; i < header; i++)
         if (b[i]) {
-            sb_error("%s: reserved header byte %d is not zero", source, i);
+            sb_error("%s: reserved header byte %u is not zero", source, i);
             return SB_ERR_PROBES;
         }
+    for (uint32_t l = 0; l < layers; l++) {
+        float h = get_f32(b + 108 + 4 * l);
+        if (!(h >= 0 && h <= 1e4) || (l && !(h > layout->layers_m[l - 1]))) {
+            sb_error("%s: layer %u at %g m: expected heights in [0, 1e4] m, each above the one before", source, l,
+                     h);
+            memset(layout, 0, sizeof(*layout));
+            return SB_ERR_PROBES;
+        }
+        layout->layers_m[l] = h;
+    }
+    layout->layer_count = layers;
     for (int i = 0; i < 3; i++) {
         layout->grid[i] = grid[i];
         layout->origin_m[i] = get_f32(b + 44 + 4 * i);
@@ -218,7 +247,7 @@ enum sb_result sb_probes_parse(const void *data, size_t size, const char *source
         return res;
     }
     sb_image_set_channel_names(image, channel_names);
-    const uint8_t *p = b + SB_PROBES_HEADER_BYTES;
+    const uint8_t *p = b + header;
     for (uint32_t c = 0; c < channels && !res; c++) {
         double lo, hi;
         channel_range(image->channel_names[c], &lo, &hi);
@@ -254,7 +283,7 @@ enum sb_result sb_probes_read(const char *path, const char *channel_names, uint3
             close(fd);
         return SB_ERR_IO;
     }
-    size_t largest = file_size(SB_PROBES_MAX_COUNT, SB_IMAGE_MAX_CHANNELS);
+    size_t largest = file_size(SB_PROBES_HEADER_BYTES, SB_PROBES_MAX_COUNT, SB_IMAGE_MAX_CHANNELS);
     if (!S_ISREG(st.st_mode) || (uint64_t)st.st_size > largest) {
         sb_error("%s: not a regular file of at most %zu bytes", path, largest);
         close(fd);

@@ -5,9 +5,9 @@
  *
  *   offset  size  field
  *        0     8  magic "SBPROBES"
- *        8     4  format version (1)
+ *        8     4  format version (1, or 2: a grid that follows the surface)
  *       12     4  byte-order mark 0x01020304
- *       16     4  header bytes (112)
+ *       16     4  header bytes (112; version 2: 152)
  *       20     4  channels per probe
  *       24     4  probe count (grid probes, then explicit ones)
  *       28    12  grid probes along x, y, z (0 0 0: no grid)
@@ -16,9 +16,23 @@
  *       56    12  the grid's spacing, metres
  *       68     4  rays per probe
  *       72    32  the bake key that produced it, lowercase hex
+ *   version 1:
  *      104     8  reserved, zero
- *      112     -  probe count x channels x float32, probe by probe
+ *   version 2:
+ *      104     4  layers L (1 to 8): the grid's y counts them
+ *      108    32  each layer's height above the surface, metres, increasing
+ *                 (float32; past L, zero)
+ *      140    12  reserved, zero
+ *   header     -  probe count x channels x float32, probe by probe
  *      end     8  XXH3-64 of every byte before it
+ *
+ * A grid of layers follows the surface: its probes stand in columns (x, z
+ * as a uniform grid's, x fastest, then the layer, then z), the probe of
+ * layer l at its height above the first surface a ray straight down its
+ * column met (the position channels say where each is). Its y origin is 0
+ * and its y spacing the distance over the top layer that a runtime fades
+ * the probes' light over. A file without layers is written as version 1,
+ * byte for byte as before.
  *
  * The reader trusts nothing: every field is checked against the format's
  * caps and the others before anything is allocated, the size must match
@@ -34,9 +48,11 @@
 
 #include "image.h"
 #include "result.h"
+#include "scene.h"
 
-#define SB_PROBES_VERSION 1
-#define SB_PROBES_HEADER_BYTES 112
+#define SB_PROBES_VERSION 2
+#define SB_PROBES_HEADER_BYTES_V1 112
+#define SB_PROBES_HEADER_BYTES 152
 #define SB_PROBES_MAX_COUNT (1u << 20)
 #define SB_PROBES_MAX_GRID 1024 /* probes along one axis */
 
@@ -95,6 +111,10 @@ struct sb_probe_layout {
     float spacing_m[3];
     uint32_t ray_count;
     char key[33]; /* the bake key, or "" */
+    /* 0: a uniform grid; else grid[1] layers that follow the surface, at
+     * these heights above it (m, increasing) */
+    uint32_t layer_count;
+    float layers_m[SB_PROBES_MAX_LAYERS];
 };
 
 /* Write the probes (image: width = probe count, height = depth = 1, the

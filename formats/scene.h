@@ -103,6 +103,8 @@ struct sb_world_params {
 
 /* The scene's "probes": where the sky-visibility probes go. */
 #define SB_PROBES_MAX_EXPLICIT 256
+/* A grid that follows the surface has at most this many layers (probes.h). */
+#define SB_PROBES_MAX_LAYERS 8
 struct sb_probe_params {
     double spacing_m;          /* a grid over the world's bounds, this far apart [2]; 0: none */
     double margin_m;           /* the grid's bounds: the world's, grown by this [0] */
@@ -110,6 +112,11 @@ struct sb_probe_params {
     double bounds_m[2][3];     /* min, max corners */
     uint32_t rays;             /* per probe, a multiple of 64 [2048] */
     double inside_fraction;    /* more back-face hits than this: inside geometry [0.25] */
+    /* layers_m given: the grid follows the surface, layer_count probes a
+     * column at these heights (m, increasing) above the first surface a ray
+     * down the column meets, instead of spacing_m apart in y [none] */
+    int layer_count;
+    double layers_m[SB_PROBES_MAX_LAYERS];
     uint32_t bounce_rays;      /* sky_bounce: rays a probe for the surfaces it sees, a multiple of 64 [256] */
     uint32_t bounce_secondary; /* sky_bounce: rays from each surface hit, a multiple of 8 [64] */
     int explicit_count;

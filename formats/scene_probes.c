@@ -36,8 +36,8 @@ static enum sb_result probes_validate(const struct sb_scene *scene, const char *
 
 static enum sb_result probes_section_parse(const cJSON *obj, struct sb_scene *scene, const char *source)
 {
-    static const char *const keys[] = {"spacing_m",   "margin_m",    "bounds_m",         "rays", "inside_fraction",
-                                       "positions_m", "bounce_rays", "bounce_secondary", NULL};
+    static const char *const keys[] = {"spacing_m",   "margin_m",    "bounds_m",         "rays",     "inside_fraction",
+                                       "positions_m", "bounce_rays", "bounce_secondary", "layers_m", NULL};
     struct sb_probe_params *p = &scene->probes;
     sb_probe_params_default(p);
     scene->has_probes = true;
@@ -112,6 +112,27 @@ static enum sb_result probes_section_parse(const cJSON *obj, struct sb_scene *sc
             res = sb_json_vec3(e, source, path, -1e4, 1e4, p->positions_m[p->explicit_count++]);
         }
     }
+    if (!res && (item = cJSON_GetObjectItemCaseSensitive(obj, "layers_m"))) {
+        int n = cJSON_IsArray(item) ? cJSON_GetArraySize(item) : 0;
+        if (n < 1 || n > SB_PROBES_MAX_LAYERS) {
+            sb_error("%s: probes.layers_m: expected an array of 1 to %d heights above the surface (m)", source,
+                     SB_PROBES_MAX_LAYERS);
+            return cJSON_IsArray(item) ? SB_ERR_OUT_OF_RANGE : SB_ERR_WRONG_TYPE;
+        }
+        for (const cJSON *e = item->child; e && !res; e = e->next, p->layer_count++) {
+            char path[64];
+            snprintf(path, sizeof(path), "probes.layers_m[%d]", p->layer_count);
+            double *h = &p->layers_m[p->layer_count];
+            if (!(res = sb_json_number(e, source, path, 0.01, 1000, h)) && p->layer_count && !(*h > h[-1])) {
+                sb_error("%s: %s: %g is not above the layer before it (%g)", source, path, *h, h[-1]);
+                res = SB_ERR_OUT_OF_RANGE;
+            }
+        }
+        if (!res && p->spacing_m == 0) {
+            sb_error("%s: probes.layers_m: the layers need a grid (probes.spacing_m above 0)", source);
+            return SB_ERR_OUT_OF_RANGE;
+        }
+    }
     if (!res && p->spacing_m == 0 && !p->explicit_count) {
         sb_error("%s: probes: no grid (spacing_m 0) and no positions_m: no probe at all", source);
         return SB_ERR_OUT_OF_RANGE;
@@ -139,6 +160,8 @@ static cJSON *probes_section_json(const struct sb_scene *scene)
         cJSON_AddNumberToObject(o, "bounce_rays", p->bounce_rays);
         cJSON_AddNumberToObject(o, "bounce_secondary", p->bounce_secondary);
     }
+    if (p->layer_count) /* only when given: scenes without keep their hash */
+        cJSON_AddItemToObject(o, "layers_m", cJSON_CreateDoubleArray(p->layers_m, p->layer_count));
     cJSON *list = cJSON_AddArrayToObject(o, "positions_m");
     for (int i = 0; i < p->explicit_count; i++)
         cJSON_AddItemToArray(list, cJSON_CreateDoubleArray(p->positions_m[i], 3));

@@ -1161,7 +1161,8 @@ static void test_probes(void)
     size_t size = f ? fread(bytes, 1, sizeof(bytes), f) : 0;
     if (f)
         fclose(f);
-    CHECK(size == SB_PROBES_HEADER_BYTES + (size_t)n * ch * 4 + 8, "size %zu", size);
+    CHECK(size == SB_PROBES_HEADER_BYTES_V1 + (size_t)n * ch * 4 + 8, "a grid without layers is version 1: size %zu",
+          size);
     int refused = 0, tried = 0;
     for (size_t cut = 0; cut < size; cut++, tried++)
         refused += sb_probes_parse(bytes, cut, "cut", SB_SKY_VISIBILITY_CHANNELS, 1000, &got, &back) != SB_OK;
@@ -1192,7 +1193,8 @@ static void test_probes(void)
         enum sb_result want;
         const char *what;
     } fields[] = {
-        {8, 2, SB_ERR_VERSION, "a newer version"},
+        {8, 3, SB_ERR_VERSION, "a newer version"},
+        {8, 2, SB_ERR_PROBES, "version 2 with version 1's header"},
         {8, 0, SB_ERR_VERSION, "version 0"},
         {12, 0x04030201, SB_ERR_PROBES, "big endian"},
         {16, 116, SB_ERR_PROBES, "another header size"},
@@ -1204,11 +1206,11 @@ static void test_probes(void)
         {48, 0x7fc00000, SB_ERR_PROBES, "a NaN origin"},
         {72, 0x41414141, SB_ERR_PROBES, "a key that is not hex"},
         {108, 1, SB_ERR_PROBES, "a reserved byte"},
-        {SB_PROBES_HEADER_BYTES + 6 * 4, 0x3f000000, SB_ERR_NUMERIC, "valid = 0.5"},
-        {SB_PROBES_HEADER_BYTES + 7 * 4, 0x40000000, SB_ERR_NUMERIC, "a fraction of 2"},
-        {SB_PROBES_HEADER_BYTES + 9 * 4, 0xbf800000, SB_ERR_NUMERIC, "a negative distance"},
-        {SB_PROBES_HEADER_BYTES + 12 * 4, 0x41200000, SB_ERR_NUMERIC, "an SH coefficient of 10"},
-        {SB_PROBES_HEADER_BYTES + 0 * 4, 0x7f800000, SB_ERR_NUMERIC, "an infinite position"},
+        {SB_PROBES_HEADER_BYTES_V1 + 6 * 4, 0x3f000000, SB_ERR_NUMERIC, "valid = 0.5"},
+        {SB_PROBES_HEADER_BYTES_V1 + 7 * 4, 0x40000000, SB_ERR_NUMERIC, "a fraction of 2"},
+        {SB_PROBES_HEADER_BYTES_V1 + 9 * 4, 0xbf800000, SB_ERR_NUMERIC, "a negative distance"},
+        {SB_PROBES_HEADER_BYTES_V1 + 12 * 4, 0x41200000, SB_ERR_NUMERIC, "an SH coefficient of 10"},
+        {SB_PROBES_HEADER_BYTES_V1 + 0 * 4, 0x7f800000, SB_ERR_NUMERIC, "an infinite position"},
     };
     for (size_t i = 0; i < sizeof(fields) / sizeof(fields[0]); i++) {
         uint8_t edited[4096];
@@ -1223,6 +1225,75 @@ static void test_probes(void)
             sb_image_finish(&back);
     }
     CHECK(sb_probes_read(dir, SB_SKY_VISIBILITY_CHANNELS, 1000, &got, &back) == SB_ERR_IO, "a directory");
+
+    /* A grid of layers that follow the surface: version 2, its heights
+     * round-trip, every prefix and bit flip is refused, and so are layers
+     * that do not match the grid or do not rise. */
+    struct sb_image layered = {0};
+    const uint32_t nl = 2 * 2 * 2;
+    CHECK(sb_image_init(&layered, nl, 1, ch) == SB_OK, "image");
+    sb_image_set_channel_names(&layered, SB_SKY_VISIBILITY_CHANNELS);
+    memcpy(layered.data, img.data, sizeof(float) * (n < nl ? n : nl) * ch);
+    for (uint32_t i = n; i < nl; i++)
+        memcpy(&layered.data[i * ch], img.data, sizeof(float) * ch);
+    struct sb_probe_layout terrain = {.grid = {2, 2, 2},
+                                      .origin_m = {-1, 0, 2},
+                                      .spacing_m = {12.5f, 20, 12.5f},
+                                      .ray_count = 512,
+                                      .layer_count = 2,
+                                      .layers_m = {1.5f, 10}};
+    CHECK(sb_probes_write(path, &terrain, &layered) == SB_OK, "write layers");
+    CHECK(sb_probes_read(path, SB_SKY_VISIBILITY_CHANNELS, 1000, &got, &back) == SB_OK, "read layers back");
+    CHECK(got.layer_count == 2 && got.layers_m[0] == 1.5f && got.layers_m[1] == 10 && got.grid[1] == 2 &&
+              got.spacing_m[1] == 20 && back.width == nl && !memcmp(back.data, layered.data, sizeof(float) * nl * ch),
+          "the layers' round trip is exact");
+    sb_image_finish(&back);
+    f = fopen(path, "rb");
+    size = f ? fread(bytes, 1, sizeof(bytes), f) : 0;
+    if (f)
+        fclose(f);
+    CHECK(size == SB_PROBES_HEADER_BYTES + (size_t)nl * ch * 4 + 8 && bytes[8] == 2, "version 2: size %zu", size);
+    refused = tried = 0;
+    for (size_t cut = 0; cut < size; cut++, tried++)
+        refused += sb_probes_parse(bytes, cut, "cut", SB_SKY_VISIBILITY_CHANNELS, 1000, &got, &back) != SB_OK;
+    CHECK(refused == tried, "layers: every truncated prefix is refused (%d of %d)", refused, tried);
+    refused = tried = 0;
+    for (size_t i = 0; i < size; i++)
+        for (int bit = 0; bit < 8; bit++, tried++) {
+            bytes[i] ^= (uint8_t)(1u << bit);
+            enum sb_result res = sb_probes_parse(bytes, size, "flip", SB_SKY_VISIBILITY_CHANNELS, 1000, &got, &back);
+            refused += res != SB_OK;
+            if (res == SB_OK)
+                sb_image_finish(&back);
+            bytes[i] ^= (uint8_t)(1u << bit);
+        }
+    CHECK(refused == tried, "layers: every bit flip is refused (%d of %d)", refused, tried);
+    struct {
+        size_t offset;
+        uint32_t value;
+        const char *what;
+    } layer_fields[] = {
+        {104, 3, "more layers than the grid is high"},
+        {104, 0, "no layers in version 2"},
+        {104, 9, "more layers than the cap"},
+        {112, 0x3f800000, "a layer below the one before it"},
+        {108, 0x7fc00000, "a NaN height"},
+        {108, 0xbf800000, "a negative height"},
+        {116, 0x40000000, "a height past the layers"},
+        {148, 1, "a reserved byte"},
+    };
+    for (size_t i = 0; i < sizeof(layer_fields) / sizeof(layer_fields[0]); i++) {
+        uint8_t edited[4096];
+        memcpy(edited, bytes, size);
+        for (int k = 0; k < 4; k++)
+            edited[layer_fields[i].offset + k] = (uint8_t)(layer_fields[i].value >> (8 * k));
+        restamp(edited, size);
+        enum sb_result res = sb_probes_parse(edited, size, "edited", SB_SKY_VISIBILITY_CHANNELS, 1000, &got, &back);
+        CHECK(res == SB_ERR_PROBES, "%s: %s", layer_fields[i].what, sb_result_name(res));
+        if (res == SB_OK)
+            sb_image_finish(&back);
+    }
+    sb_image_finish(&layered);
     unlink(path);
     rmdir(dir);
     sb_image_finish(&img);

@@ -37,7 +37,7 @@ check "only what was asked for" test ! -e "$tmp/p/transmittance.exr"
 check "verify" expect_exit 0 "$skybake" verify "$tmp/p"
 check "info lists sky_visibility" expect_exit 0 "$skybake" info "$tmp/p"
 check "info shows the grid" grep -q '"grid":\[6,1,6\]' "$tmp/out"
-check "manifest has format_version 6" grep -Eq '"format_version":[[:space:]]*6,' "$tmp/p/manifest.json"
+check "manifest has format_version 7" grep -Eq '"format_version":[[:space:]]*7,' "$tmp/p/manifest.json"
 check "diff with itself" expect_exit 0 "$skybake" diff "$tmp/p" "$tmp/p"
 hash() { sed -n 's/.*"content_hash":[[:space:]]*"\([0-9a-f]*\)".*/\1/p' "$tmp/p/manifest.json"; }
 first=$(hash)
@@ -215,6 +215,43 @@ check "and nothing is written" test ! -e "$tmp/r_inside"
 refl '[{"position_m":[0,1,0],"box_m":[[0,0,0],[0,3,5]]}]' >"$tmp/r_flat.json"
 check "a flat box is refused" expect_exit 2 "$skybake" bake "$tmp/r_flat.json" -o "$tmp/r_flat"
 check "naming the field" grep -q "reflections.probes\[0\].box_m" "$tmp/err"
+
+# A grid of layers that follows the surface: spacing 3 m over the world's
+# 20 m, so that the middle column stands over the slab (2 m up) and the
+# others over the ground; each probe at its layer's height over its column.
+sed -i 's/^v 2 2.5 2$/v 2 2 2/' "$tmp/world.obj"
+printf '{"atmosphere":{"preset":"earth"},"products":["sky_visibility","sky_bounce"],"world":{"file":"world.obj"},"probes":{"spacing_m":3,"rays":512,"layers_m":[1,5],"bounce_rays":64,"bounce_secondary":8}}' >"$tmp/layers.json"
+check "bake a grid of layers" expect_exit 0 "$skybake" bake "$tmp/layers.json" -o "$tmp/layers" -q
+check "verify it" expect_exit 0 "$skybake" verify "$tmp/layers"
+check "info gives the grid and its layers" expect_exit 0 "$skybake" info "$tmp/layers"
+check "7 columns by 7, 2 layers" grep -q '"grid":\[7,2,7\].*"layers_m":\[1,5\]' "$tmp/out"
+check "each probe at its layer over the surface under its column" python3 - "$tmp/layers/sky_visibility.sbprobes" <<'PY'
+import struct, sys
+b = open(sys.argv[1], "rb").read()
+version, = struct.unpack_from("<I", b, 8)
+header, channels, count = struct.unpack_from("<III", b, 16)
+nx, nl, nz = struct.unpack_from("<III", b, 28)
+layers, = struct.unpack_from("<I", b, 104)
+heights = struct.unpack_from("<%df" % layers, b, 108)
+assert version == 2 and header == 152 and layers == nl == 2 and heights == (1.0, 5.0), (version, header, layers, heights)
+for z in range(nz):
+    for x in range(nx):
+        want = 2.0 if x == nx // 2 and z == nz // 2 else 0.0  # the slab under the middle column
+        for l in range(nl):
+            r = struct.unpack_from("<%df" % channels, b, header + 4 * channels * (x + nx * (l + nl * z)))
+            surface = r[1] - r[4] - heights[l]  # where it was placed, before any push out
+            assert abs(surface - want) < 1e-4, (x, l, z, surface, want)
+            assert abs(r[0] - r[3] - (-9 + 3 * x)) < 1e-5 and abs(r[2] - r[5] - (-9 + 3 * z)) < 1e-5, (x, z, r[:6])
+PY
+cp -r "$tmp/layers" "$tmp/layers6"
+sed -i 's/"format_version":[[:space:]]*[0-9]*/"format_version": 6/' "$tmp/layers6/manifest.json"
+check "a grid in layers in a version 6 pack is refused" expect_exit 1 "$skybake" verify "$tmp/layers6"
+check "naming the version" grep -q "format version 6 cannot hold" "$tmp/err"
+for bad in '"layers_m":[2,1]' '"layers_m":[]' '"layers_m":[1,2,3,4,5,6,7,8,9]' '"layers_m":[0]' '"spacing_m":0,"positions_m":[[0,1,0]],"layers_m":[1]'; do
+    printf '{"atmosphere":{"preset":"earth"},"products":["sky_visibility"],"world":{"file":"world.obj"},"probes":{%s}}' "$bad" >"$tmp/bad_layers.json"
+    check "probes {$bad} refused" expect_exit 2 "$skybake" bake "$tmp/bad_layers.json" -o "$tmp/bad_layers"
+    check "naming probes.layers_m" grep -q "probes.layers_m" "$tmp/err"
+done
 
 echo "probes cli: $checks checks, $fails failed"
 echo "$((checks - fails)) passed, $fails failed"

@@ -944,6 +944,52 @@ static void test_probes(const char *dir)
     CHECK(overhang_sky > 0.8, "without the probes the overhang is lit like open ground (%.3f)", overhang_sky);
     CHECK(room < 0.01, "inside the closed room: %.4f of open ground with the probes; near black expected", room);
     CHECK(room_sky > 0.1, "without the probes the room is lit by the sky (%.3f)", room_sky);
+
+    /* The same world's probes in layers over its surfaces (1 m columns,
+     * 0.5 to 3.5 m up): open ground is lit as by the uniform grid (the
+     * probes the points read stand where the grid's do). The slab's and
+     * the room's columns stand on their tops, so nothing under them is
+     * resolved: the detail layout's work, not the layers'. */
+    char layers_dir[420];
+    snprintf(layers_dir, sizeof(layers_dir), "%s-layers", pack_dir);
+    scene = calloc(1, sizeof(*scene));
+    snprintf(scene->preset, sizeof(scene->preset), "earth");
+    sb_atmosphere_preset_earth(&scene->atmosphere);
+    scene->wants[SB_PRODUCT_IRRADIANCE_GROUND] = scene->wants[SB_PRODUCT_SKY_VISIBILITY] = true;
+    scene->wants[SB_PRODUCT_SKY_BOUNCE] = true;
+    snprintf(scene->world.file, sizeof(scene->world.file), "%s", world_path);
+    scene->has_world = true;
+    scene->world.units_m = scene->world.scale = 1.0;
+    scene->has_probes = true;
+    sb_probe_params_default(&scene->probes);
+    scene->probes.spacing_m = 1.0;
+    scene->probes.rays = 1024;
+    scene->probes.bounce_rays = 128;
+    scene->probes.bounce_secondary = 32;
+    scene->probes.has_bounds = true;
+    memcpy(scene->probes.bounds_m, bounds, sizeof(bounds));
+    scene->probes.layer_count = 4;
+    for (int l = 0; l < 4; l++)
+        scene->probes.layers_m[l] = 0.5 + l;
+    struct sb_pack layer_pack;
+    ok = sb_bake_scene(vk, scene, layers_dir, NULL, &report) == SB_OK && sb_pack_open(layers_dir, &layer_pack) == SB_OK;
+    free(scene);
+    CHECK(ok && layer_pack.artifacts[SB_PRODUCT_SKY_VISIBILITY].probes.layer_count == 4, "bake the layers");
+    if (ok) {
+        double layered[4];
+        struct sb_renderer *r = NULL;
+        struct sb_renderer_params rp = {.width = W, .height = H, .shadow_size = 512};
+        CHECK(sb_renderer_create(vk, &layer_pack, &w, &rp, &r) == SB_OK, "renderer");
+        if (r)
+            probe_views(r, layered);
+        sb_renderer_destroy(&r);
+        printf("probes in layers over the surface: open ground %.3f of the uniform grid's light, %.3f of the "
+               "sky-alone model's\n",
+               layered[1] / lit[1], layered[1] / sky[1]);
+        CHECK(fabs(layered[1] / lit[1] - 1.0) < 0.02, "open ground under layers as under the grid: %.4f",
+              layered[1] / lit[1]);
+        sb_pack_close(&layer_pack);
+    }
     sb_world_finish(&w);
     sb_pack_close(&probe_pack);
 }

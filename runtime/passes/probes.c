@@ -115,6 +115,10 @@ static enum sb_result upload_probes(struct sb_renderer *r, struct probes *s)
     }
     g->grid[3] = r->probe_count;
     g->origin_m[3] = (float)entries;
+    _Static_assert(SB_PROBES_MAX_LAYERS <= 8, "sb_probes_gpu holds 8 layers");
+    g->layered[0] = layout->layer_count;
+    for (uint32_t l = 0; l < layout->layer_count; l++)
+        g->layers_m[l / 4][l % 4] = layout->layers_m[l];
     mean_albedo(r->world, g->bounce_albedo);
     const struct sb_image *bounce = &pack->images[SB_PRODUCT_SKY_BOUNCE];
     const struct sb_probe_layout *bounce_layout = &pack->artifacts[SB_PRODUCT_SKY_BOUNCE].probes;
@@ -142,9 +146,20 @@ static enum sb_result upload_probes(struct sb_renderer *r, struct probes *s)
         const float *sh = c + SB_SKY_VISIBILITY_SH;
         for (int k = 0; k < SB_PROBE_SH; k++)
             o[4 + k] = w[band[k]] > 1e-3 ? (float)(sh[k] / w[band[k]]) : sh[k];
+        if (layout->layer_count) { /* the surface under its column: where it was placed, less its layer */
+            uint32_t l = p / layout->grid[0] % layout->grid[1];
+            o[13] = c[SB_SKY_VISIBILITY_POSITION + 1] - c[SB_SKY_VISIBILITY_OFFSET + 1] - layout->layers_m[l];
+        }
     }
-    sb_info("probes: %u x %u x %u, %.3g m apart, light the world (bounce %s)", layout->grid[0], layout->grid[1],
-            layout->grid[2], (double)layout->spacing_m[0], has_bounce ? "baked" : "modelled");
+    if (layout->layer_count)
+        sb_info("probes: %u x %u columns %.3g m apart, %u layers over the surface (%.3g to %.3g m), light the "
+                "world (bounce %s)",
+                layout->grid[0], layout->grid[2], (double)layout->spacing_m[0], layout->layer_count,
+                (double)layout->layers_m[0], (double)layout->layers_m[layout->layer_count - 1],
+                has_bounce ? "baked" : "modelled");
+    else
+        sb_info("probes: %u x %u x %u, %.3g m apart, light the world (bounce %s)", layout->grid[0],
+                layout->grid[1], layout->grid[2], (double)layout->spacing_m[0], has_bounce ? "baked" : "modelled");
     return SB_OK;
 }
 

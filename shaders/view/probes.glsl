@@ -34,6 +34,36 @@ const float SH_COSINE[3] = float[3](SB_SH_COSINE_FACTORS);
 const int SH_BAND[SB_PROBE_SH] = int[SB_PROBE_SH](SB_SH_BANDS);
 
 #ifndef PROBE_LIGHT_WRITABLE
+/* Probe `index`'s irradiance along n and r (yn, yr: their SH bases), added
+ * with weight w times DDGI's wrap of the direction from pos toward it; an
+ * invalid probe adds nothing. */
+void probe_add(uint index, float w, vec3 pos, vec3 n, float yn[SB_PROBE_SH], float yr[SB_PROBE_SH], inout vec3 e_n,
+               inout vec3 e_r, inout float wsum)
+{
+    vec4 where = probe_data[SB_PROBE_VEC4S * index];
+    if (w <= 0.0 || where.w == 0.0)
+        return;
+    vec3 to = where.xyz - pos;
+    float len = length(to);
+    float wrap = len > 1e-4 ? 0.5 * (dot(to / len, n) + 1.0) : 1.0;
+    w *= wrap * wrap + 0.2;
+    vec3 sn = vec3(0.0), sr = vec3(0.0);
+    for (int k = 0; k < SB_PROBE_SH; k++) {
+        vec3 e = probe_irradiance[SB_PROBE_SH * index + k].rgb;
+        sn += e * yn[k];
+        sr += e * yr[k];
+    }
+    e_n += w * max(sn, vec3(0.0));
+    e_r += w * max(sr, vec3(0.0));
+    wsum += w;
+}
+
+/* Layer l's height over the surface (a grid of layers). */
+float probe_layer(int l)
+{
+    return probes.layers_m[l >> 2][l & 3];
+}
+
 /*
  * Irradiance from the probes at world point pos (m) on a surface of normal
  * n, and along a second direction r (the mirror direction, for the
@@ -43,6 +73,11 @@ const int SH_BAND[SB_PROBE_SH] = int[SB_PROBE_SH](SB_SH_BANDS);
  * renormalised. *coverage is 1 inside the grid (and half a spacing past
  * its outer probes), fading to 0 one spacing further, and 0 with no probe
  * (or no valid one) around.
+ *
+ * A grid of layers over the surface: bilinear between the 4 columns
+ * around pos, and in each column linear between the two layers around
+ * pos's height over that column's surface (below the lowest, the lowest;
+ * above the top, the top, fading to nothing over the y spacing).
  */
 void probe_lookup(vec3 pos, vec3 n, vec3 r, out vec3 e_n, out vec3 e_r, out float coverage)
 {
@@ -52,6 +87,52 @@ void probe_lookup(vec3 pos, vec3 n, vec3 r, out vec3 e_n, out vec3 e_r, out floa
     if (probes.grid.w == 0u)
         return;
     vec3 spacing = probes.spacing_m.xyz;
+    float yn[SB_PROBE_SH], yr[SB_PROBE_SH];
+    sh9_basis(n, yn);
+    sh9_basis(r, yr);
+    float wsum = 0.0;
+    int layers = int(probes.layered.x);
+    if (layers > 0) {
+        float lowest_gap = layers > 1 ? probe_layer(1) - probe_layer(0) : probe_layer(0);
+        vec3 q = pos + n * (0.25 * min(min(spacing.x, spacing.z), lowest_gap));
+        vec2 g = (q.xz - probes.origin_m.xz) / spacing.xz;
+        vec2 last = vec2(probes.grid.xz) - 1.0;
+        vec2 outside = max(max(-g, g - last) - 0.5, vec2(0.0));
+        float fade = clamp(1.0 - max(outside.x, outside.y), 0.0, 1.0);
+        if (fade <= 0.0)
+            return;
+        vec2 c = clamp(g, vec2(0.0), last);
+        vec2 base = min(floor(c), max(last - 1.0, vec2(0.0)));
+        vec2 f = c - base;
+        float column_cover = 0.0;
+        for (int corner = 0; corner < 4; corner++) {
+            vec2 o = vec2(corner & 1, corner >> 1);
+            uvec2 at = uvec2(min(base + o, last));
+            vec2 bi = mix(1.0 - f, f, o);
+            float w = bi.x * bi.y;
+            uint column = at.x + probes.grid.x * probes.grid.y * at.y; /* its layer 0 */
+            float dy = q.y - probe_data[SB_PROBE_VEC4S * column + 3u].y;
+            int l = 0;
+            while (l + 2 < layers && dy > probe_layer(l + 1))
+                l++;
+            float fl = layers > 1 ? clamp((dy - probe_layer(l)) / (probe_layer(l + 1) - probe_layer(l)), 0.0, 1.0)
+                                  : 0.0;
+            float above = max(dy - probe_layer(layers - 1), 0.0) / spacing.y;
+            float vfade = clamp(1.0 - above, 0.0, 1.0);
+            column_cover += w * vfade;
+            probe_add(column + probes.grid.x * uint(l), w * vfade * (1.0 - fl), pos, n, yn, yr, e_n, e_r, wsum);
+            if (layers > 1)
+                probe_add(column + probes.grid.x * uint(l + 1), w * vfade * fl, pos, n, yn, yr, e_n, e_r, wsum);
+        }
+        if (wsum <= 1e-6) {
+            e_n = e_r = vec3(0.0);
+            return;
+        }
+        e_n /= wsum;
+        e_r /= wsum;
+        coverage = fade * column_cover;
+        return;
+    }
     vec3 q = pos + n * (0.25 * min(spacing.x, min(spacing.y, spacing.z)));
     vec3 g = (q - probes.origin_m.xyz) / spacing;
     vec3 last = vec3(probes.grid.xyz) - 1.0;
@@ -62,32 +143,12 @@ void probe_lookup(vec3 pos, vec3 n, vec3 r, out vec3 e_n, out vec3 e_r, out floa
     vec3 c = clamp(g, vec3(0.0), last);
     vec3 base = min(floor(c), max(last - 1.0, vec3(0.0)));
     vec3 f = c - base;
-    float yn[SB_PROBE_SH], yr[SB_PROBE_SH];
-    sh9_basis(n, yn);
-    sh9_basis(r, yr);
-    float wsum = 0.0;
     for (int corner = 0; corner < 8; corner++) {
         vec3 o = vec3(corner & 1, (corner >> 1) & 1, (corner >> 2) & 1);
         uvec3 at = uvec3(min(base + o, last));
         vec3 tri = mix(1.0 - f, f, o);
-        float w = tri.x * tri.y * tri.z;
         uint index = at.x + probes.grid.x * (at.y + probes.grid.y * at.z);
-        vec4 where = probe_data[SB_PROBE_VEC4S * index];
-        if (w <= 0.0 || where.w == 0.0)
-            continue;
-        vec3 to = where.xyz - pos;
-        float len = length(to);
-        float wrap = len > 1e-4 ? 0.5 * (dot(to / len, n) + 1.0) : 1.0;
-        w *= wrap * wrap + 0.2;
-        vec3 sn = vec3(0.0), sr = vec3(0.0);
-        for (int k = 0; k < SB_PROBE_SH; k++) {
-            vec3 e = probe_irradiance[SB_PROBE_SH * index + k].rgb;
-            sn += e * yn[k];
-            sr += e * yr[k];
-        }
-        e_n += w * max(sn, vec3(0.0));
-        e_r += w * max(sr, vec3(0.0));
-        wsum += w;
+        probe_add(index, tri.x * tri.y * tri.z, pos, n, yn, yr, e_n, e_r, wsum);
     }
     if (wsum <= 1e-6) {
         e_n = e_r = vec3(0.0);

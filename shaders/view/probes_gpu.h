@@ -24,6 +24,12 @@ struct sb_probes_gpu {
     SB_VEC4(origin_m);       /* xyz: the first probe (world, m); w: tensor entries */
     SB_VEC4(spacing_m);      /* xyz: between probes; w: 1 when the pack's sky_bounce is in probe_data */
     SB_VEC4(bounce_albedo);  /* rgb: the world's mean albedo by area (the bounce model); w: unused */
+    /* A grid whose layers follow the surface (formats/probes.h): x its
+     * layer count (grid.y; 0: a uniform grid), and each layer's height
+     * over the surface under its column (m), 4 a vec4; each probe's 4th
+     * vec4 holds its column's surface height in y. */
+    SB_UVEC4(layered);
+    SB_VEC4(layers_m[2]);
     SB_VEC4(tensor[SB_SH_TENSOR_MAX]); /* x: the integral of Y_i Y_j Y_k; y, z, w: i, j, k */
 };
 
