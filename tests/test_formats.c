@@ -1104,6 +1104,29 @@ static void restamp(uint8_t *b, size_t size)
         b[size - 8 + i] = (uint8_t)(h >> (8 * i));
 }
 
+/* Every truncated prefix and every bit flip of a probe file's bytes is
+ * refused (`what` names the file in the messages). */
+static void check_probes_damage(uint8_t *bytes, size_t size, const char *what)
+{
+    struct sb_probe_layout got;
+    struct sb_image back;
+    int refused = 0, tried = 0;
+    for (size_t cut = 0; cut < size; cut++, tried++)
+        refused += sb_probes_parse(bytes, cut, "cut", SB_SKY_VISIBILITY_CHANNELS, 1000, &got, &back) != SB_OK;
+    CHECK(refused == tried, "%s: every truncated prefix is refused (%d of %d)", what, refused, tried);
+    refused = tried = 0;
+    for (size_t i = 0; i < size; i++)
+        for (int bit = 0; bit < 8; bit++, tried++) {
+            bytes[i] ^= (uint8_t)(1u << bit);
+            enum sb_result res = sb_probes_parse(bytes, size, "flip", SB_SKY_VISIBILITY_CHANNELS, 1000, &got, &back);
+            refused += res != SB_OK;
+            if (res == SB_OK)
+                sb_image_finish(&back);
+            bytes[i] ^= (uint8_t)(1u << bit);
+        }
+    CHECK(refused == tried, "%s: every bit flip is refused (%d of %d)", what, refused, tried);
+}
+
 static void test_probes(void)
 {
     /* The channel indices C code uses are the names' positions. */
@@ -1163,21 +1186,7 @@ static void test_probes(void)
         fclose(f);
     CHECK(size == SB_PROBES_HEADER_BYTES_V1 + (size_t)n * ch * 4 + 8, "a grid without layers is version 1: size %zu",
           size);
-    int refused = 0, tried = 0;
-    for (size_t cut = 0; cut < size; cut++, tried++)
-        refused += sb_probes_parse(bytes, cut, "cut", SB_SKY_VISIBILITY_CHANNELS, 1000, &got, &back) != SB_OK;
-    CHECK(refused == tried, "every truncated prefix is refused (%d of %d)", refused, tried);
-    refused = tried = 0;
-    for (size_t i = 0; i < size; i++)
-        for (int bit = 0; bit < 8; bit++, tried++) {
-            bytes[i] ^= (uint8_t)(1u << bit);
-            enum sb_result res = sb_probes_parse(bytes, size, "flip", SB_SKY_VISIBILITY_CHANNELS, 1000, &got, &back);
-            refused += res != SB_OK;
-            if (res == SB_OK)
-                sb_image_finish(&back);
-            bytes[i] ^= (uint8_t)(1u << bit);
-        }
-    CHECK(refused == tried, "every bit flip is refused (%d of %d)", refused, tried);
+    check_probes_damage(bytes, size, "a grid");
     uint8_t longer[4200];
     memcpy(longer, bytes, size);
     longer[size] = 0;
@@ -1253,21 +1262,7 @@ static void test_probes(void)
     if (f)
         fclose(f);
     CHECK(size == SB_PROBES_HEADER_BYTES + (size_t)nl * ch * 4 + 8 && bytes[8] == 2, "version 2: size %zu", size);
-    refused = tried = 0;
-    for (size_t cut = 0; cut < size; cut++, tried++)
-        refused += sb_probes_parse(bytes, cut, "cut", SB_SKY_VISIBILITY_CHANNELS, 1000, &got, &back) != SB_OK;
-    CHECK(refused == tried, "layers: every truncated prefix is refused (%d of %d)", refused, tried);
-    refused = tried = 0;
-    for (size_t i = 0; i < size; i++)
-        for (int bit = 0; bit < 8; bit++, tried++) {
-            bytes[i] ^= (uint8_t)(1u << bit);
-            enum sb_result res = sb_probes_parse(bytes, size, "flip", SB_SKY_VISIBILITY_CHANNELS, 1000, &got, &back);
-            refused += res != SB_OK;
-            if (res == SB_OK)
-                sb_image_finish(&back);
-            bytes[i] ^= (uint8_t)(1u << bit);
-        }
-    CHECK(refused == tried, "layers: every bit flip is refused (%d of %d)", refused, tried);
+    check_probes_damage(bytes, size, "a grid in layers");
     struct {
         size_t offset;
         uint32_t value;

@@ -872,13 +872,10 @@ static void probe_views(struct sb_renderer *r, double out[4])
     free(rgb);
 }
 
-static void test_probes(const char *dir)
+/* The scene that bakes probe_world's probes (1 m apart, over the box
+ * around the overhang and the room) and their bounce. */
+static struct sb_scene *probe_scene(const char *world_path)
 {
-    char world_path[400], pack_dir[400];
-    snprintf(world_path, sizeof(world_path), "%s/probe-world.json", dir);
-    snprintf(pack_dir, sizeof(pack_dir), "%s/probe-pack", dir);
-    FILE *f = fopen(world_path, "w");
-    CHECK(f && fputs(probe_world, f) >= 0 && fclose(f) == 0, "write %s", world_path);
     struct sb_scene *scene = calloc(1, sizeof(*scene));
     snprintf(scene->name, sizeof(scene->name), "probes test");
     snprintf(scene->preset, sizeof(scene->preset), "earth");
@@ -898,6 +895,17 @@ static void test_probes(const char *dir)
     scene->probes.has_bounds = true;
     const double bounds[2][3] = {{-18, 0.5, -18}, {12, 4.5, -4}};
     memcpy(scene->probes.bounds_m, bounds, sizeof(bounds));
+    return scene;
+}
+
+static void test_probes(const char *dir)
+{
+    char world_path[400], pack_dir[400];
+    snprintf(world_path, sizeof(world_path), "%s/probe-world.json", dir);
+    snprintf(pack_dir, sizeof(pack_dir), "%s/probe-pack", dir);
+    FILE *f = fopen(world_path, "w");
+    CHECK(f && fputs(probe_world, f) >= 0 && fclose(f) == 0, "write %s", world_path);
+    struct sb_scene *scene = probe_scene(world_path);
     struct sb_bake_report report;
     struct sb_pack probe_pack;
     struct sb_world w;
@@ -952,22 +960,7 @@ static void test_probes(const char *dir)
      * resolved: the detail layout's work, not the layers'. */
     char layers_dir[420];
     snprintf(layers_dir, sizeof(layers_dir), "%s-layers", pack_dir);
-    scene = calloc(1, sizeof(*scene));
-    snprintf(scene->preset, sizeof(scene->preset), "earth");
-    sb_atmosphere_preset_earth(&scene->atmosphere);
-    scene->wants[SB_PRODUCT_IRRADIANCE_GROUND] = scene->wants[SB_PRODUCT_SKY_VISIBILITY] = true;
-    scene->wants[SB_PRODUCT_SKY_BOUNCE] = true;
-    snprintf(scene->world.file, sizeof(scene->world.file), "%s", world_path);
-    scene->has_world = true;
-    scene->world.units_m = scene->world.scale = 1.0;
-    scene->has_probes = true;
-    sb_probe_params_default(&scene->probes);
-    scene->probes.spacing_m = 1.0;
-    scene->probes.rays = 1024;
-    scene->probes.bounce_rays = 128;
-    scene->probes.bounce_secondary = 32;
-    scene->probes.has_bounds = true;
-    memcpy(scene->probes.bounds_m, bounds, sizeof(bounds));
+    scene = probe_scene(world_path);
     scene->probes.layer_count = 4;
     for (int l = 0; l < 4; l++)
         scene->probes.layers_m[l] = 0.5 + l;
