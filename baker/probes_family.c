@@ -46,8 +46,8 @@ struct probes_state {
     struct sb_surfaces surfaces; /* the bounce's, made with rc */
 };
 
-static enum sb_result plan(const struct sb_scene *scene, const struct sb_level *level, struct sb_probe_layout *layout,
-                           uint64_t *grid_out);
+static enum sb_result plan(const struct sb_scene *scene, const struct sb_level *level, bool say,
+                           struct sb_probe_layout *layout, uint64_t *grid_out);
 
 static enum sb_result probes_create(struct sb_vk *vk, const struct sb_scene *scene, void **out)
 {
@@ -58,7 +58,7 @@ static enum sb_result probes_create(struct sb_vk *vk, const struct sb_scene *sce
     struct sb_probe_layout layout = {0};
     uint64_t grid;
     if (!res)
-        res = plan(scene, st->level, &layout, &grid);
+        res = plan(scene, st->level, true, &layout, &grid);
     if (res) {
         sb_level_release(&st->level);
         free(st);
@@ -102,6 +102,8 @@ static void probes_key(void *state, const struct sb_scene *scene, enum sb_produc
         sb_key_add3(key, "at", p->positions_m[i]);
     for (int l = 0; l < p->layer_count; l++) /* none: the keys of uniform grids as they were */
         sb_key_add(key, " layer=%a", p->layers_m[l]);
+    if (p->budget_mb > 0)
+        sb_key_add(key, " budget_mb=%a", p->budget_mb);
     sb_sky_visibility_code_hash(code);
     sb_key_add(key, " code %s", code);
     if (id == SB_PRODUCT_SKY_BOUNCE) { /* and the visibility's key, as its input */
@@ -126,8 +128,56 @@ static enum sb_result raycaster(struct probes_state *st, struct sb_vk *vk)
 /* The grid over the world's bounds (or the scene's), centred on them, and
  * its size checked against the caps: from the scene and its world alone,
  * so that probes_create refuses a grid before any product is baked. */
-static enum sb_result plan(const struct sb_scene *scene, const struct sb_level *level, struct sb_probe_layout *layout,
-                           uint64_t *grid_out)
+/* The bytes a probe takes in the pack: its sky_visibility record and, when
+ * the scene bakes it, its sky_bounce record. */
+static uint64_t probe_bytes(const struct sb_scene *scene)
+{
+    return 4 * (SB_SKY_VISIBILITY_CHANNEL_COUNT +
+                (scene->wants[SB_PRODUCT_SKY_BOUNCE] ? SB_SKY_BOUNCE_CHANNEL_COUNT : 0));
+}
+
+/* The grid `spacing` apart over lo..hi (layers over the surface where the
+ * scene has them) into layout; returns its probe count, or 0 when an axis
+ * would pass SB_PROBES_MAX_GRID (*axis: which). */
+static uint64_t grid_at(const struct sb_probe_params *p, const float lo[3], const float hi[3], double spacing,
+                        struct sb_probe_layout *layout, int *axis)
+{
+    uint64_t grid = 1;
+    for (int k = 0; k < 3; k++) {
+        if (k == 1 && p->layer_count) {
+            /* layers over the surface: the y origin 0, the y spacing
+             * the distance over the top layer a runtime fades over */
+            int n = p->layer_count;
+            layout->grid[1] = (uint32_t)n;
+            layout->origin_m[1] = 0;
+            layout->spacing_m[1] = (float)(n > 1 ? p->layers_m[n - 1] - p->layers_m[n - 2] : p->layers_m[0]);
+            layout->layer_count = (uint32_t)n;
+            for (int l = 0; l < n; l++)
+                layout->layers_m[l] = (float)p->layers_m[l];
+            grid *= (uint64_t)n;
+            continue;
+        }
+        double extent = (double)hi[k] - lo[k] + 2 * p->margin_m;
+        double n = floor(extent / spacing) + 1;
+        if (n > SB_PROBES_MAX_GRID) {
+            *axis = k;
+            return 0;
+        }
+        layout->grid[k] = (uint32_t)n;
+        layout->spacing_m[k] = (float)spacing;
+        layout->origin_m[k] = (float)(0.5 * ((double)lo[k] + hi[k]) - 0.5 * (n - 1) * spacing);
+        grid *= (uint64_t)n;
+    }
+    return grid;
+}
+
+/*
+ * The grid over the world's casters (or the scene's bounds), spaced wider
+ * than probes.spacing_m where the probes would take more than the scene's
+ * budget (`say`: log that), and its size checked against the caps.
+ */
+static enum sb_result plan(const struct sb_scene *scene, const struct sb_level *level, bool say,
+                           struct sb_probe_layout *layout, uint64_t *grid_out)
 {
     const struct sb_probe_params *p = &scene->probes;
     uint64_t grid = 0;
@@ -138,43 +188,56 @@ static enum sb_result plan(const struct sb_scene *scene, const struct sb_level *
             lo[k] = (float)p->bounds_m[0][k];
             hi[k] = (float)p->bounds_m[1][k];
         }
-        grid = 1;
-        for (int k = 0; k < 3; k++) {
-            if (k == 1 && p->layer_count) {
-                /* layers over the surface: the y origin 0, the y spacing
-                 * the distance over the top layer a runtime fades over */
-                int n = p->layer_count;
-                layout->grid[1] = (uint32_t)n;
-                layout->origin_m[1] = 0;
-                layout->spacing_m[1] = (float)(n > 1 ? p->layers_m[n - 1] - p->layers_m[n - 2] : p->layers_m[0]);
-                layout->layer_count = (uint32_t)n;
-                for (int l = 0; l < n; l++)
-                    layout->layers_m[l] = (float)p->layers_m[l];
-                grid *= (uint64_t)n;
-                continue;
+        int axis = 0;
+        double spacing = p->spacing_m, budget = p->budget_mb * 1e6, per = (double)probe_bytes(scene);
+        grid = grid_at(p, lo, hi, spacing, layout, &axis);
+        double want = (double)(grid + (uint64_t)p->explicit_count) * per;
+        if (budget > 0 && (!grid || want > budget)) {
+            /* wider by the count's root (2 axes under layers, 3 without),
+             * then by 1% steps where the counts' rounding leaves it over */
+            int axes = p->layer_count ? 2 : 3;
+            double bytes = want;
+            for (int step = 0; step < 1000 && (!grid || bytes > budget); step++) {
+                double ratio = grid ? pow(bytes / budget, 1.0 / axes) : 2.0;
+                spacing *= ratio > 1.01 ? ratio : 1.01;
+                grid = grid_at(p, lo, hi, spacing, layout, &axis);
+                bytes = (double)(grid + (uint64_t)p->explicit_count) * per;
             }
-            double extent = (double)hi[k] - lo[k] + 2 * p->margin_m;
-            double n = floor(extent / p->spacing_m) + 1;
-            if (n > SB_PROBES_MAX_GRID) {
-                sb_error("probes: %.0f probes along %c (the %s %.1f m across with a %g m margin); at most %d: raise "
-                         "probes.spacing_m%s%s",
-                         n, "xyz"[k], p -> has_bounds ? "bounds are" : "world is", (double)hi[k] - lo[k], p->margin_m,
-                         SB_PROBES_MAX_GRID, p->has_bounds ? "" : " or give probes.bounds_m",
-                         p->has_bounds ? "" : " (a model in millimetres or centimetres: set world.units_m)");
+            if (grid && (double)p->explicit_count * per > budget)
+                grid = 0; /* the explicit probes alone do not fit: refused below */
+            if (grid && say)
+                sb_warn("probes: %g m apart the probes would take %.3g MB, over probes.budget_mb (%g): %.3g m apart "
+                        "instead, %llu probes, %.3g MB",
+                        p->spacing_m, want / 1e6, p->budget_mb, spacing, (unsigned long long)(grid + p->explicit_count),
+                        bytes / 1e6);
+            if (!grid) {
+                sb_error("probes: no grid fits probes.budget_mb (%g MB; %llu explicit probes take %.3f MB)",
+                         p->budget_mb, (unsigned long long)p->explicit_count, p->explicit_count * per / 1e6);
                 return SB_ERR_TOO_LARGE;
             }
-            layout->grid[k] = (uint32_t)n;
-            layout->spacing_m[k] = (float)p->spacing_m;
-            layout->origin_m[k] = (float)(0.5 * ((double)lo[k] + hi[k]) - 0.5 * (n - 1) * p->spacing_m);
-            grid *= (uint64_t)n;
         }
+        if (!grid) {
+            double extent = (double)hi[axis] - lo[axis];
+            sb_error("probes: %.0f probes along %c (the %s %.1f m across with a %g m margin); at most %d: raise "
+                     "probes.spacing_m%s%s",
+                     floor((extent + 2 * p->margin_m) / spacing) + 1, "xyz"[axis],
+                     p->has_bounds ? "bounds are" : "world is", extent, p->margin_m, SB_PROBES_MAX_GRID,
+                     p->has_bounds ? "" : " or give probes.bounds_m",
+                     p->has_bounds ? "" : " (a model in millimetres or centimetres: set world.units_m)");
+            return SB_ERR_TOO_LARGE;
+        }
+    }
+    if (p->budget_mb > 0 && !grid && (double)p->explicit_count * (double)probe_bytes(scene) > p->budget_mb * 1e6) {
+        sb_error("probes: %d explicit probes take %.3g MB, over probes.budget_mb (%g)", p->explicit_count,
+                 p->explicit_count * (double)probe_bytes(scene) / 1e6, p->budget_mb);
+        return SB_ERR_TOO_LARGE;
     }
     if (grid + (uint64_t)p->explicit_count > SB_PROBES_MAX_COUNT) {
         /* a model in millimetres is the usual reason a world is this large */
         sb_error("probes: %llu probes (a grid of %u x %u x %u, %g m apart, over the %s); at most %u: raise "
                  "probes.spacing_m%s%s",
                  (unsigned long long)(grid + p->explicit_count), layout->grid[0], layout->grid[1], layout->grid[2],
-                 p->spacing_m, p->has_bounds ? "bounds" : "world's shadow casters", SB_PROBES_MAX_COUNT,
+                 (double)layout->spacing_m[0], p->has_bounds ? "bounds" : "world's shadow casters", SB_PROBES_MAX_COUNT,
                  p->has_bounds ? "" : ", give probes.bounds_m",
                  scene->has_world && !p->has_bounds
                      ? ", or, for a model in millimetres or centimetres, set world.units_m (0.001, 0.01)"
@@ -233,7 +296,7 @@ static enum sb_result place(const struct probes_state *st, const struct sb_scene
     const struct sb_level *level = st->level;
     const struct sb_probe_params *p = &scene->probes;
     uint64_t grid;
-    enum sb_result res = plan(scene, level, layout, &grid);
+    enum sb_result res = plan(scene, level, false, layout, &grid);
     if (res)
         return res;
     layout->explicit_count = (uint32_t)p->explicit_count;
@@ -438,6 +501,12 @@ static enum sb_result bake_visibility(struct probes_state *st, const struct sb_s
              "\"inside\":%u,\"pushed_out\":%u,\"invalid\":%u,\"deringed\":%u,\"lowest_before_dering\":%.6g}",
              layout->ray_count, layout->grid[0], layout->grid[1], layout->grid[2], (double)layout->spacing_m[0],
              layout->explicit_count, (unsigned long long)level->placed_triangles, inside, pushed, inside - pushed, deringed, lowest);
+    if (scene->probes.budget_mb > 0) { /* the probes' bytes against the budget (none: as it was) */
+        size_t len = strlen(a->settings_json);
+        snprintf(a->settings_json + len - 1, sizeof(a->settings_json) - (len - 1),
+                 ",\"bytes\":%llu,\"budget_mb\":%.9g}", (unsigned long long)count * probe_bytes(scene),
+                 scene->probes.budget_mb);
+    }
     if (layout->layer_count) { /* the layers' heights, after the rest (none: as it was) */
         size_t len = strlen(a->settings_json);
         int n = snprintf(a->settings_json + len - 1, sizeof(a->settings_json) - (len - 1), ",\"layers_m\":[");

@@ -117,6 +117,9 @@ struct sb_probe_params {
      * down the column meets, instead of spacing_m apart in y [none] */
     int layer_count;
     double layers_m[SB_PROBES_MAX_LAYERS];
+    /* the probe products' bytes at most, MB (1e6 bytes): a grid that
+     * would take more is spaced wider until it fits [0: no budget] */
+    double budget_mb;
     uint32_t bounce_rays;      /* sky_bounce: rays a probe for the surfaces it sees, a multiple of 64 [256] */
     uint32_t bounce_secondary; /* sky_bounce: rays from each surface hit, a multiple of 8 [64] */
     int explicit_count;

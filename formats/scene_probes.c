@@ -37,7 +37,8 @@ static enum sb_result probes_validate(const struct sb_scene *scene, const char *
 static enum sb_result probes_section_parse(const cJSON *obj, struct sb_scene *scene, const char *source)
 {
     static const char *const keys[] = {"spacing_m",   "margin_m",    "bounds_m",         "rays",     "inside_fraction",
-                                       "positions_m", "bounce_rays", "bounce_secondary", "layers_m", NULL};
+                                       "positions_m", "bounce_rays", "bounce_secondary", "layers_m",
+                                       "budget_mb",   NULL};
     struct sb_probe_params *p = &scene->probes;
     sb_probe_params_default(p);
     scene->has_probes = true;
@@ -68,6 +69,8 @@ static enum sb_result probes_section_parse(const cJSON *obj, struct sb_scene *sc
             }
         p->has_bounds = !res;
     }
+    if (!res && (item = cJSON_GetObjectItemCaseSensitive(obj, "budget_mb")))
+        res = sb_json_number(item, source, "probes.budget_mb", 0.001, 1e5, &p->budget_mb);
     if (!res && (item = cJSON_GetObjectItemCaseSensitive(obj, "inside_fraction")))
         res = sb_json_number(item, source, "probes.inside_fraction", 0, 1, &p->inside_fraction);
     if (!res && (item = cJSON_GetObjectItemCaseSensitive(obj, "rays"))) {
@@ -160,6 +163,8 @@ static cJSON *probes_section_json(const struct sb_scene *scene)
         cJSON_AddNumberToObject(o, "bounce_rays", p->bounce_rays);
         cJSON_AddNumberToObject(o, "bounce_secondary", p->bounce_secondary);
     }
+    if (p->budget_mb > 0) /* only when given: scenes without keep their hash */
+        cJSON_AddNumberToObject(o, "budget_mb", p->budget_mb);
     if (p->layer_count) /* only when given: scenes without keep their hash */
         cJSON_AddItemToObject(o, "layers_m", cJSON_CreateDoubleArray(p->layers_m, p->layer_count));
     cJSON *list = cJSON_AddArrayToObject(o, "positions_m");

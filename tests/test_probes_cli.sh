@@ -247,6 +247,21 @@ cp -r "$tmp/layers" "$tmp/layers6"
 sed -i 's/"format_version":[[:space:]]*[0-9]*/"format_version": 6/' "$tmp/layers6/manifest.json"
 check "a grid in layers in a version 6 pack is refused" expect_exit 1 "$skybake" verify "$tmp/layers6"
 check "naming the version" grep -q "format version 6 cannot hold" "$tmp/err"
+# A memory budget: the grid is spaced wider until its probes' bytes fit,
+# saying so; the bytes are in the artifact's settings.
+printf '{"atmosphere":{"preset":"earth"},"products":["sky_visibility","sky_bounce"],"world":{"file":"world.obj"},"probes":{"spacing_m":1,"rays":64,"layers_m":[1,5],"budget_mb":0.05,"bounce_rays":64,"bounce_secondary":8}}' >"$tmp/budget.json"
+check "bake within a budget" expect_exit 0 "$skybake" bake "$tmp/budget.json" -o "$tmp/budget"
+check "saying the grid was spaced wider" grep -q "over probes.budget_mb (0.05): 3.35 m apart instead" "$tmp/err"
+check "info gives its bytes" expect_exit 0 "$skybake" info "$tmp/budget"
+bytes=$(grep -o '"bytes":[0-9]*' "$tmp/out" | head -1 | cut -d: -f2)
+check "within the budget ($bytes bytes)" test -n "$bytes" -a "${bytes:-0}" -le 50000 -a "${bytes:-0}" -gt 25000
+check "the files hold what the settings say" test "$(($(stat -c %s "$tmp/budget/sky_visibility.sbprobes") + $(stat -c %s "$tmp/budget/sky_bounce.sbprobes")))" -ge "${bytes:-0}"
+printf '{"atmosphere":{"preset":"earth"},"products":["sky_visibility"],"world":{"file":"world.obj"},"probes":{"spacing_m":0,"positions_m":[[0,1,0],[1,1,0],[2,1,0],[3,1,0],[4,1,0],[5,1,0],[6,1,0],[7,1,0],[8,1,0],[0,1,1],[1,1,1],[2,1,1],[3,1,1]],"budget_mb":0.001}}' >"$tmp/budget_small.json"
+check "13 explicit probes, 1040 bytes, over a budget of 1000 are refused" expect_exit 1 "$skybake" bake "$tmp/budget_small.json" -o "$tmp/budget_small"
+check "naming probes.budget_mb" grep -q "probes.budget_mb" "$tmp/err"
+printf '{"atmosphere":{"preset":"earth"},"products":["sky_visibility"],"world":{"file":"world.obj"},"probes":{"budget_mb":0}}' >"$tmp/budget_zero.json"
+check "a budget of 0 is refused" expect_exit 2 "$skybake" bake "$tmp/budget_zero.json" -o "$tmp/budget_zero"
+check "naming it" grep -q "probes.budget_mb" "$tmp/err"
 for bad in '"layers_m":[2,1]' '"layers_m":[]' '"layers_m":[1,2,3,4,5,6,7,8,9]' '"layers_m":[0]' '"spacing_m":0,"positions_m":[[0,1,0]],"layers_m":[1]'; do
     printf '{"atmosphere":{"preset":"earth"},"products":["sky_visibility"],"world":{"file":"world.obj"},"probes":{%s}}' "$bad" >"$tmp/bad_layers.json"
     check "probes {$bad} refused" expect_exit 2 "$skybake" bake "$tmp/bad_layers.json" -o "$tmp/bad_layers"
