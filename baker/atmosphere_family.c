@@ -73,13 +73,10 @@ static enum sb_result bake_to_tolerance(struct sb_atmosphere_baker *baker, const
 /* The settings' JSON object with the tolerance and the measured error added. */
 static void add_error_json(char *json, size_t size, double tolerance, const struct sb_error *e, const char *probe)
 {
-    size_t len = strlen(json);
-    if (!len || json[len - 1] != '}')
-        return;
-    snprintf(json + len - 1, size - (len - 1),
-             ",\"tolerance\":%.17g,\"error\":{\"max_rel\":%.6g,\"rms_rel\":%.6g,\"values\":%u,"
-             "\"against\":\"fp64 reference\",\"at\":\"%s\"}}",
-             tolerance, e->max_rel, e->rms_rel, e->count, probe);
+    sb_settings_json_add(json, size,
+                         ",\"tolerance\":%.17g,\"error\":{\"max_rel\":%.6g,\"rms_rel\":%.6g,\"values\":%u,"
+                         "\"against\":\"fp64 reference\",\"at\":\"%s\"}",
+                         tolerance, e->max_rel, e->rms_rel, e->count, probe);
 }
 
 /* The parameters a product's kernels read: the medium for all; the ground's

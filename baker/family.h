@@ -56,6 +56,11 @@ struct sb_family_baker {
                         struct sb_pipeline_params out[SB_FAMILY_KERNELS_MAX]);
 };
 
+/* Add fields (printf's `fmt`, starting with a comma) to the end of the JSON
+ * object in json[size] (an artifact's settings_json): nothing when it is
+ * not one, or when they would not fit. */
+void sb_settings_json_add(char *json, size_t size, const char *fmt, ...) __attribute__((format(printf, 3, 4)));
+
 /* The baker of `family` (< SB_FAMILY_COUNT). */
 const struct sb_family_baker *sb_family_baker(enum sb_family family);
 

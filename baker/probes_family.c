@@ -501,19 +501,17 @@ static enum sb_result bake_visibility(struct probes_state *st, const struct sb_s
              "\"inside\":%u,\"pushed_out\":%u,\"invalid\":%u,\"deringed\":%u,\"lowest_before_dering\":%.6g}",
              layout->ray_count, layout->grid[0], layout->grid[1], layout->grid[2], (double)layout->spacing_m[0],
              layout->explicit_count, (unsigned long long)level->placed_triangles, inside, pushed, inside - pushed, deringed, lowest);
-    if (scene->probes.budget_mb > 0) { /* the probes' bytes against the budget (none: as it was) */
-        size_t len = strlen(a->settings_json);
-        snprintf(a->settings_json + len - 1, sizeof(a->settings_json) - (len - 1),
-                 ",\"bytes\":%llu,\"budget_mb\":%.9g}", (unsigned long long)count * probe_bytes(scene),
-                 scene->probes.budget_mb);
-    }
-    if (layout->layer_count) { /* the layers' heights, after the rest (none: as it was) */
-        size_t len = strlen(a->settings_json);
-        int n = snprintf(a->settings_json + len - 1, sizeof(a->settings_json) - (len - 1), ",\"layers_m\":[");
-        for (uint32_t l = 0; l < layout->layer_count && n > 0; l++)
-            n += snprintf(a->settings_json + len - 1 + n, sizeof(a->settings_json) - (len - 1) - (size_t)n, "%s%.9g",
-                          l ? "," : "", (double)layout->layers_m[l]);
-        snprintf(a->settings_json + len - 1 + n, sizeof(a->settings_json) - (len - 1) - (size_t)n, "]}");
+    /* the budget's and the layers' fields only where the scene has them:
+     * the settings of other bakes as they were */
+    if (scene->probes.budget_mb > 0)
+        sb_settings_json_add(a->settings_json, sizeof(a->settings_json), ",\"bytes\":%llu,\"budget_mb\":%.9g",
+                             (unsigned long long)count * probe_bytes(scene), scene->probes.budget_mb);
+    if (layout->layer_count) {
+        char heights[SB_PROBES_MAX_LAYERS * 18] = "";
+        for (uint32_t l = 0; l < layout->layer_count; l++)
+            snprintf(heights + strlen(heights), sizeof(heights) - strlen(heights), "%s%.9g", l ? "," : "",
+                     (double)layout->layers_m[l]);
+        sb_settings_json_add(a->settings_json, sizeof(a->settings_json), ",\"layers_m\":[%s]", heights);
     }
     sb_artifact_set_world(a, st->mesh_hash, st->path);
     sb_info("sky_visibility: %u probes over %llu triangles; %u inside geometry, %u pushed out; %u deringed", count,
