@@ -954,8 +954,9 @@ static void test_probes(const char *dir)
     CHECK(room_sky > 0.1, "without the probes the room is lit by the sky (%.3f)", room_sky);
 
     /* The same world's probes in layers over its surfaces (1 m columns,
-     * 0.5 to 3.5 m up): open ground is lit as by the uniform grid (the
-     * probes the points read stand where the grid's do). The slab's and
+     * 0.5 to 3.5 m up): open ground is lit as by the uniform grid, to
+     * 0.5% (the probes the point reads stand where the grid's do; a
+     * lookup that missed them would give the sky-alone model, 2.7% off). The slab's and
      * the room's columns stand on their tops, so nothing under them is
      * resolved: the detail layout's work, not the layers'. */
     char layers_dir[420];
@@ -979,7 +980,7 @@ static void test_probes(const char *dir)
         printf("probes in layers over the surface: open ground %.3f of the uniform grid's light, %.3f of the "
                "sky-alone model's\n",
                layered[1] / lit[1], layered[1] / sky[1]);
-        CHECK(fabs(layered[1] / lit[1] - 1.0) < 0.02, "open ground under layers as under the grid: %.4f",
+        CHECK(fabs(layered[1] / lit[1] - 1.0) < 0.005, "open ground under layers as under the grid: %.4f",
               layered[1] / lit[1]);
         sb_pack_close(&layer_pack);
     }
