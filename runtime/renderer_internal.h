@@ -59,23 +59,23 @@ struct sb_renderer {
     struct sb_texture transmittance, multiscattering, irradiance_ground; /* "transmittance", ...: RGBA32F, the
                                                                             LUT; the refined and lookup forms */
     struct sb_buffer frame, vertices, exposure;                          /* "frame", "vertices", "exposure" */
-    struct sb_buffer bvh_nodes, bvh_triangles;         /* "bvh nodes", "bvh triangles": the world's BVH when traced */
-    struct sb_texel_set textures;                      /* "texture records", "texels": the world's textures */
-    struct sb_buffer instances;                        /* "instances": sb_instance_gpu[] (one zero when none) */
-    struct sb_buffer emissive;                         /* "emissive": sb_emissive_gpu[] (one zero when none) */
+    struct sb_buffer bvh_nodes, bvh_triangles; /* "bvh nodes", "bvh triangles": the world's BVH when traced */
+    struct sb_texel_set textures;              /* "texture records", "texels": the world's textures */
+    struct sb_buffer instances;                /* "instances": sb_instance_gpu[] (one zero when none) */
+    struct sb_buffer emissive;                 /* "emissive": sb_emissive_gpu[] (one zero when none) */
     /* An instanced world's draws, a mesh each: its vertices in its own
      * space and its instances [first_instance, + instance_count). */
     struct sb_draw_group {
         uint32_t first_vertex, caster_first_vertex, end_vertex, first_instance, instance_count;
-    } *draw_groups;
+    } * draw_groups;
     uint32_t draw_group_count; /* 0: the world in place, drawn as one list */
     /* This frame's cull of an instanced world: each list (the frame, then
      * each cascade) holds, a group after another, the instances a draw
      * draws; "visible instances", written by the host before each submit. */
     struct sb_buffer visible;
     struct sb_visible_range {
-        uint32_t first, count; /* in the visible buffer */
-    } *visible_ranges;         /* [(1 + SB_CASCADES) x draw_group_count] */
+        uint32_t first, count;      /* in the visible buffer */
+    } * visible_ranges;             /* [(1 + SB_CASCADES) x draw_group_count] */
     double (*instance_boxes)[2][3]; /* each instance's box in the world, and its casters' */
     double (*caster_instance_boxes)[2][3];
     struct sb_texture hdr, depth, ldr;                 /* "hdr", "depth", "ldr": the frame */
@@ -194,6 +194,17 @@ void sb_renderer_barrier(VkCommandBuffer cmd);
  * product otherwise) into r->atmosphere and its LUTs, r->radiance_scale
  * and the frame scales, r->ground_radius_km and r->thickness_km. */
 enum sb_result sb_atmosphere_upload(struct sb_renderer *r, const struct sb_pack *pack);
+
+/* world_gpu.c: the world's vertices, textures, emitting materials,
+ * instances and their draws, and its BVH when r->scene_traced, into the
+ * renderer's buffers ("vertices", ...), with its box and its casters'
+ * boxes; released by sb_world_release (which accepts a partial upload).
+ * sb_world_cull fills this frame's lists of visible instances (an
+ * instanced world's; r->view_proj and r->camera_m set). */
+struct sb_world;
+enum sb_result sb_world_upload(struct sb_renderer *r, const struct sb_world *world);
+void sb_world_release(struct sb_renderer *r);
+void sb_world_cull(struct sb_renderer *r, const struct sb_cascades *cascades);
 
 /* grading.c: the scene-linear grading's GPU form; a .cube LUT (NULL: a
  * stand-in) as lut3d.glsl reads it, in a buffer of its own. */
