@@ -191,12 +191,17 @@ enum sb_result sb_bake_scene(struct sb_vk *vk, const struct sb_scene *scene, con
             snprintf(a->settings_json, sizeof(a->settings_json), "%s", was->settings_json);
             a->bake_ms = was->bake_ms;
             a->gpu_ms = was->gpu_ms;
-            a->probes = was->probes;
+            a->probes = was->probes; /* its columns move with it */
+            old->artifacts[p].probes.columns = NULL;
+            old->artifacts[p].probes.column_count = 0;
             baked[p] = old->images[p];
             old->images[p] = (struct sb_image){0};
             if ((family->adopt && (res = family->adopt(state, id, &baked[p]))) ||
-                (res = sb_pack_writer_add_image(writer, a, &baked[p])))
+                (res = sb_pack_writer_add_image(writer, a, &baked[p]))) {
+                sb_probe_layout_finish(&a->probes);
                 goto cleanup;
+            }
+            sb_probe_layout_finish(&a->probes);
             if (strcmp(a->content_hash, was->content_hash) != 0) {
                 sb_error("%s: %s: content hash %s on writing, %s when read", out_dir, sb_product_name(id),
                          a->content_hash, was->content_hash);
@@ -209,10 +214,14 @@ enum sb_result sb_bake_scene(struct sb_vk *vk, const struct sb_scene *scene, con
 
         double t0 = 1e3 * sb_now_s();
         struct sb_image *image = &baked[p];
-        if ((res = family->bake(state, vk, scene, id, baked, image, a)))
+        if ((res = family->bake(state, vk, scene, id, baked, image, a))) {
+            sb_probe_layout_finish(&a->probes);
             goto cleanup;
+        }
         a->bake_ms = 1e3 * sb_now_s() - t0;
-        if ((res = sb_pack_writer_add_image(writer, a, image)))
+        res = sb_pack_writer_add_image(writer, a, image);
+        sb_probe_layout_finish(&a->probes);
+        if (res)
             goto cleanup;
         report_add(report, a, image, false);
     }

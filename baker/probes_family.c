@@ -18,11 +18,12 @@
 #include "bvh.h"
 #include "family.h"
 #include "json.h"
+#include "level.h"
 #include "load.h"
 #include "log.h"
-#include "level.h"
 #include "mesh.h"
 #include "parallel.h"
+#include "probe_detail.h"
 #include "raycast.h"
 #include "sh.h"
 #include "sky_bounce.h"
@@ -44,6 +45,9 @@ struct probes_state {
     struct sb_bvh bvh;
     struct sb_raycaster *rc;
     struct sb_surfaces surfaces; /* the bounce's, made with rc */
+    /* the detail's brick columns, placed by the first bake that needs them */
+    struct sb_probe_layout detail;
+    bool detail_placed;
 };
 
 static enum sb_result plan(const struct sb_scene *scene, const struct sb_level *level, bool say,
@@ -77,6 +81,7 @@ static void probes_destroy(void **state)
             sb_surfaces_destroy(st->rc->vk, &st->surfaces);
         sb_raycaster_destroy(&st->rc);
         sb_bvh_finish(&st->bvh);
+        sb_probe_layout_finish(&st->detail);
         sb_level_release(&st->level);
     }
     free(st);
@@ -104,6 +109,13 @@ static void probes_key(void *state, const struct sb_scene *scene, enum sb_produc
         sb_key_add(key, " layer=%a", p->layers_m[l]);
     if (p->budget_mb > 0)
         sb_key_add(key, " budget_mb=%a", p->budget_mb);
+    if (p->detail_spacing_m > 0) { /* none: the keys as they were */
+        sb_key_add(key, " detail_spacing_m=%a", p->detail_spacing_m);
+        for (int i = 0; i < p->detail_volume_count; i++) {
+            sb_key_add3(key, p->detail_volumes[i].detail ? "force_min" : "forbid_min", p->detail_volumes[i].min_m);
+            sb_key_add3(key, p->detail_volumes[i].detail ? "force_max" : "forbid_max", p->detail_volumes[i].max_m);
+        }
+    }
     sb_sky_visibility_code_hash(code);
     sb_key_add(key, " code %s", code);
     if (id == SB_PRODUCT_SKY_BOUNCE) { /* and the visibility's key, as its input */
@@ -132,8 +144,8 @@ static enum sb_result raycaster(struct probes_state *st, struct sb_vk *vk)
  * the scene bakes it, its sky_bounce record. */
 static uint64_t probe_bytes(const struct sb_scene *scene)
 {
-    return 4 * (SB_SKY_VISIBILITY_CHANNEL_COUNT +
-                (scene->wants[SB_PRODUCT_SKY_BOUNCE] ? SB_SKY_BOUNCE_CHANNEL_COUNT : 0));
+    return 4 *
+           (SB_SKY_VISIBILITY_CHANNEL_COUNT + (scene->wants[SB_PRODUCT_SKY_BOUNCE] ? SB_SKY_BOUNCE_CHANNEL_COUNT : 0));
 }
 
 /* The grid `spacing` apart over lo..hi (layers over the surface where the
@@ -221,7 +233,7 @@ static enum sb_result plan(const struct sb_scene *scene, const struct sb_level *
             sb_error("probes: %.0f probes along %c (the %s %.1f m across with a %g m margin); at most %d: raise "
                      "probes.spacing_m%s%s",
                      floor((extent + 2 * p->margin_m) / spacing) + 1, "xyz"[axis],
-                     p->has_bounds ? "bounds are" : "world is", extent, p->margin_m, SB_PROBES_MAX_GRID,
+                     p -> has_bounds ? "bounds are" : "world is", extent, p->margin_m, SB_PROBES_MAX_GRID,
                      p->has_bounds ? "" : " or give probes.bounds_m",
                      p->has_bounds ? "" : " (a model in millimetres or centimetres: set world.units_m)");
             return SB_ERR_TOO_LARGE;
@@ -231,6 +243,11 @@ static enum sb_result plan(const struct sb_scene *scene, const struct sb_level *
         sb_error("probes: %d explicit probes take %.3g MB, over probes.budget_mb (%g)", p->explicit_count,
                  p->explicit_count * (double)probe_bytes(scene) / 1e6, p->budget_mb);
         return SB_ERR_TOO_LARGE;
+    }
+    if (p->detail_spacing_m > 0) {
+        enum sb_result res = sb_probe_detail_check(level, p, p->detail_spacing_m);
+        if (res)
+            return res;
     }
     if (grid + (uint64_t)p->explicit_count > SB_PROBES_MAX_COUNT) {
         /* a model in millimetres is the usual reason a world is this large */
@@ -287,21 +304,79 @@ static enum sb_result column_surfaces(const struct probes_state *st, const struc
     return res;
 }
 
-/* Where the probes go. A grid of layers needs the raycaster (st->rc) to
- * find its columns' surfaces; without it (the bounce, which takes the
- * visibility's positions) its layers stand over y 0. */
-static enum sb_result place(const struct probes_state *st, const struct sb_scene *scene,
-                            struct sb_probe_layout *layout, float **positions, uint32_t *count, bool surfaces)
+/*
+ * The detail's brick columns (probe_detail.h), once a bake: at the scene's
+ * spacing, coarsened until they fit what the budget leaves after the
+ * grid's and the explicit probes' `taken` bytes (and none when nothing is
+ * left), saying so.
+ */
+static enum sb_result place_detail(struct probes_state *st, const struct sb_scene *scene, uint64_t taken)
+{
+    const struct sb_probe_params *p = &scene->probes;
+    if (st->detail_placed || p->detail_spacing_m <= 0)
+        return SB_OK;
+    double spacing = p->detail_spacing_m, per = (double)probe_bytes(scene);
+    double left = p->budget_mb > 0 ? p->budget_mb * 1e6 - (double)taken * per : INFINITY;
+    enum sb_result res = SB_OK;
+    if (left < per * SB_PROBES_BRICK * SB_PROBES_BRICK) {
+        sb_warn("probes: the grid takes all of probes.budget_mb (%g): no detail", p->budget_mb);
+    } else {
+        double t0 = sb_now_s();
+        res = sb_probe_detail_place(st->rc, &st->bvh, st->level, p, spacing, &st->detail);
+        uint32_t first = st->detail.detail_count;
+        for (int step = 0; step < 100 && !res && st->detail.detail_count * per > left; step++) {
+            /* a surface's bricks go with the spacing's square, a room's with its cube */
+            double ratio = pow(st->detail.detail_count * per / left, 1.0 / 3.0);
+            spacing *= ratio > 1.02 ? ratio : 1.02;
+            sb_probe_layout_finish(&st->detail);
+            res = sb_probe_detail_place(st->rc, &st->bvh, st->level, p, spacing, &st->detail);
+        }
+        if (!res && spacing != p->detail_spacing_m)
+            sb_warn("probes: detail %g m apart would take %.3g MB, over what probes.budget_mb (%g) leaves after the "
+                    "grid (%.3g MB): %.3g m apart instead, %u probes, %.3g MB",
+                    p->detail_spacing_m, first * per / 1e6, p->budget_mb, left / 1e6, spacing, st->detail.detail_count,
+                    st->detail.detail_count * per / 1e6);
+        sb_debug("probes: detail placed in %.1f ms", 1e3 * (sb_now_s() - t0));
+    }
+    st->detail_placed = !res;
+    return res;
+}
+
+/* Where the probes go: the grid's, the detail's, the explicit ones. A
+ * grid of layers needs the raycaster (st->rc) to find its columns'
+ * surfaces; without `surfaces` (the bounce, which takes the visibility's
+ * positions) its layers stand over y 0. Detail needs the raycaster. */
+static enum sb_result place(struct probes_state *st, const struct sb_scene *scene, struct sb_probe_layout *layout,
+                            float **positions, uint32_t *count, bool surfaces)
 {
     const struct sb_level *level = st->level;
     const struct sb_probe_params *p = &scene->probes;
     uint64_t grid;
     enum sb_result res = plan(scene, level, false, layout, &grid);
+    if (!res)
+        res = place_detail(st, scene, grid + (uint64_t)p->explicit_count);
     if (res)
         return res;
+    uint32_t detail = st->detail.detail_count;
+    if (detail) {
+        if (grid + detail + (uint64_t)p->explicit_count > SB_PROBES_MAX_COUNT) {
+            sb_error("probes: %llu grid, %u detail and %d explicit probes; at most %u: raise probes.spacing_m or "
+                     "probes.detail_spacing_m, or set probes.budget_mb",
+                     (unsigned long long)grid, detail, p->explicit_count, SB_PROBES_MAX_COUNT);
+            return SB_ERR_TOO_LARGE;
+        }
+        struct sb_probe_layout copy;
+        if (sb_probe_layout_copy(&copy, &st->detail))
+            return SB_ERR_NOMEM;
+        layout->detail_spacing_m = copy.detail_spacing_m;
+        memcpy(layout->detail_origin_m, copy.detail_origin_m, sizeof(layout->detail_origin_m));
+        layout->detail_count = copy.detail_count;
+        layout->column_count = copy.column_count;
+        layout->columns = copy.columns;
+    }
     layout->explicit_count = (uint32_t)p->explicit_count;
     layout->ray_count = p->rays;
-    *count = (uint32_t)grid + (uint32_t)p->explicit_count;
+    *count = (uint32_t)grid + detail + (uint32_t)p->explicit_count;
     *positions = malloc((size_t)*count * 3 * sizeof(float));
     if (!*positions)
         return SB_ERR_NOMEM;
@@ -324,9 +399,10 @@ static enum sb_result place(const struct probes_state *st, const struct sb_scene
             (*positions)[3 * (size_t)i + 1] = ground[c[0] + layout->grid[0] * c[2]] + layout->layers_m[c[1]];
     }
     free(ground);
+    sb_probe_detail_positions(layout, *positions + 3 * grid);
     for (int e = 0; e < p->explicit_count; e++)
         for (int k = 0; k < 3; k++)
-            (*positions)[3 * (grid + e) + k] = (float)p->positions_m[e][k];
+            (*positions)[3 * (grid + detail + e) + k] = (float)p->positions_m[e][k];
     return SB_OK;
 }
 
@@ -335,12 +411,12 @@ static enum sb_result place(const struct probes_state *st, const struct sb_scene
  * geometry: try the candidate offsets, all in one batch of few rays, and
  * move each to the first that is free; flag the rest invalid.
  */
-static enum sb_result push_out(struct sb_raycaster *rc, const struct sb_scene *scene, float *positions, float *offsets,
-                               float *valid, const float *results, uint32_t count, uint32_t *inside, uint32_t *pushed,
-                               double *gpu_ms)
+static enum sb_result push_out(struct sb_raycaster *rc, const struct sb_scene *scene,
+                               const struct sb_probe_layout *layout, float *positions, float *offsets, float *valid,
+                               const float *results, uint32_t count, uint32_t *inside, uint32_t *pushed, double *gpu_ms)
 {
     const int per = 26 * (int)(sizeof(push_steps) / sizeof(push_steps[0]));
-    double unit = scene->probes.spacing_m > 0 ? scene->probes.spacing_m : 1.0;
+    const uint64_t grid = (uint64_t)layout->grid[0] * layout->grid[1] * layout->grid[2];
     uint32_t *which = NULL, n = 0;
     float *candidates = NULL, *trial = NULL;
     enum sb_result res = SB_OK;
@@ -365,6 +441,9 @@ static enum sb_result push_out(struct sb_raycaster *rc, const struct sb_scene *s
             which[n++] = i;
     for (uint32_t j = 0; j < n; j++) {
         int c = 0;
+        /* the steps scale with the spacing of the probes around it */
+        bool detail = which[j] >= grid && which[j] < grid + layout->detail_count;
+        double unit = detail ? layout->detail_spacing_m : scene->probes.spacing_m > 0 ? scene->probes.spacing_m : 1.0;
         for (size_t s = 0; s < sizeof(push_steps) / sizeof(push_steps[0]); s++)
             for (int d = 0; d < 27; d++) {
                 if (d == 13)
@@ -446,7 +525,7 @@ static enum sb_result bake_visibility(struct probes_state *st, const struct sb_s
         goto done;
     gpu_ms += ms;
     t1 = sb_now_s();
-    if ((res = push_out(rc, scene, positions, offsets, valid, results, count, &inside, &pushed, &ms)))
+    if ((res = push_out(rc, scene, layout, positions, offsets, valid, results, count, &inside, &pushed, &ms)))
         goto done;
     gpu_ms += inside ? ms : 0; /* every candidate place of every probe inside */
     t2 = sb_now_s();
@@ -500,7 +579,8 @@ static enum sb_result bake_visibility(struct probes_state *st, const struct sb_s
              "{\"rays\":%u,\"grid\":[%u,%u,%u],\"spacing_m\":%.9g,\"explicit\":%u,\"triangles\":%llu,"
              "\"inside\":%u,\"pushed_out\":%u,\"invalid\":%u,\"deringed\":%u,\"lowest_before_dering\":%.6g}",
              layout->ray_count, layout->grid[0], layout->grid[1], layout->grid[2], (double)layout->spacing_m[0],
-             layout->explicit_count, (unsigned long long)level->placed_triangles, inside, pushed, inside - pushed, deringed, lowest);
+             layout->explicit_count, (unsigned long long)level->placed_triangles, inside, pushed, inside - pushed,
+             deringed, lowest);
     /* the budget's and the layers' fields only where the scene has them:
      * the settings of other bakes as they were */
     if (scene->probes.budget_mb > 0)
@@ -513,9 +593,14 @@ static enum sb_result bake_visibility(struct probes_state *st, const struct sb_s
                      (double)layout->layers_m[l]);
         sb_settings_json_add(a->settings_json, sizeof(a->settings_json), ",\"layers_m\":[%s]", heights);
     }
+    if (layout->column_count)
+        sb_settings_json_add(a->settings_json, sizeof(a->settings_json),
+                             ",\"detail\":{\"spacing_m\":%.9g,\"brick_columns\":%u,\"probes\":%u}",
+                             (double)layout->detail_spacing_m, layout->column_count, layout->detail_count);
     sb_artifact_set_world(a, st->mesh_hash, st->path);
-    sb_info("sky_visibility: %u probes over %llu triangles; %u inside geometry, %u pushed out; %u deringed", count,
-            (unsigned long long)level->placed_triangles, inside, pushed, deringed);
+    sb_info("sky_visibility: %u probes over %llu triangles (%u in detail); %u inside geometry, %u pushed out; %u "
+            "deringed",
+            count, (unsigned long long)level->placed_triangles, layout->detail_count, inside, pushed, deringed);
 done:
     if (res)
         sb_image_finish(image);

@@ -307,6 +307,7 @@ enum sb_result sb_pack_writer_add_image(struct sb_pack_writer *w, struct sb_arti
         return res;
     }
     w->artifacts[i] = *artifact;
+    w->artifacts[i].probes.columns = NULL; /* the caller's: the manifest needs no columns */
     w->artifact_count++;
     w->pending = NULL;
     fault_point("artifact");
@@ -734,6 +735,13 @@ static enum sb_result read_artifact_image(const char *dir, int dir_fd, struct sb
                      pack->format_version);
             res = SB_ERR_PROBES;
         }
+        if (!res && a->probes.column_count && pack->format_version < 8) {
+            sb_error("%s: %s: detail probes, which format version %d cannot hold (8 and later)", path, name,
+                     pack->format_version);
+            res = SB_ERR_PROBES;
+        }
+        if (res)
+            sb_probe_layout_finish(&a->probes);
     } else {
         res = format->storage == SB_STORAGE_VDB_HALF
                   ? sb_vdb_read(path, format->channel_names, texels, image, NULL, NULL)
@@ -973,8 +981,10 @@ enum sb_result sb_pack_verify(const char *dir, unsigned *problem_count)
 
 void sb_pack_close(struct sb_pack *pack)
 {
-    for (int p = 0; p < SB_PRODUCT_COUNT; p++)
+    for (int p = 0; p < SB_PRODUCT_COUNT; p++) {
         sb_image_finish(&pack->images[p]);
+        sb_probe_layout_finish(&pack->artifacts[p].probes);
+    }
     free(pack->scene);
     memset(pack, 0, sizeof(*pack));
 }

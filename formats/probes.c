@@ -83,21 +83,76 @@ static void channel_range(const char *name, double *lo, double *hi)
     }
 }
 
-static size_t file_size(uint32_t header, uint32_t probes, uint32_t channels)
+static size_t file_size(uint32_t header, uint32_t columns, uint32_t probes, uint32_t channels)
 {
-    return header + (size_t)probes * channels * 4 + 8;
+    return header + (size_t)columns * SB_PROBES_COLUMN_BYTES + (size_t)probes * channels * 4 + 8;
+}
+
+void sb_probe_layout_finish(struct sb_probe_layout *layout)
+{
+    free(layout->columns);
+    layout->columns = NULL;
+    layout->column_count = 0;
+    layout->detail_count = 0;
+}
+
+enum sb_result sb_probe_layout_copy(struct sb_probe_layout *to, const struct sb_probe_layout *from)
+{
+    *to = *from;
+    if (!from->column_count)
+        return SB_OK;
+    to->columns = malloc(from->column_count * sizeof(*to->columns));
+    if (!to->columns) {
+        memset(to, 0, sizeof(*to));
+        return SB_ERR_NOMEM;
+    }
+    memcpy(to->columns, from->columns, from->column_count * sizeof(*to->columns));
+    return SB_OK;
+}
+
+int64_t sb_probe_detail_index(const struct sb_probe_layout *layout, uint64_t grid_count, int32_t x, int32_t y,
+                              int32_t z)
+{
+    if (x < 0 || z < 0 || y < 0)
+        return -1;
+    int32_t bx = x / SB_PROBES_BRICK, bz = z / SB_PROBES_BRICK;
+    uint32_t lo = 0, hi = layout->column_count;
+    uint64_t first = grid_count;
+    while (lo < hi) {
+        uint32_t mid = lo + (hi - lo) / 2;
+        const struct sb_probe_column *c = &layout->columns[mid];
+        if (c->z < bz || (c->z == bz && c->x < bx))
+            lo = mid + 1;
+        else
+            hi = mid;
+    }
+    if (lo == layout->column_count || layout->columns[lo].x != bx || layout->columns[lo].z != bz)
+        return -1;
+    const struct sb_probe_column *c = &layout->columns[lo];
+    if (y < c->y0 || (uint32_t)(y - c->y0) >= c->rows)
+        return -1;
+    /* the columns before it: their rows, summed (the runtime keeps them in a table) */
+    for (uint32_t i = 0; i < lo; i++)
+        first += (uint64_t)layout->columns[i].rows * SB_PROBES_BRICK * SB_PROBES_BRICK;
+    return (int64_t)(first +
+                     ((uint64_t)(y - c->y0) * SB_PROBES_BRICK + (uint32_t)(z % SB_PROBES_BRICK)) * SB_PROBES_BRICK +
+                     (uint32_t)(x % SB_PROBES_BRICK));
 }
 
 enum sb_result sb_probes_write(const char *path, const struct sb_probe_layout *layout, const struct sb_image *image)
 {
-    /* without layers, version 1: the files are what they were */
-    uint32_t header = layout->layer_count ? SB_PROBES_HEADER_BYTES : SB_PROBES_HEADER_BYTES_V1;
-    size_t size = file_size(header, image->width, image->channel_count);
+    /* the oldest version that holds the layout: without layers or detail,
+     * version 1, and the files are what they were */
+    uint32_t version = layout->column_count ? 3 : layout->layer_count ? 2 : 1;
+    uint32_t header = version == 3   ? SB_PROBES_HEADER_BYTES
+                      : version == 2 ? SB_PROBES_HEADER_BYTES_V2
+                                     : SB_PROBES_HEADER_BYTES_V1;
+    size_t size = file_size(header, layout->column_count, image->width, image->channel_count);
     uint8_t *bytes = calloc(1, size);
     if (!bytes)
         return SB_ERR_NOMEM;
     memcpy(bytes, magic, 8);
-    put_u32(bytes + 8, layout->layer_count ? 2 : 1);
+    put_u32(bytes + 8, version);
     put_u32(bytes + 12, BYTE_ORDER_MARK);
     put_u32(bytes + 16, header);
     put_u32(bytes + 20, image->channel_count);
@@ -116,6 +171,20 @@ enum sb_result sb_probes_write(const char *path, const struct sb_probe_layout *l
             put_f32(bytes + 108 + 4 * l, layout->layers_m[l]);
     }
     uint8_t *p = bytes + header;
+    if (version == 3) {
+        put_f32(bytes + 140, layout->detail_spacing_m);
+        for (int k = 0; k < 3; k++)
+            put_f32(bytes + 144 + 4 * k, layout->detail_origin_m[k]);
+        put_u32(bytes + 156, layout->column_count);
+        put_u32(bytes + 160, layout->detail_count);
+        for (uint32_t c = 0; c < layout->column_count; c++, p += SB_PROBES_COLUMN_BYTES) {
+            const struct sb_probe_column *col = &layout->columns[c];
+            put_u32(p, (uint32_t)col->x);
+            put_u32(p + 4, (uint32_t)col->z);
+            put_u32(p + 8, (uint32_t)col->y0);
+            put_u32(p + 12, col->rows);
+        }
+    }
     for (uint64_t i = 0; i < (uint64_t)image->width * image->channel_count; i++, p += 4)
         put_f32(p, image->data[i]);
     put_u64(p, XXH3_64bits(bytes, size - 8));
@@ -123,6 +192,61 @@ enum sb_result sb_probes_write(const char *path, const struct sb_probe_layout *l
     enum sb_result res = sb_write_file(path, bytes, size, "probe file");
     free(bytes);
     return res;
+}
+
+/* A version 3 file's detail: its lattice and brick columns, checked
+ * (finite, in range, sorted, their probes summing to `detail`); nonzero
+ * on a problem, logged. */
+static int check_detail(const uint8_t *b, uint32_t header, uint32_t columns, uint32_t detail, const char *source,
+                        struct sb_probe_layout *layout)
+{
+    float spacing = get_f32(b + 140);
+    if (!(spacing >= 0.01f && spacing <= 1000.0f)) {
+        sb_error("%s: detail spacing %g m: expected 0.01 to 1000", source, spacing);
+        return 1;
+    }
+    for (int k = 0; k < 3; k++) {
+        layout->detail_origin_m[k] = get_f32(b + 144 + 4 * k);
+        if (!(fabsf(layout->detail_origin_m[k]) <= 1e5f)) {
+            sb_error("%s: the detail lattice's origin %c is %g: expected a finite value within 1e5 m", source, "xyz"[k],
+                     layout -> detail_origin_m[k]);
+            return 1;
+        }
+    }
+    layout->detail_spacing_m = spacing;
+    struct sb_probe_column *c = malloc(columns * sizeof(*c));
+    if (!c) {
+        sb_error("%s: out of memory for %u brick columns", source, columns);
+        return 1;
+    }
+    uint64_t sum = 0;
+    const int32_t most = SB_PROBES_MAX_LATTICE / SB_PROBES_BRICK;
+    for (uint32_t i = 0; i < columns; i++) {
+        const uint8_t *r = b + header + (size_t)i * SB_PROBES_COLUMN_BYTES;
+        c[i] = (struct sb_probe_column){(int32_t)get_u32(r), (int32_t)get_u32(r + 4), (int32_t)get_u32(r + 8),
+                                        get_u32(r + 12)};
+        bool in_range = c[i].x >= 0 && c[i].x < most && c[i].z >= 0 && c[i].z < most && c[i].y0 >= 0 &&
+                        c[i].rows >= 1 && (uint64_t)c[i].y0 + c[i].rows <= SB_PROBES_MAX_LATTICE;
+        bool after = !i || c[i].z > c[i - 1].z || (c[i].z == c[i - 1].z && c[i].x > c[i - 1].x);
+        if (!in_range || !after) {
+            sb_error("%s: brick column %u (x %d, z %d, rows %d + %u): %s", source, i, c[i].x, c[i].z, c[i].y0,
+                     c[i].rows,
+                     in_range ? "not after the one before it (increasing z, then x)"
+                              : "out of the lattice's range (x, z, y0 >= 0, rows >= 1, 65536 steps)");
+            free(c);
+            return 1;
+        }
+        sum += (uint64_t)c[i].rows * SB_PROBES_BRICK * SB_PROBES_BRICK;
+    }
+    if (sum != detail) {
+        sb_error("%s: the brick columns hold %llu probes, the header says %u", source, (unsigned long long)sum, detail);
+        free(c);
+        return 1;
+    }
+    layout->columns = c;
+    layout->column_count = columns;
+    layout->detail_count = detail;
+    return 0;
 }
 
 enum sb_result sb_probes_parse(const void *data, size_t size, const char *source, const char *channel_names,
@@ -152,7 +276,9 @@ enum sb_result sb_probes_parse(const void *data, size_t size, const char *source
     }
     uint32_t header = get_u32(b + 16), channels = get_u32(b + 20), count = get_u32(b + 24);
     uint32_t grid[3] = {get_u32(b + 28), get_u32(b + 32), get_u32(b + 36)}, explicit_count = get_u32(b + 40);
-    uint32_t expect_header = version == 1 ? SB_PROBES_HEADER_BYTES_V1 : SB_PROBES_HEADER_BYTES;
+    uint32_t expect_header = version == 1   ? SB_PROBES_HEADER_BYTES_V1
+                             : version == 2 ? SB_PROBES_HEADER_BYTES_V2
+                                            : SB_PROBES_HEADER_BYTES;
     if (header != expect_header) {
         sb_error("%s: header of %u bytes, version %u has %u", source, header, version, expect_header);
         return SB_ERR_PROBES;
@@ -162,9 +288,15 @@ enum sb_result sb_probes_parse(const void *data, size_t size, const char *source
         return SB_ERR_BAD_IMAGE;
     }
     uint32_t layers = version == 1 ? 0 : get_u32(b + 104);
-    if (version > 1 && (layers < 1 || layers > SB_PROBES_MAX_LAYERS || layers != grid[1])) {
-        sb_error("%s: %u layers in a grid %u high: 1 to %d, the grid's y", source, layers, grid[1],
-                 SB_PROBES_MAX_LAYERS);
+    if ((version == 2 && layers < 1) ||
+        (version > 1 && (layers > SB_PROBES_MAX_LAYERS || (layers && layers != grid[1])))) {
+        sb_error("%s: %u layers in a grid %u high: %d to %d, the grid's y", source, layers, grid[1],
+                 version == 2 ? 1 : 0, SB_PROBES_MAX_LAYERS);
+        return SB_ERR_PROBES;
+    }
+    uint32_t columns = version == 3 ? get_u32(b + 156) : 0, detail = version == 3 ? get_u32(b + 160) : 0;
+    if (version == 3 && (columns < 1 || columns > SB_PROBES_MAX_COLUMNS)) {
+        sb_error("%s: %u brick columns of detail: 1 to %u", source, columns, SB_PROBES_MAX_COLUMNS);
         return SB_ERR_PROBES;
     }
     struct sb_image names = {0};
@@ -185,15 +317,16 @@ enum sb_result sb_probes_parse(const void *data, size_t size, const char *source
         }
         grid_count *= grid[i];
     }
-    if (!count || count > max_probes || count > SB_PROBES_MAX_COUNT || grid_count + explicit_count != count) {
-        sb_error("%s: %u probes (grid %llu, explicit %u): expected their sum, 1 to %u", source, count,
-                 (unsigned long long)grid_count, explicit_count,
+    if (!count || count > max_probes || count > SB_PROBES_MAX_COUNT ||
+        grid_count + detail + (uint64_t)explicit_count != count) {
+        sb_error("%s: %u probes (grid %llu, detail %u, explicit %u): expected their sum, 1 to %u", source, count,
+                 (unsigned long long)grid_count, detail, explicit_count,
                  max_probes < SB_PROBES_MAX_COUNT ? max_probes : SB_PROBES_MAX_COUNT);
         return SB_ERR_PROBES;
     }
-    if (size != file_size(header, count, channels)) {
-        sb_error("%s: %zu bytes, %u probes of %u channels take %zu", source, size, count, channels,
-                 file_size(header, count, channels));
+    if (size != file_size(header, columns, count, channels)) {
+        sb_error("%s: %zu bytes, %u brick columns and %u probes of %u channels take %zu", source, size, columns, count,
+                 channels, file_size(header, columns, count, channels));
         return SB_ERR_BAD_IMAGE;
     }
     if (get_u64(b + size - 8) != XXH3_64bits(b, size - 8)) {
@@ -201,15 +334,14 @@ enum sb_result sb_probes_parse(const void *data, size_t size, const char *source
         return SB_ERR_HASH_MISMATCH;
     }
     for (uint32_t i = version == 1 ? 104 : 108 + 4 * layers; i < header; i++)
-        if (b[i]) {
+        if (b[i] && !(version == 3 && i >= 140 && i < 164)) {
             sb_error("%s: reserved header byte %u is not zero", source, i);
             return SB_ERR_PROBES;
         }
     for (uint32_t l = 0; l < layers; l++) {
         float h = get_f32(b + 108 + 4 * l);
         if (!(h >= 0 && h <= 1e4) || (l && !(h > layout->layers_m[l - 1]))) {
-            sb_error("%s: layer %u at %g m: expected heights in [0, 1e4] m, each above the one before", source, l,
-                     h);
+            sb_error("%s: layer %u at %g m: expected heights in [0, 1e4] m, each above the one before", source, l, h);
             memset(layout, 0, sizeof(*layout));
             return SB_ERR_PROBES;
         }
@@ -241,13 +373,18 @@ enum sb_result sb_probes_parse(const void *data, size_t size, const char *source
     }
     memcpy(layout->key, b + 72, 32);
     layout->key[32] = '\0';
+    if (version == 3 && check_detail(b, header, columns, detail, source, layout)) {
+        memset(layout, 0, sizeof(*layout));
+        return SB_ERR_PROBES;
+    }
     enum sb_result res = sb_image_init(image, count, 1, channels);
     if (res) {
+        sb_probe_layout_finish(layout);
         memset(layout, 0, sizeof(*layout));
         return res;
     }
     sb_image_set_channel_names(image, channel_names);
-    const uint8_t *p = b + header;
+    const uint8_t *p = b + header + (size_t)columns * SB_PROBES_COLUMN_BYTES;
     for (uint32_t c = 0; c < channels && !res; c++) {
         double lo, hi;
         channel_range(image->channel_names[c], &lo, &hi);
@@ -265,6 +402,7 @@ enum sb_result sb_probes_parse(const void *data, size_t size, const char *source
     }
     if (res) {
         sb_image_finish(image);
+        sb_probe_layout_finish(layout);
         memset(layout, 0, sizeof(*layout));
     }
     return res;
@@ -283,7 +421,8 @@ enum sb_result sb_probes_read(const char *path, const char *channel_names, uint3
             close(fd);
         return SB_ERR_IO;
     }
-    size_t largest = file_size(SB_PROBES_HEADER_BYTES, SB_PROBES_MAX_COUNT, SB_IMAGE_MAX_CHANNELS);
+    size_t largest = file_size(SB_PROBES_HEADER_BYTES, SB_PROBES_MAX_COUNT / (SB_PROBES_BRICK * SB_PROBES_BRICK),
+                               SB_PROBES_MAX_COUNT, SB_IMAGE_MAX_CHANNELS);
     if (!S_ISREG(st.st_mode) || (uint64_t)st.st_size > largest) {
         sb_error("%s: not a regular file of at most %zu bytes", path, largest);
         close(fd);

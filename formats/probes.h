@@ -23,7 +23,18 @@
  *      108    32  each layer's height above the surface, metres, increasing
  *                 (float32; past L, zero)
  *      140    12  reserved, zero
- *   header     -  probe count x channels x float32, probe by probe
+ *   version 3 (detail):
+ *      104    36  as version 2, but L may be 0 (a uniform grid, or none)
+ *      140     4  the detail's spacing, metres
+ *      144    12  the detail lattice's first probe, metres
+ *      156     4  brick columns C (1 to 2^18)
+ *      160     4  detail probes D
+ *      164    28  reserved, zero
+ *   header     -  version 3: C brick columns of 16 bytes: x, z (int32, in
+ *                 bricks of SB_PROBES_BRICK lattice steps), the lowest
+ *                 lattice row y0 (int32) and the rows (uint32), in
+ *                 increasing z then x, each once
+ *      then    -  probe count x channels x float32, probe by probe
  *      end     8  XXH3-64 of every byte before it
  *
  * A grid of layers follows the surface: its probes stand in columns (x, z
@@ -33,6 +44,14 @@
  * and its y spacing the distance over the top layer that a runtime fades
  * the probes' light over. A file without layers is written as version 1,
  * byte for byte as before.
+ *
+ * Detail (version 3) is a sparse lattice of probes where geometry is:
+ * brick columns SB_PROBES_BRICK x SB_PROBES_BRICK lattice columns across,
+ * each as many rows high as the geometry under it needs. Brick column
+ * (x, z) with rows y0.. y0 + rows - 1 holds the lattice probes (4x + i,
+ * y, 4z + k), i, k < 4, stored y by y, then k, then i (x fastest), at
+ * origin + spacing x (lattice index). Detail probes come after the grid's
+ * and before the explicit ones, brick column by brick column.
  *
  * The reader trusts nothing: every field is checked against the format's
  * caps and the others before anything is allocated, the size must match
@@ -50,9 +69,14 @@
 #include "result.h"
 #include "scene.h"
 
-#define SB_PROBES_VERSION 2
+#define SB_PROBES_VERSION 3
 #define SB_PROBES_HEADER_BYTES_V1 112
-#define SB_PROBES_HEADER_BYTES 152
+#define SB_PROBES_HEADER_BYTES_V2 152
+#define SB_PROBES_HEADER_BYTES 192
+#define SB_PROBES_BRICK 4                /* a brick column's lattice columns along x and along z */
+#define SB_PROBES_MAX_COLUMNS (1u << 18) /* brick columns in a file */
+#define SB_PROBES_MAX_LATTICE (1 << 16)  /* lattice steps along an axis */
+#define SB_PROBES_COLUMN_BYTES 16
 #define SB_PROBES_MAX_COUNT (1u << 20)
 #define SB_PROBES_MAX_GRID 1024 /* probes along one axis */
 
@@ -103,7 +127,16 @@ _Static_assert(SB_SKY_VISIBILITY_SH + 9 == SB_SKY_VISIBILITY_CHANNEL_COUNT, "the
         2) "," SB_IRRADIANCE_3(3) "," SB_IRRADIANCE_3(4) "," SB_IRRADIANCE_3(5) "," SB_IRRADIANCE_3(6) "," SB_IRRADIANCE_3(7) "," SB_IRRADIANCE_3(8)
 #define SB_REFLECTION_PROBES_CHANNEL_COUNT 36
 
-/* Where the probes are: a grid (x fastest) then explicit ones. */
+/* A brick column of the detail lattice (the file's record). */
+struct sb_probe_column {
+    int32_t x, z;  /* in bricks from the lattice's origin, >= 0 */
+    int32_t y0;    /* its lowest row, lattice steps from the origin, >= 0 */
+    uint32_t rows; /* >= 1; y0 + rows <= SB_PROBES_MAX_LATTICE */
+};
+
+/* Where the probes are: a grid (x fastest), detail, then explicit ones.
+ * A layout with detail owns its columns: copy it with
+ * sb_probe_layout_copy, free it with sb_probe_layout_finish. */
 struct sb_probe_layout {
     uint32_t grid[3];
     uint32_t explicit_count;
@@ -115,7 +148,23 @@ struct sb_probe_layout {
      * these heights above it (m, increasing) */
     uint32_t layer_count;
     float layers_m[SB_PROBES_MAX_LAYERS];
+    /* detail: column_count brick columns holding detail_count probes
+     * (0: none) */
+    float detail_spacing_m;
+    float detail_origin_m[3];
+    uint32_t detail_count;
+    uint32_t column_count;
+    struct sb_probe_column *columns; /* owned */
 };
+
+/* Free a layout's columns (and zero them); a zeroed layout is accepted. */
+void sb_probe_layout_finish(struct sb_probe_layout *layout);
+/* *to = *from with its own copy of the columns (SB_ERR_NOMEM: *to zeroed). */
+enum sb_result sb_probe_layout_copy(struct sb_probe_layout *to, const struct sb_probe_layout *from);
+/* The index among a layout's probes of detail lattice probe (x, y, z), or
+ * -1 when no brick column holds it (a binary search over the columns). */
+int64_t sb_probe_detail_index(const struct sb_probe_layout *layout, uint64_t grid_count, int32_t x, int32_t y,
+                              int32_t z);
 
 /* Write the probes (image: width = probe count, height = depth = 1, the
  * channels in the product's order) with their layout. Atomic only as the

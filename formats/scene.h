@@ -105,20 +105,34 @@ struct sb_world_params {
 #define SB_PROBES_MAX_EXPLICIT 256
 /* A grid that follows the surface has at most this many layers (probes.h). */
 #define SB_PROBES_MAX_LAYERS 8
+/* Detail volumes a scene may give. */
+#define SB_PROBES_MAX_VOLUMES 32
 struct sb_probe_params {
-    double spacing_m;          /* a grid over the world's bounds, this far apart [2]; 0: none */
-    double margin_m;           /* the grid's bounds: the world's, grown by this [0] */
-    bool has_bounds;           /* the grid covers bounds_m instead of the world's bounds */
-    double bounds_m[2][3];     /* min, max corners */
-    uint32_t rays;             /* per probe, a multiple of 64 [2048] */
-    double inside_fraction;    /* more back-face hits than this: inside geometry [0.25] */
+    double spacing_m;       /* a grid over the world's bounds, this far apart [2]; 0: none */
+    double margin_m;        /* the grid's bounds: the world's, grown by this [0] */
+    bool has_bounds;        /* the grid covers bounds_m instead of the world's bounds */
+    double bounds_m[2][3];  /* min, max corners */
+    uint32_t rays;          /* per probe, a multiple of 64 [2048] */
+    double inside_fraction; /* more back-face hits than this: inside geometry [0.25] */
     /* layers_m given: the grid follows the surface, layer_count probes a
      * column at these heights (m, increasing) above the first surface a ray
      * down the column meets, instead of spacing_m apart in y [none] */
     int layer_count;
     double layers_m[SB_PROBES_MAX_LAYERS];
+    /* Detail where geometry is: a lattice this far apart in brick columns
+     * over every place a ray down meets two surfaces or more (a roof over
+     * a floor, a car over the road; formats/probes.h) [0: none] */
+    double detail_spacing_m;
+    /* boxes that force detail over their whole volume (`detail` true) or
+     * forbid it in theirs, in order, the later winning */
+    int detail_volume_count;
+    struct sb_probe_volume {
+        double min_m[3], max_m[3];
+        bool detail;
+    } detail_volumes[SB_PROBES_MAX_VOLUMES];
     /* the probe products' bytes at most, MB (1e6 bytes): a grid that
-     * would take more is spaced wider until it fits [0: no budget] */
+     * would take more is spaced wider until it fits, then the detail
+     * coarsened until it fits in what the grid leaves [0: no budget] */
     double budget_mb;
     uint32_t bounce_rays;      /* sky_bounce: rays a probe for the surfaces it sees, a multiple of 64 [256] */
     uint32_t bounce_secondary; /* sky_bounce: rays from each surface hit, a multiple of 8 [64] */

@@ -34,11 +34,64 @@ static enum sb_result probes_validate(const struct sb_scene *scene, const char *
     return SB_OK;
 }
 
+/* "detail_volumes": [{"min_m": [x, y, z], "max_m": [x, y, z], "detail": true}, ...] */
+static enum sb_result parse_volumes(const cJSON *list, const char *source, struct sb_probe_params *p)
+{
+    static const char *const keys[] = {"min_m", "max_m", "detail", NULL};
+    if (!cJSON_IsArray(list) || cJSON_GetArraySize(list) > SB_PROBES_MAX_VOLUMES) {
+        sb_error("%s: probes.detail_volumes: expected an array of at most %d {\"min_m\", \"max_m\", \"detail\"}",
+                 source, SB_PROBES_MAX_VOLUMES);
+        return cJSON_IsArray(list) ? SB_ERR_OUT_OF_RANGE : SB_ERR_WRONG_TYPE;
+    }
+    if (p->detail_spacing_m == 0 && cJSON_GetArraySize(list)) {
+        sb_error("%s: probes.detail_volumes: volumes need detail (probes.detail_spacing_m above 0)", source);
+        return SB_ERR_OUT_OF_RANGE;
+    }
+    enum sb_result res = SB_OK;
+    for (const cJSON *e = list->child; e && !res; e = e->next, p->detail_volume_count++) {
+        struct sb_probe_volume *v = &p->detail_volumes[p->detail_volume_count];
+        char path[96];
+        snprintf(path, sizeof(path), "probes.detail_volumes[%d]", p->detail_volume_count);
+        if (!cJSON_IsObject(e)) {
+            sb_error("%s: %s: expected an object", source, path);
+            return SB_ERR_WRONG_TYPE;
+        }
+        if ((res = sb_json_only_keys(e, source, path, keys)))
+            return res;
+        const cJSON *min = cJSON_GetObjectItemCaseSensitive(e, "min_m"),
+                    *max = cJSON_GetObjectItemCaseSensitive(e, "max_m"),
+                    *detail = cJSON_GetObjectItemCaseSensitive(e, "detail");
+        if (!min || !max || !detail) {
+            sb_error("%s: %s: needs \"min_m\", \"max_m\" and \"detail\"", source, path);
+            return SB_ERR_MISSING_FIELD;
+        }
+        if (!cJSON_IsBool(detail)) {
+            sb_error("%s: %s.detail: expected true (force detail) or false (forbid it)", source, path);
+            return SB_ERR_WRONG_TYPE;
+        }
+        v->detail = cJSON_IsTrue(detail);
+        char at[112];
+        snprintf(at, sizeof(at), "%s.min_m", path);
+        res = sb_json_vec3(min, source, at, -1e4, 1e4, v->min_m);
+        snprintf(at, sizeof(at), "%s.max_m", path);
+        if (!res)
+            res = sb_json_vec3(max, source, at, -1e4, 1e4, v->max_m);
+        for (int k = 0; k < 3 && !res; k++)
+            if (!(v->max_m[k] > v->min_m[k])) {
+                sb_error("%s: %s: the max corner's %c (%g) is not above the min's (%g)", source, path, "xyz"[k],
+                         v -> max_m[k], v -> min_m[k]);
+                res = SB_ERR_OUT_OF_RANGE;
+            }
+    }
+    return res;
+}
+
 static enum sb_result probes_section_parse(const cJSON *obj, struct sb_scene *scene, const char *source)
 {
-    static const char *const keys[] = {"spacing_m",   "margin_m",    "bounds_m",         "rays",     "inside_fraction",
-                                       "positions_m", "bounce_rays", "bounce_secondary", "layers_m",
-                                       "budget_mb",   NULL};
+    static const char *const keys[] = {
+        "spacing_m",   "margin_m",         "bounds_m", "rays",      "inside_fraction",  "positions_m",
+        "bounce_rays", "bounce_secondary", "layers_m", "budget_mb", "detail_spacing_m", "detail_volumes",
+        NULL};
     struct sb_probe_params *p = &scene->probes;
     sb_probe_params_default(p);
     scene->has_probes = true;
@@ -136,8 +189,16 @@ static enum sb_result probes_section_parse(const cJSON *obj, struct sb_scene *sc
             return SB_ERR_OUT_OF_RANGE;
         }
     }
-    if (!res && p->spacing_m == 0 && !p->explicit_count) {
-        sb_error("%s: probes: no grid (spacing_m 0) and no positions_m: no probe at all", source);
+    if (!res && (item = cJSON_GetObjectItemCaseSensitive(obj, "detail_spacing_m")) &&
+        !(res = sb_json_number(item, source, "probes.detail_spacing_m", 0, 1000, &p->detail_spacing_m)) &&
+        p->detail_spacing_m > 0 && p->detail_spacing_m < 0.05) {
+        sb_error("%s: probes.detail_spacing_m: %g; 0 (no detail) or at least 0.05 m", source, p->detail_spacing_m);
+        return SB_ERR_OUT_OF_RANGE;
+    }
+    if (!res && (item = cJSON_GetObjectItemCaseSensitive(obj, "detail_volumes")))
+        res = parse_volumes(item, source, p);
+    if (!res && p->spacing_m == 0 && !p->explicit_count && p->detail_spacing_m == 0) {
+        sb_error("%s: probes: no grid (spacing_m 0), no detail and no positions_m: no probe at all", source);
         return SB_ERR_OUT_OF_RANGE;
     }
     return res;
@@ -167,6 +228,17 @@ static cJSON *probes_section_json(const struct sb_scene *scene)
         cJSON_AddNumberToObject(o, "budget_mb", p->budget_mb);
     if (p->layer_count) /* only when given: scenes without keep their hash */
         cJSON_AddItemToObject(o, "layers_m", cJSON_CreateDoubleArray(p->layers_m, p->layer_count));
+    if (p->detail_spacing_m > 0) { /* likewise */
+        cJSON_AddNumberToObject(o, "detail_spacing_m", p->detail_spacing_m);
+        cJSON *list = cJSON_AddArrayToObject(o, "detail_volumes");
+        for (int i = 0; i < p->detail_volume_count; i++) {
+            cJSON *v = cJSON_CreateObject();
+            cJSON_AddItemToObject(v, "min_m", cJSON_CreateDoubleArray(p->detail_volumes[i].min_m, 3));
+            cJSON_AddItemToObject(v, "max_m", cJSON_CreateDoubleArray(p->detail_volumes[i].max_m, 3));
+            cJSON_AddBoolToObject(v, "detail", p->detail_volumes[i].detail);
+            cJSON_AddItemToArray(list, v);
+        }
+    }
     cJSON *list = cJSON_AddArrayToObject(o, "positions_m");
     for (int i = 0; i < p->explicit_count; i++)
         cJSON_AddItemToArray(list, cJSON_CreateDoubleArray(p->positions_m[i], 3));

@@ -195,6 +195,10 @@ void sb_renderer_barrier(VkCommandBuffer cmd);
  * and the frame scales, r->ground_radius_km and r->thickness_km. */
 enum sb_result sb_atmosphere_upload(struct sb_renderer *r, const struct sb_pack *pack);
 
+/* passes/probes.c: in a create hook, the pass reads the probes
+ * (probes.glsl's probe_lookup: "probes", "probe light", "probe detail"). */
+void sb_pass_read_probes(struct sb_renderer *r);
+
 /* world_gpu.c: the world's vertices, textures, emitting materials,
  * instances and their draws, and its BVH when r->scene_traced, into the
  * renderer's buffers ("vertices", ...), with its box and its casters'

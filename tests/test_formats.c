@@ -1202,7 +1202,8 @@ static void test_probes(void)
         enum sb_result want;
         const char *what;
     } fields[] = {
-        {8, 3, SB_ERR_VERSION, "a newer version"},
+        {8, 4, SB_ERR_VERSION, "a newer version"},
+        {8, 3, SB_ERR_PROBES, "version 3 with version 1's header"},
         {8, 2, SB_ERR_PROBES, "version 2 with version 1's header"},
         {8, 0, SB_ERR_VERSION, "version 0"},
         {12, 0x04030201, SB_ERR_PROBES, "big endian"},
@@ -1261,7 +1262,7 @@ static void test_probes(void)
     size = f ? fread(bytes, 1, sizeof(bytes), f) : 0;
     if (f)
         fclose(f);
-    CHECK(size == SB_PROBES_HEADER_BYTES + (size_t)nl * ch * 4 + 8 && bytes[8] == 2, "version 2: size %zu", size);
+    CHECK(size == SB_PROBES_HEADER_BYTES_V2 + (size_t)nl * ch * 4 + 8 && bytes[8] == 2, "version 2: size %zu", size);
     check_probes_damage(bytes, size, "a grid in layers");
     struct {
         size_t offset;
@@ -1288,6 +1289,104 @@ static void test_probes(void)
         if (res == SB_OK)
             sb_image_finish(&back);
     }
+
+    /* Detail: version 3, its brick columns round-trip, every prefix and
+     * bit flip is refused, and so are columns out of order, out of the
+     * lattice, or not holding the probes the header says. */
+    struct sb_image detailed = {0};
+    const uint32_t nd = nl + 16;
+    CHECK(sb_image_init(&detailed, nd, 1, ch) == SB_OK, "image");
+    sb_image_set_channel_names(&detailed, SB_SKY_VISIBILITY_CHANNELS);
+    for (uint32_t i = 0; i < nd; i++)
+        memcpy(&detailed.data[i * ch], &layered.data[(i % nl) * ch], sizeof(float) * ch);
+    struct sb_probe_column column = {.x = 3, .z = 1, .y0 = 7, .rows = 1};
+    struct sb_probe_layout bricks = terrain;
+    bricks.detail_spacing_m = 0.5f;
+    bricks.detail_origin_m[0] = -4;
+    bricks.detail_origin_m[1] = -2;
+    bricks.detail_origin_m[2] = 8;
+    bricks.detail_count = 16;
+    bricks.column_count = 1;
+    bricks.columns = &column;
+    CHECK(sb_probes_write(path, &bricks, &detailed) == SB_OK, "write detail");
+    CHECK(sb_probes_read(path, SB_SKY_VISIBILITY_CHANNELS, 1000, &got, &back) == SB_OK, "read detail back");
+    CHECK(got.column_count == 1 && got.detail_count == 16 && got.detail_spacing_m == 0.5f &&
+              got.detail_origin_m[2] == 8 && got.columns[0].x == 3 && got.columns[0].z == 1 && got.columns[0].y0 == 7 &&
+              got.columns[0].rows == 1 && got.layer_count == 2 && back.width == nd &&
+              !memcmp(back.data, detailed.data, sizeof(float) * nd * ch),
+          "the detail's round trip is exact");
+    /* lattice probe (4 * 3 + 1, 7, 4 * 1 + 2): after the grid's, row 0, z 2, x 1 */
+    CHECK(sb_probe_detail_index(&got, nl, 13, 7, 6) == nl + 2 * 4 + 1, "a lattice probe's index");
+    CHECK(sb_probe_detail_index(&got, nl, 13, 8, 6) == -1 && sb_probe_detail_index(&got, nl, 11, 7, 6) == -1 &&
+              sb_probe_detail_index(&got, nl, 13, 7, 3) == -1,
+          "lattice probes no column holds");
+    struct sb_probe_layout copy;
+    CHECK(sb_probe_layout_copy(&copy, &got) == SB_OK && copy.columns != got.columns && copy.columns[0].y0 == 7,
+          "a layout's copy owns its columns");
+    sb_probe_layout_finish(&copy);
+    sb_probe_layout_finish(&got);
+    CHECK(!got.columns && !got.column_count, "finished");
+    sb_image_finish(&back);
+    f = fopen(path, "rb");
+    size = f ? fread(bytes, 1, sizeof(bytes), f) : 0;
+    if (f)
+        fclose(f);
+    CHECK(size == SB_PROBES_HEADER_BYTES + SB_PROBES_COLUMN_BYTES + (size_t)nd * ch * 4 + 8 && bytes[8] == 3,
+          "version 3: size %zu", size);
+    check_probes_damage(bytes, size, "detail");
+    struct {
+        size_t offset;
+        uint32_t value;
+        const char *what;
+    } detail_fields[] = {
+        {140, 0, "a zero spacing"},
+        {140, 0x7fc00000, "a NaN spacing"},
+        {144, 0x7f800000, "an infinite origin"},
+        {156, 0, "no brick columns in version 3"},
+        {160, 32, "more detail probes than the columns hold"},
+        {164, 1, "a reserved byte"},
+        {SB_PROBES_HEADER_BYTES, 0xffffffff, "a column left of the lattice"},
+        {SB_PROBES_HEADER_BYTES + 4, 1u << 14, "a column past the lattice"},
+        {SB_PROBES_HEADER_BYTES + 8, 65536, "rows past the lattice"},
+        {SB_PROBES_HEADER_BYTES + 12, 0, "a column of no rows"},
+        {SB_PROBES_HEADER_BYTES + 12, 2, "a column holding more than the header says"},
+    };
+    for (size_t i = 0; i < sizeof(detail_fields) / sizeof(detail_fields[0]); i++) {
+        uint8_t edited[4096];
+        memcpy(edited, bytes, size);
+        for (int k = 0; k < 4; k++)
+            edited[detail_fields[i].offset + k] = (uint8_t)(detail_fields[i].value >> (8 * k));
+        restamp(edited, size);
+        enum sb_result res = sb_probes_parse(edited, size, "edited", SB_SKY_VISIBILITY_CHANNELS, 1000, &got, &back);
+        CHECK(res == SB_ERR_PROBES, "%s: %s", detail_fields[i].what, sb_result_name(res));
+        if (res == SB_OK) {
+            sb_image_finish(&back);
+            sb_probe_layout_finish(&got);
+        }
+    }
+    /* two columns, the second before the first */
+    struct sb_probe_column two[2] = {{.x = 2, .z = 1, .y0 = 0, .rows = 1}, {.x = 1, .z = 1, .y0 = 0, .rows = 1}};
+    struct sb_image wide = {0};
+    CHECK(sb_image_init(&wide, nl + 32, 1, ch) == SB_OK, "image");
+    sb_image_set_channel_names(&wide, SB_SKY_VISIBILITY_CHANNELS);
+    for (uint32_t i = 0; i < nl + 32; i++)
+        memcpy(&wide.data[i * ch], &layered.data[(i % nl) * ch], sizeof(float) * ch);
+    bricks.columns = two;
+    bricks.column_count = 2;
+    bricks.detail_count = 32;
+    CHECK(sb_probes_write(path, &bricks, &wide) == SB_OK, "write two columns");
+    enum sb_result unordered = sb_probes_read(path, SB_SKY_VISIBILITY_CHANNELS, 1000, &got, &back);
+    CHECK(unordered == SB_ERR_PROBES, "columns out of order: %s", sb_result_name(unordered));
+    two[0].x = 1;
+    two[1].x = 2;
+    CHECK(sb_probes_write(path, &bricks, &wide) == SB_OK &&
+              sb_probes_read(path, SB_SKY_VISIBILITY_CHANNELS, 1000, &got, &back) == SB_OK &&
+              sb_probe_detail_index(&got, nl, 8, 0, 4) == nl + 16,
+          "columns in order: the second's first probe follows the first's");
+    sb_probe_layout_finish(&got);
+    sb_image_finish(&back);
+    sb_image_finish(&wide);
+    sb_image_finish(&detailed);
     sb_image_finish(&layered);
     unlink(path);
     rmdir(dir);

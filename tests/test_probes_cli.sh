@@ -37,7 +37,7 @@ check "only what was asked for" test ! -e "$tmp/p/transmittance.exr"
 check "verify" expect_exit 0 "$skybake" verify "$tmp/p"
 check "info lists sky_visibility" expect_exit 0 "$skybake" info "$tmp/p"
 check "info shows the grid" grep -q '"grid":\[6,1,6\]' "$tmp/out"
-check "manifest has format_version 7" grep -Eq '"format_version":[[:space:]]*7,' "$tmp/p/manifest.json"
+check "manifest has format_version 8" grep -Eq '"format_version":[[:space:]]*8,' "$tmp/p/manifest.json"
 check "diff with itself" expect_exit 0 "$skybake" diff "$tmp/p" "$tmp/p"
 hash() { sed -n 's/.*"content_hash":[[:space:]]*"\([0-9a-f]*\)".*/\1/p' "$tmp/p/manifest.json"; }
 first=$(hash)
@@ -267,6 +267,84 @@ for bad in '"layers_m":[2,1]' '"layers_m":[]' '"layers_m":[1,2,3,4,5,6,7,8,9]' '
     check "probes {$bad} refused" expect_exit 2 "$skybake" bake "$tmp/bad_layers.json" -o "$tmp/bad_layers"
     check "naming probes.layers_m" grep -q "probes.layers_m" "$tmp/err"
 done
+
+# Detail where geometry is: a closed room (a box 4 m across and 3 m high,
+# its floor 5 cm over the ground) gets brick columns over its footprint
+# and one lattice column around it; the open ground, which the layers
+# follow, none. The brick columns are in the file (version 3), the same on
+# 1 and 3 threads; a budget coarsens the detail after the grid, saying so;
+# a volume forbids it.
+cat >"$tmp/room.obj" <<'OBJ'
+v -20 0 -20
+v -20 0 20
+v 20 0 20
+v 20 0 -20
+f 1 2 3
+f 1 3 4
+v -2 0.05 -2
+v 2 0.05 -2
+v 2 0.05 2
+v -2 0.05 2
+v -2 3 -2
+v 2 3 -2
+v 2 3 2
+v -2 3 2
+f 5 6 7
+f 5 7 8
+f 9 11 10
+f 9 12 11
+f 5 9 10
+f 5 10 6
+f 6 10 11
+f 6 11 7
+f 7 11 12
+f 7 12 8
+f 8 12 9
+f 8 9 5
+OBJ
+room() { # extra probes keys
+    printf '{"atmosphere":{"preset":"earth"},"products":["sky_visibility","sky_bounce"],"world":{"file":"room.obj"},"probes":{"spacing_m":4,"rays":256,"layers_m":[1,5],"bounce_rays":64,"bounce_secondary":8%s}}' "$1"
+}
+room ',"detail_spacing_m":0.5' >"$tmp/room.json"
+check "bake the room with detail" expect_exit 0 "$skybake" bake "$tmp/room.json" -o "$tmp/room1" --threads 1 -v
+# 4 m across at 0.5 m: lattice columns -2.5 to 2.5 around it, in bricks of 4
+check "detail over the room alone" grep -q "two surfaces or more; 9 brick columns" "$tmp/err"
+check "info gives the detail" expect_exit 0 "$skybake" info "$tmp/room1"
+check "the settings say so" grep -q '"detail":{"spacing_m":0.5,"brick_columns":9,"probes":' "$tmp/out"
+check "version 3 files" sh -c "od -An -tu4 -j8 -N4 '$tmp/room1/sky_visibility.sbprobes' | grep -qw 3"
+check "verify" expect_exit 0 "$skybake" verify "$tmp/room1"
+check "bake it on 3 threads" expect_exit 0 "$skybake" bake "$tmp/room.json" -o "$tmp/room3" --threads 3 -q
+check "the same visibility" cmp -s "$tmp/room1/sky_visibility.sbprobes" "$tmp/room3/sky_visibility.sbprobes"
+check "the same bounce" cmp -s "$tmp/room1/sky_bounce.sbprobes" "$tmp/room3/sky_bounce.sbprobes"
+check "a rebake reuses both" expect_exit 0 "$skybake" bake "$tmp/room.json" -o "$tmp/room1"
+check "reused" sh -c "grep -q 'sky_visibility.*reused' '$tmp/err' && grep -q 'sky_bounce.*reused' '$tmp/err'"
+check "the reused files are the same" cmp -s "$tmp/room1/sky_bounce.sbprobes" "$tmp/room3/sky_bounce.sbprobes"
+room ',"detail_spacing_m":0.5,"budget_mb":0.15' >"$tmp/room_budget.json"
+check "bake the room within a budget" expect_exit 0 "$skybake" bake "$tmp/room_budget.json" -o "$tmp/room_budget"
+check "saying the detail was coarsened" grep -q "detail 0.5 m apart would take .* MB, over what probes.budget_mb (0.15) leaves" "$tmp/err"
+check "info" expect_exit 0 "$skybake" info "$tmp/room_budget"
+bytes=$(sed -n 's/.*"bytes":\([0-9]*\).*/\1/p' "$tmp/out" | head -n 1)
+check "within the budget ($bytes bytes)" test -n "$bytes" -a "${bytes:-0}" -le 150000
+room ',"detail_spacing_m":0.5,"detail_volumes":[{"min_m":[-5,-1,-5],"max_m":[5,10,5],"detail":false}]' >"$tmp/room_forbid.json"
+check "bake the room, detail forbidden" expect_exit 0 "$skybake" bake "$tmp/room_forbid.json" -o "$tmp/room_forbid" -v
+check "no detail" grep -q "(0 in detail)" "$tmp/err"
+room ',"detail_spacing_m":2,"detail_volumes":[{"min_m":[10,0,10],"max_m":[14,4,14],"detail":true}]' >"$tmp/room_force.json"
+check "bake the room, detail forced on open ground" expect_exit 0 "$skybake" bake "$tmp/room_force.json" -o "$tmp/room_force" -v
+check "the forced volume's columns too" sh -c "grep -q 'two surfaces or more; [0-9]* brick columns' '$tmp/err' && ! grep -q '; 1 brick columns' '$tmp/err'"
+for bad in '"detail_spacing_m":0.01' '"detail_spacing_m":-1' '"detail_volumes":[{"min_m":[0,0,0],"max_m":[1,1,1],"detail":true}]' \
+    '"detail_spacing_m":1,"detail_volumes":[{"min_m":[0,0,0],"max_m":[0,1,1],"detail":true}]' \
+    '"detail_spacing_m":1,"detail_volumes":[{"min_m":[0,0,0],"max_m":[1,1,1]}]' \
+    '"detail_spacing_m":1,"detail_volumes":[{"min_m":[0,0,0],"max_m":[1,1,1],"detail":1}]' \
+    '"detail_spacing_m":1,"detail_volumes":{}'; do
+    printf '{"atmosphere":{"preset":"earth"},"products":["sky_visibility"],"world":{"file":"room.obj"},"probes":{%s}}' "$bad" >"$tmp/bad_detail.json"
+    check "probes {$bad} refused" expect_exit 2 "$skybake" bake "$tmp/bad_detail.json" -o "$tmp/bad_detail"
+    check "naming probes.detail_" grep -q "probes.detail_" "$tmp/err"
+done
+printf 'v 0 0 0\nv 1 0 0\nv 0 1 0\nv 4000 0 0\nv 4001 0 0\nv 4000 1 0\nf 1 2 3\nf 4 5 6\n' >"$tmp/far.obj"
+printf '{"atmosphere":{"preset":"earth"},"products":["transmittance","sky_visibility"],"world":{"file":"far.obj"},"probes":{"spacing_m":0,"detail_spacing_m":0.05}}' >"$tmp/fine.json"
+check "a lattice past its cap is refused before any bake" expect_exit 1 "$skybake" bake "$tmp/fine.json" -o "$tmp/fine"
+check "before the transmittance" sh -c "! grep -q 'transmittance' '$tmp/err'"
+check "naming probes.detail_spacing_m" grep -q "raise probes.detail_spacing_m" "$tmp/err"
 
 echo "probes cli: $checks checks, $fails failed"
 echo "$((checks - fails)) passed, $fails failed"

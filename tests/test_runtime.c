@@ -898,6 +898,117 @@ static struct sb_scene *probe_scene(const char *world_path)
     return scene;
 }
 
+#define SEAM_POINTS 46
+/*
+ * The ambient light at ground points 0.1 m apart along a line from open
+ * ground toward the overhang's edge (x -6, z -3 to -7.5), seen from 6 m
+ * straight above, into light[]: the line crosses where the detail around
+ * the overhang ends. Returns the largest change between neighbours over
+ * their mean.
+ */
+static double seam_step(const struct sb_pack *p, const struct sb_world *w, double light[SEAM_POINTS])
+{
+    struct sb_renderer *r = NULL;
+    struct sb_renderer_params rp = {.width = W, .height = H, .shadow_size = 512};
+    if (sb_renderer_create(vk, p, w, &rp, &r) != SB_OK)
+        return NAN;
+    struct sb_view v = base_view();
+    v.sun_elevation = -4.0 * DEG;
+    v.camera_m[0] = -6.0;
+    v.camera_m[1] = 6.0;
+    v.camera_m[2] = -5.25;
+    v.pitch = -90.0 * DEG;
+    v.fov_y = 60.0 * DEG;
+    double most = NAN;
+    if (render(r, &v)) {
+        float *rgb = frame_rgb(r);
+        most = 0.0;
+        double before = NAN;
+        for (int i = 0; i < SEAM_POINTS; i++) {
+            const double at[3] = {-6.0, 0.0, -3.0 - 0.1 * i};
+            double e = ground_luminance(r, rgb, at, "a point of the seam's line");
+            if (i)
+                most = fmax(most, fabs(e - before) / (0.5 * (e + before)));
+            light[i] = e;
+            before = e;
+        }
+        free(rgb);
+    }
+    sb_renderer_destroy(&r);
+    return most;
+}
+
+/*
+ * Detail where geometry is (1 m apart) over the same layers: probes stand
+ * inside the closed room and under the overhang, where the layers,
+ * standing on their tops, have none, and the ground under the overhang is
+ * lit as under the uniform 1 m grid. Where the detail ends on open ground
+ * no seam shows: the detail's light is blended into the layers' over its
+ * last lattice step, so along a line across its edge the largest change
+ * between points 0.1 m apart is at most a third of the largest difference
+ * between the two layouts' light on that line (a cut would put all of it
+ * in one step; a blend over ten steps, a tenth), beyond the layers' own.
+ * The room's light leaking through its walls is measured, not yet held
+ * to a bound: leak prevention is the next step (docs/probes.md).
+ */
+static void test_detail(const char *world_path, const char *layers_dir, const struct sb_world *w, const double lit[4],
+                        double view, double seam_layers, const double layers_line[SEAM_POINTS])
+{
+    char dir[440];
+    snprintf(dir, sizeof(dir), "%s-detail", layers_dir);
+    struct sb_scene *scene = probe_scene(world_path);
+    scene->probes.layer_count = 4;
+    for (int l = 0; l < 4; l++)
+        scene->probes.layers_m[l] = 0.5 + l;
+    scene->probes.detail_spacing_m = 1.0;
+    struct sb_bake_report report;
+    struct sb_pack detail_pack;
+    bool ok = sb_bake_scene(vk, scene, dir, NULL, &report) == SB_OK && sb_pack_open(dir, &detail_pack) == SB_OK;
+    free(scene);
+    CHECK(ok && detail_pack.artifacts[SB_PRODUCT_SKY_VISIBILITY].probes.column_count > 0,
+          "bake the layers with detail");
+    if (!ok)
+        return;
+    const struct sb_probe_layout *layout = &detail_pack.artifacts[SB_PRODUCT_SKY_VISIBILITY].probes;
+    /* a probe inside the room (x 5 to 11, z -15 to -9, y 0 to 2.7) and one under the overhang, valid */
+    uint64_t grid = (uint64_t)layout->grid[0] * layout->grid[1] * layout->grid[2];
+    int inside = 0, under = 0;
+    const struct sb_image *vis = &detail_pack.images[SB_PRODUCT_SKY_VISIBILITY];
+    for (uint32_t i = (uint32_t)grid; i < grid + layout->detail_count; i++) {
+        const float *c = &vis->data[(size_t)i * SB_SKY_VISIBILITY_CHANNEL_COUNT];
+        if (c[SB_SKY_VISIBILITY_VALID] == 0.0f)
+            continue;
+        inside += c[0] > 5 && c[0] < 11 && c[2] > -15 && c[2] < -9 && c[1] > 0 && c[1] < 2.7;
+        under += c[0] > -10 && c[0] < -2 && c[2] > -16 && c[2] < -8 && c[1] > 0 && c[1] < 1.8;
+    }
+    double detailed[4];
+    struct sb_renderer *r = NULL;
+    struct sb_renderer_params rp = {.width = W, .height = H, .shadow_size = 512};
+    CHECK(sb_renderer_create(vk, &detail_pack, w, &rp, &r) == SB_OK, "renderer");
+    if (r)
+        probe_views(r, detailed);
+    sb_renderer_destroy(&r);
+    double line[SEAM_POINTS], apart = 0.0;
+    double seam = seam_step(&detail_pack, w, line);
+    for (int i = 0; i < SEAM_POINTS; i++)
+        apart = fmax(apart, fabs(line[i] - layers_line[i]) / (0.5 * (line[i] + layers_line[i])));
+    printf("detail 1 m apart over the layers: %u probes in %u brick columns, %d valid inside the room, %d under the "
+           "overhang; under the overhang %.3f of open ground (uniform grid %.3f), the room %.4f (grid %.4f); across "
+           "the detail's edge the light changes by %.4f at most between points 0.1 m apart (layers alone %.4f), the "
+           "two layouts' light %.4f apart at most on the line\n",
+           layout->detail_count, layout->column_count, inside, under, detailed[0] / detailed[1], lit[0] / lit[1],
+           detailed[2] / detailed[1], lit[2] / lit[1], seam, seam_layers, apart);
+    CHECK(inside > 0 && under > 0, "detail probes inside the room (%d) and under the overhang (%d)", inside, under);
+    CHECK(detailed[0] / detailed[1] < 2.0 * view, "under the overhang with detail: %.3f of open ground, at most %.3f",
+          detailed[0] / detailed[1], 2.0 * view);
+    CHECK(apart > 0.02, "the detail changes the light along the line (%.4f): the seam test can fail", apart);
+    CHECK(seam <= apart / 3.0 + seam_layers,
+          "no seam where the detail ends: %.4f at most between neighbours, the layouts %.4f apart, the layers' own "
+          "%.4f",
+          seam, apart, seam_layers);
+    sb_pack_close(&detail_pack);
+}
+
 static void test_probes(const char *dir)
 {
     char world_path[400], pack_dir[400];
@@ -982,6 +1093,9 @@ static void test_probes(const char *dir)
                layered[1] / lit[1], layered[1] / sky[1]);
         CHECK(fabs(layered[1] / lit[1] - 1.0) < 0.005, "open ground under layers as under the grid: %.4f",
               layered[1] / lit[1]);
+        double line[SEAM_POINTS];
+        double seam_layers = seam_step(&layer_pack, &w, line);
+        test_detail(world_path, layers_dir, &w, lit, view, seam_layers, line);
         sb_pack_close(&layer_pack);
     }
     sb_world_finish(&w);
@@ -1561,8 +1675,8 @@ static void test_textures(const struct sb_renderer_params *rp)
             printf("textured floor, %s: left (black) %.4g, right (white) %.4g; without textures %.4g, %.4g\n",
                    k ? "traced" : "raster", with[k][0], with[k][1], without[k][0], without[k][1]);
             /* black: the sky's specular and the air's light alone */
-            CHECK(with[k][1] > 5 * with[k][0], "%s: the texture's halves (%g, %g)", k ? "traced" : "raster",
-                  with[k][0], with[k][1]);
+            CHECK(with[k][1] > 5 * with[k][0], "%s: the texture's halves (%g, %g)", k ? "traced" : "raster", with[k][0],
+                  with[k][1]);
             /* white texels are the material's own albedo (1): the floor without its texture */
             CHECK(fabs(with[k][1] - without[k][1]) < 1e-3 * without[k][1] && with[k][0] < 0.05 * without[k][0],
                   "%s: white texels as the untextured floor, black far darker (%g, %g; %g, %g)",

@@ -106,8 +106,7 @@ static enum sb_result fog_create(struct sb_renderer *r)
     sb_pass_sample(r, SB_VIEW_BINDING_FROXEL_HISTORY, SB_PREVIOUS(light), NULL);
     sb_pass_use(r, SB_VIEW_BINDING_FROXEL_OUT, froxels, SB_USE_STORE);
     sb_pass_sample(r, SB_VIEW_BINDING_FOG_NOISE, sb_graph_image(r, "fog noise", &f->noise), r->repeat);
-    sb_pass_use(r, SB_VIEW_BINDING_PROBES, sb_pass_find(r, "probes"), SB_USE_LOAD);
-    sb_pass_use(r, SB_VIEW_BINDING_PROBE_LIGHT, sb_pass_find(r, "probe light"), SB_USE_LOAD);
+    sb_pass_read_probes(r);
     sb_pass_use(r, SB_VIEW_BINDING_CLOUDS, sb_pass_find(r, "clouds"), SB_USE_LOAD);
     sb_pass_sample(r, SB_VIEW_BINDING_CLOUD_SHADOW, sb_pass_find(r, "cloud shadow"), NULL);
     if (r->scene_traced) {

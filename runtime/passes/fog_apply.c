@@ -21,8 +21,7 @@ static enum sb_result fog_apply_create(struct sb_renderer *r)
     sb_pass_sample(r, SB_VIEW_BINDING_DEPTH, sb_pass_find(r, "depth"), r->nearest);
     sb_pass_use(r, SB_VIEW_BINDING_FOG, sb_pass_find(r, "fog"), SB_USE_LOAD);
     sb_pass_sample(r, SB_VIEW_BINDING_FROXEL, froxels, NULL);
-    sb_pass_use(r, SB_VIEW_BINDING_PROBES, sb_pass_find(r, "probes"), SB_USE_LOAD);
-    sb_pass_use(r, SB_VIEW_BINDING_PROBE_LIGHT, sb_pass_find(r, "probe light"), SB_USE_LOAD);
+    sb_pass_read_probes(r);
     sb_pass_use(r, SB_VIEW_BINDING_CLOUDS, sb_pass_find(r, "clouds"), SB_USE_LOAD);
     sb_pass_sample(r, SB_VIEW_BINDING_CLOUD_SHADOW, sb_pass_find(r, "cloud shadow"), NULL);
     return sb_pass_frame_kernel(r, sb_spv_fog_apply, sizeof(sb_spv_fog_apply), "fog apply");

@@ -2,9 +2,9 @@
  * The sky-visibility probes relit each frame (probes.glsl): the sky's SH
  * from the sky-view LUT (probe_sky), then each probe's irradiance SH from
  * its visibility and bounce (probe_light), which the scene and the fog
- * read. The pack's probe grid is uploaded here; without one the buffers
- * hold a probe of zeros and the pass records nothing. "probes" and "probe
- * light" in the graph's table.
+ * read. The pack's probe grid and detail are uploaded here; without them
+ * the buffers hold a probe of zeros and the pass records nothing.
+ * "probes", "probe light" and "probe detail" in the graph's table.
  */
 #include <math.h>
 #include <stdlib.h>
@@ -20,6 +20,7 @@
 
 struct probes {
     struct sb_buffer probes, light; /* sb_probes_gpu and its probes; the sky's and probes' SH */
+    struct sb_buffer detail;        /* the detail's table of brick columns (one absent one without) */
     VkPipeline sky_kernel, light_kernel;
 };
 
@@ -31,7 +32,8 @@ static void mean_albedo(const struct sb_world *world, float out[3])
     double sum[3] = {0, 0, 0}, area = 0;
     uint32_t copies = world->instance_count ? world->instance_count : 1;
     for (uint32_t i = 0; i < copies; i++) {
-        const struct sb_world_mesh_range *range = world->instance_count ? &world->meshes[world->instance_mesh[i]] : NULL;
+        const struct sb_world_mesh_range *range =
+            world->instance_count ? &world->meshes[world->instance_mesh[i]] : NULL;
         const struct sb_instance_gpu *in = range ? &world->instances[i] : NULL;
         double det = 1.0;
         if (in) {
@@ -48,8 +50,7 @@ static void mean_albedo(const struct sb_world *world, float out[3])
                 e1[k] = (double)t[1].position[k] - t[0].position[k];
                 e2[k] = (double)t[2].position[k] - t[0].position[k];
             }
-            double n[3] = {e1[1] * e2[2] - e1[2] * e2[1], e1[2] * e2[0] - e1[0] * e2[2],
-                           e1[0] * e2[1] - e1[1] * e2[0]};
+            double n[3] = {e1[1] * e2[2] - e1[2] * e2[1], e1[2] * e2[0] - e1[0] * e2[2], e1[0] * e2[1] - e1[1] * e2[0]};
             if (in) {
                 double placed[3];
                 for (int r = 0; r < 3; r++)
@@ -69,9 +70,61 @@ static void mean_albedo(const struct sb_world *world, float out[3])
 /* Floats a probe takes in the probes buffer (config.h, probes_gpu.h, probes.glsl). */
 #define PROBE_FLOATS (4 * SB_PROBE_VEC4S)
 
+/* Entries of the detail's table at most (64 MiB). */
+#define SB_PROBES_MAX_DETAIL_TABLE (1u << 22)
+
+/* The detail's table: an entry for each brick column of the lattice (x
+ * fastest; probes_gpu.h), those the layout holds filled. Without detail,
+ * one absent entry. */
+static enum sb_result upload_detail(struct sb_renderer *r, struct probes *s, const struct sb_probe_layout *layout,
+                                    uint32_t first, struct sb_probes_gpu *g)
+{
+    uint32_t size[2] = {0, 0};
+    for (uint32_t c = 0; c < layout->column_count && r->probe_count; c++) {
+        size[0] = (uint32_t)layout->columns[c].x + 1 > size[0] ? (uint32_t)layout->columns[c].x + 1 : size[0];
+        size[1] = (uint32_t)layout->columns[c].z + 1 > size[1] ? (uint32_t)layout->columns[c].z + 1 : size[1];
+    }
+    uint64_t entries = (uint64_t)size[0] * size[1];
+    if (entries > SB_PROBES_MAX_DETAIL_TABLE) {
+        sb_warn("the pack's detail probes span %u x %u brick columns, over the %u skyview's table holds: the "
+                "grid's probes light the world alone",
+                size[0], size[1], SB_PROBES_MAX_DETAIL_TABLE);
+        entries = 0;
+    }
+    enum sb_result res =
+        sb_renderer_upload(r, NULL, (entries ? entries : 1) * 4 * sizeof(uint32_t), "probe detail", &s->detail);
+    if (res || !entries || !g)
+        return res;
+    uint32_t(*table)[4] = s->detail.mapped;
+    for (uint32_t c = 0; c < layout->column_count; c++) {
+        const struct sb_probe_column *col = &layout->columns[c];
+        uint32_t *e = table[(uint64_t)col->z * size[0] + (uint32_t)col->x];
+        e[0] = (uint32_t)col->y0;
+        e[1] = col->rows;
+        e[2] = first;
+        first += col->rows * SB_PROBES_BRICK * SB_PROBES_BRICK;
+    }
+    g->detail[0] = size[0];
+    g->detail[1] = size[1];
+    g->detail[2] = 0; /* unused: each entry names its first probe */
+    g->detail[3] = layout->column_count;
+    for (int k = 0; k < 3; k++)
+        g->detail_origin_m[k] = layout->detail_origin_m[k];
+    g->detail_origin_m[3] = layout->detail_spacing_m;
+    return SB_OK;
+}
+
+void sb_pass_read_probes(struct sb_renderer *r)
+{
+    sb_pass_use(r, SB_VIEW_BINDING_PROBES, sb_pass_find(r, "probes"), SB_USE_LOAD);
+    sb_pass_use(r, SB_VIEW_BINDING_PROBE_LIGHT, sb_pass_find(r, "probe light"), SB_USE_LOAD);
+    sb_pass_use(r, SB_VIEW_BINDING_PROBE_DETAIL, sb_pass_find(r, "probe detail"), SB_USE_LOAD);
+}
+
 /*
- * The pack's sky-visibility probes, or none: the grid's probes (explicit
- * ones are for other uses: a runtime interpolates a grid), each as
+ * The pack's sky-visibility probes, or none: the grid's probes and the
+ * detail's (explicit ones are for other uses: a runtime interpolates
+ * between probes it knows the places of), each as
  * (position, valid), its 9 SH coefficients; the tensor's non-zero entries;
  * the light buffer the probes pass writes.
  */
@@ -81,17 +134,20 @@ static enum sb_result upload_probes(struct sb_renderer *r, struct probes *s)
     const struct sb_probe_layout *layout = &pack->artifacts[SB_PRODUCT_SKY_VISIBILITY].probes;
     const struct sb_image *image = &pack->images[SB_PRODUCT_SKY_VISIBILITY];
     uint64_t grid = (uint64_t)layout->grid[0] * layout->grid[1] * layout->grid[2];
-    bool use = pack->present[SB_PRODUCT_SKY_VISIBILITY] && !r->params.no_probes && grid > 0 && grid <= image->width &&
-               image->channel_count == SB_SKY_VISIBILITY_CHANNEL_COUNT;
+    uint64_t placed = grid + layout->detail_count;
+    bool use = pack->present[SB_PRODUCT_SKY_VISIBILITY] && !r->params.no_probes && placed > 0 &&
+               placed <= image->width && image->channel_count == SB_SKY_VISIBILITY_CHANNEL_COUNT;
     if (pack->present[SB_PRODUCT_SKY_VISIBILITY] && !r->params.no_probes && !use)
-        sb_warn("the pack's sky_visibility has no probe grid: the world is lit by the sky alone");
-    r->probe_count = use ? (uint32_t)grid : 0;
+        sb_warn("the pack's sky_visibility has no probe grid or detail: the world is lit by the sky alone");
+    r->probe_count = use ? (uint32_t)placed : 0;
     size_t count = r->probe_count ? r->probe_count : 1;
     enum sb_result res = sb_renderer_upload(
         r, NULL, sizeof(struct sb_probes_gpu) + count * PROBE_FLOATS * sizeof(float), "probes", &s->probes);
     if (!res)
         res = sb_renderer_upload(r, NULL, (SB_PROBE_SH + count * SB_PROBE_SH) * 4 * sizeof(float), "probe light",
                                  &s->light);
+    if (!res)
+        res = upload_detail(r, s, layout, (uint32_t)grid, r->probe_count ? s->probes.mapped : NULL);
     if (res || !r->probe_count)
         return res;
     struct sb_probes_gpu *g = s->probes.mapped;
@@ -123,7 +179,8 @@ static enum sb_result upload_probes(struct sb_renderer *r, struct probes *s)
     const struct sb_image *bounce = &pack->images[SB_PRODUCT_SKY_BOUNCE];
     const struct sb_probe_layout *bounce_layout = &pack->artifacts[SB_PRODUCT_SKY_BOUNCE].probes;
     bool has_bounce = pack->present[SB_PRODUCT_SKY_BOUNCE] && bounce->width == image->width &&
-                      !memcmp(bounce_layout->grid, layout->grid, sizeof(layout->grid));
+                      !memcmp(bounce_layout->grid, layout->grid, sizeof(layout->grid)) &&
+                      bounce_layout->detail_count == layout->detail_count;
     if (pack->present[SB_PRODUCT_SKY_BOUNCE] && !has_bounce)
         sb_warn("the pack's sky_bounce has another grid than its sky_visibility: the bounce is modelled");
     g->spacing_m[3] = has_bounce ? 1.0f : 0.0f;
@@ -146,7 +203,7 @@ static enum sb_result upload_probes(struct sb_renderer *r, struct probes *s)
         const float *sh = c + SB_SKY_VISIBILITY_SH;
         for (int k = 0; k < SB_PROBE_SH; k++)
             o[4 + k] = w[band[k]] > 1e-3 ? (float)(sh[k] / w[band[k]]) : sh[k];
-        if (layout->layer_count) { /* the surface under its column: where it was placed, less its layer */
+        if (layout->layer_count && p < grid) { /* the surface under its column: where it was placed, less its layer */
             uint32_t l = p / layout->grid[0] % layout->grid[1];
             o[13] = c[SB_SKY_VISIBILITY_POSITION + 1] - c[SB_SKY_VISIBILITY_OFFSET + 1] - layout->layers_m[l];
         }
@@ -158,8 +215,11 @@ static enum sb_result upload_probes(struct sb_renderer *r, struct probes *s)
                 (double)layout->layers_m[0], (double)layout->layers_m[layout->layer_count - 1],
                 has_bounce ? "baked" : "modelled");
     else
-        sb_info("probes: %u x %u x %u, %.3g m apart, light the world (bounce %s)", layout->grid[0],
-                layout->grid[1], layout->grid[2], (double)layout->spacing_m[0], has_bounce ? "baked" : "modelled");
+        sb_info("probes: %u x %u x %u, %.3g m apart, light the world (bounce %s)", layout->grid[0], layout->grid[1],
+                layout->grid[2], (double)layout->spacing_m[0], has_bounce ? "baked" : "modelled");
+    if (layout->detail_count)
+        sb_info("probes: detail %.3g m apart, %u probes in %u brick columns", (double)layout->detail_spacing_m,
+                layout->detail_count, layout->column_count);
     return SB_OK;
 }
 
@@ -174,6 +234,7 @@ static enum sb_result probes_create(struct sb_renderer *r)
         return res;
     sb_resource probes = sb_graph_buffer(r, "probes", &s->probes);
     sb_resource light = sb_graph_buffer(r, "probe light", &s->light);
+    sb_graph_buffer(r, "probe detail", &s->detail);
     if (!r->probe_count)
         return SB_OK;
     sb_pass_read_atmosphere(r);
@@ -194,6 +255,7 @@ static void probes_destroy(struct sb_renderer *r)
     sb_renderer_release(r, (const VkPipeline[]){s->sky_kernel, s->light_kernel}, 2, NULL, 0);
     sb_buffer_destroy(r->vk, &s->probes);
     sb_buffer_destroy(r->vk, &s->light);
+    sb_buffer_destroy(r->vk, &s->detail);
     free(s);
 }
 

@@ -210,8 +210,7 @@ static enum sb_result scene_create(struct sb_renderer *r)
     }
     sb_pass_sample(r, SB_VIEW_BINDING_AERIAL, sb_pass_find(r, "aerial"), NULL);
     sb_pass_sample(r, SB_VIEW_BINDING_AERIAL_T, sb_pass_find(r, "aerial transmittance"), NULL);
-    sb_pass_use(r, SB_VIEW_BINDING_PROBES, sb_pass_find(r, "probes"), SB_USE_LOAD);
-    sb_pass_use(r, SB_VIEW_BINDING_PROBE_LIGHT, sb_pass_find(r, "probe light"), SB_USE_LOAD);
+    sb_pass_read_probes(r);
     sb_pass_use(r, SB_VIEW_BINDING_REFLECTIONS, sb_graph_buffer(r, "reflections", &s->reflections), SB_USE_LOAD);
     sb_pass_use(r, SB_VIEW_BINDING_REFLECTION_CUBES, sb_graph_buffer(r, "reflection cubes", &s->cubes), SB_USE_LOAD);
     sb_pass_use(r, SB_VIEW_BINDING_CLOUDS, sb_pass_find(r, "clouds"), SB_USE_LOAD);

@@ -34,6 +34,10 @@ const float SH_COSINE[3] = float[3](SB_SH_COSINE_FACTORS);
 const int SH_BAND[SB_PROBE_SH] = int[SB_PROBE_SH](SB_SH_BANDS);
 
 #ifndef PROBE_LIGHT_WRITABLE
+layout(std430, set = 0, binding = SB_VIEW_BINDING_PROBE_DETAIL) readonly buffer ProbeDetailBuffer {
+    uvec4 probe_columns[]; /* the detail's table (sb_probes_gpu.detail) */
+};
+
 /* Probe `index`'s irradiance along n and r (yn, yr: their SH bases), added
  * with weight w times DDGI's wrap of the direction from pos toward it; an
  * invalid probe adds nothing. */
@@ -65,31 +69,65 @@ float probe_layer(int l)
 }
 
 /*
- * Irradiance from the probes at world point pos (m) on a surface of normal
- * n, and along a second direction r (the mirror direction, for the
- * ambient specular): trilinear between the 8 grid probes around pos pushed
- * a quarter of a spacing along n, each weighted by DDGI's wrap of the
- * direction toward it, probes flagged invalid skipped and the weights
- * renormalised. *coverage is 1 inside the grid (and half a spacing past
- * its outer probes), fading to 0 one spacing further, and 0 with no probe
- * (or no valid one) around.
- *
- * A grid of layers over the surface: bilinear between the 4 columns
- * around pos, and in each column linear between the two layers around
- * pos's height over that column's surface (below the lowest, the lowest;
- * above the top, the top, fading to nothing over the y spacing).
+ * The detail's irradiance at pos (formats/probes.h): trilinear between the
+ * 8 lattice probes around pos pushed a quarter of a step along n, weighted
+ * as probe_add weighs them, invalid ones skipped and the weights
+ * renormalised. Returns the detail's share: the trilinear weight of the
+ * corners it has (valid or not), 1 inside it, falling to 0 over the last
+ * lattice step out of it; 0 where none of its corners is valid.
  */
-void probe_lookup(vec3 pos, vec3 n, vec3 r, out vec3 e_n, out vec3 e_r, out float coverage)
+float probe_detail(vec3 pos, vec3 n, float yn[SB_PROBE_SH], float yr[SB_PROBE_SH], out vec3 e_n, out vec3 e_r)
+{
+    e_n = vec3(0.0);
+    e_r = vec3(0.0);
+    if (probes.detail.w == 0u)
+        return 0.0;
+    float s = probes.detail_origin_m.w;
+    vec3 g = clamp((pos + n * (0.25 * s) - probes.detail_origin_m.xyz) / s, vec3(-2.0), vec3(70000.0));
+    vec3 base = floor(g);
+    vec3 f = g - base;
+    float present = 0.0, wsum = 0.0;
+    for (int corner = 0; corner < 8; corner++) {
+        vec3 o = vec3(corner & 1, (corner >> 1) & 1, (corner >> 2) & 1);
+        ivec3 at = ivec3(base + o);
+        if (any(lessThan(at, ivec3(0))))
+            continue;
+        uvec3 u = uvec3(at);
+        uvec2 b = u.xz / uint(SB_PROBE_BRICK);
+        if (b.x >= probes.detail.x || b.y >= probes.detail.y)
+            continue;
+        uvec4 column = probe_columns[b.x + probes.detail.x * b.y];
+        if (u.y < column.x || u.y - column.x >= column.y)
+            continue;
+        vec3 tri = mix(1.0 - f, f, o);
+        float w = tri.x * tri.y * tri.z;
+        uint brick = uint(SB_PROBE_BRICK);
+        uint index = column.z + ((u.y - column.x) * brick + u.z % brick) * brick + u.x % brick;
+        present += w;
+        probe_add(index, w, pos, n, yn, yr, e_n, e_r, wsum);
+    }
+    if (wsum <= 1e-6) {
+        e_n = e_r = vec3(0.0);
+        return 0.0;
+    }
+    e_n /= wsum;
+    e_r /= wsum;
+    return present;
+}
+
+/*
+ * The grid's irradiance at pos (the layers' or the uniform grid's) and its
+ * coverage, as probe_lookup says.
+ */
+void probe_grid(vec3 pos, vec3 n, float yn[SB_PROBE_SH], float yr[SB_PROBE_SH], out vec3 e_n, out vec3 e_r,
+                out float coverage)
 {
     e_n = vec3(0.0);
     e_r = vec3(0.0);
     coverage = 0.0;
-    if (probes.grid.w == 0u)
+    if (probes.grid.x == 0u)
         return;
     vec3 spacing = probes.spacing_m.xyz;
-    float yn[SB_PROBE_SH], yr[SB_PROBE_SH];
-    sh9_basis(n, yn);
-    sh9_basis(r, yr);
     float wsum = 0.0;
     int layers = int(probes.layered.x);
     if (layers > 0) {
@@ -157,6 +195,61 @@ void probe_lookup(vec3 pos, vec3 n, vec3 r, out vec3 e_n, out vec3 e_r, out floa
     e_n /= wsum;
     e_r /= wsum;
     coverage = fade;
+}
+
+/*
+ * Irradiance from the probes at world point pos (m) on a surface of normal
+ * n, and along a second direction r (the mirror direction, for the
+ * ambient specular): the detail's where it is, the grid's elsewhere, the
+ * two blended by the detail's share over its last lattice step, so no
+ * seam shows where the detail ends. *coverage is 1 where either covers
+ * pos, fading to 0 where neither does (the caller lights the rest by the
+ * sky alone).
+ *
+ * The grid: trilinear between the 8 grid probes around pos pushed a
+ * quarter of a spacing along n, each weighted by DDGI's wrap of the
+ * direction toward it, probes flagged invalid skipped and the weights
+ * renormalised; its coverage is 1 inside the grid (and half a spacing
+ * past its outer probes), fading to 0 one spacing further, and 0 with no
+ * probe (or no valid one) around.
+ *
+ * A grid of layers over the surface: bilinear between the 4 columns
+ * around pos, and in each column linear between the two layers around
+ * pos's height over that column's surface (below the lowest, the lowest;
+ * above the top, the top, fading to nothing over the y spacing).
+ */
+void probe_lookup(vec3 pos, vec3 n, vec3 r, out vec3 e_n, out vec3 e_r, out float coverage)
+{
+    e_n = vec3(0.0);
+    e_r = vec3(0.0);
+    coverage = 0.0;
+    if (probes.grid.w == 0u)
+        return;
+    float yn[SB_PROBE_SH], yr[SB_PROBE_SH];
+    sh9_basis(n, yn);
+    sh9_basis(r, yr);
+    vec3 detail_n, detail_r;
+    float detail = probe_detail(pos, n, yn, yr, detail_n, detail_r);
+    if (detail >= 1.0 - 1e-6) {
+        e_n = detail_n;
+        e_r = detail_r;
+        coverage = 1.0;
+        return;
+    }
+    vec3 grid_n, grid_r;
+    float grid;
+    probe_grid(pos, n, yn, yr, grid_n, grid_r, grid);
+    if (detail <= 0.0) { /* the grid's alone, as it was */
+        e_n = grid_n;
+        e_r = grid_r;
+        coverage = grid;
+        return;
+    }
+    coverage = detail + (1.0 - detail) * grid;
+    if (coverage <= 1e-6)
+        return;
+    e_n = (detail * detail_n + (1.0 - detail) * grid * grid_n) / coverage;
+    e_r = (detail * detail_r + (1.0 - detail) * grid * grid_r) / coverage;
 }
 #endif
 

@@ -9,6 +9,7 @@
 
 #define SB_VIEW_BINDING_PROBES 20        /* struct sb_probes_gpu, then SB_PROBE_VEC4S vec4s a probe */
 #define SB_VIEW_BINDING_PROBE_LIGHT 21   /* the sky's SH, then each probe's irradiance SH (probes.glsl) */
+#define SB_VIEW_BINDING_PROBE_DETAIL 56  /* the detail's brick columns, uvec4 each (probes.glsl) */
 
 /* The sky-visibility probes skyview lights the world with (probes.glsl):
  * the grid of a pack's sky_visibility product, and the SH triple-product
@@ -19,6 +20,7 @@
 #define SB_SH_TENSOR_MAX 128 /* 83 are not zero */
 #define SB_PROBE_SKY_THREADS 64
 #define SB_PROBE_SKY_DIRECTIONS 4096
+#define SB_PROBE_BRICK 4 /* lattice columns across a brick column (SB_PROBES_BRICK) */
 struct sb_probes_gpu {
     SB_UVEC4(grid);          /* xyz: probes along each axis; w: grid probes (0: none, the sky-only ambient) */
     SB_VEC4(origin_m);       /* xyz: the first probe (world, m); w: tensor entries */
@@ -30,6 +32,13 @@ struct sb_probes_gpu {
      * vec4 holds its column's surface height in y. */
     SB_UVEC4(layered);
     SB_VEC4(layers_m[2]);
+    /* Detail (formats/probes.h): a table of x by y brick columns over the
+     * lattice (z: the index of its first probe; w: the columns present, 0:
+     * no detail), the lattice's first probe (xyz, m) and spacing (w). A
+     * column's entry: its lowest row, its rows (0: absent), its first
+     * probe's index, 0. */
+    SB_UVEC4(detail);
+    SB_VEC4(detail_origin_m);
     SB_VEC4(tensor[SB_SH_TENSOR_MAX]); /* x: the integral of Y_i Y_j Y_k; y, z, w: i, j, k */
 };
 
