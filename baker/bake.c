@@ -191,8 +191,9 @@ enum sb_result sb_bake_scene(struct sb_vk *vk, const struct sb_scene *scene, con
             snprintf(a->settings_json, sizeof(a->settings_json), "%s", was->settings_json);
             a->bake_ms = was->bake_ms;
             a->gpu_ms = was->gpu_ms;
-            a->probes = was->probes; /* its columns move with it */
+            a->probes = was->probes; /* its columns and sight masks move with it */
             old->artifacts[p].probes.columns = NULL;
+            old->artifacts[p].probes.sight = NULL;
             old->artifacts[p].probes.column_count = 0;
             baked[p] = old->images[p];
             old->images[p] = (struct sb_image){0};

@@ -24,6 +24,7 @@
 #include "mesh.h"
 #include "parallel.h"
 #include "probe_detail.h"
+#include "probe_sight.h"
 #include "raycast.h"
 #include "sh.h"
 #include "sky_bounce.h"
@@ -33,6 +34,11 @@
  * directions at these fractions of the spacing (or of 1 m without a grid),
  * tried in a fixed order with PUSH_RAYS rays each. */
 static const double push_steps[] = {0.25, 0.5};
+/* The detail's: its lattice stands half a step off round coordinates,
+ * where floors and walls often are, and a quarter or half step would put
+ * a pushed probe onto one (a probe on a floor sees through it). */
+static const double detail_push_steps[] = {0.3, 0.6};
+_Static_assert(sizeof(push_steps) == sizeof(detail_push_steps), "as many candidates a probe");
 #define PUSH_RAYS 256
 #define PROBES_RECIPE 2 /* 2: rays cast in sb_probe_ray_order */
 
@@ -118,6 +124,10 @@ static void probes_key(void *state, const struct sb_scene *scene, enum sb_produc
     }
     sb_sky_visibility_code_hash(code);
     sb_key_add(key, " code %s", code);
+    if (p->detail_spacing_m > 0) { /* the detail's sight masks */
+        sb_probe_sight_code_hash(code);
+        sb_key_add(key, " sight_code %s", code);
+    }
     if (id == SB_PRODUCT_SKY_BOUNCE) { /* and the visibility's key, as its input */
         sb_sky_bounce_code_hash(code);
         sb_key_add(key, " bounce_rays=%u secondary=%u bounce_code %s", p->bounce_rays, p->bounce_secondary, code);
@@ -315,8 +325,9 @@ static enum sb_result place_detail(struct probes_state *st, const struct sb_scen
     const struct sb_probe_params *p = &scene->probes;
     if (st->detail_placed || p->detail_spacing_m <= 0)
         return SB_OK;
-    double spacing = p->detail_spacing_m, per = (double)probe_bytes(scene);
-    double left = p->budget_mb > 0 ? p->budget_mb * 1e6 - (double)taken * per : INFINITY;
+    /* a detail probe's records and its sight mask */
+    double spacing = p->detail_spacing_m, per = (double)probe_bytes(scene) + 4.0 * SB_PROBES_SIGHT_WORDS;
+    double left = p->budget_mb > 0 ? p->budget_mb * 1e6 - (double)taken * (double)probe_bytes(scene) : INFINITY;
     enum sb_result res = SB_OK;
     if (left < per * SB_PROBES_BRICK * SB_PROBES_BRICK) {
         sb_warn("probes: the grid takes all of probes.budget_mb (%g): no detail", p->budget_mb);
@@ -449,7 +460,8 @@ static enum sb_result push_out(struct sb_raycaster *rc, const struct sb_scene *s
                 if (d == 13)
                     continue; /* the probe itself */
                 int dx = d % 3 - 1, dy = d / 3 % 3 - 1, dz = d / 9 - 1;
-                double len = sqrt((double)(dx * dx + dy * dy + dz * dz)), step = push_steps[s] * unit / len;
+                double len = sqrt((double)(dx * dx + dy * dy + dz * dz)),
+                       step = (detail ? detail_push_steps : push_steps)[s] * unit / len;
                 float *q = &candidates[3 * ((size_t)j * per + c++)];
                 q[0] = (float)(positions[3 * (size_t)which[j]] + dx * step);
                 q[1] = (float)(positions[3 * (size_t)which[j] + 1] + dy * step);
@@ -532,10 +544,28 @@ static enum sb_result bake_visibility(struct probes_state *st, const struct sb_s
     if (pushed && (res = sb_sky_visibility_bake(rc, positions, count, &params, results, &ms)))
         goto done;
     gpu_ms += pushed ? ms : 0;
+    double t3 = sb_now_s();
+    if (layout->detail_count) { /* the detail's sight masks, from where its probes ended up */
+        uint64_t grid = (uint64_t)layout->grid[0] * layout->grid[1] * layout->grid[2];
+        float *lattice = malloc((size_t)layout->detail_count * 3 * sizeof(float));
+        layout->sight = malloc((size_t)layout->detail_count * SB_PROBES_SIGHT_WORDS * sizeof(*layout->sight));
+        if (!lattice || !layout->sight) {
+            free(lattice);
+            res = SB_ERR_NOMEM;
+            goto done;
+        }
+        sb_probe_detail_positions(layout, lattice);
+        res = sb_probe_sight_bake(rc, positions + 3 * grid, lattice, layout->detail_count, layout->detail_spacing_m,
+                                  layout->sight, &ms);
+        free(lattice);
+        if (res)
+            goto done;
+        gpu_ms += ms;
+    }
     sb_debug("sky_visibility: %u probes cast in %.1f ms, %u inside tried at %u places each in %.1f ms, cast again "
-             "in %.1f ms",
+             "in %.1f ms; %u sight masks in %.1f ms",
              count, 1e3 * (t1 - t0), inside, 26 * (unsigned)(sizeof(push_steps) / sizeof(push_steps[0])),
-             1e3 * (t2 - t1), 1e3 * (sb_now_s() - t2));
+             1e3 * (t2 - t1), 1e3 * (t3 - t2), layout->detail_count, 1e3 * (sb_now_s() - t3));
     if ((res = sb_image_init(image, count, 1, SB_SKY_VISIBILITY_CHANNEL_COUNT)))
         goto done;
     sb_image_set_channel_names(image, SB_SKY_VISIBILITY_CHANNELS);
@@ -585,7 +615,9 @@ static enum sb_result bake_visibility(struct probes_state *st, const struct sb_s
      * the settings of other bakes as they were */
     if (scene->probes.budget_mb > 0)
         sb_settings_json_add(a->settings_json, sizeof(a->settings_json), ",\"bytes\":%llu,\"budget_mb\":%.9g",
-                             (unsigned long long)count * probe_bytes(scene), scene->probes.budget_mb);
+                             (unsigned long long)count * probe_bytes(scene) +
+                                 (unsigned long long)layout->detail_count * 4 * SB_PROBES_SIGHT_WORDS,
+                             scene->probes.budget_mb);
     if (layout->layer_count) {
         char heights[SB_PROBES_MAX_LAYERS * 18] = "";
         for (uint32_t l = 0; l < layout->layer_count; l++)
@@ -689,6 +721,8 @@ static uint32_t probes_kernels(void *state, const struct sb_scene *scene, enum s
     bool instanced = st->level->instance_count > 0;
     uint32_t n = sb_surfaces_level_kernels(st->level, id == SB_PRODUCT_SKY_BOUNCE, out);
     out[n++] = id == SB_PRODUCT_SKY_BOUNCE ? sb_sky_bounce_kernel(instanced) : sb_sky_visibility_kernel(instanced);
+    if (id == SB_PRODUCT_SKY_VISIBILITY && scene->probes.detail_spacing_m > 0)
+        out[n++] = sb_probe_sight_kernel(instanced);
     return n;
 }
 

@@ -271,7 +271,10 @@ enum sb_result sb_pack_writer_add_image(struct sb_pack_writer *w, struct sb_arti
                  artifact->world_path);
         return SB_ERR_OUT_OF_RANGE;
     }
-    sb_image_content_hash(image, artifact->content_hash);
+    if (format->storage == SB_STORAGE_PROBES)
+        sb_probes_content_hash(image, &artifact->probes, artifact->content_hash);
+    else
+        sb_image_content_hash(image, artifact->content_hash);
 
     struct sb_attribute attrs[4];
     int n = 0;
@@ -307,7 +310,8 @@ enum sb_result sb_pack_writer_add_image(struct sb_pack_writer *w, struct sb_arti
         return res;
     }
     w->artifacts[i] = *artifact;
-    w->artifacts[i].probes.columns = NULL; /* the caller's: the manifest needs no columns */
+    w->artifacts[i].probes.columns = NULL; /* the caller's: the manifest needs neither */
+    w->artifacts[i].probes.sight = NULL;
     w->artifact_count++;
     w->pending = NULL;
     fault_point("artifact");
@@ -740,6 +744,11 @@ static enum sb_result read_artifact_image(const char *dir, int dir_fd, struct sb
                      pack->format_version);
             res = SB_ERR_PROBES;
         }
+        if (!res && a->probes.sight && pack->format_version < 9) {
+            sb_error("%s: %s: sight masks of detail probes, which format version %d cannot hold (9 and later)",
+                     path, name, pack->format_version);
+            res = SB_ERR_PROBES;
+        }
         if (res)
             sb_probe_layout_finish(&a->probes);
     } else {
@@ -761,7 +770,10 @@ static enum sb_result read_artifact_image(const char *dir, int dir_fd, struct sb
         return SB_ERR_NUMERIC;
     }
     char hash[SB_HASH_HEX_SIZE];
-    sb_image_content_hash(image, hash);
+    if (format->storage == SB_STORAGE_PROBES)
+        sb_probes_content_hash(image, &a->probes, hash);
+    else
+        sb_image_content_hash(image, hash);
     if (strcmp(hash, a->content_hash) != 0) {
         sb_error("%s: %s: content hash %s, the manifest records %s: the file was changed or corrupted", path, name,
                  hash, a->content_hash);

@@ -11,8 +11,12 @@
 #include <unistd.h>
 #include <xxhash.h>
 
+#include "config.h"
 #include "io.h"
 #include "log.h"
+
+_Static_assert(SB_PROBES_SIGHT_SIDE == SB_PROBE_SIGHT_SIDE && SB_PROBES_SIGHT_WORDS == SB_PROBE_SIGHT_WORDS,
+               "the files hold the masks the baker makes");
 
 static const char magic[8] = {'S', 'B', 'P', 'R', 'O', 'B', 'E', 'S'};
 #define BYTE_ORDER_MARK 0x01020304u
@@ -83,15 +87,19 @@ static void channel_range(const char *name, double *lo, double *hi)
     }
 }
 
-static size_t file_size(uint32_t header, uint32_t columns, uint32_t probes, uint32_t channels)
+/* A file's bytes: `sight` detail probes' sight masks (0: none). */
+static size_t file_size(uint32_t header, uint32_t columns, uint32_t sight, uint32_t probes, uint32_t channels)
 {
-    return header + (size_t)columns * SB_PROBES_COLUMN_BYTES + (size_t)probes * channels * 4 + 8;
+    return header + (size_t)columns * SB_PROBES_COLUMN_BYTES + (size_t)sight * SB_PROBES_SIGHT_WORDS * 4 +
+           (size_t)probes * channels * 4 + 8;
 }
 
 void sb_probe_layout_finish(struct sb_probe_layout *layout)
 {
     free(layout->columns);
+    free(layout->sight);
     layout->columns = NULL;
+    layout->sight = NULL;
     layout->column_count = 0;
     layout->detail_count = 0;
 }
@@ -99,15 +107,22 @@ void sb_probe_layout_finish(struct sb_probe_layout *layout)
 enum sb_result sb_probe_layout_copy(struct sb_probe_layout *to, const struct sb_probe_layout *from)
 {
     *to = *from;
-    if (!from->column_count)
-        return SB_OK;
-    to->columns = malloc(from->column_count * sizeof(*to->columns));
-    if (!to->columns) {
-        memset(to, 0, sizeof(*to));
-        return SB_ERR_NOMEM;
-    }
-    memcpy(to->columns, from->columns, from->column_count * sizeof(*to->columns));
+    to->columns = NULL;
+    to->sight = NULL;
+    size_t sight = from->sight ? (size_t)from->detail_count * SB_PROBES_SIGHT_WORDS * sizeof(*to->sight) : 0;
+    if (from->column_count && !(to->columns = malloc(from->column_count * sizeof(*to->columns))))
+        goto fail;
+    if (sight && !(to->sight = malloc(sight)))
+        goto fail;
+    if (from->column_count)
+        memcpy(to->columns, from->columns, from->column_count * sizeof(*to->columns));
+    if (sight)
+        memcpy(to->sight, from->sight, sight);
     return SB_OK;
+fail:
+    free(to->columns);
+    memset(to, 0, sizeof(*to));
+    return SB_ERR_NOMEM;
 }
 
 int64_t sb_probe_detail_index(const struct sb_probe_layout *layout, uint64_t grid_count, int32_t x, int32_t y,
@@ -139,15 +154,40 @@ int64_t sb_probe_detail_index(const struct sb_probe_layout *layout, uint64_t gri
                      (uint32_t)(x % SB_PROBES_BRICK));
 }
 
+void sb_probes_content_hash(const struct sb_image *image, const struct sb_probe_layout *layout,
+                            char out[SB_HASH_HEX_SIZE])
+{
+    sb_image_content_hash(image, out);
+    if (!layout->sight)
+        return;
+    static const char tag[] = "skybake-probe-sight-v1";
+    XXH3_state_t *state = XXH3_createState();
+    XXH3_128bits_reset(state);
+    XXH3_128bits_update(state, tag, sizeof(tag));
+    XXH3_128bits_update(state, out, SB_HASH_HEX_SIZE - 1);
+    uint8_t chunk[4096];
+    uint64_t n = (uint64_t)layout->detail_count * SB_PROBES_SIGHT_WORDS;
+    for (uint64_t i = 0; i < n;) {
+        size_t k = 0;
+        for (; k + 4 <= sizeof(chunk) && i < n; k += 4, i++)
+            put_u32(chunk + k, layout->sight[i]);
+        XXH3_128bits_update(state, chunk, k);
+    }
+    XXH128_hash_t h = XXH3_128bits_digest(state);
+    XXH3_freeState(state);
+    snprintf(out, SB_HASH_HEX_SIZE, "%016llx%016llx", (unsigned long long)h.high64, (unsigned long long)h.low64);
+}
+
 enum sb_result sb_probes_write(const char *path, const struct sb_probe_layout *layout, const struct sb_image *image)
 {
     /* the oldest version that holds the layout: without layers or detail,
      * version 1, and the files are what they were */
-    uint32_t version = layout->column_count ? 3 : layout->layer_count ? 2 : 1;
-    uint32_t header = version == 3   ? SB_PROBES_HEADER_BYTES
+    uint32_t version = layout->sight ? 4 : layout->column_count ? 3 : layout->layer_count ? 2 : 1;
+    uint32_t header = version >= 3   ? SB_PROBES_HEADER_BYTES
                       : version == 2 ? SB_PROBES_HEADER_BYTES_V2
                                      : SB_PROBES_HEADER_BYTES_V1;
-    size_t size = file_size(header, layout->column_count, image->width, image->channel_count);
+    uint32_t sight = version == 4 ? layout->detail_count : 0;
+    size_t size = file_size(header, layout->column_count, sight, image->width, image->channel_count);
     uint8_t *bytes = calloc(1, size);
     if (!bytes)
         return SB_ERR_NOMEM;
@@ -171,7 +211,7 @@ enum sb_result sb_probes_write(const char *path, const struct sb_probe_layout *l
             put_f32(bytes + 108 + 4 * l, layout->layers_m[l]);
     }
     uint8_t *p = bytes + header;
-    if (version == 3) {
+    if (version >= 3) {
         put_f32(bytes + 140, layout->detail_spacing_m);
         for (int k = 0; k < 3; k++)
             put_f32(bytes + 144 + 4 * k, layout->detail_origin_m[k]);
@@ -184,6 +224,11 @@ enum sb_result sb_probes_write(const char *path, const struct sb_probe_layout *l
             put_u32(p + 8, (uint32_t)col->y0);
             put_u32(p + 12, col->rows);
         }
+    }
+    if (version == 4) {
+        put_u32(bytes + 164, SB_PROBES_SIGHT_SIDE);
+        for (uint64_t i = 0; i < (uint64_t)sight * SB_PROBES_SIGHT_WORDS; i++, p += 4)
+            put_u32(p, layout->sight[i]);
     }
     for (uint64_t i = 0; i < (uint64_t)image->width * image->channel_count; i++, p += 4)
         put_f32(p, image->data[i]);
@@ -249,6 +294,24 @@ static int check_detail(const uint8_t *b, uint32_t header, uint32_t columns, uin
     return 0;
 }
 
+/* A version 4 file's sight masks (`sight` of them at p; none: 0): every
+ * bit pattern is a mask; nonzero when out of memory, logged. */
+static int read_sight(const uint8_t *p, uint32_t sight, const char *source, struct sb_probe_layout *layout)
+{
+    if (!sight)
+        return 0;
+    uint64_t n = (uint64_t)sight * SB_PROBES_SIGHT_WORDS;
+    uint32_t *words = malloc(n * sizeof(*words));
+    if (!words) {
+        sb_error("%s: out of memory for %u sight masks", source, sight);
+        return 1;
+    }
+    for (uint64_t i = 0; i < n; i++)
+        words[i] = get_u32(p + 4 * i);
+    layout->sight = words;
+    return 0;
+}
+
 enum sb_result sb_probes_parse(const void *data, size_t size, const char *source, const char *channel_names,
                                uint32_t max_probes, struct sb_probe_layout *layout, struct sb_image *image)
 {
@@ -279,6 +342,7 @@ enum sb_result sb_probes_parse(const void *data, size_t size, const char *source
     uint32_t expect_header = version == 1   ? SB_PROBES_HEADER_BYTES_V1
                              : version == 2 ? SB_PROBES_HEADER_BYTES_V2
                                             : SB_PROBES_HEADER_BYTES;
+    bool has_detail = version >= 3;
     if (header != expect_header) {
         sb_error("%s: header of %u bytes, version %u has %u", source, header, version, expect_header);
         return SB_ERR_PROBES;
@@ -294,11 +358,17 @@ enum sb_result sb_probes_parse(const void *data, size_t size, const char *source
                  version == 2 ? 1 : 0, SB_PROBES_MAX_LAYERS);
         return SB_ERR_PROBES;
     }
-    uint32_t columns = version == 3 ? get_u32(b + 156) : 0, detail = version == 3 ? get_u32(b + 160) : 0;
-    if (version == 3 && (columns < 1 || columns > SB_PROBES_MAX_COLUMNS)) {
+    uint32_t columns = has_detail ? get_u32(b + 156) : 0, detail = has_detail ? get_u32(b + 160) : 0;
+    if (has_detail && (columns < 1 || columns > SB_PROBES_MAX_COLUMNS)) {
         sb_error("%s: %u brick columns of detail: 1 to %u", source, columns, SB_PROBES_MAX_COLUMNS);
         return SB_ERR_PROBES;
     }
+    if (version == 4 && get_u32(b + 164) != SB_PROBES_SIGHT_SIDE) {
+        sb_error("%s: sight masks of %u samples an axis: this skybake reads %d", source, get_u32(b + 164),
+                 SB_PROBES_SIGHT_SIDE);
+        return SB_ERR_PROBES;
+    }
+    uint32_t sight = version == 4 ? detail : 0;
     struct sb_image names = {0};
     sb_image_set_channel_names(&names, channel_names);
     uint32_t expect = 0;
@@ -324,9 +394,9 @@ enum sb_result sb_probes_parse(const void *data, size_t size, const char *source
                  max_probes < SB_PROBES_MAX_COUNT ? max_probes : SB_PROBES_MAX_COUNT);
         return SB_ERR_PROBES;
     }
-    if (size != file_size(header, columns, count, channels)) {
-        sb_error("%s: %zu bytes, %u brick columns and %u probes of %u channels take %zu", source, size, columns, count,
-                 channels, file_size(header, columns, count, channels));
+    if (size != file_size(header, columns, sight, count, channels)) {
+        sb_error("%s: %zu bytes, %u brick columns, %u sight masks and %u probes of %u channels take %zu", source,
+                 size, columns, sight, count, channels, file_size(header, columns, sight, count, channels));
         return SB_ERR_BAD_IMAGE;
     }
     if (get_u64(b + size - 8) != XXH3_64bits(b, size - 8)) {
@@ -334,7 +404,7 @@ enum sb_result sb_probes_parse(const void *data, size_t size, const char *source
         return SB_ERR_HASH_MISMATCH;
     }
     for (uint32_t i = version == 1 ? 104 : 108 + 4 * layers; i < header; i++)
-        if (b[i] && !(version == 3 && i >= 140 && i < 164)) {
+        if (b[i] && !(has_detail && i >= 140 && i < (version == 4 ? 168u : 164u))) {
             sb_error("%s: reserved header byte %u is not zero", source, i);
             return SB_ERR_PROBES;
         }
@@ -373,7 +443,9 @@ enum sb_result sb_probes_parse(const void *data, size_t size, const char *source
     }
     memcpy(layout->key, b + 72, 32);
     layout->key[32] = '\0';
-    if (version == 3 && check_detail(b, header, columns, detail, source, layout)) {
+    if (has_detail && (check_detail(b, header, columns, detail, source, layout) ||
+                       read_sight(b + header + (size_t)columns * SB_PROBES_COLUMN_BYTES, sight, source, layout))) {
+        sb_probe_layout_finish(layout);
         memset(layout, 0, sizeof(*layout));
         return SB_ERR_PROBES;
     }
@@ -384,7 +456,7 @@ enum sb_result sb_probes_parse(const void *data, size_t size, const char *source
         return res;
     }
     sb_image_set_channel_names(image, channel_names);
-    const uint8_t *p = b + header + (size_t)columns * SB_PROBES_COLUMN_BYTES;
+    const uint8_t *p = b + header + (size_t)columns * SB_PROBES_COLUMN_BYTES + (size_t)sight * SB_PROBES_SIGHT_WORDS * 4;
     for (uint32_t c = 0; c < channels && !res; c++) {
         double lo, hi;
         channel_range(image->channel_names[c], &lo, &hi);
@@ -422,7 +494,7 @@ enum sb_result sb_probes_read(const char *path, const char *channel_names, uint3
         return SB_ERR_IO;
     }
     size_t largest = file_size(SB_PROBES_HEADER_BYTES, SB_PROBES_MAX_COUNT / (SB_PROBES_BRICK * SB_PROBES_BRICK),
-                               SB_PROBES_MAX_COUNT, SB_IMAGE_MAX_CHANNELS);
+                               SB_PROBES_MAX_COUNT, SB_PROBES_MAX_COUNT, SB_IMAGE_MAX_CHANNELS);
     if (!S_ISREG(st.st_mode) || (uint64_t)st.st_size > largest) {
         sb_error("%s: not a regular file of at most %zu bytes", path, largest);
         close(fd);

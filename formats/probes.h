@@ -30,10 +30,20 @@
  *      156     4  brick columns C (1 to 2^18)
  *      160     4  detail probes D
  *      164    28  reserved, zero
- *   header     -  version 3: C brick columns of 16 bytes: x, z (int32, in
- *                 bricks of SB_PROBES_BRICK lattice steps), the lowest
- *                 lattice row y0 (int32) and the rows (uint32), in
+ *   version 4 (detail with its sight masks):
+ *      104    60  as version 3
+ *      164     4  the sight masks' samples along an axis: SB_PROBES_SIGHT_SIDE (8)
+ *      168    24  reserved, zero
+ *   header     -  versions 3 and 4: C brick columns of 16 bytes: x, z
+ *                 (int32, in bricks of SB_PROBES_BRICK lattice steps), the
+ *                 lowest lattice row y0 (int32) and the rows (uint32), in
  *                 increasing z then x, each once
+ *      then    -  version 4: D sight masks of 64 bytes, detail probe by
+ *                 detail probe: 16 uint32, bit b (word b / 32, bit b % 32)
+ *                 set when the probe sees sample point b = (k 8 + j) 8 + i
+ *                 of the 8 lattice cells around its lattice point, at that
+ *                 point plus ((i, j, k) + 0.5) / 4 - 1 spacings (shaders/
+ *                 config.h, SB_PROBE_SIGHT_*)
  *      then    -  probe count x channels x float32, probe by probe
  *      end     8  XXH3-64 of every byte before it
  *
@@ -69,7 +79,7 @@
 #include "result.h"
 #include "scene.h"
 
-#define SB_PROBES_VERSION 3
+#define SB_PROBES_VERSION 4
 #define SB_PROBES_HEADER_BYTES_V1 112
 #define SB_PROBES_HEADER_BYTES_V2 152
 #define SB_PROBES_HEADER_BYTES 192
@@ -79,6 +89,11 @@
 #define SB_PROBES_COLUMN_BYTES 16
 #define SB_PROBES_MAX_COUNT (1u << 20)
 #define SB_PROBES_MAX_GRID 1024 /* probes along one axis */
+/* The detail probes' sight masks (version 4): SB_PROBES_SIGHT_SIDE^3 bits
+ * a probe in SB_PROBES_SIGHT_WORDS words (shaders/config.h's
+ * SB_PROBE_SIGHT_*, which bake them). */
+#define SB_PROBES_SIGHT_SIDE 8
+#define SB_PROBES_SIGHT_WORDS 16
 
 /* The sky-visibility product's channels (docs/pack.md): where the probe
  * is (after any push out of geometry) and how far it was moved; 1 when
@@ -155,16 +170,27 @@ struct sb_probe_layout {
     uint32_t detail_count;
     uint32_t column_count;
     struct sb_probe_column *columns; /* owned */
+    /* the detail probes' sight masks (version 4; NULL: none):
+     * detail_count x SB_PROBES_SIGHT_WORDS */
+    uint32_t *sight; /* owned */
 };
 
-/* Free a layout's columns (and zero them); a zeroed layout is accepted. */
+/* Free a layout's columns and sight masks (and zero them); a zeroed
+ * layout is accepted. */
 void sb_probe_layout_finish(struct sb_probe_layout *layout);
-/* *to = *from with its own copy of the columns (SB_ERR_NOMEM: *to zeroed). */
+/* *to = *from with its own copy of the columns and sight masks
+ * (SB_ERR_NOMEM: *to zeroed). */
 enum sb_result sb_probe_layout_copy(struct sb_probe_layout *to, const struct sb_probe_layout *from);
 /* The index among a layout's probes of detail lattice probe (x, y, z), or
  * -1 when no brick column holds it (a binary search over the columns). */
 int64_t sb_probe_detail_index(const struct sb_probe_layout *layout, uint64_t grid_count, int32_t x, int32_t y,
                               int32_t z);
+
+/* The content hash of a probe product (pack.h): the records' (image.h's
+ * sb_image_content_hash) and, where the layout has them, the sight
+ * masks' (a layout without is hashed as before them). */
+void sb_probes_content_hash(const struct sb_image *image, const struct sb_probe_layout *layout,
+                            char out[SB_HASH_HEX_SIZE]);
 
 /* Write the probes (image: width = probe count, height = depth = 1, the
  * channels in the product's order) with their layout. Atomic only as the

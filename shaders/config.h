@@ -387,6 +387,31 @@ struct sb_probe_push {
     float tmax_m;      /* and see the sky past this distance */
 };
 
+/* The detail probes' sight masks (probe_sight.comp, baker/probe_sight.h):
+ * which points of the 8 lattice cells around a detail probe it sees in a
+ * straight line. The cells' cube, 2 spacings across about the probe's
+ * lattice point, holds SB_PROBE_SIGHT_SIDE^3 sample points, sample (i, j,
+ * k) at the lattice point plus ((i, j, k) + 0.5) 2 / SIDE - 1 spacings
+ * (a quarter spacing apart, none on the lattice's planes or halfway
+ * between);
+ * bit (k 8 + j) 8 + i of the probe's SB_PROBE_SIGHT_WORDS words is set
+ * when the segment from the probe (where the push out of geometry left
+ * it) to that point meets nothing. One workgroup a probe, an invocation
+ * SB_PROBE_SIGHT_SAMPLES / SB_PROBE_THREADS points. Bindings: the raycast
+ * kernel's nodes and triangles; rays: two vec4 a probe (its position, its
+ * lattice point, m); hits: the words. */
+#define SB_PROBE_SIGHT_SIDE 8
+#define SB_PROBE_SIGHT_SAMPLES (SB_PROBE_SIGHT_SIDE * SB_PROBE_SIGHT_SIDE * SB_PROBE_SIGHT_SIDE)
+#define SB_PROBE_SIGHT_WORDS (SB_PROBE_SIGHT_SAMPLES / 32)
+#define SB_PROBE_SIGHT_BINDING_COUNT 4
+
+struct sb_probe_sight_push {
+    SB_UINT probe_count;
+    SB_UINT pad;
+    float tmin_m;    /* segments start this far out */
+    float spacing_m; /* the lattice's */
+};
+
 /* Reflection probes (baker/reflection.h, docs/reflections.md). Cube
  * texels are stored as OpenEXR's cube layout has them (cube.glsl): face f
  * of an N x 6N image is rows [f N, (f + 1) N), the faces +x, -x, +y, -y,

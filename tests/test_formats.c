@@ -1202,7 +1202,8 @@ static void test_probes(void)
         enum sb_result want;
         const char *what;
     } fields[] = {
-        {8, 4, SB_ERR_VERSION, "a newer version"},
+        {8, 5, SB_ERR_VERSION, "a newer version"},
+        {8, 4, SB_ERR_PROBES, "version 4 with version 1's header"},
         {8, 3, SB_ERR_PROBES, "version 3 with version 1's header"},
         {8, 2, SB_ERR_PROBES, "version 2 with version 1's header"},
         {8, 0, SB_ERR_VERSION, "version 0"},
@@ -1386,6 +1387,64 @@ static void test_probes(void)
     sb_probe_layout_finish(&got);
     sb_image_finish(&back);
     sb_image_finish(&wide);
+
+    /* Detail with its sight masks: version 4, the masks round-trip and
+     * count in the content hash (a layout without hashes as its records
+     * alone), every prefix and bit flip is refused, and so are another
+     * mask size and a reserved byte. */
+    uint32_t sight[16 * SB_PROBES_SIGHT_WORDS];
+    for (uint32_t i = 0; i < 16 * SB_PROBES_SIGHT_WORDS; i++)
+        sight[i] = 0x9E3779B9u * (i + 1);
+    bricks.columns = &column;
+    bricks.column_count = 1;
+    bricks.detail_count = 16;
+    bricks.sight = sight;
+    CHECK(sb_probes_write(path, &bricks, &detailed) == SB_OK, "write detail with sight masks");
+    CHECK(sb_probes_read(path, SB_SKY_VISIBILITY_CHANNELS, 1000, &got, &back) == SB_OK && got.sight &&
+              !memcmp(got.sight, sight, sizeof(sight)) && got.column_count == 1 &&
+              !memcmp(back.data, detailed.data, sizeof(float) * nd * ch),
+          "the sight masks' round trip is exact");
+    char with_sight[SB_HASH_HEX_SIZE], without_sight[SB_HASH_HEX_SIZE], records[SB_HASH_HEX_SIZE],
+        flipped[SB_HASH_HEX_SIZE];
+    sb_probes_content_hash(&back, &got, with_sight);
+    got.sight[37] ^= 1u << 9;
+    sb_probes_content_hash(&back, &got, flipped);
+    sb_image_content_hash(&back, records);
+    CHECK(sb_probe_layout_copy(&copy, &got) == SB_OK && copy.sight != got.sight && copy.sight[37] == got.sight[37],
+          "a layout's copy owns its sight masks");
+    sb_probe_layout_finish(&copy);
+    sb_probe_layout_finish(&got);
+    CHECK(!got.sight, "finished");
+    sb_probes_content_hash(&back, &got, without_sight);
+    CHECK(strcmp(with_sight, flipped) != 0 && strcmp(with_sight, records) != 0 && !strcmp(without_sight, records),
+          "the content hash covers the sight masks, and is the records' without them");
+    sb_image_finish(&back);
+    f = fopen(path, "rb");
+    size = f ? fread(bytes, 1, sizeof(bytes), f) : 0;
+    if (f)
+        fclose(f);
+    CHECK(size == SB_PROBES_HEADER_BYTES + SB_PROBES_COLUMN_BYTES + sizeof(sight) + (size_t)nd * ch * 4 + 8 &&
+              bytes[8] == 4,
+          "version 4: size %zu", size);
+    check_probes_damage(bytes, size, "sight masks");
+    const struct {
+        size_t offset;
+        uint32_t value;
+        const char *what;
+    } sight_fields[] = {{164, 4, "masks of 4 samples an axis"}, {164, 0, "no mask size"}, {168, 1, "a reserved byte"}};
+    for (size_t i = 0; i < sizeof(sight_fields) / sizeof(sight_fields[0]); i++) {
+        uint8_t edited[4096];
+        memcpy(edited, bytes, size);
+        for (int k = 0; k < 4; k++)
+            edited[sight_fields[i].offset + k] = (uint8_t)(sight_fields[i].value >> (8 * k));
+        restamp(edited, size);
+        enum sb_result res = sb_probes_parse(edited, size, "edited", SB_SKY_VISIBILITY_CHANNELS, 1000, &got, &back);
+        CHECK(res == SB_ERR_PROBES, "%s: %s", sight_fields[i].what, sb_result_name(res));
+        if (res == SB_OK) {
+            sb_image_finish(&back);
+            sb_probe_layout_finish(&got);
+        }
+    }
     sb_image_finish(&detailed);
     sb_image_finish(&layered);
     unlink(path);

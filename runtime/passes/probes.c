@@ -21,6 +21,7 @@
 struct probes {
     struct sb_buffer probes, light; /* sb_probes_gpu and its probes; the sky's and probes' SH */
     struct sb_buffer detail;        /* the detail's table of brick columns (one absent one without) */
+    struct sb_buffer sight;         /* the detail probes' sight masks (one word without) */
     VkPipeline sky_kernel, light_kernel;
 };
 
@@ -77,8 +78,9 @@ static void mean_albedo(const struct sb_world *world, float out[3])
  * fastest; probes_gpu.h), those the layout holds filled. Without detail,
  * one absent entry. */
 static enum sb_result upload_detail(struct sb_renderer *r, struct probes *s, const struct sb_probe_layout *layout,
-                                    uint32_t first, struct sb_probes_gpu *g)
+                                    uint32_t grid, struct sb_probes_gpu *g)
 {
+    uint32_t first = grid;
     uint32_t size[2] = {0, 0};
     for (uint32_t c = 0; c < layout->column_count && r->probe_count; c++) {
         size[0] = (uint32_t)layout->columns[c].x + 1 > size[0] ? (uint32_t)layout->columns[c].x + 1 : size[0];
@@ -91,8 +93,12 @@ static enum sb_result upload_detail(struct sb_renderer *r, struct probes *s, con
                 size[0], size[1], SB_PROBES_MAX_DETAIL_TABLE);
         entries = 0;
     }
+    bool sight = entries && g && layout->sight;
+    size_t words = sight ? (size_t)layout->detail_count * SB_PROBES_SIGHT_WORDS : 1;
     enum sb_result res =
         sb_renderer_upload(r, NULL, (entries ? entries : 1) * 4 * sizeof(uint32_t), "probe detail", &s->detail);
+    if (!res)
+        res = sb_renderer_upload(r, sight ? layout->sight : NULL, words * sizeof(uint32_t), "probe sight", &s->sight);
     if (res || !entries || !g)
         return res;
     uint32_t(*table)[4] = s->detail.mapped;
@@ -102,11 +108,12 @@ static enum sb_result upload_detail(struct sb_renderer *r, struct probes *s, con
         e[0] = (uint32_t)col->y0;
         e[1] = col->rows;
         e[2] = first;
+        e[3] = first - grid; /* its first detail probe's: its sight masks' */
         first += col->rows * SB_PROBES_BRICK * SB_PROBES_BRICK;
     }
     g->detail[0] = size[0];
     g->detail[1] = size[1];
-    g->detail[2] = 0; /* unused: each entry names its first probe */
+    g->detail[2] = sight;
     g->detail[3] = layout->column_count;
     for (int k = 0; k < 3; k++)
         g->detail_origin_m[k] = layout->detail_origin_m[k];
@@ -119,6 +126,7 @@ void sb_pass_read_probes(struct sb_renderer *r)
     sb_pass_use(r, SB_VIEW_BINDING_PROBES, sb_pass_find(r, "probes"), SB_USE_LOAD);
     sb_pass_use(r, SB_VIEW_BINDING_PROBE_LIGHT, sb_pass_find(r, "probe light"), SB_USE_LOAD);
     sb_pass_use(r, SB_VIEW_BINDING_PROBE_DETAIL, sb_pass_find(r, "probe detail"), SB_USE_LOAD);
+    sb_pass_use(r, SB_VIEW_BINDING_PROBE_SIGHT, sb_pass_find(r, "probe sight"), SB_USE_LOAD);
 }
 
 /*
@@ -218,8 +226,9 @@ static enum sb_result upload_probes(struct sb_renderer *r, struct probes *s)
         sb_info("probes: %u x %u x %u, %.3g m apart, light the world (bounce %s)", layout->grid[0], layout->grid[1],
                 layout->grid[2], (double)layout->spacing_m[0], has_bounce ? "baked" : "modelled");
     if (layout->detail_count)
-        sb_info("probes: detail %.3g m apart, %u probes in %u brick columns", (double)layout->detail_spacing_m,
-                layout->detail_count, layout->column_count);
+        sb_info("probes: detail %.3g m apart, %u probes in %u brick columns%s", (double)layout->detail_spacing_m,
+                layout->detail_count, layout->column_count,
+                layout->sight ? ", each seen only where it sees" : " (without sight masks: light may leak through walls)");
     return SB_OK;
 }
 
@@ -235,6 +244,7 @@ static enum sb_result probes_create(struct sb_renderer *r)
     sb_resource probes = sb_graph_buffer(r, "probes", &s->probes);
     sb_resource light = sb_graph_buffer(r, "probe light", &s->light);
     sb_graph_buffer(r, "probe detail", &s->detail);
+    sb_graph_buffer(r, "probe sight", &s->sight);
     if (!r->probe_count)
         return SB_OK;
     sb_pass_read_atmosphere(r);
@@ -256,6 +266,7 @@ static void probes_destroy(struct sb_renderer *r)
     sb_buffer_destroy(r->vk, &s->probes);
     sb_buffer_destroy(r->vk, &s->light);
     sb_buffer_destroy(r->vk, &s->detail);
+    sb_buffer_destroy(r->vk, &s->sight);
     free(s);
 }
 

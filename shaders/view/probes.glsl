@@ -37,12 +37,46 @@ const int SH_BAND[SB_PROBE_SH] = int[SB_PROBE_SH](SB_SH_BANDS);
 layout(std430, set = 0, binding = SB_VIEW_BINDING_PROBE_DETAIL) readonly buffer ProbeDetailBuffer {
     uvec4 probe_columns[]; /* the detail's table (sb_probes_gpu.detail) */
 };
+layout(std430, set = 0, binding = SB_VIEW_BINDING_PROBE_SIGHT) readonly buffer ProbeSightBuffer {
+    uint probe_sight[]; /* SB_PROBE_SIGHT_WORDS a detail probe (config.h) */
+};
+
+/*
+ * How much of the point q the detail probe whose sight mask is `mask` and
+ * whose lattice point is `lattice` sees: its mask's bits (1: the segment
+ * from the probe to that sample point meets nothing) interpolated
+ * trilinearly at q, which lies in one of the 8 cells around the lattice
+ * point; outside the samples, the nearest ones. Samples are a quarter
+ * spacing apart and q stands a quarter spacing off its surface, so the 8
+ * samples around q lie on its side of a flat wall: a probe behind the wall
+ * sees none of them.
+ */
+float probe_sees(uint mask, vec3 lattice, vec3 q, float spacing)
+{
+    const float side = float(SB_PROBE_SIGHT_SIDE);
+    vec3 t = clamp(((q - lattice) / spacing + 1.0) * (0.5 * side) - 0.5, vec3(0.0), vec3(side - 1.0));
+    vec3 base = min(floor(t), vec3(side - 2.0));
+    vec3 f = t - base;
+    uvec3 b = uvec3(base);
+    float seen = 0.0;
+    for (int corner = 0; corner < 8; corner++) {
+        uvec3 o = uvec3(corner & 1, (corner >> 1) & 1, (corner >> 2) & 1);
+        uvec3 at = b + o;
+        uint bit = (at.z * uint(SB_PROBE_SIGHT_SIDE) + at.y) * uint(SB_PROBE_SIGHT_SIDE) + at.x;
+        uint word = probe_sight[mask * uint(SB_PROBE_SIGHT_WORDS) + (bit >> 5)];
+        vec3 tri = mix(1.0 - f, f, vec3(o));
+        seen += ((word >> (bit & 31u)) & 1u) != 0u ? tri.x * tri.y * tri.z : 0.0;
+    }
+    return seen;
+}
 
 /* Probe `index`'s irradiance along n and r (yn, yr: their SH bases), added
- * with weight w times DDGI's wrap of the direction from pos toward it; an
- * invalid probe adds nothing. */
-void probe_add(uint index, float w, vec3 pos, vec3 n, float yn[SB_PROBE_SH], float yr[SB_PROBE_SH], inout vec3 e_n,
-               inout vec3 e_r, inout float wsum)
+ * with weight w times DDGI's wrap of the direction from pos toward it and
+ * `visible` (probe_sees, at least 0.05 so that a point no probe sees
+ * still gets light; 1 for a probe without a sight mask), a product under
+ * 0.2 crushed toward 0 as DDGI does; an invalid probe adds nothing. */
+void probe_add(uint index, float w, float visible, vec3 pos, vec3 n, float yn[SB_PROBE_SH], float yr[SB_PROBE_SH],
+               inout vec3 e_n, inout vec3 e_r, inout float wsum)
 {
     vec4 where = probe_data[SB_PROBE_VEC4S * index];
     if (w <= 0.0 || where.w == 0.0)
@@ -50,7 +84,10 @@ void probe_add(uint index, float w, vec3 pos, vec3 n, float yn[SB_PROBE_SH], flo
     vec3 to = where.xyz - pos;
     float len = length(to);
     float wrap = len > 1e-4 ? 0.5 * (dot(to / len, n) + 1.0) : 1.0;
-    w *= wrap * wrap + 0.2;
+    float seen = (wrap * wrap + 0.2) * visible;
+    if (seen < 0.2) /* never with visible 1 */
+        seen *= seen * seen * 25.0;
+    w *= seen;
     vec3 sn = vec3(0.0), sr = vec3(0.0);
     for (int k = 0; k < SB_PROBE_SH; k++) {
         vec3 e = probe_irradiance[SB_PROBE_SH * index + k].rgb;
@@ -102,9 +139,13 @@ float probe_detail(vec3 pos, vec3 n, float yn[SB_PROBE_SH], float yr[SB_PROBE_SH
         vec3 tri = mix(1.0 - f, f, o);
         float w = tri.x * tri.y * tri.z;
         uint brick = uint(SB_PROBE_BRICK);
-        uint index = column.z + ((u.y - column.x) * brick + u.z % brick) * brick + u.x % brick;
+        uint local = ((u.y - column.x) * brick + u.z % brick) * brick + u.x % brick;
+        float visible = 1.0;
+        if (probes.detail.z != 0u)
+            visible = max(probe_sees(column.w + local, probes.detail_origin_m.xyz + vec3(at) * s, pos + n * (0.25 * s), s),
+                          0.05);
         present += w;
-        probe_add(index, w, pos, n, yn, yr, e_n, e_r, wsum);
+        probe_add(column.z + local, w, visible, pos, n, yn, yr, e_n, e_r, wsum);
     }
     if (wsum <= 1e-6) {
         e_n = e_r = vec3(0.0);
@@ -158,9 +199,9 @@ void probe_grid(vec3 pos, vec3 n, float yn[SB_PROBE_SH], float yr[SB_PROBE_SH], 
             float above = max(dy - probe_layer(layers - 1), 0.0) / spacing.y;
             float vfade = clamp(1.0 - above, 0.0, 1.0);
             column_cover += w * vfade;
-            probe_add(column + probes.grid.x * uint(l), w * vfade * (1.0 - fl), pos, n, yn, yr, e_n, e_r, wsum);
+            probe_add(column + probes.grid.x * uint(l), w * vfade * (1.0 - fl), 1.0, pos, n, yn, yr, e_n, e_r, wsum);
             if (layers > 1)
-                probe_add(column + probes.grid.x * uint(l + 1), w * vfade * fl, pos, n, yn, yr, e_n, e_r, wsum);
+                probe_add(column + probes.grid.x * uint(l + 1), w * vfade * fl, 1.0, pos, n, yn, yr, e_n, e_r, wsum);
         }
         if (wsum <= 1e-6) {
             e_n = e_r = vec3(0.0);
@@ -186,7 +227,7 @@ void probe_grid(vec3 pos, vec3 n, float yn[SB_PROBE_SH], float yr[SB_PROBE_SH], 
         uvec3 at = uvec3(min(base + o, last));
         vec3 tri = mix(1.0 - f, f, o);
         uint index = at.x + probes.grid.x * (at.y + probes.grid.y * at.z);
-        probe_add(index, tri.x * tri.y * tri.z, pos, n, yn, yr, e_n, e_r, wsum);
+        probe_add(index, tri.x * tri.y * tri.z, 1.0, pos, n, yn, yr, e_n, e_r, wsum);
     }
     if (wsum <= 1e-6) {
         e_n = e_r = vec3(0.0);

@@ -10,6 +10,7 @@
 #define SB_VIEW_BINDING_PROBES 20        /* struct sb_probes_gpu, then SB_PROBE_VEC4S vec4s a probe */
 #define SB_VIEW_BINDING_PROBE_LIGHT 21   /* the sky's SH, then each probe's irradiance SH (probes.glsl) */
 #define SB_VIEW_BINDING_PROBE_DETAIL 56  /* the detail's brick columns, uvec4 each (probes.glsl) */
+#define SB_VIEW_BINDING_PROBE_SIGHT 57   /* the detail probes' sight masks, config.h's SB_PROBE_SIGHT_* */
 
 /* The sky-visibility probes skyview lights the world with (probes.glsl):
  * the grid of a pack's sky_visibility product, and the SH triple-product
@@ -33,10 +34,11 @@ struct sb_probes_gpu {
     SB_UVEC4(layered);
     SB_VEC4(layers_m[2]);
     /* Detail (formats/probes.h): a table of x by y brick columns over the
-     * lattice (z: the index of its first probe; w: the columns present, 0:
-     * no detail), the lattice's first probe (xyz, m) and spacing (w). A
-     * column's entry: its lowest row, its rows (0: absent), its first
-     * probe's index, 0. */
+     * lattice (z: 1 when the detail probes' sight masks are bound; w:
+     * the columns present, 0: no detail), the lattice's first probe (xyz,
+     * m) and spacing (w). A column's entry: its lowest row, its rows (0:
+     * absent), its first probe's index, and that among the detail probes
+     * (its first sight mask's). */
     SB_UVEC4(detail);
     SB_VEC4(detail_origin_m);
     SB_VEC4(tensor[SB_SH_TENSOR_MAX]); /* x: the integral of Y_i Y_j Y_k; y, z, w: i, j, k */

@@ -95,6 +95,8 @@ vec4 scene_shade(vec3 offset, vec3 n, vec3 albedo, vec2 metallic_roughness, vec3
         e_n = mix(e_n, probe_n, coverage);
         l_env = mix(l_env, probe_r / PI, coverage);
     }
+    if (frame.size.w == SB_DEBUG_AMBIENT)
+        return vec4(fp16_safe(e_n * frame.aerial.y), 1.0);
     const vec4 c0 = vec4(-1.0, -0.0275, -0.572, 0.022), c1 = vec4(1.0, 0.0425, 1.04, -0.04);
     vec4 rr = roughness * c0 + c1;
     float a004 = min(rr.x * rr.x, exp2(-9.28 * n_dot_v)) * rr.x + rr.y;

@@ -53,6 +53,7 @@
 #define SB_DEBUG_CLOUD_TRANSMITTANCE 5 /* the clouds' transmittance (grey) */
 #define SB_DEBUG_CLOUD_SHADOW 6       /* the scene: the clouds' transmittance toward the sun (grey) */
 #define SB_DEBUG_SUN_VISIBILITY 7     /* the scene: the sun's visibility, its shadows (grey) */
+#define SB_DEBUG_AMBIENT 8            /* the scene: the ambient irradiance on its surfaces (rgb: the probes' or the sky model's) */
 
 #define SB_SKY_VIEW_WIDTH 192 /* azimuth from the sun, 0 to pi */
 #define SB_SKY_VIEW_HEIGHT 108 /* zenith angle, the horizon between rows 53 and 54 */
