@@ -84,12 +84,21 @@ enum sb_result sb_probe_detail_check(const struct sb_level *level, const struct 
     return lattice_check(&l, spacing);
 }
 
-/* Each lattice column's surfaces: rays straight down from over the world,
+/* Column flags: the last surface met was a front face; the column holds
+ * a covered gap. */
+#define FRONT 1u
+#define COVERED 2u
+
+/*
+ * Each lattice column's surfaces: rays straight down from over the world,
  * each starting again just under the surface the last one met, until one
  * meets nothing. count[c] surfaces, the highest at top[c], the lowest at
- * low[c]. */
-static enum sb_result column_surfaces(struct sb_raycaster *rc, const struct lattice *l, float start_y, uint8_t *count,
-                                      float *top, float *low, double *gpu_ms)
+ * low[c]; flags[c] COVERED where the column holds a covered gap: open
+ * space at least `gap` high between two surfaces (not the inside of a
+ * solid, entered through a front face and left through a back face).
+ */
+static enum sb_result column_surfaces(struct sb_raycaster *rc, const struct lattice *l, float start_y, double gap,
+                                      uint8_t *count, uint8_t *flags, float *top, float *low, double *gpu_ms)
 {
     uint64_t n = (uint64_t)l->columns[0] * (uint64_t)l->columns[1];
     uint32_t chunk = n < RAYS_A_CAST ? (uint32_t)n : RAYS_A_CAST;
@@ -98,7 +107,7 @@ static enum sb_result column_surfaces(struct sb_raycaster *rc, const struct latt
     enum sb_result res = rays && hits && which ? SB_OK : SB_ERR_NOMEM;
     /* an active column's next ray starts at low[c] (start_y before any hit) */
     for (uint64_t c = 0; c < n; c++) {
-        count[c] = 0;
+        count[c] = flags[c] = 0;
         low[c] = top[c] = start_y;
     }
     uint64_t next = 0; /* columns are cast in order; a chunk is filled with those still going */
@@ -134,8 +143,12 @@ static enum sb_result column_surfaces(struct sb_raycaster *rc, const struct latt
                     continue;
                 uint32_t c = which[i];
                 float y = rays[8 * (size_t)i + 1] - hits[4 * (size_t)i];
+                bool front = !(triangle & SB_BVH_BACK_FACE);
                 if (!count[c])
                     top[c] = y;
+                else if (!((flags[c] & FRONT) && !front) && (double)low[c] - y >= gap)
+                    flags[c] |= COVERED;
+                flags[c] = (uint8_t)((flags[c] & ~FRONT) | (front ? FRONT : 0));
                 low[c] = y;
                 count[c]++;
                 any = true;
@@ -170,25 +183,28 @@ enum sb_result sb_probe_detail_place(struct sb_raycaster *rc, const struct sb_bv
     uint64_t n = (uint64_t)l.columns[0] * (uint64_t)l.columns[1];
     int64_t bx_count = l.columns[0] / BRICK, bz_count = l.columns[1] / BRICK;
     uint64_t bricks = (uint64_t)bx_count * (uint64_t)bz_count;
-    uint8_t *count = malloc(n);
+    uint8_t *count = malloc(n), *flags = malloc(n);
     float *top = malloc(n * sizeof(float)), *low = malloc(n * sizeof(float));
     float *brick_lo = malloc(bricks * sizeof(float)), *brick_hi = malloc(bricks * sizeof(float));
-    if (!count || !top || !low || !brick_lo || !brick_hi) {
+    if (!count || !flags || !top || !low || !brick_lo || !brick_hi) {
         res = SB_ERR_NOMEM;
         goto done;
     }
     double gpu_ms = 0, t0 = sb_now_s();
-    if ((res = column_surfaces(rc, &l, root->max[1] + 1.0f, count, top, low, &gpu_ms)))
+    /* a gap thinner than the scene's detail spacing holds no row of its
+     * own (under a car, a solid box on the ground): the grid's probes
+     * light it as they light the ground around */
+    if ((res = column_surfaces(rc, &l, root->max[1] + 1.0f, p->detail_spacing_m, count, flags, top, low, &gpu_ms)))
         goto done;
-    /* a column that meets two surfaces or more makes detail over its
-     * range in its brick column and those of its 8 neighbours' */
+    /* a column that holds a covered gap makes detail over its range in
+     * its brick column and those of its 8 neighbours' */
     for (uint64_t b = 0; b < bricks; b++) {
         brick_lo[b] = INFINITY;
         brick_hi[b] = -INFINITY;
     }
     uint64_t multiple = 0;
     for (uint64_t c = 0; c < n; c++) {
-        if (count[c] < 2)
+        if (!(flags[c] & COVERED))
             continue;
         multiple++;
         int64_t x = (int64_t)(c % (uint64_t)l.columns[0]), z = (int64_t)(c / (uint64_t)l.columns[0]);
@@ -271,7 +287,7 @@ enum sb_result sb_probe_detail_place(struct sb_raycaster *rc, const struct sb_bv
     for (int k = 0; k < 3; k++)
         layout->detail_origin_m[k] = (float)l.origin[k];
     sb_debug("probes: detail %g m apart: %llu lattice columns cast down (%.1f ms, %.3f ms on the device), %llu over "
-             "two surfaces or more; %u brick columns, %u probes",
+             "a covered gap; %u brick columns, %u probes",
              spacing, (unsigned long long)n, 1e3 * (sb_now_s() - t0), gpu_ms, (unsigned long long)multiple,
              layout->column_count, layout->detail_count);
 done:
@@ -281,6 +297,7 @@ done:
         layout->column_count = layout->detail_count = 0;
     }
     free(count);
+    free(flags);
     free(top);
     free(low);
     free(brick_lo);

@@ -1,11 +1,13 @@
 /*
  * Detail probes where geometry is (docs/probes.md, "Detail"): brick
  * columns of a lattice (formats/probes.h) over every place where a ray
- * straight down meets two surfaces or more (a roof over a floor, a car
- * over the road, a bridge over a river), from the lowest surface to one
- * step over the highest, and a lattice column around each such place;
- * the scene's detail volumes then force or forbid it. Open ground, which
- * the grid's layers follow, gets none.
+ * straight down passes a covered gap, open space at least the scene's
+ * detail spacing high between two surfaces (a room under its roof, the
+ * ground under a bridge or an overhang; not the inside of a solid, nor the
+ * hand's breadth under a car), from the lowest surface to one step over
+ * the highest, and a lattice column around each such place; the scene's
+ * detail volumes then force or forbid it. Open ground, which the grid's
+ * layers follow, gets none.
  */
 #ifndef SB_BAKER_PROBE_DETAIL_H
 #define SB_BAKER_PROBE_DETAIL_H

@@ -120,8 +120,9 @@ struct sb_probe_params {
     int layer_count;
     double layers_m[SB_PROBES_MAX_LAYERS];
     /* Detail where geometry is: a lattice this far apart in brick columns
-     * over every place a ray down meets two surfaces or more (a roof over
-     * a floor, a car over the road; formats/probes.h) [0: none] */
+     * over every place a ray down passes a covered gap at least this high
+     * (a room under its roof, the ground under an overhang;
+     * formats/probes.h) [0: none] */
     double detail_spacing_m;
     /* boxes that force detail over their whole volume (`detail` true) or
      * forbid it in theirs, in order, the later winning */

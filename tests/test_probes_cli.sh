@@ -269,9 +269,10 @@ for bad in '"layers_m":[2,1]' '"layers_m":[]' '"layers_m":[1,2,3,4,5,6,7,8,9]' '
 done
 
 # Detail where geometry is: a closed room (a box 4 m across and 3 m high,
-# its floor 5 cm over the ground) gets brick columns over its footprint
-# and one lattice column around it; the open ground, which the layers
-# follow, none. The brick columns are in the file (version 3), the same on
+# its faces facing in, its floor 5 cm over the ground) gets brick columns
+# over its footprint and one lattice column around it; the open ground,
+# which the layers follow, none. The brick columns are in the file (the
+# visibility's version 4, with its sight masks; the bounce's 3), the same on
 # 1 and 3 threads; a budget coarsens the detail after the grid, saying so;
 # a volume forbids it.
 cat >"$tmp/room.obj" <<'OBJ'
@@ -289,18 +290,18 @@ v -2 3 -2
 v 2 3 -2
 v 2 3 2
 v -2 3 2
-f 5 6 7
-f 5 7 8
-f 9 11 10
-f 9 12 11
-f 5 9 10
-f 5 10 6
-f 6 10 11
-f 6 11 7
-f 7 11 12
-f 7 12 8
-f 8 12 9
-f 8 9 5
+f 5 7 6
+f 5 8 7
+f 9 10 11
+f 9 11 12
+f 5 10 9
+f 5 6 10
+f 6 11 10
+f 6 7 11
+f 7 12 11
+f 7 8 12
+f 8 9 12
+f 8 5 9
 OBJ
 room() { # extra probes keys
     printf '{"atmosphere":{"preset":"earth"},"products":["sky_visibility","sky_bounce"],"world":{"file":"room.obj"},"probes":{"spacing_m":4,"rays":256,"layers_m":[1,5],"bounce_rays":64,"bounce_secondary":8%s}}' "$1"
@@ -308,7 +309,13 @@ room() { # extra probes keys
 room ',"detail_spacing_m":0.5' >"$tmp/room.json"
 check "bake the room with detail" expect_exit 0 "$skybake" bake "$tmp/room.json" -o "$tmp/room1" --threads 1 -v
 # 4 m across at 0.5 m: lattice columns -2.5 to 2.5 around it, in bricks of 4
-check "detail over the room alone" grep -q "two surfaces or more; 9 brick columns" "$tmp/err"
+check "detail over the room alone" grep -q "a covered gap; 9 brick columns" "$tmp/err"
+# the same box with its faces out is a solid block on the ground: no gap
+# in it, none under it (5 cm), so no detail
+sed '/^f [5-9]/s/^f \([0-9]*\) \([0-9]*\) \([0-9]*\)$/f \1 \3 \2/; /^f 1[0-2]/s/^f \([0-9]*\) \([0-9]*\) \([0-9]*\)$/f \1 \3 \2/' "$tmp/room.obj" >"$tmp/block.obj"
+sed 's/room.obj/block.obj/' "$tmp/room.json" >"$tmp/block.json"
+check "bake a solid block with detail" expect_exit 0 "$skybake" bake "$tmp/block.json" -o "$tmp/block" -v
+check "no covered gap, no detail" grep -q "0 over a covered gap; 0 brick columns" "$tmp/err"
 check "info gives the detail" expect_exit 0 "$skybake" info "$tmp/room1"
 check "the settings say so" grep -q '"detail":{"spacing_m":0.5,"brick_columns":9,"probes":' "$tmp/out"
 check "the visibility's file is version 4 (sight masks)" sh -c "od -An -tu4 -j8 -N4 '$tmp/room1/sky_visibility.sbprobes' | grep -qw 4"
@@ -335,7 +342,7 @@ check "bake the room, detail forbidden" expect_exit 0 "$skybake" bake "$tmp/room
 check "no detail" grep -q "(0 in detail)" "$tmp/err"
 room ',"detail_spacing_m":2,"detail_volumes":[{"min_m":[10,0,10],"max_m":[14,4,14],"detail":true}]' >"$tmp/room_force.json"
 check "bake the room, detail forced on open ground" expect_exit 0 "$skybake" bake "$tmp/room_force.json" -o "$tmp/room_force" -v
-check "the forced volume's columns too" sh -c "grep -q 'two surfaces or more; [0-9]* brick columns' '$tmp/err' && ! grep -q '; 1 brick columns' '$tmp/err'"
+check "the forced volume's columns too" sh -c "grep -q 'a covered gap; [0-9]* brick columns' '$tmp/err' && ! grep -q '; 1 brick columns' '$tmp/err'"
 for bad in '"detail_spacing_m":0.01' '"detail_spacing_m":-1' '"detail_volumes":[{"min_m":[0,0,0],"max_m":[1,1,1],"detail":true}]' \
     '"detail_spacing_m":1,"detail_volumes":[{"min_m":[0,0,0],"max_m":[0,1,1],"detail":true}]' \
     '"detail_spacing_m":1,"detail_volumes":[{"min_m":[0,0,0],"max_m":[1,1,1]}]' \
