@@ -150,12 +150,12 @@ static enum sb_result raycaster(struct probes_state *st, struct sb_vk *vk)
 /* The grid over the world's bounds (or the scene's), centred on them, and
  * its size checked against the caps: from the scene and its world alone,
  * so that probes_create refuses a grid before any product is baked. */
-/* The bytes a probe takes in the pack: its sky_visibility record and, when
- * the scene bakes it, its sky_bounce record. */
+/* The bytes a probe takes in the pack: its sky_visibility record (fp32)
+ * and, when the scene bakes it, its sky_bounce record (binary16). */
 static uint64_t probe_bytes(const struct sb_scene *scene)
 {
-    return 4 *
-           (SB_SKY_VISIBILITY_CHANNEL_COUNT + (scene->wants[SB_PRODUCT_SKY_BOUNCE] ? SB_SKY_BOUNCE_CHANNEL_COUNT : 0));
+    return 4 * SB_SKY_VISIBILITY_CHANNEL_COUNT +
+           (scene->wants[SB_PRODUCT_SKY_BOUNCE] ? 2 * SB_SKY_BOUNCE_CHANNEL_COUNT : 0);
 }
 
 /* The grid `spacing` apart over lo..hi (layers over the surface where the
@@ -681,6 +681,11 @@ static enum sb_result bake_bounce(struct probes_state *st, const struct sb_scene
         goto done;
     sb_image_set_channel_names(image, SB_SKY_BOUNCE_CHANNELS);
     memcpy(image->data, out, (size_t)count * SB_BOUNCE_FLOATS * sizeof(float));
+    int64_t bad; /* stored as binary16 (its file's values): 4.9e-4 relative, its range +-6.7 */
+    if ((res = sb_image_round_to_half(image, &bad))) {
+        sb_error("sky_bounce: value %lld does not fit binary16", (long long)bad);
+        goto done;
+    }
     snprintf(a->settings_json, sizeof(a->settings_json),
              "{\"rays\":%u,\"secondary\":%u,\"grid\":[%u,%u,%u],\"spacing_m\":%.9g,\"explicit\":%u,"
              "\"valid\":%u,\"model\":\"one Lambertian bounce; order-1 SH at the probe x order-2 SH of the light at "

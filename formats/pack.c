@@ -296,7 +296,7 @@ enum sb_result sb_pack_writer_add_image(struct sb_pack_writer *w, struct sb_arti
     if (format->storage == SB_STORAGE_PROBES) {
         snprintf(artifact->probes.key, sizeof(artifact->probes.key), "%s", artifact->key);
         w->artifacts[i] = *artifact;
-        res = sb_probes_write(path, &artifact->probes, image);
+        res = sb_probes_write(path, &artifact->probes, image, !strcmp(format->pixel_type, "float16"));
     } else {
         res = format->storage == SB_STORAGE_VDB_HALF   ? sb_vdb_write(path, image, attrs, n)
               : format->storage == SB_STORAGE_EXR_CUBE ? sb_exr_cube_write(path, image, attrs, n)
@@ -621,8 +621,9 @@ static enum sb_result read_artifact_entry(const cJSON *entry, int index, struct 
     char pixel_type[16];
     if ((res = manifest_string(entry, "pixel_type", pixel_type, sizeof(pixel_type), source, where)))
         return res;
-    if (strcmp(pixel_type, format->pixel_type) != 0) {
-        sb_error("%s: %spixel_type: \"%s\", expected \"%s\"", source, where, pixel_type, format->pixel_type);
+    const char *want_type = sb_product_pixel_type(id, pack->format_version);
+    if (strcmp(pixel_type, want_type) != 0) {
+        sb_error("%s: %spixel_type: \"%s\", expected \"%s\"", source, where, pixel_type, want_type);
         return SB_ERR_BAD_IMAGE;
     }
     /* Channels: the product's, in its order. */
@@ -742,6 +743,12 @@ static enum sb_result read_artifact_image(const char *dir, int dir_fd, struct sb
         if (!res && a->probes.column_count && pack->format_version < 8) {
             sb_error("%s: %s: detail probes, which format version %d cannot hold (8 and later)", path, name,
                      pack->format_version);
+            res = SB_ERR_PROBES;
+        }
+        if (!res && a->probes.half != !strcmp(sb_product_pixel_type(id, pack->format_version), "float16")) {
+            sb_error("%s: %s: values stored as %s, the pack's format version %d stores %s", path, name,
+                     a->probes.half ? "binary16" : "fp32", pack->format_version,
+                     sb_product_pixel_type(id, pack->format_version));
             res = SB_ERR_PROBES;
         }
         if (!res && a->probes.sight && pack->format_version < 9) {

@@ -87,11 +87,13 @@ static void channel_range(const char *name, double *lo, double *hi)
     }
 }
 
-/* A file's bytes: `sight` detail probes' sight masks (0: none). */
-static size_t file_size(uint32_t header, uint32_t columns, uint32_t sight, uint32_t probes, uint32_t channels)
+/* A file's bytes: `sight` detail probes' sight masks (0: none), values
+ * of value_bytes (4: fp32, 2: binary16). */
+static size_t file_size(uint32_t header, uint32_t columns, uint32_t sight, uint32_t probes, uint32_t channels,
+                        uint32_t value_bytes)
 {
     return header + (size_t)columns * SB_PROBES_COLUMN_BYTES + (size_t)sight * SB_PROBES_SIGHT_WORDS * 4 +
-           (size_t)probes * channels * 4 + 8;
+           (size_t)probes * channels * value_bytes + 8;
 }
 
 void sb_probe_layout_finish(struct sb_probe_layout *layout)
@@ -178,16 +180,22 @@ void sb_probes_content_hash(const struct sb_image *image, const struct sb_probe_
     snprintf(out, SB_HASH_HEX_SIZE, "%016llx%016llx", (unsigned long long)h.high64, (unsigned long long)h.low64);
 }
 
-enum sb_result sb_probes_write(const char *path, const struct sb_probe_layout *layout, const struct sb_image *image)
+enum sb_result sb_probes_write(const char *path, const struct sb_probe_layout *layout, const struct sb_image *image,
+                               bool half)
 {
-    /* the oldest version that holds the layout: without layers or detail,
-     * version 1, and the files are what they were */
-    uint32_t version = layout->sight ? 4 : layout->column_count ? 3 : layout->layer_count ? 2 : 1;
+    /* the oldest version that holds the layout and the values: without
+     * layers or detail, in fp32, version 1, and the files are what they
+     * were */
+    uint32_t version = half ? 5 : layout->sight ? 4 : layout->column_count ? 3 : layout->layer_count ? 2 : 1;
     uint32_t header = version >= 3   ? SB_PROBES_HEADER_BYTES
                       : version == 2 ? SB_PROBES_HEADER_BYTES_V2
                                      : SB_PROBES_HEADER_BYTES_V1;
-    uint32_t sight = version == 4 ? layout->detail_count : 0;
-    size_t size = file_size(header, layout->column_count, sight, image->width, image->channel_count);
+    uint32_t sight = layout->sight && layout->column_count ? layout->detail_count : 0, value_bytes = half ? 2 : 4;
+    if (half && sb_image_find_not_half(image) >= 0) {
+        sb_error("%s: values that binary16 does not hold exactly, for a file stored as half", path);
+        return SB_ERR_NUMERIC;
+    }
+    size_t size = file_size(header, layout->column_count, sight, image->width, image->channel_count, value_bytes);
     uint8_t *bytes = calloc(1, size);
     if (!bytes)
         return SB_ERR_NOMEM;
@@ -211,7 +219,7 @@ enum sb_result sb_probes_write(const char *path, const struct sb_probe_layout *l
             put_f32(bytes + 108 + 4 * l, layout->layers_m[l]);
     }
     uint8_t *p = bytes + header;
-    if (version >= 3) {
+    if (version >= 3 && layout->column_count) {
         put_f32(bytes + 140, layout->detail_spacing_m);
         for (int k = 0; k < 3; k++)
             put_f32(bytes + 144 + 4 * k, layout->detail_origin_m[k]);
@@ -225,13 +233,22 @@ enum sb_result sb_probes_write(const char *path, const struct sb_probe_layout *l
             put_u32(p + 12, col->rows);
         }
     }
-    if (version == 4) {
+    if (sight) {
         put_u32(bytes + 164, SB_PROBES_SIGHT_SIDE);
         for (uint64_t i = 0; i < (uint64_t)sight * SB_PROBES_SIGHT_WORDS; i++, p += 4)
             put_u32(p, layout->sight[i]);
     }
-    for (uint64_t i = 0; i < (uint64_t)image->width * image->channel_count; i++, p += 4)
-        put_f32(p, image->data[i]);
+    if (half)
+        put_u32(bytes + 168, value_bytes);
+    for (uint64_t i = 0; i < (uint64_t)image->width * image->channel_count; i++, p += value_bytes) {
+        if (half) {
+            uint16_t h = sb_half_from_float(image->data[i]);
+            p[0] = (uint8_t)h;
+            p[1] = (uint8_t)(h >> 8);
+        } else {
+            put_f32(p, image->data[i]);
+        }
+    }
     put_u64(p, XXH3_64bits(bytes, size - 8));
 
     enum sb_result res = sb_write_file(path, bytes, size, "probe file");
@@ -342,7 +359,6 @@ enum sb_result sb_probes_parse(const void *data, size_t size, const char *source
     uint32_t expect_header = version == 1   ? SB_PROBES_HEADER_BYTES_V1
                              : version == 2 ? SB_PROBES_HEADER_BYTES_V2
                                             : SB_PROBES_HEADER_BYTES;
-    bool has_detail = version >= 3;
     if (header != expect_header) {
         sb_error("%s: header of %u bytes, version %u has %u", source, header, version, expect_header);
         return SB_ERR_PROBES;
@@ -358,17 +374,27 @@ enum sb_result sb_probes_parse(const void *data, size_t size, const char *source
                  version == 2 ? 1 : 0, SB_PROBES_MAX_LAYERS);
         return SB_ERR_PROBES;
     }
-    uint32_t columns = has_detail ? get_u32(b + 156) : 0, detail = has_detail ? get_u32(b + 160) : 0;
-    if (has_detail && (columns < 1 || columns > SB_PROBES_MAX_COLUMNS)) {
+    /* versions 3 and 4 hold detail (4: with sight masks); version 5 may
+     * (no brick columns: none), with masks or not */
+    uint32_t columns = version >= 3 ? get_u32(b + 156) : 0, detail = version >= 3 ? get_u32(b + 160) : 0;
+    bool has_detail = columns > 0;
+    if ((version == 3 || version == 4 || columns) && (columns < 1 || columns > SB_PROBES_MAX_COLUMNS)) {
         sb_error("%s: %u brick columns of detail: 1 to %u", source, columns, SB_PROBES_MAX_COLUMNS);
         return SB_ERR_PROBES;
     }
-    if (version == 4 && get_u32(b + 164) != SB_PROBES_SIGHT_SIDE) {
-        sb_error("%s: sight masks of %u samples an axis: this skybake reads %d", source, get_u32(b + 164),
-                 SB_PROBES_SIGHT_SIDE);
+    uint32_t side = version >= 4 ? get_u32(b + 164) : 0;
+    if ((version == 4 || side) && (side != SB_PROBES_SIGHT_SIDE || !has_detail)) {
+        sb_error("%s: sight masks of %u samples an axis%s: this skybake reads %d, over detail", source, side,
+                 has_detail ? "" : " without detail", SB_PROBES_SIGHT_SIDE);
         return SB_ERR_PROBES;
     }
-    uint32_t sight = version == 4 ? detail : 0;
+    uint32_t sight = side ? detail : 0;
+    uint32_t value_bytes = version == 5 ? get_u32(b + 168) : 4;
+    if (value_bytes != (version == 5 ? 2u : 4u)) {
+        sb_error("%s: values of %u bytes: version %u stores %s", source, value_bytes, version,
+                 version == 5 ? "binary16 (2)" : "fp32 (4)");
+        return SB_ERR_PROBES;
+    }
     struct sb_image names = {0};
     sb_image_set_channel_names(&names, channel_names);
     uint32_t expect = 0;
@@ -394,9 +420,10 @@ enum sb_result sb_probes_parse(const void *data, size_t size, const char *source
                  max_probes < SB_PROBES_MAX_COUNT ? max_probes : SB_PROBES_MAX_COUNT);
         return SB_ERR_PROBES;
     }
-    if (size != file_size(header, columns, sight, count, channels)) {
+    size_t expect_size = file_size(header, columns, sight, count, channels, value_bytes);
+    if (size != expect_size) {
         sb_error("%s: %zu bytes, %u brick columns, %u sight masks and %u probes of %u channels take %zu", source,
-                 size, columns, sight, count, channels, file_size(header, columns, sight, count, channels));
+                 size, columns, sight, count, channels, expect_size);
         return SB_ERR_BAD_IMAGE;
     }
     if (get_u64(b + size - 8) != XXH3_64bits(b, size - 8)) {
@@ -404,7 +431,8 @@ enum sb_result sb_probes_parse(const void *data, size_t size, const char *source
         return SB_ERR_HASH_MISMATCH;
     }
     for (uint32_t i = version == 1 ? 104 : 108 + 4 * layers; i < header; i++)
-        if (b[i] && !(has_detail && i >= 140 && i < (version == 4 ? 168u : 164u))) {
+        if (b[i] && !(has_detail && i >= 140 && i < 164) && !(sight && i >= 164 && i < 168) &&
+            !(version == 5 && i >= 168 && i < 172)) {
             sb_error("%s: reserved header byte %u is not zero", source, i);
             return SB_ERR_PROBES;
         }
@@ -457,11 +485,13 @@ enum sb_result sb_probes_parse(const void *data, size_t size, const char *source
     }
     sb_image_set_channel_names(image, channel_names);
     const uint8_t *p = b + header + (size_t)columns * SB_PROBES_COLUMN_BYTES + (size_t)sight * SB_PROBES_SIGHT_WORDS * 4;
+    layout->half = value_bytes == 2;
     for (uint32_t c = 0; c < channels && !res; c++) {
         double lo, hi;
         channel_range(image->channel_names[c], &lo, &hi);
         for (uint32_t i = 0; i < count; i++) {
-            float v = get_f32(p + 4 * ((size_t)i * channels + c));
+            const uint8_t *at = p + value_bytes * ((size_t)i * channels + c);
+            float v = value_bytes == 2 ? sb_half_to_float((uint16_t)(at[0] | at[1] << 8)) : get_f32(at);
             bool flag = !strcmp(image->channel_names[c], "valid"); /* 0 or 1, nothing between */
             if (!isfinite(v) || v < lo || v > hi || (flag && v != 0.0f && v != 1.0f)) {
                 sb_error("%s: probe %u channel %s is %g, expected a finite value in [%g, %g]", source, i,
@@ -494,7 +524,7 @@ enum sb_result sb_probes_read(const char *path, const char *channel_names, uint3
         return SB_ERR_IO;
     }
     size_t largest = file_size(SB_PROBES_HEADER_BYTES, SB_PROBES_MAX_COUNT / (SB_PROBES_BRICK * SB_PROBES_BRICK),
-                               SB_PROBES_MAX_COUNT, SB_PROBES_MAX_COUNT, SB_IMAGE_MAX_CHANNELS);
+                               SB_PROBES_MAX_COUNT, SB_PROBES_MAX_COUNT, SB_IMAGE_MAX_CHANNELS, 4);
     if (!S_ISREG(st.st_mode) || (uint64_t)st.st_size > largest) {
         sb_error("%s: not a regular file of at most %zu bytes", path, largest);
         close(fd);

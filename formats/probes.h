@@ -1,11 +1,13 @@
 /*
- * Probe files (.sbprobes): a set of probes with one fp32 record each, in
+ * Probe files (.sbprobes): a set of probes with one record each (fp32, or binary16), in
  * skybake's own small binary format (docs/pack.md, "Probe files"). Little
  * endian throughout:
  *
  *   offset  size  field
  *        0     8  magic "SBPROBES"
- *        8     4  format version (1, or 2: a grid that follows the surface)
+ *        8     4  format version (1; 2: a grid that follows the surface; 3:
+ *                 detail; 4: detail with its sight masks; 5: values stored
+ *                 as binary16)
  *       12     4  byte-order mark 0x01020304
  *       16     4  header bytes (112; version 2: 152)
  *       20     4  channels per probe
@@ -34,17 +36,23 @@
  *      104    60  as version 3
  *      164     4  the sight masks' samples along an axis: SB_PROBES_SIGHT_SIDE (8)
  *      168    24  reserved, zero
- *   header     -  versions 3 and 4: C brick columns of 16 bytes: x, z
+ *   version 5 (values as binary16):
+ *      104    64  as version 4, but C may be 0 (no detail: bytes 140 to
+ *                 163 zero) and byte 164 0 (no sight masks; 8 needs detail)
+ *      168     4  bytes a value: 2
+ *      172    20  reserved, zero
+ *   header     -  versions 3 to 5: C brick columns of 16 bytes: x, z
  *                 (int32, in bricks of SB_PROBES_BRICK lattice steps), the
  *                 lowest lattice row y0 (int32) and the rows (uint32), in
  *                 increasing z then x, each once
- *      then    -  version 4: D sight masks of 64 bytes, detail probe by
+ *      then    -  versions 4 and 5: D sight masks of 64 bytes, detail probe by
  *                 detail probe: 16 uint32, bit b (word b / 32, bit b % 32)
  *                 set when the probe sees sample point b = (k 8 + j) 8 + i
  *                 of the 8 lattice cells around its lattice point, at that
  *                 point plus ((i, j, k) + 0.5) / 4 - 1 spacings (shaders/
  *                 config.h, SB_PROBE_SIGHT_*)
- *      then    -  probe count x channels x float32, probe by probe
+ *      then    -  probe count x channels x float32 (version 5: IEEE
+ *                 binary16), probe by probe
  *      end     8  XXH3-64 of every byte before it
  *
  * A grid of layers follows the surface: its probes stand in columns (x, z
@@ -72,6 +80,7 @@
 #ifndef SB_PROBES_H
 #define SB_PROBES_H
 
+#include <stdbool.h>
 #include <stddef.h>
 #include <stdint.h>
 
@@ -79,7 +88,7 @@
 #include "result.h"
 #include "scene.h"
 
-#define SB_PROBES_VERSION 4
+#define SB_PROBES_VERSION 5
 #define SB_PROBES_HEADER_BYTES_V1 112
 #define SB_PROBES_HEADER_BYTES_V2 152
 #define SB_PROBES_HEADER_BYTES 192
@@ -173,6 +182,7 @@ struct sb_probe_layout {
     /* the detail probes' sight masks (version 4; NULL: none):
      * detail_count x SB_PROBES_SIGHT_WORDS */
     uint32_t *sight; /* owned */
+    bool half;       /* read: the values were stored as binary16 (version 5) */
 };
 
 /* Free a layout's columns and sight masks (and zero them); a zeroed
@@ -193,9 +203,12 @@ void sb_probes_content_hash(const struct sb_image *image, const struct sb_probe_
                             char out[SB_HASH_HEX_SIZE]);
 
 /* Write the probes (image: width = probe count, height = depth = 1, the
- * channels in the product's order) with their layout. Atomic only as the
+ * channels in the product's order) with their layout, their values as
+ * fp32 or (`half`) binary16, which must hold each exactly
+ * (sb_image_round_to_half; SB_ERR_NUMERIC otherwise). Atomic only as the
  * pack is (the writer's temporary directory). */
-enum sb_result sb_probes_write(const char *path, const struct sb_probe_layout *layout, const struct sb_image *image);
+enum sb_result sb_probes_write(const char *path, const struct sb_probe_layout *layout, const struct sb_image *image,
+                               bool half);
 
 /*
  * Parse a probe file's bytes (source names it in messages). channel_names

@@ -28,6 +28,12 @@ const char *sb_product_name(enum sb_product_id id)
     return (unsigned)id < SB_PRODUCT_COUNT ? product_formats[id].name : "unknown";
 }
 
+const char *sb_product_pixel_type(enum sb_product_id id, int format_version)
+{
+    const struct sb_product_format *f = &product_formats[id];
+    return f->half_since && format_version < f->half_since ? "float32" : f->pixel_type;
+}
+
 bool sb_product_from_name(const char *name, enum sb_product_id *id)
 {
     for (int p = 0; p < SB_PRODUCT_COUNT; p++)

@@ -58,12 +58,15 @@ struct sb_product_format {
     int since_version;            /* the first format version holding the product */
     enum sb_storage storage;
     const char *pixel_type; /* the manifest's pixel_type: "float32", "float16" */
+    int half_since;         /* a probe product stored as float16 from this format version on, float32 before; 0 */
     const char *extension;  /* of its file: "exr", "vdb" */
     enum sb_family family;
 };
 
 const struct sb_product_format *sb_product_format(enum sb_product_id id);
 const char *sb_product_name(enum sb_product_id id);
+/* The pixel_type of the product's files in packs of `format_version`. */
+const char *sb_product_pixel_type(enum sb_product_id id, int format_version);
 bool sb_product_from_name(const char *name, enum sb_product_id *id);
 
 #endif

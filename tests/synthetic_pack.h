@@ -71,7 +71,7 @@ static inline enum sb_result write_synthetic_pack(const char *dir, const char *n
         for (uint64_t i = 0; i < sb_image_float_count(&image); i++)
             image.data[i] = probes ? (i % f->channel_count == 6 ? 1.0f : (float)(i * 2654435761u % 1000u) * 1e-3f)
                                    : (float)((double)(i * 2654435761u % 1000003u) * 1e-6 + p);
-        if (f->storage == SB_STORAGE_VDB_HALF)
+        if (!strcmp(f->pixel_type, "float16"))
             sb_image_round_to_half(&image, NULL);
         struct sb_artifact a = {.product = (enum sb_product_id)p,
                                 .probes = {.explicit_count = probes ? shape[0] : 0, .ray_count = 64}};

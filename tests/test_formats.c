@@ -702,14 +702,26 @@ static void edit_version_3(cJSON *r)
 {
     cJSON_ReplaceItemInObject(r, "format_version", cJSON_CreateNumber(3));
 }
+/* The bounce's pixel_type as packs before format version 10 record it. */
+static void edit_bounce_fp32(cJSON *r)
+{
+    cJSON *artifacts = cJSON_GetObjectItem(r, "artifacts"), *a;
+    cJSON_ArrayForEach(a, artifacts)
+    {
+        if (!strcmp(cJSON_GetStringValue(cJSON_GetObjectItem(a, "name")), "sky_bounce"))
+            cJSON_ReplaceItemInObject(a, "pixel_type", cJSON_CreateString("float32"));
+    }
+}
 static void edit_version_4(cJSON *r)
 {
     cJSON_ReplaceItemInObject(r, "format_version", cJSON_CreateNumber(4));
+    edit_bounce_fp32(r);
 }
 /* Version 5 with the DFG alone of the reflections: what version 5 wrote. */
 static void edit_version_5(cJSON *r)
 {
     cJSON_ReplaceItemInObject(r, "format_version", cJSON_CreateNumber(5));
+    edit_bounce_fp32(r);
 }
 /* What version 1 wrote: no cloud products (in the scene or the pack), no
  * file_hash; the scene's hash recomputed for the scene without clouds. */
@@ -1170,7 +1182,7 @@ static void test_probes(void)
                                      .ray_count = 2048,
                                      .key = "0123456789abcdef0123456789abcdef"},
                            got;
-    CHECK(sb_probes_write(path, &layout, &img) == SB_OK, "write");
+    CHECK(sb_probes_write(path, &layout, &img, false) == SB_OK, "write");
     CHECK(sb_probes_read(path, SB_SKY_VISIBILITY_CHANNELS, 1000, &got, &back) == SB_OK, "read back");
     CHECK(back.width == n && back.channel_count == ch && !memcmp(back.data, img.data, sizeof(float) * n * ch) &&
               !memcmp(got.grid, layout.grid, sizeof(got.grid)) && got.explicit_count == layout.explicit_count &&
@@ -1202,7 +1214,8 @@ static void test_probes(void)
         enum sb_result want;
         const char *what;
     } fields[] = {
-        {8, 5, SB_ERR_VERSION, "a newer version"},
+        {8, 6, SB_ERR_VERSION, "a newer version"},
+        {8, 5, SB_ERR_PROBES, "version 5 with version 1's header"},
         {8, 4, SB_ERR_PROBES, "version 4 with version 1's header"},
         {8, 3, SB_ERR_PROBES, "version 3 with version 1's header"},
         {8, 2, SB_ERR_PROBES, "version 2 with version 1's header"},
@@ -1253,7 +1266,7 @@ static void test_probes(void)
                                       .ray_count = 512,
                                       .layer_count = 2,
                                       .layers_m = {1.5f, 10}};
-    CHECK(sb_probes_write(path, &terrain, &layered) == SB_OK, "write layers");
+    CHECK(sb_probes_write(path, &terrain, &layered, false) == SB_OK, "write layers");
     CHECK(sb_probes_read(path, SB_SKY_VISIBILITY_CHANNELS, 1000, &got, &back) == SB_OK, "read layers back");
     CHECK(got.layer_count == 2 && got.layers_m[0] == 1.5f && got.layers_m[1] == 10 && got.grid[1] == 2 &&
               got.spacing_m[1] == 20 && back.width == nl && !memcmp(back.data, layered.data, sizeof(float) * nl * ch),
@@ -1309,7 +1322,7 @@ static void test_probes(void)
     bricks.detail_count = 16;
     bricks.column_count = 1;
     bricks.columns = &column;
-    CHECK(sb_probes_write(path, &bricks, &detailed) == SB_OK, "write detail");
+    CHECK(sb_probes_write(path, &bricks, &detailed, false) == SB_OK, "write detail");
     CHECK(sb_probes_read(path, SB_SKY_VISIBILITY_CHANNELS, 1000, &got, &back) == SB_OK, "read detail back");
     CHECK(got.column_count == 1 && got.detail_count == 16 && got.detail_spacing_m == 0.5f &&
               got.detail_origin_m[2] == 8 && got.columns[0].x == 3 && got.columns[0].z == 1 && got.columns[0].y0 == 7 &&
@@ -1375,12 +1388,12 @@ static void test_probes(void)
     bricks.columns = two;
     bricks.column_count = 2;
     bricks.detail_count = 32;
-    CHECK(sb_probes_write(path, &bricks, &wide) == SB_OK, "write two columns");
+    CHECK(sb_probes_write(path, &bricks, &wide, false) == SB_OK, "write two columns");
     enum sb_result unordered = sb_probes_read(path, SB_SKY_VISIBILITY_CHANNELS, 1000, &got, &back);
     CHECK(unordered == SB_ERR_PROBES, "columns out of order: %s", sb_result_name(unordered));
     two[0].x = 1;
     two[1].x = 2;
-    CHECK(sb_probes_write(path, &bricks, &wide) == SB_OK &&
+    CHECK(sb_probes_write(path, &bricks, &wide, false) == SB_OK &&
               sb_probes_read(path, SB_SKY_VISIBILITY_CHANNELS, 1000, &got, &back) == SB_OK &&
               sb_probe_detail_index(&got, nl, 8, 0, 4) == nl + 16,
           "columns in order: the second's first probe follows the first's");
@@ -1399,7 +1412,7 @@ static void test_probes(void)
     bricks.column_count = 1;
     bricks.detail_count = 16;
     bricks.sight = sight;
-    CHECK(sb_probes_write(path, &bricks, &detailed) == SB_OK, "write detail with sight masks");
+    CHECK(sb_probes_write(path, &bricks, &detailed, false) == SB_OK, "write detail with sight masks");
     CHECK(sb_probes_read(path, SB_SKY_VISIBILITY_CHANNELS, 1000, &got, &back) == SB_OK && got.sight &&
               !memcmp(got.sight, sight, sizeof(sight)) && got.column_count == 1 &&
               !memcmp(back.data, detailed.data, sizeof(float) * nd * ch),
@@ -1445,6 +1458,73 @@ static void test_probes(void)
             sb_probe_layout_finish(&got);
         }
     }
+
+    /* Values as binary16: version 5, with detail and masks or without
+     * any; values binary16 does not hold exactly are refused on writing;
+     * the round trip is exact; every prefix and bit flip is refused, and
+     * so are other value sizes, masks without detail and detail fields
+     * without columns. */
+    int64_t not_half;
+    CHECK(sb_probes_write(path, &bricks, &detailed, true) == SB_ERR_NUMERIC, "values binary16 does not hold");
+    CHECK(sb_image_round_to_half(&detailed, &not_half) == SB_OK, "round to binary16");
+    CHECK(sb_probes_write(path, &bricks, &detailed, true) == SB_OK &&
+              sb_probes_read(path, SB_SKY_VISIBILITY_CHANNELS, 1000, &got, &back) == SB_OK && got.half && got.sight &&
+              !memcmp(got.sight, sight, sizeof(sight)) &&
+              !memcmp(back.data, detailed.data, sizeof(float) * nd * ch),
+          "binary16 with detail: the round trip is exact");
+    sb_probe_layout_finish(&got);
+    sb_image_finish(&back);
+    f = fopen(path, "rb");
+    size = f ? fread(bytes, 1, sizeof(bytes), f) : 0;
+    if (f)
+        fclose(f);
+    CHECK(size == SB_PROBES_HEADER_BYTES + SB_PROBES_COLUMN_BYTES + sizeof(sight) + (size_t)nd * ch * 2 + 8 &&
+              bytes[8] == 5,
+          "version 5: size %zu", size);
+    check_probes_damage(bytes, size, "binary16 with detail");
+    const struct {
+        size_t offset;
+        uint32_t value;
+        const char *what;
+    } half_fields[] = {{168, 4, "values of 4 bytes in version 5"},
+                       {168, 0, "no value size"},
+                       {172, 1, "a reserved byte"},
+                       {156, 0, "detail fields without columns"}};
+    for (size_t i = 0; i < sizeof(half_fields) / sizeof(half_fields[0]); i++) {
+        uint8_t edited[4096];
+        memcpy(edited, bytes, size);
+        for (int k = 0; k < 4; k++)
+            edited[half_fields[i].offset + k] = (uint8_t)(half_fields[i].value >> (8 * k));
+        restamp(edited, size);
+        enum sb_result res = sb_probes_parse(edited, size, "edited", SB_SKY_VISIBILITY_CHANNELS, 1000, &got, &back);
+        CHECK(res != SB_OK, "%s: %s", half_fields[i].what, sb_result_name(res));
+        if (res == SB_OK) {
+            sb_image_finish(&back);
+            sb_probe_layout_finish(&got);
+        }
+    }
+    struct sb_probe_layout plain = terrain; /* layers, no detail */
+    CHECK(sb_image_round_to_half(&layered, &not_half) == SB_OK &&
+              sb_probes_write(path, &plain, &layered, true) == SB_OK &&
+              sb_probes_read(path, SB_SKY_VISIBILITY_CHANNELS, 1000, &got, &back) == SB_OK && got.half &&
+              !got.column_count && !got.sight && got.layer_count == terrain.layer_count &&
+              !memcmp(back.data, layered.data, sizeof(float) * nl * ch),
+          "binary16 without detail: the round trip is exact");
+    sb_probe_layout_finish(&got);
+    sb_image_finish(&back);
+    f = fopen(path, "rb");
+    size = f ? fread(bytes, 1, sizeof(bytes), f) : 0;
+    if (f)
+        fclose(f);
+    CHECK(size == SB_PROBES_HEADER_BYTES + (size_t)nl * ch * 2 + 8 && bytes[8] == 5, "version 5 without detail: %zu",
+          size);
+    check_probes_damage(bytes, size, "binary16 without detail");
+    uint8_t edited[4096];
+    memcpy(edited, bytes, size);
+    edited[164] = 8;
+    restamp(edited, size);
+    CHECK(sb_probes_parse(edited, size, "edited", SB_SKY_VISIBILITY_CHANNELS, 1000, &got, &back) == SB_ERR_PROBES,
+          "sight masks without detail");
     sb_image_finish(&detailed);
     sb_image_finish(&layered);
     unlink(path);

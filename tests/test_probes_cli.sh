@@ -37,7 +37,7 @@ check "only what was asked for" test ! -e "$tmp/p/transmittance.exr"
 check "verify" expect_exit 0 "$skybake" verify "$tmp/p"
 check "info lists sky_visibility" expect_exit 0 "$skybake" info "$tmp/p"
 check "info shows the grid" grep -q '"grid":\[6,1,6\]' "$tmp/out"
-check "manifest has format_version 9" grep -Eq '"format_version":[[:space:]]*9,' "$tmp/p/manifest.json"
+check "manifest has format_version 10" grep -Eq '"format_version":[[:space:]]*10,' "$tmp/p/manifest.json"
 check "diff with itself" expect_exit 0 "$skybake" diff "$tmp/p" "$tmp/p"
 hash() { sed -n 's/.*"content_hash":[[:space:]]*"\([0-9a-f]*\)".*/\1/p' "$tmp/p/manifest.json"; }
 first=$(hash)
@@ -251,7 +251,7 @@ check "naming the version" grep -q "format version 6 cannot hold" "$tmp/err"
 # saying so; the bytes are in the artifact's settings.
 printf '{"atmosphere":{"preset":"earth"},"products":["sky_visibility","sky_bounce"],"world":{"file":"world.obj"},"probes":{"spacing_m":1,"rays":64,"layers_m":[1,5],"budget_mb":0.05,"bounce_rays":64,"bounce_secondary":8}}' >"$tmp/budget.json"
 check "bake within a budget" expect_exit 0 "$skybake" bake "$tmp/budget.json" -o "$tmp/budget"
-check "saying the grid was spaced wider" grep -q "over probes.budget_mb (0.05): 3.35 m apart instead" "$tmp/err"
+check "saying the grid was spaced wider" grep -Eq "over probes.budget_mb \(0.05\): [0-9.]+ m apart instead" "$tmp/err"
 check "info gives its bytes" expect_exit 0 "$skybake" info "$tmp/budget"
 bytes=$(grep -o '"bytes":[0-9]*' "$tmp/out" | head -1 | cut -d: -f2)
 check "within the budget ($bytes bytes)" test -n "$bytes" -a "${bytes:-0}" -le 50000 -a "${bytes:-0}" -gt 25000
@@ -319,7 +319,7 @@ check "no covered gap, no detail" grep -q "0 over a covered gap; 0 brick columns
 check "info gives the detail" expect_exit 0 "$skybake" info "$tmp/room1"
 check "the settings say so" grep -q '"detail":{"spacing_m":0.5,"brick_columns":9,"probes":' "$tmp/out"
 check "the visibility's file is version 4 (sight masks)" sh -c "od -An -tu4 -j8 -N4 '$tmp/room1/sky_visibility.sbprobes' | grep -qw 4"
-check "the bounce's is version 3 (none)" sh -c "od -An -tu4 -j8 -N4 '$tmp/room1/sky_bounce.sbprobes' | grep -qw 3"
+check "the bounce's is version 5 (binary16)" sh -c "od -An -tu4 -j8 -N4 '$tmp/room1/sky_bounce.sbprobes' | grep -qw 5"
 check "verify" expect_exit 0 "$skybake" verify "$tmp/room1"
 cp -r "$tmp/room1" "$tmp/room8"
 sed -i 's/"format_version":[[:space:]]*[0-9]*/"format_version": 8/' "$tmp/room8/manifest.json"
