@@ -40,7 +40,7 @@ static const double push_steps[] = {0.25, 0.5};
 static const double detail_push_steps[] = {0.3, 0.6};
 _Static_assert(sizeof(push_steps) == sizeof(detail_push_steps), "as many candidates a probe");
 #define PUSH_RAYS 256
-#define PROBES_RECIPE 2 /* 2: rays cast in sb_probe_ray_order */
+#define PROBES_RECIPE 3 /* 2: rays cast in sb_probe_ray_order; 3: the exact deringing window */
 
 /* The world as read for this bake: the key's input and the bake's; its
  * BVH on the device, built by the first product baked. */

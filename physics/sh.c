@@ -141,23 +141,48 @@ static void window(const double c[SB_PROBE_SH], double h, double out[SB_PROBE_SH
         out[k] = c[k] * w[band[k]];
 }
 
+/*
+ * The reconstruction at a test direction is linear in h on each half of
+ * the window's range (sb_sh9_window_factors): with the direction's band
+ * sums s0, s1, s2, it is s0 + (1 - h / 4) s1 + (1 - 3 h / 4) s2 on [0, 1]
+ * and s0 + (2 - h) (3 s1 / 4 + s2 / 4) on [1, 2], s0 >= 0 at h = 2. So
+ * each direction's smallest h from which it stays non-negative is exact,
+ * and the window is their largest: one pass over the directions, not a
+ * bisection's twenty.
+ */
 double sb_sh9_dering(double c[SB_PROBE_SH], double *min_before)
 {
-    double lowest = sb_sh9_min(c, NULL);
+    pthread_once(&test_once, make_test_directions);
+    static const int band[SB_PROBE_SH] = {SB_SH_BANDS};
+    double lowest = INFINITY, h = 0.0;
+    for (uint32_t i = 0; i < SB_SH_TEST_DIRECTIONS; i++) {
+        double s[3] = {0, 0, 0};
+        for (int k = 0; k < SB_PROBE_SH; k++)
+            s[band[k]] += c[k] * test_basis[i][k];
+        lowest = fmin(lowest, test_value(c, i));
+        double at1 = s[0] + 0.75 * s[1] + 0.25 * s[2], slope = 0.75 * s[1] + 0.25 * s[2];
+        double from; /* where this direction turns non-negative for good */
+        if (at1 < 0.0)
+            from = slope < 0.0 ? 2.0 - s[0] / -slope : 2.0; /* on [1, 2], rising to s0 >= 0 */
+        else if (s[0] + s[1] + s[2] < 0.0)
+            from = (s[0] + s[1] + s[2]) / (0.25 * s[1] + 0.75 * s[2]); /* on [0, 1], rising to at1 */
+        else
+            from = 0.0;
+        h = fmax(h, fmin(from, 2.0));
+    }
     *min_before = lowest;
     if (lowest >= 0.0)
         return 0.0;
-    double lo = 0.0, hi = 2.0, w[SB_PROBE_SH];
+    /* the exact h may leave a rounding's worth below zero: step up by
+     * ulps until no test direction is negative (a few at most) */
+    double w[SB_PROBE_SH];
     uint32_t hint = 0;
-    for (int it = 0; it < 20; it++) {
-        double mid = 0.5 * (lo + hi);
-        window(c, mid, w);
-        if (!has_negative(w, &hint))
-            hi = mid;
-        else
-            lo = mid;
+    for (int step = 0; step < 64; step++) {
+        window(c, h, w);
+        if (!has_negative(w, &hint) || h >= 2.0)
+            break;
+        h = fmin(2.0, h + fmax(h, 1.0) * 0x1p-40);
     }
-    window(c, hi, w);
     memcpy(c, w, sizeof(w));
-    return hi;
+    return h;
 }

@@ -38,7 +38,9 @@ double sb_sh9_min(const double c[SB_PROBE_SH], double where[3]);
  * (on the test directions). The window is h in [0, 2]: from 0 (none)
  * through 1 (Hann: bands scaled 1, 3/4, 1/4) to 2 (the constant band
  * alone, which is never negative for a non-negative function's
- * projection); the smallest h that works is found by bisection to 2^-20.
+ * projection); the smallest h that works, exactly (the reconstruction is
+ * linear in h on [0, 1] and on [1, 2]), stepped up by a few ulps where
+ * rounding leaves a test direction below zero.
  * Returns h; *min_before gets the smallest value before (>= 0: nothing done).
  */
 double sb_sh9_dering(double c[SB_PROBE_SH], double *min_before);

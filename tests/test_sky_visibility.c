@@ -843,11 +843,21 @@ static void test_dering(void)
     double z[3], c[SB_PROBE_SH], axis[3] = {0.6, 0.64, 0.48}, before;
     cap_zonal(0.3, z);
     sb_sh9_from_zonal(z, axis, c);
-    double c0 = c[0];
+    double c0 = c[0], orig[SB_PROBE_SH];
+    memcpy(orig, c, sizeof(orig));
     double h = sb_sh9_dering(c, &before);
     double after = sb_sh9_min(c, NULL);
-    printf("dering: a 0.3 rad cap: min %.4f before, %.2e after, window %.3f\n", before, after, h);
+    /* the smallest window that works: a millionth less leaves a negative */
+    static const int band[SB_PROBE_SH] = {SB_SH_BANDS};
+    double w[3], less[SB_PROBE_SH];
+    sb_sh9_window_factors(h * (1 - 1e-6), w);
+    for (int k = 0; k < SB_PROBE_SH; k++)
+        less[k] = orig[k] * w[band[k]];
+    double below = sb_sh9_min(less, NULL);
+    printf("dering: a 0.3 rad cap: min %.4f before, %.2e after, window %.6f (%.2e with a millionth less)\n", before,
+           after, h, below);
     CHECK(before < 0 && after >= 0 && after < 1e-4 && c[0] == c0 && h > 0 && h <= 2, "dering a narrow cap");
+    CHECK(below < 0, "the window is the smallest that works (%.3g a millionth under it)", below);
     /* the hemisphere's order-2 projection is 1/2 + 3/4 cos(theta): -1/4 opposite */
     cap_zonal(M_PI / 2, z);
     sb_sh9_from_zonal(z, axis, c);
