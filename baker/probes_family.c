@@ -335,12 +335,31 @@ static enum sb_result place_detail(struct probes_state *st, const struct sb_scen
         double t0 = sb_now_s();
         res = sb_probe_detail_place(st->rc, &st->bvh, st->level, p, spacing, &st->detail);
         uint32_t first = st->detail.detail_count;
+        double over = 0.0; /* the widest spacing found over the budget */
         for (int step = 0; step < 100 && !res && st->detail.detail_count * per > left; step++) {
             /* a surface's bricks go with the spacing's square, a room's with its cube */
             double ratio = pow(st->detail.detail_count * per / left, 1.0 / 3.0);
+            over = spacing;
             spacing *= ratio > 1.02 ? ratio : 1.02;
             sb_probe_layout_finish(&st->detail);
             res = sb_probe_detail_place(st->rc, &st->bvh, st->level, p, spacing, &st->detail);
+        }
+        /* The count is not monotonic in the spacing (brick columns snap to
+         * the lattice): between the last spacing over the budget and the
+         * first within it, bisection finds a narrower one that fits (the
+         * test level: 2.61 m became 2.0x m) */
+        for (int step = 0; step < 6 && !res && over > 0.0 && st->detail.detail_count * per <= left; step++) {
+            double mid = 0.5 * (over + spacing);
+            struct sb_probe_layout trial = {0};
+            res = sb_probe_detail_place(st->rc, &st->bvh, st->level, p, mid, &trial);
+            if (!res && trial.detail_count * per <= left) {
+                sb_probe_layout_finish(&st->detail);
+                st->detail = trial;
+                spacing = mid;
+            } else {
+                sb_probe_layout_finish(&trial);
+                over = mid;
+            }
         }
         if (!res && spacing != p->detail_spacing_m)
             sb_warn("probes: detail %g m apart would take %.3g MB, over what probes.budget_mb (%g) leaves after the "
