@@ -1139,6 +1139,51 @@ static void check_probes_damage(uint8_t *bytes, size_t size, const char *what)
     CHECK(refused == tried, "%s: every bit flip is refused (%d of %d)", what, refused, tried);
 }
 
+/* A probe file's bytes as written, into bytes[cap]; their size. */
+static size_t read_back(const char *path, uint8_t *bytes, size_t cap)
+{
+    FILE *f = fopen(path, "rb");
+    size_t size = f ? fread(bytes, 1, cap, f) : 0;
+    if (f)
+        fclose(f);
+    return size;
+}
+
+/* A field of a probe file set to a value, its checksum restamped: what the
+ * parser makes of it (anything it returns freed). */
+struct field_edit {
+    size_t offset;
+    uint32_t value;
+    const char *what;
+};
+
+static enum sb_result parse_edited(const uint8_t *bytes, size_t size, const struct field_edit *e)
+{
+    uint8_t edited[4096];
+    memcpy(edited, bytes, size);
+    for (int k = 0; k < 4; k++)
+        edited[e->offset + k] = (uint8_t)(e->value >> (8 * k));
+    restamp(edited, size);
+    struct sb_probe_layout got;
+    struct sb_image back;
+    enum sb_result res = sb_probes_parse(edited, size, "edited", SB_SKY_VISIBILITY_CHANNELS, 1000, &got, &back);
+    if (res == SB_OK) {
+        sb_image_finish(&back);
+        sb_probe_layout_finish(&got);
+    }
+    return res;
+}
+
+/* Every edit refused with `want` (SB_OK: with anything but SB_OK). */
+static void check_edits(const uint8_t *bytes, size_t size, const struct field_edit *edits, size_t n,
+                        enum sb_result want)
+{
+    for (size_t i = 0; i < n; i++) {
+        enum sb_result res = parse_edited(bytes, size, &edits[i]);
+        CHECK(want == SB_OK ? res != SB_OK : res == want, "%s: %s", edits[i].what, sb_result_name(res));
+    }
+}
+
 static void test_probes(void)
 {
     /* The channel indices C code uses are the names' positions. */
@@ -1191,11 +1236,8 @@ static void test_probes(void)
               !strcmp(got.key, layout.key),
           "the round trip is exact");
     sb_image_finish(&back);
-    FILE *f = fopen(path, "rb");
     uint8_t bytes[4096];
-    size_t size = f ? fread(bytes, 1, sizeof(bytes), f) : 0;
-    if (f)
-        fclose(f);
+    size_t size = read_back(path, bytes, sizeof(bytes));
     CHECK(size == SB_PROBES_HEADER_BYTES_V1 + (size_t)n * ch * 4 + 8, "a grid without layers is version 1: size %zu",
           size);
     check_probes_damage(bytes, size, "a grid");
@@ -1237,16 +1279,10 @@ static void test_probes(void)
         {SB_PROBES_HEADER_BYTES_V1 + 0 * 4, 0x7f800000, SB_ERR_NUMERIC, "an infinite position"},
     };
     for (size_t i = 0; i < sizeof(fields) / sizeof(fields[0]); i++) {
-        uint8_t edited[4096];
-        memcpy(edited, bytes, size);
-        for (int k = 0; k < 4; k++)
-            edited[fields[i].offset + k] = (uint8_t)(fields[i].value >> (8 * k));
-        restamp(edited, size);
-        enum sb_result res = sb_probes_parse(edited, size, "edited", SB_SKY_VISIBILITY_CHANNELS, 1000, &got, &back);
+        enum sb_result res =
+            parse_edited(bytes, size, &(struct field_edit){fields[i].offset, fields[i].value, fields[i].what});
         CHECK(res == fields[i].want, "%s: %s, expected %s", fields[i].what, sb_result_name(res),
               sb_result_name(fields[i].want));
-        if (res == SB_OK)
-            sb_image_finish(&back);
     }
     CHECK(sb_probes_read(dir, SB_SKY_VISIBILITY_CHANNELS, 1000, &got, &back) == SB_ERR_IO, "a directory");
 
@@ -1272,10 +1308,7 @@ static void test_probes(void)
               got.spacing_m[1] == 20 && back.width == nl && !memcmp(back.data, layered.data, sizeof(float) * nl * ch),
           "the layers' round trip is exact");
     sb_image_finish(&back);
-    f = fopen(path, "rb");
-    size = f ? fread(bytes, 1, sizeof(bytes), f) : 0;
-    if (f)
-        fclose(f);
+    size = read_back(path, bytes, sizeof(bytes));
     CHECK(size == SB_PROBES_HEADER_BYTES_V2 + (size_t)nl * ch * 4 + 8 && bytes[8] == 2, "version 2: size %zu", size);
     check_probes_damage(bytes, size, "a grid in layers");
     struct {
@@ -1341,18 +1374,11 @@ static void test_probes(void)
     sb_probe_layout_finish(&got);
     CHECK(!got.columns && !got.column_count, "finished");
     sb_image_finish(&back);
-    f = fopen(path, "rb");
-    size = f ? fread(bytes, 1, sizeof(bytes), f) : 0;
-    if (f)
-        fclose(f);
+    size = read_back(path, bytes, sizeof(bytes));
     CHECK(size == SB_PROBES_HEADER_BYTES + SB_PROBES_COLUMN_BYTES + (size_t)nd * ch * 4 + 8 && bytes[8] == 3,
           "version 3: size %zu", size);
     check_probes_damage(bytes, size, "detail");
-    struct {
-        size_t offset;
-        uint32_t value;
-        const char *what;
-    } detail_fields[] = {
+    static const struct field_edit detail_fields[] = {
         {140, 0, "a zero spacing"},
         {140, 0x7fc00000, "a NaN spacing"},
         {144, 0x7f800000, "an infinite origin"},
@@ -1365,19 +1391,7 @@ static void test_probes(void)
         {SB_PROBES_HEADER_BYTES + 12, 0, "a column of no rows"},
         {SB_PROBES_HEADER_BYTES + 12, 2, "a column holding more than the header says"},
     };
-    for (size_t i = 0; i < sizeof(detail_fields) / sizeof(detail_fields[0]); i++) {
-        uint8_t edited[4096];
-        memcpy(edited, bytes, size);
-        for (int k = 0; k < 4; k++)
-            edited[detail_fields[i].offset + k] = (uint8_t)(detail_fields[i].value >> (8 * k));
-        restamp(edited, size);
-        enum sb_result res = sb_probes_parse(edited, size, "edited", SB_SKY_VISIBILITY_CHANNELS, 1000, &got, &back);
-        CHECK(res == SB_ERR_PROBES, "%s: %s", detail_fields[i].what, sb_result_name(res));
-        if (res == SB_OK) {
-            sb_image_finish(&back);
-            sb_probe_layout_finish(&got);
-        }
-    }
+    check_edits(bytes, size, detail_fields, sizeof(detail_fields) / sizeof(detail_fields[0]), SB_ERR_PROBES);
     /* two columns, the second before the first */
     struct sb_probe_column two[2] = {{.x = 2, .z = 1, .y0 = 0, .rows = 1}, {.x = 1, .z = 1, .y0 = 0, .rows = 1}};
     struct sb_image wide = {0};
@@ -1432,32 +1446,14 @@ static void test_probes(void)
     CHECK(strcmp(with_sight, flipped) != 0 && strcmp(with_sight, records) != 0 && !strcmp(without_sight, records),
           "the content hash covers the sight masks, and is the records' without them");
     sb_image_finish(&back);
-    f = fopen(path, "rb");
-    size = f ? fread(bytes, 1, sizeof(bytes), f) : 0;
-    if (f)
-        fclose(f);
+    size = read_back(path, bytes, sizeof(bytes));
     CHECK(size == SB_PROBES_HEADER_BYTES + SB_PROBES_COLUMN_BYTES + sizeof(sight) + (size_t)nd * ch * 4 + 8 &&
               bytes[8] == 4,
           "version 4: size %zu", size);
     check_probes_damage(bytes, size, "sight masks");
-    const struct {
-        size_t offset;
-        uint32_t value;
-        const char *what;
-    } sight_fields[] = {{164, 4, "masks of 4 samples an axis"}, {164, 0, "no mask size"}, {168, 1, "a reserved byte"}};
-    for (size_t i = 0; i < sizeof(sight_fields) / sizeof(sight_fields[0]); i++) {
-        uint8_t edited[4096];
-        memcpy(edited, bytes, size);
-        for (int k = 0; k < 4; k++)
-            edited[sight_fields[i].offset + k] = (uint8_t)(sight_fields[i].value >> (8 * k));
-        restamp(edited, size);
-        enum sb_result res = sb_probes_parse(edited, size, "edited", SB_SKY_VISIBILITY_CHANNELS, 1000, &got, &back);
-        CHECK(res == SB_ERR_PROBES, "%s: %s", sight_fields[i].what, sb_result_name(res));
-        if (res == SB_OK) {
-            sb_image_finish(&back);
-            sb_probe_layout_finish(&got);
-        }
-    }
+    static const struct field_edit sight_fields[] = {
+        {164, 4, "masks of 4 samples an axis"}, {164, 0, "no mask size"}, {168, 1, "a reserved byte"}};
+    check_edits(bytes, size, sight_fields, sizeof(sight_fields) / sizeof(sight_fields[0]), SB_ERR_PROBES);
 
     /* Values as binary16: version 5, with detail and masks or without
      * any; values binary16 does not hold exactly are refused on writing;
@@ -1474,35 +1470,16 @@ static void test_probes(void)
           "binary16 with detail: the round trip is exact");
     sb_probe_layout_finish(&got);
     sb_image_finish(&back);
-    f = fopen(path, "rb");
-    size = f ? fread(bytes, 1, sizeof(bytes), f) : 0;
-    if (f)
-        fclose(f);
+    size = read_back(path, bytes, sizeof(bytes));
     CHECK(size == SB_PROBES_HEADER_BYTES + SB_PROBES_COLUMN_BYTES + sizeof(sight) + (size_t)nd * ch * 2 + 8 &&
               bytes[8] == 5,
           "version 5: size %zu", size);
     check_probes_damage(bytes, size, "binary16 with detail");
-    const struct {
-        size_t offset;
-        uint32_t value;
-        const char *what;
-    } half_fields[] = {{168, 4, "values of 4 bytes in version 5"},
-                       {168, 0, "no value size"},
-                       {172, 1, "a reserved byte"},
-                       {156, 0, "detail fields without columns"}};
-    for (size_t i = 0; i < sizeof(half_fields) / sizeof(half_fields[0]); i++) {
-        uint8_t edited[4096];
-        memcpy(edited, bytes, size);
-        for (int k = 0; k < 4; k++)
-            edited[half_fields[i].offset + k] = (uint8_t)(half_fields[i].value >> (8 * k));
-        restamp(edited, size);
-        enum sb_result res = sb_probes_parse(edited, size, "edited", SB_SKY_VISIBILITY_CHANNELS, 1000, &got, &back);
-        CHECK(res != SB_OK, "%s: %s", half_fields[i].what, sb_result_name(res));
-        if (res == SB_OK) {
-            sb_image_finish(&back);
-            sb_probe_layout_finish(&got);
-        }
-    }
+    static const struct field_edit half_fields[] = {{168, 4, "values of 4 bytes in version 5"},
+                                                    {168, 0, "no value size"},
+                                                    {172, 1, "a reserved byte"},
+                                                    {156, 0, "detail fields without columns"}};
+    check_edits(bytes, size, half_fields, sizeof(half_fields) / sizeof(half_fields[0]), SB_OK);
     struct sb_probe_layout plain = terrain; /* layers, no detail */
     CHECK(sb_image_round_to_half(&layered, &not_half) == SB_OK &&
               sb_probes_write(path, &plain, &layered, true) == SB_OK &&
@@ -1512,18 +1489,11 @@ static void test_probes(void)
           "binary16 without detail: the round trip is exact");
     sb_probe_layout_finish(&got);
     sb_image_finish(&back);
-    f = fopen(path, "rb");
-    size = f ? fread(bytes, 1, sizeof(bytes), f) : 0;
-    if (f)
-        fclose(f);
+    size = read_back(path, bytes, sizeof(bytes));
     CHECK(size == SB_PROBES_HEADER_BYTES + (size_t)nl * ch * 2 + 8 && bytes[8] == 5, "version 5 without detail: %zu",
           size);
     check_probes_damage(bytes, size, "binary16 without detail");
-    uint8_t edited[4096];
-    memcpy(edited, bytes, size);
-    edited[164] = 8;
-    restamp(edited, size);
-    CHECK(sb_probes_parse(edited, size, "edited", SB_SKY_VISIBILITY_CHANNELS, 1000, &got, &back) == SB_ERR_PROBES,
+    CHECK(parse_edited(bytes, size, &(struct field_edit){164, 8, "sight masks without detail"}) == SB_ERR_PROBES,
           "sight masks without detail");
     sb_image_finish(&detailed);
     sb_image_finish(&layered);

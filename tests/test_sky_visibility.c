@@ -342,18 +342,27 @@ static void reconstruction_error(const struct sb_mesh *mesh, const struct sb_emb
     CHECK(sum_sky / samples < 0.07, "the sky's mean irradiance error %.3f", sum_sky / samples);
 }
 
+/* The IFC house on the device, and its bounds (false, checked and
+ * finished, when it does not load). */
+static bool house_ready(struct sb_vk *vk, struct scene *house, float lo[3], float hi[3])
+{
+    if (sb_mesh_load(IFC_HOUSE, NULL, &house->mesh) || !scene_ready(vk, house)) {
+        CHECK(false, "the IFC house");
+        scene_finish(house);
+        return false;
+    }
+    sb_mesh_bounds(&house->mesh, lo, hi);
+    return true;
+}
+
 /* Probes in and around the IFC house against Embree's rays over the same
  * directions, projected in fp64; then determinism and deringing. */
 static void test_house(struct sb_vk *vk)
 {
     struct scene house = {.name = "IFC house"};
-    if (sb_mesh_load(IFC_HOUSE, NULL, &house.mesh) || !scene_ready(vk, &house)) {
-        CHECK(false, "the IFC house");
-        scene_finish(&house);
-        return;
-    }
     float lo[3], hi[3];
-    sb_mesh_bounds(&house.mesh, lo, hi);
+    if (!house_ready(vk, &house, lo, hi))
+        return;
     enum { N = 4 * 4 * 4 };
     float positions[3 * N];
     for (int i = 0; i < N; i++)
@@ -472,13 +481,9 @@ static void test_sight(struct sb_vk *vk)
     scene_finish(&wall);
 
     struct scene house = {.name = "IFC house"};
-    if (sb_mesh_load(IFC_HOUSE, NULL, &house.mesh) || !scene_ready(vk, &house)) {
-        CHECK(false, "the IFC house");
-        scene_finish(&house);
-        return;
-    }
     float lo[3], hi[3];
-    sb_mesh_bounds(&house.mesh, lo, hi);
+    if (!house_ready(vk, &house, lo, hi))
+        return;
     enum { N = 6 * 4 * 6 };
     float lattice[3 * N], positions[3 * N];
     for (int i = 0; i < N; i++)
