@@ -25,6 +25,7 @@ int LLVMFuzzerTestOneInput(const unsigned char *data, size_t size)
         if (image.width > cap || image.channel_count != SB_SKY_VISIBILITY_CHANNEL_COUNT)
             abort();
         sb_image_finish(&image);
+        sb_probe_layout_finish(&layout); /* detail's columns and sight masks */
     }
     return 0;
 }
