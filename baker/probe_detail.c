@@ -163,8 +163,12 @@ static enum sb_result column_surfaces(struct sb_raycaster *rc, const struct latt
     return res;
 }
 
+/* A cap passed: an error, or (under a budget, which coarsens) a note. */
+#define over_cap(budget, ...) sb_log((budget) ? SB_LOG_DEBUG : SB_LOG_ERROR, __VA_ARGS__)
+
 enum sb_result sb_probe_detail_place(struct sb_raycaster *rc, const struct sb_bvh *bvh, const struct sb_level *level,
-                                     const struct sb_probe_params *p, double spacing, struct sb_probe_layout *layout)
+                                     const struct sb_probe_params *p, double spacing, bool budget,
+                                     struct sb_probe_layout *layout)
 {
     layout->columns = NULL;
     layout->column_count = layout->detail_count = 0;
@@ -246,8 +250,8 @@ enum sb_result sb_probe_detail_place(struct sb_raycaster *rc, const struct sb_bv
     for (uint64_t b = 0; b < bricks; b++)
         columns += brick_lo[b] <= brick_hi[b];
     if (columns > SB_PROBES_MAX_COLUMNS) {
-        sb_error("probes: detail %g m apart takes %llu brick columns; at most %u: raise probes.detail_spacing_m, "
-                 "or forbid detail where it is not needed (probes.detail_volumes)",
+        over_cap(budget, "probes: detail %g m apart takes %llu brick columns; at most %u: raise probes.detail_spacing_m, "
+                 "set probes.budget_mb, or forbid detail where it is not needed (probes.detail_volumes)",
                  spacing, (unsigned long long)columns, SB_PROBES_MAX_COLUMNS);
         res = SB_ERR_TOO_LARGE;
         goto done;
@@ -276,8 +280,8 @@ enum sb_result sb_probe_detail_place(struct sb_raycaster *rc, const struct sb_bv
         probes += (uint64_t)(y1 - y0 + 1) * BRICK * BRICK;
     }
     if (probes > SB_PROBES_MAX_COUNT) {
-        sb_error("probes: detail %g m apart takes %llu probes; at most %u: raise probes.detail_spacing_m, or forbid "
-                 "detail where it is not needed (probes.detail_volumes)",
+        over_cap(budget, "probes: detail %g m apart takes %llu probes; at most %u: raise probes.detail_spacing_m, set "
+                 "probes.budget_mb, or forbid detail where it is not needed (probes.detail_volumes)",
                  spacing, (unsigned long long)probes, SB_PROBES_MAX_COUNT);
         res = SB_ERR_TOO_LARGE;
         goto done;

@@ -28,10 +28,12 @@ struct sb_bvh;
  * detail_count; its other fields untouched). Rays are cast through rc,
  * over bvh (whose root bounds the world). SB_ERR_TOO_LARGE, logged, when
  * the lattice would pass SB_PROBES_MAX_LATTICE steps or the columns
- * SB_PROBES_MAX_COLUMNS. None found: column_count 0.
+ * SB_PROBES_MAX_COLUMNS; past the columns' or the probes' cap under a
+ * `budget` (whose caller coarsens) it is logged as a note, not an error.
+ * None found: column_count 0.
  */
 enum sb_result sb_probe_detail_place(struct sb_raycaster *rc, const struct sb_bvh *bvh, const struct sb_level *level,
-                                     const struct sb_probe_params *params, double spacing,
+                                     const struct sb_probe_params *params, double spacing, bool budget,
                                      struct sb_probe_layout *layout);
 
 /* Check, from the scene and its world alone, that the lattice fits its

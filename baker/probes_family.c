@@ -333,16 +333,25 @@ static enum sb_result place_detail(struct probes_state *st, const struct sb_scen
         sb_warn("probes: the grid takes all of probes.budget_mb (%g): no detail", p->budget_mb);
     } else {
         double t0 = sb_now_s();
-        res = sb_probe_detail_place(st->rc, &st->bvh, st->level, p, spacing, &st->detail);
-        uint32_t first = st->detail.detail_count;
+        bool budget = p->budget_mb > 0;
+        res = sb_probe_detail_place(st->rc, &st->bvh, st->level, p, spacing, budget, &st->detail);
+        /* under a budget, past the file's caps is over the budget too */
+        bool capped = budget && res == SB_ERR_TOO_LARGE;
+        char first[64]; /* what the scene's spacing would take */
+        if (capped)
+            snprintf(first, sizeof(first), "more than a probe file holds");
+        else
+            snprintf(first, sizeof(first), "%.3g MB", st->detail.detail_count * per / 1e6);
         double over = 0.0; /* the widest spacing found over the budget */
-        for (int step = 0; step < 100 && !res && st->detail.detail_count * per > left; step++) {
-            /* a surface's bricks go with the spacing's square, a room's with its cube */
-            double ratio = pow(st->detail.detail_count * per / left, 1.0 / 3.0);
+        for (int step = 0; step < 100 && (capped || (!res && st->detail.detail_count * per > left)); step++) {
+            /* a surface's bricks go with the spacing's square, a room's
+             * with its cube; past a cap, the count is not known */
+            double ratio = capped ? 1.5 : pow(st->detail.detail_count * per / left, 1.0 / 3.0);
             over = spacing;
             spacing *= ratio > 1.02 ? ratio : 1.02;
             sb_probe_layout_finish(&st->detail);
-            res = sb_probe_detail_place(st->rc, &st->bvh, st->level, p, spacing, &st->detail);
+            res = sb_probe_detail_place(st->rc, &st->bvh, st->level, p, spacing, budget, &st->detail);
+            capped = budget && res == SB_ERR_TOO_LARGE;
         }
         /* The count is not monotonic in the spacing (brick columns snap to
          * the lattice): between the last spacing over the budget and the
@@ -351,8 +360,10 @@ static enum sb_result place_detail(struct probes_state *st, const struct sb_scen
         for (int step = 0; step < 6 && !res && over > 0.0 && st->detail.detail_count * per <= left; step++) {
             double mid = 0.5 * (over + spacing);
             struct sb_probe_layout trial = {0};
-            res = sb_probe_detail_place(st->rc, &st->bvh, st->level, p, mid, &trial);
-            if (!res && trial.detail_count * per <= left) {
+            enum sb_result r = sb_probe_detail_place(st->rc, &st->bvh, st->level, p, mid, budget, &trial);
+            if (r && r != SB_ERR_TOO_LARGE) {
+                res = r;
+            } else if (!r && trial.detail_count * per <= left) {
                 sb_probe_layout_finish(&st->detail);
                 st->detail = trial;
                 spacing = mid;
@@ -362,9 +373,9 @@ static enum sb_result place_detail(struct probes_state *st, const struct sb_scen
             }
         }
         if (!res && spacing != p->detail_spacing_m)
-            sb_warn("probes: detail %g m apart would take %.3g MB, over what probes.budget_mb (%g) leaves after the "
+            sb_warn("probes: detail %g m apart would take %s, over what probes.budget_mb (%g) leaves after the "
                     "grid (%.3g MB): %.3g m apart instead, %u probes, %.3g MB",
-                    p->detail_spacing_m, first * per / 1e6, p->budget_mb, left / 1e6, spacing, st->detail.detail_count,
+                    p->detail_spacing_m, first, p->budget_mb, left / 1e6, spacing, st->detail.detail_count,
                     st->detail.detail_count * per / 1e6);
         sb_debug("probes: detail placed in %.1f ms", 1e3 * (sb_now_s() - t0));
     }

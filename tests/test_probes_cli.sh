@@ -337,6 +337,16 @@ check "saying the detail was coarsened" grep -q "detail 0.5 m apart would take .
 check "info" expect_exit 0 "$skybake" info "$tmp/room_budget"
 bytes=$(sed -n 's/.*"bytes":\([0-9]*\).*/\1/p' "$tmp/out" | head -n 1)
 check "within the budget ($bytes bytes)" test -n "$bytes" -a "${bytes:-0}" -le 150000
+# A hall 10 m across: 5 cm detail over it would pass a probe file's 2^20
+# probes. Alone, refused, naming the cap; under a budget, coarsened.
+awk '$1 == "v" && NR > 4 { printf "v %g %s %g\n", 2.5 * $2, $3, 2.5 * $4; next } { print }' "$tmp/room.obj" >"$tmp/hall.obj"
+room ',"detail_spacing_m":0.05' | sed 's/room.obj/hall.obj/' >"$tmp/hall.json"
+check "5 cm detail over a 10 m hall is refused" expect_exit 1 "$skybake" bake "$tmp/hall.json" -o "$tmp/hall"
+check "naming the cap" grep -q "detail 0.05 m apart takes [0-9]* probes; at most 1048576" "$tmp/err"
+room ',"detail_spacing_m":0.05,"budget_mb":0.5' | sed 's/room.obj/hall.obj/' >"$tmp/hall_budget.json"
+check "under a budget, baked" expect_exit 0 "$skybake" bake "$tmp/hall_budget.json" -o "$tmp/hall_budget"
+check "saying the detail was coarsened from past the cap" grep -q "detail 0.05 m apart would take more than a probe file holds" "$tmp/err"
+check "no error on the way" sh -c "! grep -q 'error' '$tmp/err'"
 room ',"detail_spacing_m":0.5,"detail_volumes":[{"min_m":[-5,-1,-5],"max_m":[5,10,5],"detail":false}]' >"$tmp/room_forbid.json"
 check "bake the room, detail forbidden" expect_exit 0 "$skybake" bake "$tmp/room_forbid.json" -o "$tmp/room_forbid" -v
 check "no detail" grep -q "(0 in detail)" "$tmp/err"
