@@ -322,7 +322,9 @@ struct importer {
     const struct sb_mesh_load_params *params;
     struct sb_mesh *mesh;
     uint32_t *material_map; /* the file's material -> the mesh's */
-    uint64_t triangles;     /* counted before anything is added */
+    bool *see_through;      /* the file's material lets light through: its triangles are left out */
+    uint64_t see_through_triangles;
+    uint64_t triangles; /* counted before anything is added */
     /* kept as parts (sb_mesh_import_parts): each file mesh's part, -1 none */
     struct sb_mesh_parts *parts;
     int32_t *part_of;
@@ -386,7 +388,12 @@ static enum sb_result add_node(struct importer *im, const struct aiNode *node, c
         const struct aiMesh *am = im->scene->mMeshes[node->mMeshes[i]];
         if (!(am->mPrimitiveTypes & aiPrimitiveType_TRIANGLE) || (im->single_only && im->uses[node->mMeshes[i]] != 1))
             continue;
-        uint32_t material = im->material_map[am->mMaterialIndex < im->scene->mNumMaterials ? am->mMaterialIndex : 0];
+        uint32_t file_material = am->mMaterialIndex < im->scene->mNumMaterials ? am->mMaterialIndex : 0;
+        uint32_t material = im->material_map[file_material];
+        if (im->see_through[file_material]) {
+            im->see_through_triangles += am->mNumFaces;
+            continue;
+        }
         /* tangents where a normal map needs them (assimp's, from the texture coordinates) */
         bool tangents = am->mTangents && am->mBitangents && am->mNormals && am->mTextureCoords[0] &&
                         im->mesh->material_list[material].textures[SB_TEXTURE_NORMAL] >= 0;
@@ -637,7 +644,8 @@ static enum sb_result add_materials(struct importer *im)
         return SB_ERR_TOO_LARGE;
     }
     im->material_map = calloc(count, sizeof(uint32_t));
-    if (!im->material_map)
+    im->see_through = calloc(count, sizeof(bool));
+    if (!im->material_map || !im->see_through)
         return SB_ERR_NOMEM;
     for (unsigned i = 0; i < count; i++) {
         const struct aiMaterial *mat = i < im->scene->mNumMaterials ? im->scene->mMaterials[i] : NULL;
@@ -673,6 +681,15 @@ static enum sb_result add_materials(struct importer *im)
             out->metallic = fminf(fmaxf((float)value, 0.0f), 1.0f);
         if (mat && (res = add_textures(im, mat, out)))
             return res;
+        /* Glass (an opacity under one half, IFC's and OBJ's; or glTF's
+         * transmission over one half) is an opening: the probes' rays and
+         * the sun pass it, and nothing draws it (skybake models no
+         * refraction, and a pane's few per cent of reflection and
+         * absorption are left out) */
+        if (mat && ((aiGetMaterialFloat(mat, AI_MATKEY_OPACITY, &value) == aiReturn_SUCCESS && value < 0.5f) ||
+                    (aiGetMaterialFloat(mat, AI_MATKEY_TRANSMISSION_FACTOR, &value) == aiReturn_SUCCESS &&
+                     value > 0.5f)))
+            im->see_through[i] = true;
     }
     return SB_OK;
 }
@@ -804,12 +821,17 @@ static enum sb_result import(const char *path, const struct sb_mesh_load_params 
     }
     if (res)
         goto done;
+    if (im.see_through_triangles)
+        sb_info("%s: %llu triangles of see-through materials (glass) left out: light passes them as openings", path,
+                (unsigned long long)im.see_through_triangles);
     if (!mesh->triangle_count) {
-        sb_error("%s: no triangle of non-zero area (%u left out as degenerate)", path, mesh->dropped_degenerate);
+        sb_error("%s: no triangle of non-zero area (%u left out as degenerate, %llu as see-through)", path,
+                 mesh->dropped_degenerate, (unsigned long long)im.see_through_triangles);
         res = SB_ERR_MESH;
     }
 done:
     free(im.material_map);
+    free(im.see_through);
     free(im.uses);
     free(im.part_of);
     aiReleaseImport(im.scene);

@@ -744,6 +744,44 @@ static void write_file(const char *path, const char *text)
     }
 }
 
+/* Glass is an opening: the triangles of a material whose opacity is under
+ * one half (an OBJ's d, IFC's transparency) are left out, those of one
+ * over it kept; the IFC house keeps none of its panes ("Glas", 0.12). */
+static void test_glass(void)
+{
+    char dir[256], path[300];
+    CHECK(test_temp_dir("skybake-glass", dir, sizeof(dir)), "temporary directory");
+    snprintf(path, sizeof(path), "%s/panes.mtl", dir);
+    write_file(path, "newmtl wall\nKd 0.5 0.5 0.5\nnewmtl glass\nKd 0.1 0.1 0.1\nd 0.12\n"
+                     "newmtl frosted\nKd 0.8 0.8 0.8\nd 0.6\n");
+    snprintf(path, sizeof(path), "%s/panes.obj", dir);
+    write_file(path, "mtllib panes.mtl\nv 0 0 0\nv 1 0 0\nv 0 1 0\nv 0 0 1\nv 1 0 1\nv 0 1 1\nv 0 0 2\nv 1 0 2\n"
+                     "v 0 1 2\nusemtl wall\nf 1 2 3\nusemtl glass\nf 4 5 6\nusemtl frosted\nf 7 8 9\n");
+    struct sb_mesh m = {0};
+    CHECK(sb_mesh_load(path, NULL, &m) == SB_OK, "panes.obj loads");
+    bool wall = false, frosted = false, glass = false;
+    for (uint32_t t = 0; t < m.triangle_count; t++) {
+        const char *name = m.material_list[m.materials[t]].name;
+        wall |= !strcmp(name, "wall");
+        frosted |= !strcmp(name, "frosted");
+        glass |= !strcmp(name, "glass");
+    }
+    CHECK(m.triangle_count == 2 && wall && frosted && !glass, "the glass pane left out, the rest kept: %u triangles",
+          m.triangle_count);
+    sb_mesh_finish(&m);
+    unlink(path);
+    snprintf(path, sizeof(path), "%s/panes.mtl", dir);
+    unlink(path);
+    rmdir(dir);
+    struct sb_mesh house = {0};
+    CHECK(sb_mesh_load(IFC_HOUSE, NULL, &house) == SB_OK, "the IFC house loads");
+    uint32_t panes = 0;
+    for (uint32_t t = 0; t < house.triangle_count; t++)
+        panes += !strcmp(house.material_list[house.materials[t]].name, "Glas");
+    CHECK(panes == 0, "the IFC house's panes are left out: %u triangles of Glas", panes);
+    sb_mesh_finish(&house);
+}
+
 /* A scene's world from a mesh file: `ground_json` ("" for the default) in
  * its world section, loaded as the baker and skyview load it. */
 static enum sb_result load_scene_world(const char *dir, const char *file, const char *ground_json, struct sb_mesh *m)
@@ -1467,6 +1505,7 @@ int main(void)
 {
     sb_log_set_level(SB_LOG_WARN);
     test_loading();
+    test_glass();
     test_world_file();
     test_ground();
     test_hostile();
