@@ -140,7 +140,7 @@ static enum sb_result bench_one(struct sb_vk *vk, const char *name, struct sb_me
         if (!res)
             res = sb_sky_visibility_bake(rc, positions, count, &params, out, &ms);
         if (!res)
-            res = sb_sky_bounce_bake(rc, &surfaces, positions, NULL, count, &bounce, bounced, &bms);
+            res = sb_sky_bounce_bake(rc, &surfaces, positions, NULL, count, &bounce, bounced, &bms, NULL);
         if (k >= 0) {
             times[k] = ms;
             bounce_times[k] = bms;

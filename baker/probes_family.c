@@ -130,7 +130,9 @@ static void probes_key(void *state, const struct sb_scene *scene, enum sb_produc
     }
     if (id == SB_PRODUCT_SKY_BOUNCE) { /* and the visibility's key, as its input */
         sb_sky_bounce_code_hash(code);
-        sb_key_add(key, " bounce_rays=%u secondary=%u bounce_code %s", p->bounce_rays, p->bounce_secondary, code);
+        /* bounce_sum: the host's sum of the bounces (sky_bounce.c) */
+        sb_key_add(key, " bounce_rays=%u secondary=%u bounces=%u bounce_sum 1 bounce_code %s", p->bounce_rays,
+                   p->bounce_secondary, p->bounces, code);
     }
 }
 
@@ -703,10 +705,13 @@ static enum sb_result bake_bounce(struct probes_state *st, const struct sb_scene
         valid_count += v[SB_SKY_VISIBILITY_VALID] != 0;
     }
     struct sb_sky_bounce_params params = {.ray_count = scene->probes.bounce_rays,
-                                          .secondary = scene->probes.bounce_secondary};
+                                          .secondary = scene->probes.bounce_secondary,
+                                          .bounces = scene->probes.bounces};
+    struct sb_sky_bounce_report report;
     if (!st->surfaces.material_count && (res = sb_surfaces_create_level(st->rc->vk, st->level, &st->surfaces)))
         goto done;
-    if ((res = sb_sky_bounce_bake(st->rc, &st->surfaces, positions, valid, count, &params, out, &a->gpu_ms)) ||
+    if ((res = sb_sky_bounce_bake(st->rc, &st->surfaces, positions, valid, count, &params, out, &a->gpu_ms,
+                                  &report)) ||
         (res = sb_image_init(image, count, 1, SB_SKY_BOUNCE_CHANNEL_COUNT)))
         goto done;
     sb_image_set_channel_names(image, SB_SKY_BOUNCE_CHANNELS);
@@ -718,12 +723,16 @@ static enum sb_result bake_bounce(struct probes_state *st, const struct sb_scene
     }
     snprintf(a->settings_json, sizeof(a->settings_json),
              "{\"rays\":%u,\"secondary\":%u,\"grid\":[%u,%u,%u],\"spacing_m\":%.9g,\"explicit\":%u,"
-             "\"valid\":%u,\"model\":\"one Lambertian bounce; order-1 SH at the probe x order-2 SH of the light at "
-             "the surfaces\"}",
+             "\"valid\":%u,\"bounces\":%u,\"bounces_summed\":%u,\"added_mean\":%.4g,\"added_most\":%.4g,"
+             "\"model\":\"Lambertian bounces; order-1 SH at the probe x order-2 SH of the light at the surfaces; "
+             "bounces past the first lit by the probe's own light\"}",
              params.ray_count, params.secondary, layout->grid[0], layout->grid[1], layout->grid[2],
-             (double)layout->spacing_m[0], layout->explicit_count, valid_count);
-    sb_info("sky_bounce: %u probes (%u valid), %u rays each, %u from each surface hit", count, valid_count,
-            params.ray_count, params.secondary);
+             (double)layout->spacing_m[0], layout->explicit_count, valid_count, params.bounces, report.most_bounces,
+             report.mean_added, report.most_added);
+    sb_info("sky_bounce: %u probes (%u valid), %u rays each, %u from each surface hit; %s%u bounces, which add "
+            "%.1f%% to the first on average, %.1f%% at most",
+            count, valid_count, params.ray_count, params.secondary, params.bounces ? "" : "up to ",
+            report.most_bounces, 100 * report.mean_added, 100 * report.most_added);
 done:
     if (res)
         sb_image_finish(image);

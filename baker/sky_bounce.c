@@ -1,5 +1,7 @@
 #include "sky_bounce.h"
 
+#include <math.h>
+#include <stdlib.h>
 #include <string.h>
 
 #include "log.h"
@@ -17,9 +19,64 @@ struct sb_pipeline_params sb_sky_bounce_kernel(bool instanced)
     };
 }
 
+uint32_t sb_sky_bounce_sum(float *kernel, uint32_t bounces, double *added)
+{
+    enum { K = SB_PROBE_SH, S = SB_BOUNCE_SH };
+    double total[S][K][3], term[S][K][3], next[S][K][3], op[S][S][3];
+    double first = 0, peak = 0;
+    for (int m = 0; m < S; m++) {
+        for (int k = 0; k < K; k++)
+            for (int c = 0; c < 3; c++) {
+                total[m][k][c] = term[m][k][c] = kernel[(m * K + k) * 3 + c];
+                peak = fmax(peak, fabs(term[m][k][c]));
+            }
+        for (int j = 0; j < S; j++)
+            for (int c = 0; c < 3; c++)
+                op[m][j][c] = kernel[SB_BOUNCE_FLOATS + (m * S + j) * 3 + c];
+    }
+    for (int c = 0; c < 3; c++)
+        first += total[0][0][c];
+    uint32_t most = bounces ? bounces : SB_SKY_BOUNCE_MAX, n = 1;
+    /* the next bounce is M times the last, channel by channel */
+    for (; n < most && peak > 0; n++) {
+        double size = 0;
+        for (int m = 0; m < S; m++)
+            for (int k = 0; k < K; k++)
+                for (int c = 0; c < 3; c++) {
+                    double v = 0;
+                    for (int j = 0; j < S; j++)
+                        v += op[m][j][c] * term[j][k][c];
+                    next[m][k][c] = v;
+                    size = fmax(size, fabs(v));
+                }
+        memcpy(term, next, sizeof(term));
+        peak = 0;
+        for (int m = 0; m < S; m++)
+            for (int k = 0; k < K; k++)
+                for (int c = 0; c < 3; c++) {
+                    total[m][k][c] += term[m][k][c];
+                    peak = fmax(peak, fabs(total[m][k][c]));
+                }
+        if (!bounces && size < SB_SKY_BOUNCE_CONVERGED * peak) {
+            n++;
+            break;
+        }
+    }
+    double all = 0;
+    for (int m = 0; m < S; m++)
+        for (int k = 0; k < K; k++)
+            for (int c = 0; c < 3; c++)
+                kernel[(m * K + k) * 3 + c] = (float)total[m][k][c];
+    for (int c = 0; c < 3; c++)
+        all += total[0][0][c];
+    if (added)
+        *added = first > 0 ? all / first - 1.0 : 0.0;
+    return n;
+}
+
 enum sb_result sb_sky_bounce_bake(struct sb_raycaster *rc, const struct sb_surfaces *surfaces, const float *positions,
                                   const float *valid, uint32_t probe_count, const struct sb_sky_bounce_params *params,
-                                  float *out, double *gpu_ms)
+                                  float *out, double *gpu_ms, struct sb_sky_bounce_report *report)
 {
     static const struct sb_sky_bounce_params defaults = {0};
     params = params ? params : &defaults;
@@ -31,18 +88,25 @@ enum sb_result sb_sky_bounce_bake(struct sb_raycaster *rc, const struct sb_surfa
     };
     if (gpu_ms)
         *gpu_ms = 0;
+    if (report)
+        *report = (struct sb_sky_bounce_report){0};
     if (pc.ray_count % SB_PROBE_THREADS || pc.ray_count > SB_PROBE_MAX_RAYS || pc.secondary > SB_PROBE_MAX_RAYS / 2 ||
-        !probe_count || !surfaces->material_count) {
-        sb_error("sky bounce: %u rays and %u from each hit for %u probes (rays: a multiple of %u up to %u)",
-                 pc.ray_count, pc.secondary, probe_count, SB_PROBE_THREADS, SB_PROBE_MAX_RAYS);
+        !probe_count || !surfaces->material_count || params->bounces > SB_SKY_BOUNCE_MAX) {
+        sb_error("sky bounce: %u rays and %u from each hit for %u probes, %u bounces (rays: a multiple of %u up to "
+                 "%u; bounces up to %u)",
+                 pc.ray_count, pc.secondary, probe_count, params->bounces, SB_PROBE_THREADS, SB_PROBE_MAX_RAYS,
+                 SB_SKY_BOUNCE_MAX);
         return SB_ERR_OUT_OF_RANGE;
     }
     struct sb_vk *vk = rc->vk;
     struct sb_buffer probes = {0}, results = {0};
     struct sb_pipeline pipeline = {0};
     const struct sb_pipeline_params pp = sb_sky_bounce_kernel(rc->instanced);
-    enum sb_result res;
-    if ((res = sb_probe_buffers_create(vk, positions, valid, probe_count, SB_BOUNCE_FLOATS, &probes, &results)) ||
+    float *kernel = malloc((size_t)probe_count * SB_BOUNCE_KERNEL_FLOATS * sizeof(float));
+    enum sb_result res = kernel ? SB_OK : SB_ERR_NOMEM;
+    if (res ||
+        (res = sb_probe_buffers_create(vk, positions, valid, probe_count, SB_BOUNCE_KERNEL_FLOATS, &probes,
+                                       &results)) ||
         (res = sb_pipeline_create(vk, &pp, &pipeline)))
         goto done;
     const struct sb_buffer *bindings[SB_BOUNCE_BINDING_COUNT] = {
@@ -53,8 +117,26 @@ enum sb_result sb_sky_bounce_bake(struct sb_raycaster *rc, const struct sb_surfa
     };
     sb_surfaces_bindings(surfaces, &bindings[SB_BOUNCE_BINDING_SURFACE]);
     sb_pipeline_bind(vk, &pipeline, bindings);
-    res = sb_probe_kernel_run(vk, &pipeline, &pc, probe_count, &results, out, gpu_ms);
+    if ((res = sb_probe_kernel_run(vk, &pipeline, &pc, probe_count, &results, kernel, gpu_ms)))
+        goto done;
+    uint32_t counted = 0;
+    double sum = 0;
+    for (uint32_t i = 0; i < probe_count; i++) {
+        float *k = &kernel[(size_t)i * SB_BOUNCE_KERNEL_FLOATS];
+        double added;
+        uint32_t n = sb_sky_bounce_sum(k, params->bounces, &added);
+        memcpy(&out[(size_t)i * SB_BOUNCE_FLOATS], k, SB_BOUNCE_FLOATS * sizeof(float));
+        if (report && (!valid || valid[i] != 0)) {
+            report->most_bounces = n > report->most_bounces ? n : report->most_bounces;
+            report->most_added = fmax(report->most_added, added);
+            sum += added;
+            counted++;
+        }
+    }
+    if (report && counted)
+        report->mean_added = sum / counted;
 done:
+    free(kernel);
     sb_pipeline_destroy(vk, &pipeline);
     sb_buffer_destroy(vk, &results);
     sb_buffer_destroy(vk, &probes);

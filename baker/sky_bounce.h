@@ -6,8 +6,14 @@
  * sky L (SH) and sun (direction s, irradiance E): the radiance bounced
  * toward the probe is, in the order-1 SH of w,
  *   b_m = sum_k B[m][k] (L_k + E Y_k(s)).
- * Lambertian surfaces, one bounce; the surfaces' own sky visibility is
- * cast from each hit. Deterministic: fixed ray sets, a fixed sum order.
+ * Lambertian surfaces; the surfaces' own sky visibility is cast from each
+ * hit. Every bounce: the light the probe's surfaces send it lights them
+ * again as it arrives at the probe (the probe's own field stands for
+ * theirs, as DDGI's recursion does with its probes), so B becomes
+ * B1 + M B1 + M M B1 + ..., M the kernel's 4 x 4 operator on order-1
+ * light (config.h); summed until a bounce adds under
+ * SB_SKY_BOUNCE_CONVERGED of the light so far, or a stated count.
+ * Deterministic: fixed ray sets, a fixed sum order, the sums in fp64.
  */
 #ifndef SB_BAKER_SKY_BOUNCE_H
 #define SB_BAKER_SKY_BOUNCE_H
@@ -16,12 +22,24 @@
 
 #include "mesh.h"
 #include "raycast.h"
+#include "scene.h"
 #include "surfaces.h"
 
 struct sb_sky_bounce_params {
     uint32_t ray_count; /* rays a probe, a multiple of SB_PROBE_THREADS [256] */
     uint32_t secondary; /* about this many rays from each hit (a 2x spherical set, half cast) [64] */
     float tmin_m;       /* rays start this far from the probe [1e-4] */
+    uint32_t bounces;   /* 1: one bounce; 0: until converged [0] */
+};
+
+#define SB_SKY_BOUNCE_CONVERGED 1e-3 /* a bounce adding less ends the sum */
+#define SB_SKY_BOUNCE_MAX SB_PROBES_MAX_BOUNCES /* bounces at most (scene.h) */
+
+/* What the bounces past the first added, over the valid probes. */
+struct sb_sky_bounce_report {
+    uint32_t most_bounces; /* the most any probe took */
+    double mean_added;     /* their light over the first bounce's, mean (the mean channel's constant band) */
+    double most_added;     /* and the most */
 };
 
 /* The kernel sb_sky_bounce_bake makes, for a BVH of instances or not. */
@@ -33,11 +51,20 @@ struct sb_pipeline_params sb_sky_bounce_kernel(bool instanced);
  * probe_count] (config.h: m, then k, then rgb). `surfaces` are what the
  * BVH's triangles are (their albedos and textures: the same meshes'). A
  * hit's albedo is its texture's at the ray cone's footprint (surface.glsl).
- * *gpu_ms (may be NULL) gets the GPU time.
+ * *gpu_ms (may be NULL) gets the GPU time, *report (may be NULL) what the
+ * bounces past the first added.
  */
 enum sb_result sb_sky_bounce_bake(struct sb_raycaster *raycaster, const struct sb_surfaces *surfaces,
-                                  const float *positions, const float *valid, uint32_t probe_count, const struct sb_sky_bounce_params *params,
-                                  float *out, double *gpu_ms);
+                                  const float *positions, const float *valid, uint32_t probe_count,
+                                  const struct sb_sky_bounce_params *params, float *out, double *gpu_ms,
+                                  struct sb_sky_bounce_report *report);
+
+/* Sum the bounces of one probe in place: `kernel` holds the kernel's
+ * SB_BOUNCE_KERNEL_FLOATS (B1, then M); its first SB_BOUNCE_FLOATS become
+ * B1 + M B1 + ... to `bounces` terms (0: until converged). Returns the
+ * bounces summed; *added (may be NULL) the light past the first's over
+ * the first's (constant band, channels summed; 0 where B1's is 0). */
+uint32_t sb_sky_bounce_sum(float *kernel, uint32_t bounces, double *added);
 
 /* XXH3-128 of the kernel's SPIR-V (and the texture mips'), for bake keys. */
 void sb_sky_bounce_code_hash(char out[33]);

@@ -103,6 +103,7 @@ struct sb_world_params {
 
 /* The scene's "probes": where the sky-visibility probes go. */
 #define SB_PROBES_MAX_EXPLICIT 256
+#define SB_PROBES_MAX_BOUNCES 64 /* probes.bounces (baker/sky_bounce.h's SB_SKY_BOUNCE_MAX) */
 /* A grid that follows the surface has at most this many layers (probes.h). */
 #define SB_PROBES_MAX_LAYERS 8
 /* Detail volumes a scene may give. */
@@ -137,6 +138,7 @@ struct sb_probe_params {
     double budget_mb;
     uint32_t bounce_rays;      /* sky_bounce: rays a probe for the surfaces it sees, a multiple of 64 [256] */
     uint32_t bounce_secondary; /* sky_bounce: rays from each surface hit, a multiple of 8 [64] */
+    uint32_t bounces;          /* sky_bounce: 1 to SB_PROBES_MAX_BOUNCES bounces, 0 every one [0] */
     int explicit_count;
     double positions_m[SB_PROBES_MAX_EXPLICIT][3];
 };

@@ -90,8 +90,8 @@ static enum sb_result probes_section_parse(const cJSON *obj, struct sb_scene *sc
 {
     static const char *const keys[] = {
         "spacing_m",   "margin_m",         "bounds_m", "rays",      "inside_fraction",  "positions_m",
-        "bounce_rays", "bounce_secondary", "layers_m", "budget_mb", "detail_spacing_m", "detail_volumes",
-        NULL};
+        "bounce_rays", "bounce_secondary", "bounces",  "layers_m",  "budget_mb",        "detail_spacing_m",
+        "detail_volumes", NULL};
     struct sb_probe_params *p = &scene->probes;
     sb_probe_params_default(p);
     scene->has_probes = true;
@@ -141,7 +141,8 @@ static enum sb_result probes_section_parse(const cJSON *obj, struct sb_scene *sc
         double lo, hi, multiple;
         uint32_t *out;
     } counts[] = {{"bounce_rays", 64, 4096, 64, &p->bounce_rays},
-                  {"bounce_secondary", 8, 1024, 8, &p->bounce_secondary}};
+                  {"bounce_secondary", 8, 1024, 8, &p->bounce_secondary},
+                  {"bounces", 0, SB_PROBES_MAX_BOUNCES, 1, &p->bounces}};
     for (size_t i = 0; i < sizeof(counts) / sizeof(counts[0]) && !res; i++) {
         if (!(item = cJSON_GetObjectItemCaseSensitive(obj, counts[i].key)))
             continue;
@@ -223,6 +224,8 @@ static cJSON *probes_section_json(const struct sb_scene *scene)
     if (scene->wants[SB_PRODUCT_SKY_BOUNCE]) { /* only then: scenes without keep their hash */
         cJSON_AddNumberToObject(o, "bounce_rays", p->bounce_rays);
         cJSON_AddNumberToObject(o, "bounce_secondary", p->bounce_secondary);
+        if (p->bounces) /* only when given: 0 is every bounce */
+            cJSON_AddNumberToObject(o, "bounces", p->bounces);
     }
     if (p->budget_mb > 0) /* only when given: scenes without keep their hash */
         cJSON_AddNumberToObject(o, "budget_mb", p->budget_mb);

@@ -344,6 +344,13 @@ struct sb_texture_mips_push {
 #define SB_BOUNCE_BINDING_COUNT (SB_BOUNCE_BINDING_SURFACE + SB_SURFACE_BINDING_COUNT)
 #define SB_BOUNCE_SH 4 /* order 1 at the probe */
 #define SB_BOUNCE_FLOATS (SB_BOUNCE_SH * SB_PROBE_SH * 3)
+/* After each probe's SB_BOUNCE_FLOATS the kernel writes the bounce's
+ * operator on the probe's own light, M[m][j] rgb (m, j < 4): the radiance
+ * the surfaces its rays hit send back toward it in the order-1 SH of w,
+ * lit by a radiance b_j (order-1 SH) arriving at them as it arrives at the
+ * probe; baker/sky_bounce.c sums the bounces B + M B + M M B + ... */
+#define SB_BOUNCE_OPERATOR_FLOATS (SB_BOUNCE_SH * SB_BOUNCE_SH * 3)
+#define SB_BOUNCE_KERNEL_FLOATS (SB_BOUNCE_FLOATS + SB_BOUNCE_OPERATOR_FLOATS)
 
 /* skyview's probes buffer (probes.glsl, SB_VIEW_BINDING_PROBES): after
  * struct sb_probes_gpu, SB_PROBE_VEC4S vec4s a probe: (position m, valid),

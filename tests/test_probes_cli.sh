@@ -111,6 +111,11 @@ check "108 channels" grep -q '"channels":[[:space:]]*"bounce.0.0.r,.*bounce.3.8.
 sed -i 's/"bounce_secondary":16/"bounce_secondary":24/' "$tmp/b.json"
 check "other bounce settings" expect_exit 0 "$skybake" bake "$tmp/b.json" -o "$tmp/p"
 check "rebake the bounce alone" sh -c "grep -q 'sky_visibility.*reused' '$tmp/err' && ! grep -q 'sky_bounce.*reused' '$tmp/err'"
+check "every bounce by default, saying how many were summed" sh -c "tr -d '[:space:]' <'$tmp/p/manifest.json' | grep -q '\"bounces\":0,\"bounces_summed\":[1-9]'"
+sed -i 's/"bounce_secondary":24/"bounce_secondary":24,"bounces":1/' "$tmp/b.json"
+check "one bounce" expect_exit 0 "$skybake" bake "$tmp/b.json" -o "$tmp/p"
+check "rebakes the bounce alone" sh -c "grep -q 'sky_visibility.*reused' '$tmp/err' && ! grep -q 'sky_bounce.*reused' '$tmp/err'"
+check "its settings say one" sh -c "tr -d '[:space:]' <'$tmp/p/manifest.json' | grep -q '\"bounces\":1,\"bounces_summed\":1,\"added_mean\":0,'"
 check "the bounce alone asks for the visibility" sh -c "printf '{\"atmosphere\":{\"preset\":\"earth\"},\"products\":[\"sky_bounce\"],\"world\":{\"file\":\"world.obj\"},\"probes\":{\"spacing_m\":4,\"rays\":64,\"bounce_rays\":64,\"bounce_secondary\":8}}' >'$tmp/bo.json' && '$skybake' bake '$tmp/bo.json' -o '$tmp/bo' -q && test -s '$tmp/bo/sky_visibility.sbprobes'"
 check "the bounce's settings only in scenes that ask for it" sh -c "grep -q bounce_rays '$tmp/bo/manifest.json' && ! grep -q bounce_rays '$tmp/q/manifest.json'"
 
@@ -137,7 +142,7 @@ check "the old pack is whole" diff -r "$tmp/p" "$tmp/before"
 printf '{"atmosphere":{"preset":"earth"},"products":["sky_visibility"]}' >"$tmp/noworld.json"
 check "sky_visibility without a world is a scene error" expect_exit 2 "$skybake" bake "$tmp/noworld.json" -o "$tmp/n"
 check "it says what is missing" grep -q "needs a \"world\"" "$tmp/err"
-for bad in '"bounce_rays":100' '"bounce_secondary":3' '"bounds_m":[[0,0,0],[1,1]]' '"bounds_m":[[0,0,0],[1,-1,1]]' '"bounds_m":[[0,0,0],[1,1,2e4]]' \
+for bad in '"bounce_rays":100' '"bounce_secondary":3' '"bounces":65' '"bounces":-1' '"bounces":1.5' '"bounds_m":[[0,0,0],[1,1]]' '"bounds_m":[[0,0,0],[1,-1,1]]' '"bounds_m":[[0,0,0],[1,1,2e4]]' \
     '"spacing_m":-1' '"rays":100' '"rays":1e9' '"inside_fraction":2' '"positions_m":[[1,2]]' '"nope":1' '"spacing_m":0'; do
     printf '{"atmosphere":{"preset":"earth"},"products":["sky_visibility"],"world":{"file":"world.obj"},"probes":{%s}}' "$bad" >"$tmp/bad.json"
     check "probes {$bad} is a scene error" expect_exit 2 "$skybake" bake "$tmp/bad.json" -o "$tmp/n"

@@ -8,8 +8,11 @@
 // surface's side is cast; summed as B[m][k] += 4 pi / n Y_m(w) rho / pi g_k
 // over the probe's rays w. A runtime relights it for any environment L and
 // sun: the radiance bounced toward the probe from w is sum_k B[m][k] L_k
-// (and E_sun sum_k B[m][k] Y_k(sun)) in the order-1 SH of w. One workgroup
-// a probe; partial sums added in a fixed tree order.
+// (and E_sun sum_k B[m][k] Y_k(sun)) in the order-1 SH of w. With it, the
+// operator of the next bounces (config.h): M[m][j] += 4 pi / n Y_m(w)
+// rho / pi A_j Y_j(n), the irradiance at the hit of an order-1 radiance
+// b_j (A_j the clamped cosine's pi, 2 pi / 3) sent back toward the probe.
+// One workgroup a probe; partial sums added in a fixed tree order.
 #extension GL_GOOGLE_include_directive : require
 #include "config.h"
 
@@ -37,9 +40,13 @@ void main()
     vec3 origin = probes[probe].xyz;
     bool valid = probes[probe].w != 0.0;
     vec3 acc[SB_BOUNCE_SH][SB_PROBE_SH];
-    for (int m = 0; m < SB_BOUNCE_SH; m++)
+    vec3 op[SB_BOUNCE_SH][SB_BOUNCE_SH];
+    for (int m = 0; m < SB_BOUNCE_SH; m++) {
         for (int k = 0; k < SB_PROBE_SH; k++)
             acc[m][k] = vec3(0.0);
+        for (int j = 0; j < SB_BOUNCE_SH; j++)
+            op[m][j] = vec3(0.0);
+    }
     uint sphere = 2u * pc.secondary;
     float spread = sqrt(12.566370614359172 / float(pc.ray_count)); // a ray's cone, radians
     for (uint r = lane; r < pc.ray_count && valid; r += SB_PROBE_THREADS) {
@@ -80,6 +87,12 @@ void main()
         for (int m = 0; m < SB_BOUNCE_SH; m++)
             for (int k = 0; k < SB_PROBE_SH; k++)
                 acc[m][k] += (ym[m] * g[k]) * weight;
+        float yn[SB_PROBE_SH];
+        sh9_basis(n, yn);
+        vec3 lambert = rho * 0.3183098861837907; // rho / pi
+        for (int m = 0; m < SB_BOUNCE_SH; m++)
+            for (int j = 0; j < SB_BOUNCE_SH; j++)
+                op[m][j] += (ym[m] * (j == 0 ? 3.141592653589793 : 2.0943951023931953) * yn[j]) * lambert;
     }
     float scale = 12.566370614359172 / float(pc.ray_count);
     for (int m = 0; m < SB_BOUNCE_SH; m++) {
@@ -95,7 +108,24 @@ void main()
         }
         if (lane == 0)
             for (int j = 0; j < SB_PROBE_SH * 3; j++)
-                results[probe * SB_BOUNCE_FLOATS + m * SB_PROBE_SH * 3 + j] = partial[j][0] * scale;
+                results[probe * SB_BOUNCE_KERNEL_FLOATS + m * SB_PROBE_SH * 3 + j] = partial[j][0] * scale;
+        barrier();
+    }
+    for (int m = 0; m < SB_BOUNCE_SH; m++) {
+        for (int j = 0; j < SB_BOUNCE_SH; j++)
+            for (int c = 0; c < 3; c++)
+                partial[3 * j + c][lane] = op[m][j][c];
+        barrier();
+        for (uint stride = SB_PROBE_THREADS / 2; stride > 0; stride /= 2) {
+            if (lane < stride)
+                for (int j = 0; j < SB_BOUNCE_SH * 3; j++)
+                    partial[j][lane] += partial[j][lane + stride];
+            barrier();
+        }
+        if (lane == 0)
+            for (int j = 0; j < SB_BOUNCE_SH * 3; j++)
+                results[probe * SB_BOUNCE_KERNEL_FLOATS + SB_BOUNCE_FLOATS + m * SB_BOUNCE_SH * 3 + j] =
+                    partial[j][0] * scale;
         barrier();
     }
 }
