@@ -6,6 +6,7 @@
 #include <string.h>
 
 #include "atmosphere_ref.h"
+#include "splitmix.h"
 
 #define PT_PI 3.14159265358979323846
 #define MAX_CUTS 128
@@ -19,18 +20,10 @@ struct rng {
     uint64_t s[4];
 };
 
-static uint64_t splitmix64(uint64_t *x)
-{
-    uint64_t z = (*x += 0x9e3779b97f4a7c15ull);
-    z = (z ^ (z >> 30)) * 0xbf58476d1ce4e5b9ull;
-    z = (z ^ (z >> 27)) * 0x94d049bb133111ebull;
-    return z ^ (z >> 31);
-}
-
 static uint64_t mix(uint64_t h, uint64_t v)
 {
     uint64_t x = h ^ v;
-    return splitmix64(&x);
+    return sb_splitmix64(&x);
 }
 
 static uint64_t double_bits(double d)
@@ -43,7 +36,7 @@ static uint64_t double_bits(double d)
 static void rng_seed(struct rng *g, uint64_t stream)
 {
     for (int i = 0; i < 4; i++)
-        g->s[i] = splitmix64(&stream);
+        g->s[i] = sb_splitmix64(&stream);
 }
 
 static uint64_t rotl(uint64_t x, int k)

@@ -5,6 +5,7 @@
 #include <string.h>
 
 #include "sh.h"
+#include "splitmix.h"
 
 /* A path: where it goes next, what it carries, what it has gathered. */
 struct path {
@@ -15,19 +16,6 @@ struct path {
     uint32_t surfaces; /* met so far */
     bool alive, direct; /* direct: its first ray saw the sky */
 };
-
-static uint64_t splitmix(uint64_t *s)
-{
-    uint64_t z = (*s += 0x9e3779b97f4a7c15ull);
-    z = (z ^ (z >> 30)) * 0xbf58476d1ce4e5b9ull;
-    z = (z ^ (z >> 27)) * 0x94d049bb133111ebull;
-    return z ^ (z >> 31);
-}
-
-static double uniform(uint64_t *s)
-{
-    return (double)(splitmix(s) >> 11) * 0x1p-53;
-}
 
 void sb_bounce_ref_normal(int i, double n[3])
 {
@@ -46,7 +34,7 @@ static void cosine_about(const double n[3], uint64_t *rng, double d[3])
     double sign = copysign(1.0, n[2]), a = -1.0 / (sign + n[2]), b = n[0] * n[1] * a;
     double t[3] = {1.0 + sign * n[0] * n[0] * a, sign * b, -sign * n[0]};
     double u[3] = {b, sign + n[1] * n[1] * a, -n[1]};
-    double r1 = uniform(rng), r2 = uniform(rng), r = sqrt(r1), phi = 2 * M_PI * r2, z = sqrt(fmax(0.0, 1 - r1));
+    double r1 = sb_splitmix_uniform(rng), r2 = sb_splitmix_uniform(rng), r = sqrt(r1), phi = 2 * M_PI * r2, z = sqrt(fmax(0.0, 1 - r1));
     for (int k = 0; k < 3; k++)
         d[k] = r * cos(phi) * t[k] + r * sin(phi) * u[k] + z * n[k];
 }
@@ -87,7 +75,7 @@ static bool trace_point(const struct sb_mesh *mesh, const struct sb_embree *e, c
     for (uint32_t i = 0; ok && i < paths; i++) {
         struct path *q = &p[i];
         q->rng = seed ^ (0x632be59bd9b4e019ull * (i + 1));
-        double z = 1 - 2 * uniform(&q->rng), phi = 2 * M_PI * uniform(&q->rng), r = sqrt(fmax(0.0, 1 - z * z));
+        double z = 1 - 2 * sb_splitmix_uniform(&q->rng), phi = 2 * M_PI * sb_splitmix_uniform(&q->rng), r = sqrt(fmax(0.0, 1 - z * z));
         double d[3] = {r * cos(phi), z, r * sin(phi)};
         memcpy(q->origin, point, sizeof(q->origin));
         memcpy(q->dir, d, sizeof(q->dir));
@@ -159,7 +147,7 @@ static bool trace_point(const struct sb_mesh *mesh, const struct sb_embree *e, c
             /* past the second surface, Russian roulette on the albedo */
             double keep = fmin(0.95, fmax(rho[0], fmax(rho[1], rho[2])));
             if (q->surfaces >= 2) {
-                if (uniform(&q->rng) >= keep)
+                if (sb_splitmix_uniform(&q->rng) >= keep)
                     q->alive = false;
                 else
                     for (int c = 0; c < 3; c++)

@@ -12,6 +12,7 @@
 #include "load.h"
 #include "log.h"
 #include "scene.h"
+#include "splitmix.h"
 #include "world_file.h"
 
 /* A file a world file places, where: its unique entry, its placement in
@@ -142,19 +143,6 @@ static enum sb_result add_parts(struct loader *ld, uint32_t self, const struct s
     return SB_OK;
 }
 
-static uint64_t splitmix(uint64_t *state)
-{
-    uint64_t z = (*state += 0x9e3779b97f4a7c15ull);
-    z = (z ^ (z >> 30)) * 0xbf58476d1ce4e5b9ull;
-    z = (z ^ (z >> 27)) * 0x94d049bb133111ebull;
-    return z ^ (z >> 31);
-}
-
-static double uniform(uint64_t *state)
-{
-    return (double)(splitmix(state) >> 11) * 0x1.0p-53;
-}
-
 static enum sb_result resolve(struct loader *ld, const char *path, uint32_t depth, const char *named_by,
                               uint32_t *out);
 
@@ -200,10 +188,10 @@ static void scatter(const struct sb_bvh *surface, const struct sb_world_file_ref
     uint64_t state = r->seed * 0x2545f4914f6cdd1dull + 1;
     uint32_t missed = 0;
     for (uint32_t i = 0; i < r->count; i++) {
-        double x = r->area_m[0] + uniform(&state) * (r->area_m[2] - r->area_m[0]);
-        double z = r->area_m[1] + uniform(&state) * (r->area_m[3] - r->area_m[1]);
-        double yaw = 360.0 * uniform(&state);
-        double s = r->scale_range[0] + uniform(&state) * (r->scale_range[1] - r->scale_range[0]);
+        double x = r->area_m[0] + sb_splitmix_uniform(&state) * (r->area_m[2] - r->area_m[0]);
+        double z = r->area_m[1] + sb_splitmix_uniform(&state) * (r->area_m[3] - r->area_m[1]);
+        double yaw = 360.0 * sb_splitmix_uniform(&state);
+        double s = r->scale_range[0] + sb_splitmix_uniform(&state) * (r->scale_range[1] - r->scale_range[0]);
         float o[3] = {(float)x, (float)SB_MESH_MAX_EXTENT_M, (float)z}, d[3] = {0, -1, 0};
         struct sb_hit hit;
         double y = 0.0;

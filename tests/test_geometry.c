@@ -27,6 +27,7 @@
 #include "log.h"
 #include "load.h"
 #include "mesh.h"
+#include "splitmix.h"
 #include "raycast.h"
 #include "scene.h"
 #include "shapes.h"
@@ -66,11 +67,7 @@ static uint64_t rng = 0x9e3779b97f4a7c15ull;
 
 static double uniform(void)
 {
-    uint64_t z = (rng += 0x9e3779b97f4a7c15ull);
-    z = (z ^ (z >> 30)) * 0xbf58476d1ce4e5b9ull;
-    z = (z ^ (z >> 27)) * 0x94d049bb133111ebull;
-    z ^= z >> 31;
-    return (z >> 11) * 0x1.0p-53;
+    return sb_splitmix_uniform(&rng);
 }
 
 static void random_direction(float d[3])
