@@ -42,7 +42,7 @@ static void usage(FILE *f)
                "       skybake info PACK [--json]\n"
                "       skybake verify PACK [--json]\n"
                "       skybake diff A B [--tol REL] [--floor F] [--json]\n"
-               "       skybake preview PACK OUT.png\n"
+               "       skybake preview PACK OUT.png [--probes]\n"
                "       skybake --version | --help\n"
                "\n"
                "Bakes what SCENE (JSON, see docs/scene.md) needs into the pack OUT_DIR:\n"
@@ -117,7 +117,11 @@ static void usage(FILE *f)
                "\n"
                "preview: a contact sheet of PACK's reflection cubes as a PNG: a block a\n"
                "cube, a row a mip (sharp to rough), the six faces as stored (+x -x +y -y\n"
-               "+z -z), one exposure for the sheet. Exit 2 if the pack has no cubes.\n"
+               "+z -z), one exposure for the sheet. With --probes, or for a pack with\n"
+               "sky_visibility and no cubes, the probe layout from above (north, -z, up):\n"
+               "grid probes white, detail probes amber over their brick columns (blue),\n"
+               "explicit ones green, each as bright as the sky it sees, invalid ones red.\n"
+               "Exit 2 if the pack has neither.\n"
                "\n"
                "environment: SKYBAKE_VALIDATE=1 as --validate; SKYBAKE_PIPELINE_STATS=1 logs\n"
                "each compute kernel's registers and memory as the driver reports them (on\n"
@@ -516,8 +520,14 @@ static int cmd_verify(int argc, char **argv)
 static int cmd_preview(int argc, char **argv)
 {
     const char *args[2];
-    bool json = false;
-    if (!pack_args(argc, argv, "preview", args, 2, &json, NULL, NULL))
+    bool json = false, probes = false;
+    int kept = 0;
+    for (int i = 0; i < argc; i++) /* preview's own option, then the common ones */
+        if (!strcmp(argv[i], "--probes"))
+            probes = true;
+        else
+            argv[kept++] = argv[i];
+    if (!pack_args(kept, argv, "preview", args, 2, &json, NULL, NULL))
         return EXIT_USAGE;
     struct sb_pack pack;
     enum sb_result res = sb_pack_open(args[0], &pack);
@@ -525,7 +535,11 @@ static int cmd_preview(int argc, char **argv)
         sb_error("%s: not a valid pack (%s)", args[0], sb_result_name(res));
         return EXIT_USAGE;
     }
-    res = sb_pack_contact_sheet(&pack, args[1]);
+    /* the probe map when asked for, or when the pack has no cubes */
+    if (probes || (!pack.present[SB_PRODUCT_REFLECTION_CUBES] && pack.present[SB_PRODUCT_SKY_VISIBILITY]))
+        res = sb_pack_probe_map(&pack, args[1]);
+    else
+        res = sb_pack_contact_sheet(&pack, args[1]);
     sb_pack_close(&pack);
     if (res)
         return res == SB_ERR_USAGE ? EXIT_USAGE : EXIT_BAKE_FAILED;

@@ -350,3 +350,95 @@ enum sb_result sb_pack_contact_sheet(const struct sb_pack *pack, const char *png
     free(rgba);
     return res;
 }
+
+/* The probe map's canvas: the probes' footprint in x and z, MAP_SIDE
+ * pixels along its longer side, north (-z) up. */
+#define MAP_SIDE 1024
+struct map {
+    uint32_t width, height;
+    double x0, z0, scale; /* pixels per m */
+    uint8_t *rgba;
+};
+
+static void map_put(struct map *m, double x, double z, int radius, const uint8_t colour[3])
+{
+    int64_t cx = (int64_t)floor((x - m->x0) * m->scale), cy = (int64_t)floor((z - m->z0) * m->scale);
+    for (int64_t y = cy - radius; y <= cy + radius; y++)
+        for (int64_t px = cx - radius; px <= cx + radius; px++)
+            if (px >= 0 && y >= 0 && px < m->width && y < m->height)
+                memcpy(&m->rgba[4 * ((size_t)y * m->width + (size_t)px)], colour, 3);
+}
+
+/* A probe's colour: its kind's, as bright as the sky it sees (the constant
+ * band over its largest, 2 sqrt(pi)); red when invalid. */
+static void probe_colour(const float *record, const uint8_t tint[3], uint8_t out[3])
+{
+    static const uint8_t invalid[3] = {230, 40, 40};
+    if (record[SB_SKY_VISIBILITY_VALID] == 0) {
+        memcpy(out, invalid, 3);
+        return;
+    }
+    double open = record[SB_SKY_VISIBILITY_SH] / (2 * sqrt(M_PI));
+    open = open < 0 ? 0 : open > 1 ? 1 : open;
+    for (int k = 0; k < 3; k++)
+        out[k] = (uint8_t)(tint[k] * (0.3 + 0.7 * open));
+}
+
+enum sb_result sb_pack_probe_map(const struct sb_pack *pack, const char *png_path)
+{
+    if (!pack->present[SB_PRODUCT_SKY_VISIBILITY] || !pack->images[SB_PRODUCT_SKY_VISIBILITY].width) {
+        sb_error("%s: the pack has no sky_visibility probes to draw", png_path);
+        return SB_ERR_USAGE;
+    }
+    const struct sb_image *img = &pack->images[SB_PRODUCT_SKY_VISIBILITY];
+    const struct sb_probe_layout *l = &pack->artifacts[SB_PRODUCT_SKY_VISIBILITY].probes;
+    uint64_t count = img->width, grid = (uint64_t)l->grid[0] * l->grid[1] * l->grid[2];
+    const size_t stride = SB_SKY_VISIBILITY_CHANNEL_COUNT;
+    double lo[2] = {INFINITY, INFINITY}, hi[2] = {-INFINITY, -INFINITY};
+    for (uint64_t i = 0; i < count; i++) {
+        const float *r = &img->data[i * stride + SB_SKY_VISIBILITY_POSITION];
+        lo[0] = fmin(lo[0], r[0]), hi[0] = fmax(hi[0], r[0]);
+        lo[1] = fmin(lo[1], r[2]), hi[1] = fmax(hi[1], r[2]);
+    }
+    double pad = 0.02 * fmax(fmax(hi[0] - lo[0], hi[1] - lo[1]), 1.0), w = hi[0] - lo[0] + 2 * pad,
+           h = hi[1] - lo[1] + 2 * pad;
+    struct map m = {.x0 = lo[0] - pad, .z0 = lo[1] - pad, .scale = MAP_SIDE / fmax(w, h)};
+    m.width = (uint32_t)fmax(64, ceil(w * m.scale));
+    m.height = (uint32_t)fmax(64, ceil(h * m.scale));
+    m.rgba = malloc((size_t)m.width * m.height * 4);
+    if (!m.rgba)
+        return SB_ERR_NOMEM;
+    for (size_t i = 0; i < (size_t)m.width * m.height; i++) {
+        m.rgba[4 * i] = m.rgba[4 * i + 1] = m.rgba[4 * i + 2] = 24;
+        m.rgba[4 * i + 3] = 255;
+    }
+    /* the detail's brick columns, a dark blue ground under their probes */
+    static const uint8_t column[3] = {24, 44, 84}, white[3] = {255, 255, 255}, amber[3] = {255, 176, 48},
+                         green[3] = {60, 220, 90};
+    double brick = l->detail_spacing_m * SB_PROBES_BRICK;
+    for (uint32_t c = 0; c < l->column_count && l->detail_count; c++) {
+        double x = l->detail_origin_m[0] + l->columns[c].x * brick, z = l->detail_origin_m[2] + l->columns[c].z * brick;
+        int64_t px0 = (int64_t)ceil((x - m.x0) * m.scale), px1 = (int64_t)ceil((x + brick - m.x0) * m.scale);
+        int64_t py0 = (int64_t)ceil((z - m.z0) * m.scale), py1 = (int64_t)ceil((z + brick - m.z0) * m.scale);
+        for (int64_t py = py0 < 0 ? 0 : py0; py < py1 && py < m.height; py++)
+            for (int64_t px = px0 < 0 ? 0 : px0; px < px1 && px < m.width; px++)
+                memcpy(&m.rgba[4 * ((size_t)py * m.width + (size_t)px)], column, 3);
+    }
+    /* the grid's probes, the detail's over them, the explicit ones on top;
+     * a dot a twelfth of the spacing across, 1 to 7 pixels */
+    double grid_px = fmin(l->spacing_m[0], l->spacing_m[2]) * m.scale, detail_px = l->detail_spacing_m * m.scale;
+    int grid_radius = (int)fmin(3, grid_px / 12), detail_radius = (int)fmin(3, detail_px / 12);
+    uint64_t first[3] = {0, grid, grid + l->detail_count}, end[3] = {grid, grid + l->detail_count, count};
+    const uint8_t *tint[3] = {white, amber, green};
+    const int radius[3] = {grid_radius, detail_radius, 2};
+    for (int kind = 0; kind < 3; kind++)
+        for (uint64_t i = first[kind]; i < end[kind] && i < count; i++) {
+            const float *r = &img->data[i * stride];
+            uint8_t c[3];
+            probe_colour(r, tint[kind], c);
+            map_put(&m, r[SB_SKY_VISIBILITY_POSITION], r[SB_SKY_VISIBILITY_POSITION + 2], radius[kind], c);
+        }
+    enum sb_result res = sb_png_write(png_path, m.width, m.height, m.rgba);
+    free(m.rgba);
+    return res;
+}

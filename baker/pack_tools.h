@@ -23,6 +23,13 @@
  */
 enum sb_result sb_pack_contact_sheet(const struct sb_pack *pack, const char *png_path);
 
+/* The probe layout as a PNG, a top view (north, -z, up) of the
+ * sky_visibility probes' footprint, 1024 pixels along its longer side:
+ * the grid's probes white, the detail's amber over their brick columns
+ * (dark blue), explicit probes green, each dot as bright as the sky the
+ * probe sees, invalid probes red. SB_ERR_USAGE without sky_visibility. */
+enum sb_result sb_pack_probe_map(const struct sb_pack *pack, const char *png_path);
+
 /* Print the open pack read from `dir` as a table, or as one JSON object, on stdout. */
 void sb_pack_info_print(const struct sb_pack *pack, const char *dir, bool json);
 

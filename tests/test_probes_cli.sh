@@ -211,8 +211,8 @@ if command -v exrheader >/dev/null; then
 fi
 check "a contact sheet of the cubes" expect_exit 0 "$skybake" preview "$tmp/r" "$tmp/sheet.png"
 check "is a PNG" sh -c "head -c 8 '$tmp/sheet.png' | od -An -c | grep -q 'P   N   G'"
-check "preview of a pack without cubes is refused" expect_exit 2 "$skybake" preview "$tmp/p" "$tmp/none.png"
-check "and writes nothing" test ! -e "$tmp/none.png"
+check "a pack of probes without cubes previews their layout" expect_exit 0 "$skybake" preview "$tmp/p" "$tmp/layout.png"
+check "as a PNG" sh -c "head -c 8 '$tmp/layout.png' | od -An -c | grep -q 'P   N   G'"
 refl '[{"position_m":[0,0.5,-18],"box_m":[[-12,0,-40],[12,10,-8]]}]' >"$tmp/r_inside.json"
 check "a probe inside the metal box is refused" expect_exit 1 "$skybake" bake "$tmp/r_inside.json" -o "$tmp/r_inside"
 check "naming it" grep -q "reflections.probes\[0\].*inside geometry" "$tmp/err"
@@ -326,6 +326,18 @@ check "the settings say so" grep -q '"detail":{"spacing_m":0.5,"brick_columns":9
 check "the visibility's file is version 4 (sight masks)" sh -c "od -An -tu4 -j8 -N4 '$tmp/room1/sky_visibility.sbprobes' | grep -qw 4"
 check "the bounce's is version 5 (binary16)" sh -c "od -An -tu4 -j8 -N4 '$tmp/room1/sky_bounce.sbprobes' | grep -qw 5"
 check "verify" expect_exit 0 "$skybake" verify "$tmp/room1"
+check "a preview of the layout" expect_exit 0 "$skybake" preview "$tmp/room1" "$tmp/room1.png"
+check "1024 pixels across the world" sh -c "python3 '$root/tests/png_stats.py' size '$tmp/room1.png' | grep -qx '1024 1024'"
+# the room (4 m of the world's 40) at the middle: brick columns under
+# detail probes, no bare ground
+check "the detail's columns over the room" sh -c "test \"\$(python3 '$root/tests/png_stats.py' ink '$tmp/room1.png' 492 492 40 40 24 24 24)\" = 1600"
+check "bare ground away from it" sh -c "test \"\$(python3 '$root/tests/png_stats.py' ink '$tmp/room1.png' 30 30 40 40 24 24 24)\" -lt 100"
+printf '{"atmosphere":{"preset":"earth"},"products":["transmittance"]}' >"$tmp/sky_only.json"
+check "a pack without probes" expect_exit 0 "$skybake" bake "$tmp/sky_only.json" -o "$tmp/sky_only" -q
+check "has no layout to preview" expect_exit 2 "$skybake" preview "$tmp/sky_only" "$tmp/none.png" --probes
+check "saying so" grep -q "no sky_visibility probes" "$tmp/err"
+check "nor cubes" expect_exit 2 "$skybake" preview "$tmp/sky_only" "$tmp/none.png"
+check "and writes nothing" test ! -e "$tmp/none.png"
 cp -r "$tmp/room1" "$tmp/room8"
 sed -i 's/"format_version":[[:space:]]*[0-9]*/"format_version": 8/' "$tmp/room8/manifest.json"
 check "sight masks in a version 8 pack are refused" expect_exit 1 "$skybake" verify "$tmp/room8"
