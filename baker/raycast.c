@@ -97,12 +97,23 @@ enum sb_result sb_raycaster_cast(struct sb_raycaster *rc, const float *rays, uin
     return sb_buffer_read(rc->vk, &rc->hits, hits);
 }
 
+enum sb_result sb_probe_kernel_pass(struct sb_vk *vk, struct sb_pipeline *pipeline, const void *push,
+                                    uint32_t probe_count, double *gpu_ms)
+{
+    uint32_t gx = probe_count < 65535 ? probe_count : 65535, gy = (probe_count + gx - 1) / gx;
+    double ms = 0;
+    enum sb_result res = sb_dispatch(vk, pipeline, push, gx, gy, 1, &ms);
+    if (gpu_ms)
+        *gpu_ms += ms;
+    return res;
+}
+
 enum sb_result sb_probe_kernel_run(struct sb_vk *vk, struct sb_pipeline *pipeline, const void *push,
                                    uint32_t probe_count, struct sb_buffer *results, void *out, double *gpu_ms)
 {
-    uint32_t gx = probe_count < 65535 ? probe_count : 65535, gy = (probe_count + gx - 1) / gx;
-    double ms;
-    enum sb_result res = sb_dispatch(vk, pipeline, push, gx, gy, 1, gpu_ms ? gpu_ms : &ms);
+    if (gpu_ms)
+        *gpu_ms = 0;
+    enum sb_result res = sb_probe_kernel_pass(vk, pipeline, push, probe_count, gpu_ms);
     return res ? res : sb_buffer_read(vk, results, out);
 }
 

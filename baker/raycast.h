@@ -54,9 +54,14 @@ enum sb_result sb_probe_buffers_create(struct sb_vk *vk, const float *positions,
                                        uint32_t probe_count, uint32_t floats, struct sb_buffer *probes,
                                        struct sb_buffer *results);
 
-/* Run a probe kernel (bound, its push constants `push`): one workgroup a
- * probe, in rows of at most 65535; then read `results` into out. *gpu_ms
- * (may be NULL) gets the GPU time. */
+/* Run one pass of a probe kernel (bound, its push constants `push`): one
+ * workgroup a probe, in rows of at most 65535; its GPU time is added to
+ * *gpu_ms (may be NULL). */
+enum sb_result sb_probe_kernel_pass(struct sb_vk *vk, struct sb_pipeline *pipeline, const void *push,
+                                    uint32_t probe_count, double *gpu_ms);
+
+/* One pass, then read `results` into out. *gpu_ms (may be NULL) gets the
+ * GPU time. */
 enum sb_result sb_probe_kernel_run(struct sb_vk *vk, struct sb_pipeline *pipeline, const void *push,
                                    uint32_t probe_count, struct sb_buffer *results, void *out, double *gpu_ms);
 

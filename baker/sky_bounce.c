@@ -117,7 +117,15 @@ enum sb_result sb_sky_bounce_bake(struct sb_raycaster *rc, const struct sb_surfa
     };
     sb_surfaces_bindings(surfaces, &bindings[SB_BOUNCE_BINDING_SURFACE]);
     sb_pipeline_bind(vk, &pipeline, bindings);
-    if ((res = sb_probe_kernel_run(vk, &pipeline, &pc, probe_count, &results, kernel, gpu_ms)))
+    /* the passes (config.h, SB_BOUNCE_PASS_DIRECTIONS), in a fixed order */
+    for (uint32_t ray = 0; ray < pc.ray_count && !res; ray += SB_PROBE_THREADS)
+        for (uint32_t dir = 0; dir < 2 * pc.secondary && !res; dir += SB_BOUNCE_PASS_DIRECTIONS) {
+            pc.first_ray = ray;
+            pc.first_direction = dir;
+            res = sb_probe_kernel_pass(vk, &pipeline, &pc, probe_count, gpu_ms);
+            pc.accumulate = 1;
+        }
+    if (res || (res = sb_buffer_read(vk, &results, kernel)))
         goto done;
     uint32_t counted = 0;
     double sum = 0;

@@ -105,7 +105,15 @@ enum sb_result sb_sky_visibility_bake(struct sb_raycaster *rc, const float *posi
     };
     sb_pipeline_bind(vk, &pipeline, bindings);
     double t0 = sb_now_s();
-    res = sb_probe_kernel_run(vk, &pipeline, &pc, probe_count, &results, out, gpu_ms);
+    /* the passes (config.h, SB_VISIBILITY_PASS_RAYS), in a fixed order */
+    for (uint32_t first = 0; first < pc.ray_count && !res; first += SB_VISIBILITY_PASS_RAYS) {
+        pc.first_ray = first;
+        pc.accumulate = first > 0;
+        pc.last = first + SB_VISIBILITY_PASS_RAYS >= pc.ray_count;
+        res = sb_probe_kernel_pass(vk, &pipeline, &pc, probe_count, gpu_ms);
+    }
+    if (!res)
+        res = sb_buffer_read(vk, &results, out);
     sb_debug("sky visibility: %u probes x %u rays: buffers %.1f ms, run and read back %.1f ms", probe_count,
              pc.ray_count, 1e3 * (t0 - start), 1e3 * (sb_now_s() - t0));
 done:

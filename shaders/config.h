@@ -368,7 +368,23 @@ struct sb_bounce_push {
     SB_UINT ray_count; /* a multiple of SB_PROBE_THREADS */
     SB_UINT secondary; /* half the sphere set's size: about this many rays from each hit */
     float tmin_m;
+    /* one pass: rays [first_ray, first_ray + SB_PROBE_THREADS), one a
+     * thread, each casting the sphere set's directions [first_direction,
+     * first_direction + SB_BOUNCE_PASS_DIRECTIONS); added to what the
+     * passes before wrote when `accumulate` (baker/sky_bounce.c) */
+    SB_UINT first_ray;
+    SB_UINT first_direction;
+    SB_UINT accumulate;
+    SB_UINT pad;
 };
+/* Mesa's lavapipe ends every loop of a kernel invocation once the
+ * invocation has run 65535 loop iterations in all (gallivm's
+ * LP_MAX_TGSI_LOOP_ITERATIONS), silently: a probe's whole bounce in one
+ * invocation (4 rays x 64 of 128 directions at the defaults, each cast a
+ * BVH traversal of tens to hundreds of steps) came back cut short in the
+ * IFC house from 144 secondary rays. A pass keeps an invocation to one ray
+ * and this many directions (half of them cast). */
+#define SB_BOUNCE_PASS_DIRECTIONS 64
 
 /* The DFG (split-sum) LUT of GGX specular (dfg.comp, baker/dfg.h): texel
  * (i, j) at n.v = (i + 0.5) / SB_DFG_SIZE and perceptual roughness
@@ -392,7 +408,17 @@ struct sb_probe_push {
     SB_UINT ray_count; /* a multiple of SB_PROBE_THREADS */
     float tmin_m;      /* rays start this far out */
     float tmax_m;      /* and see the sky past this distance */
+    /* one pass: rays [first_ray, first_ray + SB_VISIBILITY_PASS_RAYS),
+     * their sums added to the passes' before when `accumulate`; the last
+     * pass turns the sums into the record (baker/sky_visibility.c) */
+    SB_UINT first_ray;
+    SB_UINT accumulate;
+    SB_UINT last;
+    SB_UINT pad;
 };
+/* 16 rays a thread a pass: lavapipe's 65535 loop iterations an invocation
+ * (SB_BOUNCE_PASS_DIRECTIONS) hold about 200 casts */
+#define SB_VISIBILITY_PASS_RAYS (16 * SB_PROBE_THREADS)
 
 /* The detail probes' sight masks (probe_sight.comp, baker/probe_sight.h):
  * which points of the 8 lattice cells around a detail probe it sees in a

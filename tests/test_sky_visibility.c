@@ -556,6 +556,56 @@ static void test_sight(struct sb_vk *vk)
     scene_finish(&house);
 }
 
+/* The most rays a probe (65536, 1024 a thread): against Embree's rays
+ * projected in fp64, at a probe in the house's rooms and one outside.
+ * One invocation for all of them passed lavapipe's 65535 loop iterations
+ * and stopped early; passes (config.h) keep each to 16 casts a thread. */
+static void test_many_rays(struct sb_vk *vk)
+{
+    enum { MANY = SB_PROBE_MAX_RAYS };
+    struct scene house = {.name = "IFC house"};
+    float lo[3], hi[3];
+    if (!house_ready(vk, &house, lo, hi))
+        return;
+    struct sb_embree e = {0};
+    float positions[6] = {2.6f, 1.8f, -1.8f, lo[0] - 3, 1.5f, lo[2] - 3}, out[2 * SB_VISIBILITY_FLOATS];
+    float *rays = malloc(sizeof(float) * 8 * MANY), *hits = malloc(sizeof(float) * 4 * MANY);
+    if (rays && hits && sb_embree_create(&house.mesh, &e) && bake_rays(&house, positions, 2, MANY, out)) {
+        double worst = 0;
+        for (int i = 0; i < 2; i++) {
+            double ref[SB_PROBE_SH] = {0}, d[3];
+            sb_probe_rays(&positions[3 * i], MANY, 1e-4f, rays);
+            sb_embree_cast(&e, rays, MANY, hits);
+            for (uint32_t r = 0; r < MANY; r++) {
+                uint32_t t;
+                memcpy(&t, &hits[4 * r + 1], sizeof(t));
+                if (t != SB_BVH_MISS)
+                    continue;
+                double y[SB_PROBE_SH];
+                sb_probe_direction(r, MANY, d);
+                sb_sh9_basis(d, y);
+                for (int k = 0; k < SB_PROBE_SH; k++)
+                    ref[k] += y[k] * 4 * M_PI / MANY;
+            }
+            worst = fmax(worst, max_abs_diff(&out[SB_VISIBILITY_FLOATS * i], ref));
+        }
+        /* a ray classified otherwise moves a coefficient by 4 pi / n
+         * max|Y| */
+        double quantum = 4 * M_PI / MANY * 1.0925;
+        printf("sky visibility at %d rays a probe (IFC house, in a room and outside): within %.2e of Embree's rays "
+               "projected in fp64 (%.1f rays' worth)\n",
+               MANY, worst, worst / quantum);
+        CHECK(worst <= 8 * quantum, "%d rays a probe: %g from Embree's", MANY, worst);
+    } else {
+        CHECK(false, "%d rays a probe in the IFC house", MANY);
+    }
+    if (e.device)
+        sb_embree_destroy(&e);
+    free(rays);
+    free(hits);
+    scene_finish(&house);
+}
+
 /* ---- The bounce (sky_bounce.h) ------------------------------------------------- */
 
 static bool bake_bounce(struct scene *s, const float *positions, uint32_t count, uint32_t rays, uint32_t secondary,
@@ -822,6 +872,19 @@ static void test_bounce(struct sb_vk *vk)
              * the rest a geometric tail */
             CHECK(worst_every <= 4 * quantum * gain + 2 * SB_SKY_BOUNCE_CONVERGED * peak_every,
                   "every bounce: %g from the fp64 sum (%.2f quanta)", worst_every, worst_every / quantum);
+        }
+        /* Many rays a probe: lavapipe ends an invocation's loops after
+         * 65535 iterations in all; a probe's bounce in one invocation came
+         * back with 3% of its light here from 144 secondary rays. The
+         * passes (config.h) keep each invocation to a ray and a slice. */
+        static float deep[SB_BOUNCE_FLOATS];
+        double ref[SB_BOUNCE_FLOATS], op[SB_BOUNCE_OPERATOR_FLOATS], p;
+        if (bake_bounce(&house, positions, 1, 256, 1024, 1, deep)) {
+            bounce_reference(&house.mesh, &e, positions, 256, 1024, ref, op);
+            double quantum = 4 * M_PI / 256 * 0.4886 / M_PI * 4 * M_PI / 2048 * 1.0925, diff = bounce_diff(deep, ref, &p);
+            printf("bounce, IFC house, 256 x 1024 rays: within %.2e of the fp64 estimator (%.2f quanta; largest %.3g)\n",
+                   diff, diff / quantum, p);
+            CHECK(diff <= 4 * quantum, "256 x 1024 rays: %g from the fp64 estimator", diff);
         }
     } else {
         CHECK(false, "the IFC house for the bounce");
@@ -1249,6 +1312,7 @@ int main(void)
         test_analytic(vk);
         test_house(vk);
         test_sight(vk);
+        test_many_rays(vk);
         test_bounce(vk);
         test_textured_bounce(vk);
         test_bounce_path_traced(vk);

@@ -12,7 +12,9 @@
 // operator of the next bounces (config.h): M[m][j] += 4 pi / n Y_m(w)
 // rho / pi A_j Y_j(n), the irradiance at the hit of an order-1 radiance
 // b_j (A_j the clamped cosine's pi, 2 pi / 3) sent back toward the probe.
-// One workgroup a probe; partial sums added in a fixed tree order.
+// One workgroup a probe, in passes (config.h: a ray a thread and a slice
+// of the sphere set each, added to the passes before); partial sums added
+// in a fixed tree order, the passes in a fixed order.
 #extension GL_GOOGLE_include_directive : require
 #include "config.h"
 
@@ -20,7 +22,7 @@ layout(local_size_x = SB_PROBE_THREADS) in;
 layout(std430, binding = SB_RAYCAST_BINDING_NODES) readonly buffer Nodes { vec4 bvh_nodes[]; };
 layout(std430, binding = SB_RAYCAST_BINDING_TRIANGLES) readonly buffer Triangles { vec4 bvh_triangles[]; };
 layout(std430, binding = SB_RAYCAST_BINDING_RAYS) readonly buffer Probes { vec4 probes[]; };
-layout(std430, binding = SB_RAYCAST_BINDING_HITS) writeonly buffer Out { float results[]; };
+layout(std430, binding = SB_RAYCAST_BINDING_HITS) buffer Out { float results[]; };
 layout(push_constant) uniform Push { sb_bounce_push pc; };
 
 #define BVH_HIT_SLOT
@@ -49,11 +51,15 @@ void main()
     }
     uint sphere = 2u * pc.secondary;
     float spread = sqrt(12.566370614359172 / float(pc.ray_count)); // a ray's cone, radians
-    for (uint r = lane; r < pc.ray_count && valid; r += SB_PROBE_THREADS) {
-        vec3 w = probe_direction(r, pc.ray_count);
-        BvhHit hit = bvh_trace(origin, w, pc.tmin_m, 1e30, false);
-        if (hit.triangle == SB_BVH_MISS)
-            continue;
+    // one pass (config.h): a ray a thread, a slice of the sphere set
+    uint r = pc.first_ray + lane, first = pc.first_direction;
+    uint last = min(first + SB_BOUNCE_PASS_DIRECTIONS, sphere);
+    vec3 w = probe_direction(min(r, pc.ray_count - 1u), pc.ray_count);
+    BvhHit hit;
+    hit.triangle = SB_BVH_MISS;
+    if (r < pc.ray_count && valid)
+        hit = bvh_trace(origin, w, pc.tmin_m, 1e30, false);
+    if (hit.triangle != SB_BVH_MISS) {
         vec4 e1 = bvh_triangles[3 * hit.slot + 1], e2 = bvh_triangles[3 * hit.slot + 2];
 #ifdef BVH_INSTANCES
         vec3 n = normalize(bvh_world_normal(cross(e1.xyz, e2.xyz), hit.instance));
@@ -69,7 +75,7 @@ void main()
         float g[SB_PROBE_SH];
         for (int k = 0; k < SB_PROBE_SH; k++)
             g[k] = 0.0;
-        for (uint i = 0u; i < sphere; i++) {
+        for (uint i = first; i < last; i++) {
             vec3 l = probe_direction(i, sphere);
             float c = dot(n, l);
             if (c <= 0.0)
@@ -89,7 +95,7 @@ void main()
                 acc[m][k] += (ym[m] * g[k]) * weight;
         float yn[SB_PROBE_SH];
         sh9_basis(n, yn);
-        vec3 lambert = rho * 0.3183098861837907; // rho / pi
+        vec3 lambert = rho * (first == 0u ? 0.3183098861837907 : 0.0); // rho / pi, in the first slice's pass
         for (int m = 0; m < SB_BOUNCE_SH; m++)
             for (int j = 0; j < SB_BOUNCE_SH; j++)
                 op[m][j] += (ym[m] * (j == 0 ? 3.141592653589793 : 2.0943951023931953) * yn[j]) * lambert;
@@ -107,8 +113,10 @@ void main()
             barrier();
         }
         if (lane == 0)
-            for (int j = 0; j < SB_PROBE_SH * 3; j++)
-                results[probe * SB_BOUNCE_KERNEL_FLOATS + m * SB_PROBE_SH * 3 + j] = partial[j][0] * scale;
+            for (int j = 0; j < SB_PROBE_SH * 3; j++) {
+                uint at = probe * SB_BOUNCE_KERNEL_FLOATS + m * SB_PROBE_SH * 3 + j;
+                results[at] = (pc.accumulate != 0u ? results[at] : 0.0) + partial[j][0] * scale;
+            }
         barrier();
     }
     for (int m = 0; m < SB_BOUNCE_SH; m++) {
@@ -123,9 +131,10 @@ void main()
             barrier();
         }
         if (lane == 0)
-            for (int j = 0; j < SB_BOUNCE_SH * 3; j++)
-                results[probe * SB_BOUNCE_KERNEL_FLOATS + SB_BOUNCE_FLOATS + m * SB_BOUNCE_SH * 3 + j] =
-                    partial[j][0] * scale;
+            for (int j = 0; j < SB_BOUNCE_SH * 3; j++) {
+                uint at = probe * SB_BOUNCE_KERNEL_FLOATS + SB_BOUNCE_FLOATS + m * SB_BOUNCE_SH * 3 + j;
+                results[at] = (pc.accumulate != 0u ? results[at] : 0.0) + partial[j][0] * scale;
+            }
         barrier();
     }
 }

@@ -2,9 +2,10 @@
 // Sky visibility at probes: every ray that escapes the geometry (misses
 // every triangle within tmax) adds the SH basis of its direction, weighted
 // 4 pi / n; rays that hit count back faces (a probe inside geometry sees
-// mostly back faces) and their distances. One workgroup a probe; the
-// partial sums are added in a fixed tree order, so results do not depend
-// on scheduling.
+// mostly back faces) and their distances. One workgroup a probe, in passes
+// of SB_VISIBILITY_PASS_RAYS rays (config.h); the partial sums are added
+// in a fixed tree order and the passes in a fixed order, so results do
+// not depend on scheduling.
 #extension GL_GOOGLE_include_directive : require
 #include "config.h"
 
@@ -12,7 +13,7 @@ layout(local_size_x = SB_PROBE_THREADS) in;
 layout(std430, binding = SB_RAYCAST_BINDING_NODES) readonly buffer Nodes { vec4 bvh_nodes[]; };
 layout(std430, binding = SB_RAYCAST_BINDING_TRIANGLES) readonly buffer Triangles { vec4 bvh_triangles[]; };
 layout(std430, binding = SB_RAYCAST_BINDING_RAYS) readonly buffer Probes { vec4 probes[]; };
-layout(std430, binding = SB_RAYCAST_BINDING_HITS) writeonly buffer Out { float results[]; };
+layout(std430, binding = SB_RAYCAST_BINDING_HITS) buffer Out { float results[]; };
 layout(std430, binding = SB_PROBE_BINDING_ORDER) readonly buffer Order { uint order[]; };
 layout(push_constant) uniform Push { sb_probe_push pc; };
 
@@ -34,7 +35,8 @@ void main()
         sums[k] = 0.0;
     // Neighbouring invocations cast neighbouring directions (order[] is
     // sorted along a space-filling curve): they traverse the same nodes.
-    for (uint k = lane; k < pc.ray_count; k += SB_PROBE_THREADS) {
+    uint end = min(pc.first_ray + SB_VISIBILITY_PASS_RAYS, pc.ray_count);
+    for (uint k = pc.first_ray + lane; k < end; k += SB_PROBE_THREADS) {
         vec3 d = probe_direction(order[k], pc.ray_count);
         BvhHit hit = bvh_trace(origin, d, pc.tmin_m, pc.tmax_m, false);
         if (hit.triangle == SB_BVH_MISS) {
@@ -58,12 +60,20 @@ void main()
         barrier();
     }
     if (lane == 0) {
-        float n = float(pc.ray_count), hits = partial[SB_PROBE_SH + 1][0];
-        uint base = probe * SB_VISIBILITY_FLOATS;
-        for (int k = 0; k < SB_PROBE_SH; k++)
-            results[base + k] = partial[k][0] * (12.566370614359172 / n);
-        results[base + SB_PROBE_SH] = hits > 0.0 ? partial[SB_PROBE_SH][0] / n : 0.0;
-        results[base + SB_PROBE_SH + 1] = hits / n;
-        results[base + SB_PROBE_SH + 2] = hits > 0.0 ? partial[SB_PROBE_SH + 2][0] / hits : 0.0;
+        uint base = probe * SB_VISIBILITY_FLOATS; // the passes' sums so far, then the record
+        float total[SUMS];
+        for (int k = 0; k < SUMS; k++)
+            total[k] = partial[k][0] + (pc.accumulate != 0u ? results[base + k] : 0.0);
+        if (pc.last == 0u) {
+            for (int k = 0; k < SUMS; k++)
+                results[base + k] = total[k];
+        } else {
+            float n = float(pc.ray_count), hits = total[SB_PROBE_SH + 1];
+            for (int k = 0; k < SB_PROBE_SH; k++)
+                results[base + k] = total[k] * (12.566370614359172 / n);
+            results[base + SB_PROBE_SH] = hits > 0.0 ? total[SB_PROBE_SH] / n : 0.0;
+            results[base + SB_PROBE_SH + 1] = hits / n;
+            results[base + SB_PROBE_SH + 2] = hits > 0.0 ? total[SB_PROBE_SH + 2] / hits : 0.0;
+        }
     }
 }
