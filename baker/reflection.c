@@ -101,12 +101,22 @@ enum sb_result sb_reflection_capture(struct sb_vk *vk, const struct sb_capture_i
             bindings[SB_CAPTURE_BINDING_SURFACE + b] = &dummy;
     sb_atmosphere_bind_inputs(in->atmosphere, bindings);
     sb_pipeline_bind(vk, pipeline, bindings);
-    double ms = 0;
-    if (!(res = sb_dispatch(vk, pipeline, &pc, (n + SB_WORKGROUP_X - 1) / SB_WORKGROUP_X,
-                            (6 * n + SB_WORKGROUP_Y - 1) / SB_WORKGROUP_Y, 1, &ms)))
+    /* the passes (config.h, SB_CAPTURE_PASS_DIRECTIONS), in a fixed order;
+     * one without a world */
+    double total = 0;
+    uint32_t directions = in->rc ? 2 * p->ambient_rays : 1;
+    for (uint32_t first = 0; first < directions && !res; first += SB_CAPTURE_PASS_DIRECTIONS) {
+        double ms = 0;
+        pc.first_direction = first;
+        pc.accumulate = first > 0;
+        res = sb_dispatch(vk, pipeline, &pc, (n + SB_WORKGROUP_X - 1) / SB_WORKGROUP_X,
+                          (6 * n + SB_WORKGROUP_Y - 1) / SB_WORKGROUP_Y, 1, &ms);
+        total += ms;
+    }
+    if (!res)
         res = sb_buffer_read(vk, &result, out);
     if (gpu_ms)
-        *gpu_ms = ms;
+        *gpu_ms = total;
 done:
     sb_pipeline_destroy(vk, &temp);
     sb_buffer_destroy(vk, &result);

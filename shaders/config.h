@@ -466,7 +466,14 @@ struct sb_capture_push {
     SB_UINT has_world;      /* 0: the sky alone */
     SB_UINT ambient_rays;   /* from each hit: a sphere set of 2x this, the surface's side cast */
     float tmin_m;
+    /* one pass: the sphere set's directions [first_direction,
+     * first_direction + SB_CAPTURE_PASS_DIRECTIONS), added to the passes'
+     * before when `accumulate` (lavapipe's loop limit: config.h,
+     * SB_BOUNCE_PASS_DIRECTIONS); the sky and the sun in the first */
+    SB_UINT first_direction;
+    SB_UINT accumulate;
 };
+#define SB_CAPTURE_PASS_DIRECTIONS 128
 
 /* GGX prefiltering (reflection_prefilter.comp): threads_per_texel
  * invocations a texel of level `level`, SB_PREFILTER_THREADS a workgroup,

@@ -252,6 +252,23 @@ int main(void)
     for (size_t t = 0; t < (size_t)6 * N * N * 4; t++)
         finite &= isfinite(level0[t]) && level0[t] >= 0;
     CHECK(finite, "the capture holds a negative or non-finite value");
+    /* 1024 ambient rays a surface, cast in 16 passes (config.h: each
+     * invocation at most 64 casts, under lavapipe's loop limit), against
+     * 32 in one: the same light but for the quadrature, over the -y face
+     * (all ground). */
+    {
+        struct sb_capture_params many = cp;
+        many.ambient_rays = 1024;
+        CHECK(sb_reflection_capture(vk, &world_in, &many, again, NULL) == SB_OK, "world capture, 1024 ambient rays");
+        double sum_a = 0, sum_b = 0;
+        for (size_t t = (size_t)3 * N * N; t < (size_t)4 * N * N; t++) {
+            sum_a += level0[4 * t] + level0[4 * t + 1] + level0[4 * t + 2];
+            sum_b += again[4 * t] + again[4 * t + 1] + again[4 * t + 2];
+        }
+        printf("capture with 1024 ambient rays a surface: the ground below %.4f of its light with 32\n",
+               sum_b / sum_a);
+        CHECK(fabs(sum_b / sum_a - 1) < 0.02, "1024 ambient rays: %.4f of 32's light", sum_b / sum_a);
+    }
 
     /* The capture reads a surface's albedo from its texture: over a floor
      * black where x < 0 and white where x > 0, the -y face is black (0)

@@ -9,6 +9,8 @@
 // a shadow ray) plus the sky's, over a spherical Fibonacci set from the
 // point (the sky's order-2 SH where a ray escapes, nothing where it is
 // blocked: one bounce). w flags a back face: a probe inside geometry.
+// In passes of SB_CAPTURE_PASS_DIRECTIONS of the sphere set (config.h),
+// added in a fixed order.
 #extension GL_GOOGLE_include_directive : require
 #include "config.h"
 
@@ -18,7 +20,7 @@ layout(local_size_x = SB_WORKGROUP_X, local_size_y = SB_WORKGROUP_Y) in;
 #include "atmosphere.glsl"
 #include "sky_radiance.glsl"
 
-layout(std430, binding = SB_CAPTURE_BINDING_OUT) writeonly buffer Out { vec4 radiance[]; };
+layout(std430, binding = SB_CAPTURE_BINDING_OUT) buffer Out { vec4 radiance[]; };
 layout(std430, binding = SB_CAPTURE_BINDING_NODES) readonly buffer Nodes { vec4 bvh_nodes[]; };
 layout(std430, binding = SB_CAPTURE_BINDING_TRIANGLES) readonly buffer Triangles { vec4 bvh_triangles[]; };
 layout(std430, binding = SB_CAPTURE_BINDING_SKY_SH) readonly buffer SkySh { vec4 sky_sh[SB_PROBE_SH]; };
@@ -52,11 +54,11 @@ vec3 surface(vec3 origin, vec3 d, BvhHit hit)
     float h = clamp(pc.origin_m.w + (x.y - origin.y) * 1e-3, 0.0, atmosphere_thickness());
     vec3 E = vec3(0.0);
     float ns = dot(n, s);
-    if (ns > 0.0 && bvh_trace(from, s, eps, 1e30, true).triangle == SB_BVH_MISS)
+    uint first = pc.first_direction, sphere = 2u * pc.ambient_rays;
+    if (first == 0u && ns > 0.0 && bvh_trace(from, s, eps, 1e30, true).triangle == SB_BVH_MISS)
         E += atm.solar_irradiance.rgb * sun_transmittance(h, clamp(s.y, -1.0, 1.0)) * ns;
-    uint sphere = 2u * pc.ambient_rays;
     vec3 sky_E = vec3(0.0);
-    for (uint i = 0u; i < sphere; i++) {
+    for (uint i = first; i < min(first + SB_CAPTURE_PASS_DIRECTIONS, sphere); i++) {
         vec3 l = probe_direction(i, sphere);
         float c = dot(n, l);
         if (c <= 0.0 || bvh_trace(from, l, eps, 1e30, true).triangle != SB_BVH_MISS)
@@ -89,8 +91,11 @@ void main()
     if (pc.has_world != 0u)
         hit = bvh_trace(origin, d, pc.tmin_m, 1e30, false);
     if (hit.triangle == SB_BVH_MISS)
-        out_value = vec4(sky(h, d), 0.0);
+        out_value = vec4(pc.first_direction == 0u ? sky(h, d) : vec3(0.0), 0.0);
     else
         out_value = vec4(surface(origin, d, hit), (hit.triangle & SB_BVH_BACK_FACE) != 0u ? 1.0 : 0.0);
+    // a pass (config.h) adds its slice of the ambient light to the passes' before
+    if (pc.accumulate != 0u)
+        out_value.rgb += radiance[t.y * n + t.x].rgb;
     radiance[t.y * n + t.x] = out_value;
 }
