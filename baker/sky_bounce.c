@@ -19,6 +19,51 @@ struct sb_pipeline_params sb_sky_bounce_kernel(bool instanced)
     };
 }
 
+/* (I - M)^-1 of one channel's operator, by Gauss-Jordan with partial
+ * pivots; false when M's largest row sum is 1 or more (the series might
+ * not converge: it is summed term by term instead) or the inverse is not
+ * finite. */
+static bool every_bounce(double m[SB_BOUNCE_SH][SB_BOUNCE_SH], double inverse[SB_BOUNCE_SH][SB_BOUNCE_SH])
+{
+    enum { S = SB_BOUNCE_SH };
+    double a[S][2 * S], norm = 0;
+    for (int i = 0; i < S; i++) {
+        double row = 0;
+        for (int j = 0; j < S; j++) {
+            a[i][j] = (i == j) - m[i][j];
+            a[i][S + j] = i == j;
+            row += fabs(m[i][j]);
+        }
+        norm = fmax(norm, row);
+    }
+    if (!(norm < 1))
+        return false;
+    for (int c = 0; c < S; c++) {
+        int pivot = c;
+        for (int i = c + 1; i < S; i++)
+            if (fabs(a[i][c]) > fabs(a[pivot][c]))
+                pivot = i;
+        for (int j = 0; j < 2 * S; j++) {
+            double t = a[c][j];
+            a[c][j] = a[pivot][j];
+            a[pivot][j] = t;
+        }
+        for (int i = 0; i < S; i++)
+            if (i != c) {
+                double f = a[i][c] / a[c][c];
+                for (int j = 0; j < 2 * S; j++)
+                    a[i][j] -= f * a[c][j];
+            }
+    }
+    for (int i = 0; i < S; i++)
+        for (int j = 0; j < S; j++) {
+            inverse[i][j] = a[i][S + j] / a[i][i];
+            if (!isfinite(inverse[i][j]))
+                return false;
+        }
+    return true;
+}
+
 uint32_t sb_sky_bounce_sum(float *kernel, uint32_t bounces, double *added)
 {
     enum { K = SB_PROBE_SH, S = SB_BOUNCE_SH };
@@ -36,7 +81,27 @@ uint32_t sb_sky_bounce_sum(float *kernel, uint32_t bounces, double *added)
     }
     for (int c = 0; c < 3; c++)
         first += total[0][0][c];
-    uint32_t most = bounces ? bounces : SB_SKY_BOUNCE_MAX, n = 1;
+    /* every bounce: (I - M)^-1 B1, where the series surely converges */
+    bool closed = !bounces;
+    for (int c = 0; c < 3 && closed; c++) {
+        double m[S][S], g[S][S];
+        for (int i = 0; i < S; i++)
+            for (int j = 0; j < S; j++)
+                m[i][j] = op[i][j][c];
+        if ((closed = every_bounce(m, g)))
+            for (int i = 0; i < S; i++)
+                for (int k = 0; k < K; k++) {
+                    double v = 0;
+                    for (int j = 0; j < S; j++)
+                        v += g[i][j] * term[j][k][c];
+                    next[i][k][c] = v;
+                }
+    }
+    if (closed) {
+        memcpy(total, next, sizeof(total));
+        peak = 0; /* no series to sum */
+    }
+    uint32_t most = bounces ? bounces : SB_SKY_BOUNCE_MAX, n = closed ? 0 : 1;
     /* the next bounce is M times the last, channel by channel */
     for (; n < most && peak > 0; n++) {
         double size = 0;

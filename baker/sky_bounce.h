@@ -11,8 +11,10 @@
  * again as it arrives at the probe (the probe's own field stands for
  * theirs, as DDGI's recursion does with its probes), so B becomes
  * B1 + M B1 + M M B1 + ..., M the kernel's 4 x 4 operator on order-1
- * light (config.h); summed until a bounce adds under
- * SB_SKY_BOUNCE_CONVERGED of the light so far, or a stated count.
+ * light (config.h): every bounce as (I - M)^-1 B1 where the series
+ * surely converges (M's largest row sum under 1), else summed until a
+ * bounce adds under SB_SKY_BOUNCE_CONVERGED of the light so far; or a
+ * stated count of bounces.
  * Deterministic: fixed ray sets, a fixed sum order, the sums in fp64.
  */
 #ifndef SB_BAKER_SKY_BOUNCE_H
@@ -37,7 +39,7 @@ struct sb_sky_bounce_params {
 
 /* What the bounces past the first added, over the valid probes. */
 struct sb_sky_bounce_report {
-    uint32_t most_bounces; /* the most any probe took */
+    uint32_t most_bounces; /* the most terms any probe's series took (0: every probe in closed form) */
     double mean_added;     /* their light over the first bounce's, mean (the mean channel's constant band) */
     double most_added;     /* and the most */
 };
@@ -61,9 +63,11 @@ enum sb_result sb_sky_bounce_bake(struct sb_raycaster *raycaster, const struct s
 
 /* Sum the bounces of one probe in place: `kernel` holds the kernel's
  * SB_BOUNCE_KERNEL_FLOATS (B1, then M); its first SB_BOUNCE_FLOATS become
- * B1 + M B1 + ... to `bounces` terms (0: until converged). Returns the
- * bounces summed; *added (may be NULL) the light past the first's over
- * the first's (constant band, channels summed; 0 where B1's is 0). */
+ * B1 + M B1 + ... to `bounces` terms, or every bounce (0: (I - M)^-1 B1,
+ * or the series until converged where M's row sums reach 1). Returns the
+ * terms summed, 0 for the closed form; *added (may be NULL) the light
+ * past the first's over the first's (constant band, channels summed; 0
+ * where B1's is 0). */
 uint32_t sb_sky_bounce_sum(float *kernel, uint32_t bounces, double *added);
 
 /* XXH3-128 of the kernel's SPIR-V (and the texture mips'), for bake keys. */

@@ -1111,8 +1111,8 @@ static void test_bounce_path_traced(struct sb_vk *vk)
                names[l], 100 * err[l][0], 100 * worst[l][0], 100 * err[l][1], 100 * worst[l][1], 100 * noise[l]);
     }
     printf("path traced in %.1f s (%u paths a point, each lighting)\n", t1 - t0, PATHS);
-    /* Measured on lavapipe: the sky alone 7.8% on average (one bounce
-     * 26%); the sun alone and both far off: the sun at a surface is the
+    /* Measured on lavapipe: the sky alone 6.5% on average (one bounce
+     * 22%); the sun alone and both far off: the sun at a surface is the
      * order-2 SH of its (n . l) V(l), and through a window that rings
      * (docs/probes.md, "Every bounce"). */
     CHECK(noise[2] < 0.02, "the path tracer's noise: %.2f%%", 100 * noise[2]);
