@@ -65,7 +65,8 @@ static void usage(FILE *f)
                "  --sun-elevation DEG     the sun above the horizon (default 30)\n"
                "  --sun-azimuth DEG       clockwise from north, -z (default 150)\n"
                "  --camera X,Y,Z[,YAW,PITCH[,FOV]]\n"
-               "                          metres (y up, origin on the ground) and degrees: yaw\n"
+               "                          metres (y up, origin on the planet's ground; a\n"
+               "                          world's valleys may go 10 km under it) and degrees: yaw\n"
                "                          clockwise from north, pitch above the horizontal,\n"
                "                          vertical field of view (default 0,2,0,0,3,50; under\n"
                "                          the world's surface, lifted onto it; when that cannot\n"
@@ -461,8 +462,8 @@ static int parse_options(int argc, char **argv, struct options *o)
             ok = parse_number(argv[++i], 1.0 / 60.0, 24, &o->sheet_step_h);
             note_option(o, a);
         } else if (!strcmp(a, "--camera") && next) {
-            ok = parse_doubles(argv[++i], c, 3, 6, &n) && fabs(c[0]) <= 1e7 && fabs(c[2]) <= 1e7 && c[1] > 0.0 &&
-                 c[1] <= 1e8;
+            ok = parse_doubles(argv[++i], c, 3, 6, &n) && fabs(c[0]) <= 1e7 && fabs(c[2]) <= 1e7 &&
+                 c[1] >= -SB_CAMERA_LOWEST_M && c[1] <= 1e8;
             if (ok) {
                 o->camera_given = true;
                 memcpy(o->view.camera_m, c, sizeof(o->view.camera_m));

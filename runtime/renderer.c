@@ -345,8 +345,12 @@ static void fill_frame(struct sb_renderer *r, const struct sb_view *v, struct sb
         }
     }
 
+    /* the atmosphere's camera stays over the planet's ground, as the LUTs
+     * were made: a camera in a world's valley under y 0 sees the sky from
+     * the ground (its world still from where it is) */
     const double R = r->ground_radius_km;
-    double km[3] = {v->camera_m[0] * 1e-3, R + v->camera_m[1] * 1e-3, v->camera_m[2] * 1e-3};
+    double km[3] = {v->camera_m[0] * 1e-3, R + fmax(v->camera_m[1], SB_CAMERA_LOWEST_ATMOSPHERE_M) * 1e-3,
+                    v->camera_m[2] * 1e-3};
     double altitude = sqrt(km[0] * km[0] + km[1] * km[1] + km[2] * km[2]) - R;
     const double sun_radius = 0.2666 * M_PI / 180.0; /* the sun's mean angular radius */
     store4(f->camera_m, v->camera_m[0], v->camera_m[1], v->camera_m[2], SB_NEAR_M);

@@ -29,6 +29,12 @@ enum sb_scene_method {
 
 struct sb_lut3d;
 
+/* The camera (struct sb_view's camera_m, y up from the planet's ground):
+ * a world's valleys may take it this far under y 0; the atmosphere sees it
+ * no lower than SB_CAMERA_LOWEST_ATMOSPHERE_M over the ground. */
+#define SB_CAMERA_LOWEST_M 1e4
+#define SB_CAMERA_LOWEST_ATMOSPHERE_M 0.01
+
 /* Scene-linear grading (runtime/grading.c, passes/grade_linear.c): on the exposed frame (mid grey at
  * 0.18), before bloom and the tone curve. */
 #define SB_GRADING_NEUTRAL_K 6504.0 /* D65's correlated colour temperature */

@@ -86,7 +86,7 @@ enum sb_result sb_viewer_run(struct sb_renderer *r, struct sb_window *window, co
         double f = (in.forward - in.back) * speed, s = (in.right - in.left) * speed;
         view.camera_m[0] += sin(view.yaw) * f + cos(view.yaw) * s;
         view.camera_m[2] += -cos(view.yaw) * f + sin(view.yaw) * s;
-        view.camera_m[1] = fmax(0.1, view.camera_m[1] + (in.up - in.down) * speed);
+        view.camera_m[1] = fmax(-SB_CAMERA_LOWEST_M, view.camera_m[1] + (in.up - in.down) * speed);
         view.yaw += in.look_dx * LOOK_DEG_PER_PX * DEG;
         view.pitch = fmin(fmax(view.pitch - in.look_dy * LOOK_DEG_PER_PX * DEG, -89.0 * DEG), 89.0 * DEG);
         /* The sun: by hand, or along the path. */

@@ -68,6 +68,14 @@ check "three frames, each tone mapper" expect_exit 0 "$skyview" "$tmp/pack" -o "
 check "frame_0002.png" test -s "$tmp/g/frame_0002.png"
 check "aces" expect_exit 0 "$skyview" "$tmp/pack" -o "$tmp/g" $small --tonemap aces --no-bloom
 check "camera above the atmosphere" expect_exit 0 "$skyview" "$tmp/pack" -o "$tmp/g" $small --camera 0,1000000,0,0,-60,60
+# A camera in a world's valley, 5 m under the planet's ground (the test
+# level's terrain goes 12 m under it): the sky as from the ground itself,
+# bit for bit, over a world of one box far behind the camera
+printf '{"version":1,"ground":false,"boxes":[{"center_m":[0,1,60],"size_m":[2,2,2],"albedo":[0.5,0.5,0.5]}]}' >"$tmp/far_box.json"
+check "a camera under y 0" expect_exit 0 "$skyview" "$tmp/pack" -o "$tmp/valley" $small --world "$tmp/far_box.json" --camera 0,-5,0,0,20,50 --no-fog
+check "from the ground" expect_exit 0 "$skyview" "$tmp/pack" -o "$tmp/ground" $small --world "$tmp/far_box.json" --camera 0,0.01,0,0,20,50 --no-fog
+check "sees the same sky" sh -c "test \"\$(python3 '$root/tests/png_stats.py' diff '$tmp/valley/frame_0000.png' '$tmp/ground/frame_0000.png')\" = '0.0000 0'"
+check "a camera 10 km under it is refused" expect_exit 2 "$skyview" "$tmp/pack" -o "$tmp/deep" $small --camera 0,-10001,0
 # The traced scene (test_runtime checks its pixels); here the command line.
 check "the scene traced" expect_exit 0 "$skyview" "$tmp/pack" -o "$tmp/t" $small --scene traced --world "$root/data/worlds/colonnade.json"
 check "traced, camera above the atmosphere" expect_exit 0 "$skyview" "$tmp/pack" -o "$tmp/t" $small --scene traced --camera 0,1000000,0,0,-60,60
