@@ -156,6 +156,58 @@ int64_t sb_probe_detail_index(const struct sb_probe_layout *layout, uint64_t gri
                      (uint32_t)(x % SB_PROBES_BRICK));
 }
 
+/* Probe `mask`'s sight of q, its lattice point at `lattice` (probes.glsl's
+ * probe_sees, in fp64). */
+static double sight_of(const uint32_t *mask, const double lattice[3], const double q[3], double spacing)
+{
+    const double side = SB_PROBES_SIGHT_SIDE;
+    double t[3], f[3];
+    int b[3];
+    for (int k = 0; k < 3; k++) {
+        t[k] = fmin(fmax(((q[k] - lattice[k]) / spacing + 1.0) * 0.5 * side - 0.5, 0.0), side - 1.0);
+        b[k] = (int)fmin(floor(t[k]), side - 2.0);
+        f[k] = t[k] - b[k];
+    }
+    double seen = 0;
+    for (int corner = 0; corner < 8; corner++) {
+        int o[3] = {corner & 1, corner >> 1 & 1, corner >> 2 & 1};
+        uint32_t bit = (uint32_t)(((b[2] + o[2]) * SB_PROBES_SIGHT_SIDE + b[1] + o[1]) * SB_PROBES_SIGHT_SIDE + b[0] + o[0]);
+        if (mask[bit >> 5] >> (bit & 31) & 1u)
+            seen += (o[0] ? f[0] : 1 - f[0]) * (o[1] ? f[1] : 1 - f[1]) * (o[2] ? f[2] : 1 - f[2]);
+    }
+    return seen;
+}
+
+double sb_probe_detail_sight(const struct sb_probe_layout *layout, uint64_t grid_count, const float *valid,
+                             size_t valid_stride, const double q[3])
+{
+    if (!layout->detail_count || !(layout->detail_spacing_m > 0))
+        return -1;
+    double h = layout->detail_spacing_m, best = -1;
+    int32_t cell[3];
+    for (int k = 0; k < 3; k++) {
+        double at = floor((q[k] - layout->detail_origin_m[k]) / h);
+        if (!(at >= 0 && at < SB_PROBES_MAX_LATTICE))
+            return -1;
+        cell[k] = (int32_t)at;
+    }
+    for (int corner = 0; corner < 8; corner++) {
+        int32_t x = cell[0] + (corner & 1), y = cell[1] + (corner >> 1 & 1), z = cell[2] + (corner >> 2 & 1);
+        int64_t i = sb_probe_detail_index(layout, grid_count, x, y, z);
+        if (i < 0)
+            continue;
+        best = fmax(best, 0.0);
+        if (valid[(size_t)i * valid_stride] == 0)
+            continue;
+        double lattice[3] = {layout->detail_origin_m[0] + x * h, layout->detail_origin_m[1] + y * h,
+                             layout->detail_origin_m[2] + z * h};
+        best = fmax(best, layout->sight ? sight_of(&layout->sight[((uint64_t)i - grid_count) * SB_PROBES_SIGHT_WORDS],
+                                                   lattice, q, h)
+                                        : 1.0);
+    }
+    return best;
+}
+
 void sb_probes_content_hash(const struct sb_image *image, const struct sb_probe_layout *layout,
                             char out[SB_HASH_HEX_SIZE])
 {

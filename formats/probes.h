@@ -195,6 +195,14 @@ enum sb_result sb_probe_layout_copy(struct sb_probe_layout *to, const struct sb_
  * -1 when no brick column holds it (a binary search over the columns). */
 int64_t sb_probe_detail_index(const struct sb_probe_layout *layout, uint64_t grid_count, int32_t x, int32_t y,
                               int32_t z);
+/* How well the detail probes around point q (m) see it: the most, over
+ * the 8 lattice probes of q's cell that stand in a brick column and are
+ * valid (valid[i] != 0 for the layout's probe i), of their sight of q as
+ * skyview reads it (their mask interpolated trilinearly: probes.glsl's
+ * probe_sees); 1 for such a probe without sight masks. -1 when no detail
+ * probe stands around q. */
+double sb_probe_detail_sight(const struct sb_probe_layout *layout, uint64_t grid_count, const float *valid,
+                             size_t valid_stride, const double q[3]);
 
 /* The content hash of a probe product (pack.h): the records' (image.h's
  * sb_image_content_hash) and, where the layout has them, the sight
