@@ -729,10 +729,23 @@ static enum sb_result bake_bounce(struct probes_state *st, const struct sb_scene
              params.ray_count, params.secondary, layout->grid[0], layout->grid[1], layout->grid[2],
              (double)layout->spacing_m[0], layout->explicit_count, valid_count, params.bounces, report.most_bounces,
              report.mean_added, report.most_added);
-    sb_info("sky_bounce: %u probes (%u valid), %u rays each, %u from each surface hit; %s%u bounces, which add "
-            "%.1f%% to the first on average, %.1f%% at most",
-            count, valid_count, params.ray_count, params.secondary, params.bounces ? "" : "up to ",
-            report.most_bounces, 100 * report.mean_added, 100 * report.most_added);
+    char summed[160]; /* how the bounces were summed, and what the later ones added */
+    if (params.bounces == 1)
+        snprintf(summed, sizeof(summed), "one bounce");
+    else if (params.bounces)
+        snprintf(summed, sizeof(summed), "%u bounces", params.bounces);
+    else if (report.most_bounces)
+        snprintf(summed, sizeof(summed), "every bounce (in closed form, or a series of up to %u where it might not "
+                 "converge)", report.most_bounces);
+    else
+        snprintf(summed, sizeof(summed), "every bounce (in closed form)");
+    if (params.bounces != 1) {
+        size_t used = strlen(summed);
+        snprintf(summed + used, sizeof(summed) - used, ", the later ones adding %.1f%% to the first on average, "
+                 "%.1f%% at most", 100 * report.mean_added, 100 * report.most_added);
+    }
+    sb_info("sky_bounce: %u probes (%u valid), %u rays each, %u from each surface hit; %s", count, valid_count,
+            params.ray_count, params.secondary, summed);
 done:
     if (res)
         sb_image_finish(image);

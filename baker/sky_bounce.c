@@ -81,6 +81,11 @@ uint32_t sb_sky_bounce_sum(float *kernel, uint32_t bounces, double *added)
     }
     for (int c = 0; c < 3; c++)
         first += total[0][0][c];
+    if (peak == 0) { /* nothing to bounce */
+        if (added)
+            *added = 0;
+        return 0;
+    }
     /* every bounce: (I - M)^-1 B1, where the series surely converges */
     bool closed = !bounces;
     for (int c = 0; c < 3 && closed; c++) {

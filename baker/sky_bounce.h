@@ -65,9 +65,9 @@ enum sb_result sb_sky_bounce_bake(struct sb_raycaster *raycaster, const struct s
  * SB_BOUNCE_KERNEL_FLOATS (B1, then M); its first SB_BOUNCE_FLOATS become
  * B1 + M B1 + ... to `bounces` terms, or every bounce (0: (I - M)^-1 B1,
  * or the series until converged where M's row sums reach 1). Returns the
- * terms summed, 0 for the closed form; *added (may be NULL) the light
- * past the first's over the first's (constant band, channels summed; 0
- * where B1's is 0). */
+ * terms summed, 0 for the closed form or nothing to bounce; *added (may
+ * be NULL) the light past the first's over the first's (constant band,
+ * channels summed; 0 where B1's is 0). */
 uint32_t sb_sky_bounce_sum(float *kernel, uint32_t bounces, double *added);
 
 /* XXH3-128 of the kernel's SPIR-V (and the texture mips'), for bake keys. */

@@ -1058,8 +1058,9 @@ static double probe_irradiance(const float *visibility, const float *bounce, con
 }
 
 /* A sky of radiance a (1 + 0.5 y) per channel (exactly order 1, never
- * negative) and a warmer sun `el` degrees up, azimuth 40, of 4 times the
- * sky's horizontal irradiance (a pi 4 / 3) in the mean. */
+ * negative) and a warmer sun `el` degrees up, azimuth 40: 4 times the
+ * sky's horizontal irradiance (a pi 4 / 3) per channel, times 1.3 in red
+ * and green and 0.8 in blue. */
 static void gradient_sky(double el_deg, struct sb_bounce_lighting *light)
 {
     const double a[3] = {0.30, 0.45, 0.80}, warm[3] = {1.3, 1.3, 0.8}, el = el_deg * M_PI / 180, az = 40 * M_PI / 180;
