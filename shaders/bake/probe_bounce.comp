@@ -119,7 +119,8 @@ void main()
             }
         barrier();
     }
-    for (int m = 0; m < SB_BOUNCE_SH; m++) {
+    // M comes only from a pass over the first slice (its other passes add nothing)
+    for (int m = 0; m < SB_BOUNCE_SH && first == 0u; m++) {
         for (int j = 0; j < SB_BOUNCE_SH; j++)
             for (int c = 0; c < 3; c++)
                 partial[3 * j + c][lane] = op[m][j][c];
