@@ -194,7 +194,9 @@ enum sb_result sb_bake_scene(struct sb_vk *vk, const struct sb_scene *scene, con
             a->probes = was->probes; /* its columns and sight masks move with it */
             old->artifacts[p].probes.columns = NULL;
             old->artifacts[p].probes.sight = NULL;
+            old->artifacts[p].probes.tiles = NULL;
             old->artifacts[p].probes.column_count = 0;
+            old->artifacts[p].probes.tile_count = 0;
             baked[p] = old->images[p];
             old->images[p] = (struct sb_image){0};
             if ((family->adopt && (res = family->adopt(state, id, &baked[p]))) ||
@@ -213,6 +215,8 @@ enum sb_result sb_bake_scene(struct sb_vk *vk, const struct sb_scene *scene, con
             continue;
         }
 
+        if (reuse && old->present[id] && family->previous)
+            family->previous(state, id, &old->artifacts[p], &old->images[p]);
         double t0 = 1e3 * sb_now_s();
         struct sb_image *image = &baked[p];
         if ((res = family->bake(state, vk, scene, id, baked, image, a))) {

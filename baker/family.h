@@ -47,6 +47,11 @@ struct sb_family_baker {
     /* A product reused from an older pack, for the family's later bakes
      * that read it; NULL when they read baked[] only. */
     enum sb_result (*adopt)(void *state, enum sb_product_id id, const struct sb_image *image);
+    /* A product of the older pack there (verified, baked on this device)
+     * whose key changed, offered before bake(): a family that can keep
+     * parts of it (the probes' tiles) takes what it needs, moving *image
+     * out; NULL: none kept. */
+    void (*previous)(void *state, enum sb_product_id id, struct sb_artifact *was, struct sb_image *image);
     /* The kernels bake() makes for `id`, at most SB_FAMILY_KERNELS_MAX;
      * returns their count. bake.c compiles every product's at once, on
      * every core, before the first bake (sb_pipelines_prepare): a driver's

@@ -62,6 +62,9 @@ static void usage(FILE *f)
                "options:\n"
                "  -o, --output DIR    the pack to write (required)\n"
                "  --force             bake every product, reusing nothing\n"
+               "  --tile X,Z          bake this tile of the probes alone (repeatable; probes.tile_m):\n"
+               "                      the pack's other tiles are kept where their keys held, else left\n"
+               "                      unbaked (invalid) for another bake into the same pack\n"
                "  --device NAME|INDEX Vulkan device by index or name substring\n"
                "                      (default: first discrete GPU, else the first device)\n"
                "  --threads N         CPU threads for the BVH build and the CPU steps\n"
@@ -189,6 +192,8 @@ static int cmd_bake(int argc, char **argv)
 {
     const char *scene_path = NULL, *out_dir = NULL;
     struct sb_bake_options options = {0};
+    int32_t tiles[SB_PROBES_MAX_ONLY_TILES][2];
+    int tile_count = 0;
     struct sb_vk_params params = sb_vk_params_from_env();
     bool json = false;
     for (int i = 0; i < argc; i++) {
@@ -202,7 +207,18 @@ static int cmd_bake(int argc, char **argv)
             out_dir = argv[++i];
         else if (!strcmp(a, "--force"))
             options.force = true;
-        else if (a[0] == '-' && a[1]) {
+        else if (!strcmp(a, "--tile") && i + 1 < argc) {
+            long x, z;
+            char end;
+            if (tile_count == SB_PROBES_MAX_ONLY_TILES || sscanf(argv[++i], "%ld,%ld%c", &x, &z, &end) != 2 ||
+                labs(x) > 1000000 || labs(z) > 1000000) {
+                fprintf(stderr, "skybake: --tile takes X,Z (a tile's integer coordinates, probes.tile_m apart from 0), "
+                                "at most %d times\n", SB_PROBES_MAX_ONLY_TILES);
+                return EXIT_USAGE;
+            }
+            tiles[tile_count][0] = (int32_t)x;
+            tiles[tile_count++][1] = (int32_t)z;
+        } else if (a[0] == '-' && a[1]) {
             fprintf(stderr, "skybake: unknown or incomplete option '%s'\n", a);
             usage(stderr);
             return EXIT_USAGE;
@@ -222,6 +238,13 @@ static int cmd_bake(int argc, char **argv)
     struct sb_scene scene;
     if (sb_scene_load(scene_path, &scene))
         return EXIT_USAGE;
+    if (tile_count && !(scene.probes.tile_m > 0 && (scene.wants[SB_PRODUCT_SKY_VISIBILITY] ||
+                                                      scene.wants[SB_PRODUCT_SKY_BOUNCE]))) {
+        fprintf(stderr, "skybake: --tile: %s bakes no probes in tiles (probes.tile_m)\n", scene_path);
+        return EXIT_USAGE;
+    }
+    scene.probes.only_tile_count = tile_count;
+    memcpy(scene.probes.only_tiles, tiles, sizeof(tiles[0]) * (size_t)tile_count);
 
     struct sb_vk *vk = NULL;
     enum sb_result res = sb_vk_create(&params, &vk);

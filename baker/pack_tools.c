@@ -76,6 +76,22 @@ static cJSON *info_json(const struct sb_pack *pack, const char *dir)
             cJSON_AddStringToObject(o, "world_hash", a->world_hash);
             cJSON_AddStringToObject(o, "world_path", a->world_path);
         }
+        if (a->probes.tile_count) { /* each tile, for a farm that splits a level */
+            cJSON *tiles = cJSON_AddArrayToObject(o, "tiles");
+            for (uint32_t t = 0; t < a->probes.tile_count; t++) {
+                const struct sb_probe_tile *tile = &a->probes.tiles[t];
+                cJSON *e = cJSON_CreateObject();
+                char content[17];
+                snprintf(content, sizeof(content), "%016llx", (unsigned long long)tile->content);
+                cJSON_AddNumberToObject(e, "x", tile->x);
+                cJSON_AddNumberToObject(e, "z", tile->z);
+                cJSON_AddNumberToObject(e, "probes", tile->probes);
+                cJSON_AddBoolToObject(e, "baked", tile->flags & SB_PROBES_TILE_BAKED);
+                cJSON_AddStringToObject(e, "key", tile->key);
+                cJSON_AddStringToObject(e, "content", content);
+                cJSON_AddItemToArray(tiles, e);
+            }
+        }
         cJSON_AddItemToArray(artifacts, o);
     }
     return root;
@@ -109,6 +125,15 @@ void sb_pack_info_print(const struct sb_pack *pack, const char *dir, bool json)
         if (a->world_hash[0])
             printf("%-18s baked against the world %s (%s)\n", "", a->world_path[0] ? a->world_path : "(path unknown)",
                    a->world_hash);
+        if (a->probes.tile_count) {
+            uint32_t baked = 0;
+            for (uint32_t t = 0; t < a->probes.tile_count; t++)
+                baked += a->probes.tiles[t].flags & SB_PROBES_TILE_BAKED;
+            printf("%-18s %u tiles of %g m (%u baked, %u left for another bake), rays reaching %g m; --json lists "
+                   "them\n",
+                   "", a->probes.tile_count, (double)a->probes.tile_m, baked, a->probes.tile_count - baked,
+                   (double)a->probes.reach_m);
+        }
     }
 }
 

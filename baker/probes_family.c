@@ -14,6 +14,7 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <xxhash.h>
 
 #include "bvh.h"
 #include "family.h"
@@ -25,6 +26,8 @@
 #include "parallel.h"
 #include "probe_detail.h"
 #include "probe_sight.h"
+#include "probe_tiles.h"
+#include "skybake_version.h"
 #include "raycast.h"
 #include "sh.h"
 #include "sky_bounce.h"
@@ -54,7 +57,19 @@ struct probes_state {
     /* the detail's brick columns, placed by the first bake that needs them */
     struct sb_probe_layout detail;
     bool detail_placed;
+    /* tiles: what the level places where (made by the first bake), and
+     * each product as the pack there before held it (probes_previous) */
+    struct sb_level_regions regions;
+    bool regions_made;
+    struct sb_probe_layout prev_layout[2]; /* sky_visibility, sky_bounce */
+    struct sb_image prev_image[2];
 };
+
+/* The probe products' index in probes_state's arrays. */
+static int slot(enum sb_product_id id)
+{
+    return id == SB_PRODUCT_SKY_BOUNCE;
+}
 
 static enum sb_result plan(const struct sb_scene *scene, const struct sb_level *level, bool say,
                            struct sb_probe_layout *layout, uint64_t *grid_out);
@@ -88,21 +103,30 @@ static void probes_destroy(void **state)
         sb_raycaster_destroy(&st->rc);
         sb_bvh_finish(&st->bvh);
         sb_probe_layout_finish(&st->detail);
+        sb_level_regions_finish(&st->regions);
+        for (int i = 0; i < 2; i++) {
+            sb_probe_layout_finish(&st->prev_layout[i]);
+            sb_image_finish(&st->prev_image[i]);
+        }
         sb_level_release(&st->level);
     }
     free(st);
     *state = NULL;
 }
 
-/* The world as it was read (every vertex, index, material and albedo after
- * the placement: a glTF's external buffers and a linked file included),
- * not the file's bytes; the probe settings; the kernel. */
-static void probes_key(void *state, const struct sb_scene *scene, enum sb_product_id id, struct sb_key_text *key)
+/* How far the probes' rays reach (0: unlimited): the scene's, else a
+ * quarter of its tiles. */
+static double reach_of(const struct sb_probe_params *p)
 {
-    const struct probes_state *st = state;
+    return p->reach_m > 0 ? p->reach_m : p->tile_m > 0 ? p->tile_m / 4 : 0;
+}
+
+/* What a probe product depends on but the world: the probe settings and
+ * the kernels (a tile's key adds what of the world its probes see). */
+static void key_settings(const struct sb_scene *scene, enum sb_product_id id, struct sb_key_text *key)
+{
     const struct sb_probe_params *p = &scene->probes;
     char code[SB_HASH_HEX_SIZE];
-    sb_key_add(key, " recipe %d world %s bvh %d", PROBES_RECIPE, st->mesh_hash, SB_BVH_VERSION);
     sb_key_add(key, " spacing_m=%a margin_m=%a rays=%u inside=%a", p->spacing_m, p->margin_m, p->rays,
                p->inside_fraction);
     if (p->has_bounds) {
@@ -122,6 +146,8 @@ static void probes_key(void *state, const struct sb_scene *scene, enum sb_produc
             sb_key_add3(key, p->detail_volumes[i].detail ? "force_max" : "forbid_max", p->detail_volumes[i].max_m);
         }
     }
+    if (p->tile_m > 0 || p->reach_m > 0) /* likewise */
+        sb_key_add(key, " tile_m=%a reach_m=%a", p->tile_m, reach_of(p));
     sb_sky_visibility_code_hash(code);
     sb_key_add(key, " code %s", code);
     if (p->detail_spacing_m > 0) { /* the detail's sight masks */
@@ -136,15 +162,53 @@ static void probes_key(void *state, const struct sb_scene *scene, enum sb_produc
     }
 }
 
+/* The world as it was read (every vertex, index, material and albedo after
+ * the placement: a glTF's external buffers and a linked file included),
+ * not the file's bytes; the probe settings; the kernel; the tiles a bake
+ * of some tiles alone bakes. */
+static void probes_key(void *state, const struct sb_scene *scene, enum sb_product_id id, struct sb_key_text *key)
+{
+    const struct probes_state *st = state;
+    sb_key_add(key, " recipe %d world %s bvh %d", PROBES_RECIPE, st->mesh_hash, SB_BVH_VERSION);
+    key_settings(scene, id, key);
+    for (int i = 0; i < scene->probes.only_tile_count; i++)
+        sb_key_add(key, " only_tile=%d,%d", scene->probes.only_tiles[i][0], scene->probes.only_tiles[i][1]);
+}
+
+static void probes_previous(void *state, enum sb_product_id id, struct sb_artifact *was, struct sb_image *image)
+{
+    struct probes_state *st = state;
+    int i = slot(id);
+    if (!was->probes.tile_count)
+        return; /* nothing to keep but whole products (bake.c) */
+    sb_probe_layout_finish(&st->prev_layout[i]);
+    sb_image_finish(&st->prev_image[i]);
+    if (sb_probe_layout_copy(&st->prev_layout[i], &was->probes))
+        return; /* out of memory: every tile is baked */
+    st->prev_image[i] = *image;
+    *image = (struct sb_image){0};
+}
+
 static uint32_t probes_depends_on(enum sb_product_id id)
 {
     return id == SB_PRODUCT_SKY_BOUNCE ? 1u << SB_PRODUCT_SKY_VISIBILITY : 0;
 }
 
-static enum sb_result raycaster(struct probes_state *st, struct sb_vk *vk)
+/* The level's BVH on the device; under tiles its wide instances flagged
+ * (probe_tiles.h: what every tile sees at any distance). */
+static enum sb_result raycaster(struct probes_state *st, const struct sb_scene *scene, struct sb_vk *vk)
 {
     enum sb_result res = SB_OK;
-    if (!st->rc && !(res = sb_level_build_bvh(st->level, &st->bvh)))
+    if (st->rc)
+        return SB_OK;
+    if (scene->probes.tile_m > 0 && !st->regions_made &&
+        !(res = sb_level_regions_make(st->level, 2 * scene->probes.tile_m, &st->regions)))
+        st->regions_made = true;
+    if (!res)
+        res = sb_level_build_bvh(st->level, &st->bvh);
+    if (!res && st->regions_made)
+        sb_level_regions_mark(&st->regions, &st->bvh);
+    if (!res)
         res = sb_raycaster_create(vk, &st->bvh, &st->rc);
     return res;
 }
@@ -182,14 +246,19 @@ static uint64_t grid_at(const struct sb_probe_params *p, const float lo[3], cons
             continue;
         }
         double extent = (double)hi[k] - lo[k] + 2 * p->margin_m;
-        double n = floor(extent / spacing) + 1;
+        double n = floor(extent / spacing) + 1, first = 0;
+        if (p->tile_m > 0) { /* on multiples of the spacing: a grid that moves rebakes every tile */
+            first = floor(((double)lo[k] - p->margin_m) / spacing);
+            n = ceil(((double)hi[k] + p->margin_m) / spacing) - first + 1;
+        }
         if (n > SB_PROBES_MAX_GRID) {
             *axis = k;
             return 0;
         }
         layout->grid[k] = (uint32_t)n;
         layout->spacing_m[k] = (float)spacing;
-        layout->origin_m[k] = (float)(0.5 * ((double)lo[k] + hi[k]) - 0.5 * (n - 1) * spacing);
+        layout->origin_m[k] = p->tile_m > 0 ? (float)(first * spacing)
+                                            : (float)(0.5 * ((double)lo[k] + hi[k]) - 0.5 * (n - 1) * spacing);
         grid *= (uint64_t)n;
     }
     return grid;
@@ -316,11 +385,23 @@ static enum sb_result column_surfaces(const struct probes_state *st, const struc
     return res;
 }
 
+/* The detail's spacings a budget coarsens to: the scene's times 2^(k /
+ * DETAIL_LEVELS), k >= 1. Levels rather than any spacing that fits keep
+ * the spacing where it was when a house moves (the count moves a little;
+ * the spacing, and with it every tile's key, stays unless the count
+ * crosses a level), and the search short. */
+#define DETAIL_LEVELS 16
+
+static double detail_level(double spacing, int k)
+{
+    return spacing * exp2((double)k / DETAIL_LEVELS);
+}
+
 /*
  * The detail's brick columns (probe_detail.h), once a bake: at the scene's
- * spacing, coarsened until they fit what the budget leaves after the
- * grid's and the explicit probes' `taken` bytes (and none when nothing is
- * left), saying so.
+ * spacing, else under a budget at the finest level (detail_level) whose
+ * probes fit what the budget leaves after the grid's and the explicit
+ * probes' `taken` bytes (none when nothing is left), saying so.
  */
 static enum sb_result place_detail(struct probes_state *st, const struct sb_scene *scene, uint64_t taken)
 {
@@ -328,59 +409,80 @@ static enum sb_result place_detail(struct probes_state *st, const struct sb_scen
     if (st->detail_placed || p->detail_spacing_m <= 0)
         return SB_OK;
     /* a detail probe's records and its sight mask */
-    double spacing = p->detail_spacing_m, per = (double)probe_bytes(scene) + 4.0 * SB_PROBES_SIGHT_WORDS;
+    double per = (double)probe_bytes(scene) + 4.0 * SB_PROBES_SIGHT_WORDS;
     double left = p->budget_mb > 0 ? p->budget_mb * 1e6 - (double)taken * (double)probe_bytes(scene) : INFINITY;
     enum sb_result res = SB_OK;
     if (left < per * SB_PROBES_BRICK * SB_PROBES_BRICK) {
         sb_warn("probes: the grid takes all of probes.budget_mb (%g): no detail", p->budget_mb);
-    } else {
-        double t0 = sb_now_s();
-        bool budget = p->budget_mb > 0;
-        res = sb_probe_detail_place(st->rc, &st->bvh, st->level, p, spacing, budget, &st->detail);
-        /* under a budget, past the file's caps is over the budget too */
-        bool capped = budget && res == SB_ERR_TOO_LARGE;
-        char first[64]; /* what the scene's spacing would take */
-        if (capped)
-            snprintf(first, sizeof(first), "more than a probe file holds");
-        else
-            snprintf(first, sizeof(first), "%.3g MB", st->detail.detail_count * per / 1e6);
-        double over = 0.0; /* the widest spacing found over the budget */
-        for (int step = 0; step < 100 && (capped || (!res && st->detail.detail_count * per > left)); step++) {
-            /* a surface's bricks go with the spacing's square, a room's
-             * with its cube; past a cap, the count is not known */
-            double ratio = capped ? 1.5 : pow(st->detail.detail_count * per / left, 1.0 / 3.0);
-            over = spacing;
-            spacing *= ratio > 1.02 ? ratio : 1.02;
-            sb_probe_layout_finish(&st->detail);
-            res = sb_probe_detail_place(st->rc, &st->bvh, st->level, p, spacing, budget, &st->detail);
-            capped = budget && res == SB_ERR_TOO_LARGE;
-        }
-        /* The count is not monotonic in the spacing (brick columns snap to
-         * the lattice): between the last spacing over the budget and the
-         * first within it, bisection finds a narrower one that fits (the
-         * test level: 2.61 m became 2.0x m) */
-        for (int step = 0; step < 6 && !res && over > 0.0 && st->detail.detail_count * per <= left; step++) {
-            double mid = 0.5 * (over + spacing);
+        st->detail_placed = true;
+        return SB_OK;
+    }
+    double t0 = sb_now_s();
+    bool budget = p->budget_mb > 0;
+    int placements = 1;
+    res = sb_probe_detail_place(st->rc, &st->bvh, st->level, p, p->detail_spacing_m, budget, &st->detail);
+    /* under a budget, past the file's caps is over the budget too */
+    bool capped = budget && res == SB_ERR_TOO_LARGE;
+    char first[64]; /* what the scene's spacing would take */
+    if (capped)
+        snprintf(first, sizeof(first), "more than a probe file holds");
+    else
+        snprintf(first, sizeof(first), "%.3g MB", st->detail.detail_count * per / 1e6);
+    int level = 0;
+    if (capped || (!res && st->detail.detail_count * per > left)) {
+        res = SB_OK;
+        /* the first guess: a surface's bricks go with the spacing's
+         * square, a room's with its cube; past a cap, the count is not
+         * known: half an octave */
+        double ratio = capped ? M_SQRT2 : cbrt(st->detail.detail_count * per / left);
+        int k = (int)fmax(1.0, ceil(DETAIL_LEVELS * log2(ratio)));
+        int fits = 0, over = 0; /* the finest level found to fit, the coarsest found over (0: none) */
+        struct sb_probe_layout found = {0};
+        /* up from the guess until a level fits, then down until one does
+         * not: the finest level that fits next to one that does not (the
+         * count is not monotonic in the spacing: brick columns snap to
+         * the lattice) */
+        for (int step = 0; step < 8 * DETAIL_LEVELS && k >= 1 && !(fits && over && fits == over + 1); step++) {
             struct sb_probe_layout trial = {0};
-            enum sb_result r = sb_probe_detail_place(st->rc, &st->bvh, st->level, p, mid, budget, &trial);
+            enum sb_result r = sb_probe_detail_place(st->rc, &st->bvh, st->level, p, detail_level(p->detail_spacing_m, k),
+                                                     budget, &trial);
+            placements++;
             if (r && r != SB_ERR_TOO_LARGE) {
                 res = r;
-            } else if (!r && trial.detail_count * per <= left) {
-                sb_probe_layout_finish(&st->detail);
-                st->detail = trial;
-                spacing = mid;
-            } else {
-                sb_probe_layout_finish(&trial);
-                over = mid;
+                break;
             }
+            if (!r && trial.detail_count * per <= left) {
+                sb_probe_layout_finish(&found);
+                found = trial;
+                fits = k--;
+            } else {
+                /* up by the count's square root (a surface's bricks), at
+                 * least a level; past a cap, half an octave */
+                double step_up = r ? 0.5 * DETAIL_LEVELS : ceil(DETAIL_LEVELS * 0.5 * log2(trial.detail_count * per / left));
+                sb_probe_layout_finish(&trial);
+                over = k;
+                if (fits)
+                    break; /* the level under the finest fit is over */
+                k += (int)fmax(1.0, step_up);
+            }
+            if (k < 1)
+                break;
         }
-        if (!res && spacing != p->detail_spacing_m)
-            sb_warn("probes: detail %g m apart would take %s, over what probes.budget_mb (%g) leaves after the "
-                    "grid (%.3g MB): %.3g m apart instead, %u probes, %.3g MB",
-                    p->detail_spacing_m, first, p->budget_mb, left / 1e6, spacing, st->detail.detail_count,
-                    st->detail.detail_count * per / 1e6);
-        sb_debug("probes: detail placed in %.1f ms", 1e3 * (sb_now_s() - t0));
+        sb_probe_layout_finish(&st->detail);
+        if (!res && !fits) {
+            sb_error("probes: no detail spacing up to %g m fits probes.budget_mb (%g)",
+                     detail_level(p->detail_spacing_m, 8 * DETAIL_LEVELS), p->budget_mb);
+            res = SB_ERR_TOO_LARGE;
+        }
+        st->detail = found;
+        level = fits;
     }
+    if (!res && level)
+        sb_warn("probes: detail %g m apart would take %s, over what probes.budget_mb (%g) leaves after the "
+                "grid (%.3g MB): %.3g m apart instead, %u probes, %.3g MB",
+                p->detail_spacing_m, first, p->budget_mb, left / 1e6, detail_level(p->detail_spacing_m, level),
+                st->detail.detail_count, st->detail.detail_count * per / 1e6);
+    sb_debug("probes: detail placed in %.1f ms (%d placements)", 1e3 * (sb_now_s() - t0), placements);
     st->detail_placed = !res;
     return res;
 }
@@ -452,14 +554,15 @@ static enum sb_result place(struct probes_state *st, const struct sb_scene *scen
 /*
  * Probes with more back-face hits than the scene allows sit inside
  * geometry: try the candidate offsets, all in one batch of few rays, and
- * move each to the first that is free; flag the rest invalid.
+ * move each to the first that is free; flag the rest invalid. unit[i]:
+ * the spacing of the probes around probe i (the steps scale with it), its
+ * sign whether it is a detail probe.
  */
-static enum sb_result push_out(struct sb_raycaster *rc, const struct sb_scene *scene,
-                               const struct sb_probe_layout *layout, float *positions, float *offsets, float *valid,
-                               const float *results, uint32_t count, uint32_t *inside, uint32_t *pushed, double *gpu_ms)
+static enum sb_result push_out(struct sb_raycaster *rc, const struct sb_scene *scene, const float *unit,
+                               float *positions, float *offsets, float *valid, const float *results, uint32_t count,
+                               uint32_t *inside, uint32_t *pushed, double *gpu_ms)
 {
     const int per = 26 * (int)(sizeof(push_steps) / sizeof(push_steps[0]));
-    const uint64_t grid = (uint64_t)layout->grid[0] * layout->grid[1] * layout->grid[2];
     uint32_t *which = NULL, n = 0;
     float *candidates = NULL, *trial = NULL;
     enum sb_result res = SB_OK;
@@ -484,23 +587,22 @@ static enum sb_result push_out(struct sb_raycaster *rc, const struct sb_scene *s
             which[n++] = i;
     for (uint32_t j = 0; j < n; j++) {
         int c = 0;
-        /* the steps scale with the spacing of the probes around it */
-        bool detail = which[j] >= grid && which[j] < grid + layout->detail_count;
-        double unit = detail ? layout->detail_spacing_m : scene->probes.spacing_m > 0 ? scene->probes.spacing_m : 1.0;
+        bool detail = unit[which[j]] < 0;
+        double size = fabs((double)unit[which[j]]);
         for (size_t s = 0; s < sizeof(push_steps) / sizeof(push_steps[0]); s++)
             for (int d = 0; d < 27; d++) {
                 if (d == 13)
                     continue; /* the probe itself */
                 int dx = d % 3 - 1, dy = d / 3 % 3 - 1, dz = d / 9 - 1;
                 double len = sqrt((double)(dx * dx + dy * dy + dz * dz)),
-                       step = (detail ? detail_push_steps : push_steps)[s] * unit / len;
+                       step = (detail ? detail_push_steps : push_steps)[s] * size / len;
                 float *q = &candidates[3 * ((size_t)j * per + c++)];
                 q[0] = (float)(positions[3 * (size_t)which[j]] + dx * step);
                 q[1] = (float)(positions[3 * (size_t)which[j] + 1] + dy * step);
                 q[2] = (float)(positions[3 * (size_t)which[j] + 2] + dz * step);
             }
     }
-    struct sb_sky_visibility_params quick = {.ray_count = PUSH_RAYS};
+    struct sb_sky_visibility_params quick = {.ray_count = PUSH_RAYS, .tmax_m = (float)reach_of(&scene->probes)};
     if ((res = sb_sky_visibility_bake(rc, candidates, n * per, &quick, trial, gpu_ms)))
         goto done;
     for (uint32_t j = 0; j < n; j++)
@@ -541,115 +643,406 @@ static void dering_one(void *user, int i)
     job->window[i] = sb_sh9_dering(job->sh[i], &job->before[i]);
 }
 
-static enum sb_result bake_visibility(struct probes_state *st, const struct sb_scene *scene, struct sb_image *image,
-                                      struct sb_artifact *a)
+/*
+ * A bake's tiles (docs/probes.md, "Tiles"): each tile's key, whether it is
+ * cast, kept from the pack there before (its key unchanged) or left
+ * unbaked (a bake of other tiles alone), and the probes to cast.
+ */
+enum tile_fate { TILE_CAST, TILE_KEPT, TILE_LEFT };
+
+struct tile_plan {
+    struct sb_probe_tiling tiling, prev; /* count 0: no tiles */
+    uint8_t *fate;                       /* per tile */
+    uint32_t *prev_tile;                 /* per kept tile: its index in the pack before */
+    uint32_t *cast, cast_count;          /* the probes to cast, increasing */
+    uint32_t counts[3];                  /* tiles by fate */
+};
+
+static void tile_plan_finish(struct tile_plan *plan)
+{
+    sb_probe_tiling_finish(&plan->tiling);
+    sb_probe_tiling_finish(&plan->prev);
+    free(plan->fate);
+    free(plan->prev_tile);
+    free(plan->cast);
+    memset(plan, 0, sizeof(*plan));
+}
+
+/* Tile t's bake key: the product's settings without the world, the tile,
+ * the `stride` floats of each of its probes at what[] (where they stand
+ * before any push out; the bounce: their visibility records), and the
+ * world within `margin` of them. */
+static void tile_key(struct probes_state *st, const struct sb_scene *scene, enum sb_product_id id,
+                     const struct sb_probe_layout *layout, const struct tile_plan *plan, uint32_t t,
+                     const float *what, uint32_t stride, double margin, char out[33])
+{
+    const struct sb_probe_tiling *tiling = &plan->tiling;
+    uint64_t grid = (uint64_t)layout->grid[0] * layout->grid[1] * layout->grid[2];
+    double lo[2] = {INFINITY, INFINITY}, hi[2] = {-INFINITY, -INFINITY};
+    uint32_t grid_probes = 0;
+    XXH3_state_t *h = XXH3_createState();
+    if (!h) {
+        memset(out, '0', 32);
+        out[32] = '\0';
+        return;
+    }
+    XXH3_128bits_reset(h);
+    for (uint32_t j = tiling->first[t]; j < tiling->first[t + 1]; j++) {
+        uint32_t i = tiling->order[j];
+        const float *w = &what[(size_t)i * stride];
+        grid_probes += i < grid;
+        XXH3_128bits_update(h, w, stride * sizeof(float));
+        lo[0] = fmin(lo[0], w[0]);
+        hi[0] = fmax(hi[0], w[0]);
+        lo[1] = fmin(lo[1], w[2]);
+        hi[1] = fmax(hi[1], w[2]);
+    }
+    XXH128_hash_t probes = XXH3_128bits_digest(h);
+    XXH3_freeState(h);
+    for (int k = 0; k < 2; k++) {
+        lo[k] -= margin;
+        hi[k] += margin;
+    }
+    char world[33];
+    sb_level_region_hash(&st->regions, lo, hi, world);
+    struct sb_key_text key = {.length = 0};
+    sb_key_add(&key, "skybake-probe-tile-v1 format %d skybake %s product %s stored %s recipe %d bvh %d",
+               SB_PACK_FORMAT_VERSION, SKYBAKE_VERSION, sb_product_name(id), sb_product_format(id)->pixel_type,
+               PROBES_RECIPE, SB_BVH_VERSION);
+    key_settings(scene, id, &key);
+    sb_key_add(&key, " tile %d %d of %a: %u probes, %u of the grid, detail %a apart, at %016llx%016llx, world %s",
+               layout->tiles[t].x, layout->tiles[t].z, (double)layout->tile_m, tiling->first[t + 1] - tiling->first[t],
+               grid_probes, (double)layout->detail_spacing_m, (unsigned long long)probes.high64,
+               (unsigned long long)probes.low64, world);
+    sb_hash_bytes(key.text, key.length < sizeof(key.text) ? key.length : sizeof(key.text) - 1, out);
+}
+
+/* The tile of the pack before at x, z, or -1. */
+static int64_t find_tile(const struct sb_probe_layout *layout, int32_t x, int32_t z)
+{
+    uint32_t lo = 0, hi = layout->tile_count;
+    while (lo < hi) {
+        uint32_t mid = lo + (hi - lo) / 2;
+        const struct sb_probe_tile *t = &layout->tiles[mid];
+        if (t->z < z || (t->z == z && t->x < x))
+            lo = mid + 1;
+        else
+            hi = mid;
+    }
+    return lo < layout->tile_count && layout->tiles[lo].x == x && layout->tiles[lo].z == z ? (int64_t)lo : -1;
+}
+
+/*
+ * Plan a bake of `count` probes: without tiles, cast them all; with, key
+ * each tile (tile_key), keep those the pack before baked under the same
+ * key, leave those a bake of some tiles alone does not name, and cast the
+ * rest.
+ */
+static enum sb_result plan_tiles(struct probes_state *st, const struct sb_scene *scene, enum sb_product_id id,
+                                 struct sb_probe_layout *layout, uint32_t count, const float *what, uint32_t stride,
+                                 double margin, struct tile_plan *plan)
+{
+    const struct sb_probe_params *p = &scene->probes;
+    memset(plan, 0, sizeof(*plan));
+    enum sb_result res = SB_OK;
+    if (p->tile_m > 0) {
+        res = sb_probe_tiling_make(layout, (float)p->tile_m, count, &plan->tiling);
+        if (!res && !(plan->fate = calloc(plan->tiling.count, 1)))
+            res = SB_ERR_NOMEM;
+        if (!res && !(plan->prev_tile = calloc(plan->tiling.count, sizeof(*plan->prev_tile))))
+            res = SB_ERR_NOMEM;
+        if (res) {
+            tile_plan_finish(plan);
+            return res;
+        }
+        layout->reach_m = (float)reach_of(p);
+        struct sb_probe_layout *prev = &st->prev_layout[slot(id)];
+        const struct sb_image *prev_image = &st->prev_image[slot(id)];
+        /* the pack before's tiles as its reader checked them: the same
+         * assignment, its own tile records left as they were */
+        struct sb_probe_layout assigned = *prev;
+        assigned.tiles = NULL;
+        bool have_prev = prev->tile_count && prev->tile_m == layout->tile_m && prev_image->width &&
+                         prev_image->channel_count == sb_product_format(id)->channel_count &&
+                         !sb_probe_tiling_make(&assigned, prev->tile_m, prev_image->width, &plan->prev) &&
+                         plan->prev.count == prev->tile_count;
+        free(assigned.tiles);
+        for (uint32_t t = 0; t < plan->tiling.count; t++) {
+            struct sb_probe_tile *tile = &layout->tiles[t];
+            tile_key(st, scene, id, layout, plan, t, what, stride, margin, tile->key);
+            int64_t was = have_prev ? find_tile(prev, tile->x, tile->z) : -1;
+            bool named = !p->only_tile_count;
+            for (int i = 0; i < p->only_tile_count; i++)
+                named |= p->only_tiles[i][0] == tile->x && p->only_tiles[i][1] == tile->z;
+            if (was >= 0 && (prev->tiles[was].flags & SB_PROBES_TILE_BAKED) && prev->tiles[was].probes == tile->probes &&
+                !strcmp(prev->tiles[was].key, tile->key)) {
+                plan->fate[t] = TILE_KEPT;
+                plan->prev_tile[t] = (uint32_t)was;
+            } else {
+                plan->fate[t] = named ? TILE_CAST : TILE_LEFT;
+            }
+            plan->counts[plan->fate[t]]++;
+        }
+        for (int i = 0; i < p->only_tile_count; i++) {
+            bool found = false;
+            for (uint32_t t = 0; t < plan->tiling.count && !found; t++)
+                found = p->only_tiles[i][0] == layout->tiles[t].x && p->only_tiles[i][1] == layout->tiles[t].z;
+            if (!found)
+                sb_warn("%s: --tile %d,%d holds no probe (tiles of %g m from x = z = 0)", sb_product_name(id),
+                        p->only_tiles[i][0], p->only_tiles[i][1], p->tile_m);
+        }
+    }
+    if (!(plan->cast = malloc((count ? count : 1) * sizeof(*plan->cast)))) {
+        tile_plan_finish(plan);
+        return SB_ERR_NOMEM;
+    }
+    for (uint32_t i = 0; i < count; i++)
+        if (!plan->tiling.count || plan->fate[plan->tiling.tile_of[i]] == TILE_CAST)
+            plan->cast[plan->cast_count++] = i;
+    return SB_OK;
+}
+
+/* The records (and a visibility's sight masks) of the tiles kept, from
+ * the pack before into image and layout, and each tile's flags and
+ * content (the others' keys cleared). */
+static void finish_tiles(struct probes_state *st, enum sb_product_id id, const struct tile_plan *plan,
+                         struct sb_probe_layout *layout, struct sb_image *image, bool half)
+{
+    const struct sb_probe_layout *prev = &st->prev_layout[slot(id)];
+    const struct sb_image *prev_image = &st->prev_image[slot(id)];
+    uint64_t grid = (uint64_t)layout->grid[0] * layout->grid[1] * layout->grid[2];
+    uint64_t prev_grid = (uint64_t)prev->grid[0] * prev->grid[1] * prev->grid[2];
+    uint32_t channels = image->channel_count;
+    for (uint32_t t = 0; t < plan->tiling.count; t++) {
+        struct sb_probe_tile *tile = &layout->tiles[t];
+        if (plan->fate[t] == TILE_KEPT) {
+            uint32_t was = plan->prev_tile[t];
+            for (uint32_t j = 0; j < tile->probes; j++) {
+                uint32_t to = plan->tiling.order[plan->tiling.first[t] + j];
+                uint32_t from = plan->prev.order[plan->prev.first[was] + j];
+                memcpy(&image->data[(size_t)to * channels], &prev_image->data[(size_t)from * channels],
+                       channels * sizeof(float));
+                if (layout->sight && prev->sight && to >= grid && from >= prev_grid)
+                    memcpy(&layout->sight[(to - grid) * SB_PROBES_SIGHT_WORDS],
+                           &prev->sight[(from - prev_grid) * SB_PROBES_SIGHT_WORDS],
+                           SB_PROBES_SIGHT_WORDS * sizeof(*layout->sight));
+            }
+        }
+        if (plan->fate[t] == TILE_LEFT) {
+            tile->flags = 0;
+            tile->key[0] = '\0';
+            tile->content = 0;
+        } else {
+            tile->flags = SB_PROBES_TILE_BAKED;
+        }
+    }
+    for (uint32_t t = 0; t < plan->tiling.count; t++)
+        if (plan->fate[t] != TILE_LEFT)
+            layout->tiles[t].content = sb_probe_tile_content(layout, image, half,
+                                                             &plan->tiling.order[plan->tiling.first[t]],
+                                                             plan->tiling.first[t + 1] - plan->tiling.first[t]);
+}
+
+/* What the bake says of its tiles, in the log and the settings. */
+static void report_tiles(enum sb_product_id id, const struct tile_plan *plan, struct sb_artifact *a)
+{
+    if (!plan->tiling.count)
+        return;
+    sb_info("%s: %u tiles: %u baked, %u kept (their keys unchanged), %u left for another bake", sb_product_name(id),
+            plan->tiling.count, plan->counts[TILE_CAST], plan->counts[TILE_KEPT], plan->counts[TILE_LEFT]);
+    sb_settings_json_add(a->settings_json, sizeof(a->settings_json),
+                         ",\"tiles\":{\"count\":%u,\"baked\":%u,\"kept\":%u,\"left\":%u,\"side_m\":%.9g,"
+                         "\"reach_m\":%.9g}",
+                         plan->tiling.count, plan->counts[TILE_CAST], plan->counts[TILE_KEPT],
+                         plan->counts[TILE_LEFT], (double)a->probes.tile_m, (double)a->probes.reach_m);
+}
+
+/* The visibility bake's steps over the probes it casts (`n` of them, at
+ * positions[], unit[] as push_out reads it; lattice[] the detail probes'
+ * lattice points, NaN for the others): cast, push out, cast again where
+ * any moved, the detail's sight masks (into sight[], SB_PROBES_SIGHT_WORDS
+ * a probe, for the detail probes only), deringing. */
+struct cast {
+    uint32_t n;
+    float *positions, *unit, *lattice, *offsets, *valid, *results;
+    uint32_t *sight;
+    struct dering_job dering;
+    uint32_t inside, pushed;
+};
+
+static void cast_finish(struct cast *c)
+{
+    free(c->positions);
+    free(c->unit);
+    free(c->lattice);
+    free(c->offsets);
+    free(c->valid);
+    free(c->results);
+    free(c->sight);
+    free(c->dering.window);
+    free(c->dering.before);
+    free(c->dering.sh);
+}
+
+static enum sb_result cast_probes(struct probes_state *st, const struct sb_scene *scene, double detail_spacing,
+                                  struct cast *c, double *gpu_ms)
 {
     struct sb_raycaster *rc = st->rc;
-    float *positions = NULL, *offsets = NULL, *valid = NULL, *results = NULL;
-    uint32_t count = 0, inside = 0, pushed = 0, deringed = 0;
-    double lowest = 0, gpu_ms = 0;
-    struct sb_probe_layout *layout = &a->probes;
-    memset(layout, 0, sizeof(*layout));
-    enum sb_result res;
-    const struct sb_level *level = st->level;
-    double placed = sb_now_s();
-    if ((res = place(st, scene, layout, &positions, &count, true)))
-        goto done;
-    sb_debug("sky_visibility: %u probes placed in %.1f ms", count, 1e3 * (sb_now_s() - placed));
-    offsets = calloc((size_t)count * 3, sizeof(float));
-    valid = calloc(count, sizeof(float));
-    results = malloc((size_t)count * SB_VISIBILITY_FLOATS * sizeof(float));
-    if (!offsets || !valid || !results) {
-        res = SB_ERR_NOMEM;
-        goto done;
-    }
-    struct sb_sky_visibility_params params = {.ray_count = scene->probes.rays};
+    uint32_t n = c->n, detail = 0;
+    c->offsets = calloc((size_t)n * 3 + 1, sizeof(float));
+    c->valid = calloc((size_t)n + 1, sizeof(float));
+    c->results = malloc(((size_t)n * SB_VISIBILITY_FLOATS + 1) * sizeof(float));
+    c->dering.window = malloc(((size_t)n + 1) * sizeof(double));
+    c->dering.before = malloc(((size_t)n + 1) * sizeof(double));
+    c->dering.sh = malloc(((size_t)n + 1) * sizeof(double[SB_PROBE_SH]));
+    if (!c->offsets || !c->valid || !c->results || !c->dering.window || !c->dering.before || !c->dering.sh)
+        return SB_ERR_NOMEM;
+    c->dering.results = c->results;
+    if (!n)
+        return SB_OK;
+    struct sb_sky_visibility_params params = {.ray_count = scene->probes.rays,
+                                              .tmax_m = (float)reach_of(&scene->probes)};
     double ms = 0, t0 = sb_now_s(), t1, t2;
-    if ((res = sb_sky_visibility_bake(rc, positions, count, &params, results, &ms)))
-        goto done;
-    gpu_ms += ms;
+    enum sb_result res = sb_sky_visibility_bake(rc, c->positions, n, &params, c->results, &ms);
+    if (res)
+        return res;
+    *gpu_ms += ms;
     t1 = sb_now_s();
-    if ((res = push_out(rc, scene, layout, positions, offsets, valid, results, count, &inside, &pushed, &ms)))
-        goto done;
-    gpu_ms += inside ? ms : 0; /* every candidate place of every probe inside */
+    if ((res = push_out(rc, scene, c->unit, c->positions, c->offsets, c->valid, c->results, n, &c->inside, &c->pushed,
+                        &ms)))
+        return res;
+    *gpu_ms += c->inside ? ms : 0; /* every candidate place of every probe inside */
     t2 = sb_now_s();
-    if (pushed && (res = sb_sky_visibility_bake(rc, positions, count, &params, results, &ms)))
-        goto done;
-    gpu_ms += pushed ? ms : 0;
+    if (c->pushed && (res = sb_sky_visibility_bake(rc, c->positions, n, &params, c->results, &ms)))
+        return res;
+    *gpu_ms += c->pushed ? ms : 0;
     double t3 = sb_now_s();
-    if (layout->detail_count) { /* the detail's sight masks, from where its probes ended up */
-        uint64_t grid = (uint64_t)layout->grid[0] * layout->grid[1] * layout->grid[2];
-        float *lattice = malloc((size_t)layout->detail_count * 3 * sizeof(float));
-        layout->sight = malloc((size_t)layout->detail_count * SB_PROBES_SIGHT_WORDS * sizeof(*layout->sight));
-        if (!lattice || !layout->sight) {
-            free(lattice);
-            res = SB_ERR_NOMEM;
-            goto done;
-        }
-        sb_probe_detail_positions(layout, lattice);
-        res = sb_probe_sight_bake(rc, positions + 3 * grid, lattice, layout->detail_count, layout->detail_spacing_m,
-                                  layout->sight, &ms);
-        free(lattice);
+    for (uint32_t i = 0; i < n; i++)
+        detail += c->unit[i] < 0;
+    if (detail) { /* the detail's sight masks, from where its probes ended up */
+        float *from = malloc((size_t)detail * 3 * sizeof(float)), *to = malloc((size_t)detail * 3 * sizeof(float));
+        c->sight = malloc((size_t)detail * SB_PROBES_SIGHT_WORDS * sizeof(*c->sight));
+        res = from && to && c->sight ? SB_OK : SB_ERR_NOMEM;
+        for (uint32_t i = 0, d = 0; i < n && !res; i++)
+            if (c->unit[i] < 0) {
+                memcpy(&from[3 * (size_t)d], &c->positions[3 * (size_t)i], 3 * sizeof(float));
+                memcpy(&to[3 * (size_t)d++], &c->lattice[3 * (size_t)i], 3 * sizeof(float));
+            }
+        if (!res)
+            res = sb_probe_sight_bake(rc, from, to, detail, (float)detail_spacing, c->sight, &ms);
+        free(from);
+        free(to);
         if (res)
-            goto done;
-        gpu_ms += ms;
+            return res;
+        *gpu_ms += ms;
     }
     sb_debug("sky_visibility: %u probes cast in %.1f ms, %u inside tried at %u places each in %.1f ms, cast again "
              "in %.1f ms; %u sight masks in %.1f ms",
-             count, 1e3 * (t1 - t0), inside, 26 * (unsigned)(sizeof(push_steps) / sizeof(push_steps[0])),
-             1e3 * (t2 - t1), 1e3 * (t3 - t2), layout->detail_count, 1e3 * (sb_now_s() - t3));
-    if ((res = sb_image_init(image, count, 1, SB_SKY_VISIBILITY_CHANNEL_COUNT)))
+             n, 1e3 * (t1 - t0), c->inside, 26 * (unsigned)(sizeof(push_steps) / sizeof(push_steps[0])),
+             1e3 * (t2 - t1), 1e3 * (t3 - t2), detail, 1e3 * (sb_now_s() - t3));
+    double dering_t0 = sb_now_s();
+    sb_parallel_for((int)n, dering_one, &c->dering);
+    sb_debug("sky_visibility: deringing in %.1f ms", 1e3 * (sb_now_s() - dering_t0));
+    return SB_OK;
+}
+
+static enum sb_result bake_visibility(struct probes_state *st, const struct sb_scene *scene, struct sb_image *image,
+                                      struct sb_artifact *a)
+{
+    float *positions = NULL, *lattice = NULL;
+    uint32_t count = 0, deringed = 0, invalid = 0;
+    double lowest = 0, gpu_ms = 0;
+    struct sb_probe_layout *layout = &a->probes;
+    memset(layout, 0, sizeof(*layout));
+    struct tile_plan plan = {0};
+    struct cast c = {0};
+    const struct sb_probe_params *p = &scene->probes;
+    const struct sb_level *level = st->level;
+    double placed = sb_now_s();
+    enum sb_result res = place(st, scene, layout, &positions, &count, true);
+    if (res)
         goto done;
-    sb_image_set_channel_names(image, SB_SKY_VISIBILITY_CHANNELS);
-    struct dering_job job = {.results = results,
-                             .window = malloc(count * sizeof(double)),
-                             .before = malloc(count * sizeof(double)),
-                             .sh = malloc(count * sizeof(double[SB_PROBE_SH]))};
-    if (!job.window || !job.before || !job.sh) {
-        free(job.window);
-        free(job.before);
-        free(job.sh);
+    sb_debug("sky_visibility: %u probes placed in %.1f ms", count, 1e3 * (sb_now_s() - placed));
+    uint64_t grid = (uint64_t)layout->grid[0] * layout->grid[1] * layout->grid[2];
+    double grid_unit = p->spacing_m > 0 ? p->spacing_m : 1.0, detail_unit = layout->detail_spacing_m;
+    /* what a tile's probes see: their rays' reach from where a push out
+     * may move them, the bounce's second rays' as far again, the sight
+     * masks' cells */
+    double margin = 0.6 * fmax(grid_unit, detail_unit) + fmax(2 * reach_of(p), 3.5 * detail_unit) + 0.01;
+    if ((res = plan_tiles(st, scene, SB_PRODUCT_SKY_VISIBILITY, layout, count, positions, 3, margin, &plan)))
+        goto done;
+    /* the detail probes' lattice points: their sight masks' centres */
+    lattice = malloc(((size_t)layout->detail_count + 1) * 3 * sizeof(float));
+    c.n = plan.cast_count;
+    c.positions = malloc(((size_t)c.n + 1) * 3 * sizeof(float));
+    c.unit = malloc(((size_t)c.n + 1) * sizeof(float));
+    c.lattice = malloc(((size_t)c.n + 1) * 3 * sizeof(float));
+    if (!lattice || !c.positions || !c.unit || !c.lattice) {
         res = SB_ERR_NOMEM;
         goto done;
     }
-    double dering_t0 = sb_now_s();
-    sb_parallel_for((int)count, dering_one, &job);
-    sb_debug("sky_visibility: deringing in %.1f ms", 1e3 * (sb_now_s() - dering_t0));
-    for (uint32_t i = 0; i < count; i++) {
+    sb_probe_detail_positions(layout, lattice);
+    for (uint32_t j = 0; j < c.n; j++) {
+        uint32_t i = plan.cast[j];
+        bool detail = i >= grid && i < grid + layout->detail_count;
+        memcpy(&c.positions[3 * (size_t)j], &positions[3 * (size_t)i], 3 * sizeof(float));
+        c.unit[j] = detail ? -(float)detail_unit : (float)grid_unit;
+        for (int k = 0; k < 3; k++)
+            c.lattice[3 * (size_t)j + k] = detail ? lattice[3 * (i - grid) + k] : NAN;
+    }
+    if ((res = cast_probes(st, scene, detail_unit, &c, &gpu_ms)))
+        goto done;
+    if ((res = sb_image_init(image, count, 1, SB_SKY_VISIBILITY_CHANNEL_COUNT)))
+        goto done;
+    sb_image_set_channel_names(image, SB_SKY_VISIBILITY_CHANNELS);
+    if (layout->detail_count &&
+        !(layout->sight = calloc((size_t)layout->detail_count * SB_PROBES_SIGHT_WORDS, sizeof(*layout->sight)))) {
+        res = SB_ERR_NOMEM;
+        goto done;
+    }
+    for (uint32_t j = 0, d = 0; j < c.n; j++) {
+        uint32_t i = plan.cast[j];
         float *o = &image->data[(size_t)i * SB_SKY_VISIBILITY_CHANNEL_COUNT];
-        const float *r = &results[(size_t)i * SB_VISIBILITY_FLOATS];
-        const double *c = job.sh[i], window = job.window[i];
+        const float *r = &c.results[(size_t)j * SB_VISIBILITY_FLOATS];
+        const double *sh = c.dering.sh[j], window = c.dering.window[j];
         deringed += window > 0;
-        lowest = fmin(lowest, job.before[i]);
+        lowest = fmin(lowest, c.dering.before[j]);
         for (int k = 0; k < 3; k++) {
-            o[SB_SKY_VISIBILITY_POSITION + k] = positions[3 * (size_t)i + k];
-            o[SB_SKY_VISIBILITY_OFFSET + k] = offsets[3 * (size_t)i + k];
+            o[SB_SKY_VISIBILITY_POSITION + k] = c.positions[3 * (size_t)j + k];
+            o[SB_SKY_VISIBILITY_OFFSET + k] = c.offsets[3 * (size_t)j + k];
         }
-        o[SB_SKY_VISIBILITY_VALID] = valid[i];
+        o[SB_SKY_VISIBILITY_VALID] = c.valid[j];
         o[SB_SKY_VISIBILITY_BACK_FRACTION] = r[SB_PROBE_SH];
         o[SB_SKY_VISIBILITY_HIT_FRACTION] = r[SB_PROBE_SH + 1];
         o[SB_SKY_VISIBILITY_MEAN_DISTANCE] = r[SB_PROBE_SH + 2];
         o[SB_SKY_VISIBILITY_DERING_WINDOW] = (float)window;
+        /* |c_k| <= sqrt(4 pi), the norm of a visibility in [0, 1]: a probe
+         * that sees no geometry at all may sum a rounding past it in fp32 */
+        const double most = 3.5449075698852539; /* the largest float within sqrt(4 pi) */
         for (int k = 0; k < SB_PROBE_SH; k++)
-            o[SB_SKY_VISIBILITY_SH + k] = (float)c[k];
+            o[SB_SKY_VISIBILITY_SH + k] = (float)fmin(fmax(sh[k], -most), most);
+        if (c.unit[j] < 0)
+            memcpy(&layout->sight[(i - grid) * SB_PROBES_SIGHT_WORDS], &c.sight[(size_t)d++ * SB_PROBES_SIGHT_WORDS],
+                   SB_PROBES_SIGHT_WORDS * sizeof(*layout->sight));
     }
-    free(job.window);
-    free(job.before);
-    free(job.sh);
+    if (plan.tiling.count)
+        finish_tiles(st, SB_PRODUCT_SKY_VISIBILITY, &plan, layout, image, false);
+    for (uint32_t i = 0; i < count; i++)
+        invalid += image->data[(size_t)i * SB_SKY_VISIBILITY_CHANNEL_COUNT + SB_SKY_VISIBILITY_VALID] == 0;
     a->gpu_ms = gpu_ms;
     snprintf(a->settings_json, sizeof(a->settings_json),
              "{\"rays\":%u,\"grid\":[%u,%u,%u],\"spacing_m\":%.9g,\"explicit\":%u,\"triangles\":%llu,"
              "\"inside\":%u,\"pushed_out\":%u,\"invalid\":%u,\"deringed\":%u,\"lowest_before_dering\":%.6g}",
              layout->ray_count, layout->grid[0], layout->grid[1], layout->grid[2], (double)layout->spacing_m[0],
-             layout->explicit_count, (unsigned long long)level->placed_triangles, inside, pushed, inside - pushed,
-             deringed, lowest);
+             layout->explicit_count, (unsigned long long)level->placed_triangles, c.inside, c.pushed,
+             plan.tiling.count ? invalid : c.inside - c.pushed, deringed, lowest);
     /* the budget's and the layers' fields only where the scene has them:
      * the settings of other bakes as they were */
-    if (scene->probes.budget_mb > 0)
+    if (p->budget_mb > 0)
         sb_settings_json_add(a->settings_json, sizeof(a->settings_json), ",\"bytes\":%llu,\"budget_mb\":%.9g",
                              (unsigned long long)count * probe_bytes(scene) +
                                  (unsigned long long)layout->detail_count * 4 * SB_PROBES_SIGHT_WORDS,
-                             scene->probes.budget_mb);
+                             p->budget_mb);
     if (layout->layer_count) {
         char heights[SB_PROBES_MAX_LAYERS * 18] = "";
         for (uint32_t l = 0; l < layout->layer_count; l++)
@@ -661,17 +1054,19 @@ static enum sb_result bake_visibility(struct probes_state *st, const struct sb_s
         sb_settings_json_add(a->settings_json, sizeof(a->settings_json),
                              ",\"detail\":{\"spacing_m\":%.9g,\"brick_columns\":%u,\"probes\":%u}",
                              (double)layout->detail_spacing_m, layout->column_count, layout->detail_count);
+    report_tiles(SB_PRODUCT_SKY_VISIBILITY, &plan, a);
     sb_artifact_set_world(a, st->mesh_hash, st->path);
-    sb_info("sky_visibility: %u probes over %llu triangles (%u in detail); %u inside geometry, %u pushed out; %u "
-            "deringed",
-            count, (unsigned long long)level->placed_triangles, layout->detail_count, inside, pushed, deringed);
+    sb_info("sky_visibility: %u probes over %llu triangles (%u in detail); %u cast: %u inside geometry, %u pushed "
+            "out; %u deringed",
+            count, (unsigned long long)level->placed_triangles, layout->detail_count, c.n, c.inside, c.pushed,
+            deringed);
 done:
     if (res)
         sb_image_finish(image);
+    tile_plan_finish(&plan);
+    cast_finish(&c);
     free(positions);
-    free(offsets);
-    free(valid);
-    free(results);
+    free(lattice);
     return res;
 }
 
@@ -684,43 +1079,54 @@ static enum sb_result bake_bounce(struct probes_state *st, const struct sb_scene
     uint32_t count = 0;
     struct sb_probe_layout *layout = &a->probes;
     memset(layout, 0, sizeof(*layout));
+    struct tile_plan plan = {0};
     enum sb_result res = place(st, scene, layout, &positions, &count, false);
     if (!res && (visibility->width != count || visibility->channel_count != SB_SKY_VISIBILITY_CHANNEL_COUNT)) {
         sb_error("sky_bounce: sky_visibility holds %u probes, the scene places %u", visibility->width, count);
         res = SB_ERR_BAD_IMAGE;
     }
-    if (res)
+    /* a tile's bounce reads its visibility records and the world its
+     * rays and their surfaces' rays reach */
+    double margin = 2 * reach_of(&scene->probes) + 0.01;
+    if (res || (res = plan_tiles(st, scene, SB_PRODUCT_SKY_BOUNCE, layout, count, visibility->data,
+                                 SB_SKY_VISIBILITY_CHANNEL_COUNT, margin, &plan)))
         goto done;
-    valid = malloc(count * sizeof(float));
-    out = malloc((size_t)count * SB_BOUNCE_FLOATS * sizeof(float));
+    uint32_t n = plan.cast_count;
+    valid = malloc(((size_t)n + 1) * sizeof(float));
+    out = malloc(((size_t)n * SB_BOUNCE_FLOATS + 1) * sizeof(float));
     if (!valid || !out) {
         res = SB_ERR_NOMEM;
         goto done;
     }
     uint32_t valid_count = 0;
-    for (uint32_t i = 0; i < count; i++) {
-        const float *v = &visibility->data[(size_t)i * SB_SKY_VISIBILITY_CHANNEL_COUNT];
-        memcpy(&positions[3 * (size_t)i], v, 3 * sizeof(float));
-        valid[i] = v[SB_SKY_VISIBILITY_VALID];
+    for (uint32_t j = 0; j < n; j++) {
+        const float *v = &visibility->data[(size_t)plan.cast[j] * SB_SKY_VISIBILITY_CHANNEL_COUNT];
+        memcpy(&positions[3 * (size_t)j], v, 3 * sizeof(float));
+        valid[j] = v[SB_SKY_VISIBILITY_VALID];
         valid_count += v[SB_SKY_VISIBILITY_VALID] != 0;
     }
     struct sb_sky_bounce_params params = {.ray_count = scene->probes.bounce_rays,
                                           .secondary = scene->probes.bounce_secondary,
-                                          .bounces = scene->probes.bounces};
-    struct sb_sky_bounce_report report;
+                                          .bounces = scene->probes.bounces,
+                                          .tmax_m = (float)reach_of(&scene->probes)};
+    struct sb_sky_bounce_report report = {0};
     if (!st->surfaces.material_count && (res = sb_surfaces_create_level(st->rc->vk, st->level, &st->surfaces)))
         goto done;
-    if ((res = sb_sky_bounce_bake(st->rc, &st->surfaces, positions, valid, count, &params, out, &a->gpu_ms,
-                                  &report)) ||
+    if ((n && (res = sb_sky_bounce_bake(st->rc, &st->surfaces, positions, valid, n, &params, out, &a->gpu_ms,
+                                        &report))) ||
         (res = sb_image_init(image, count, 1, SB_SKY_BOUNCE_CHANNEL_COUNT)))
         goto done;
     sb_image_set_channel_names(image, SB_SKY_BOUNCE_CHANNELS);
-    memcpy(image->data, out, (size_t)count * SB_BOUNCE_FLOATS * sizeof(float));
+    for (uint32_t j = 0; j < n; j++)
+        memcpy(&image->data[(size_t)plan.cast[j] * SB_BOUNCE_FLOATS], &out[(size_t)j * SB_BOUNCE_FLOATS],
+               SB_BOUNCE_FLOATS * sizeof(float));
     int64_t bad; /* stored as binary16 (its file's values): 4.9e-4 relative, its range +-6.7 */
     if ((res = sb_image_round_to_half(image, &bad))) {
         sb_error("sky_bounce: value %lld does not fit binary16", (long long)bad);
         goto done;
     }
+    if (plan.tiling.count)
+        finish_tiles(st, SB_PRODUCT_SKY_BOUNCE, &plan, layout, image, true);
     snprintf(a->settings_json, sizeof(a->settings_json),
              "{\"rays\":%u,\"secondary\":%u,\"grid\":[%u,%u,%u],\"spacing_m\":%.9g,\"explicit\":%u,"
              "\"valid\":%u,\"bounces\":%u,\"bounces_summed\":%u,\"added_mean\":%.4g,\"added_most\":%.4g,"
@@ -729,6 +1135,7 @@ static enum sb_result bake_bounce(struct probes_state *st, const struct sb_scene
              params.ray_count, params.secondary, layout->grid[0], layout->grid[1], layout->grid[2],
              (double)layout->spacing_m[0], layout->explicit_count, valid_count, params.bounces, report.most_bounces,
              report.mean_added, report.most_added);
+    report_tiles(SB_PRODUCT_SKY_BOUNCE, &plan, a);
     char summed[160]; /* how the bounces were summed, and what the later ones added */
     if (params.bounces == 1)
         snprintf(summed, sizeof(summed), "one bounce");
@@ -744,11 +1151,12 @@ static enum sb_result bake_bounce(struct probes_state *st, const struct sb_scene
         snprintf(summed + used, sizeof(summed) - used, ", the later ones adding %.1f%% to the first on average, "
                  "%.1f%% at most", 100 * report.mean_added, 100 * report.most_added);
     }
-    sb_info("sky_bounce: %u probes (%u valid), %u rays each, %u from each surface hit; %s", count, valid_count,
-            params.ray_count, params.secondary, summed);
+    sb_info("sky_bounce: %u probes (%u cast, %u of them valid), %u rays each, %u from each surface hit; %s", count, n,
+            valid_count, params.ray_count, params.secondary, summed);
 done:
     if (res)
         sb_image_finish(image);
+    tile_plan_finish(&plan);
     free(positions);
     free(valid);
     free(out);
@@ -762,7 +1170,7 @@ static enum sb_result probes_bake(void *state, struct sb_vk *vk, const struct sb
     struct probes_state *st = state;
     double t0 = sb_now_s();
     bool had = st->rc != NULL;
-    enum sb_result res = raycaster(st, vk);
+    enum sb_result res = raycaster(st, scene, vk);
     if (res)
         return res;
     if (!had)
@@ -790,4 +1198,5 @@ const struct sb_family_baker sb_probes_family = {
     .destroy = probes_destroy,
     .bake = probes_bake,
     .kernels = probes_kernels,
+    .previous = probes_previous,
 };

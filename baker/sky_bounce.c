@@ -155,6 +155,7 @@ enum sb_result sb_sky_bounce_bake(struct sb_raycaster *rc, const struct sb_surfa
         .ray_count = params->ray_count ? params->ray_count : 256,
         .secondary = params->secondary ? params->secondary : 64,
         .tmin_m = params->tmin_m > 0 ? params->tmin_m : 1e-4f,
+        .tmax_m = params->tmax_m > 0 ? params->tmax_m : 1e30f,
     };
     if (gpu_ms)
         *gpu_ms = 0;

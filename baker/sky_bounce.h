@@ -32,6 +32,7 @@ struct sb_sky_bounce_params {
     uint32_t secondary; /* about this many rays from each hit (a 2x spherical set, half cast) [64] */
     float tmin_m;       /* rays start this far from the probe [1e-4] */
     uint32_t bounces;   /* 1: one bounce; 0: until converged [0] */
+    float tmax_m;       /* a ray (from the probe or a surface) reaching this far sees the sky [1e30] */
 };
 
 #define SB_SKY_BOUNCE_CONVERGED 1e-3 /* a bounce adding less ends the sum */

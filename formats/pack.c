@@ -312,6 +312,7 @@ enum sb_result sb_pack_writer_add_image(struct sb_pack_writer *w, struct sb_arti
     w->artifacts[i] = *artifact;
     w->artifacts[i].probes.columns = NULL; /* the caller's: the manifest needs neither */
     w->artifacts[i].probes.sight = NULL;
+    w->artifacts[i].probes.tiles = NULL;
     w->artifact_count++;
     w->pending = NULL;
     fault_point("artifact");
@@ -754,6 +755,11 @@ static enum sb_result read_artifact_image(const char *dir, int dir_fd, struct sb
         if (!res && a->probes.sight && pack->format_version < 9) {
             sb_error("%s: %s: sight masks of detail probes, which format version %d cannot hold (9 and later)",
                      path, name, pack->format_version);
+            res = SB_ERR_PROBES;
+        }
+        if (!res && a->probes.tile_count && pack->format_version < 11) {
+            sb_error("%s: %s: probes in tiles, which format version %d cannot hold (11 and later)", path, name,
+                     pack->format_version);
             res = SB_ERR_PROBES;
         }
         if (res)

@@ -87,23 +87,26 @@ static void channel_range(const char *name, double *lo, double *hi)
     }
 }
 
-/* A file's bytes: `sight` detail probes' sight masks (0: none), values
- * of value_bytes (4: fp32, 2: binary16). */
-static size_t file_size(uint32_t header, uint32_t columns, uint32_t sight, uint32_t probes, uint32_t channels,
-                        uint32_t value_bytes)
+/* A file's bytes: `sight` detail probes' sight masks (0: none), `tiles`
+ * tiles, values of value_bytes (4: fp32, 2: binary16). */
+static size_t file_size(uint32_t header, uint32_t columns, uint32_t tiles, uint32_t sight, uint32_t probes,
+                        uint32_t channels, uint32_t value_bytes)
 {
-    return header + (size_t)columns * SB_PROBES_COLUMN_BYTES + (size_t)sight * SB_PROBES_SIGHT_WORDS * 4 +
-           (size_t)probes * channels * value_bytes + 8;
+    return header + (size_t)columns * SB_PROBES_COLUMN_BYTES + (size_t)tiles * SB_PROBES_TILE_BYTES +
+           (size_t)sight * SB_PROBES_SIGHT_WORDS * 4 + (size_t)probes * channels * value_bytes + 8;
 }
 
 void sb_probe_layout_finish(struct sb_probe_layout *layout)
 {
     free(layout->columns);
     free(layout->sight);
+    free(layout->tiles);
     layout->columns = NULL;
     layout->sight = NULL;
+    layout->tiles = NULL;
     layout->column_count = 0;
     layout->detail_count = 0;
+    layout->tile_count = 0;
 }
 
 enum sb_result sb_probe_layout_copy(struct sb_probe_layout *to, const struct sb_probe_layout *from)
@@ -111,20 +114,151 @@ enum sb_result sb_probe_layout_copy(struct sb_probe_layout *to, const struct sb_
     *to = *from;
     to->columns = NULL;
     to->sight = NULL;
+    to->tiles = NULL;
     size_t sight = from->sight ? (size_t)from->detail_count * SB_PROBES_SIGHT_WORDS * sizeof(*to->sight) : 0;
     if (from->column_count && !(to->columns = malloc(from->column_count * sizeof(*to->columns))))
         goto fail;
     if (sight && !(to->sight = malloc(sight)))
         goto fail;
+    if (from->tile_count && !(to->tiles = malloc(from->tile_count * sizeof(*to->tiles))))
+        goto fail;
     if (from->column_count)
         memcpy(to->columns, from->columns, from->column_count * sizeof(*to->columns));
     if (sight)
         memcpy(to->sight, from->sight, sight);
+    if (from->tile_count)
+        memcpy(to->tiles, from->tiles, from->tile_count * sizeof(*to->tiles));
     return SB_OK;
 fail:
     free(to->columns);
+    free(to->sight);
     memset(to, 0, sizeof(*to));
     return SB_ERR_NOMEM;
+}
+
+/* A tile's coordinates packed to sort by z, then x. */
+static uint64_t tile_code(int64_t x, int64_t z)
+{
+    return (uint64_t)(z + INT32_MAX) << 32 | (uint64_t)(x + INT32_MAX);
+}
+
+static int compare_u64(const void *a, const void *b)
+{
+    uint64_t x = *(const uint64_t *)a, y = *(const uint64_t *)b;
+    return (x > y) - (x < y);
+}
+
+/* Each grid and detail probe's tile, packed (tile_code), into code[]. */
+static void tile_codes(const struct sb_probe_layout *l, double side, uint64_t *code)
+{
+    uint64_t grid = (uint64_t)l->grid[0] * l->grid[1] * l->grid[2], i = 0;
+    for (; i < grid; i++) {
+        double x = (double)l->origin_m[0] + (double)(i % l->grid[0]) * l->spacing_m[0];
+        double z = (double)l->origin_m[2] + (double)(i / l->grid[0] / l->grid[1]) * l->spacing_m[2];
+        code[i] = tile_code((int64_t)floor(x / side), (int64_t)floor(z / side));
+    }
+    for (uint32_t c = 0; c < l->column_count; c++) {
+        const struct sb_probe_column *col = &l->columns[c];
+        double x = (double)l->detail_origin_m[0] + (double)col->x * SB_PROBES_BRICK * l->detail_spacing_m;
+        double z = (double)l->detail_origin_m[2] + (double)col->z * SB_PROBES_BRICK * l->detail_spacing_m;
+        uint64_t k = tile_code((int64_t)floor(x / side), (int64_t)floor(z / side));
+        for (uint64_t j = 0; j < (uint64_t)col->rows * SB_PROBES_BRICK * SB_PROBES_BRICK; j++)
+            code[i++] = k;
+    }
+}
+
+enum sb_result sb_probe_tiles_assign(struct sb_probe_layout *layout, float side, uint32_t *tile_of)
+{
+    uint64_t grid = (uint64_t)layout->grid[0] * layout->grid[1] * layout->grid[2];
+    uint64_t n = grid + layout->detail_count;
+    free(layout->tiles);
+    layout->tiles = NULL;
+    layout->tile_count = 0;
+    if (layout->explicit_count)
+        return SB_ERR_PROBES;
+    if (!n)
+        return SB_OK;
+    uint64_t *code = malloc(n * sizeof(*code)), *sorted = malloc(n * sizeof(*sorted));
+    if (!code || !sorted) {
+        free(code);
+        free(sorted);
+        return SB_ERR_NOMEM;
+    }
+    tile_codes(layout, side, code);
+    memcpy(sorted, code, n * sizeof(*code));
+    qsort(sorted, n, sizeof(*sorted), compare_u64);
+    uint64_t tiles = 0;
+    for (uint64_t i = 0; i < n; i++)
+        tiles += !i || sorted[i] != sorted[i - 1];
+    enum sb_result res = tiles > SB_PROBES_MAX_TILES ? SB_ERR_TOO_LARGE : SB_OK;
+    if (!res && !(layout->tiles = calloc(tiles, sizeof(*layout->tiles))))
+        res = SB_ERR_NOMEM;
+    for (uint64_t i = 0, t = 0; i < n && !res; i++) {
+        if (i && sorted[i] == sorted[i - 1]) {
+            layout->tiles[t - 1].probes++;
+            continue;
+        }
+        layout->tiles[t++] = (struct sb_probe_tile){.x = (int32_t)((int64_t)(uint32_t)sorted[i] - INT32_MAX),
+                                                    .z = (int32_t)((int64_t)(sorted[i] >> 32) - INT32_MAX),
+                                                    .probes = 1};
+    }
+    if (!res) {
+        layout->tile_count = (uint32_t)tiles;
+        layout->tile_m = side;
+        for (uint64_t i = 0; i < n && tile_of; i++) {
+            uint32_t lo = 0, hi = (uint32_t)tiles; /* the sorted tiles hold every code */
+            while (lo < hi) {
+                uint32_t mid = lo + (hi - lo) / 2;
+                if (tile_code(layout->tiles[mid].x, layout->tiles[mid].z) < code[i])
+                    lo = mid + 1;
+                else
+                    hi = mid;
+            }
+            tile_of[i] = lo;
+        }
+    }
+    free(code);
+    free(sorted);
+    return res;
+}
+
+/* A record's stored bytes into `out` (value_bytes a value). */
+static void store_record(const float *values, uint32_t channels, uint32_t value_bytes, uint8_t *out)
+{
+    for (uint32_t c = 0; c < channels; c++, out += value_bytes) {
+        if (value_bytes == 2) {
+            uint16_t h = sb_half_from_float(values[c]);
+            out[0] = (uint8_t)h;
+            out[1] = (uint8_t)(h >> 8);
+        } else {
+            put_f32(out, values[c]);
+        }
+    }
+}
+
+uint64_t sb_probe_tile_content(const struct sb_probe_layout *layout, const struct sb_image *image, bool half,
+                               const uint32_t *probes, uint32_t count)
+{
+    uint64_t grid = (uint64_t)layout->grid[0] * layout->grid[1] * layout->grid[2];
+    uint32_t value_bytes = half ? 2 : 4;
+    uint8_t record[4 * SB_IMAGE_MAX_CHANNELS];
+    XXH3_state_t *state = XXH3_createState();
+    if (!state)
+        return 0;
+    XXH3_64bits_reset(state);
+    for (uint32_t j = 0; j < count; j++) {
+        store_record(&image->data[(size_t)probes[j] * image->channel_count], image->channel_count, value_bytes, record);
+        XXH3_64bits_update(state, record, (size_t)image->channel_count * value_bytes);
+    }
+    for (uint32_t j = 0; j < count && layout->sight; j++)
+        if (probes[j] >= grid)
+            for (int w = 0; w < SB_PROBES_SIGHT_WORDS; w++) {
+                put_u32(record, layout->sight[(probes[j] - grid) * SB_PROBES_SIGHT_WORDS + w]);
+                XXH3_64bits_update(state, record, 4);
+            }
+    uint64_t h = XXH3_64bits_digest(state);
+    XXH3_freeState(state);
+    return h;
 }
 
 int64_t sb_probe_detail_index(const struct sb_probe_layout *layout, uint64_t grid_count, int32_t x, int32_t y,
@@ -238,7 +372,12 @@ enum sb_result sb_probes_write(const char *path, const struct sb_probe_layout *l
     /* the oldest version that holds the layout and the values: without
      * layers or detail, in fp32, version 1, and the files are what they
      * were */
-    uint32_t version = half ? 5 : layout->sight ? 4 : layout->column_count ? 3 : layout->layer_count ? 2 : 1;
+    uint32_t version = layout->tile_count ? 6
+                       : half             ? 5
+                       : layout->sight    ? 4
+                       : layout->column_count ? 3
+                       : layout->layer_count  ? 2
+                                              : 1;
     uint32_t header = version >= 3   ? SB_PROBES_HEADER_BYTES
                       : version == 2 ? SB_PROBES_HEADER_BYTES_V2
                                      : SB_PROBES_HEADER_BYTES_V1;
@@ -247,7 +386,8 @@ enum sb_result sb_probes_write(const char *path, const struct sb_probe_layout *l
         sb_error("%s: values that binary16 does not hold exactly, for a file stored as half", path);
         return SB_ERR_NUMERIC;
     }
-    size_t size = file_size(header, layout->column_count, sight, image->width, image->channel_count, value_bytes);
+    size_t size = file_size(header, layout->column_count, layout->tile_count, sight, image->width,
+                            image->channel_count, value_bytes);
     uint8_t *bytes = calloc(1, size);
     if (!bytes)
         return SB_ERR_NOMEM;
@@ -285,22 +425,33 @@ enum sb_result sb_probes_write(const char *path, const struct sb_probe_layout *l
             put_u32(p + 12, col->rows);
         }
     }
+    if (layout->tile_count) {
+        put_f32(bytes + 172, layout->tile_m);
+        put_f32(bytes + 176, layout->reach_m);
+        put_u32(bytes + 180, layout->tile_count);
+        for (uint32_t t = 0; t < layout->tile_count; t++, p += SB_PROBES_TILE_BYTES) {
+            const struct sb_probe_tile *tile = &layout->tiles[t];
+            put_u32(p, (uint32_t)tile->x);
+            put_u32(p + 4, (uint32_t)tile->z);
+            put_u32(p + 8, tile->probes);
+            put_u32(p + 12, tile->flags);
+            for (int i = 0; i < 16 && tile->key[0]; i++) {
+                unsigned v;
+                sscanf(tile->key + 2 * i, "%2x", &v);
+                p[16 + i] = (uint8_t)v;
+            }
+            put_u64(p + 32, tile->content);
+        }
+    }
     if (sight) {
         put_u32(bytes + 164, SB_PROBES_SIGHT_SIDE);
         for (uint64_t i = 0; i < (uint64_t)sight * SB_PROBES_SIGHT_WORDS; i++, p += 4)
             put_u32(p, layout->sight[i]);
     }
-    if (half)
+    if (version >= 5)
         put_u32(bytes + 168, value_bytes);
-    for (uint64_t i = 0; i < (uint64_t)image->width * image->channel_count; i++, p += value_bytes) {
-        if (half) {
-            uint16_t h = sb_half_from_float(image->data[i]);
-            p[0] = (uint8_t)h;
-            p[1] = (uint8_t)(h >> 8);
-        } else {
-            put_f32(p, image->data[i]);
-        }
-    }
+    for (uint32_t i = 0; i < image->width; i++, p += (size_t)value_bytes * image->channel_count)
+        store_record(&image->data[(size_t)i * image->channel_count], image->channel_count, value_bytes, p);
     put_u64(p, XXH3_64bits(bytes, size - 8));
 
     enum sb_result res = sb_write_file(path, bytes, size, "probe file");
@@ -381,6 +532,108 @@ static int read_sight(const uint8_t *p, uint32_t sight, const char *source, stru
     return 0;
 }
 
+/* A version 6 file's tiles (`tiles` records at p), checked against the
+ * tiles the layout's probes fall in, each baked tile's content against
+ * its records (at `values`) and sight masks (at `sight`; NULL: none), and
+ * each other tile's records and masks zero; nonzero on a problem, logged. */
+static int read_tiles(const uint8_t *p, uint32_t tiles, float side, const uint8_t *values, uint32_t channels,
+                      uint32_t value_bytes, const uint8_t *sight, const char *source, struct sb_probe_layout *layout)
+{
+    uint64_t grid = (uint64_t)layout->grid[0] * layout->grid[1] * layout->grid[2];
+    uint64_t n = grid + layout->detail_count;
+    struct sb_probe_layout expect = *layout; /* its own tiles, nothing else owned */
+    expect.tiles = NULL;
+    uint32_t *tile_of = malloc((n ? n : 1) * sizeof(*tile_of)), *order = malloc((n ? n : 1) * sizeof(*order)),
+             *first = calloc((size_t)tiles + 1, sizeof(*first));
+    struct sb_probe_tile *t = calloc(tiles, sizeof(*t));
+    int bad = !tile_of || !order || !first || !t;
+    if (bad)
+        sb_error("%s: out of memory for %u tiles", source, tiles);
+    if (!bad && (bad = sb_probe_tiles_assign(&expect, side, tile_of) != SB_OK))
+        sb_error("%s: the probes fall in more than %u tiles of %g m", source, SB_PROBES_MAX_TILES, side);
+    if (!bad && (bad = expect.tile_count != tiles))
+        sb_error("%s: %u tiles, but the probes fall in %u tiles of %g m", source, tiles, expect.tile_count, side);
+    for (uint32_t i = 0; i < tiles && !bad; i++) {
+        const uint8_t *r = p + (size_t)i * SB_PROBES_TILE_BYTES;
+        t[i].x = (int32_t)get_u32(r);
+        t[i].z = (int32_t)get_u32(r + 4);
+        t[i].probes = get_u32(r + 8);
+        t[i].flags = get_u32(r + 12);
+        t[i].content = get_u64(r + 32);
+        bool keyed = false;
+        for (int k = 0; k < 16; k++)
+            keyed |= r[16 + k] != 0;
+        if (t[i].x != expect.tiles[i].x || t[i].z != expect.tiles[i].z || t[i].probes != expect.tiles[i].probes) {
+            sb_error("%s: tile %u (x %d, z %d, %u probes): the probes make tile %u x %d, z %d of %u probes", source, i,
+                     t[i].x, t[i].z, t[i].probes, i, expect.tiles[i].x, expect.tiles[i].z, expect.tiles[i].probes);
+            bad = 1;
+        } else if (t[i].flags & ~SB_PROBES_TILE_BAKED) {
+            sb_error("%s: tile %u: flags 0x%x, only bit 0 (baked) is defined", source, i, t[i].flags);
+            bad = 1;
+        } else if (!(t[i].flags & SB_PROBES_TILE_BAKED) && (keyed || t[i].content)) {
+            sb_error("%s: tile %u is not baked but has a key or a content hash", source, i);
+            bad = 1;
+        }
+        if (!bad && keyed)
+            for (int k = 0; k < 16; k++)
+                snprintf(t[i].key + 2 * k, 3, "%02x", r[16 + k]);
+    }
+    /* each tile's probes in order: a counting sort */
+    for (uint64_t i = 0; i < n && !bad; i++)
+        first[tile_of[i] + 1]++;
+    for (uint32_t i = 0; i < tiles && !bad; i++)
+        first[i + 1] += first[i];
+    for (uint64_t i = 0; i < n && !bad; i++)
+        order[first[tile_of[i]]++] = (uint32_t)i;
+    for (uint32_t i = tiles; i > 0 && !bad; i--)
+        first[i] = first[i - 1];
+    if (!bad)
+        first[0] = 0;
+    size_t record = (size_t)channels * value_bytes, mask = 4 * SB_PROBES_SIGHT_WORDS;
+    XXH3_state_t *state = bad ? NULL : XXH3_createState();
+    bad |= !state;
+    for (uint32_t i = 0; i < tiles && !bad; i++) {
+        bool baked = t[i].flags & SB_PROBES_TILE_BAKED, zero = true;
+        XXH3_64bits_reset(state);
+        for (uint32_t j = first[i]; j < first[i + 1]; j++) {
+            const uint8_t *at = values + order[j] * record;
+            if (baked)
+                XXH3_64bits_update(state, at, record);
+            for (size_t k = 0; k < record && !baked; k++)
+                zero &= at[k] == 0;
+        }
+        for (uint32_t j = first[i]; j < first[i + 1] && sight; j++) {
+            if (order[j] < grid)
+                continue;
+            const uint8_t *at = sight + (order[j] - grid) * mask;
+            if (baked)
+                XXH3_64bits_update(state, at, mask);
+            for (size_t k = 0; k < mask && !baked; k++)
+                zero &= at[k] == 0;
+        }
+        if (baked && XXH3_64bits_digest(state) != t[i].content) {
+            sb_error("%s: tile %u (x %d, z %d): its probes do not hash to its content", source, i, t[i].x, t[i].z);
+            bad = 1;
+        } else if (!baked && !zero) {
+            sb_error("%s: tile %u (x %d, z %d) is not baked but its probes are not zero", source, i, t[i].x, t[i].z);
+            bad = 1;
+        }
+    }
+    XXH3_freeState(state);
+    free(expect.tiles);
+    free(tile_of);
+    free(order);
+    free(first);
+    if (bad) {
+        free(t);
+        return 1;
+    }
+    layout->tiles = t;
+    layout->tile_count = tiles;
+    layout->tile_m = side;
+    return 0;
+}
+
 enum sb_result sb_probes_parse(const void *data, size_t size, const char *source, const char *channel_names,
                                uint32_t max_probes, struct sb_probe_layout *layout, struct sb_image *image)
 {
@@ -441,10 +694,21 @@ enum sb_result sb_probes_parse(const void *data, size_t size, const char *source
         return SB_ERR_PROBES;
     }
     uint32_t sight = side ? detail : 0;
-    uint32_t value_bytes = version == 5 ? get_u32(b + 168) : 4;
-    if (value_bytes != (version == 5 ? 2u : 4u)) {
+    uint32_t value_bytes = version >= 5 ? get_u32(b + 168) : 4;
+    if (version == 6 ? value_bytes != 2 && value_bytes != 4 : value_bytes != (version == 5 ? 2u : 4u)) {
         sb_error("%s: values of %u bytes: version %u stores %s", source, value_bytes, version,
-                 version == 5 ? "binary16 (2)" : "fp32 (4)");
+                 version == 6   ? "binary16 (2) or fp32 (4)"
+                 : version == 5 ? "binary16 (2)"
+                                : "fp32 (4)");
+        return SB_ERR_PROBES;
+    }
+    uint32_t tiles = version == 6 ? get_u32(b + 180) : 0;
+    float tile_m = version == 6 ? get_f32(b + 172) : 0, reach_m = version == 6 ? get_f32(b + 176) : 0;
+    if (version == 6 && (tiles < 1 || tiles > SB_PROBES_MAX_TILES || !(tile_m >= 1 && tile_m <= 1e4f) ||
+                         !(reach_m > 0 && reach_m <= 1e5f) || explicit_count)) {
+        sb_error("%s: %u tiles of %g m, rays reaching %g m, %u explicit probes: expected 1 to %u tiles of 1 to 1e4 m, "
+                 "a reach in (0, 1e5] m and no explicit probes",
+                 source, tiles, tile_m, reach_m, explicit_count, SB_PROBES_MAX_TILES);
         return SB_ERR_PROBES;
     }
     struct sb_image names = {0};
@@ -472,10 +736,10 @@ enum sb_result sb_probes_parse(const void *data, size_t size, const char *source
                  max_probes < SB_PROBES_MAX_COUNT ? max_probes : SB_PROBES_MAX_COUNT);
         return SB_ERR_PROBES;
     }
-    size_t expect_size = file_size(header, columns, sight, count, channels, value_bytes);
+    size_t expect_size = file_size(header, columns, tiles, sight, count, channels, value_bytes);
     if (size != expect_size) {
-        sb_error("%s: %zu bytes, %u brick columns, %u sight masks and %u probes of %u channels take %zu", source,
-                 size, columns, sight, count, channels, expect_size);
+        sb_error("%s: %zu bytes, %u brick columns, %u tiles, %u sight masks and %u probes of %u channels take %zu",
+                 source, size, columns, tiles, sight, count, channels, expect_size);
         return SB_ERR_BAD_IMAGE;
     }
     if (get_u64(b + size - 8) != XXH3_64bits(b, size - 8)) {
@@ -484,7 +748,7 @@ enum sb_result sb_probes_parse(const void *data, size_t size, const char *source
     }
     for (uint32_t i = version == 1 ? 104 : 108 + 4 * layers; i < header; i++)
         if (b[i] && !(has_detail && i >= 140 && i < 164) && !(sight && i >= 164 && i < 168) &&
-            !(version == 5 && i >= 168 && i < 172)) {
+            !(version >= 5 && i >= 168 && i < 172) && !(version == 6 && i >= 172 && i < 184)) {
             sb_error("%s: reserved header byte %u is not zero", source, i);
             return SB_ERR_PROBES;
         }
@@ -523,12 +787,18 @@ enum sb_result sb_probes_parse(const void *data, size_t size, const char *source
     }
     memcpy(layout->key, b + 72, 32);
     layout->key[32] = '\0';
-    if (has_detail && (check_detail(b, header, columns, detail, source, layout) ||
-                       read_sight(b + header + (size_t)columns * SB_PROBES_COLUMN_BYTES, sight, source, layout))) {
+    const uint8_t *tile_records = b + header + (size_t)columns * SB_PROBES_COLUMN_BYTES;
+    const uint8_t *masks = tile_records + (size_t)tiles * SB_PROBES_TILE_BYTES;
+    const uint8_t *values = masks + (size_t)sight * SB_PROBES_SIGHT_WORDS * 4;
+    if ((has_detail && (check_detail(b, header, columns, detail, source, layout) ||
+                        read_sight(masks, sight, source, layout))) ||
+        (tiles && read_tiles(tile_records, tiles, tile_m, values, channels, value_bytes, sight ? masks : NULL,
+                             source, layout))) {
         sb_probe_layout_finish(layout);
         memset(layout, 0, sizeof(*layout));
         return SB_ERR_PROBES;
     }
+    layout->reach_m = reach_m;
     enum sb_result res = sb_image_init(image, count, 1, channels);
     if (res) {
         sb_probe_layout_finish(layout);
@@ -536,7 +806,7 @@ enum sb_result sb_probes_parse(const void *data, size_t size, const char *source
         return res;
     }
     sb_image_set_channel_names(image, channel_names);
-    const uint8_t *p = b + header + (size_t)columns * SB_PROBES_COLUMN_BYTES + (size_t)sight * SB_PROBES_SIGHT_WORDS * 4;
+    const uint8_t *p = values;
     layout->half = value_bytes == 2;
     for (uint32_t c = 0; c < channels && !res; c++) {
         double lo, hi;
@@ -576,7 +846,7 @@ enum sb_result sb_probes_read(const char *path, const char *channel_names, uint3
         return SB_ERR_IO;
     }
     size_t largest = file_size(SB_PROBES_HEADER_BYTES, SB_PROBES_MAX_COUNT / (SB_PROBES_BRICK * SB_PROBES_BRICK),
-                               SB_PROBES_MAX_COUNT, SB_PROBES_MAX_COUNT, SB_IMAGE_MAX_CHANNELS, 4);
+                               SB_PROBES_MAX_TILES, SB_PROBES_MAX_COUNT, SB_PROBES_MAX_COUNT, SB_IMAGE_MAX_CHANNELS, 4);
     if (!S_ISREG(st.st_mode) || (uint64_t)st.st_size > largest) {
         sb_error("%s: not a regular file of at most %zu bytes", path, largest);
         close(fd);

@@ -7,7 +7,7 @@
  *        0     8  magic "SBPROBES"
  *        8     4  format version (1; 2: a grid that follows the surface; 3:
  *                 detail; 4: detail with its sight masks; 5: values stored
- *                 as binary16)
+ *                 as binary16; 6: tiles)
  *       12     4  byte-order mark 0x01020304
  *       16     4  header bytes (112; version 2: 152)
  *       20     4  channels per probe
@@ -41,9 +41,25 @@
  *                 163 zero) and byte 164 0 (no sight masks; 8 needs detail)
  *      168     4  bytes a value: 2
  *      172    20  reserved, zero
- *   header     -  versions 3 to 5: C brick columns of 16 bytes: x, z
+ *   version 6 (tiles):
+ *      104    64  as version 5
+ *      168     4  bytes a value: 2 (binary16) or 4 (fp32)
+ *      172     4  the tiles' side, metres (float32, 1 to 1e4)
+ *      176     4  the rays' reach, metres (float32, > 0: past it a ray sees
+ *                 the sky)
+ *      180     4  tiles T (1 to SB_PROBES_MAX_TILES)
+ *      184     8  reserved, zero
+ *   header     -  versions 3 to 6: C brick columns of 16 bytes: x, z
  *                 (int32, in bricks of SB_PROBES_BRICK lattice steps), the
  *                 lowest lattice row y0 (int32) and the rows (uint32), in
+ *                 increasing z then x, each once
+ *      then    -  version 6: T tiles of 40 bytes: x, z (int32: the tile
+ *                 covers x to x + 1 sides along x from 0, likewise z), its
+ *                 probes (uint32, >= 1), flags (uint32: bit 0 baked, the
+ *                 rest zero), the XXH3-128 bake key of its probes (16
+ *                 bytes, high half first, big endian; zero when not baked)
+ *                 and the XXH3-64 of their stored records then sight masks
+ *                 (uint64; zero when not baked, and so are its records), in
  *                 increasing z then x, each once
  *      then    -  versions 4 and 5: D sight masks of 64 bytes, detail probe by
  *                 detail probe: 16 uint32, bit b (word b / 32, bit b % 32)
@@ -71,6 +87,15 @@
  * origin + spacing x (lattice index). Detail probes come after the grid's
  * and before the explicit ones, brick column by brick column.
  *
+ * Tiles (version 6) split a grid and its detail by where they stand, in
+ * squares `side` metres across from x = z = 0, so that a bake can redo the
+ * tiles whose world changed and keep the rest (docs/probes.md, "Tiles"): a
+ * grid probe belongs to the tile its column stands in, a detail probe to
+ * the tile of its brick column's first lattice column
+ * (sb_probe_tiles_assign). A file with tiles has no explicit probes. A
+ * tile not baked (a bake of some tiles alone) holds zeros: its probes are
+ * invalid.
+ *
  * The reader trusts nothing: every field is checked against the format's
  * caps and the others before anything is allocated, the size must match
  * exactly (no truncation, nothing trailing), the checksum must hold and
@@ -88,7 +113,7 @@
 #include "result.h"
 #include "scene.h"
 
-#define SB_PROBES_VERSION 5
+#define SB_PROBES_VERSION 6
 #define SB_PROBES_HEADER_BYTES_V1 112
 #define SB_PROBES_HEADER_BYTES_V2 152
 #define SB_PROBES_HEADER_BYTES 192
@@ -103,6 +128,9 @@
  * SB_PROBE_SIGHT_*, which bake them). */
 #define SB_PROBES_SIGHT_SIDE 8
 #define SB_PROBES_SIGHT_WORDS 16
+#define SB_PROBES_MAX_TILES (1u << 16)
+#define SB_PROBES_TILE_BYTES 40
+#define SB_PROBES_TILE_BAKED 1u /* a tile's flags: its probes were baked */
 
 /* The sky-visibility product's channels (docs/pack.md): where the probe
  * is (after any push out of geometry) and how far it was moved; 1 when
@@ -158,6 +186,15 @@ struct sb_probe_column {
     uint32_t rows; /* >= 1; y0 + rows <= SB_PROBES_MAX_LATTICE */
 };
 
+/* A tile of a layout (the file's record). */
+struct sb_probe_tile {
+    int32_t x, z;     /* it covers [x, x + 1) x [z, z + 1) tile sides */
+    uint32_t probes;  /* the layout's probes that belong to it, >= 1 */
+    uint32_t flags;   /* SB_PROBES_TILE_BAKED */
+    char key[33];     /* its bake key, 32 lowercase hex digits ("" when not baked) */
+    uint64_t content; /* XXH3-64 of its stored records then sight masks (0 when not baked) */
+};
+
 /* Where the probes are: a grid (x fastest), detail, then explicit ones.
  * A layout with detail owns its columns: copy it with
  * sb_probe_layout_copy, free it with sb_probe_layout_finish. */
@@ -183,14 +220,35 @@ struct sb_probe_layout {
      * detail_count x SB_PROBES_SIGHT_WORDS */
     uint32_t *sight; /* owned */
     bool half;       /* read: the values were stored as binary16 (version 5) */
+    /* tiles (version 6; tile_count 0: none): in increasing z, then x */
+    float tile_m, reach_m;
+    uint32_t tile_count;
+    struct sb_probe_tile *tiles; /* owned */
 };
 
-/* Free a layout's columns and sight masks (and zero them); a zeroed
- * layout is accepted. */
+/* Free a layout's columns, sight masks and tiles (and zero them); a
+ * zeroed layout is accepted. */
 void sb_probe_layout_finish(struct sb_probe_layout *layout);
-/* *to = *from with its own copy of the columns and sight masks
+/* *to = *from with its own copy of the columns, sight masks and tiles
  * (SB_ERR_NOMEM: *to zeroed). */
 enum sb_result sb_probe_layout_copy(struct sb_probe_layout *to, const struct sb_probe_layout *from);
+
+/*
+ * The tiles `side` metres across that a layout's grid and detail probes
+ * fall in (formats/probes.h: a grid probe by its column, a detail probe by
+ * its brick column's first lattice column), into layout->tiles (their
+ * probe counts set, flags, keys and contents zero) with tile_m = side; and
+ * (tile_of may be NULL) each probe's tile, an index into them. A layout
+ * with explicit probes has no tiles: SB_ERR_PROBES. SB_ERR_TOO_LARGE past
+ * SB_PROBES_MAX_TILES.
+ */
+enum sb_result sb_probe_tiles_assign(struct sb_probe_layout *layout, float side, uint32_t *tile_of);
+
+/* XXH3-64 of a tile's probes' records as a file stores them (binary16
+ * when `half`), then their sight masks: what its record's content holds.
+ * probes[]: the tile's `count` probes, in increasing index. */
+uint64_t sb_probe_tile_content(const struct sb_probe_layout *layout, const struct sb_image *image, bool half,
+                               const uint32_t *probes, uint32_t count);
 /* The index among a layout's probes of detail lattice probe (x, y, z), or
  * -1 when no brick column holds it (a binary search over the columns). */
 int64_t sb_probe_detail_index(const struct sb_probe_layout *layout, uint64_t grid_count, int32_t x, int32_t y,

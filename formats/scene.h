@@ -108,6 +108,7 @@ struct sb_world_params {
 #define SB_PROBES_MAX_LAYERS 8
 /* Detail volumes a scene may give. */
 #define SB_PROBES_MAX_VOLUMES 32
+#define SB_PROBES_MAX_ONLY_TILES 64
 struct sb_probe_params {
     double spacing_m;       /* a grid over the world's bounds, this far apart [2]; 0: none */
     double margin_m;        /* the grid's bounds: the world's, grown by this [0] */
@@ -139,6 +140,15 @@ struct sb_probe_params {
     uint32_t bounce_rays;      /* sky_bounce: rays a probe for the surfaces it sees, a multiple of 64 [256] */
     uint32_t bounce_secondary; /* sky_bounce: rays from each surface hit, a multiple of 8 [64] */
     uint32_t bounces;          /* sky_bounce: 1 to SB_PROBES_MAX_BOUNCES bounces, 0 every one [0] */
+    /* Tiles this wide (m, squares from x = z = 0) that a bake redoes
+     * alone when the world around them changed (docs/probes.md, "Tiles")
+     * [0: none]; the rays' reach, past which a ray sees the sky [0: a
+     * quarter of tile_m with tiles, else unlimited] */
+    double tile_m, reach_m;
+    /* Set by `skybake bake --tile X,Z` (not a scene field): bake these
+     * tiles alone, the others left unbaked [none: every tile] */
+    int only_tile_count;
+    int32_t only_tiles[SB_PROBES_MAX_ONLY_TILES][2];
     int explicit_count;
     double positions_m[SB_PROBES_MAX_EXPLICIT][3];
 };

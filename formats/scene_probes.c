@@ -91,7 +91,7 @@ static enum sb_result probes_section_parse(const cJSON *obj, struct sb_scene *sc
     static const char *const keys[] = {
         "spacing_m",   "margin_m",         "bounds_m", "rays",      "inside_fraction",  "positions_m",
         "bounce_rays", "bounce_secondary", "bounces",  "layers_m",  "budget_mb",        "detail_spacing_m",
-        "detail_volumes", NULL};
+        "detail_volumes", "tile_m",        "reach_m",  NULL};
     struct sb_probe_params *p = &scene->probes;
     sb_probe_params_default(p);
     scene->has_probes = true;
@@ -198,6 +198,21 @@ static enum sb_result probes_section_parse(const cJSON *obj, struct sb_scene *sc
     }
     if (!res && (item = cJSON_GetObjectItemCaseSensitive(obj, "detail_volumes")))
         res = parse_volumes(item, source, p);
+    if (!res && (item = cJSON_GetObjectItemCaseSensitive(obj, "reach_m")))
+        res = sb_json_number(item, source, "probes.reach_m", 0, 1e5, &p->reach_m);
+    if (!res && (item = cJSON_GetObjectItemCaseSensitive(obj, "tile_m")) &&
+        !(res = sb_json_number(item, source, "probes.tile_m", 0, 1e4, &p->tile_m)) && p->tile_m > 0) {
+        if (p->tile_m < 1) {
+            sb_error("%s: probes.tile_m: %g; 0 (no tiles) or at least 1 m", source, p->tile_m);
+            return SB_ERR_OUT_OF_RANGE;
+        }
+        if (p->explicit_count) { /* they stand nowhere in particular: every tile would own them */
+            sb_error("%s: probes.tile_m: tiles hold a grid and its detail, not probes.positions_m (%d given): bake "
+                     "those in a scene of their own",
+                     source, p->explicit_count);
+            return SB_ERR_OUT_OF_RANGE;
+        }
+    }
     if (!res && p->spacing_m == 0 && !p->explicit_count && p->detail_spacing_m == 0) {
         sb_error("%s: probes: no grid (spacing_m 0), no detail and no positions_m: no probe at all", source);
         return SB_ERR_OUT_OF_RANGE;
@@ -229,6 +244,10 @@ static cJSON *probes_section_json(const struct sb_scene *scene)
     }
     if (p->budget_mb > 0) /* only when given: scenes without keep their hash */
         cJSON_AddNumberToObject(o, "budget_mb", p->budget_mb);
+    if (p->tile_m > 0) /* likewise */
+        cJSON_AddNumberToObject(o, "tile_m", p->tile_m);
+    if (p->reach_m > 0)
+        cJSON_AddNumberToObject(o, "reach_m", p->reach_m);
     if (p->layer_count) /* only when given: scenes without keep their hash */
         cJSON_AddItemToObject(o, "layers_m", cJSON_CreateDoubleArray(p->layers_m, p->layer_count));
     if (p->detail_spacing_m > 0) { /* likewise */

@@ -52,7 +52,8 @@ struct sb_bvh_instance_record {
     float to_object[3][4]; /* world to the mesh's space: rows of an affine 3 x 4 */
     uint32_t root;         /* the mesh's root node */
     uint32_t instance;     /* the instance's index */
-    uint32_t pad[2];
+    uint32_t flags;        /* SB_BVH_INSTANCE_WIDE (shaders/config.h), else 0 */
+    uint32_t pad;
 };
 
 struct sb_bvh {

@@ -267,8 +267,11 @@ struct sb_noise_push {
 /* Two levels (a world of instances): a top-level leaf whose count is
  * SB_BVH_INSTANCE_LEAF holds one instance, its record at node `first`: two
  * nodes, the world-to-object rows (three vec4s), then its mesh's root node,
- * the instance's index and two zeros (as uints). */
+ * the instance's index, its flags and a zero (as uints). */
 #define SB_BVH_INSTANCE_LEAF 0x80000000u
+/* An instance's flags: met at any distance, past a tiled bake's reach
+ * (bvh.glsl's bvh_reach; baker/probe_tiles.h) */
+#define SB_BVH_INSTANCE_WIDE 1u
 #define SB_BVH_NO_INSTANCE 0xffffffffu
 #define SB_RAYCAST_BINDING_NODES 0
 #define SB_RAYCAST_BINDING_TRIANGLES 1
@@ -375,7 +378,7 @@ struct sb_bounce_push {
     SB_UINT first_ray;
     SB_UINT first_direction;
     SB_UINT accumulate;
-    SB_UINT pad;
+    float tmax_m; /* a ray, from the probe or from a surface, reaching this far sees the sky */
 };
 /* Mesa's lavapipe ends every loop of a kernel invocation once the
  * invocation has run 65535 loop iterations in all (gallivm's

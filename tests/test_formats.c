@@ -1256,7 +1256,8 @@ static void test_probes(void)
         enum sb_result want;
         const char *what;
     } fields[] = {
-        {8, 6, SB_ERR_VERSION, "a newer version"},
+        {8, 7, SB_ERR_VERSION, "a newer version"},
+        {8, 6, SB_ERR_PROBES, "version 6 with version 1's header"},
         {8, 5, SB_ERR_PROBES, "version 5 with version 1's header"},
         {8, 4, SB_ERR_PROBES, "version 4 with version 1's header"},
         {8, 3, SB_ERR_PROBES, "version 3 with version 1's header"},
@@ -1495,6 +1496,80 @@ static void test_probes(void)
     check_probes_damage(bytes, size, "binary16 without detail");
     CHECK(parse_edited(bytes, size, &(struct field_edit){164, 8, "sight masks without detail"}) == SB_ERR_PROBES,
           "sight masks without detail");
+
+    /* Tiles: version 6, the tiles the probes fall in (sb_probe_tiles_assign:
+     * the grid's columns and the detail's brick column, 10 m squares from
+     * 0), their keys and contents round-trip, a tile left unbaked holds
+     * zeros; every prefix and bit flip is refused, and so are tiles that
+     * do not match the probes, a content that does not hash, an unbaked
+     * tile with a key or with values, and hostile sides and reaches. */
+    struct sb_probe_layout tiled;
+    uint32_t tile_of[nd];
+    CHECK(sb_probe_layout_copy(&tiled, &bricks) == SB_OK, "copy");
+    CHECK(sb_probe_tiles_assign(&tiled, 10.0f, tile_of) == SB_OK && tiled.tile_count == 5 && tiled.tile_m == 10.0f,
+          "the probes fall in 5 tiles of 10 m (%u)", tiled.tile_count);
+    /* the grid's x -1 and 11.5, z 2 and 14.5: tiles x -1 and 1, z 0 and 1;
+     * the detail's brick column starts at x 2, z 10: tile 0, 1 */
+    CHECK(tiled.tiles[0].x == -1 && tiled.tiles[0].z == 0 && tiled.tiles[0].probes == 2 && tiled.tiles[3].x == 0 &&
+              tiled.tiles[3].z == 1 && tiled.tiles[3].probes == 16 && tile_of[nl] == 3 && tile_of[1] == 1,
+          "tiles in increasing z then x, each probe's");
+    tiled.reach_m = 32;
+    for (uint32_t i = 0; i < nd; i++) /* the last tile (x 1, z 1) left unbaked */
+        if (tile_of[i] == 4)
+            memset(&detailed.data[i * ch], 0, sizeof(float) * ch);
+    for (uint32_t t = 0; t < tiled.tile_count; t++) {
+        if (t == 4)
+            continue;
+        tiled.tiles[t].flags = SB_PROBES_TILE_BAKED;
+        snprintf(tiled.tiles[t].key, sizeof(tiled.tiles[t].key), "%032x", 0xabc0u + t);
+        uint32_t mine[nd], n_mine = 0;
+        for (uint32_t i = 0; i < nd; i++)
+            if (tile_of[i] == t)
+                mine[n_mine++] = i;
+        tiled.tiles[t].content = sb_probe_tile_content(&tiled, &detailed, false, mine, n_mine);
+    }
+    CHECK(sb_probes_write(path, &tiled, &detailed, false) == SB_OK &&
+              sb_probes_read(path, SB_SKY_VISIBILITY_CHANNELS, 1000, &got, &back) == SB_OK && got.tile_count == 5 &&
+              !memcmp(got.tiles, tiled.tiles, 5 * sizeof(*got.tiles)) && got.reach_m == 32 && !got.half &&
+              !memcmp(back.data, detailed.data, sizeof(float) * nd * ch) && !memcmp(got.sight, sight, sizeof(sight)),
+          "tiles: the round trip is exact");
+    CHECK(sb_probe_layout_copy(&copy, &got) == SB_OK && copy.tiles != got.tiles && copy.tiles[3].probes == 16,
+          "a layout's copy owns its tiles");
+    sb_probe_layout_finish(&copy);
+    sb_probe_layout_finish(&got);
+    CHECK(!got.tiles && !got.tile_count, "finished");
+    sb_image_finish(&back);
+    size = read_back(path, bytes, sizeof(bytes));
+    size_t tiles_at = SB_PROBES_HEADER_BYTES + SB_PROBES_COLUMN_BYTES;
+    CHECK(size == tiles_at + 5 * SB_PROBES_TILE_BYTES + sizeof(sight) + (size_t)nd * ch * 4 + 8 && bytes[8] == 6,
+          "version 6: size %zu", size);
+    check_probes_damage(bytes, size, "tiles");
+    size_t values_at = tiles_at + 5 * SB_PROBES_TILE_BYTES + sizeof(sight);
+    const struct field_edit tile_fields[] = {
+        {172, 0, "tiles of 0 m"},
+        {172, 0x7fc00000, "tiles of NaN m"},
+        {176, 0, "rays reaching 0 m"},
+        {180, 0, "no tiles"},
+        {180, 4, "fewer tiles than the probes fall in"},
+        {184, 1, "a reserved byte"},
+        {40, 1, "an explicit probe"},
+        {tiles_at, 5, "a tile elsewhere"},
+        {tiles_at + 8, 3, "a tile holding other probes"},
+        {tiles_at + 12, 2, "an undefined flag"},
+        {tiles_at + 32, 7, "a content that does not hash"},
+        {tiles_at + 4 * SB_PROBES_TILE_BYTES + 16, 1, "an unbaked tile with a key"},
+        {tiles_at + 4 * SB_PROBES_TILE_BYTES + 32, 1, "an unbaked tile with a content"},
+        {values_at + (size_t)1 * ch * 4 + 11 * 4, 0x3e123457, "a value in a baked tile, its content not rehashed"},
+        {values_at + (size_t)(nl - 1) * ch * 4 + 6 * 4, 0x3f800000, "a value in an unbaked tile"},
+    };
+    check_edits(bytes, size, tile_fields, sizeof(tile_fields) / sizeof(tile_fields[0]), SB_OK);
+    CHECK(parse_edited(bytes, size, &(struct field_edit){168, 2, "values of 2 bytes with 4 stored"}) != SB_OK &&
+              parse_edited(bytes, size, &(struct field_edit){168, 3, "values of 3 bytes"}) != SB_OK,
+          "value sizes");
+    struct sb_probe_layout explicit_too = terrain;
+    explicit_too.explicit_count = 1;
+    CHECK(sb_probe_tiles_assign(&explicit_too, 10.0f, NULL) == SB_ERR_PROBES, "explicit probes have no tile");
+    sb_probe_layout_finish(&tiled);
     sb_image_finish(&detailed);
     sb_image_finish(&layered);
     unlink(path);

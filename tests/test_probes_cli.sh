@@ -37,7 +37,7 @@ check "only what was asked for" test ! -e "$tmp/p/transmittance.exr"
 check "verify" expect_exit 0 "$skybake" verify "$tmp/p"
 check "info lists sky_visibility" expect_exit 0 "$skybake" info "$tmp/p"
 check "info shows the grid" grep -q '"grid":\[6,1,6\]' "$tmp/out"
-check "manifest has format_version 10" grep -Eq '"format_version":[[:space:]]*10,' "$tmp/p/manifest.json"
+check "manifest has format_version 11" grep -Eq '"format_version":[[:space:]]*11,' "$tmp/p/manifest.json"
 check "diff with itself" expect_exit 0 "$skybake" diff "$tmp/p" "$tmp/p"
 hash() { sed -n 's/.*"content_hash":[[:space:]]*"\([0-9a-f]*\)".*/\1/p' "$tmp/p/manifest.json"; }
 first=$(hash)
@@ -384,6 +384,82 @@ printf '{"atmosphere":{"preset":"earth"},"products":["transmittance","sky_visibi
 check "a lattice past its cap is refused before any bake" expect_exit 1 "$skybake" bake "$tmp/fine.json" -o "$tmp/fine"
 check "before the transmittance" sh -c "! grep -q 'transmittance' '$tmp/err'"
 check "naming probes.detail_spacing_m" grep -q "raise probes.detail_spacing_m" "$tmp/err"
+
+# Tiles: a level of huts and a room on a 100 m ground, in tiles 16 m
+# across, rays reaching 4 m. Moving one hut 4 m rebakes the tiles whose
+# probes' box, grown by what they see (0.6 of the spacing for a push out,
+# then twice the reach: 10.41 m), meets the hut's box before or after, and
+# no other (counted here from the tile list); the pack is then byte for byte
+# a forced bake's. A tile baked alone (--tile) holds that bake's bytes, the
+# rest unbaked; a bake into that pack keeps it and bakes the rest.
+printf 'v -50 0 -50\nv -50 0 50\nv 50 0 50\nv 50 0 -50\nf 1 2 3\nf 1 3 4\n' >"$tmp/ground.obj"
+sed -n '/^v -2 0.05 -2$/,$p' "$tmp/room.obj" | awk '/^f/ { printf "f %d %d %d\n", $2 - 4, $3 - 4, $4 - 4; next } { print }' >"$tmp/room_only.obj"
+level() { # the moving hut's x
+    printf '{"version":1,"ground":false,"instances":[{"file":"ground.obj"},{"file":"hut.json","translate_m":[-30,0,-30]},{"file":"hut.json","translate_m":[%s,0,10]},{"file":"hut.json","translate_m":[30,0,-20]},{"file":"room_only.obj","translate_m":[-30,0,25]}]}' "$1" >"$tmp/tiles-world.json"
+}
+level 20
+printf '{"version":1,"name":"tiles","atmosphere":{"preset":"earth"},"products":["sky_visibility","sky_bounce"],"world":{"file":"tiles-world.json"},"probes":{"spacing_m":4,"layers_m":[1.5,6],"rays":256,"bounce_rays":64,"bounce_secondary":8,"detail_spacing_m":1,"tile_m":16,"reach_m":4}}' >"$tmp/tiles.json"
+check "bake a level in tiles" expect_exit 0 "$skybake" bake "$tmp/tiles.json" -o "$tmp/tiles"
+check "every tile baked" grep -q "sky_visibility: \([0-9]*\) tiles: \1 baked, 0 kept" "$tmp/err"
+check "with detail" grep -q "([1-9][0-9]* in detail)" "$tmp/err"
+check "the visibility's file is version 6" sh -c "od -An -tu4 -j8 -N4 '$tmp/tiles/sky_visibility.sbprobes' | grep -qw 6"
+check "verify" expect_exit 0 "$skybake" verify "$tmp/tiles"
+check "info lists the tiles" expect_exit 0 "$skybake" info "$tmp/tiles" --json
+cp "$tmp/out" "$tmp/tiles-before.json"
+level 24
+check "one hut moved 4 m: rebake" expect_exit 0 "$skybake" bake "$tmp/tiles.json" -o "$tmp/tiles"
+baked=$(sed -n 's/.*sky_visibility: [0-9]* tiles: \([0-9]*\) baked, \([0-9]*\) kept.*/\1/p' "$tmp/err")
+bounce_baked=$(sed -n 's/.*sky_bounce: [0-9]* tiles: \([0-9]*\) baked, \([0-9]*\) kept.*/\1/p' "$tmp/err")
+expected=$(python3 - "$tmp/tiles-before.json" <<'PY'
+import json, math, sys
+tiles = [a for a in json.load(open(sys.argv[1]))["artifacts"] if a["name"] == "sky_visibility"][0]["tiles"]
+margin = 0.6 * 4 + 2 * 4 + 0.01
+boxes = [(20 - 2, 20 + 4, 8, 12), (24 - 2, 24 + 4, 8, 12)]  # the hut (a 4 m box, a cube 3 m to its +x) before, after
+columns = [4 * k for k in range(-13, 14)]  # the grid: -52 to 52 m, 4 m apart
+def span(t):
+    c = [x for x in columns if math.floor(x / 16) == t]
+    return min(c) - margin, max(c) + margin
+n = 0
+for t in tiles:
+    (x0, x1), (z0, z1) = span(t["x"]), span(t["z"])
+    n += any(x0 <= b[1] and x1 >= b[0] and z0 <= b[3] and z1 >= b[2] for b in boxes)
+print(n, len(tiles))
+PY
+)
+check "the tiles around the hut rebaked: $baked of ${expected#* } (expected ${expected% *})" test -n "$baked" -a "$baked" = "${expected% *}"
+check "and no more than a tenth" test "$((10 * ${baked:-99}))" -le "${expected#* }"
+check "the bounce's likewise ($bounce_baked)" test -n "$bounce_baked" -a "$bounce_baked" -le "$baked"
+check "a forced bake of the moved level" expect_exit 0 "$skybake" bake "$tmp/tiles.json" -o "$tmp/tiles-full" --force -q
+check "the same visibility, byte for byte" cmp -s "$tmp/tiles/sky_visibility.sbprobes" "$tmp/tiles-full/sky_visibility.sbprobes"
+check "the same bounce, byte for byte" cmp -s "$tmp/tiles/sky_bounce.sbprobes" "$tmp/tiles-full/sky_bounce.sbprobes"
+check "a tile baked alone" expect_exit 0 "$skybake" bake "$tmp/tiles.json" -o "$tmp/tile-one" --tile -2,1
+check "one baked, the rest left" grep -q "sky_visibility: \([0-9]*\) tiles: 1 baked, 0 kept (their keys unchanged), [1-9][0-9]* left" "$tmp/err"
+check "verify the partial pack" expect_exit 0 "$skybake" verify "$tmp/tile-one"
+check "info" expect_exit 0 "$skybake" info "$tmp/tile-one" --json
+cp "$tmp/out" "$tmp/tile-one.json"
+check "info of the whole" expect_exit 0 "$skybake" info "$tmp/tiles-full" --json
+check "the tile (the room's, with detail) holds the whole bake's bytes" python3 - "$tmp/tile-one.json" "$tmp/out" <<'PY'
+import json, sys
+def tiles(path, name):
+    return {(t["x"], t["z"]): t for a in json.load(open(path))["artifacts"] if a["name"] == name for t in a["tiles"]}
+for name in ("sky_visibility", "sky_bounce"):
+    one, whole = tiles(sys.argv[1], name), tiles(sys.argv[2], name)
+    assert one.keys() == whole.keys(), name
+    assert one[(-2, 1)]["baked"] and one[(-2, 1)]["content"] == whole[(-2, 1)]["content"], (name, one[(-2, 1)])
+    assert one[(-2, 1)]["key"] == whole[(-2, 1)]["key"], name
+    assert not any(t["baked"] for k, t in one.items() if k != (-2, 1)), name
+PY
+check "a bake into the partial pack" expect_exit 0 "$skybake" bake "$tmp/tiles.json" -o "$tmp/tile-one"
+check "keeps the tile" grep -q "sky_visibility: [0-9]* tiles: [0-9]* baked, 1 kept (their keys unchanged), 0 left" "$tmp/err"
+check "and is the whole bake" cmp -s "$tmp/tile-one/sky_visibility.sbprobes" "$tmp/tiles-full/sky_visibility.sbprobes"
+check "a tile of no probe is said" expect_exit 0 "$skybake" bake "$tmp/tiles.json" -o "$tmp/tile-none" --tile 40,40 -q
+check "--tile needs tiles" expect_exit 2 "$skybake" bake "$tmp/room.json" -o "$tmp/n" --tile 0,0
+check "--tile X,Z" expect_exit 2 "$skybake" bake "$tmp/tiles.json" -o "$tmp/n" --tile 0
+for bad in '"tile_m":0.5' '"tile_m":-1' '"tile_m":2e4' '"reach_m":-1' '"tile_m":16,"positions_m":[[0,1,0]]'; do
+    printf '{"atmosphere":{"preset":"earth"},"products":["sky_visibility"],"world":{"file":"room.obj"},"probes":{"spacing_m":4,%s}}' "$bad" >"$tmp/bad_tiles.json"
+    check "probes {$bad} refused" expect_exit 2 "$skybake" bake "$tmp/bad_tiles.json" -o "$tmp/bad_tiles"
+    check "naming probes.tile_m or reach_m" grep -q "probes\.\(tile_m\|reach_m\)" "$tmp/err"
+done
 
 echo "probes cli: $checks checks, $fails failed"
 echo "$((checks - fails)) passed, $fails failed"

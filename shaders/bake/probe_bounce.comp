@@ -35,6 +35,7 @@ shared float partial[SB_PROBE_SH * 3][SB_PROBE_THREADS];
 
 void main()
 {
+    bvh_reach = pc.tmax_m; // placed objects past it are not met (a tiled bake's reach)
     uint probe = gl_WorkGroupID.x + gl_WorkGroupID.y * gl_NumWorkGroups.x;
     uint lane = gl_LocalInvocationID.x;
     if (probe >= pc.probe_count)
@@ -72,6 +73,10 @@ void main()
         vec3 x = origin + w * hit.t;
         float eps = 1e-4 + 2e-6 * max(abs(x.x), max(abs(x.y), abs(x.z)));
         vec3 from = x + n * eps;
+        // the surface's rays meet placed objects only as far from the
+        // probe as twice the reach in all (a tiled bake's: a hit on a wide
+        // terrain may lie past it)
+        bvh_reach = max(2.0 * pc.tmax_m - hit.t, 0.0);
         float g[SB_PROBE_SH];
         for (int k = 0; k < SB_PROBE_SH; k++)
             g[k] = 0.0;

@@ -25,6 +25,7 @@ shared float partial[SUMS][SB_PROBE_THREADS];
 
 void main()
 {
+    bvh_reach = pc.tmax_m; // placed objects past it are not met (a tiled bake's reach)
     uint probe = gl_WorkGroupID.x + gl_WorkGroupID.y * gl_NumWorkGroups.x;
     uint lane = gl_LocalInvocationID.x;
     if (probe >= pc.probe_count)
@@ -38,7 +39,7 @@ void main()
     uint end = min(pc.first_ray + SB_VISIBILITY_PASS_RAYS, pc.ray_count);
     for (uint k = pc.first_ray + lane; k < end; k += SB_PROBE_THREADS) {
         vec3 d = probe_direction(order[k], pc.ray_count);
-        BvhHit hit = bvh_trace(origin, d, pc.tmin_m, pc.tmax_m, false);
+        BvhHit hit = bvh_trace(origin, d, pc.tmin_m, 1e30, false);
         if (hit.triangle == SB_BVH_MISS) {
             float y[SB_PROBE_SH];
             sh9_basis(d, y);

@@ -12,6 +12,12 @@
 // SPIR-V, its speed on lavapipe, its bake hashes); with it, one or two
 // levels (instances): at an instance's leaf the ray goes into the mesh's
 // space (an affine map keeps t), and a marker on the stack brings it back.
+//
+// A tiled probe bake's reach (docs/probes.md, "Tiles"): with instances, a
+// kernel may set bvh_reach; an instance whose record is not flagged
+// SB_BVH_INSTANCE_WIDE (a terrain, a ground) is then met only closer than
+// that (t along the world direction). Unset, nothing changes.
+float bvh_reach = 1e30;
 
 struct BvhHit {
     float t;
@@ -101,6 +107,7 @@ BvhHit bvh_trace(vec3 world_o, vec3 world_d, float tmin, float tmax, bool any_hi
     vec3 o = world_o, d = world_d;
     vec3 inv_d = bvh_inverse_direction(d);
     uint instance = SB_BVH_NO_INSTANCE;
+    float limit = 1e30; // the instance's: bvh_reach unless it is wide
     // the top level's path, the instance's end (SB_BVH_MISS), the mesh's path
     uint stack[2 * SB_BVH_MAX_DEPTH + 3];
     int top = 0;
@@ -117,21 +124,22 @@ BvhHit bvh_trace(vec3 world_o, vec3 world_d, float tmin, float tmax, bool any_hi
             d = vec3(dot(r0.xyz, world_d), dot(r1.xyz, world_d), dot(r2.xyz, world_d));
             inv_d = bvh_inverse_direction(d);
             instance = first;
+            limit = (floatBitsToUint(bvh_nodes[2 * first + 3].z) & SB_BVH_INSTANCE_WIDE) != 0u ? 1e30 : bvh_reach;
             stack[top++] = SB_BVH_MISS;
             node = floatBitsToUint(bvh_nodes[2 * first + 3].x);
             continue;
         }
         if (count != 0u) {
             for (uint i = first; i < first + count; i++) {
-                if (bvh_hit_triangle(i, o, d, tmin, hit.t, any_hit, hit)) {
+                if (bvh_hit_triangle(i, o, d, tmin, min(hit.t, limit), any_hit, hit)) {
                     hit.instance = instance;
                     if (any_hit)
                         return hit;
                 }
             }
         } else {
-            bool a = bvh_hit_box(first, o, inv_d, tmin, hit.t, ta);
-            bool b = bvh_hit_box(first + 1u, o, inv_d, tmin, hit.t, tb);
+            bool a = bvh_hit_box(first, o, inv_d, tmin, min(hit.t, limit), ta);
+            bool b = bvh_hit_box(first + 1u, o, inv_d, tmin, min(hit.t, limit), tb);
             if (a && b) {
                 bool right_nearer = tb < ta;
                 stack[top++] = right_nearer ? first : first + 1u;
@@ -153,6 +161,7 @@ BvhHit bvh_trace(vec3 world_o, vec3 world_d, float tmin, float tmax, bool any_hi
             d = world_d;
             inv_d = bvh_inverse_direction(d);
             instance = SB_BVH_NO_INSTANCE;
+            limit = 1e30;
         }
     }
     return hit;
