@@ -153,22 +153,28 @@ enum sb_result sb_bake_scene(struct sb_vk *vk, const struct sb_scene *scene, con
     struct sb_pack *old = calloc(1, sizeof(*old));
     if (!old)
         return SB_ERR_NOMEM;
+    double opened = sb_now_s();
     bool reuse = !(options && options->force) && open_previous(vk, out_dir, old);
+    if (reuse)
+        sb_debug("bake: the pack there read and verified in %.1f ms", 1e3 * (sb_now_s() - opened));
 
     uint32_t mask = sb_bake_closure(scene);
     enum sb_result res = sb_pack_writer_create(out_dir, &writer);
     if (res)
         goto cleanup;
+    double created = sb_now_s();
     for (int p = 0; p < SB_PRODUCT_COUNT; p++) {
         enum sb_family f = sb_product_format((enum sb_product_id)p)->family;
         const struct sb_family_baker *family = sb_family_baker(f);
         if ((mask & (1u << p)) && family->create && !states[f] && (res = family->create(vk, scene, &states[f])))
             goto cleanup;
     }
-
+    double keyed = sb_now_s();
     char keys[SB_PRODUCT_COUNT][SB_HASH_HEX_SIZE];
     sb_bake_keys(scene, mask, states, keys);
     prepare_kernels(vk, scene, mask, reuse ? old : NULL, keys, states);
+    sb_debug("bake: the families ready (worlds read) in %.1f ms, keys and kernels in %.1f ms", 1e3 * (keyed - created),
+             1e3 * (sb_now_s() - keyed));
     int total = 0, done = 0;
     for (int p = 0; p < SB_PRODUCT_COUNT; p++)
         total += (mask >> p) & 1;
@@ -224,7 +230,9 @@ enum sb_result sb_bake_scene(struct sb_vk *vk, const struct sb_scene *scene, con
             goto cleanup;
         }
         a->bake_ms = 1e3 * sb_now_s() - t0;
+        double added = sb_now_s();
         res = sb_pack_writer_add_image(writer, a, image);
+        sb_debug("%s: written and hashed in %.1f ms", sb_product_name(id), 1e3 * (sb_now_s() - added));
         sb_probe_layout_finish(&a->probes);
         if (res)
             goto cleanup;
@@ -239,7 +247,9 @@ enum sb_result sb_bake_scene(struct sb_vk *vk, const struct sb_scene *scene, con
     struct sb_device_info device;
     sb_vk_device_info(vk, &device);
     sb_status("writing the pack");
+    double written = sb_now_s();
     res = sb_pack_writer_commit(&writer, scene_json, &device);
+    sb_debug("bake: the pack committed in %.1f ms", 1e3 * (sb_now_s() - written));
 
 cleanup:
     sb_status(NULL);

@@ -5,6 +5,7 @@
 #include <string.h>
 
 #include "log.h"
+#include "parallel.h"
 #include "probe_bounce.spv.h"
 #include "probe_bounce_instanced.spv.h"
 
@@ -144,6 +145,22 @@ uint32_t sb_sky_bounce_sum(float *kernel, uint32_t bounces, double *added)
     return n;
 }
 
+/* The bounces summed a probe at a time on every core (each probe's own:
+ * the same whatever the thread count). */
+struct sum_job {
+    float *kernel, *out;
+    uint32_t bounces, *terms;
+    double *added;
+};
+
+static void sum_one(void *user, int i)
+{
+    struct sum_job *job = user;
+    float *k = &job->kernel[(size_t)i * SB_BOUNCE_KERNEL_FLOATS];
+    job->terms[i] = sb_sky_bounce_sum(k, job->bounces, &job->added[i]);
+    memcpy(&job->out[(size_t)i * SB_BOUNCE_FLOATS], k, SB_BOUNCE_FLOATS * sizeof(float));
+}
+
 enum sb_result sb_sky_bounce_bake(struct sb_raycaster *rc, const struct sb_surfaces *surfaces, const float *positions,
                                   const float *valid, uint32_t probe_count, const struct sb_sky_bounce_params *params,
                                   float *out, double *gpu_ms, struct sb_sky_bounce_report *report)
@@ -174,6 +191,7 @@ enum sb_result sb_sky_bounce_bake(struct sb_raycaster *rc, const struct sb_surfa
     struct sb_pipeline pipeline = {0};
     const struct sb_pipeline_params pp = sb_sky_bounce_kernel(rc->instanced);
     float *kernel = malloc((size_t)probe_count * SB_BOUNCE_KERNEL_FLOATS * sizeof(float));
+    struct sum_job job = {.kernel = kernel, .out = out, .bounces = params->bounces};
     enum sb_result res = kernel ? SB_OK : SB_ERR_NOMEM;
     if (res ||
         (res = sb_probe_buffers_create(vk, positions, valid, probe_count, SB_BOUNCE_KERNEL_FLOATS, &probes,
@@ -198,23 +216,30 @@ enum sb_result sb_sky_bounce_bake(struct sb_raycaster *rc, const struct sb_surfa
         }
     if (res || (res = sb_buffer_read(vk, &results, kernel)))
         goto done;
+    double t0 = sb_now_s();
+    job.terms = malloc(probe_count * sizeof(uint32_t));
+    job.added = malloc(probe_count * sizeof(double));
+    if (!job.terms || !job.added) {
+        res = SB_ERR_NOMEM;
+        goto done;
+    }
+    sb_parallel_for((int)probe_count, sum_one, &job);
     uint32_t counted = 0;
-    double sum = 0;
-    for (uint32_t i = 0; i < probe_count; i++) {
-        float *k = &kernel[(size_t)i * SB_BOUNCE_KERNEL_FLOATS];
-        double added;
-        uint32_t n = sb_sky_bounce_sum(k, params->bounces, &added);
-        memcpy(&out[(size_t)i * SB_BOUNCE_FLOATS], k, SB_BOUNCE_FLOATS * sizeof(float));
-        if (report && (!valid || valid[i] != 0)) {
-            report->most_bounces = n > report->most_bounces ? n : report->most_bounces;
-            report->most_added = fmax(report->most_added, added);
-            sum += added;
-            counted++;
-        }
+    double sum = 0; /* in probe order: the same sum whatever the threads */
+    for (uint32_t i = 0; i < probe_count && report; i++) {
+        if (valid && valid[i] == 0)
+            continue;
+        report->most_bounces = job.terms[i] > report->most_bounces ? job.terms[i] : report->most_bounces;
+        report->most_added = fmax(report->most_added, job.added[i]);
+        sum += job.added[i];
+        counted++;
     }
     if (report && counted)
         report->mean_added = sum / counted;
+    sb_debug("sky bounce: %u probes' bounces summed in %.1f ms", probe_count, 1e3 * (sb_now_s() - t0));
 done:
+    free(job.terms);
+    free(job.added);
     free(kernel);
     sb_pipeline_destroy(vk, &pipeline);
     sb_buffer_destroy(vk, &results);
