@@ -717,21 +717,6 @@ static void tile_key(struct probes_state *st, const struct sb_scene *scene, enum
     sb_hash_bytes(key.text, key.length < sizeof(key.text) ? key.length : sizeof(key.text) - 1, out);
 }
 
-/* The tile of the pack before at x, z, or -1. */
-static int64_t find_tile(const struct sb_probe_layout *layout, int32_t x, int32_t z)
-{
-    uint32_t lo = 0, hi = layout->tile_count;
-    while (lo < hi) {
-        uint32_t mid = lo + (hi - lo) / 2;
-        const struct sb_probe_tile *t = &layout->tiles[mid];
-        if (t->z < z || (t->z == z && t->x < x))
-            lo = mid + 1;
-        else
-            hi = mid;
-    }
-    return lo < layout->tile_count && layout->tiles[lo].x == x && layout->tiles[lo].z == z ? (int64_t)lo : -1;
-}
-
 /*
  * Plan a bake of `count` probes: without tiles, cast them all; with, key
  * each tile (tile_key), keep those the pack before baked under the same
@@ -770,7 +755,7 @@ static enum sb_result plan_tiles(struct probes_state *st, const struct sb_scene 
         for (uint32_t t = 0; t < plan->tiling.count; t++) {
             struct sb_probe_tile *tile = &layout->tiles[t];
             tile_key(st, scene, id, layout, plan, t, what, stride, margin, tile->key);
-            int64_t was = have_prev ? find_tile(prev, tile->x, tile->z) : -1;
+            int64_t was = have_prev ? sb_probe_tile_find(prev, tile->x, tile->z) : -1;
             bool named = !p->only_tile_count;
             for (int i = 0; i < p->only_tile_count; i++)
                 named |= p->only_tiles[i][0] == tile->x && p->only_tiles[i][1] == tile->z;

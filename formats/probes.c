@@ -142,6 +142,16 @@ static uint64_t tile_code(int64_t x, int64_t z)
     return (uint64_t)(z + INT32_MAX) << 32 | (uint64_t)(x + INT32_MAX);
 }
 
+static int32_t tile_x(uint64_t code)
+{
+    return (int32_t)((int64_t)(uint32_t)code - INT32_MAX);
+}
+
+static int32_t tile_z(uint64_t code)
+{
+    return (int32_t)((int64_t)(code >> 32) - INT32_MAX);
+}
+
 static int compare_u64(const void *a, const void *b)
 {
     uint64_t x = *(const uint64_t *)a, y = *(const uint64_t *)b;
@@ -198,28 +208,31 @@ enum sb_result sb_probe_tiles_assign(struct sb_probe_layout *layout, float side,
             layout->tiles[t - 1].probes++;
             continue;
         }
-        layout->tiles[t++] = (struct sb_probe_tile){.x = (int32_t)((int64_t)(uint32_t)sorted[i] - INT32_MAX),
-                                                    .z = (int32_t)((int64_t)(sorted[i] >> 32) - INT32_MAX),
-                                                    .probes = 1};
+        layout->tiles[t++] = (struct sb_probe_tile){.x = tile_x(sorted[i]), .z = tile_z(sorted[i]), .probes = 1};
     }
     if (!res) {
         layout->tile_count = (uint32_t)tiles;
         layout->tile_m = side;
-        for (uint64_t i = 0; i < n && tile_of; i++) {
-            uint32_t lo = 0, hi = (uint32_t)tiles; /* the sorted tiles hold every code */
-            while (lo < hi) {
-                uint32_t mid = lo + (hi - lo) / 2;
-                if (tile_code(layout->tiles[mid].x, layout->tiles[mid].z) < code[i])
-                    lo = mid + 1;
-                else
-                    hi = mid;
-            }
-            tile_of[i] = lo;
-        }
+        for (uint64_t i = 0; i < n && tile_of; i++) /* the tiles hold every code */
+            tile_of[i] = (uint32_t)sb_probe_tile_find(layout, tile_x(code[i]), tile_z(code[i]));
     }
     free(code);
     free(sorted);
     return res;
+}
+
+int64_t sb_probe_tile_find(const struct sb_probe_layout *layout, int32_t x, int32_t z)
+{
+    uint32_t lo = 0, hi = layout->tile_count;
+    while (lo < hi) {
+        uint32_t mid = lo + (hi - lo) / 2;
+        const struct sb_probe_tile *t = &layout->tiles[mid];
+        if (t->z < z || (t->z == z && t->x < x))
+            lo = mid + 1;
+        else
+            hi = mid;
+    }
+    return lo < layout->tile_count && layout->tiles[lo].x == x && layout->tiles[lo].z == z ? (int64_t)lo : -1;
 }
 
 /* A record's stored bytes into `out` (value_bytes a value). */

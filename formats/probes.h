@@ -244,6 +244,9 @@ enum sb_result sb_probe_layout_copy(struct sb_probe_layout *to, const struct sb_
  */
 enum sb_result sb_probe_tiles_assign(struct sb_probe_layout *layout, float side, uint32_t *tile_of);
 
+/* The index of tile (x, z) among the layout's tiles, or -1. */
+int64_t sb_probe_tile_find(const struct sb_probe_layout *layout, int32_t x, int32_t z);
+
 /* XXH3-64 of a tile's probes' records as a file stores them (binary16
  * when `half`), then their sight masks: what its record's content holds.
  * probes[]: the tile's `count` probes, in increasing index. */
