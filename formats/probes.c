@@ -158,6 +158,15 @@ static int compare_u64(const void *a, const void *b)
     return (x > y) - (x < y);
 }
 
+/* The tile along an axis of coordinate `at` (m), within +-1e9 tiles
+ * (a hostile file's grid may reach past any real one: never a cast out of
+ * range). */
+static int64_t tile_of_coordinate(double at, double side)
+{
+    double t = floor(at / side);
+    return !(t >= -1e9) ? -1000000000 : t > 1e9 ? 1000000000 : (int64_t)t; /* NaN: the lowest */
+}
+
 /* Each grid and detail probe's tile, packed (tile_code), into code[]. */
 static void tile_codes(const struct sb_probe_layout *l, double side, uint64_t *code)
 {
@@ -165,13 +174,13 @@ static void tile_codes(const struct sb_probe_layout *l, double side, uint64_t *c
     for (; i < grid; i++) {
         double x = (double)l->origin_m[0] + (double)(i % l->grid[0]) * l->spacing_m[0];
         double z = (double)l->origin_m[2] + (double)(i / l->grid[0] / l->grid[1]) * l->spacing_m[2];
-        code[i] = tile_code((int64_t)floor(x / side), (int64_t)floor(z / side));
+        code[i] = tile_code(tile_of_coordinate(x, side), tile_of_coordinate(z, side));
     }
     for (uint32_t c = 0; c < l->column_count; c++) {
         const struct sb_probe_column *col = &l->columns[c];
         double x = (double)l->detail_origin_m[0] + (double)col->x * SB_PROBES_BRICK * l->detail_spacing_m;
         double z = (double)l->detail_origin_m[2] + (double)col->z * SB_PROBES_BRICK * l->detail_spacing_m;
-        uint64_t k = tile_code((int64_t)floor(x / side), (int64_t)floor(z / side));
+        uint64_t k = tile_code(tile_of_coordinate(x, side), tile_of_coordinate(z, side));
         for (uint64_t j = 0; j < (uint64_t)col->rows * SB_PROBES_BRICK * SB_PROBES_BRICK; j++)
             code[i++] = k;
     }
@@ -184,7 +193,7 @@ enum sb_result sb_probe_tiles_assign(struct sb_probe_layout *layout, float side,
     free(layout->tiles);
     layout->tiles = NULL;
     layout->tile_count = 0;
-    if (layout->explicit_count)
+    if (layout->explicit_count || !(side >= 1.0f && side <= 1e4f))
         return SB_ERR_PROBES;
     if (!n)
         return SB_OK;

@@ -239,8 +239,8 @@ enum sb_result sb_probe_layout_copy(struct sb_probe_layout *to, const struct sb_
  * its brick column's first lattice column), into layout->tiles (their
  * probe counts set, flags, keys and contents zero) with tile_m = side; and
  * (tile_of may be NULL) each probe's tile, an index into them. A layout
- * with explicit probes has no tiles: SB_ERR_PROBES. SB_ERR_TOO_LARGE past
- * SB_PROBES_MAX_TILES.
+ * with explicit probes has no tiles, nor does a side outside 1 to 1e4 m:
+ * SB_ERR_PROBES. SB_ERR_TOO_LARGE past SB_PROBES_MAX_TILES.
  */
 enum sb_result sb_probe_tiles_assign(struct sb_probe_layout *layout, float side, uint32_t *tile_of);
 

@@ -1569,6 +1569,13 @@ static void test_probes(void)
     struct sb_probe_layout explicit_too = terrain;
     explicit_too.explicit_count = 1;
     CHECK(sb_probe_tiles_assign(&explicit_too, 10.0f, NULL) == SB_ERR_PROBES, "explicit probes have no tile");
+    struct sb_probe_layout far = terrain; /* a grid reaching past any tile index: clamped, never a bad cast */
+    far.spacing_m[0] = 3e38f;
+    far.tiles = NULL;
+    CHECK(sb_probe_tiles_assign(&far, 1.0f, NULL) == SB_OK && far.tile_count == 4 && far.tiles[1].x == 1000000000 &&
+              sb_probe_tiles_assign(&far, NAN, NULL) == SB_ERR_PROBES,
+          "a grid past any tile, a side that is not a number");
+    sb_probe_layout_finish(&far);
     sb_probe_layout_finish(&tiled);
     sb_image_finish(&detailed);
     sb_image_finish(&layered);
