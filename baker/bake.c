@@ -157,6 +157,23 @@ enum sb_result sb_bake_scene(struct sb_vk *vk, const struct sb_scene *scene, con
     bool reuse = !(options && options->force) && open_previous(vk, out_dir, old);
     if (reuse)
         sb_debug("bake: the pack there read and verified in %.1f ms", 1e3 * (sb_now_s() - opened));
+    /* --from packs: verified and of this device, else left out (saying why) */
+    struct sb_pack *from[SB_BAKE_MAX_FROM] = {0};
+    int from_count = 0;
+    for (int k = 0; options && !options->force && k < options->from_count && k < SB_BAKE_MAX_FROM; k++) {
+        struct sb_pack *pack = calloc(1, sizeof(*pack));
+        if (!pack)
+            break;
+        if (open_previous(vk, options->from[k], pack)) {
+            from[from_count++] = pack;
+            continue;
+        }
+        char manifest[4200];
+        snprintf(manifest, sizeof(manifest), "%s/%s", options->from[k], SB_PACK_MANIFEST);
+        if (access(manifest, F_OK) != 0)
+            sb_warn("%s (--from): no pack there", options->from[k]);
+        free(pack);
+    }
 
     uint32_t mask = sb_bake_closure(scene);
     enum sb_result res = sb_pack_writer_create(out_dir, &writer);
@@ -223,6 +240,9 @@ enum sb_result sb_bake_scene(struct sb_vk *vk, const struct sb_scene *scene, con
 
         if (reuse && old->present[id] && family->previous)
             family->previous(state, id, &old->artifacts[p], &old->images[p]);
+        for (int k = 0; k < from_count && family->previous; k++)
+            if (from[k]->present[id])
+                family->previous(state, id, &from[k]->artifacts[p], &from[k]->images[p]);
         double t0 = 1e3 * sb_now_s();
         struct sb_image *image = &baked[p];
         if ((res = family->bake(state, vk, scene, id, baked, image, a))) {
@@ -257,6 +277,10 @@ cleanup:
     free(scene_json);
     sb_pack_close(old);
     free(old);
+    for (int k = 0; k < from_count; k++) {
+        sb_pack_close(from[k]);
+        free(from[k]);
+    }
     for (int p = 0; p < SB_PRODUCT_COUNT; p++)
         sb_image_finish(&baked[p]);
     for (int f = 0; f < SB_FAMILY_COUNT; f++)

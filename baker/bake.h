@@ -20,8 +20,15 @@
 #include "pack.h"
 #include "scene.h"
 
+#define SB_BAKE_MAX_FROM 16                       /* --from packs */
+#define SB_BAKE_MAX_SOURCES (1 + SB_BAKE_MAX_FROM) /* the pack there, then those */
+
 struct sb_bake_options {
     bool force; /* bake every product, reusing nothing */
+    /* more packs (baked on this device) whose parts a family may keep,
+     * after the pack there: the probes' tiles of a farm's machines */
+    const char *from[SB_BAKE_MAX_FROM];
+    int from_count;
 };
 
 struct sb_bake_report {

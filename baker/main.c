@@ -65,6 +65,8 @@ static void usage(FILE *f)
                "  --tile X,Z          bake this tile of the probes alone (repeatable; probes.tile_m):\n"
                "                      the pack's other tiles are kept where their keys held, else left\n"
                "                      unbaked (invalid) for another bake into the same pack\n"
+               "  --from PACK         also keep the probes' tiles PACK baked under the same keys\n"
+               "                      (repeatable, after the pack at -o; this device's): a farm's merge\n"
                "  --device NAME|INDEX Vulkan device by index or name substring\n"
                "                      (default: first discrete GPU, else the first device)\n"
                "  --threads N         CPU threads for the BVH build and the CPU steps\n"
@@ -207,7 +209,13 @@ static int cmd_bake(int argc, char **argv)
             out_dir = argv[++i];
         else if (!strcmp(a, "--force"))
             options.force = true;
-        else if (!strcmp(a, "--tile") && i + 1 < argc) {
+        else if (!strcmp(a, "--from") && i + 1 < argc) {
+            if (options.from_count == SB_BAKE_MAX_FROM) {
+                fprintf(stderr, "skybake: --from: at most %d packs\n", SB_BAKE_MAX_FROM);
+                return EXIT_USAGE;
+            }
+            options.from[options.from_count++] = argv[++i];
+        } else if (!strcmp(a, "--tile") && i + 1 < argc) {
             long x, z;
             char end;
             if (tile_count == SB_PROBES_MAX_ONLY_TILES || sscanf(argv[++i], "%ld,%ld%c", &x, &z, &end) != 2 ||

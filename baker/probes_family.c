@@ -16,6 +16,7 @@
 #include <string.h>
 #include <xxhash.h>
 
+#include "bake.h"
 #include "bvh.h"
 #include "family.h"
 #include "json.h"
@@ -61,8 +62,11 @@ struct probes_state {
      * each product as the pack there before held it (probes_previous) */
     struct sb_level_regions regions;
     bool regions_made;
-    struct sb_probe_layout prev_layout[2]; /* sky_visibility, sky_bounce */
-    struct sb_image prev_image[2];
+    struct previous {
+        struct sb_probe_layout layout;
+        struct sb_image image;
+    } prev[2][SB_BAKE_MAX_SOURCES]; /* sky_visibility, sky_bounce: the pack there, then --from packs */
+    uint32_t prev_count[2];
 };
 
 /* The probe products' index in probes_state's arrays. */
@@ -104,10 +108,11 @@ static void probes_destroy(void **state)
         sb_bvh_finish(&st->bvh);
         sb_probe_layout_finish(&st->detail);
         sb_level_regions_finish(&st->regions);
-        for (int i = 0; i < 2; i++) {
-            sb_probe_layout_finish(&st->prev_layout[i]);
-            sb_image_finish(&st->prev_image[i]);
-        }
+        for (int i = 0; i < 2; i++)
+            for (uint32_t k = 0; k < st->prev_count[i]; k++) {
+                sb_probe_layout_finish(&st->prev[i][k].layout);
+                sb_image_finish(&st->prev[i][k].image);
+            }
         sb_level_release(&st->level);
     }
     free(st);
@@ -179,14 +184,14 @@ static void probes_previous(void *state, enum sb_product_id id, struct sb_artifa
 {
     struct probes_state *st = state;
     int i = slot(id);
-    if (!was->probes.tile_count)
+    if (!was->probes.tile_count || st->prev_count[i] == SB_BAKE_MAX_SOURCES)
         return; /* nothing to keep but whole products (bake.c) */
-    sb_probe_layout_finish(&st->prev_layout[i]);
-    sb_image_finish(&st->prev_image[i]);
-    if (sb_probe_layout_copy(&st->prev_layout[i], &was->probes))
-        return; /* out of memory: every tile is baked */
-    st->prev_image[i] = *image;
+    struct previous *to = &st->prev[i][st->prev_count[i]];
+    if (sb_probe_layout_copy(&to->layout, &was->probes))
+        return; /* out of memory: its tiles are cast */
+    to->image = *image;
     *image = (struct sb_image){0};
+    st->prev_count[i]++;
 }
 
 static uint32_t probes_depends_on(enum sb_product_id id)
@@ -651,18 +656,22 @@ static void dering_one(void *user, int i)
 enum tile_fate { TILE_CAST, TILE_KEPT, TILE_LEFT };
 
 struct tile_plan {
-    struct sb_probe_tiling tiling, prev; /* count 0: no tiles */
-    uint8_t *fate;                       /* per tile */
-    uint32_t *prev_tile;                 /* per kept tile: its index in the pack before */
-    uint32_t *cast, cast_count;          /* the probes to cast, increasing */
-    uint32_t counts[3];                  /* tiles by fate */
+    struct sb_probe_tiling tiling;                  /* count 0: no tiles */
+    struct sb_probe_tiling prev[SB_BAKE_MAX_SOURCES]; /* each earlier pack's (count 0: none usable) */
+    uint8_t *fate;                                  /* per tile */
+    uint8_t *source;                                /* per kept tile: the earlier pack it comes from */
+    uint32_t *prev_tile;                            /* per kept tile: its index there */
+    uint32_t *cast, cast_count;                     /* the probes to cast, increasing */
+    uint32_t counts[3];                             /* tiles by fate */
 };
 
 static void tile_plan_finish(struct tile_plan *plan)
 {
     sb_probe_tiling_finish(&plan->tiling);
-    sb_probe_tiling_finish(&plan->prev);
+    for (int k = 0; k < SB_BAKE_MAX_SOURCES; k++)
+        sb_probe_tiling_finish(&plan->prev[k]);
     free(plan->fate);
+    free(plan->source);
     free(plan->prev_tile);
     free(plan->cast);
     memset(plan, 0, sizeof(*plan));
@@ -719,8 +728,8 @@ static void tile_key(struct probes_state *st, const struct sb_scene *scene, enum
 
 /*
  * Plan a bake of `count` probes: without tiles, cast them all; with, key
- * each tile (tile_key), keep those the pack before baked under the same
- * key, leave those a bake of some tiles alone does not name, and cast the
+ * each tile (tile_key), keep those an earlier pack (the one there, then
+ * each --from pack: probes_previous) baked under the same key, leave those a bake of some tiles alone does not name, and cast the
  * rest.
  */
 static enum sb_result plan_tiles(struct probes_state *st, const struct sb_scene *scene, enum sb_product_id id,
@@ -736,35 +745,44 @@ static enum sb_result plan_tiles(struct probes_state *st, const struct sb_scene 
             res = SB_ERR_NOMEM;
         if (!res && !(plan->prev_tile = calloc(plan->tiling.count, sizeof(*plan->prev_tile))))
             res = SB_ERR_NOMEM;
+        if (!res && !(plan->source = calloc(plan->tiling.count, 1)))
+            res = SB_ERR_NOMEM;
         if (res) {
             tile_plan_finish(plan);
             return res;
         }
         layout->reach_m = (float)reach_of(p);
-        struct sb_probe_layout *prev = &st->prev_layout[slot(id)];
-        const struct sb_image *prev_image = &st->prev_image[slot(id)];
-        /* the pack before's tiles as its reader checked them: the same
-         * assignment, its own tile records left as they were */
-        struct sb_probe_layout assigned = *prev;
-        assigned.tiles = NULL;
-        bool have_prev = prev->tile_count && prev->tile_m == layout->tile_m && prev_image->width &&
-                         prev_image->channel_count == sb_product_format(id)->channel_count &&
-                         !sb_probe_tiling_make(&assigned, prev->tile_m, prev_image->width, &plan->prev) &&
-                         plan->prev.count == prev->tile_count;
-        free(assigned.tiles);
+        /* the earlier packs' tiles as their reader checked them: the same
+         * assignment, their own tile records left as they were */
+        const struct previous *prev = st->prev[slot(id)];
+        uint32_t sources = st->prev_count[slot(id)];
+        for (uint32_t k = 0; k < sources; k++) {
+            struct sb_probe_layout assigned = prev[k].layout;
+            assigned.tiles = NULL;
+            if (!(prev[k].layout.tile_m == layout->tile_m && prev[k].image.width &&
+                  prev[k].image.channel_count == sb_product_format(id)->channel_count &&
+                  !sb_probe_tiling_make(&assigned, prev[k].layout.tile_m, prev[k].image.width, &plan->prev[k]) &&
+                  plan->prev[k].count == prev[k].layout.tile_count))
+                sb_probe_tiling_finish(&plan->prev[k]); /* count 0: not used */
+            free(assigned.tiles);
+        }
         for (uint32_t t = 0; t < plan->tiling.count; t++) {
             struct sb_probe_tile *tile = &layout->tiles[t];
             tile_key(st, scene, id, layout, plan, t, what, stride, margin, tile->key);
-            int64_t was = have_prev ? sb_probe_tile_find(prev, tile->x, tile->z) : -1;
             bool named = !p->only_tile_count;
             for (int i = 0; i < p->only_tile_count; i++)
                 named |= p->only_tiles[i][0] == tile->x && p->only_tiles[i][1] == tile->z;
-            if (was >= 0 && (prev->tiles[was].flags & SB_PROBES_TILE_BAKED) && prev->tiles[was].probes == tile->probes &&
-                !strcmp(prev->tiles[was].key, tile->key)) {
-                plan->fate[t] = TILE_KEPT;
-                plan->prev_tile[t] = (uint32_t)was;
-            } else {
-                plan->fate[t] = named ? TILE_CAST : TILE_LEFT;
+            plan->fate[t] = named ? TILE_CAST : TILE_LEFT;
+            /* the first earlier pack that baked it under the same key */
+            for (uint32_t k = 0; k < sources && plan->fate[t] != TILE_KEPT; k++) {
+                int64_t was = plan->prev[k].count ? sb_probe_tile_find(&prev[k].layout, tile->x, tile->z) : -1;
+                const struct sb_probe_tile *there = was >= 0 ? &prev[k].layout.tiles[was] : NULL;
+                if (there && (there->flags & SB_PROBES_TILE_BAKED) && there->probes == tile->probes &&
+                    !strcmp(there->key, tile->key)) {
+                    plan->fate[t] = TILE_KEPT;
+                    plan->source[t] = (uint8_t)k;
+                    plan->prev_tile[t] = (uint32_t)was;
+                }
             }
             plan->counts[plan->fate[t]]++;
         }
@@ -788,24 +806,25 @@ static enum sb_result plan_tiles(struct probes_state *st, const struct sb_scene 
 }
 
 /* The records (and a visibility's sight masks) of the tiles kept, from
- * the pack before into image and layout, and each tile's flags and
+ * the earlier packs into image and layout, and each tile's flags and
  * content (the others' keys cleared). */
 static void finish_tiles(struct probes_state *st, enum sb_product_id id, const struct tile_plan *plan,
                          struct sb_probe_layout *layout, struct sb_image *image, bool half)
 {
-    const struct sb_probe_layout *prev = &st->prev_layout[slot(id)];
-    const struct sb_image *prev_image = &st->prev_image[slot(id)];
     uint64_t grid = (uint64_t)layout->grid[0] * layout->grid[1] * layout->grid[2];
-    uint64_t prev_grid = (uint64_t)prev->grid[0] * prev->grid[1] * prev->grid[2];
     uint32_t channels = image->channel_count;
     for (uint32_t t = 0; t < plan->tiling.count; t++) {
         struct sb_probe_tile *tile = &layout->tiles[t];
         if (plan->fate[t] == TILE_KEPT) {
+            const struct previous *source = &st->prev[slot(id)][plan->source[t]];
+            const struct sb_probe_layout *prev = &source->layout;
+            const struct sb_probe_tiling *was_tiling = &plan->prev[plan->source[t]];
+            uint64_t prev_grid = (uint64_t)prev->grid[0] * prev->grid[1] * prev->grid[2];
             uint32_t was = plan->prev_tile[t];
             for (uint32_t j = 0; j < tile->probes; j++) {
                 uint32_t to = plan->tiling.order[plan->tiling.first[t] + j];
-                uint32_t from = plan->prev.order[plan->prev.first[was] + j];
-                memcpy(&image->data[(size_t)to * channels], &prev_image->data[(size_t)from * channels],
+                uint32_t from = was_tiling->order[was_tiling->first[was] + j];
+                memcpy(&image->data[(size_t)to * channels], &source->image.data[(size_t)from * channels],
                        channels * sizeof(float));
                 if (layout->sight && prev->sight && to >= grid && from >= prev_grid)
                     memcpy(&layout->sight[(to - grid) * SB_PROBES_SIGHT_WORDS],

@@ -452,6 +452,18 @@ PY
 check "a bake into the partial pack" expect_exit 0 "$skybake" bake "$tmp/tiles.json" -o "$tmp/tile-one"
 check "keeps the tile" grep -q "sky_visibility: [0-9]* tiles: [0-9]* baked, 1 kept (their keys unchanged), 0 left" "$tmp/err"
 check "and is the whole bake" cmp -s "$tmp/tile-one/sky_visibility.sbprobes" "$tmp/tiles-full/sky_visibility.sbprobes"
+# A farm: two machines bake a tile each into packs of their own; a third
+# merges them (--from) casting nothing, then bakes the rest into the merge
+check "machine a bakes tile -2,1" expect_exit 0 "$skybake" bake "$tmp/tiles.json" -o "$tmp/farm-a" --tile -2,1 -q
+check "machine b bakes tile 1,0" expect_exit 0 "$skybake" bake "$tmp/tiles.json" -o "$tmp/farm-b" --tile 1,0 -q
+check "a merge of the two" expect_exit 0 "$skybake" bake "$tmp/tiles.json" -o "$tmp/farm" --tile -2,1 --tile 1,0 --from "$tmp/farm-a" --from "$tmp/farm-b"
+check "casts nothing, keeps both" grep -q "sky_visibility: [0-9]* tiles: 0 baked, 2 kept (their keys unchanged), [1-9][0-9]* left" "$tmp/err"
+check "the bounce's likewise" grep -q "sky_bounce: [0-9]* tiles: 0 baked, 2 kept (their keys unchanged), [1-9][0-9]* left" "$tmp/err"
+check "the rest baked into the merge" expect_exit 0 "$skybake" bake "$tmp/tiles.json" -o "$tmp/farm"
+check "keeps the two" grep -q "sky_visibility: [0-9]* tiles: [0-9]* baked, 2 kept (their keys unchanged), 0 left" "$tmp/err"
+check "and is the whole bake" sh -c "cmp -s '$tmp/farm/sky_visibility.sbprobes' '$tmp/tiles-full/sky_visibility.sbprobes' && cmp -s '$tmp/farm/sky_bounce.sbprobes' '$tmp/tiles-full/sky_bounce.sbprobes'"
+check "--from a pack that is not there is said" expect_exit 0 "$skybake" bake "$tmp/tiles.json" -o "$tmp/farm" --from "$tmp/nowhere"
+check "naming it" grep -q "nowhere (--from): no pack there" "$tmp/err"
 check "a tile of no probe is said" expect_exit 0 "$skybake" bake "$tmp/tiles.json" -o "$tmp/tile-none" --tile 40,40 -q
 check "--tile needs tiles" expect_exit 2 "$skybake" bake "$tmp/room.json" -o "$tmp/n" --tile 0,0
 check "--tile X,Z" expect_exit 2 "$skybake" bake "$tmp/tiles.json" -o "$tmp/n" --tile 0
