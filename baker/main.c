@@ -237,6 +237,10 @@ static int cmd_bake(int argc, char **argv)
             return EXIT_USAGE;
         }
     }
+    if (options.force && options.from_count) {
+        fprintf(stderr, "skybake: --force reuses nothing: it and --from do not go together\n");
+        return EXIT_USAGE;
+    }
     if (!scene_path || !out_dir) {
         fprintf(stderr, "skybake: bake needs a SCENE and -o OUT_DIR\n");
         usage(stderr);

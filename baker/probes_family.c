@@ -441,7 +441,7 @@ static enum sb_result place_detail(struct probes_state *st, const struct sb_scen
          * known: half an octave */
         double ratio = capped ? M_SQRT2 : cbrt(st->detail.detail_count * per / left);
         int k = (int)fmax(1.0, ceil(DETAIL_LEVELS * log2(ratio)));
-        int fits = 0, over = 0; /* the finest level found to fit, the coarsest found over (0: none) */
+        int fits = 0, over = 0, tried = k; /* the finest level found to fit, the last found over (0: none) */
         struct sb_probe_layout found = {0};
         /* up from the guess until a level fits, then down until one does
          * not: the finest level that fits next to one that does not (the
@@ -452,6 +452,7 @@ static enum sb_result place_detail(struct probes_state *st, const struct sb_scen
             enum sb_result r = sb_probe_detail_place(st->rc, &st->bvh, st->level, p, detail_level(p->detail_spacing_m, k),
                                                      budget, &trial);
             placements++;
+            tried = k > tried ? k : tried;
             if (r && r != SB_ERR_TOO_LARGE) {
                 res = r;
                 break;
@@ -475,8 +476,9 @@ static enum sb_result place_detail(struct probes_state *st, const struct sb_scen
         }
         sb_probe_layout_finish(&st->detail);
         if (!res && !fits) {
-            sb_error("probes: no detail spacing up to %g m fits probes.budget_mb (%g)",
-                     detail_level(p->detail_spacing_m, 8 * DETAIL_LEVELS), p->budget_mb);
+            sb_error("probes: no detail spacing up to %g m fits probes.budget_mb (%g): raise the budget or "
+                     "probes.detail_spacing_m",
+                     detail_level(p->detail_spacing_m, tried), p->budget_mb);
             res = SB_ERR_TOO_LARGE;
         }
         st->detail = found;
@@ -729,8 +731,8 @@ static void tile_key(struct probes_state *st, const struct sb_scene *scene, enum
 /*
  * Plan a bake of `count` probes: without tiles, cast them all; with, key
  * each tile (tile_key), keep those an earlier pack (the one there, then
- * each --from pack: probes_previous) baked under the same key, leave those a bake of some tiles alone does not name, and cast the
- * rest.
+ * each --from pack: probes_previous) baked under the same key, leave
+ * those a bake of some tiles alone does not name, and cast the rest.
  */
 static enum sb_result plan_tiles(struct probes_state *st, const struct sb_scene *scene, enum sb_product_id id,
                                  struct sb_probe_layout *layout, uint32_t count, const float *what, uint32_t stride,
@@ -953,7 +955,7 @@ static enum sb_result cast_probes(struct probes_state *st, const struct sb_scene
 static enum sb_result bake_visibility(struct probes_state *st, const struct sb_scene *scene, struct sb_image *image,
                                       struct sb_artifact *a)
 {
-    float *positions = NULL, *lattice = NULL;
+    float *positions = NULL;
     uint32_t count = 0, deringed = 0, invalid = 0;
     double lowest = 0, gpu_ms = 0;
     struct sb_probe_layout *layout = &a->probes;
@@ -970,29 +972,28 @@ static enum sb_result bake_visibility(struct probes_state *st, const struct sb_s
     uint64_t grid = (uint64_t)layout->grid[0] * layout->grid[1] * layout->grid[2];
     double grid_unit = p->spacing_m > 0 ? p->spacing_m : 1.0, detail_unit = layout->detail_spacing_m;
     /* what a tile's probes see: their rays' reach from where a push out
-     * may move them, the bounce's second rays' as far again, the sight
-     * masks' cells */
-    double margin = 0.6 * fmax(grid_unit, detail_unit) + fmax(2 * reach_of(p), 3.5 * detail_unit) + 0.01;
+     * may move them, or the sight masks' cells (the bounce's tiles grow
+     * by its own rays' reach: bake_bounce) */
+    double margin = 0.6 * fmax(grid_unit, detail_unit) + fmax(reach_of(p), 3.5 * detail_unit) + 0.01;
     if ((res = plan_tiles(st, scene, SB_PRODUCT_SKY_VISIBILITY, layout, count, positions, 3, margin, &plan)))
         goto done;
-    /* the detail probes' lattice points: their sight masks' centres */
-    lattice = malloc(((size_t)layout->detail_count + 1) * 3 * sizeof(float));
     c.n = plan.cast_count;
     c.positions = malloc(((size_t)c.n + 1) * 3 * sizeof(float));
     c.unit = malloc(((size_t)c.n + 1) * sizeof(float));
     c.lattice = malloc(((size_t)c.n + 1) * 3 * sizeof(float));
-    if (!lattice || !c.positions || !c.unit || !c.lattice) {
+    if (!c.positions || !c.unit || !c.lattice) {
         res = SB_ERR_NOMEM;
         goto done;
     }
-    sb_probe_detail_positions(layout, lattice);
     for (uint32_t j = 0; j < c.n; j++) {
         uint32_t i = plan.cast[j];
         bool detail = i >= grid && i < grid + layout->detail_count;
         memcpy(&c.positions[3 * (size_t)j], &positions[3 * (size_t)i], 3 * sizeof(float));
         c.unit[j] = detail ? -(float)detail_unit : (float)grid_unit;
+        /* a detail probe's place before any push out is its lattice
+         * point, its sight mask's centre */
         for (int k = 0; k < 3; k++)
-            c.lattice[3 * (size_t)j + k] = detail ? lattice[3 * (i - grid) + k] : NAN;
+            c.lattice[3 * (size_t)j + k] = detail ? positions[3 * (size_t)i + k] : NAN;
     }
     if ((res = cast_probes(st, scene, detail_unit, &c, &gpu_ms)))
         goto done;
@@ -1038,8 +1039,8 @@ static enum sb_result bake_visibility(struct probes_state *st, const struct sb_s
              "{\"rays\":%u,\"grid\":[%u,%u,%u],\"spacing_m\":%.9g,\"explicit\":%u,\"triangles\":%llu,"
              "\"inside\":%u,\"pushed_out\":%u,\"invalid\":%u,\"deringed\":%u,\"lowest_before_dering\":%.6g}",
              layout->ray_count, layout->grid[0], layout->grid[1], layout->grid[2], (double)layout->spacing_m[0],
-             layout->explicit_count, (unsigned long long)level->placed_triangles, c.inside, c.pushed,
-             plan.tiling.count ? invalid : c.inside - c.pushed, deringed, lowest);
+             layout->explicit_count, (unsigned long long)level->placed_triangles, c.inside, c.pushed, invalid,
+             deringed, lowest);
     /* the budget's and the layers' fields only where the scene has them:
      * the settings of other bakes as they were */
     if (p->budget_mb > 0)
@@ -1070,7 +1071,6 @@ done:
     tile_plan_finish(&plan);
     cast_finish(&c);
     free(positions);
-    free(lattice);
     return res;
 }
 
