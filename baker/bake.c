@@ -214,6 +214,8 @@ enum sb_result sb_bake_scene(struct sb_vk *vk, const struct sb_scene *scene, con
             snprintf(a->settings_json, sizeof(a->settings_json), "%s", was->settings_json);
             a->bake_ms = was->bake_ms;
             a->gpu_ms = was->gpu_ms;
+            memcpy(a->world_hash, was->world_hash, sizeof(a->world_hash)); /* the world it was baked against */
+            memcpy(a->world_path, was->world_path, sizeof(a->world_path));
             a->probes = was->probes; /* its columns and sight masks move with it */
             old->artifacts[p].probes.columns = NULL;
             old->artifacts[p].probes.sight = NULL;

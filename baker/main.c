@@ -251,7 +251,8 @@ static int cmd_bake(int argc, char **argv)
     if (sb_scene_load(scene_path, &scene))
         return EXIT_USAGE;
     if (tile_count && !(scene.probes.tile_m > 0 && (scene.wants[SB_PRODUCT_SKY_VISIBILITY] ||
-                                                      scene.wants[SB_PRODUCT_SKY_BOUNCE]))) {
+                                                      scene.wants[SB_PRODUCT_SKY_BOUNCE] ||
+                                                      scene.wants[SB_PRODUCT_SUN_BOUNCE]))) {
         fprintf(stderr, "skybake: --tile: %s bakes no probes in tiles (probes.tile_m)\n", scene_path);
         return EXIT_USAGE;
     }

@@ -65,14 +65,20 @@ struct probes_state {
     struct previous {
         struct sb_probe_layout layout;
         struct sb_image image;
-    } prev[2][SB_BAKE_MAX_SOURCES]; /* sky_visibility, sky_bounce: the pack there, then --from packs */
-    uint32_t prev_count[2];
+    } prev[3][SB_BAKE_MAX_SOURCES]; /* sky_visibility, sky_bounce, sun_bounce: the pack there, then --from packs */
+    uint32_t prev_count[3];
 };
 
 /* The probe products' index in probes_state's arrays. */
 static int slot(enum sb_product_id id)
 {
-    return id == SB_PRODUCT_SKY_BOUNCE;
+    return id == SB_PRODUCT_SKY_BOUNCE ? 1 : id == SB_PRODUCT_SUN_BOUNCE ? 2 : 0;
+}
+
+/* The two bounce products, made by one kernel. */
+static bool is_bounce(enum sb_product_id id)
+{
+    return id == SB_PRODUCT_SKY_BOUNCE || id == SB_PRODUCT_SUN_BOUNCE;
 }
 
 static enum sb_result plan(const struct sb_scene *scene, const struct sb_level *level, bool say,
@@ -108,7 +114,7 @@ static void probes_destroy(void **state)
         sb_bvh_finish(&st->bvh);
         sb_probe_layout_finish(&st->detail);
         sb_level_regions_finish(&st->regions);
-        for (int i = 0; i < 2; i++)
+        for (int i = 0; i < 3; i++)
             for (uint32_t k = 0; k < st->prev_count[i]; k++) {
                 sb_probe_layout_finish(&st->prev[i][k].layout);
                 sb_image_finish(&st->prev[i][k].image);
@@ -165,6 +171,11 @@ static void key_settings(const struct sb_scene *scene, enum sb_product_id id, st
         sb_key_add(key, " bounce_rays=%u secondary=%u bounces=%u bounce_sum 1 bounce_code %s", p->bounce_rays,
                    p->bounce_secondary, p->bounces, code);
     }
+    if (id == SB_PRODUCT_SUN_BOUNCE) { /* sun_sum: the table's sum and shape (sky_bounce.c) */
+        sb_sky_bounce_code_hash(code);
+        sb_key_add(key, " sun_rays=%u bounces=%u sun_sum 1 sun_side %d bounce_code %s", p->sun_rays, p->bounces,
+                   SB_SUN_SIDE, code);
+    }
 }
 
 /* The world as it was read (every vertex, index, material and albedo after
@@ -196,7 +207,10 @@ static void probes_previous(void *state, enum sb_product_id id, struct sb_artifa
 
 static uint32_t probes_depends_on(enum sb_product_id id)
 {
-    return id == SB_PRODUCT_SKY_BOUNCE ? 1u << SB_PRODUCT_SKY_VISIBILITY : 0;
+    /* the sun's bounce relights with the sky's (a runtime reads both) */
+    return id == SB_PRODUCT_SUN_BOUNCE ? 1u << SB_PRODUCT_SKY_VISIBILITY | 1u << SB_PRODUCT_SKY_BOUNCE
+           : id == SB_PRODUCT_SKY_BOUNCE ? 1u << SB_PRODUCT_SKY_VISIBILITY
+                                         : 0;
 }
 
 /* The level's BVH on the device; under tiles its wide instances flagged
@@ -222,11 +236,13 @@ static enum sb_result raycaster(struct probes_state *st, const struct sb_scene *
  * its size checked against the caps: from the scene and its world alone,
  * so that probes_create refuses a grid before any product is baked. */
 /* The bytes a probe takes in the pack: its sky_visibility record (fp32)
- * and, when the scene bakes it, its sky_bounce record (binary16). */
+ * and, when the scene bakes them, its sky_bounce and sun_bounce records
+ * (binary16). */
 static uint64_t probe_bytes(const struct sb_scene *scene)
 {
     return 4 * SB_SKY_VISIBILITY_CHANNEL_COUNT +
-           (scene->wants[SB_PRODUCT_SKY_BOUNCE] ? 2 * SB_SKY_BOUNCE_CHANNEL_COUNT : 0);
+           (scene->wants[SB_PRODUCT_SKY_BOUNCE] ? 2 * SB_SKY_BOUNCE_CHANNEL_COUNT : 0) +
+           (scene->wants[SB_PRODUCT_SUN_BOUNCE] ? 2 * SB_SUN_BOUNCE_CHANNEL_COUNT : 0);
 }
 
 /* The grid `spacing` apart over lo..hi (layers over the surface where the
@@ -1074,11 +1090,15 @@ done:
     return res;
 }
 
-/* The bounce at the visibility's probes (their positions after any push
- * out; invalid ones get zeros), over the same grid. */
-static enum sb_result bake_bounce(struct probes_state *st, const struct sb_scene *scene,
+/* The bounce (sky_bounce) or the sun's (sun_bounce) at the visibility's
+ * probes (their positions after any push out; invalid ones get zeros),
+ * over the same grid. */
+static enum sb_result bake_bounce(struct probes_state *st, const struct sb_scene *scene, enum sb_product_id id,
                                   const struct sb_image *visibility, struct sb_image *image, struct sb_artifact *a)
 {
+    bool sun = id == SB_PRODUCT_SUN_BOUNCE;
+    const char *name = sb_product_name(id);
+    const uint32_t floats = sun ? SB_BOUNCE_SUN_TABLE : SB_BOUNCE_FLOATS;
     float *positions = NULL, *valid = NULL, *out = NULL;
     uint32_t count = 0;
     struct sb_probe_layout *layout = &a->probes;
@@ -1086,18 +1106,18 @@ static enum sb_result bake_bounce(struct probes_state *st, const struct sb_scene
     struct tile_plan plan = {0};
     enum sb_result res = place(st, scene, layout, &positions, &count, false);
     if (!res && (visibility->width != count || visibility->channel_count != SB_SKY_VISIBILITY_CHANNEL_COUNT)) {
-        sb_error("sky_bounce: sky_visibility holds %u probes, the scene places %u", visibility->width, count);
+        sb_error("%s: sky_visibility holds %u probes, the scene places %u", name, visibility->width, count);
         res = SB_ERR_BAD_IMAGE;
     }
     /* a tile's bounce reads its visibility records and the world its
      * rays and their surfaces' rays reach */
     double margin = 2 * reach_of(&scene->probes) + 0.01;
-    if (res || (res = plan_tiles(st, scene, SB_PRODUCT_SKY_BOUNCE, layout, count, visibility->data,
+    if (res || (res = plan_tiles(st, scene, id, layout, count, visibility->data,
                                  SB_SKY_VISIBILITY_CHANNEL_COUNT, margin, &plan)))
         goto done;
     uint32_t n = plan.cast_count;
     valid = malloc(((size_t)n + 1) * sizeof(float));
-    out = malloc(((size_t)n * SB_BOUNCE_FLOATS + 1) * sizeof(float));
+    out = malloc(((size_t)n * floats + 1) * sizeof(float));
     if (!valid || !out) {
         res = SB_ERR_NOMEM;
         goto done;
@@ -1109,37 +1129,39 @@ static enum sb_result bake_bounce(struct probes_state *st, const struct sb_scene
         valid[j] = v[SB_SKY_VISIBILITY_VALID];
         valid_count += v[SB_SKY_VISIBILITY_VALID] != 0;
     }
-    struct sb_sky_bounce_params params = {.ray_count = scene->probes.bounce_rays,
-                                          .secondary = scene->probes.bounce_secondary,
+    struct sb_sky_bounce_params params = {.ray_count = sun ? scene->probes.sun_rays : scene->probes.bounce_rays,
+                                          .secondary = sun ? 0 : scene->probes.bounce_secondary,
                                           .bounces = scene->probes.bounces,
-                                          .tmax_m = (float)reach_of(&scene->probes)};
+                                          .tmax_m = (float)reach_of(&scene->probes),
+                                          .sun = sun};
     struct sb_sky_bounce_report report = {0};
     if (!st->surfaces.material_count && (res = sb_surfaces_create_level(st->rc->vk, st->level, &st->surfaces)))
         goto done;
     if ((n && (res = sb_sky_bounce_bake(st->rc, &st->surfaces, positions, valid, n, &params, out, &a->gpu_ms,
                                         &report))) ||
-        (res = sb_image_init(image, count, 1, SB_SKY_BOUNCE_CHANNEL_COUNT)))
+        (res = sb_image_init(image, count, 1, floats)))
         goto done;
-    sb_image_set_channel_names(image, SB_SKY_BOUNCE_CHANNELS);
+    sb_image_set_channel_names(image, sun ? SB_SUN_BOUNCE_CHANNELS : SB_SKY_BOUNCE_CHANNELS);
     for (uint32_t j = 0; j < n; j++)
-        memcpy(&image->data[(size_t)plan.cast[j] * SB_BOUNCE_FLOATS], &out[(size_t)j * SB_BOUNCE_FLOATS],
-               SB_BOUNCE_FLOATS * sizeof(float));
+        memcpy(&image->data[(size_t)plan.cast[j] * floats], &out[(size_t)j * floats], floats * sizeof(float));
     int64_t bad; /* stored as binary16 (its file's values): 4.9e-4 relative, its range +-6.7 */
     if ((res = sb_image_round_to_half(image, &bad))) {
-        sb_error("sky_bounce: value %lld does not fit binary16", (long long)bad);
+        sb_error("%s: value %lld does not fit binary16", name, (long long)bad);
         goto done;
     }
     if (plan.tiling.count)
-        finish_tiles(st, SB_PRODUCT_SKY_BOUNCE, &plan, layout, image, true);
+        finish_tiles(st, id, &plan, layout, image, true);
     snprintf(a->settings_json, sizeof(a->settings_json),
              "{\"rays\":%u,\"secondary\":%u,\"grid\":[%u,%u,%u],\"spacing_m\":%.9g,\"explicit\":%u,"
              "\"valid\":%u,\"bounces\":%u,\"bounces_summed\":%u,\"added_mean\":%.4g,\"added_most\":%.4g,"
-             "\"model\":\"Lambertian bounces; order-1 SH at the probe x order-2 SH of the light at the surfaces; "
-             "bounces past the first lit by the probe's own light\"}",
+             "\"model\":\"%s; bounces past the first lit by the probe's own light\"}",
              params.ray_count, params.secondary, layout->grid[0], layout->grid[1], layout->grid[2],
              (double)layout->spacing_m[0], layout->explicit_count, valid_count, params.bounces, report.most_bounces,
-             report.mean_added, report.most_added);
-    report_tiles(SB_PRODUCT_SKY_BOUNCE, &plan, a);
+             report.mean_added, report.most_added,
+             sun ? "Lambertian bounces of a sun from 12 x 12 directions over the upper hemisphere's octahedral map, "
+                   "each the mean of its bilinear neighbourhood; order-1 SH at the probe, grey, times one rgb shape"
+                 : "Lambertian bounces; order-1 SH at the probe x order-2 SH of the light at the surfaces");
+    report_tiles(id, &plan, a);
     char summed[160]; /* how the bounces were summed, and what the later ones added */
     if (params.bounces == 1)
         snprintf(summed, sizeof(summed), "one bounce");
@@ -1155,8 +1177,12 @@ static enum sb_result bake_bounce(struct probes_state *st, const struct sb_scene
         snprintf(summed + used, sizeof(summed) - used, ", the later ones adding %.1f%% to the first on average, "
                  "%.1f%% at most", 100 * report.mean_added, 100 * report.most_added);
     }
-    sb_info("sky_bounce: %u probes (%u cast, %u of them valid), %u rays each, %u from each surface hit; %s", count, n,
-            valid_count, params.ray_count, params.secondary, summed);
+    if (sun)
+        sb_info("sun_bounce: %u probes (%u cast, %u of them valid), %u rays each, %u sun directions from each surface "
+                "hit; %s", count, n, valid_count, params.ray_count, SB_SUN_DIRECTIONS, summed);
+    else
+        sb_info("sky_bounce: %u probes (%u cast, %u of them valid), %u rays each, %u from each surface hit; %s", count,
+                n, valid_count, params.ray_count, params.secondary, summed);
 done:
     if (res)
         sb_image_finish(image);
@@ -1179,8 +1205,8 @@ static enum sb_result probes_bake(void *state, struct sb_vk *vk, const struct sb
         return res;
     if (!had)
         sb_debug("probes: the BVH built and on the device in %.1f ms", 1e3 * (sb_now_s() - t0));
-    return id == SB_PRODUCT_SKY_BOUNCE ? bake_bounce(st, scene, &baked[SB_PRODUCT_SKY_VISIBILITY], image, a)
-                                       : bake_visibility(st, scene, image, a);
+    return is_bounce(id) ? bake_bounce(st, scene, id, &baked[SB_PRODUCT_SKY_VISIBILITY], image, a)
+                         : bake_visibility(st, scene, image, a);
 }
 
 static uint32_t probes_kernels(void *state, const struct sb_scene *scene, enum sb_product_id id,
@@ -1188,8 +1214,8 @@ static uint32_t probes_kernels(void *state, const struct sb_scene *scene, enum s
 {
     const struct probes_state *st = state;
     bool instanced = st->level->instance_count > 0;
-    uint32_t n = sb_surfaces_level_kernels(st->level, id == SB_PRODUCT_SKY_BOUNCE, out);
-    out[n++] = id == SB_PRODUCT_SKY_BOUNCE ? sb_sky_bounce_kernel(instanced) : sb_sky_visibility_kernel(instanced);
+    uint32_t n = sb_surfaces_level_kernels(st->level, is_bounce(id), out);
+    out[n++] = is_bounce(id) ? sb_sky_bounce_kernel(instanced) : sb_sky_visibility_kernel(instanced);
     if (id == SB_PRODUCT_SKY_VISIBILITY && scene->probes.detail_spacing_m > 0)
         out[n++] = sb_probe_sight_kernel(instanced);
     return n;

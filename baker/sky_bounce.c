@@ -9,6 +9,9 @@
 #include "probe_bounce.spv.h"
 #include "probe_bounce_instanced.spv.h"
 
+_Static_assert(1,
+               "the product's channels (probes.h) name the sun table's 64 directions");
+
 struct sb_pipeline_params sb_sky_bounce_kernel(bool instanced)
 {
     return (struct sb_pipeline_params){
@@ -65,23 +68,33 @@ static bool every_bounce(double m[SB_BOUNCE_SH][SB_BOUNCE_SH], double inverse[SB
     return true;
 }
 
-uint32_t sb_sky_bounce_sum(float *kernel, uint32_t bounces, double *added)
+/* Where column k of the transfer (k < SB_PROBE_SH: the light's SH; then
+ * the sun table's directions) is in the kernel's output for m, c. */
+static size_t column_at(int m, int k, int c)
 {
-    enum { K = SB_PROBE_SH, S = SB_BOUNCE_SH };
-    double total[S][K][3], term[S][K][3], next[S][K][3], op[S][S][3];
+    return k < SB_PROBE_SH ? (size_t)(m * SB_PROBE_SH + k) * 3 + c
+                           : SB_BOUNCE_KERNEL_FLOATS + (size_t)((k - SB_PROBE_SH) * SB_BOUNCE_SH + m) * 3 + c;
+}
+
+uint32_t sb_sky_bounce_sum(float *kernel, bool sun, uint32_t bounces, double *added)
+{
+    enum { MOST = SB_PROBE_SH + SB_SUN_DIRECTIONS, S = SB_BOUNCE_SH };
+    const int K = sun ? MOST : SB_PROBE_SH;
+    double total[S][MOST][3], term[S][MOST][3], next[S][MOST][3], op[S][S][3];
     double first = 0, peak = 0;
     for (int m = 0; m < S; m++) {
         for (int k = 0; k < K; k++)
             for (int c = 0; c < 3; c++) {
-                total[m][k][c] = term[m][k][c] = kernel[(m * K + k) * 3 + c];
+                total[m][k][c] = term[m][k][c] = kernel[column_at(m, k, c)];
                 peak = fmax(peak, fabs(term[m][k][c]));
             }
         for (int j = 0; j < S; j++)
             for (int c = 0; c < 3; c++)
                 op[m][j][c] = kernel[SB_BOUNCE_FLOATS + (m * S + j) * 3 + c];
     }
-    for (int c = 0; c < 3; c++)
-        first += total[0][0][c];
+    for (int c = 0; c < 3; c++) /* the light the first bounce sends: the sky's constant band, or the sun's */
+        for (int k = sun ? SB_PROBE_SH : 0; k < (sun ? K : 1); k++)
+            first += total[0][k][c];
     if (peak == 0) { /* nothing to bounce */
         if (added)
             *added = 0;
@@ -137,9 +150,10 @@ uint32_t sb_sky_bounce_sum(float *kernel, uint32_t bounces, double *added)
     for (int m = 0; m < S; m++)
         for (int k = 0; k < K; k++)
             for (int c = 0; c < 3; c++)
-                kernel[(m * K + k) * 3 + c] = (float)total[m][k][c];
+                kernel[column_at(m, k, c)] = (float)total[m][k][c];
     for (int c = 0; c < 3; c++)
-        all += total[0][0][c];
+        for (int k = sun ? SB_PROBE_SH : 0; k < (sun ? K : 1); k++)
+            all += total[0][k][c];
     if (added)
         *added = first > 0 ? all / first - 1.0 : 0.0;
     return n;
@@ -149,16 +163,38 @@ uint32_t sb_sky_bounce_sum(float *kernel, uint32_t bounces, double *added)
  * the same whatever the thread count). */
 struct sum_job {
     float *kernel, *out;
-    uint32_t bounces, *terms;
+    bool sun;
+    uint32_t bounces, stride, *terms;
     double *added;
 };
+
+void sb_sky_bounce_sun_table(const float *kernel, float table[SB_BOUNCE_SUN_TABLE])
+{
+    const float *sun = kernel + SB_BOUNCE_KERNEL_FLOATS;
+    double shape[SB_BOUNCE_SH * 3] = {0}, sum = 0;
+    for (int j = 0; j < SB_SUN_DIRECTIONS; j++) {
+        const float *b = &sun[j * SB_BOUNCE_SH * 3];
+        double grey = ((double)b[0] + b[1] + b[2]) / 3;
+        table[j] = (float)fmin(fmax(grey, -SB_SKY_BOUNCE_LIMIT), SB_SKY_BOUNCE_LIMIT);
+        sum += grey;
+        for (int mc = 0; mc < SB_BOUNCE_SH * 3; mc++)
+            shape[mc] += b[mc];
+    }
+    for (int mc = 0; mc < SB_BOUNCE_SH * 3; mc++) {
+        double v = sum > 0 ? shape[mc] / sum : 0.0;
+        table[SB_SUN_DIRECTIONS + mc] = (float)fmin(fmax(v, -SB_SKY_BOUNCE_LIMIT), SB_SKY_BOUNCE_LIMIT);
+    }
+}
 
 static void sum_one(void *user, int i)
 {
     struct sum_job *job = user;
-    float *k = &job->kernel[(size_t)i * SB_BOUNCE_KERNEL_FLOATS];
-    job->terms[i] = sb_sky_bounce_sum(k, job->bounces, &job->added[i]);
-    memcpy(&job->out[(size_t)i * SB_BOUNCE_FLOATS], k, SB_BOUNCE_FLOATS * sizeof(float));
+    float *k = &job->kernel[(size_t)i * job->stride];
+    job->terms[i] = sb_sky_bounce_sum(k, job->sun, job->bounces, &job->added[i]);
+    if (job->sun)
+        sb_sky_bounce_sun_table(k, &job->out[(size_t)i * SB_BOUNCE_SUN_TABLE]);
+    else
+        memcpy(&job->out[(size_t)i * SB_BOUNCE_FLOATS], k, SB_BOUNCE_FLOATS * sizeof(float));
 }
 
 enum sb_result sb_sky_bounce_bake(struct sb_raycaster *rc, const struct sb_surfaces *surfaces, const float *positions,
@@ -167,12 +203,14 @@ enum sb_result sb_sky_bounce_bake(struct sb_raycaster *rc, const struct sb_surfa
 {
     static const struct sb_sky_bounce_params defaults = {0};
     params = params ? params : &defaults;
+    bool sun = params->sun;
     struct sb_bounce_push pc = {
         .probe_count = probe_count,
-        .ray_count = params->ray_count ? params->ray_count : 256,
-        .secondary = params->secondary ? params->secondary : 64,
+        .ray_count = params->ray_count ? params->ray_count : sun ? 1024 : 256,
+        .secondary = sun ? 0 : params->secondary ? params->secondary : 64,
         .tmin_m = params->tmin_m > 0 ? params->tmin_m : 1e-4f,
         .tmax_m = params->tmax_m > 0 ? params->tmax_m : 1e30f,
+        .stride = sun ? SB_BOUNCE_SUN_KERNEL_FLOATS : SB_BOUNCE_KERNEL_FLOATS,
     };
     if (gpu_ms)
         *gpu_ms = 0;
@@ -180,66 +218,87 @@ enum sb_result sb_sky_bounce_bake(struct sb_raycaster *rc, const struct sb_surfa
         *report = (struct sb_sky_bounce_report){0};
     if (pc.ray_count % SB_PROBE_THREADS || pc.ray_count > SB_PROBE_MAX_RAYS || pc.secondary > SB_PROBE_MAX_RAYS / 2 ||
         !probe_count || !surfaces->material_count || params->bounces > SB_SKY_BOUNCE_MAX) {
-        sb_error("sky bounce: %u rays and %u from each hit for %u probes, %u bounces (rays: a multiple of %u up to "
+        sb_error("%s bounce: %u rays and %u from each hit for %u probes, %u bounces (rays: a multiple of %u up to "
                  "%u; bounces up to %u)",
-                 pc.ray_count, pc.secondary, probe_count, params->bounces, SB_PROBE_THREADS, SB_PROBE_MAX_RAYS,
-                 SB_SKY_BOUNCE_MAX);
+                 sun ? "sun" : "sky", pc.ray_count, pc.secondary, probe_count, params->bounces, SB_PROBE_THREADS,
+                 SB_PROBE_MAX_RAYS, SB_SKY_BOUNCE_MAX);
         return SB_ERR_OUT_OF_RANGE;
     }
     struct sb_vk *vk = rc->vk;
     struct sb_buffer probes = {0}, results = {0};
     struct sb_pipeline pipeline = {0};
     const struct sb_pipeline_params pp = sb_sky_bounce_kernel(rc->instanced);
-    float *kernel = malloc((size_t)probe_count * SB_BOUNCE_KERNEL_FLOATS * sizeof(float));
-    struct sum_job job = {.kernel = kernel, .out = out, .bounces = params->bounces};
-    enum sb_result res = kernel ? SB_OK : SB_ERR_NOMEM;
-    if (res ||
-        (res = sb_probe_buffers_create(vk, positions, valid, probe_count, SB_BOUNCE_KERNEL_FLOATS, &probes,
-                                       &results)) ||
-        (res = sb_pipeline_create(vk, &pp, &pipeline)))
+    /* the kernel's output a chunk of probes at a time */
+    uint32_t chunk = (uint32_t)(SB_SKY_BOUNCE_CHUNK_BYTES / (pc.stride * sizeof(float)));
+    chunk = probe_count < chunk ? probe_count : chunk;
+    float *kernel = malloc((size_t)chunk * pc.stride * sizeof(float));
+    uint32_t *terms = malloc(probe_count * sizeof(uint32_t));
+    double *added = malloc(probe_count * sizeof(double)), summing = 0;
+    struct sum_job job = {.kernel = kernel, .sun = sun, .bounces = params->bounces, .stride = pc.stride};
+    enum sb_result res = kernel && terms && added ? SB_OK : SB_ERR_NOMEM;
+    if (res || (res = sb_pipeline_create(vk, &pp, &pipeline)))
         goto done;
-    const struct sb_buffer *bindings[SB_BOUNCE_BINDING_COUNT] = {
-        [SB_RAYCAST_BINDING_NODES] = &rc->nodes,
-        [SB_RAYCAST_BINDING_TRIANGLES] = &rc->triangles,
-        [SB_RAYCAST_BINDING_RAYS] = &probes,
-        [SB_RAYCAST_BINDING_HITS] = &results,
-    };
-    sb_surfaces_bindings(surfaces, &bindings[SB_BOUNCE_BINDING_SURFACE]);
-    sb_pipeline_bind(vk, &pipeline, bindings);
-    /* the passes (config.h, SB_BOUNCE_PASS_DIRECTIONS), in a fixed order */
-    for (uint32_t ray = 0; ray < pc.ray_count && !res; ray += SB_PROBE_THREADS)
-        for (uint32_t dir = 0; dir < 2 * pc.secondary && !res; dir += SB_BOUNCE_PASS_DIRECTIONS) {
+    for (uint32_t start = 0; start < probe_count && !res; start += chunk) {
+        uint32_t n = probe_count - start < chunk ? probe_count - start : chunk;
+        if ((res = sb_probe_buffers_create(vk, positions + 3 * (size_t)start, valid ? valid + start : NULL, n,
+                                           pc.stride, &probes, &results)))
+            break;
+        const struct sb_buffer *bindings[SB_BOUNCE_BINDING_COUNT] = {
+            [SB_RAYCAST_BINDING_NODES] = &rc->nodes,
+            [SB_RAYCAST_BINDING_TRIANGLES] = &rc->triangles,
+            [SB_RAYCAST_BINDING_RAYS] = &probes,
+            [SB_RAYCAST_BINDING_HITS] = &results,
+        };
+        sb_surfaces_bindings(surfaces, &bindings[SB_BOUNCE_BINDING_SURFACE]);
+        sb_pipeline_bind(vk, &pipeline, bindings);
+        /* the passes (config.h, SB_BOUNCE_PASS_DIRECTIONS), in a fixed
+         * order: the sphere set's slices, or a sun run's directions */
+        uint32_t sphere = 2 * pc.secondary;
+        pc.probe_count = n;
+        for (uint32_t ray = 0; ray < pc.ray_count && !res; ray += SB_PROBE_THREADS) {
             pc.first_ray = ray;
-            pc.first_direction = dir;
-            res = sb_probe_kernel_pass(vk, &pipeline, &pc, probe_count, gpu_ms);
-            pc.accumulate = 1;
+            for (uint32_t dir = 0; dir < sphere && !res; dir += SB_BOUNCE_PASS_DIRECTIONS) {
+                pc.first_direction = dir;
+                pc.accumulate = ray > 0 || dir > 0;
+                res = sb_probe_kernel_pass(vk, &pipeline, &pc, n, gpu_ms);
+            }
+            for (uint32_t dir = 0; sun && dir < SB_SUN_DIRECTIONS && !res; dir += SB_BOUNCE_SUN_PASS) {
+                pc.first_direction = dir; /* each pass its own directions, B and M in the first */
+                pc.accumulate = ray > 0;
+                res = sb_probe_kernel_pass(vk, &pipeline, &pc, n, gpu_ms);
+            }
         }
-    if (res || (res = sb_buffer_read(vk, &results, kernel)))
-        goto done;
-    double t0 = sb_now_s();
-    job.terms = malloc(probe_count * sizeof(uint32_t));
-    job.added = malloc(probe_count * sizeof(double));
-    if (!job.terms || !job.added) {
-        res = SB_ERR_NOMEM;
-        goto done;
+        if (!res)
+            res = sb_buffer_read(vk, &results, kernel);
+        sb_buffer_destroy(vk, &results);
+        sb_buffer_destroy(vk, &probes);
+        if (res)
+            break;
+        double t0 = sb_now_s();
+        job.out = out + (size_t)start * (sun ? SB_BOUNCE_SUN_TABLE : SB_BOUNCE_FLOATS);
+        job.terms = terms + start;
+        job.added = added + start;
+        sb_parallel_for((int)n, sum_one, &job);
+        summing += sb_now_s() - t0;
     }
-    sb_parallel_for((int)probe_count, sum_one, &job);
+    if (res)
+        goto done;
     uint32_t counted = 0;
     double sum = 0; /* in probe order: the same sum whatever the threads */
     for (uint32_t i = 0; i < probe_count && report; i++) {
         if (valid && valid[i] == 0)
             continue;
-        report->most_bounces = job.terms[i] > report->most_bounces ? job.terms[i] : report->most_bounces;
-        report->most_added = fmax(report->most_added, job.added[i]);
-        sum += job.added[i];
+        report->most_bounces = terms[i] > report->most_bounces ? terms[i] : report->most_bounces;
+        report->most_added = fmax(report->most_added, added[i]);
+        sum += added[i];
         counted++;
     }
     if (report && counted)
         report->mean_added = sum / counted;
-    sb_debug("sky bounce: %u probes' bounces summed in %.1f ms", probe_count, 1e3 * (sb_now_s() - t0));
+    sb_debug("%s bounce: %u probes' bounces summed in %.1f ms", sun ? "sun" : "sky", probe_count, 1e3 * summing);
 done:
-    free(job.terms);
-    free(job.added);
+    free(terms);
+    free(added);
     free(kernel);
     sb_pipeline_destroy(vk, &pipeline);
     sb_buffer_destroy(vk, &results);

@@ -28,14 +28,16 @@
 #include "surfaces.h"
 
 struct sb_sky_bounce_params {
-    uint32_t ray_count; /* rays a probe, a multiple of SB_PROBE_THREADS [256] */
+    uint32_t ray_count; /* rays a probe, a multiple of SB_PROBE_THREADS [256; the sun's 1024] */
     uint32_t secondary; /* about this many rays from each hit (a 2x spherical set, half cast) [64] */
     float tmin_m;       /* rays start this far from the probe [1e-4] */
     uint32_t bounces;   /* 1: one bounce; 0: until converged [0] */
     float tmax_m;       /* a ray (from the probe or a surface) reaching this far sees the sky [1e30] */
+    bool sun;           /* the sun's table (sun_bounce) instead of B: `secondary` unused [false] */
 };
 
 #define SB_SKY_BOUNCE_CONVERGED 1e-3 /* a bounce adding less ends the sum */
+#define SB_SKY_BOUNCE_CHUNK_BYTES (256u << 20) /* the kernel's output a dispatch at most */
 #define SB_SKY_BOUNCE_MAX SB_PROBES_MAX_BOUNCES /* bounces at most (scene.h) */
 
 /* What the bounces past the first added, over the valid probes. */
@@ -51,7 +53,9 @@ struct sb_pipeline_params sb_sky_bounce_kernel(bool instanced);
 /*
  * Bake probe_count probes at positions (xyz in m each; valid[i] 0 gives the
  * probe zeros) against the raycaster's BVH into out[SB_BOUNCE_FLOATS *
- * probe_count] (config.h: m, then k, then rgb). `surfaces` are what the
+ * probe_count] (config.h: B, m, then k, then rgb), or with params->sun
+ * into out[SB_BOUNCE_SUN_TABLE * probe_count] (their sun tables:
+ * sb_sky_bounce_sun_table). `surfaces` are what the
  * BVH's triangles are (their albedos and textures: the same meshes'). A
  * hit's albedo is its texture's at the ray cone's footprint (surface.glsl).
  * *gpu_ms (may be NULL) gets the GPU time, *report (may be NULL) what the
@@ -63,13 +67,22 @@ enum sb_result sb_sky_bounce_bake(struct sb_raycaster *raycaster, const struct s
                                   struct sb_sky_bounce_report *report);
 
 /* Sum the bounces of one probe in place: `kernel` holds the kernel's
- * SB_BOUNCE_KERNEL_FLOATS (B1, then M); its first SB_BOUNCE_FLOATS become
- * B1 + M B1 + ... to `bounces` terms, or every bounce (0: (I - M)^-1 B1,
+ * SB_BOUNCE_KERNEL_FLOATS (B1, then M; `sun`: then the sun's table); its
+ * first SB_BOUNCE_FLOATS (and the table) become B1 + M B1 + ... to
+ * `bounces` terms, or every bounce (0: (I - M)^-1 B1,
  * or the series until converged where M's row sums reach 1). Returns the
  * terms summed, 0 for the closed form or nothing to bounce; *added (may
  * be NULL) the light past the first's over the first's (constant band,
  * channels summed; 0 where B1's is 0). */
-uint32_t sb_sky_bounce_sum(float *kernel, uint32_t bounces, double *added);
+uint32_t sb_sky_bounce_sum(float *kernel, bool sun, uint32_t bounces, double *added);
+
+/* The sun table a probe's record keeps (config.h, SB_BOUNCE_SUN_TABLE),
+ * from its summed kernel output (sb_sky_bounce_sum): each direction's grey
+ * constant band T_j, then the shape S[m] rgb, the table's order-1 rgb
+ * summed over the directions over the T_j summed (0 where that is not
+ * above 0), each within SB_SKY_BOUNCE_LIMIT. A sun of irradiance E from s
+ * sends the probe E sum_j w_j(s) T_j S[m] (w: sb_sun_table_weights). */
+void sb_sky_bounce_sun_table(const float *kernel, float table[SB_BOUNCE_SUN_TABLE]);
 
 /* XXH3-128 of the kernel's SPIR-V (and the texture mips'), for bake keys. */
 void sb_sky_bounce_code_hash(char out[33]);

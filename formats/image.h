@@ -16,7 +16,7 @@
 
 #include "result.h"
 
-#define SB_IMAGE_MAX_CHANNELS 128 /* sky_bounce has 108 */
+#define SB_IMAGE_MAX_CHANNELS 192 /* sky_bounce has 184 */
 #define SB_CHANNEL_NAME_MAX 32
 
 struct sb_image {

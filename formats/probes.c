@@ -75,10 +75,9 @@ static void channel_range(const char *name, double *lo, double *hi)
     } else if (!strcmp(name, "dering_window")) {
         *lo = 0;
         *hi = 2;
-    } else if (!strncmp(name, "bounce.", 7)) {
-        /* |B| <= 4 pi max|Y_m| max|g_k| / pi, |g_k| <= pi max|Y_k|: m < 4, k < 9 */
-        *lo = -6.7079;
-        *hi = 6.7079;
+    } else if (!strncmp(name, "bounce.", 7) || !strncmp(name, "sun.", 4) || !strncmp(name, "sun_shape.", 10)) {
+        *lo = -SB_SKY_BOUNCE_LIMIT; /* probes.h */
+        *hi = SB_SKY_BOUNCE_LIMIT;
     } else if (!strncmp(name, "irradiance.", 11)) { /* radiance's units: finite is all that is known */
         *lo = -3e38;
         *hi = 3e38;

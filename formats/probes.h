@@ -169,6 +169,23 @@ _Static_assert(SB_SKY_VISIBILITY_SH + 9 == SB_SKY_VISIBILITY_CHANNEL_COUNT, "the
 #define SB_SKY_BOUNCE_CHANNELS SB_BOUNCE_9(0) "," SB_BOUNCE_9(1) "," SB_BOUNCE_9(2) "," SB_BOUNCE_9(3)
 #define SB_SKY_BOUNCE_CHANNEL_COUNT 108
 
+/* The sun-bounce product's channels (docs/probes.md, "The sun"): its
+ * table's grey constant band "sun.i.k" at each of its 12 x 12 directions
+ * (config.h, SB_SUN_SIDE: column i, row k of the octahedral map; i
+ * fastest), then its shape "sun_shape.m.c" (baker/sky_bounce.h). */
+#define SB_SUN_ROW(k)                                                                                                  \
+    "sun.0." #k ",sun.1." #k ",sun.2." #k ",sun.3." #k ",sun.4." #k ",sun.5." #k ",sun.6." #k ",sun.7." #k             \
+    ",sun.8." #k ",sun.9." #k ",sun.10." #k ",sun.11." #k
+#define SB_SUN_SHAPE(m) "sun_shape." #m ".r,sun_shape." #m ".g,sun_shape." #m ".b"
+#define SB_SUN_BOUNCE_CHANNELS                                                                                         \
+    SB_SUN_ROW(0) "," SB_SUN_ROW(1) "," SB_SUN_ROW(2) "," SB_SUN_ROW(3) "," SB_SUN_ROW(4) "," SB_SUN_ROW(             \
+        5) "," SB_SUN_ROW(6) "," SB_SUN_ROW(7) "," SB_SUN_ROW(8) "," SB_SUN_ROW(9) "," SB_SUN_ROW(10) "," SB_SUN_ROW(  \
+        11) "," SB_SUN_SHAPE(0) "," SB_SUN_SHAPE(1) "," SB_SUN_SHAPE(2) "," SB_SUN_SHAPE(3)
+#define SB_SUN_BOUNCE_CHANNEL_COUNT (144 + 12)
+/* The bounce's values are within this: |B| <= 4 pi max|Y_m| max|g_k| / pi,
+ * |g_k| <= pi max|Y_k| (m < 4, k < 9); the sun table's are clamped to it. */
+#define SB_SKY_BOUNCE_LIMIT 6.7079
+
 /* The reflection probes' channels (docs/reflections.md): where the probe
  * is, the box it stands for (min, max corners; the sky-only probe's is
  * zero), and the order-2 SH of the irradiance its cube sees (the cosine

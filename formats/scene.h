@@ -139,6 +139,7 @@ struct sb_probe_params {
     double budget_mb;
     uint32_t bounce_rays;      /* sky_bounce: rays a probe for the surfaces it sees, a multiple of 64 [256] */
     uint32_t bounce_secondary; /* sky_bounce: rays from each surface hit, a multiple of 8 [64] */
+    uint32_t sun_rays;         /* sun_bounce: rays a probe for the surfaces it sees, a multiple of 64 [1024] */
     uint32_t bounces;          /* sky_bounce: 1 to SB_PROBES_MAX_BOUNCES bounces, 0 every one [0] */
     /* Tiles this wide (m, squares from x = z = 0) that a bake redoes
      * alone when the world around them changed (docs/probes.md, "Tiles")

@@ -16,7 +16,8 @@
 void sb_probe_params_default(struct sb_probe_params *p)
 {
     *p = (struct sb_probe_params){
-        .spacing_m = 2.0, .rays = 2048, .inside_fraction = 0.25, .bounce_rays = 256, .bounce_secondary = 64};
+        .spacing_m = 2.0,      .rays = 2048,          .inside_fraction = 0.25,
+        .bounce_rays = 256,    .bounce_secondary = 64, .sun_rays = 1024};
 }
 
 static void probes_set_defaults(struct sb_scene *scene)
@@ -26,11 +27,14 @@ static void probes_set_defaults(struct sb_scene *scene)
 
 static enum sb_result probes_validate(const struct sb_scene *scene, const char *source)
 {
-    if ((scene->wants[SB_PRODUCT_SKY_VISIBILITY] || scene->wants[SB_PRODUCT_SKY_BOUNCE]) && !scene->has_world) {
-        sb_error("%s: products: %s needs a \"world\" (the geometry the probes see)", source,
-                 scene->wants[SB_PRODUCT_SKY_VISIBILITY] ? "sky_visibility" : "sky_bounce");
-        return SB_ERR_MISSING_FIELD;
-    }
+    static const enum sb_product_id probes[] = {SB_PRODUCT_SKY_VISIBILITY, SB_PRODUCT_SKY_BOUNCE,
+                                                SB_PRODUCT_SUN_BOUNCE};
+    for (size_t i = 0; i < sizeof(probes) / sizeof(probes[0]); i++)
+        if (scene->wants[probes[i]] && !scene->has_world) {
+            sb_error("%s: products: %s needs a \"world\" (the geometry the probes see)", source,
+                     sb_product_name(probes[i]));
+            return SB_ERR_MISSING_FIELD;
+        }
     return SB_OK;
 }
 
@@ -91,7 +95,7 @@ static enum sb_result probes_section_parse(const cJSON *obj, struct sb_scene *sc
     static const char *const keys[] = {
         "spacing_m",   "margin_m",         "bounds_m", "rays",      "inside_fraction",  "positions_m",
         "bounce_rays", "bounce_secondary", "bounces",  "layers_m",  "budget_mb",        "detail_spacing_m",
-        "detail_volumes", "tile_m",        "reach_m",  NULL};
+        "detail_volumes", "tile_m",        "reach_m",  "sun_rays", NULL};
     struct sb_probe_params *p = &scene->probes;
     sb_probe_params_default(p);
     scene->has_probes = true;
@@ -142,7 +146,8 @@ static enum sb_result probes_section_parse(const cJSON *obj, struct sb_scene *sc
         uint32_t *out;
     } counts[] = {{"bounce_rays", 64, 4096, 64, &p->bounce_rays},
                   {"bounce_secondary", 8, 1024, 8, &p->bounce_secondary},
-                  {"bounces", 0, SB_PROBES_MAX_BOUNCES, 1, &p->bounces}};
+                  {"bounces", 0, SB_PROBES_MAX_BOUNCES, 1, &p->bounces},
+                  {"sun_rays", 64, 4096, 64, &p->sun_rays}};
     for (size_t i = 0; i < sizeof(counts) / sizeof(counts[0]) && !res; i++) {
         if (!(item = cJSON_GetObjectItemCaseSensitive(obj, counts[i].key)))
             continue;
@@ -222,7 +227,8 @@ static enum sb_result probes_section_parse(const cJSON *obj, struct sb_scene *sc
 
 static cJSON *probes_section_json(const struct sb_scene *scene)
 {
-    bool used = scene->has_probes || scene->wants[SB_PRODUCT_SKY_VISIBILITY] || scene->wants[SB_PRODUCT_SKY_BOUNCE];
+    bool used = scene->has_probes || scene->wants[SB_PRODUCT_SKY_VISIBILITY] || scene->wants[SB_PRODUCT_SKY_BOUNCE] ||
+                scene->wants[SB_PRODUCT_SUN_BOUNCE];
     if (!used)
         return NULL;
     const struct sb_probe_params *p = &scene->probes;
@@ -239,9 +245,11 @@ static cJSON *probes_section_json(const struct sb_scene *scene)
     if (scene->wants[SB_PRODUCT_SKY_BOUNCE]) { /* only then: scenes without keep their hash */
         cJSON_AddNumberToObject(o, "bounce_rays", p->bounce_rays);
         cJSON_AddNumberToObject(o, "bounce_secondary", p->bounce_secondary);
-        if (p->bounces) /* only when given: 0 is every bounce */
-            cJSON_AddNumberToObject(o, "bounces", p->bounces);
     }
+    if (p->bounces && (scene->wants[SB_PRODUCT_SKY_BOUNCE] || scene->wants[SB_PRODUCT_SUN_BOUNCE]))
+        cJSON_AddNumberToObject(o, "bounces", p->bounces); /* only when given: 0 is every bounce */
+    if (scene->wants[SB_PRODUCT_SUN_BOUNCE]) /* only then: scenes without keep their hash */
+        cJSON_AddNumberToObject(o, "sun_rays", p->sun_rays);
     if (p->budget_mb > 0) /* only when given: scenes without keep their hash */
         cJSON_AddNumberToObject(o, "budget_mb", p->budget_mb);
     if (p->tile_m > 0) /* likewise */

@@ -30,6 +30,72 @@ void sb_probe_direction(uint32_t i, uint32_t n, double d[3])
     d[2] = r * sin(phi);
 }
 
+void sb_sun_table_direction(uint32_t j, double d[3])
+{
+    double step = 2.0 / (SB_SUN_SIDE - 1);
+    double u = -1.0 + step * (j % SB_SUN_SIDE), v = -1.0 + step * (j / SB_SUN_SIDE);
+    double x = 0.5 * (u + v), z = 0.5 * (u - v), y = fmax(1.0 - fabs(x) - fabs(z), 0.0);
+    double len = sqrt(x * x + y * y + z * z);
+    d[0] = x / len;
+    d[1] = y / len;
+    d[2] = z / len;
+}
+
+static uint32_t sun_hash(uint32_t x)
+{
+    x ^= x >> 16;
+    x *= 0x7feb352du;
+    x ^= x >> 15;
+    x *= 0x846ca68bu;
+    x ^= x >> 16;
+    return x;
+}
+
+void sb_sun_table_sample(uint32_t j, uint32_t seed, double d[3])
+{
+    uint32_t h0 = sun_hash(seed), h1 = sun_hash(h0), h2 = sun_hash(h1), h3 = sun_hash(h2);
+    double step = 2.0 / (SB_SUN_SIDE - 1), unit = 0x1p-24;
+    double u = -1.0 + step * (j % SB_SUN_SIDE) + step * ((double)(h0 >> 8) - (double)(h1 >> 8)) * unit;
+    double v = -1.0 + step * (j / SB_SUN_SIDE) + step * ((double)(h2 >> 8) - (double)(h3 >> 8)) * unit;
+    u = u > 1.0 ? 2.0 - u : (u < -1.0 ? -2.0 - u : u);
+    v = v > 1.0 ? 2.0 - v : (v < -1.0 ? -2.0 - v : v);
+    double x = 0.5 * (u + v), z = 0.5 * (u - v), y = fmax(1.0 - fabs(x) - fabs(z), 0.0);
+    double len = sqrt(x * x + y * y + z * z);
+    d[0] = x / len;
+    d[1] = y / len;
+    d[2] = z / len;
+}
+
+void sb_sun_table_weights(const double s[3], uint32_t at[4], double w[4])
+{
+    double d[3] = {s[0], fmax(s[1], 0.0), s[2]};
+    double a = fabs(d[0]) + d[1] + fabs(d[2]);
+    if (a > 0) {
+        for (int k = 0; k < 3; k++)
+            d[k] /= a;
+    } else {
+        d[0] = d[2] = 0;
+        d[1] = 1;
+    }
+    double side = SB_SUN_SIDE - 1, t[2] = {d[0] + d[2], d[0] - d[2]}, f[2];
+    uint32_t b[2];
+    for (int k = 0; k < 2; k++) {
+        t[k] = fmin(fmax((t[k] + 1.0) * 0.5 * side, 0.0), side);
+        double base = fmin(floor(t[k]), side - 1.0);
+        f[k] = t[k] - base;
+        b[k] = (uint32_t)base;
+    }
+    uint32_t i = b[0] + b[1] * SB_SUN_SIDE;
+    at[0] = i;
+    at[1] = i + 1;
+    at[2] = i + SB_SUN_SIDE;
+    at[3] = i + SB_SUN_SIDE + 1;
+    w[0] = (1 - f[0]) * (1 - f[1]);
+    w[1] = f[0] * (1 - f[1]);
+    w[2] = (1 - f[0]) * f[1];
+    w[3] = f[0] * f[1];
+}
+
 double sb_sh9_eval(const double c[SB_PROBE_SH], const double d[3])
 {
     double y[SB_PROBE_SH], sum = 0;

@@ -15,6 +15,23 @@ void sb_sh9_basis(const double d[3], double y[SB_PROBE_SH]);
 /* Ray i of n of a probe (config.h: spherical Fibonacci, y up), in fp64. */
 void sb_probe_direction(uint32_t i, uint32_t n, double d[3]);
 
+/* The sun table's direction j (config.h, SB_SUN_SIDE; sh.glsl): the
+ * corner (j % side, j / side) of a grid over the upper hemisphere's
+ * octahedral map (u = (x + z) / a, v = (x - z) / a, a = |x| + |y| + |z|,
+ * each from -1 to 1), unit, y up. */
+void sb_sun_table_direction(uint32_t j, double d[3]);
+
+/* A direction about the table's direction j drawn with the density of its
+ * bilinear weight over the map (sh.glsl's sun_table_sample, from the same
+ * hash of seed): the kernel casts one a hit and direction, seed = the
+ * probe's ray x SB_SUN_DIRECTIONS + j. */
+void sb_sun_table_sample(uint32_t j, uint32_t seed, double d[3]);
+
+/* The 4 table directions around the sun s (unit or not) and their
+ * bilinear weights, summing to 1; a sun below the horizon is read at the
+ * horizon under it. */
+void sb_sun_table_weights(const double s[3], uint32_t at[4], double w[4]);
+
 /* The SH reconstruction sum_k c[k] Y_k(d). */
 double sb_sh9_eval(const double c[SB_PROBE_SH], const double d[3]);
 

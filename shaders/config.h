@@ -354,15 +354,41 @@ struct sb_texture_mips_push {
  * probe; baker/sky_bounce.c sums the bounces B + M B + M M B + ... */
 #define SB_BOUNCE_OPERATOR_FLOATS (SB_BOUNCE_SH * SB_BOUNCE_SH * 3)
 #define SB_BOUNCE_KERNEL_FLOATS (SB_BOUNCE_FLOATS + SB_BOUNCE_OPERATOR_FLOATS)
+/* The sun's table (sun_bounce; docs/probes.md, "The sun"): the sun's
+ * bounce at SB_SUN_DIRECTIONS directions s_j of the upper hemisphere, the
+ * corners of an SB_SUN_SIDE x SB_SUN_SIDE grid over its octahedral map
+ * (physics/sh.h, sb_sun_table_direction), read bilinearly between them. A sun run
+ * of the kernel (its sphere set empty: secondary 0) writes after M, sun
+ * direction by sun direction, the radiance the surfaces send toward the
+ * probe (order-1 SH of w, rgb) when a sun of unit irradiance shines from
+ * about s_j: each hit's rho / pi (n.s) V(s), s drawn about s_j
+ * (sun_table_sample), V from a ray toward s. */
+#define SB_SUN_SIDE 12
+#define SB_SUN_DIRECTIONS (SB_SUN_SIDE * SB_SUN_SIDE)
+#define SB_BOUNCE_SUN_FLOATS (SB_SUN_DIRECTIONS * SB_BOUNCE_SH * 3)
+#define SB_BOUNCE_SUN_KERNEL_FLOATS (SB_BOUNCE_KERNEL_FLOATS + SB_BOUNCE_SUN_FLOATS)
+/* The kernel's sun rays, this many directions at a time (the workgroup's
+ * memory holds their visibility for each ray), and a pass's */
+#define SB_BOUNCE_SUN_GROUP 16
+#define SB_BOUNCE_SUN_PASS 32
+/* The product keeps the table as each direction's grey (the mean of r, g,
+ * b) constant band T_j, and one shape a probe, S[m] rgb: the table's
+ * order-1 rgb summed over the directions over its T_j summed, so that a
+ * sun from s gives sum_j w_j(s) T_j S[m] (baker/sky_bounce.h). */
+#define SB_BOUNCE_SUN_TABLE (SB_SUN_DIRECTIONS + SB_BOUNCE_SH * 3)
 
 /* skyview's probes buffer (probes.glsl, SB_VIEW_BINDING_PROBES): after
  * struct sb_probes_gpu, SB_PROBE_VEC4S vec4s a probe: (position m, valid),
  * the visibility's SB_PROBE_SH coefficients in the next 3 (x, y, z, w, ...),
- * then from vec4 SB_PROBE_BOUNCE_VEC4 the bounce transfer's SB_BOUNCE_FLOATS. */
+ * then from vec4 SB_PROBE_BOUNCE_VEC4 the bounce transfer's SB_BOUNCE_FLOATS;
+ * with the sun's bounce SB_PROBE_SUN_VEC4S vec4s a probe, from
+ * SB_PROBE_SUN_VEC4 its table's SB_BOUNCE_SUN_TABLE. */
 #define SB_PROBE_BOUNCE_VEC4 4
 #define SB_PROBE_VEC4S (SB_PROBE_BOUNCE_VEC4 + SB_BOUNCE_FLOATS / 4)
+#define SB_PROBE_SUN_VEC4 SB_PROBE_VEC4S /* with sun_bounce: its table */
+#define SB_PROBE_SUN_VEC4S (SB_PROBE_SUN_VEC4 + SB_BOUNCE_SUN_TABLE / 4)
 #ifndef GL_core_profile
-_Static_assert(SB_BOUNCE_FLOATS % 4 == 0 && 4 + SB_PROBE_SH <= 4 * SB_PROBE_BOUNCE_VEC4,
+_Static_assert(SB_BOUNCE_FLOATS % 4 == 0 && SB_BOUNCE_SUN_TABLE % 4 == 0 && 4 + SB_PROBE_SH <= 4 * SB_PROBE_BOUNCE_VEC4,
                "the probes buffer's record holds the visibility's SH and whole vec4s of the bounce");
 #endif
 
@@ -373,12 +399,16 @@ struct sb_bounce_push {
     float tmin_m;
     /* one pass: rays [first_ray, first_ray + SB_PROBE_THREADS), one a
      * thread, each casting the sphere set's directions [first_direction,
-     * first_direction + SB_BOUNCE_PASS_DIRECTIONS); added to what the
-     * passes before wrote when `accumulate` (baker/sky_bounce.c) */
+     * first_direction + SB_BOUNCE_PASS_DIRECTIONS), or past the sphere
+     * set (2 secondary) the sun table's SB_BOUNCE_SUN_PASS from
+     * first_direction - 2 secondary; added to what the passes before
+     * wrote when `accumulate` (baker/sky_bounce.c); M and B (zero in a
+     * sun run) in the pass of first_direction 0 */
     SB_UINT first_ray;
     SB_UINT first_direction;
     SB_UINT accumulate;
     float tmax_m; /* a ray, from the probe or from a surface, reaching this far sees the sky */
+    SB_UINT stride; /* the output's floats a probe: SB_BOUNCE_KERNEL_FLOATS; a sun run's SB_BOUNCE_SUN_KERNEL_FLOATS */
 };
 /* Mesa's lavapipe ends every loop of a kernel invocation once the
  * invocation has run 65535 loop iterations in all (gallivm's

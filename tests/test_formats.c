@@ -723,6 +723,10 @@ static void edit_version_5(cJSON *r)
     cJSON_ReplaceItemInObject(r, "format_version", cJSON_CreateNumber(5));
     edit_bounce_fp32(r);
 }
+static void edit_version_11(cJSON *r)
+{
+    cJSON_ReplaceItemInObject(r, "format_version", cJSON_CreateNumber(11));
+}
 /* What version 1 wrote: no cloud products (in the scene or the pack), no
  * file_hash; the scene's hash recomputed for the scene without clouds. */
 static void edit_make_version_1(cJSON *r)
@@ -939,12 +943,15 @@ static void test_pack_reader(void)
         {"one flipped byte in the compressed pixels, vouched for", NULL, FLIP_BYTE, SB_ERR_EXR, true},
         {"format version 1, as version 1 wrote it", edit_make_version_1,
          "rm cloud_shape.vdb cloud_detail.vdb cloud_curl.exr weather.exr sky_visibility.sbprobes sky_bounce.sbprobes "
-         "dfg.exr reflection_cubes.exr reflection_probes.sbprobes",
+         "dfg.exr reflection_cubes.exr reflection_probes.sbprobes sun_bounce.sbprobes",
          SB_OK, false},
         {"format version 2 listing sky_visibility", edit_version_2, NULL, SB_ERR_UNKNOWN_PRODUCT, false},
         {"format version 3 listing sky_bounce", edit_version_3, NULL, SB_ERR_UNKNOWN_PRODUCT, false},
         {"format version 4 listing dfg", edit_version_4, NULL, SB_ERR_UNKNOWN_PRODUCT, false},
         {"format version 5 listing reflection_cubes", edit_version_5, NULL, SB_ERR_UNKNOWN_PRODUCT, false},
+        {"format version 11 listing sun_bounce", edit_version_11, NULL, SB_ERR_UNKNOWN_PRODUCT, false},
+        {"truncated sun bounce file, vouched for", NULL,
+         "head -c 300 sun_bounce.sbprobes > t && mv t sun_bounce.sbprobes", SB_ERR_BAD_IMAGE, true},
         {"cube file truncated, vouched for", NULL, "head -c 4000 reflection_cubes.exr > t && mv t reflection_cubes.exr",
          SB_ERR_EXR, true},
         {"cube file replaced by the DFG's EXR, vouched for", NULL, "cp dfg.exr reflection_cubes.exr", SB_ERR_BAD_IMAGE,

@@ -37,7 +37,7 @@ check "only what was asked for" test ! -e "$tmp/p/transmittance.exr"
 check "verify" expect_exit 0 "$skybake" verify "$tmp/p"
 check "info lists sky_visibility" expect_exit 0 "$skybake" info "$tmp/p"
 check "info shows the grid" grep -q '"grid":\[6,1,6\]' "$tmp/out"
-check "manifest has format_version 11" grep -Eq '"format_version":[[:space:]]*11,' "$tmp/p/manifest.json"
+check "manifest has format_version 12" grep -Eq '"format_version":[[:space:]]*12,' "$tmp/p/manifest.json"
 check "diff with itself" expect_exit 0 "$skybake" diff "$tmp/p" "$tmp/p"
 hash() { sed -n 's/.*"content_hash":[[:space:]]*"\([0-9a-f]*\)".*/\1/p' "$tmp/p/manifest.json"; }
 first=$(hash)
@@ -348,6 +348,12 @@ check "the same bounce" cmp -s "$tmp/room1/sky_bounce.sbprobes" "$tmp/room3/sky_
 check "a rebake reuses both" expect_exit 0 "$skybake" bake "$tmp/room.json" -o "$tmp/room1"
 check "reused" sh -c "grep -q 'sky_visibility.*reused' '$tmp/err' && grep -q 'sky_bounce.*reused' '$tmp/err'"
 check "the reused files are the same" cmp -s "$tmp/room1/sky_bounce.sbprobes" "$tmp/room3/sky_bounce.sbprobes"
+check "a reused product keeps the world it was baked against" python3 - "$tmp/room1/manifest.json" "$tmp/room3/manifest.json" <<'PY'
+import json, sys
+def world(path):
+    return [(a.get("world_hash"), a.get("world_path")) for a in json.load(open(path))["artifacts"] if a["name"] == "sky_visibility"][0]
+assert world(sys.argv[1])[0] and world(sys.argv[1]) == world(sys.argv[2]), (world(sys.argv[1]), world(sys.argv[2]))
+PY
 room ',"detail_spacing_m":0.5,"budget_mb":0.15' >"$tmp/room_budget.json"
 check "bake the room within a budget" expect_exit 0 "$skybake" bake "$tmp/room_budget.json" -o "$tmp/room_budget"
 check "saying the detail was coarsened" grep -q "detail 0.5 m apart would take .* MB, over what probes.budget_mb (0.15) leaves" "$tmp/err"
@@ -400,7 +406,7 @@ level() { # the moving hut's x
     printf '{"version":1,"ground":false,"instances":[{"file":"ground.obj"},{"file":"hut.json","translate_m":[-30,0,-30]},{"file":"hut.json","translate_m":[%s,0,10]},{"file":"hut.json","translate_m":[30,0,-20]},{"file":"room_only.obj","translate_m":[-30,0,25]}]}' "$1" >"$tmp/tiles-world.json"
 }
 level 20
-printf '{"version":1,"name":"tiles","atmosphere":{"preset":"earth"},"products":["sky_visibility","sky_bounce"],"world":{"file":"tiles-world.json"},"probes":{"spacing_m":4,"layers_m":[1.5,6],"rays":256,"bounce_rays":64,"bounce_secondary":8,"detail_spacing_m":1,"tile_m":16,"reach_m":4}}' >"$tmp/tiles.json"
+printf '{"version":1,"name":"tiles","atmosphere":{"preset":"earth"},"products":["sky_visibility","sky_bounce","sun_bounce"],"world":{"file":"tiles-world.json"},"probes":{"spacing_m":4,"layers_m":[1.5,6],"rays":256,"bounce_rays":64,"bounce_secondary":8,"sun_rays":64,"detail_spacing_m":1,"tile_m":16,"reach_m":4}}' >"$tmp/tiles.json"
 check "bake a level in tiles" expect_exit 0 "$skybake" bake "$tmp/tiles.json" -o "$tmp/tiles"
 check "every tile baked" grep -q "sky_visibility: \([0-9]*\) tiles: \1 baked, 0 kept" "$tmp/err"
 check "with detail" grep -q "([1-9][0-9]* in detail)" "$tmp/err"
@@ -412,6 +418,7 @@ level 24
 check "one hut moved 4 m: rebake" expect_exit 0 "$skybake" bake "$tmp/tiles.json" -o "$tmp/tiles"
 baked=$(sed -n 's/.*sky_visibility: [0-9]* tiles: \([0-9]*\) baked, \([0-9]*\) kept.*/\1/p' "$tmp/err")
 bounce_baked=$(sed -n 's/.*sky_bounce: [0-9]* tiles: \([0-9]*\) baked, \([0-9]*\) kept.*/\1/p' "$tmp/err")
+sun_baked=$(sed -n 's/.*sun_bounce: [0-9]* tiles: \([0-9]*\) baked, \([0-9]*\) kept.*/\1/p' "$tmp/err")
 expected=$(python3 - "$tmp/tiles-before.json" <<'PY'
 import json, math, sys
 tiles = [a for a in json.load(open(sys.argv[1]))["artifacts"] if a["name"] == "sky_visibility"][0]["tiles"]
@@ -435,9 +442,11 @@ EOF
 check "the tiles around the hut rebaked: $baked of $all_tiles (expected $want_vis)" test -n "$baked" -a "$baked" = "$want_vis"
 check "and no more than a tenth" test "$((10 * ${baked:-99}))" -le "$all_tiles"
 check "the bounce's: $bounce_baked (expected $want_lo to $want_hi)" test -n "$bounce_baked" -a "${bounce_baked:-0}" -ge "$want_lo" -a "${bounce_baked:-99}" -le "$want_hi"
+check "the sun's bounce the same tiles: $sun_baked" test -n "$sun_baked" -a "$sun_baked" = "$bounce_baked"
 check "a forced bake of the moved level" expect_exit 0 "$skybake" bake "$tmp/tiles.json" -o "$tmp/tiles-full" --force -q
 check "the same visibility, byte for byte" cmp -s "$tmp/tiles/sky_visibility.sbprobes" "$tmp/tiles-full/sky_visibility.sbprobes"
 check "the same bounce, byte for byte" cmp -s "$tmp/tiles/sky_bounce.sbprobes" "$tmp/tiles-full/sky_bounce.sbprobes"
+check "the same sun bounce, byte for byte" cmp -s "$tmp/tiles/sun_bounce.sbprobes" "$tmp/tiles-full/sun_bounce.sbprobes"
 check "a tile baked alone" expect_exit 0 "$skybake" bake "$tmp/tiles.json" -o "$tmp/tile-one" --tile -2,1
 check "one baked, the rest left" grep -q "sky_visibility: \([0-9]*\) tiles: 1 baked, 0 kept (their keys unchanged), [1-9][0-9]* left" "$tmp/err"
 check "verify the partial pack" expect_exit 0 "$skybake" verify "$tmp/tile-one"
@@ -448,7 +457,7 @@ check "the tile (the room's, with detail) holds the whole bake's bytes" python3 
 import json, sys
 def tiles(path, name):
     return {(t["x"], t["z"]): t for a in json.load(open(path))["artifacts"] if a["name"] == name for t in a["tiles"]}
-for name in ("sky_visibility", "sky_bounce"):
+for name in ("sky_visibility", "sky_bounce", "sun_bounce"):
     one, whole = tiles(sys.argv[1], name), tiles(sys.argv[2], name)
     assert one.keys() == whole.keys(), name
     assert one[(-2, 1)]["baked"] and one[(-2, 1)]["content"] == whole[(-2, 1)]["content"], (name, one[(-2, 1)])
@@ -467,7 +476,7 @@ check "casts nothing, keeps both" grep -q "sky_visibility: [0-9]* tiles: 0 baked
 check "the bounce's likewise" grep -q "sky_bounce: [0-9]* tiles: 0 baked, 2 kept (their keys unchanged), [1-9][0-9]* left" "$tmp/err"
 check "the rest baked into the merge" expect_exit 0 "$skybake" bake "$tmp/tiles.json" -o "$tmp/farm"
 check "keeps the two" grep -q "sky_visibility: [0-9]* tiles: [0-9]* baked, 2 kept (their keys unchanged), 0 left" "$tmp/err"
-check "and is the whole bake" sh -c "cmp -s '$tmp/farm/sky_visibility.sbprobes' '$tmp/tiles-full/sky_visibility.sbprobes' && cmp -s '$tmp/farm/sky_bounce.sbprobes' '$tmp/tiles-full/sky_bounce.sbprobes'"
+check "and is the whole bake" sh -c "cmp -s '$tmp/farm/sky_visibility.sbprobes' '$tmp/tiles-full/sky_visibility.sbprobes' && cmp -s '$tmp/farm/sky_bounce.sbprobes' '$tmp/tiles-full/sky_bounce.sbprobes' && cmp -s '$tmp/farm/sun_bounce.sbprobes' '$tmp/tiles-full/sun_bounce.sbprobes'"
 check "--from with --force is refused" expect_exit 2 "$skybake" bake "$tmp/tiles.json" -o "$tmp/farm" --force --from "$tmp/farm-a"
 check "--from a pack that is not there is said" expect_exit 0 "$skybake" bake "$tmp/tiles.json" -o "$tmp/farm" --from "$tmp/nowhere"
 check "naming it" grep -q "nowhere (--from): no pack there" "$tmp/err"

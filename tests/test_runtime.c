@@ -1090,8 +1090,9 @@ static void leak_ratios(const struct sb_pack *p, const struct sb_world *w, doubl
 
 /*
  * Leaks: for a uniform 1 m grid (today's layout), for a level's layers
- * with 1 m detail whose sight masks are dropped, and for that layout as
- * baked, the leak_ratios; the last held at 1e-3 (issue 48's bound).
+ * with 1 m detail whose sight masks are dropped, for that layout as
+ * baked, and for it with the sun's bounce from its table (sun_bounce),
+ * the leak_ratios; the last two held at 1e-3 (issue 48's bound).
  */
 static void test_leak(const char *dir)
 {
@@ -1104,21 +1105,25 @@ static void test_leak(const char *dir)
         CHECK(false, "the leak world loads");
         return;
     }
-    double ratio[3][3];
-    for (int i = 0; i < 9; i++)
+    double ratio[4][3];
+    for (int i = 0; i < 12; i++)
         ratio[i / 3][i % 3] = NAN;
     uint32_t maps = 0;
-    for (int layout = 0; layout < 2; layout++) {
+    for (int layout = 0; layout < 3; layout++) {
         snprintf(pack_dir, sizeof(pack_dir), "%s/leak-pack-%d", dir, layout);
         struct sb_scene *scene = probe_scene(world_path);
         const double bounds[2][3] = {{1, 0.5, -5}, {10, 3.5, 5}};
         memcpy(scene->probes.bounds_m, bounds, sizeof(bounds));
-        if (layout == 1) { /* a level's layers (12.5 m apart, 1.5, 10 and 30 m up), detail 1 m apart */
+        if (layout >= 1) { /* a level's layers (12.5 m apart, 1.5, 10 and 30 m up), detail 1 m apart */
             scene->probes.has_bounds = false;
             scene->probes.spacing_m = 12.5;
             scene->probes.layer_count = 3;
             memcpy(scene->probes.layers_m, (const double[3]){1.5, 10, 30}, 3 * sizeof(double));
             scene->probes.detail_spacing_m = 1.0;
+        }
+        if (layout == 2) { /* and the sun's table */
+            scene->wants[SB_PRODUCT_SUN_BOUNCE] = true;
+            scene->probes.sun_rays = 64;
         }
         struct sb_bake_report report;
         struct sb_pack leak_pack;
@@ -1133,18 +1138,20 @@ static void test_leak(const char *dir)
                   l->column_count);
             maps = l->sight ? l->detail_count : 0;
         }
-        for (int drop = 0; drop <= layout; drop++) {
+        if (layout == 2)
+            CHECK(leak_pack.present[SB_PRODUCT_SUN_BOUNCE], "the pack holds sun_bounce");
+        for (int drop = 0; drop <= (layout == 1); drop++) {
             if (drop) { /* the same probes without their sight masks */
                 free(l->sight);
                 l->sight = NULL;
             }
-            leak_ratios(&leak_pack, &w, ratio[layout == 0 ? 0 : drop ? 1 : 2]);
+            leak_ratios(&leak_pack, &w, ratio[layout == 0 ? 0 : layout == 2 ? 3 : drop ? 1 : 2]);
         }
         sb_pack_close(&leak_pack);
     }
-    static const char *const names[3] = {"a uniform 1 m grid", "layers and 1 m detail without sight masks",
-                                         "layers and 1 m detail with them"};
-    for (int i = 0; i < 3; i++)
+    static const char *const names[4] = {"a uniform 1 m grid", "layers and 1 m detail without sight masks",
+                                         "layers and 1 m detail with them", "the same with the sun's table"};
+    for (int i = 0; i < 4; i++)
         printf("leak through 0.1 m walls, the sun 30 degrees up, %s: the inside north wall's radiance %.2e of its "
                "shaded outside's, its ambient irradiance %.2e, the worst inside wall's %.2e\n",
                names[i], ratio[i][0], ratio[i][1], ratio[i][2]);
@@ -1153,6 +1160,10 @@ static void test_leak(const char *dir)
           "with sight masks the room's inside leaks %.2e of its shaded outside's radiance, %.2e of its irradiance "
           "at worst; at most 1e-3",
           ratio[2][0], ratio[2][2]);
+    CHECK(ratio[3][0] <= 1e-3 && ratio[3][2] <= 1e-3,
+          "with the sun's table the room's inside leaks %.2e of its shaded outside's radiance, %.2e of its "
+          "irradiance at worst; at most 1e-3",
+          ratio[3][0], ratio[3][2]);
     sb_world_finish(&w);
 }
 

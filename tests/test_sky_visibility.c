@@ -696,6 +696,16 @@ static bool bake_bounce(struct scene *s, const float *positions, uint32_t count,
     return res == SB_OK;
 }
 
+/* The sun's tables (sun_bounce) at the positions: SB_BOUNCE_SUN_TABLE a probe. */
+static bool bake_sun(struct scene *s, const float *positions, uint32_t count, uint32_t rays, uint32_t bounces,
+                     float *out)
+{
+    struct sb_sky_bounce_params p = {.ray_count = rays, .bounces = bounces, .sun = true};
+    enum sb_result res = sb_sky_bounce_bake(s->rc, &s->surfaces, positions, NULL, count, &p, out, NULL, NULL);
+    CHECK(res == SB_OK, "%s: the sun's bounce: %s", s->name, sb_result_name(res));
+    return res == SB_OK;
+}
+
 static double bounce_diff(const float *a, const double *b, double *peak)
 {
     double m = 0;
@@ -711,16 +721,19 @@ static double bounce_diff(const float *a, const double *b, double *peak)
  * The estimator of probe_bounce.comp in fp64 on Embree's rays: the same
  * directions, the hit's normal and albedo from the mesh, the same offset;
  * out gets the first bounce B1, op (SB_BOUNCE_OPERATOR_FLOATS) the
- * operator M of the next.
+ * operator M of the next, sun (SB_BOUNCE_SUN_FLOATS: direction j, m, rgb)
+ * the first bounce of a unit sun from each of the table's directions.
  */
 static void bounce_reference(const struct sb_mesh *mesh, const struct sb_embree *e, const float *position,
-                             uint32_t rays, uint32_t secondary, double *out, double *op)
+                             uint32_t rays, uint32_t secondary, double *out, double *op, double *sun)
 {
     memset(out, 0, sizeof(double) * SB_BOUNCE_FLOATS);
     memset(op, 0, sizeof(double) * SB_BOUNCE_OPERATOR_FLOATS);
-    uint32_t sphere = 2 * secondary;
-    float *ray = malloc(sizeof(float) * 8 * (rays > sphere ? rays : sphere));
-    float *hit = malloc(sizeof(float) * 4 * (rays > sphere ? rays : sphere));
+    memset(sun, 0, sizeof(double) * SB_BOUNCE_SUN_FLOATS);
+    uint32_t sphere = 2 * secondary, most = rays > sphere ? rays : sphere;
+    most = most > SB_SUN_DIRECTIONS ? most : SB_SUN_DIRECTIONS;
+    float *ray = malloc(sizeof(float) * 8 * most);
+    float *hit = malloc(sizeof(float) * 4 * most);
     double *dirs = malloc(sizeof(double) * 3 * sphere);
     if (!ray || !hit || !dirs)
         goto done;
@@ -792,6 +805,36 @@ static void bounce_reference(const struct sb_mesh *mesh, const struct sb_embree 
         sb_sh9_basis(w, ym);
         sb_sh9_basis(n, yn);
         const float *rho = mesh->material_list[mesh->materials[t]].albedo;
+        /* the sun table's directions, a ray toward each the surface faces */
+        double sun_c[SB_SUN_DIRECTIONS], sun_l[3 * SB_SUN_DIRECTIONS];
+        cast = 0;
+        for (uint32_t j = 0; j < SB_SUN_DIRECTIONS; j++) {
+            double *l = &sun_l[3 * j];
+            sb_sun_table_sample(j, r * SB_SUN_DIRECTIONS + j, l);
+            sun_c[j] = n[0] * l[0] + n[1] * l[1] + n[2] * l[2];
+            if (sun_c[j] <= 0)
+                continue;
+            float *q = &ray[8 * cast++];
+            for (int k = 0; k < 3; k++) {
+                q[k] = (float)(x[k] + n[k] * eps);
+                q[4 + k] = (float)l[k];
+            }
+            q[3] = (float)eps;
+            q[7] = 1e30f;
+        }
+        sb_embree_cast(e, ray, cast, hit);
+        cast = 0;
+        for (uint32_t j = 0; j < SB_SUN_DIRECTIONS; j++) {
+            if (sun_c[j] <= 0)
+                continue;
+            uint32_t bits;
+            memcpy(&bits, &hit[4 * cast++ + 1], sizeof(bits));
+            if (bits != SB_BVH_MISS)
+                continue;
+            for (int m = 0; m < SB_BOUNCE_SH; m++)
+                for (int c = 0; c < 3; c++)
+                    sun[(j * SB_BOUNCE_SH + m) * 3 + c] += 4 * M_PI / rays * ym[m] * rho[c] / M_PI * sun_c[j];
+        }
         for (int m = 0; m < SB_BOUNCE_SH; m++)
             for (int c = 0; c < 3; c++) {
                 for (int k = 0; k < SB_PROBE_SH; k++)
@@ -809,9 +852,10 @@ done:
 }
 
 /* Every bounce in closed form: all = (I - M)^-1 B1, channel by channel,
- * by Gaussian elimination with partial pivots in fp64. Returns the gain
- * of (I - M)^-1 (its largest absolute row sum). */
-static double bounce_every(const double *first, const double *op, double *all)
+ * by Gaussian elimination with partial pivots in fp64, and likewise the
+ * sun's first bounces sun1 into sun_all. Returns the gain of (I - M)^-1
+ * (its largest absolute row sum). */
+static double bounce_every(const double *first, const double *op, const double *sun1, double *all, double *sun_all)
 {
     enum { S = SB_BOUNCE_SH, K = SB_PROBE_SH };
     double gain = 0;
@@ -855,6 +899,13 @@ static double bounce_every(const double *first, const double *op, double *all)
         for (int i = 0; i < S; i++)
             for (int k = 0; k < K; k++)
                 all[(i * K + k) * 3 + c] = x[i][k];
+        for (int j = 0; j < SB_SUN_DIRECTIONS; j++)
+            for (int i = 0; i < S; i++) {
+                double v = 0;
+                for (int l = 0; l < S; l++)
+                    v += a[i][S + l] * sun1[(j * S + l) * 3 + c];
+                sun_all[(j * S + i) * 3 + c] = v;
+            }
     }
     return gain;
 }
@@ -924,42 +975,78 @@ static void test_bounce(struct sb_vk *vk)
         for (int i = 0; i < 8; i++)
             for (int k = 0; k < 3; k++)
                 positions[3 * i + k] = lo[k] + (hi[k] - lo[k]) * ((i >> k & 1) ? 1.2f : 0.35f); /* out and in */
-        static float every[8 * SB_BOUNCE_FLOATS];
+        static float every[8 * SB_BOUNCE_FLOATS], sun_one[8 * SB_BOUNCE_SUN_TABLE], sun_every[8 * SB_BOUNCE_SUN_TABLE];
         if (bake_bounce(&house, positions, 8, 256, 64, 1, out) && bake_bounce(&house, positions, 8, 256, 64, 1, again) &&
-            bake_bounce(&house, positions, 8, 256, 64, 0, every)) {
+            bake_bounce(&house, positions, 8, 256, 64, 0, every) && bake_sun(&house, positions, 8, 256, 1, sun_one) &&
+            bake_sun(&house, positions, 8, 256, 0, sun_every)) {
             CHECK(!memcmp(out, again, sizeof(out)), "two bounce bakes differ");
-            double worst = 0, worst_every = 0, peak = 0, peak_every = 0, gain = 0;
+            double worst = 0, worst_every = 0, peak = 0, peak_every = 0, gain = 0, sun_worst[2] = {0},
+                   shape_worst[2] = {0}, sun_peak = 0;
             for (int i = 0; i < 8; i++) {
+                static double sun1[SB_BOUNCE_SUN_FLOATS], sun_all[SB_BOUNCE_SUN_FLOATS];
                 double ref[SB_BOUNCE_FLOATS], op[SB_BOUNCE_OPERATOR_FLOATS], all[SB_BOUNCE_FLOATS], p;
-                bounce_reference(&house.mesh, &e, &positions[3 * i], 256, 64, ref, op);
+                bounce_reference(&house.mesh, &e, &positions[3 * i], 256, 64, ref, op, sun1);
                 worst = fmax(worst, bounce_diff(&out[SB_BOUNCE_FLOATS * i], ref, &p));
                 peak = fmax(peak, p);
-                gain = fmax(gain, bounce_every(ref, op, all));
+                gain = fmax(gain, bounce_every(ref, op, sun1, all, sun_all));
                 worst_every = fmax(worst_every, bounce_diff(&every[SB_BOUNCE_FLOATS * i], all, &p));
                 peak_every = fmax(peak_every, p);
+                /* the sun's table: each direction's grey constant band, and
+                 * the shape times the constant bands' sum (the table's
+                 * order-1 rgb summed over its directions) */
+                for (int b = 0; b < 2; b++) {
+                    const double *sun = b ? sun_all : sun1;
+                    const float *got = (b ? sun_every : sun_one) + SB_BOUNCE_SUN_TABLE * i;
+                    double sum = 0, shape[SB_BOUNCE_SH * 3] = {0};
+                    for (int j = 0; j < SB_SUN_DIRECTIONS; j++) {
+                        double t = (sun[j * 12] + sun[j * 12 + 1] + sun[j * 12 + 2]) / 3; /* grey */
+                        sun_worst[b] = fmax(sun_worst[b], fabs(got[j] - t));
+                        sun_peak = fmax(sun_peak, fabs(t));
+                        sum += t;
+                        for (int mc = 0; mc < SB_BOUNCE_SH * 3; mc++)
+                            shape[mc] += sun[j * 12 + mc];
+                    }
+                    for (int mc = 0; mc < SB_BOUNCE_SH * 3; mc++)
+                        shape_worst[b] = fmax(shape_worst[b], fabs(got[SB_SUN_DIRECTIONS + mc] * sum - shape[mc]));
+                }
             }
             /* one secondary ray in the epsilon band moves a coefficient by
              * 4 pi / 256 max|Y_m| rho / pi 4 pi / 128 max|Y_k| c */
             double quantum = 4 * M_PI / 256 * 0.4886 / M_PI * 4 * M_PI / 128 * 1.0925;
+            /* one sun ray: 4 pi / 256 max|Y_m| rho / pi c, and a constant
+             * band 4 pi / 256 Y_0 rho / pi c */
+            double sun_quantum = 4 * M_PI / 256 * 0.4886 / M_PI, t_quantum = 4 * M_PI / 256 * 0.2821 / M_PI;
             printf("bounce, IFC house, 8 probes x 256 x 64 rays: within %.2e of the fp64 estimator on Embree's rays "
                    "(%.2f secondary-ray quanta; largest coefficient %.3g); every bounce within %.2e of its fp64 sum "
                    "(I - M)^-1 B1 (%.2f quanta; largest %.3g; the sum's gain at most %.3f)\n",
                    worst, worst / quantum, peak, worst_every, worst_every / quantum, peak_every, gain);
+            printf("  the sun's table: its constant bands within %.2e (one bounce) and %.2e (every) of the fp64 "
+                   "estimator's (%.2f, %.2f sun-ray quanta; largest %.3g); its shapes' sums within %.2e, %.2e (%.2f, "
+                   "%.2f quanta)\n",
+                   sun_worst[0], sun_worst[1], sun_worst[0] / t_quantum, sun_worst[1] / t_quantum, sun_peak,
+                   shape_worst[0], shape_worst[1], shape_worst[0] / sun_quantum, shape_worst[1] / sun_quantum);
             CHECK(worst <= 4 * quantum, "bounce: %g from the fp64 reference (%.2f quanta)", worst, worst / quantum);
             /* the same quanta through the sum's gain, and the sum's end: a
              * bounce adding under SB_SKY_BOUNCE_CONVERGED of the largest,
              * the rest a geometric tail */
             CHECK(worst_every <= 4 * quantum * gain + 2 * SB_SKY_BOUNCE_CONVERGED * peak_every,
                   "every bounce: %g from the fp64 sum (%.2f quanta)", worst_every, worst_every / quantum);
+            /* a direction's constant band: 4 of its rays in the epsilon
+             * band; the shapes' sums: as many over the 64 directions */
+            CHECK(sun_worst[0] <= 4 * t_quantum && sun_worst[1] <= 4 * t_quantum * gain + 2e-3 * sun_peak,
+                  "the sun's table: %g, %g from the fp64 reference", sun_worst[0], sun_worst[1]);
+            CHECK(shape_worst[0] <= 4 * sun_quantum * SB_SUN_DIRECTIONS &&
+                      shape_worst[1] <= 4 * sun_quantum * SB_SUN_DIRECTIONS * gain,
+                  "the sun's shapes: %g, %g from the fp64 reference", shape_worst[0], shape_worst[1]);
         }
         /* Many rays a probe: lavapipe ends an invocation's loops after
          * 65535 iterations in all; a probe's bounce in one invocation came
          * back with 3% of its light here from 144 secondary rays. The
          * passes (config.h) keep each invocation to a ray and a slice. */
         static float deep[SB_BOUNCE_FLOATS];
-        double ref[SB_BOUNCE_FLOATS], op[SB_BOUNCE_OPERATOR_FLOATS], p;
+        static double ref[SB_BOUNCE_FLOATS], op[SB_BOUNCE_OPERATOR_FLOATS], sun[SB_BOUNCE_SUN_FLOATS], p;
         if (bake_bounce(&house, positions, 1, 256, 1024, 1, deep)) {
-            bounce_reference(&house.mesh, &e, positions, 256, 1024, ref, op);
+            bounce_reference(&house.mesh, &e, positions, 256, 1024, ref, op, sun);
             double quantum = 4 * M_PI / 256 * 0.4886 / M_PI * 4 * M_PI / 2048 * 1.0925, diff = bounce_diff(deep, ref, &p);
             printf("bounce, IFC house, 256 x 1024 rays: within %.2e of the fp64 estimator (%.2f quanta; largest %.3g)\n",
                    diff, diff / quantum, p);
@@ -1012,15 +1099,18 @@ static uint32_t rooms_of_house(const struct sb_embree *e, const float lo[3], con
     return picked;
 }
 
-/* The irradiance a runtime gives a point from its probe (probes.glsl),
+/* The irradiance a runtime gives a point from its probe (probe_light.comp),
  * the mean over the 6 axes of the channels' sum: the sky through the
  * visibility V (order 2, the window undone: the raw projection), V L by
- * the triple product, and the bounce b_m = sum_k B[m][k] (L_k + E Y_k(s)),
- * convolved with the clamped cosine about each axis, the sum clamped at 0
- * per axis and channel. *sky and *bounced: the two parts' means. */
-static double probe_irradiance(const float *visibility, const float *bounce, const struct sb_bounce_lighting *light,
-                               double *sky, double *bounced)
+ * the triple product, and the bounce b_m = sum_k B[m][k] L_k plus the
+ * sun's, E sum_j w_j(s) T_j S[m] from its table (sun_bounce; or, NULL,
+ * through B: sum_k B[m][k] E Y_k(s)), convolved with the clamped cosine
+ * about each axis, the sum clamped at 0 per axis and channel. *sky and
+ * *bounced: the two parts' means. */
+static double probe_irradiance(const float *visibility, const float *bounce, const float *sun_table,
+                               const struct sb_bounce_lighting *light, double *sky, double *bounced)
 {
+    bool sh_sun = !sun_table;
     static double t[SB_PROBE_SH][SB_PROBE_SH][SB_PROBE_SH];
     static bool have;
     if (!have) {
@@ -1029,8 +1119,12 @@ static double probe_irradiance(const float *visibility, const float *bounce, con
     }
     const double band[SB_PROBE_SH] = {M_PI, 2 * M_PI / 3, 2 * M_PI / 3, 2 * M_PI / 3, M_PI / 4,
                                       M_PI / 4, M_PI / 4, M_PI / 4, M_PI / 4};
-    double ys[SB_PROBE_SH], total = 0;
+    double ys[SB_PROBE_SH], total = 0, w[4], sun_t = 0;
+    uint32_t at[4];
     sb_sh9_basis(light->sun_dir, ys);
+    sb_sun_table_weights(light->sun_dir, at, w);
+    for (int q = 0; q < 4 && sun_table; q++)
+        sun_t += w[q] * sun_table[at[q]];
     *sky = *bounced = 0;
     for (int c = 0; c < 3; c++) {
         double vl[SB_PROBE_SH] = {0}, b[SB_BOUNCE_SH] = {0};
@@ -1038,9 +1132,12 @@ static double probe_irradiance(const float *visibility, const float *bounce, con
             for (int j = 0; j < SB_PROBE_SH; j++)
                 for (int k = 0; k < SB_PROBE_SH; k++)
                     vl[k] += t[i][j][k] * visibility[i] * light->sky[j][c];
-        for (int m = 0; m < SB_BOUNCE_SH; m++)
+        for (int m = 0; m < SB_BOUNCE_SH; m++) {
             for (int k = 0; k < SB_PROBE_SH; k++)
-                b[m] += bounce[(m * SB_PROBE_SH + k) * 3 + c] * (light->sky[k][c] + light->sun[c] * ys[k]);
+                b[m] += bounce[(m * SB_PROBE_SH + k) * 3 + c] * (light->sky[k][c] + (sh_sun ? light->sun[c] * ys[k] : 0));
+            if (!sh_sun)
+                b[m] += light->sun[c] * sun_t * sun_table[SB_SUN_DIRECTIONS + 3 * m + c];
+        }
         for (int a = 0; a < SB_BOUNCE_REF_NORMALS; a++) {
             double n[3], y[SB_PROBE_SH], es = 0, eb = 0;
             sb_bounce_ref_normal(a, n);
@@ -1058,12 +1155,13 @@ static double probe_irradiance(const float *visibility, const float *bounce, con
 }
 
 /* A sky of radiance a (1 + 0.5 y) per channel (exactly order 1, never
- * negative) and a warmer sun `el` degrees up, azimuth 40: 4 times the
+ * negative) and a warmer sun `el` degrees up at azimuth `az`: 4 times the
  * sky's horizontal irradiance (a pi 4 / 3) per channel, times 1.3 in red
  * and green and 0.8 in blue. */
-static void gradient_sky(double el_deg, struct sb_bounce_lighting *light)
+static void gradient_sky(double el_deg, double az_deg, struct sb_bounce_lighting *light)
 {
-    const double a[3] = {0.30, 0.45, 0.80}, warm[3] = {1.3, 1.3, 0.8}, el = el_deg * M_PI / 180, az = 40 * M_PI / 180;
+    const double a[3] = {0.30, 0.45, 0.80}, warm[3] = {1.3, 1.3, 0.8}, el = el_deg * M_PI / 180,
+                 az = az_deg * M_PI / 180;
     memset(light, 0, sizeof(*light));
     for (int c = 0; c < 3; c++) {
         light->sky[0][c] = a[c] * sqrt(4 * M_PI);
@@ -1102,11 +1200,11 @@ static struct sb_bounce_irradiance irradiance_sum(const struct sb_bounce_irradia
 static void test_bounce_path_traced(struct sb_vk *vk)
 {
     struct sb_bounce_lighting light, sky_only, sun_only;
-    gradient_sky(30, &light);
+    gradient_sky(30, 40, &light);
     sky_only = sun_only = light;
     memset(sky_only.sun, 0, sizeof(sky_only.sun));
     memset(sun_only.sky, 0, sizeof(sun_only.sky));
-    enum { PATHS = 1 << 18 };
+    enum { PATHS = 1 << 18, SUN_RAYS = 1024 }; /* the scene's defaults: bounce_rays 256, sun_rays 1024 */
     uint32_t mat;
     double grey[3] = {0.5, 0.5, 0.5};
     struct sb_mesh plane = {0};
@@ -1149,56 +1247,95 @@ static void test_bounce_path_traced(struct sb_vk *vk)
     float at[3 * 8];
     for (uint32_t i = 0; i < 3 * count; i++)
         at[i] = (float)points[i];
-    static float vis[8 * SB_VISIBILITY_FLOATS], one[8 * SB_BOUNCE_FLOATS], every[8 * SB_BOUNCE_FLOATS];
-    static struct sb_bounce_irradiance ref[3][8];
+    static float vis[8 * SB_VISIBILITY_FLOATS], one[8 * SB_BOUNCE_FLOATS], every[8 * SB_BOUNCE_FLOATS],
+        sun_one[8 * SB_BOUNCE_SUN_TABLE], sun_every[8 * SB_BOUNCE_SUN_TABLE];
+    /* the issue's sun (30 degrees up), then two more: low in another
+     * quarter and high in a third, none of them a table direction */
+    enum { SUNS = 3 };
+    const double sun_el[SUNS] = {30, 12, 62}, sun_az[SUNS] = {40, 150, 255};
+    static struct sb_bounce_irradiance ref_sky[8], ref_sun[SUNS][8], ref_both[8];
     double t0 = sb_now_s();
-    bool ok = count && bake_rays(&house, at, count, 2048, vis) && bake_bounce(&house, at, count, 256, 64, 1, one) &&
-              bake_bounce(&house, at, count, 256, 64, 0, every) &&
-              sb_bounce_path_trace(&house.mesh, &e, points, count, &sky_only, PATHS, 0, 1, ref[0]) &&
-              sb_bounce_path_trace(&house.mesh, &e, points, count, &sun_only, PATHS, 0, 2, ref[1]);
+    bool ok = count && bake_rays(&house, at, count, 2048, vis) &&
+              bake_bounce(&house, at, count, 256, 64, 1, one) && bake_bounce(&house, at, count, 256, 64, 0, every) &&
+              bake_sun(&house, at, count, SUN_RAYS, 1, sun_one) && bake_sun(&house, at, count, SUN_RAYS, 0, sun_every) &&
+              sb_bounce_path_trace(&house.mesh, &e, points, count, &sky_only, PATHS, 0, 1, ref_sky);
+    for (int s = 0; s < SUNS && ok; s++) {
+        struct sb_bounce_lighting sun;
+        gradient_sky(sun_el[s], sun_az[s], &sun);
+        memset(sun.sky, 0, sizeof(sun.sky));
+        ok = sb_bounce_path_trace(&house.mesh, &e, points, count, &sun, PATHS, 0, 2 + (uint64_t)s, ref_sun[s]);
+    }
     CHECK(ok, "the bakes and the path tracer");
     double t1 = sb_now_s();
-    const char *names[3] = {"the sky alone", "the sun alone", "both"};
-    const struct sb_bounce_lighting *lights[3] = {&sky_only, &sun_only, &light};
-    double err[3][2] = {{0}}, worst[3][2] = {{0}}, noise[3] = {0};
-    for (int l = 0; ok && l < 3; l++) {
-        printf("irradiance at 8 points in the IFC house's rooms, %s (the mean over 6 axes): path traced (its "
-               "standard error) and from the probe with every bounce, with one\n",
-               names[l]);
-        for (uint32_t i = 0; i < count; i++) {
-            if (l == 2)
-                ref[2][i] = irradiance_sum(&ref[0][i], &ref[1][i]);
-            const struct sb_bounce_irradiance *r = &ref[l][i];
-            double sky, bounced, sky1, bounced1;
-            double v[2] = {probe_irradiance(&vis[SB_VISIBILITY_FLOATS * i], &every[SB_BOUNCE_FLOATS * i], lights[l],
-                                            &sky, &bounced),
-                           probe_irradiance(&vis[SB_VISIBILITY_FLOATS * i], &one[SB_BOUNCE_FLOATS * i], lights[l],
-                                            &sky1, &bounced1)};
-            noise[l] = fmax(noise[l], r->mean_error[2] / r->mean[2]);
-            for (int k = 0; k < 2; k++) {
-                double e_k = fabs(v[k] / r->mean[2] - 1);
-                err[l][k] += e_k / count;
-                worst[l][k] = fmax(worst[l][k], e_k);
+    /* err[sun][lighting][way]: lightings the sky alone, the sun alone and
+     * both; ways every bounce (the sun from its table), one bounce, every
+     * bounce with the sun through B's SH (before the table) */
+    double err[SUNS][3][3] = {{{0}}}, worst[SUNS][3][3] = {{{0}}}, noise = 0;
+    for (int s = 0; s < SUNS && ok; s++)
+        for (int l = s ? 1 : 0; l < 3; l++) {
+            struct sb_bounce_lighting lit;
+            gradient_sky(sun_el[s], sun_az[s], &lit);
+            if (l == 0)
+                memset(lit.sun, 0, sizeof(lit.sun));
+            if (l == 1)
+                memset(lit.sky, 0, sizeof(lit.sky));
+            const char *names[3] = {"the sky alone", "the sun alone", "both"};
+            bool say = s == 0; /* each point for the sun */
+            if (say)
+                printf("irradiance at 8 points in the IFC house's rooms, %s, the sun %.0f degrees up (the mean over 6 "
+                       "axes): path traced (its standard error) and from the probe with every bounce, with one, and "
+                       "with every bounce but the sun through B's SH (before the sun's table)\n",
+                       names[l], sun_el[s]);
+            for (uint32_t i = 0; i < count; i++) {
+                if (l == 2)
+                    ref_both[i] = irradiance_sum(&ref_sky[i], &ref_sun[s][i]);
+                const struct sb_bounce_irradiance *r = l == 0 ? &ref_sky[i] : l == 1 ? &ref_sun[s][i] : &ref_both[i];
+                double sky, bounced, sky1, bounced1;
+                const float *v_i = &vis[SB_VISIBILITY_FLOATS * i];
+                const float *b_every = &every[SB_BOUNCE_FLOATS * i], *b_one = &one[SB_BOUNCE_FLOATS * i];
+                double v[3] = {
+                    probe_irradiance(v_i, b_every, &sun_every[SB_BOUNCE_SUN_TABLE * i], &lit, &sky, &bounced),
+                    probe_irradiance(v_i, b_one, &sun_one[SB_BOUNCE_SUN_TABLE * i], &lit, &sky1, &bounced1),
+                    probe_irradiance(v_i, b_every, NULL, &lit, &sky1, &bounced1)};
+                if (l == 2)
+                    noise = fmax(noise, r->mean_error[2] / r->mean[2]);
+                for (int k = 0; k < 3; k++) {
+                    double e_k = fabs(v[k] / r->mean[2] - 1);
+                    err[s][l][k] += e_k / count;
+                    worst[s][l][k] = fmax(worst[s][l][k], e_k);
+                }
+                if (say)
+                    printf("  (%5.2f %5.2f %5.2f): %.4f (%.4f; sky seen %.4f, surfaces %.4f); probe %.4f (sky seen "
+                           "%.4f, surfaces %.4f) %+.1f%%; one bounce %.4f %+.1f%%; the sun by SH %.4f %+.1f%%\n",
+                           points[3 * i], points[3 * i + 1], points[3 * i + 2], r->mean[2], r->mean_error[2],
+                           r->mean[0], r->mean[1], v[0], sky, bounced, 100 * (v[0] / r->mean[2] - 1), v[1],
+                           100 * (v[1] / r->mean[2] - 1), v[2], 100 * (v[2] / r->mean[2] - 1));
             }
-            printf("  (%5.2f %5.2f %5.2f): %.4f (%.4f; sky seen %.4f, surfaces %.4f); probe %.4f (sky seen %.4f, "
-                   "surfaces %.4f) %+.1f%%; one bounce %.4f %+.1f%%\n",
-                   points[3 * i], points[3 * i + 1], points[3 * i + 2], r->mean[2], r->mean_error[2], r->mean[0],
-                   r->mean[1], v[0], sky, bounced, 100 * (v[0] / r->mean[2] - 1), v[1],
-                   100 * (v[1] / r->mean[2] - 1));
+            printf("  %s, the sun %.0f degrees up at azimuth %.0f: every bounce %.1f%% off on average, %.1f%% at "
+                   "worst; one bounce %.1f%%, %.1f%%; the sun by SH %.1f%%, %.1f%%\n",
+                   names[l], sun_el[s], sun_az[s], 100 * err[s][l][0], 100 * worst[s][l][0], 100 * err[s][l][1],
+                   100 * worst[s][l][1], 100 * err[s][l][2], 100 * worst[s][l][2]);
         }
-        printf("  %s: every bounce %.1f%% off on average, %.1f%% at worst; one bounce %.1f%%, %.1f%% (a standard "
-               "error at most %.2f%%)\n",
-               names[l], 100 * err[l][0], 100 * worst[l][0], 100 * err[l][1], 100 * worst[l][1], 100 * noise[l]);
+    double mean = 0, most = 0;
+    for (int s = 0; s < SUNS; s++) {
+        mean += err[s][2][0] / SUNS;
+        most = fmax(most, err[s][2][0]);
     }
-    printf("path traced in %.1f s (%u paths a point, each lighting)\n", t1 - t0, PATHS);
-    /* Measured on lavapipe: the sky alone 6.5% on average (one bounce
-     * 22%); the sun alone and both far off: the sun at a surface is the
-     * order-2 SH of its (n . l) V(l), and through a window that rings
-     * (docs/probes.md, "Every bounce"). */
-    CHECK(noise[2] < 0.02, "the path tracer's noise: %.2f%%", 100 * noise[2]);
-    CHECK(err[0][0] <= 0.10 && err[0][0] < err[0][1], "the sky alone: every bounce %.1f%% off, one %.1f%%",
-          100 * err[0][0], 100 * err[0][1]);
-    CHECK(err[2][0] < err[2][1], "both: every bounce %.1f%% off, one %.1f%%", 100 * err[2][0], 100 * err[2][1]);
+    printf("path traced in %.1f s (%u paths a point, each lighting; a standard error at most %.2f%% of a point's "
+           "light); both, every bounce: %.1f%% off on average over the %d suns, %.1f%% at the worst sun\n",
+           t1 - t0, PATHS, 100 * noise, 100 * mean, SUNS, 100 * most);
+    CHECK(noise < 0.02, "the path tracer's noise: %.2f%%", 100 * noise);
+    CHECK(err[0][0][0] <= 0.10 && err[0][0][0] < err[0][0][1], "the sky alone: every bounce %.1f%% off, one %.1f%%",
+          100 * err[0][0][0], 100 * err[0][0][1]);
+    /* the issue's measure: within 10% at its sun; at the others the table
+     * beats the sun through SH and one bounce (measured on lavapipe: 7.5%
+     * at 30 degrees, 10.1% at 12 and 12.9% at 62, where a sunlit room
+     * lights the others: docs/probes.md, "The sun") */
+    CHECK(err[0][2][0] <= 0.10, "both: every bounce %.1f%% off at 30 degrees", 100 * err[0][2][0]);
+    for (int s = 0; s < SUNS; s++)
+        CHECK(err[s][2][0] < err[s][2][1] && err[s][2][0] < err[s][2][2],
+              "the sun %.0f degrees up: every bounce %.1f%% off, one %.1f%%, the sun by SH %.1f%%", sun_el[s],
+              100 * err[s][2][0], 100 * err[s][2][1], 100 * err[s][2][2]);
     sb_embree_destroy(&e);
     scene_finish(&house);
 }
@@ -1235,8 +1372,8 @@ static void split_floor(struct sb_mesh *mesh, double h, uint32_t left, uint32_t 
 static void test_textured_bounce(struct sb_vk *vk)
 {
     const double h = 20.0, black[3] = {0, 0, 0}, white[3] = {1, 1, 1}, grey[3] = {0.5, 0.5, 0.5};
-    static float textured[4 * SB_BOUNCE_FLOATS], split[4 * SB_BOUNCE_FLOATS], flat[4 * SB_BOUNCE_FLOATS],
-        bright[4 * SB_BOUNCE_FLOATS];
+    static float textured[4 * SB_BOUNCE_FLOATS], split[4 * SB_BOUNCE_FLOATS],
+        flat[4 * SB_BOUNCE_FLOATS], bright[4 * SB_BOUNCE_FLOATS];
     const float positions[4 * 3] = {-3.0f, 1.0f, 0.5f, 2.0f, 1.5f, -1.0f, 0.3f, 4.0f, 0.2f, 0.0f, 0.7f, 6.0f};
     struct scene scenes[4] = {{.name = "textured floor"}, {.name = "split floor"}, {.name = "grey floor"},
                               {.name = "white floor"}};
@@ -1270,6 +1407,8 @@ static void test_textured_bounce(struct sb_vk *vk)
     if (ok) {
         double seam = 0, from_grey = 0, peak = 0, below = 0;
         for (int i = 0; i < 4 * SB_BOUNCE_FLOATS; i++) {
+            if (i % SB_BOUNCE_FLOATS >= SB_BOUNCE_FLOATS)
+                continue; /* B alone: the sun table's shape is a ratio */
             seam = fmax(seam, fabs((double)textured[i] - split[i]));
             from_grey = fmax(from_grey, fabs((double)textured[i] - flat[i]));
             peak = fmax(peak, fabs((double)bright[i]));
@@ -1292,6 +1431,70 @@ static void test_textured_bounce(struct sb_vk *vk)
     }
     for (int i = 0; i < 4; i++)
         scene_finish(&scenes[i]);
+}
+
+/* The sun table's map (physics/sh.h): each direction reads back as
+ * itself alone; any sun reads 4 neighbours with weights summing to 1 that
+ * put it at its place on the map; a sun below the horizon reads the
+ * horizon under it; the kernel's drawn directions stay within a grid step
+ * of theirs, over the horizon, and in the mean sit on it. */
+static void test_sun_table(void)
+{
+    enum { N = SB_SUN_SIDE };
+    double worst_self = 0, worst_place = 0, worst_sum = 0, least = 1, worst_below = 0, worst_draw = 0, worst_mean = 0;
+    for (uint32_t j = 0; j < SB_SUN_DIRECTIONS; j++) {
+        double d[3], w[4];
+        uint32_t at[4];
+        sb_sun_table_direction(j, d);
+        sb_sun_table_weights(d, at, w);
+        for (int q = 0; q < 4; q++)
+            worst_self = fmax(worst_self, fabs(w[q] - (at[q] == j)) * (at[q] < SB_SUN_DIRECTIONS));
+        /* drawn directions: within a step in u and v, the mean at the corner (away from the edges) */
+        double mean[2] = {0, 0}, corner[2] = {-1.0 + 2.0 * (j % N) / (N - 1), -1.0 + 2.0 * (j / N) / (N - 1)};
+        enum { DRAWS = 4096 };
+        for (uint32_t k = 0; k < DRAWS; k++) {
+            double s[3];
+            sb_sun_table_sample(j, k * SB_SUN_DIRECTIONS + j, s);
+            double a = fabs(s[0]) + fabs(s[1]) + fabs(s[2]), u = (s[0] + s[2]) / a, v = (s[0] - s[2]) / a;
+            worst_draw = fmax(worst_draw, fmax(fabs(u - corner[0]), fabs(v - corner[1])) * (N - 1) / 2 - 1);
+            worst_draw = fmax(worst_draw, -s[1] * 1e3);
+            mean[0] += u / DRAWS;
+            mean[1] += v / DRAWS;
+        }
+        if (j % N && j % N != N - 1 && j / N && j / N != N - 1)
+            worst_mean = fmax(worst_mean, fmax(fabs(mean[0] - corner[0]), fabs(mean[1] - corner[1])) * (N - 1) / 2);
+    }
+    for (uint32_t i = 0; i < 2048; i++) {
+        double d[3], w[4], sum = 0, u = 0, v = 0;
+        uint32_t at[4];
+        sb_probe_direction(i, 2048, d);
+        sb_sun_table_weights(d, at, w);
+        for (int q = 0; q < 4; q++) {
+            sum += w[q];
+            least = fmin(least, w[q]); /* never below 0 */
+            u += w[q] * (-1.0 + 2.0 * (at[q] % N) / (N - 1));
+            v += w[q] * (-1.0 + 2.0 * (at[q] / N) / (N - 1));
+        }
+        worst_sum = fmax(worst_sum, fabs(sum - 1));
+        double h[3] = {d[0], fmax(d[1], 0.0), d[2]}, a = fabs(h[0]) + h[1] + fabs(h[2]);
+        worst_place = fmax(worst_place, fmax(fabs(u - (h[0] + h[2]) / a), fabs(v - (h[0] - h[2]) / a)));
+        if (d[1] < 0) { /* the horizon under it */
+            double flat[3] = {d[0], 0, d[2]}, w2[4];
+            uint32_t at2[4];
+            sb_sun_table_weights(flat, at2, w2);
+            for (int q = 0; q < 4; q++)
+                worst_below = fmax(worst_below, fabs(w[q] - w2[q]) + (at[q] != at2[q]));
+        }
+    }
+    printf("the sun table's map: its directions read back as themselves within %.1e, a sun's weights (the least "
+           "%.3f) sum to 1 within %.1e and place it within %.1e; below the horizon as at it within %.1e; drawn "
+           "directions at most %.3f steps from their corner, their mean %.3f of a step\n",
+           worst_self, least, worst_sum, worst_place, worst_below, 1 + worst_draw, worst_mean);
+    CHECK(worst_self < 1e-12 && least >= 0 && worst_sum < 1e-12 && worst_place < 1e-12 && worst_below < 1e-12,
+          "the sun table's map: %g, %g, %g, %g, %g", worst_self, least, worst_sum, worst_place, worst_below);
+    /* 4096 draws of a tent a step wide: the mean's standard error 0.0058 of a step */
+    CHECK(worst_draw <= 1e-9 && worst_mean < 0.03, "the sun table's draws: %g over a step, the mean %g off", worst_draw,
+          worst_mean);
 }
 
 /* Deringing on closed forms: a narrow cone rings negative; after, the
@@ -1385,6 +1588,7 @@ int main(void)
     test_ray_order();
     test_dering();
     test_tensor();
+    test_sun_table();
     struct sb_vk *vk;
     if (test_vulkan(false, &vk) == SB_ERR_NO_DEVICE)
         return test_no_device();

@@ -68,8 +68,19 @@ static void mean_albedo(const struct sb_world *world, float out[3])
         out[i] = area > 0 ? (float)(sum[i] / area) : 0.0f;
 }
 
-/* Floats a probe takes in the probes buffer (config.h, probes_gpu.h, probes.glsl). */
-#define PROBE_FLOATS (4 * SB_PROBE_VEC4S)
+/* Whether the pack's sun_bounce goes with its sky_visibility: the same
+ * layout, probe for probe. */
+static bool has_sun_table(const struct sb_pack *pack)
+{
+    const struct sb_probe_layout *a = &pack->artifacts[SB_PRODUCT_SKY_VISIBILITY].probes,
+                                 *b = &pack->artifacts[SB_PRODUCT_SUN_BOUNCE].probes;
+    bool same = pack->present[SB_PRODUCT_SUN_BOUNCE] &&
+                pack->images[SB_PRODUCT_SUN_BOUNCE].width == pack->images[SB_PRODUCT_SKY_VISIBILITY].width &&
+                !memcmp(a->grid, b->grid, sizeof(a->grid)) && a->detail_count == b->detail_count;
+    if (pack->present[SB_PRODUCT_SUN_BOUNCE] && !same)
+        sb_warn("the pack's sun_bounce has another grid than its sky_visibility: the sun's bounce through sky_bounce");
+    return same;
+}
 
 /* Entries of the detail's table at most (64 MiB). */
 #define SB_PROBES_MAX_DETAIL_TABLE (1u << 22)
@@ -149,8 +160,19 @@ static enum sb_result upload_probes(struct sb_renderer *r, struct probes *s)
         sb_warn("the pack's sky_visibility has no probe grid or detail: the world is lit by the sky alone");
     r->probe_count = use ? (uint32_t)placed : 0;
     size_t count = r->probe_count ? r->probe_count : 1;
-    enum sb_result res = sb_renderer_upload(
-        r, NULL, sizeof(struct sb_probes_gpu) + count * PROBE_FLOATS * sizeof(float), "probes", &s->probes);
+    const struct sb_image *bounce = &pack->images[SB_PRODUCT_SKY_BOUNCE];
+    const struct sb_probe_layout *bounce_layout = &pack->artifacts[SB_PRODUCT_SKY_BOUNCE].probes;
+    bool has_bounce = pack->present[SB_PRODUCT_SKY_BOUNCE] && bounce->width == image->width &&
+                      !memcmp(bounce_layout->grid, layout->grid, sizeof(layout->grid)) &&
+                      bounce_layout->detail_count == layout->detail_count;
+    if (pack->present[SB_PRODUCT_SKY_BOUNCE] && !has_bounce)
+        sb_warn("the pack's sky_bounce has another grid than its sky_visibility: the bounce is modelled");
+    /* the sun's table (sun_bounce) relights the sun's bounce; without it the
+     * sun goes through sky_bounce's order-2 SH (docs/probes.md, "The sun") */
+    bool sun_table = has_bounce && has_sun_table(pack);
+    const size_t floats = 4 * (sun_table ? SB_PROBE_SUN_VEC4S : SB_PROBE_VEC4S); /* a probe's (config.h) */
+    enum sb_result res = sb_renderer_upload(r, NULL, sizeof(struct sb_probes_gpu) + count * floats * sizeof(float),
+                                            "probes", &s->probes);
     if (!res)
         res = sb_renderer_upload(r, NULL, (SB_PROBE_SH + count * SB_PROBE_SH) * 4 * sizeof(float), "probe light",
                                  &s->light);
@@ -184,21 +206,18 @@ static enum sb_result upload_probes(struct sb_renderer *r, struct probes *s)
     for (uint32_t l = 0; l < layout->layer_count; l++)
         g->layers_m[l / 4][l % 4] = layout->layers_m[l];
     mean_albedo(r->world, g->bounce_albedo);
-    const struct sb_image *bounce = &pack->images[SB_PRODUCT_SKY_BOUNCE];
-    const struct sb_probe_layout *bounce_layout = &pack->artifacts[SB_PRODUCT_SKY_BOUNCE].probes;
-    bool has_bounce = pack->present[SB_PRODUCT_SKY_BOUNCE] && bounce->width == image->width &&
-                      !memcmp(bounce_layout->grid, layout->grid, sizeof(layout->grid)) &&
-                      bounce_layout->detail_count == layout->detail_count;
-    if (pack->present[SB_PRODUCT_SKY_BOUNCE] && !has_bounce)
-        sb_warn("the pack's sky_bounce has another grid than its sky_visibility: the bounce is modelled");
-    g->spacing_m[3] = has_bounce ? 1.0f : 0.0f;
+    g->spacing_m[3] = sun_table ? 2.0f : has_bounce ? 1.0f : 0.0f;
     float *out = (float *)(g + 1);
     for (uint32_t p = 0; p < r->probe_count; p++) {
         const float *c = &image->data[(size_t)p * SB_SKY_VISIBILITY_CHANNEL_COUNT];
-        float *o = &out[PROBE_FLOATS * (size_t)p];
+        float *o = &out[floats * (size_t)p];
         if (has_bounce)
             memcpy(o + 4 * SB_PROBE_BOUNCE_VEC4, &bounce->data[(size_t)p * SB_SKY_BOUNCE_CHANNEL_COUNT],
                    SB_BOUNCE_FLOATS * sizeof(float));
+        if (sun_table)
+            memcpy(o + 4 * SB_PROBE_SUN_VEC4,
+                   &pack->images[SB_PRODUCT_SUN_BOUNCE].data[(size_t)p * SB_SUN_BOUNCE_CHANNEL_COUNT],
+                   SB_BOUNCE_SUN_TABLE * sizeof(float));
         memcpy(o, c + SB_SKY_VISIBILITY_POSITION, 3 * sizeof(float)); /* after any push out of geometry */
         o[3] = c[SB_SKY_VISIBILITY_VALID];
         /* The visibility as projected, the deringing window undone where it
@@ -218,13 +237,14 @@ static enum sb_result upload_probes(struct sb_renderer *r, struct probes *s)
     }
     if (layout->layer_count)
         sb_info("probes: %u x %u columns %.3g m apart, %u layers over the surface (%.3g to %.3g m), light the "
-                "world (bounce %s)",
+                "world (bounce %s%s)",
                 layout->grid[0], layout->grid[2], (double)layout->spacing_m[0], layout->layer_count,
                 (double)layout->layers_m[0], (double)layout->layers_m[layout->layer_count - 1],
-                has_bounce ? "baked" : "modelled");
+                has_bounce ? "baked" : "modelled", sun_table ? ", the sun's from its table" : "");
     else
-        sb_info("probes: %u x %u x %u, %.3g m apart, light the world (bounce %s)", layout->grid[0], layout->grid[1],
-                layout->grid[2], (double)layout->spacing_m[0], has_bounce ? "baked" : "modelled");
+        sb_info("probes: %u x %u x %u, %.3g m apart, light the world (bounce %s%s)", layout->grid[0], layout->grid[1],
+                layout->grid[2], (double)layout->spacing_m[0], has_bounce ? "baked" : "modelled",
+                sun_table ? ", the sun's from its table" : "");
     if (layout->detail_count)
         sb_info("probes: detail %.3g m apart, %u probes in %u brick columns%s", (double)layout->detail_spacing_m,
                 layout->detail_count, layout->column_count,

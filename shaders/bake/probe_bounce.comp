@@ -12,9 +12,15 @@
 // operator of the next bounces (config.h): M[m][j] += 4 pi / n Y_m(w)
 // rho / pi A_j Y_j(n), the irradiance at the hit of an order-1 radiance
 // b_j (A_j the clamped cosine's pi, 2 pi / 3) sent back toward the probe.
+// The sun's table (config.h, SB_SUN_SIDE), in passes of its own after the
+// sphere set's: the hit's rho / pi Y_m(w) (n.s) V(s) for a direction s
+// about each of the table's s_j (sun_table_sample: a tent around s_j, so
+// that the table holds each direction's neighbourhood's mean, what the
+// bilinear read between directions needs), V from a ray toward s.
 // One workgroup a probe, in passes (config.h: a ray a thread and a slice
-// of the sphere set each, added to the passes before); partial sums added
-// in a fixed tree order, the passes in a fixed order.
+// of the sphere set or of the sun's directions each, added to the passes
+// before); partial sums added in a fixed tree order (the sun's in ray
+// order), the passes in a fixed order.
 #extension GL_GOOGLE_include_directive : require
 #include "config.h"
 
@@ -32,6 +38,40 @@ layout(push_constant) uniform Push { sb_bounce_push pc; };
 #include "surface.glsl"
 
 shared float partial[SB_PROBE_SH * 3][SB_PROBE_THREADS];
+shared float sun_seen[SB_BOUNCE_SUN_GROUP][SB_PROBE_THREADS]; /* (n.s_j) V(s_j) of each ray's hit */
+shared float sun_weight[SB_BOUNCE_SH * 3][SB_PROBE_THREADS];  /* rho / pi Y_m(w), rgb */
+
+// A sun pass (first_direction past the sphere set): the table's directions
+// [first, first + SB_BOUNCE_SUN_PASS) from this thread's hit, SB_BOUNCE_SUN_GROUP at a time.
+void sun_pass(uint probe, uint lane, uint ray, uint first, bool hit, vec3 from, vec3 n, float eps,
+              vec3 weight[SB_BOUNCE_SH])
+{
+    for (int m = 0; m < SB_BOUNCE_SH; m++)
+        for (int c = 0; c < 3; c++)
+            sun_weight[3 * m + c][lane] = weight[m][c];
+    float scale = 12.566370614359172 / float(pc.ray_count);
+    uint last = min(first + SB_BOUNCE_SUN_PASS, SB_SUN_DIRECTIONS);
+    for (uint g = first; g < last; g += SB_BOUNCE_SUN_GROUP) {
+        for (uint q = 0u; q < SB_BOUNCE_SUN_GROUP; q++) {
+            float seen = 0.0;
+            vec3 s = sun_table_sample(g + q, ray * uint(SB_SUN_DIRECTIONS) + g + q);
+            float c = dot(n, s);
+            if (hit && c > 0.0 && bvh_trace(from, s, eps, 1e30, true).triangle == SB_BVH_MISS)
+                seen = c;
+            sun_seen[q][lane] = seen;
+        }
+        barrier();
+        for (uint o = lane; o < SB_BOUNCE_SUN_GROUP * SB_BOUNCE_SH * 3; o += SB_PROBE_THREADS) {
+            uint q = o / uint(SB_BOUNCE_SH * 3), mc = o % uint(SB_BOUNCE_SH * 3);
+            float sum = 0.0;
+            for (uint r = 0u; r < SB_PROBE_THREADS; r++)
+                sum += sun_seen[q][r] * sun_weight[mc][r];
+            uint at = probe * pc.stride + SB_BOUNCE_KERNEL_FLOATS + (g + q) * uint(SB_BOUNCE_SH * 3) + mc;
+            results[at] = (pc.accumulate != 0u ? results[at] : 0.0) + sum * scale;
+        }
+        barrier();
+    }
+}
 
 void main()
 {
@@ -55,7 +95,12 @@ void main()
     // one pass (config.h): a ray a thread, a slice of the sphere set
     uint r = pc.first_ray + lane, first = pc.first_direction;
     uint last = min(first + SB_BOUNCE_PASS_DIRECTIONS, sphere);
+    bool sun = first >= sphere;
     vec3 w = probe_direction(min(r, pc.ray_count - 1u), pc.ray_count);
+    vec3 sun_from = vec3(0.0), sun_n = vec3(0.0), sun_w[SB_BOUNCE_SH];
+    float sun_eps = 0.0;
+    for (int m = 0; m < SB_BOUNCE_SH; m++)
+        sun_w[m] = vec3(0.0);
     BvhHit hit;
     hit.triangle = SB_BVH_MISS;
     if (r < pc.ray_count && valid)
@@ -77,6 +122,15 @@ void main()
         // probe as twice the reach in all (a tiled bake's: a hit on a wide
         // terrain may lie past it)
         bvh_reach = max(2.0 * pc.tmax_m - hit.t, 0.0);
+        if (sun) {
+            float ys[SB_PROBE_SH];
+            sh9_basis(w, ys);
+            for (int m = 0; m < SB_BOUNCE_SH; m++)
+                sun_w[m] = rho * (0.3183098861837907 * ys[m]);
+            sun_from = from;
+            sun_n = n;
+            sun_eps = eps;
+        }
         float g[SB_PROBE_SH];
         for (int k = 0; k < SB_PROBE_SH; k++)
             g[k] = 0.0;
@@ -105,8 +159,10 @@ void main()
             for (int j = 0; j < SB_BOUNCE_SH; j++)
                 op[m][j] += (ym[m] * (j == 0 ? 3.141592653589793 : 2.0943951023931953) * yn[j]) * lambert;
     }
+    if (sun)
+        sun_pass(probe, lane, r, first - sphere, hit.triangle != SB_BVH_MISS, sun_from, sun_n, sun_eps, sun_w);
     float scale = 12.566370614359172 / float(pc.ray_count);
-    for (int m = 0; m < SB_BOUNCE_SH; m++) {
+    for (int m = 0; m < SB_BOUNCE_SH && (!sun || first == 0u); m++) { // a sun run's B: zeros, once
         for (int k = 0; k < SB_PROBE_SH; k++)
             for (int c = 0; c < 3; c++)
                 partial[3 * k + c][lane] = acc[m][k][c];
@@ -119,12 +175,12 @@ void main()
         }
         if (lane == 0)
             for (int j = 0; j < SB_PROBE_SH * 3; j++) {
-                uint at = probe * SB_BOUNCE_KERNEL_FLOATS + m * SB_PROBE_SH * 3 + j;
+                uint at = probe * pc.stride + m * SB_PROBE_SH * 3 + j;
                 results[at] = (pc.accumulate != 0u ? results[at] : 0.0) + partial[j][0] * scale;
             }
         barrier();
     }
-    // M comes only from a pass over the first slice (its other passes add nothing)
+    // M comes only from the first pass (the others add nothing)
     for (int m = 0; m < SB_BOUNCE_SH && first == 0u; m++) {
         for (int j = 0; j < SB_BOUNCE_SH; j++)
             for (int c = 0; c < 3; c++)
@@ -138,7 +194,7 @@ void main()
         }
         if (lane == 0)
             for (int j = 0; j < SB_BOUNCE_SH * 3; j++) {
-                uint at = probe * SB_BOUNCE_KERNEL_FLOATS + SB_BOUNCE_FLOATS + m * SB_BOUNCE_SH * 3 + j;
+                uint at = probe * pc.stride + SB_BOUNCE_FLOATS + m * SB_BOUNCE_SH * 3 + j;
                 results[at] = (pc.accumulate != 0u ? results[at] : 0.0) + partial[j][0] * scale;
             }
         barrier();

@@ -4,8 +4,9 @@
  * (docs/probes.md, "Runtime"):
  * - the sky it sees: the SH of the product of its visibility V and the
  *   sky's radiance L, by the triple-product tensor (truncated to order 2);
- * - the bounce, baked (sky_bounce): sum_k B[m][k] (L_k + E_sun Y_k(sun))
- *   in order 1;
+ * - the bounce, baked (sky_bounce): sum_k B[m][k] L_k in order 1, and
+ *   the sun's from its table (sun_bounce) E_sun sum_j w_j(sun) T_j S[m],
+ *   or without it sum_k B[m][k] E_sun Y_k(sun);
  * - or, without it, modelled: the directions its rays hit (the SH of 1 - V) carry the
  *   radiance of surfaces of the world's mean albedo rho lit as the probe is
  *   on average, E = pi (mean of V L) + E_sun v_sun / 4 (v_sun: V at the sun),
@@ -27,11 +28,12 @@ void main()
     if (i >= probes.grid.w)
         return;
     float v[SB_PROBE_SH];
+    uint record = probe_record(i);
     for (int k = 0; k < 4; k++) {
-        v[k] = probe_data[SB_PROBE_VEC4S * i + 1][k];
-        v[4 + k] = probe_data[SB_PROBE_VEC4S * i + 2][k];
+        v[k] = probe_data[record + 1][k];
+        v[4 + k] = probe_data[record + 2][k];
     }
-    v[8] = probe_data[SB_PROBE_VEC4S * i + 3].x;
+    v[8] = probe_data[record + 3].x;
 
     vec3 vl[SB_PROBE_SH];
     for (int k = 0; k < SB_PROBE_SH; k++)
@@ -57,7 +59,7 @@ void main()
     float hit = clamp(1.0 - v[0] * Y0, 0.0, 1.0); /* the hit fraction: 1 - V's mean */
     vec3 rho = probes.bounce_albedo.rgb;
     vec3 l_bounce = rho * e_mean / (PI * max(1.0 - rho * hit, vec3(1e-3)));
-    bool baked = probes.spacing_m.w != 0.0;
+    bool baked = probes.spacing_m.w != 0.0, sun_table = probes.spacing_m.w == 2.0;
     vec3 bounce[SB_BOUNCE_SH];
     for (int m = 0; m < SB_BOUNCE_SH; m++) {
         bounce[m] = vec3(0.0);
@@ -65,9 +67,22 @@ void main()
             uint at = 3u * uint(m * SB_PROBE_SH + k);
             vec3 b;
             for (int c = 0; c < 3; c++) /* 3 floats of the packed rgb triples */
-                b[c] = probe_data[SB_PROBE_VEC4S * i + SB_PROBE_BOUNCE_VEC4 + (at + uint(c)) / 4u][(at + uint(c)) % 4u];
-            bounce[m] += b * (sky_sh[k].rgb + e_sun * ys[k]);
+                b[c] = probe_data[record + SB_PROBE_BOUNCE_VEC4 + (at + uint(c)) / 4u][(at + uint(c)) % 4u];
+            bounce[m] += b * (sky_sh[k].rgb + (sun_table ? vec3(0.0) : e_sun * ys[k]));
         }
+    }
+    if (sun_table) { /* the sun's bounce from its table, bilinear between its directions */
+        uint at[4];
+        float w[4], t = 0.0;
+        sun_table_weights(l, at, w);
+        uint base = record + SB_PROBE_SUN_VEC4;
+        for (int q = 0; q < 4; q++)
+            t += w[q] * probe_data[base + at[q] / 4u][at[q] % 4u];
+        for (int m = 0; m < SB_BOUNCE_SH; m++)
+            for (int c = 0; c < 3; c++) {
+                uint s = uint(SB_SUN_DIRECTIONS + 3 * m + c);
+                bounce[m][c] += e_sun[c] * t * probe_data[base + s / 4u][s % 4u];
+            }
     }
 
     for (int k = 0; k < SB_PROBE_SH; k++) {

@@ -15,9 +15,16 @@
 layout(std430, set = 0, binding = SB_VIEW_BINDING_PROBES) readonly buffer ProbeBuffer {
     sb_probes_gpu probes;
     /* per probe: (position m, valid), (sh 0-3), (sh 4-7), (sh 8, 0, 0, 0), then the
-     * bounce transfer B[m][k].rgb (sky_bounce's order, 27 vec4s; zeros without) */
+     * bounce transfer B[m][k].rgb (sky_bounce's order, 27 vec4s; zeros without),
+     * then with sun_bounce its table (39 vec4s: probe_record) */
     vec4 probe_data[];
 };
+
+/* A probe's record's first vec4 (config.h): longer with the sun's table */
+uint probe_record(uint i)
+{
+    return (probes.spacing_m.w == 2.0 ? uint(SB_PROBE_SUN_VEC4S) : uint(SB_PROBE_VEC4S)) * i;
+}
 
 #ifdef PROBE_LIGHT_WRITABLE
 layout(std430, set = 0, binding = SB_VIEW_BINDING_PROBE_LIGHT) buffer ProbeLightBuffer {
@@ -78,7 +85,7 @@ float probe_sees(uint mask, vec3 lattice, vec3 q, float spacing)
 void probe_add(uint index, float w, float visible, vec3 pos, vec3 n, float yn[SB_PROBE_SH], float yr[SB_PROBE_SH],
                inout vec3 e_n, inout vec3 e_r, inout float wsum)
 {
-    vec4 where = probe_data[SB_PROBE_VEC4S * index];
+    vec4 where = probe_data[probe_record(index)];
     if (w <= 0.0 || where.w == 0.0)
         return;
     vec3 to = where.xyz - pos;
@@ -190,7 +197,7 @@ void probe_grid(vec3 pos, vec3 n, float yn[SB_PROBE_SH], float yr[SB_PROBE_SH], 
             vec2 bi = mix(1.0 - f, f, o);
             float w = bi.x * bi.y;
             uint column = at.x + probes.grid.x * probes.grid.y * at.y; /* its layer 0 */
-            float dy = q.y - probe_data[SB_PROBE_VEC4S * column + 3u].y;
+            float dy = q.y - probe_data[probe_record(column) + 3u].y;
             int l = 0;
             while (l + 2 < layers && dy > probe_layer(l + 1))
                 l++;
