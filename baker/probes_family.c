@@ -166,13 +166,13 @@ static void key_settings(const struct sb_scene *scene, enum sb_product_id id, st
         sb_key_add(key, " sight_code %s", code);
     }
     if (id == SB_PRODUCT_SKY_BOUNCE) { /* and the visibility's key, as its input */
-        sb_sky_bounce_code_hash(code);
+        sb_sky_bounce_code_hash(false, code);
         /* bounce_sum: the host's sum of the bounces (sky_bounce.c) */
         sb_key_add(key, " bounce_rays=%u secondary=%u bounces=%u bounce_sum 1 bounce_code %s", p->bounce_rays,
                    p->bounce_secondary, p->bounces, code);
     }
     if (id == SB_PRODUCT_SUN_BOUNCE) { /* sun_sum: the table's sum and shape (sky_bounce.c) */
-        sb_sky_bounce_code_hash(code);
+        sb_sky_bounce_code_hash(true, code);
         sb_key_add(key, " sun_rays=%u bounces=%u sun_sum 1 sun_side %d bounce_code %s", p->sun_rays, p->bounces,
                    SB_SUN_SIDE, code);
     }
@@ -585,7 +585,7 @@ static enum sb_result push_out(struct sb_raycaster *rc, const struct sb_scene *s
                                float *positions, float *offsets, float *valid, const float *results, uint32_t count,
                                uint32_t *inside, uint32_t *pushed, double *gpu_ms)
 {
-    const int per = 26 * (int)(sizeof(push_steps) / sizeof(push_steps[0]));
+    enum { STEPS = sizeof(push_steps) / sizeof(push_steps[0]), PER = 26 };
     uint32_t *which = NULL, n = 0;
     float *candidates = NULL, *trial = NULL;
     enum sb_result res = SB_OK;
@@ -595,54 +595,65 @@ static enum sb_result push_out(struct sb_raycaster *rc, const struct sb_scene *s
     }
     *inside = n;
     *pushed = 0;
+    if (gpu_ms)
+        *gpu_ms = 0;
     if (!n)
         return SB_OK;
     which = malloc(n * sizeof(*which));
-    candidates = malloc((size_t)n * per * 3 * sizeof(float));
-    trial = malloc((size_t)n * per * SB_VISIBILITY_FLOATS * sizeof(float));
+    candidates = malloc((size_t)n * PER * 3 * sizeof(float));
+    trial = malloc((size_t)n * PER * SB_VISIBILITY_FLOATS * sizeof(float));
     if (!which || !candidates || !trial) {
         res = SB_ERR_NOMEM;
         goto done;
     }
-    n = 0;
-    for (uint32_t i = 0; i < count; i++)
-        if (valid[i] == 0.0f)
-            which[n++] = i;
-    for (uint32_t j = 0; j < n; j++) {
-        int c = 0;
-        bool detail = unit[which[j]] < 0;
-        double size = fabs((double)unit[which[j]]);
-        for (size_t s = 0; s < sizeof(push_steps) / sizeof(push_steps[0]); s++)
+    /* the candidates a step at a time, nearest first, each step for the
+     * probes no step before moved: the first candidate in order that is
+     * not inside, as if all were cast at once */
+    for (size_t s = 0; s < STEPS && !res; s++) {
+        n = 0;
+        for (uint32_t i = 0; i < count; i++)
+            if (valid[i] == 0.0f)
+                which[n++] = i;
+        if (!n)
+            break;
+        for (uint32_t j = 0; j < n; j++) {
+            int c = 0;
+            bool detail = unit[which[j]] < 0;
+            double size = fabs((double)unit[which[j]]);
             for (int d = 0; d < 27; d++) {
                 if (d == 13)
                     continue; /* the probe itself */
                 int dx = d % 3 - 1, dy = d / 3 % 3 - 1, dz = d / 9 - 1;
                 double len = sqrt((double)(dx * dx + dy * dy + dz * dz)),
                        step = (detail ? detail_push_steps : push_steps)[s] * size / len;
-                float *q = &candidates[3 * ((size_t)j * per + c++)];
+                float *q = &candidates[3 * ((size_t)j * PER + c++)];
                 q[0] = (float)(positions[3 * (size_t)which[j]] + dx * step);
                 q[1] = (float)(positions[3 * (size_t)which[j] + 1] + dy * step);
                 q[2] = (float)(positions[3 * (size_t)which[j] + 2] + dz * step);
             }
-    }
-    struct sb_sky_visibility_params quick = {.ray_count = PUSH_RAYS, .tmax_m = (float)reach_of(&scene->probes)};
-    if ((res = sb_sky_visibility_bake(rc, candidates, n * per, &quick, trial, gpu_ms)))
-        goto done;
-    for (uint32_t j = 0; j < n; j++)
-        for (int c = 0; c < per; c++) {
-            const float *r = &trial[SB_VISIBILITY_FLOATS * ((size_t)j * per + c)];
-            if (r[SB_PROBE_SH] > scene->probes.inside_fraction)
-                continue;
-            uint32_t i = which[j];
-            for (int k = 0; k < 3; k++) {
-                float to = candidates[3 * ((size_t)j * per + c) + k];
-                offsets[3 * (size_t)i + k] = to - positions[3 * (size_t)i + k];
-                positions[3 * (size_t)i + k] = to;
-            }
-            valid[i] = 1.0f;
-            (*pushed)++;
-            break;
         }
+        struct sb_sky_visibility_params quick = {.ray_count = PUSH_RAYS, .tmax_m = (float)reach_of(&scene->probes)};
+        double ms = 0;
+        if ((res = sb_sky_visibility_bake(rc, candidates, n * PER, &quick, trial, &ms)))
+            break;
+        if (gpu_ms)
+            *gpu_ms += ms;
+        for (uint32_t j = 0; j < n; j++)
+            for (int c = 0; c < PER; c++) {
+                const float *r = &trial[SB_VISIBILITY_FLOATS * ((size_t)j * PER + c)];
+                if (r[SB_PROBE_SH] > scene->probes.inside_fraction)
+                    continue;
+                uint32_t i = which[j];
+                for (int k = 0; k < 3; k++) {
+                    float to = candidates[3 * ((size_t)j * PER + c) + k];
+                    offsets[3 * (size_t)i + k] = to - positions[3 * (size_t)i + k];
+                    positions[3 * (size_t)i + k] = to;
+                }
+                valid[i] = 1.0f;
+                (*pushed)++;
+                break;
+            }
+    }
 done:
     free(which);
     free(candidates);
@@ -933,11 +944,32 @@ static enum sb_result cast_probes(struct probes_state *st, const struct sb_scene
     if ((res = push_out(rc, scene, c->unit, c->positions, c->offsets, c->valid, c->results, n, &c->inside, &c->pushed,
                         &ms)))
         return res;
-    *gpu_ms += c->inside ? ms : 0; /* every candidate place of every probe inside */
+    *gpu_ms += ms; /* the candidate places of the probes inside */
     t2 = sb_now_s();
-    if (c->pushed && (res = sb_sky_visibility_bake(rc, c->positions, n, &params, c->results, &ms)))
-        return res;
-    *gpu_ms += c->pushed ? ms : 0;
+    if (c->pushed) { /* the probes pushed out cast again where they went (each probe's rays its own) */
+        float *at = malloc((size_t)c->pushed * 3 * sizeof(float));
+        float *again = malloc((size_t)c->pushed * SB_VISIBILITY_FLOATS * sizeof(float));
+        uint32_t *which = malloc(c->pushed * sizeof(uint32_t)), m = 0;
+        res = at && again && which ? SB_OK : SB_ERR_NOMEM;
+        for (uint32_t i = 0; i < n && !res; i++) {
+            const float *o = &c->offsets[3 * (size_t)i];
+            if ((o[0] != 0 || o[1] != 0 || o[2] != 0) && m < c->pushed) {
+                memcpy(&at[3 * (size_t)m], &c->positions[3 * (size_t)i], 3 * sizeof(float));
+                which[m++] = i;
+            }
+        }
+        if (!res && (res = sb_sky_visibility_bake(rc, at, m, &params, again, &ms)) == SB_OK) {
+            for (uint32_t j = 0; j < m; j++)
+                memcpy(&c->results[(size_t)which[j] * SB_VISIBILITY_FLOATS], &again[(size_t)j * SB_VISIBILITY_FLOATS],
+                       SB_VISIBILITY_FLOATS * sizeof(float));
+            *gpu_ms += ms;
+        }
+        free(at);
+        free(again);
+        free(which);
+        if (res)
+            return res;
+    }
     double t3 = sb_now_s();
     for (uint32_t i = 0; i < n; i++)
         detail += c->unit[i] < 0;
@@ -958,10 +990,10 @@ static enum sb_result cast_probes(struct probes_state *st, const struct sb_scene
             return res;
         *gpu_ms += ms;
     }
-    sb_debug("sky_visibility: %u probes cast in %.1f ms, %u inside tried at %u places each in %.1f ms, cast again "
-             "in %.1f ms; %u sight masks in %.1f ms",
+    sb_debug("sky_visibility: %u probes cast in %.1f ms, %u inside tried at up to %u places each in %.1f ms, %u "
+             "pushed out cast again in %.1f ms; %u sight masks in %.1f ms",
              n, 1e3 * (t1 - t0), c->inside, 26 * (unsigned)(sizeof(push_steps) / sizeof(push_steps[0])),
-             1e3 * (t2 - t1), 1e3 * (t3 - t2), detail, 1e3 * (sb_now_s() - t3));
+             1e3 * (t2 - t1), c->pushed, 1e3 * (t3 - t2), detail, 1e3 * (sb_now_s() - t3));
     double dering_t0 = sb_now_s();
     sb_parallel_for((int)n, dering_one, &c->dering);
     sb_debug("sky_visibility: deringing in %.1f ms", 1e3 * (sb_now_s() - dering_t0));
@@ -1215,7 +1247,8 @@ static uint32_t probes_kernels(void *state, const struct sb_scene *scene, enum s
     const struct probes_state *st = state;
     bool instanced = st->level->instance_count > 0;
     uint32_t n = sb_surfaces_level_kernels(st->level, is_bounce(id), out);
-    out[n++] = is_bounce(id) ? sb_sky_bounce_kernel(instanced) : sb_sky_visibility_kernel(instanced);
+    out[n++] = is_bounce(id) ? sb_sky_bounce_kernel(instanced, id == SB_PRODUCT_SUN_BOUNCE)
+                             : sb_sky_visibility_kernel(instanced);
     if (id == SB_PRODUCT_SKY_VISIBILITY && scene->probes.detail_spacing_m > 0)
         out[n++] = sb_probe_sight_kernel(instanced);
     return n;

@@ -8,19 +8,27 @@
 #include "parallel.h"
 #include "probe_bounce.spv.h"
 #include "probe_bounce_instanced.spv.h"
+#include "probe_bounce_sun.spv.h"
+#include "probe_bounce_sun_instanced.spv.h"
 
 _Static_assert(1,
                "the product's channels (probes.h) name the sun table's 64 directions");
 
-struct sb_pipeline_params sb_sky_bounce_kernel(bool instanced)
+struct sb_pipeline_params sb_sky_bounce_kernel(bool instanced, bool sun)
 {
-    return (struct sb_pipeline_params){
+    struct sb_pipeline_params p = {
         .spirv = instanced ? sb_spv_probe_bounce_instanced : sb_spv_probe_bounce,
         .spirv_size = instanced ? sizeof(sb_spv_probe_bounce_instanced) : sizeof(sb_spv_probe_bounce),
         .binding_count = SB_BOUNCE_BINDING_COUNT,
         .push_size = sizeof(struct sb_bounce_push),
         .name = "sky bounce",
     };
+    if (sun) {
+        p.spirv = instanced ? sb_spv_probe_bounce_sun_instanced : sb_spv_probe_bounce_sun;
+        p.spirv_size = instanced ? sizeof(sb_spv_probe_bounce_sun_instanced) : sizeof(sb_spv_probe_bounce_sun);
+        p.name = "sun bounce";
+    }
+    return p;
 }
 
 /* (I - M)^-1 of one channel's operator, by Gauss-Jordan with partial
@@ -227,7 +235,7 @@ enum sb_result sb_sky_bounce_bake(struct sb_raycaster *rc, const struct sb_surfa
     struct sb_vk *vk = rc->vk;
     struct sb_buffer probes = {0}, results = {0};
     struct sb_pipeline pipeline = {0};
-    const struct sb_pipeline_params pp = sb_sky_bounce_kernel(rc->instanced);
+    const struct sb_pipeline_params pp = sb_sky_bounce_kernel(rc->instanced, sun);
     /* the kernel's output a chunk of probes at a time */
     uint32_t chunk = (uint32_t)(SB_SKY_BOUNCE_CHUNK_BYTES / (pc.stride * sizeof(float)));
     chunk = probe_count < chunk ? probe_count : chunk;
@@ -306,11 +314,15 @@ done:
     return res;
 }
 
-void sb_sky_bounce_code_hash(char out[33])
+void sb_sky_bounce_code_hash(bool sun, char out[33])
 {
     char both[2 * 33];
-    sb_kernel_code_hash(sb_spv_probe_bounce, sizeof(sb_spv_probe_bounce), sb_spv_probe_bounce_instanced,
-                        sizeof(sb_spv_probe_bounce_instanced), both);
+    if (sun)
+        sb_kernel_code_hash(sb_spv_probe_bounce_sun, sizeof(sb_spv_probe_bounce_sun), sb_spv_probe_bounce_sun_instanced,
+                            sizeof(sb_spv_probe_bounce_sun_instanced), both);
+    else
+        sb_kernel_code_hash(sb_spv_probe_bounce, sizeof(sb_spv_probe_bounce), sb_spv_probe_bounce_instanced,
+                            sizeof(sb_spv_probe_bounce_instanced), both);
     sb_surfaces_code_hash(both + 32);
     sb_hash_bytes(both, 64, out);
 }

@@ -47,8 +47,9 @@ struct sb_sky_bounce_report {
     double most_added;     /* and the most */
 };
 
-/* The kernel sb_sky_bounce_bake makes, for a BVH of instances or not. */
-struct sb_pipeline_params sb_sky_bounce_kernel(bool instanced);
+/* The kernel sb_sky_bounce_bake runs, for a BVH of instances or not, for
+ * the sun's table or not. */
+struct sb_pipeline_params sb_sky_bounce_kernel(bool instanced, bool sun);
 
 /*
  * Bake probe_count probes at positions (xyz in m each; valid[i] 0 gives the
@@ -84,7 +85,8 @@ uint32_t sb_sky_bounce_sum(float *kernel, bool sun, uint32_t bounces, double *ad
  * sends the probe E sum_j w_j(s) T_j S[m] (w: sb_sun_table_weights). */
 void sb_sky_bounce_sun_table(const float *kernel, float table[SB_BOUNCE_SUN_TABLE]);
 
-/* XXH3-128 of the kernel's SPIR-V (and the texture mips'), for bake keys. */
-void sb_sky_bounce_code_hash(char out[33]);
+/* XXH3-128 of the kernel's SPIR-V (the sun's with `sun`; and the texture
+ * mips'), for bake keys. */
+void sb_sky_bounce_code_hash(bool sun, char out[33]);
 
 #endif

@@ -38,6 +38,7 @@ layout(push_constant) uniform Push { sb_bounce_push pc; };
 #include "surface.glsl"
 
 shared float partial[SB_PROBE_SH * 3][SB_PROBE_THREADS];
+#ifdef SUN_TABLE // the sun run's variant (its workgroup memory would cost the sky run's occupancy)
 shared float sun_seen[SB_BOUNCE_SUN_GROUP][SB_PROBE_THREADS]; /* (n.s_j) V(s_j) of each ray's hit */
 shared float sun_weight[SB_BOUNCE_SH * 3][SB_PROBE_THREADS];  /* rho / pi Y_m(w), rgb */
 
@@ -72,6 +73,7 @@ void sun_pass(uint probe, uint lane, uint ray, uint first, bool hit, vec3 from, 
         barrier();
     }
 }
+#endif
 
 void main()
 {
@@ -159,8 +161,10 @@ void main()
             for (int j = 0; j < SB_BOUNCE_SH; j++)
                 op[m][j] += (ym[m] * (j == 0 ? 3.141592653589793 : 2.0943951023931953) * yn[j]) * lambert;
     }
+#ifdef SUN_TABLE
     if (sun)
         sun_pass(probe, lane, r, first - sphere, hit.triangle != SB_BVH_MISS, sun_from, sun_n, sun_eps, sun_w);
+#endif
     float scale = 12.566370614359172 / float(pc.ray_count);
     for (int m = 0; m < SB_BOUNCE_SH && (!sun || first == 0u); m++) { // a sun run's B: zeros, once
         for (int k = 0; k < SB_PROBE_SH; k++)
