@@ -7,6 +7,7 @@
 #include "bvh.h"
 #include "level.h"
 #include "log.h"
+#include "parallel.h"
 
 #define BRICK SB_PROBES_BRICK
 /* Surfaces a ray down a lattice column counts at most: the lowest found
@@ -97,65 +98,99 @@ enum sb_result sb_probe_detail_check(const struct sb_level *level, const struct 
  * space at least `gap` high between two surfaces (not the inside of a
  * solid, entered through a front face and left through a back face).
  */
+/* A chunk of the columns' rays, built and read in blocks on every core
+ * (each block its own rays and columns: the same whatever the threads). */
+struct column_job {
+    const struct lattice *l;
+    const uint32_t *which; /* the chunk's columns */
+    uint32_t count;
+    int round;
+    float start_y;
+    double gap;
+    uint8_t *counts, *flags;
+    float *top, *low, *rays, *hits;
+};
+#define COLUMN_BLOCK 16384
+
+static void build_block(void *user, int block)
+{
+    struct column_job *job = user;
+    uint32_t end = (uint32_t)block * COLUMN_BLOCK + COLUMN_BLOCK;
+    end = end < job->count ? end : job->count;
+    for (uint32_t i = (uint32_t)block * COLUMN_BLOCK; i < end; i++) {
+        uint32_t c = job->which[i];
+        uint64_t x = c % (uint64_t)job->l->columns[0], z = c / (uint64_t)job->l->columns[0];
+        float *r = &job->rays[8 * (size_t)i];
+        r[0] = (float)(job->l->origin[0] + (double)x * job->l->spacing);
+        r[1] = job->round ? job->low[c] - BELOW_SURFACE_M : job->start_y;
+        r[2] = (float)(job->l->origin[2] + (double)z * job->l->spacing);
+        r[3] = 0.0f;
+        r[4] = 0.0f;
+        r[5] = -1.0f;
+        r[6] = 0.0f;
+        r[7] = 1e30f;
+    }
+}
+
+static void read_block(void *user, int block)
+{
+    struct column_job *job = user;
+    uint32_t end = (uint32_t)block * COLUMN_BLOCK + COLUMN_BLOCK;
+    end = end < job->count ? end : job->count;
+    for (uint32_t i = (uint32_t)block * COLUMN_BLOCK; i < end; i++) {
+        uint32_t triangle;
+        memcpy(&triangle, &job->hits[4 * (size_t)i + 1], sizeof(triangle));
+        if (triangle == SB_BVH_MISS)
+            continue;
+        uint32_t c = job->which[i];
+        float y = job->rays[8 * (size_t)i + 1] - job->hits[4 * (size_t)i];
+        bool front = !(triangle & SB_BVH_BACK_FACE);
+        uint8_t f = job->flags[c];
+        if (!job->counts[c])
+            job->top[c] = y;
+        else if (!((f & FRONT) && !front) && (double)job->low[c] - y >= job->gap)
+            f |= COVERED;
+        job->flags[c] = (uint8_t)((f & ~FRONT) | (front ? FRONT : 0));
+        job->low[c] = y;
+        job->counts[c]++;
+    }
+}
+
 static enum sb_result column_surfaces(struct sb_raycaster *rc, const struct lattice *l, float start_y, double gap,
                                       uint8_t *count, uint8_t *flags, float *top, float *low, double *gpu_ms)
 {
     uint64_t n = (uint64_t)l->columns[0] * (uint64_t)l->columns[1];
     uint32_t chunk = n < RAYS_A_CAST ? (uint32_t)n : RAYS_A_CAST;
     float *rays = malloc((size_t)chunk * 8 * sizeof(float)), *hits = malloc((size_t)chunk * 4 * sizeof(float));
-    uint32_t *which = malloc((size_t)chunk * sizeof(uint32_t));
+    uint32_t *which = malloc((size_t)n * sizeof(uint32_t));
     enum sb_result res = rays && hits && which ? SB_OK : SB_ERR_NOMEM;
     /* an active column's next ray starts at low[c] (start_y before any hit) */
     for (uint64_t c = 0; c < n; c++) {
         count[c] = flags[c] = 0;
         low[c] = top[c] = start_y;
     }
-    uint64_t next = 0; /* columns are cast in order; a chunk is filled with those still going */
+    struct column_job job = {.l = l, .start_y = start_y, .gap = gap, .counts = count, .flags = flags, .top = top,
+                             .low = low, .rays = rays, .hits = hits};
     for (int round = 0; round < MAX_SURFACES && !res; round++) {
-        bool any = false;
-        for (next = 0; next < n && !res;) {
-            uint32_t m = 0;
-            for (; next < n && m < chunk; next++) {
-                if (count[next] != round)
-                    continue; /* met nothing on an earlier ray: done */
-                uint64_t x = next % (uint64_t)l->columns[0], z = next / (uint64_t)l->columns[0];
-                float *r = &rays[8 * (size_t)m];
-                r[0] = (float)(l->origin[0] + (double)x * l->spacing);
-                r[1] = round ? low[next] - BELOW_SURFACE_M : start_y;
-                r[2] = (float)(l->origin[2] + (double)z * l->spacing);
-                r[3] = 0.0f;
-                r[4] = 0.0f;
-                r[5] = -1.0f;
-                r[6] = 0.0f;
-                r[7] = 1e30f;
-                which[m++] = (uint32_t)next;
-            }
-            if (!m)
-                break;
+        /* the columns still going (met something on each ray so far), in order */
+        uint32_t active = 0;
+        for (uint64_t c = 0; c < n; c++)
+            if (count[c] == round)
+                which[active++] = (uint32_t)c;
+        if (!active)
+            break;
+        job.round = round;
+        for (uint32_t first = 0; first < active && !res; first += chunk) {
+            job.which = &which[first];
+            job.count = active - first < chunk ? active - first : chunk;
+            int blocks = (int)((job.count + COLUMN_BLOCK - 1) / COLUMN_BLOCK);
+            sb_parallel_for(blocks, build_block, &job);
             double ms = 0;
-            if ((res = sb_raycaster_cast(rc, rays, m, false, hits, &ms)))
+            if ((res = sb_raycaster_cast(rc, rays, job.count, false, hits, &ms)))
                 break;
             *gpu_ms += ms;
-            for (uint32_t i = 0; i < m; i++) {
-                uint32_t triangle;
-                memcpy(&triangle, &hits[4 * (size_t)i + 1], sizeof(triangle));
-                if (triangle == SB_BVH_MISS)
-                    continue;
-                uint32_t c = which[i];
-                float y = rays[8 * (size_t)i + 1] - hits[4 * (size_t)i];
-                bool front = !(triangle & SB_BVH_BACK_FACE);
-                if (!count[c])
-                    top[c] = y;
-                else if (!((flags[c] & FRONT) && !front) && (double)low[c] - y >= gap)
-                    flags[c] |= COVERED;
-                flags[c] = (uint8_t)((flags[c] & ~FRONT) | (front ? FRONT : 0));
-                low[c] = y;
-                count[c]++;
-                any = true;
-            }
+            sb_parallel_for(blocks, read_block, &job);
         }
-        if (!any)
-            break;
     }
     free(rays);
     free(hits);

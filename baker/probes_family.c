@@ -632,7 +632,9 @@ static enum sb_result push_out(struct sb_raycaster *rc, const struct sb_scene *s
                 q[2] = (float)(positions[3 * (size_t)which[j] + 2] + dz * step);
             }
         }
-        struct sb_sky_visibility_params quick = {.ray_count = PUSH_RAYS, .tmax_m = (float)reach_of(&scene->probes)};
+        struct sb_sky_visibility_params quick = {.ray_count = PUSH_RAYS,
+                                                 .tmax_m = (float)reach_of(&scene->probes),
+                                                 .what = "sky_visibility: places to push probes out to"};
         double ms = 0;
         if ((res = sb_sky_visibility_bake(rc, candidates, n * PER, &quick, trial, &ms)))
             break;
@@ -934,7 +936,8 @@ static enum sb_result cast_probes(struct probes_state *st, const struct sb_scene
     if (!n)
         return SB_OK;
     struct sb_sky_visibility_params params = {.ray_count = scene->probes.rays,
-                                              .tmax_m = (float)reach_of(&scene->probes)};
+                                              .tmax_m = (float)reach_of(&scene->probes),
+                                              .what = "sky_visibility: probes' rays"};
     double ms = 0, t0 = sb_now_s(), t1, t2;
     enum sb_result res = sb_sky_visibility_bake(rc, c->positions, n, &params, c->results, &ms);
     if (res)

@@ -1,5 +1,6 @@
 #include "raycast.h"
 
+#include <math.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -97,14 +98,43 @@ enum sb_result sb_raycaster_cast(struct sb_raycaster *rc, const float *rays, uin
     return sb_buffer_read(rc->vk, &rc->hits, hits);
 }
 
-enum sb_result sb_probe_kernel_pass(struct sb_vk *vk, struct sb_pipeline *pipeline, const void *push,
-                                    uint32_t probe_count, double *gpu_ms)
+void sb_probe_work_begin(struct sb_probe_work *work, const char *what, uint32_t passes, uint32_t probe_count)
 {
-    uint32_t gx = probe_count < 65535 ? probe_count : 65535, gy = (probe_count + gx - 1) / gx;
+    *work = (struct sb_probe_work){.what = what, .total = (uint64_t)passes * probe_count};
+    sb_progress(what, 0, (unsigned)work->total);
+}
+
+enum sb_result sb_probe_kernel_pass(struct sb_vk *vk, struct sb_pipeline *pipeline, const void *push,
+                                    uint32_t probe_count, struct sb_probe_work *work, double *gpu_ms)
+{
     double ms = 0;
-    enum sb_result res = sb_dispatch(vk, pipeline, push, gx, gy, 1, &ms);
-    if (gpu_ms)
-        *gpu_ms += ms;
+    enum sb_result res = SB_OK;
+    if (!work) {
+        uint32_t gx = probe_count < 65535 ? probe_count : 65535, gy = (probe_count + gx - 1) / gx;
+        res = sb_dispatch(vk, pipeline, push, gx, gy, 1, &ms);
+        if (gpu_ms)
+            *gpu_ms += ms;
+        return res;
+    }
+    /* rows of SB_PROBE_ROW workgroups, some rows a dispatch (their ids
+     * from the first row on: the same probes as one dispatch) */
+    uint32_t gx = probe_count < SB_PROBE_ROW ? probe_count : SB_PROBE_ROW, gy = (probe_count + gx - 1) / gx;
+    for (uint32_t row = 0; row < gy && !res;) {
+        uint32_t rows = work->rows ? work->rows : 8;
+        rows = rows < gy - row ? rows : gy - row;
+        double t0 = sb_now_s();
+        res = sb_dispatch_base(vk, pipeline, push, (const uint32_t[3]){0, row, 0}, gx, rows, 1, &ms);
+        double s = sb_now_s() - t0;
+        if (gpu_ms)
+            *gpu_ms += ms;
+        uint64_t first = (uint64_t)row * gx, last = (uint64_t)(row + rows) * gx;
+        work->done += (last < probe_count ? last : probe_count) - first;
+        sb_progress(work->what, (unsigned)(work->done < work->total ? work->done : work->total), (unsigned)work->total);
+        row += rows;
+        /* about half a second a dispatch, from this one's time */
+        double next = s > 0 ? rows * 0.5 / s : 1e9;
+        work->rows = (uint32_t)fmin(fmax(next, 1.0), 65535.0);
+    }
     return res;
 }
 
@@ -113,7 +143,7 @@ enum sb_result sb_probe_kernel_run(struct sb_vk *vk, struct sb_pipeline *pipelin
 {
     if (gpu_ms)
         *gpu_ms = 0;
-    enum sb_result res = sb_probe_kernel_pass(vk, pipeline, push, probe_count, gpu_ms);
+    enum sb_result res = sb_probe_kernel_pass(vk, pipeline, push, probe_count, NULL, gpu_ms);
     return res ? res : sb_buffer_read(vk, results, out);
 }
 

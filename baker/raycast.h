@@ -54,11 +54,28 @@ enum sb_result sb_probe_buffers_create(struct sb_vk *vk, const float *positions,
                                        uint32_t probe_count, uint32_t floats, struct sb_buffer *probes,
                                        struct sb_buffer *results);
 
+/* A probe kernel's passes as work done of total (sb_progress: probes
+ * times passes), and how many probes a dispatch takes: about half a
+ * second's worth, so that a slow device (lavapipe's cast of a level's
+ * probes takes minutes) shows its progress and a fast one takes a pass in
+ * one or two dispatches. */
+struct sb_probe_work {
+    const char *what;
+    uint64_t done, total;
+    uint32_t rows; /* rows of SB_PROBE_ROW workgroups a dispatch (0: 8 to begin) */
+};
+#define SB_PROBE_ROW 1024
+
+/* Begin work of `passes` passes over `probe_count` probes. */
+void sb_probe_work_begin(struct sb_probe_work *work, const char *what, uint32_t passes, uint32_t probe_count);
+
 /* Run one pass of a probe kernel (bound, its push constants `push`): one
- * workgroup a probe, in rows of at most 65535; its GPU time is added to
- * *gpu_ms (may be NULL). */
+ * workgroup a probe (probe = x + y SB_PROBE_ROW ... the kernels read
+ * gl_WorkGroupID.x + gl_WorkGroupID.y gl_NumWorkGroups.x), dispatched in
+ * rows as `work` (may be NULL: one dispatch) says, its progress shown;
+ * its GPU time is added to *gpu_ms (may be NULL). */
 enum sb_result sb_probe_kernel_pass(struct sb_vk *vk, struct sb_pipeline *pipeline, const void *push,
-                                    uint32_t probe_count, double *gpu_ms);
+                                    uint32_t probe_count, struct sb_probe_work *work, double *gpu_ms);
 
 /* One pass, then read `results` into out. *gpu_ms (may be NULL) gets the
  * GPU time. */

@@ -246,6 +246,13 @@ enum sb_result sb_sky_bounce_bake(struct sb_raycaster *rc, const struct sb_surfa
     enum sb_result res = kernel && terms && added ? SB_OK : SB_ERR_NOMEM;
     if (res || (res = sb_pipeline_create(vk, &pp, &pipeline)))
         goto done;
+    uint32_t sphere = 2 * pc.secondary;
+    struct sb_probe_work work;
+    sb_probe_work_begin(&work, sun ? "sun bounce: probes' rays" : "sky bounce: probes' rays",
+                        pc.ray_count / SB_PROBE_THREADS *
+                            ((sphere + SB_BOUNCE_PASS_DIRECTIONS - 1) / SB_BOUNCE_PASS_DIRECTIONS +
+                             (sun ? (SB_SUN_DIRECTIONS + SB_BOUNCE_SUN_PASS - 1) / SB_BOUNCE_SUN_PASS : 0)),
+                        probe_count);
     for (uint32_t start = 0; start < probe_count && !res; start += chunk) {
         uint32_t n = probe_count - start < chunk ? probe_count - start : chunk;
         if ((res = sb_probe_buffers_create(vk, positions + 3 * (size_t)start, valid ? valid + start : NULL, n,
@@ -261,19 +268,18 @@ enum sb_result sb_sky_bounce_bake(struct sb_raycaster *rc, const struct sb_surfa
         sb_pipeline_bind(vk, &pipeline, bindings);
         /* the passes (config.h, SB_BOUNCE_PASS_DIRECTIONS), in a fixed
          * order: the sphere set's slices, or a sun run's directions */
-        uint32_t sphere = 2 * pc.secondary;
         pc.probe_count = n;
         for (uint32_t ray = 0; ray < pc.ray_count && !res; ray += SB_PROBE_THREADS) {
             pc.first_ray = ray;
             for (uint32_t dir = 0; dir < sphere && !res; dir += SB_BOUNCE_PASS_DIRECTIONS) {
                 pc.first_direction = dir;
                 pc.accumulate = ray > 0 || dir > 0;
-                res = sb_probe_kernel_pass(vk, &pipeline, &pc, n, gpu_ms);
+                res = sb_probe_kernel_pass(vk, &pipeline, &pc, n, &work, gpu_ms);
             }
             for (uint32_t dir = 0; sun && dir < SB_SUN_DIRECTIONS && !res; dir += SB_BOUNCE_SUN_PASS) {
                 pc.first_direction = dir; /* each pass its own directions, B and M in the first */
                 pc.accumulate = ray > 0;
-                res = sb_probe_kernel_pass(vk, &pipeline, &pc, n, gpu_ms);
+                res = sb_probe_kernel_pass(vk, &pipeline, &pc, n, &work, gpu_ms);
             }
         }
         if (!res)

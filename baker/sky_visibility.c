@@ -106,11 +106,14 @@ enum sb_result sb_sky_visibility_bake(struct sb_raycaster *rc, const float *posi
     sb_pipeline_bind(vk, &pipeline, bindings);
     double t0 = sb_now_s();
     /* the passes (config.h, SB_VISIBILITY_PASS_RAYS), in a fixed order */
+    struct sb_probe_work work;
+    sb_probe_work_begin(&work, params->what ? params->what : "sky visibility: probes' rays",
+                        (pc.ray_count + SB_VISIBILITY_PASS_RAYS - 1) / SB_VISIBILITY_PASS_RAYS, probe_count);
     for (uint32_t first = 0; first < pc.ray_count && !res; first += SB_VISIBILITY_PASS_RAYS) {
         pc.first_ray = first;
         pc.accumulate = first > 0;
         pc.last = first + SB_VISIBILITY_PASS_RAYS >= pc.ray_count;
-        res = sb_probe_kernel_pass(vk, &pipeline, &pc, probe_count, gpu_ms);
+        res = sb_probe_kernel_pass(vk, &pipeline, &pc, probe_count, &work, gpu_ms);
     }
     if (!res)
         res = sb_buffer_read(vk, &results, out);

@@ -18,6 +18,7 @@ struct sb_sky_visibility_params {
     uint32_t ray_count; /* per probe, a multiple of SB_PROBE_THREADS up to SB_PROBE_MAX_RAYS [2048] */
     float tmin_m;       /* rays start this far from the probe [1e-4] */
     float tmax_m;       /* a ray reaching this far sees the sky [1e30: the geometry's own extent] */
+    const char *what;   /* its progress's name ["sky visibility: probes' rays"] */
 };
 
 /* The kernel sb_sky_visibility_bake makes, for a BVH of instances or not. */

@@ -717,6 +717,28 @@ static double bounce_diff(const float *a, const double *b, double *peak)
     return m;
 }
 
+/* Rays from a surface point x (normal n, eps off it) along those of the
+ * `count` directions (xyz each) that leave its side, into ray[] (8 floats
+ * each, in order); returns how many. */
+static uint32_t rays_from_surface(const double x[3], const double n[3], double eps, const double *dirs,
+                                  uint32_t count, float *ray)
+{
+    uint32_t cast = 0;
+    for (uint32_t i = 0; i < count; i++) {
+        const double *l = &dirs[3 * i];
+        if (n[0] * l[0] + n[1] * l[1] + n[2] * l[2] <= 0)
+            continue;
+        float *q = &ray[8 * cast++];
+        for (int k = 0; k < 3; k++) {
+            q[k] = (float)(x[k] + n[k] * eps);
+            q[4 + k] = (float)l[k];
+        }
+        q[3] = (float)eps;
+        q[7] = 1e30f;
+    }
+    return cast;
+}
+
 /*
  * The estimator of probe_bounce.comp in fp64 on Embree's rays: the same
  * directions, the hit's normal and albedo from the mesh, the same offset;
@@ -771,22 +793,9 @@ static void bounce_reference(const struct sb_mesh *mesh, const struct sb_embree 
             big = fmax(big, fabs(x[k]));
         }
         double eps = 1e-4 + 2e-6 * big;
-        uint32_t cast = 0;
-        for (uint32_t i = 0; i < sphere; i++) {
-            const double *l = &dirs[3 * i];
-            if (n[0] * l[0] + n[1] * l[1] + n[2] * l[2] <= 0)
-                continue;
-            float *q = &ray[8 * cast++];
-            for (int k = 0; k < 3; k++) {
-                q[k] = (float)(x[k] + n[k] * eps);
-                q[4 + k] = (float)l[k];
-            }
-            q[3] = (float)eps;
-            q[7] = 1e30f;
-        }
-        sb_embree_cast(e, ray, cast, hit);
+        sb_embree_cast(e, ray, rays_from_surface(x, n, eps, dirs, sphere, ray), hit);
         double g[SB_PROBE_SH] = {0};
-        cast = 0;
+        uint32_t cast = 0;
         for (uint32_t i = 0; i < sphere; i++) {
             const double *l = &dirs[3 * i];
             double c = n[0] * l[0] + n[1] * l[1] + n[2] * l[2];
@@ -807,22 +816,12 @@ static void bounce_reference(const struct sb_mesh *mesh, const struct sb_embree 
         const float *rho = mesh->material_list[mesh->materials[t]].albedo;
         /* the sun table's directions, a ray toward each the surface faces */
         double sun_c[SB_SUN_DIRECTIONS], sun_l[3 * SB_SUN_DIRECTIONS];
-        cast = 0;
         for (uint32_t j = 0; j < SB_SUN_DIRECTIONS; j++) {
-            double *l = &sun_l[3 * j];
-            sb_sun_table_sample(j, r * SB_SUN_DIRECTIONS + j, l);
+            const double *l = &sun_l[3 * j];
+            sb_sun_table_sample(j, r * SB_SUN_DIRECTIONS + j, &sun_l[3 * j]);
             sun_c[j] = n[0] * l[0] + n[1] * l[1] + n[2] * l[2];
-            if (sun_c[j] <= 0)
-                continue;
-            float *q = &ray[8 * cast++];
-            for (int k = 0; k < 3; k++) {
-                q[k] = (float)(x[k] + n[k] * eps);
-                q[4 + k] = (float)l[k];
-            }
-            q[3] = (float)eps;
-            q[7] = 1e30f;
         }
-        sb_embree_cast(e, ray, cast, hit);
+        sb_embree_cast(e, ray, rays_from_surface(x, n, eps, sun_l, SB_SUN_DIRECTIONS, ray), hit);
         cast = 0;
         for (uint32_t j = 0; j < SB_SUN_DIRECTIONS; j++) {
             if (sun_c[j] <= 0)

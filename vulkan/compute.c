@@ -326,6 +326,13 @@ void sb_pipeline_bind(struct sb_vk *vk, struct sb_pipeline *p, const struct sb_b
 enum sb_result sb_dispatch(struct sb_vk *vk, struct sb_pipeline *p, const void *push, uint32_t gx, uint32_t gy,
                            uint32_t gz, double *gpu_ms)
 {
+    static const uint32_t none[3] = {0, 0, 0};
+    return sb_dispatch_base(vk, p, push, none, gx, gy, gz, gpu_ms);
+}
+
+enum sb_result sb_dispatch_base(struct sb_vk *vk, struct sb_pipeline *p, const void *push, const uint32_t base[3],
+                                uint32_t gx, uint32_t gy, uint32_t gz, double *gpu_ms)
+{
     enum sb_result res = SB_OK;
     VkCommandBuffer cmd = VK_NULL_HANDLE;
     VkQueryPool queries = VK_NULL_HANDLE;
@@ -349,7 +356,10 @@ enum sb_result sb_dispatch(struct sb_vk *vk, struct sb_pipeline *p, const void *
     vkCmdBindDescriptorSets(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, p->layout, 0, 1, &p->set, 0, NULL);
     if (push && p->push_size)
         vkCmdPushConstants(cmd, p->layout, VK_SHADER_STAGE_COMPUTE_BIT, 0, p->push_size, push);
-    vkCmdDispatch(cmd, gx, gy, gz);
+    if (base[0] || base[1] || base[2])
+        vkCmdDispatchBase(cmd, base[0], base[1], base[2], gx, gy, gz);
+    else
+        vkCmdDispatch(cmd, gx, gy, gz);
     if (queries)
         vkCmdWriteTimestamp(cmd, VK_PIPELINE_STAGE_BOTTOM_OF_PIPE_BIT, queries, 1);
     /* Make the shader's writes visible to the host once the fence signals. */

@@ -83,6 +83,12 @@ void sb_pipeline_bind(struct sb_vk *vk, struct sb_pipeline *pipeline, const stru
 enum sb_result sb_dispatch(struct sb_vk *vk, struct sb_pipeline *pipeline, const void *push, uint32_t groups_x,
                            uint32_t groups_y, uint32_t groups_z, double *gpu_ms);
 
+/* The same, the workgroups' ids from base[] on (vkCmdDispatchBase: every
+ * compute pipeline may take one). */
+enum sb_result sb_dispatch_base(struct sb_vk *vk, struct sb_pipeline *pipeline, const void *push,
+                                const uint32_t base[3], uint32_t groups_x, uint32_t groups_y, uint32_t groups_z,
+                                double *gpu_ms);
+
 /*
  * A GPU idles at its lowest clocks between short jobs (an H100 at 345 of
  * 1980 MHz) and raises them only after some tens of milliseconds of steady

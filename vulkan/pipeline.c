@@ -86,7 +86,7 @@ enum sb_result sb_compute_pipeline_compile(struct sb_vk *vk, VkPipelineLayout la
                 .pName = "main",
             },
         .layout = layout,
-        .flags = vk->statistics ? VK_PIPELINE_CREATE_CAPTURE_STATISTICS_BIT_KHR : 0,
+        .flags = VK_PIPELINE_CREATE_DISPATCH_BASE_BIT | (vk->statistics ? VK_PIPELINE_CREATE_CAPTURE_STATISTICS_BIT_KHR : 0),
     };
     VK(vkCreateComputePipelines(vk->device, VK_NULL_HANDLE, 1, &info, NULL, pipeline));
 cleanup:
