@@ -70,10 +70,10 @@ struct sb_probe_work {
 void sb_probe_work_begin(struct sb_probe_work *work, const char *what, uint32_t passes, uint32_t probe_count);
 
 /* Run one pass of a probe kernel (bound, its push constants `push`): one
- * workgroup a probe (probe = x + y SB_PROBE_ROW ... the kernels read
- * gl_WorkGroupID.x + gl_WorkGroupID.y gl_NumWorkGroups.x), dispatched in
- * rows as `work` (may be NULL: one dispatch) says, its progress shown;
- * its GPU time is added to *gpu_ms (may be NULL). */
+ * workgroup a probe, probe gl_WorkGroupID.x + gl_WorkGroupID.y
+ * gl_NumWorkGroups.x; with `work`, in rows of SB_PROBE_ROW dispatched a
+ * few at a time as it says, its progress shown (NULL: one dispatch, rows
+ * of up to 65535). Its GPU time is added to *gpu_ms (may be NULL). */
 enum sb_result sb_probe_kernel_pass(struct sb_vk *vk, struct sb_pipeline *pipeline, const void *push,
                                     uint32_t probe_count, struct sb_probe_work *work, double *gpu_ms);
 

@@ -11,8 +11,8 @@
 #include "probe_bounce_sun.spv.h"
 #include "probe_bounce_sun_instanced.spv.h"
 
-_Static_assert(1,
-               "the product's channels (probes.h) name the sun table's 64 directions");
+_Static_assert(SB_SUN_BOUNCE_CHANNEL_COUNT == SB_BOUNCE_SUN_TABLE && SB_SUN_DIRECTIONS == 144,
+               "sun_bounce's channels (probes.h) name the sun table's 144 directions and its shape");
 
 struct sb_pipeline_params sb_sky_bounce_kernel(bool instanced, bool sun)
 {
@@ -248,7 +248,7 @@ enum sb_result sb_sky_bounce_bake(struct sb_raycaster *rc, const struct sb_surfa
         goto done;
     uint32_t sphere = 2 * pc.secondary;
     struct sb_probe_work work;
-    sb_probe_work_begin(&work, sun ? "sun bounce: probes' rays" : "sky bounce: probes' rays",
+    sb_probe_work_begin(&work, sun ? "sun_bounce: probes' rays" : "sky_bounce: probes' rays",
                         pc.ray_count / SB_PROBE_THREADS *
                             ((sphere + SB_BOUNCE_PASS_DIRECTIONS - 1) / SB_BOUNCE_PASS_DIRECTIONS +
                              (sun ? (SB_SUN_DIRECTIONS + SB_BOUNCE_SUN_PASS - 1) / SB_BOUNCE_SUN_PASS : 0)),

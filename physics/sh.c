@@ -30,15 +30,20 @@ void sb_probe_direction(uint32_t i, uint32_t n, double d[3])
     d[2] = r * sin(phi);
 }
 
-void sb_sun_table_direction(uint32_t j, double d[3])
+/* The unit direction at (u, v) of the upper hemisphere's octahedral map. */
+static void sun_map_direction(double u, double v, double d[3])
 {
-    double step = 2.0 / (SB_SUN_SIDE - 1);
-    double u = -1.0 + step * (j % SB_SUN_SIDE), v = -1.0 + step * (j / SB_SUN_SIDE);
     double x = 0.5 * (u + v), z = 0.5 * (u - v), y = fmax(1.0 - fabs(x) - fabs(z), 0.0);
     double len = sqrt(x * x + y * y + z * z);
     d[0] = x / len;
     d[1] = y / len;
     d[2] = z / len;
+}
+
+void sb_sun_table_direction(uint32_t j, double d[3])
+{
+    double step = 2.0 / (SB_SUN_SIDE - 1);
+    sun_map_direction(-1.0 + step * (j % SB_SUN_SIDE), -1.0 + step * (j / SB_SUN_SIDE), d);
 }
 
 static uint32_t sun_hash(uint32_t x)
@@ -59,11 +64,7 @@ void sb_sun_table_sample(uint32_t j, uint32_t seed, double d[3])
     double v = -1.0 + step * (j / SB_SUN_SIDE) + step * ((double)(h2 >> 8) - (double)(h3 >> 8)) * unit;
     u = u > 1.0 ? 2.0 - u : (u < -1.0 ? -2.0 - u : u);
     v = v > 1.0 ? 2.0 - v : (v < -1.0 ? -2.0 - v : v);
-    double x = 0.5 * (u + v), z = 0.5 * (u - v), y = fmax(1.0 - fabs(x) - fabs(z), 0.0);
-    double len = sqrt(x * x + y * y + z * z);
-    d[0] = x / len;
-    d[1] = y / len;
-    d[2] = z / len;
+    sun_map_direction(u, v, d);
 }
 
 void sb_sun_table_weights(const double s[3], uint32_t at[4], double w[4])

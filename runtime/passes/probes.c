@@ -68,17 +68,17 @@ static void mean_albedo(const struct sb_world *world, float out[3])
         out[i] = area > 0 ? (float)(sum[i] / area) : 0.0f;
 }
 
-/* Whether the pack's sun_bounce goes with its sky_visibility: the same
- * layout, probe for probe. */
-static bool has_sun_table(const struct sb_pack *pack)
+/* Whether the pack's product `id` (a bounce) goes with its sky_visibility,
+ * probe for probe: the same layout; warned (`instead`: what lights the
+ * world without it) when present but not. */
+static bool goes_with_visibility(const struct sb_pack *pack, enum sb_product_id id, const char *instead)
 {
     const struct sb_probe_layout *a = &pack->artifacts[SB_PRODUCT_SKY_VISIBILITY].probes,
-                                 *b = &pack->artifacts[SB_PRODUCT_SUN_BOUNCE].probes;
-    bool same = pack->present[SB_PRODUCT_SUN_BOUNCE] &&
-                pack->images[SB_PRODUCT_SUN_BOUNCE].width == pack->images[SB_PRODUCT_SKY_VISIBILITY].width &&
+                                 *b = &pack->artifacts[id].probes;
+    bool same = pack->present[id] && pack->images[id].width == pack->images[SB_PRODUCT_SKY_VISIBILITY].width &&
                 !memcmp(a->grid, b->grid, sizeof(a->grid)) && a->detail_count == b->detail_count;
-    if (pack->present[SB_PRODUCT_SUN_BOUNCE] && !same)
-        sb_warn("the pack's sun_bounce has another grid than its sky_visibility: the sun's bounce through sky_bounce");
+    if (pack->present[id] && !same)
+        sb_warn("the pack's %s has another grid than its sky_visibility: %s", sb_product_name(id), instead);
     return same;
 }
 
@@ -161,15 +161,11 @@ static enum sb_result upload_probes(struct sb_renderer *r, struct probes *s)
     r->probe_count = use ? (uint32_t)placed : 0;
     size_t count = r->probe_count ? r->probe_count : 1;
     const struct sb_image *bounce = &pack->images[SB_PRODUCT_SKY_BOUNCE];
-    const struct sb_probe_layout *bounce_layout = &pack->artifacts[SB_PRODUCT_SKY_BOUNCE].probes;
-    bool has_bounce = pack->present[SB_PRODUCT_SKY_BOUNCE] && bounce->width == image->width &&
-                      !memcmp(bounce_layout->grid, layout->grid, sizeof(layout->grid)) &&
-                      bounce_layout->detail_count == layout->detail_count;
-    if (pack->present[SB_PRODUCT_SKY_BOUNCE] && !has_bounce)
-        sb_warn("the pack's sky_bounce has another grid than its sky_visibility: the bounce is modelled");
+    bool has_bounce = goes_with_visibility(pack, SB_PRODUCT_SKY_BOUNCE, "the bounce is modelled");
     /* the sun's table (sun_bounce) relights the sun's bounce; without it the
      * sun goes through sky_bounce's order-2 SH (docs/probes.md, "The sun") */
-    bool sun_table = has_bounce && has_sun_table(pack);
+    bool sun_table =
+        has_bounce && goes_with_visibility(pack, SB_PRODUCT_SUN_BOUNCE, "the sun's bounce through sky_bounce");
     const size_t floats = 4 * (sun_table ? SB_PROBE_SUN_VEC4S : SB_PROBE_VEC4S); /* a probe's (config.h) */
     enum sb_result res = sb_renderer_upload(r, NULL, sizeof(struct sb_probes_gpu) + count * floats * sizeof(float),
                                             "probes", &s->probes);

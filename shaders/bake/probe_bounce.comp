@@ -124,15 +124,6 @@ void main()
         // probe as twice the reach in all (a tiled bake's: a hit on a wide
         // terrain may lie past it)
         bvh_reach = max(2.0 * pc.tmax_m - hit.t, 0.0);
-        if (sun) {
-            float ys[SB_PROBE_SH];
-            sh9_basis(w, ys);
-            for (int m = 0; m < SB_BOUNCE_SH; m++)
-                sun_w[m] = rho * (0.3183098861837907 * ys[m]);
-            sun_from = from;
-            sun_n = n;
-            sun_eps = eps;
-        }
         float g[SB_PROBE_SH];
         for (int k = 0; k < SB_PROBE_SH; k++)
             g[k] = 0.0;
@@ -150,6 +141,13 @@ void main()
         }
         float ym[SB_PROBE_SH];
         sh9_basis(w, ym);
+        if (sun) { /* what the sun's pass casts from, and the hit's weight */
+            for (int m = 0; m < SB_BOUNCE_SH; m++)
+                sun_w[m] = rho * (0.3183098861837907 * ym[m]);
+            sun_from = from;
+            sun_n = n;
+            sun_eps = eps;
+        }
         vec3 weight = rho * (4.0 / float(sphere)); // (rho / pi) (4 pi / 2s): g's quadrature weight and rho / pi
         for (int m = 0; m < SB_BOUNCE_SH; m++)
             for (int k = 0; k < SB_PROBE_SH; k++)
