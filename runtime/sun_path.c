@@ -66,6 +66,9 @@ void sb_sun_position(double latitude_deg, double longitude_deg, int year, int mo
     out->declination = declination;
     out->equation_of_time_min = eot_min;
     out->apparent_longitude = wrap_degrees(longitude / DEG) * DEG;
+    /* The radius vector (Meeus, 25.5). */
+    double true_anomaly = mean_anomaly + centre * DEG;
+    out->distance_au = 1.000001018 * (1.0 - eccentricity * eccentricity) / (1.0 + eccentricity * cos(true_anomaly));
 }
 
 /*

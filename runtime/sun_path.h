@@ -23,6 +23,7 @@ struct sb_sun_position {
     double declination;          /* radians */
     double equation_of_time_min; /* apparent minus mean solar time, minutes */
     double apparent_longitude;   /* the sun's ecliptic longitude, radians in [0, 2 pi) */
+    double distance_au;          /* from the earth */
 };
 
 /* The Julian day (UT) of a Gregorian date at `utc_hours` (any real; it may
