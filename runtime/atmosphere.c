@@ -55,6 +55,13 @@ enum sb_result sb_atmosphere_upload(struct sb_renderer *r, const struct sb_pack 
     sb_atmosphere_gpu_pack(atm, &gpu);
     double sun_max = fmax(atm->solar_irradiance[0], fmax(atm->solar_irradiance[1], atm->solar_irradiance[2]));
     r->radiance_scale = sun_max > 0.0 ? 1.0 / sun_max : 1.0;
+    /* The pack's radiance is relative to its solar irradiance; the sun's
+     * illuminance above the atmosphere makes it absolute. */
+    static const double weights[3] = {SB_LUMINANCE_RGB};
+    double sun_y = weights[0] * atm->solar_irradiance[0] + weights[1] * atm->solar_irradiance[1] +
+                   weights[2] * atm->solar_irradiance[2];
+    double lux = r->params.sun_illuminance_lux > 0.0 ? r->params.sun_illuminance_lux : SB_EARTH_SUN_LUX;
+    r->cd_m2_per_unit = sun_y > 0.0 ? lux / sun_y : lux;
     r->frame_scale = r->previous_frame_scale = r->next_frame_scale = r->readback_scale = r->radiance_scale;
     r->ground_radius_km = atm->ground_radius_km;
     r->thickness_km = gpu.radii[3];

@@ -8,8 +8,7 @@
 void sb_history_advance(struct sb_history *h, const struct sb_renderer *r, struct sb_history_step *step)
 {
     const struct sb_view *v = r->view;
-    double sun[3];
-    sb_direction(v->sun_azimuth, v->sun_elevation, sun);
+    const double *sun = r->key_direction; /* the light the fog and the clouds are lit by */
     step->keep =
         h->valid && !v->snap_exposure &&
         sun[0] * h->sun[0] + sun[1] * h->sun[1] + sun[2] * h->sun[2] > cos(SB_SUN_HISTORY_LIMIT_DEG * M_PI / 180.0);

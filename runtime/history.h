@@ -18,13 +18,14 @@ struct sb_history {
     bool valid;
     struct sb_mat4 view_proj; /* the last frame's, camera-relative */
     double camera_m[3];
-    double sun[3]; /* unit, world axes */
+    double sun[3]; /* toward the key light (the sun, or the moon at night): unit, world axes */
 };
 
 /* What this frame reads of the history. */
 struct sb_history_step {
     /* Whether to blend with it: there is one, the exposure was not snapped,
-     * and the sun moved less than SB_SUN_HISTORY_LIMIT_DEG since. */
+     * and the key light (the sun, or the moon at night) moved less than
+     * SB_SUN_HISTORY_LIMIT_DEG since. */
     bool keep;
     struct sb_mat4 previous_view_proj; /* the last frame's (zero before the first) */
     double camera_motion_m[3];         /* this frame's camera minus the last one's */

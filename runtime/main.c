@@ -64,6 +64,11 @@ static void usage(FILE *f)
                "                          enough to keep the history; --window: until closed)\n"
                "  --sun-elevation DEG     the sun above the horizon (default 30)\n"
                "  --sun-azimuth DEG       clockwise from north, -z (default 150)\n"
+               "  --moon EL,AZ            the moon at that elevation and azimuth (degrees; its\n"
+               "                          phase from where the sun is); with the sun down it\n"
+               "                          lights the world (default: none, or with\n"
+               "                          --time-of-day the moon of the place and date)\n"
+               "  --no-moon               no moon, with --time-of-day either\n"
                "  --camera X,Y,Z[,YAW,PITCH[,FOV]]\n"
                "                          metres (y up, origin on the planet's ground; a\n"
                "                          world's valleys may go 10 km under it) and degrees: yaw\n"
@@ -118,6 +123,11 @@ static void usage(FILE *f)
                "                          the pack's radiance absolute for the Purkinje shift\n"
                "                          (default 128000, the earth's)\n"
                "  --exposure EV           exposure compensation (default 0)\n"
+               "  --ev-range MIN,MAX      the luminance the exposure adapts within, as EV at ISO\n"
+               "                          100 (default -5,18: a moonlit night to sunlit snow)\n"
+               "  --dim-compensation S    stops taken off the exposure a stop under dusk (EV100\n"
+               "                          5), so nights stay darker than days (default 0.333;\n"
+               "                          0: none)\n"
                "  --no-bloom              no bloom\n"
                "  --shadow-size N         texels per side of each of the 4 cascades (default 2048)\n"
                "  --scene auto|raster|traced\n"
@@ -222,6 +232,7 @@ struct options {
     bool time_of_day, sweep;
     double day_from, day_to;
     struct sb_sun_path sun_path;
+    bool no_moon; /* the path's place has no moon */
     double fps;
     enum { ENCODER_AUTO, ENCODER_FFMPEG, ENCODER_PNG } encoder;
     double sheet_step_h; /* > 0: a contact sheet instead of the sweep */
@@ -278,11 +289,16 @@ static int check_combinations(struct options *o)
             fprintf(stderr, "skyview: %s goes with --time-of-day\n", need_time[i]);
             return EXIT_USAGE;
         }
+    if (given(o, "--moon") && given(o, "--no-moon")) {
+        fprintf(stderr, "skyview: --moon and --no-moon: give one\n");
+        return EXIT_USAGE;
+    }
     if (o->time_of_day) {
-        static const char *const fixed_sun[] = {"--sun-elevation", "--sun-azimuth"};
-        for (int i = 0; i < 2; i++)
+        static const char *const fixed_sun[] = {"--sun-elevation", "--sun-azimuth", "--moon"};
+        for (int i = 0; i < 3; i++)
             if (given(o, fixed_sun[i])) {
-                fprintf(stderr, "skyview: %s and --time-of-day both set the sun: give one\n", fixed_sun[i]);
+                fprintf(stderr, "skyview: %s and --time-of-day both place the %s: give one\n", fixed_sun[i],
+                        i == 2 ? "moon" : "sun");
                 return EXIT_USAGE;
             }
         static const char *const place[] = {"--location", "--date", "--utc-offset"};
@@ -402,6 +418,15 @@ static int parse_options(int argc, char **argv, struct options *o)
             ok = parse_number(argv[++i], -360, 360, &v);
             o->view.sun_azimuth = v * DEG;
             note_option(o, a);
+        } else if (!strcmp(a, "--moon") && next) {
+            ok = parse_doubles(argv[++i], c, 2, 2, &n) && fabs(c[0]) <= 90.0 && fabs(c[1]) <= 360.0;
+            o->view.moon = true;
+            o->view.moon_elevation = c[0] * DEG;
+            o->view.moon_azimuth = c[1] * DEG;
+            note_option(o, a);
+        } else if (!strcmp(a, "--no-moon")) {
+            o->no_moon = true;
+            note_option(o, a);
         } else if (!strcmp(a, "--time-of-day") && next) {
             const char *t = argv[++i];
             char *dash = strchr(t, '-');
@@ -499,7 +524,14 @@ static int parse_options(int argc, char **argv, struct options *o)
             o->params.local_contrast = v;
         } else if (!strcmp(a, "--no-purkinje"))
             o->params.purkinje = false;
-        else if (!strcmp(a, "--sun-lux") && next) {
+        else if (!strcmp(a, "--ev-range") && next) {
+            ok = parse_doubles(argv[++i], c, 2, 2, &n) && c[0] >= -20.0 && c[1] <= 30.0 && c[0] < c[1];
+            o->params.exposure_min_ev100 = c[0];
+            o->params.exposure_max_ev100 = c[1];
+        } else if (!strcmp(a, "--dim-compensation") && next) {
+            ok = parse_number(argv[++i], 0.0, 1.0, &v);
+            o->params.dim_compensation = v > 0.0 ? v : -1.0;
+        } else if (!strcmp(a, "--sun-lux") && next) {
             ok = parse_number(argv[++i], 1e-3, 1e7, &v);
             o->params.sun_illuminance_lux = v;
         } else if (!strcmp(a, "--world") && next)
@@ -756,7 +788,7 @@ static enum sb_result render_day(const struct options *o, struct sb_renderer *r,
     for (int i = 0; i < o->frames && !res; i++) {
         double hour = o->day_from + (o->day_to - o->day_from) * i / (o->frames - 1);
         struct sb_view view = o->view;
-        sb_sun_path_at(&o->sun_path, hour, &view.sun_elevation, &view.sun_azimuth);
+        sb_view_at_hour(&view, &o->sun_path, hour, !o->no_moon);
         view.snap_exposure = i == 0;
         view.dt_s = 1.0 / o->fps;
         view.time_s = i / o->fps;
@@ -778,6 +810,10 @@ static enum sb_result render_day(const struct options *o, struct sb_renderer *r,
         cJSON_AddNumberToObject(f, "hour", hour);
         cJSON_AddNumberToObject(f, "sun_elevation_deg", view.sun_elevation / DEG);
         cJSON_AddNumberToObject(f, "sun_azimuth_deg", view.sun_azimuth / DEG);
+        if (view.moon) {
+            cJSON_AddNumberToObject(f, "moon_elevation_deg", view.moon_elevation / DEG);
+            cJSON_AddNumberToObject(f, "moon_azimuth_deg", view.moon_azimuth / DEG);
+        }
         cJSON_AddNumberToObject(f, "adapted_log2_luminance", exposure[0]);
         cJSON_AddNumberToObject(f, "metered_log2_luminance", exposure[2]);
         cJSON_AddNumberToObject(f, "exposure", exposure[1]);
@@ -821,7 +857,7 @@ static enum sb_result render_contact_sheet(const struct options *o, struct sb_re
     sb_progress("frames", 0, (unsigned)n);
     for (int t = 0; t < n && !res; t++) {
         struct sb_view view = o->view;
-        sb_sun_path_at(&o->sun_path, hours[t], &view.sun_elevation, &view.sun_azimuth);
+        sb_view_at_hour(&view, &o->sun_path, hours[t], !o->no_moon);
         view.dt_s = 1.0 / o->fps;
         for (int f = 0; f < SHEET_SETTLE_FRAMES && !res; f++) {
             view.snap_exposure = f == 0;
@@ -1020,13 +1056,14 @@ static int run(const struct options *o)
             .view = o->view,
             .sun_path = o->time_of_day ? &o->sun_path : NULL,
             .hour = o->day_from,
+            .moon = !o->no_moon,
             .frames = o->frames > 0 ? o->frames : 0,
             .screenshot = o->screenshot,
             .out_dir = o->out_dir,
             .overlay = !o->no_overlay,
         };
         if (o->time_of_day)
-            sb_sun_path_at(&o->sun_path, o->day_from, &vp.view.sun_elevation, &vp.view.sun_azimuth);
+            sb_view_at_hour(&vp.view, &o->sun_path, o->day_from, !o->no_moon);
         res = sb_window_create(vk, w, h, title, &window);
         if (!res)
             res = sb_viewer_run(r, window, &vp);
@@ -1055,7 +1092,7 @@ static int run(const struct options *o)
     for (int i = 0; i < total && !res; i++) {
         struct sb_view view = o->view;
         if (o->time_of_day)
-            sb_sun_path_at(&o->sun_path, o->day_from, &view.sun_elevation, &view.sun_azimuth);
+            sb_view_at_hour(&view, &o->sun_path, o->day_from, !o->no_moon);
         view.snap_exposure = i == 0;
         view.dt_s = 1.0 / 60.0;
         view.time_s = i * view.dt_s;

@@ -12,6 +12,8 @@
 #ifndef SB_RUNTIME_MOON_H
 #define SB_RUNTIME_MOON_H
 
+#include <stdbool.h>
+
 struct sb_moon_position {
     /* From the earth's centre, apparent (nutation in longitude included). */
     double longitude, latitude;          /* ecliptic of date, radians; longitude in [0, 2 pi) */
@@ -33,6 +35,13 @@ void sb_moon_geocentric(double jde, struct sb_moon_position *out);
  * at `utc_hours` of a Gregorian date (1800 to 2100); fills everything. */
 void sb_moon_position(double latitude_deg, double longitude_deg, int year, int month, int day, double utc_hours,
                       struct sb_moon_position *out);
+
+struct sb_sun_path;
+
+/* The moon at `hour` of a sun path's date and place (as sb_sun_path_at
+ * reads them); false, with *out untouched, for a path of keys, which has no
+ * place. */
+bool sb_moon_path_at(const struct sb_sun_path *path, double hour, struct sb_moon_position *out);
 
 /* Greenwich mean sidereal time at Julian day `jd` (UT), radians in [0, 2 pi)
  * (Meeus, eq. 12.4). */

@@ -13,6 +13,7 @@
 
 #include "image.h"
 #include "log.h"
+#include "moon.h"
 #include "physics.h"
 #include "scene.h"
 #include "shadows.h"
@@ -278,6 +279,60 @@ static void store4(float dst[4], double x, double y, double z, double w)
     dst[3] = (float)w;
 }
 
+/*
+ * The solid-angle integral of the moon's disk's shading, a Lommel-Seeliger
+ * surface, mu0 / (mu0 + mu) where the sun lights it (mu0: the cosine to the
+ * sun, mu: to the viewer), which view.glsl's moon_disk divides by so that
+ * the disk delivers the moon's irradiance whatever its phase. The law of the
+ * dusty regolith: a full moon is a flat disk, without a Lambert sphere's
+ * dark limb. Over the visible hemisphere by the angle theta from the disk's
+ * centre (a disk radius sin theta, its area element sin theta cos theta
+ * dtheta dphi, smooth to the limb) and the angle phi around it: midpoints,
+ * 64 x 128, within 1e-3 of the integral at any phase.
+ */
+static double moon_disk_integral(const double sun[3], const double moon[3], double radius)
+{
+    double e1[3], e2[3];
+    double ref[3] = {0.0, 1.0, 0.0};
+    if (fabs(moon[1]) > 0.9) {
+        ref[1] = 0.0;
+        ref[0] = 1.0;
+    }
+    e1[0] = moon[1] * ref[2] - moon[2] * ref[1]; /* moon x ref, then moon x e1 */
+    e1[1] = moon[2] * ref[0] - moon[0] * ref[2];
+    e1[2] = moon[0] * ref[1] - moon[1] * ref[0];
+    double len = sqrt(e1[0] * e1[0] + e1[1] * e1[1] + e1[2] * e1[2]);
+    for (int k = 0; k < 3; k++)
+        e1[k] /= len;
+    e2[0] = moon[1] * e1[2] - moon[2] * e1[1];
+    e2[1] = moon[2] * e1[0] - moon[0] * e1[2];
+    e2[2] = moon[0] * e1[1] - moon[1] * e1[0];
+    /* the sun in the disk's frame */
+    double s1 = 0.0, s2 = 0.0, s3 = 0.0;
+    for (int k = 0; k < 3; k++) {
+        s1 += sun[k] * e1[k];
+        s2 += sun[k] * e2[k];
+        s3 -= sun[k] * moon[k];
+    }
+    enum { THETA = 64, PHI = 128 };
+    double sum = 0.0;
+    for (int j = 0; j < THETA; j++) {
+        double theta = (j + 0.5) * (0.5 * M_PI / THETA), r = sin(theta), mu = cos(theta);
+        for (int i = 0; i < PHI; i++) {
+            double phi = (i + 0.5) * (2.0 * M_PI / PHI);
+            double mu0 = r * (cos(phi) * s1 + sin(phi) * s2) + mu * s3;
+            if (mu0 > 0.0)
+                sum += mu0 / (mu0 + mu) * r * mu;
+        }
+    }
+    return sum * (0.5 * M_PI / THETA) * (2.0 * M_PI / PHI) * radius * radius;
+}
+
+double sb_renderer_ev100(const struct sb_renderer *r, double log2_luminance)
+{
+    return log2_luminance + log2(r->cd_m2_per_unit * 100.0 / 12.5); /* log2(L S / K) */
+}
+
 static void fill_frame(struct sb_renderer *r, const struct sb_view *v, struct sb_frame_gpu *f)
 {
     memset(f, 0, sizeof(*f));
@@ -310,8 +365,29 @@ static void fill_frame(struct sb_renderer *r, const struct sb_view *v, struct sb
         .map_size = r->params.shadow_size,
         .caster_margin_m = 200.0,
     };
+    /* The moon: where it is, how bright its phase is, and whether it is the
+     * key light (the sun wholly under the horizon). */
+    const double sun_radius = 0.2666 * M_PI / 180.0; /* the sun's mean angular radius */
+    double moon[3] = {0.0, -1.0, 0.0};
+    bool moon_key = false;
+    if (v->moon) {
+        sb_direction(v->moon_azimuth, v->moon_elevation, moon);
+        double distance = v->moon_distance_km > 0.0 ? v->moon_distance_km : 384400.0;
+        double radius = asin(fmin(SB_MOON_RADIUS_KM / distance, 1.0));
+        double phase = acos(fmin(fmax(-(sun[0] * moon[0] + sun[1] * moon[1] + sun[2] * moon[2]), -1.0), 1.0));
+        double ratio = sb_moon_irradiance_ratio(phase, distance);
+        double shading = moon_disk_integral(sun, moon, radius);
+        store4(f->moon_direction, moon[0], moon[1], moon[2], radius);
+        store4(f->moon_light, ratio * SB_MOON_COLOR_R, ratio * SB_MOON_COLOR_G, ratio * SB_MOON_COLOR_B,
+               shading > 0.0 ? 1.0 / shading : 0.0);
+        moon_key = v->sun_elevation < -sun_radius;
+    }
+    r->frame_lights = moon_key ? 2 : 1;
+    store4(f->lights, r->frame_lights, moon_key ? 1.0 : 0.0, 0.0, 0.0);
+    memcpy(r->key_direction, moon_key ? moon : sun, sizeof(r->key_direction));
+
     struct sb_cascades cascades;
-    sb_cascades_compute(&cp, v->camera_m, forward, sun, &cascades);
+    sb_cascades_compute(&cp, v->camera_m, forward, r->key_direction, &cascades);
     if (r->draw_group_count)
         sb_world_cull(r, &cascades);
     for (int c = 0; c < SB_CASCADES; c++) {
@@ -352,7 +428,6 @@ static void fill_frame(struct sb_renderer *r, const struct sb_view *v, struct sb
     double km[3] = {v->camera_m[0] * 1e-3, R + fmax(v->camera_m[1], SB_CAMERA_LOWEST_ATMOSPHERE_M) * 1e-3,
                     v->camera_m[2] * 1e-3};
     double altitude = sqrt(km[0] * km[0] + km[1] * km[1] + km[2] * km[2]) - R;
-    const double sun_radius = 0.2666 * M_PI / 180.0; /* the sun's mean angular radius */
     store4(f->camera_m, v->camera_m[0], v->camera_m[1], v->camera_m[2], SB_NEAR_M);
     store4(f->camera_km, km[0], km[1], km[2], altitude);
     /* the shaders' test, on the same fp32 values */
@@ -371,12 +446,20 @@ static void fill_frame(struct sb_renderer *r, const struct sb_view *v, struct sb
     store4(f->sun_direction, sun[0], sun[1], sun[2], sun_radius);
     store4(f->shadow, 0.1, 1.5, r->params.shadow_size, 1.0);
     store4(f->aerial, SB_AERIAL_FAR_KM, r->frame_scale, 0.0, 0.0);
-    /* Bins 1 to 255 span 2^-20 to 2^12 of the solar irradiance's units:
-     * from nautical twilight (the sun 12 to 14 degrees down, where the
-     * exposure stops following the light and night falls) to beyond the
-     * sun-lit snow. */
+    /* Bins 1 to 255 span 2^-34 to 2^12 of the solar irradiance's units
+     * (0.18 stops a bin): from a moonless night's sky to beyond the sun-lit
+     * snow. The meter adapts within the EV range (renderer.h). */
     double log_sun = log2(1.0 / r->radiance_scale);
-    store4(f->exposure, log_sun - 20.0, 32.0, 0.10, 0.90);
+    store4(f->exposure, log_sun - 34.0, 46.0, 0.10, 0.90);
+    const struct sb_renderer_params *p = &r->params;
+    bool ev_given = p->exposure_min_ev100 != 0.0 || p->exposure_max_ev100 != 0.0;
+    double ev_lo = ev_given ? p->exposure_min_ev100 : SB_EXPOSURE_MIN_EV100;
+    double ev_hi = ev_given ? p->exposure_max_ev100 : SB_EXPOSURE_MAX_EV100;
+    double dim = p->dim_compensation > 0.0   ? p->dim_compensation
+                 : p->dim_compensation < 0.0 ? 0.0
+                                             : SB_EXPOSURE_DIM_STOPS;
+    double to_log_units = -sb_renderer_ev100(r, 0.0);
+    store4(f->meter, ev_lo + to_log_units, ev_hi + to_log_units, dim, SB_EXPOSURE_DIM_EV100 + to_log_units);
     store4(f->adaptation, 3.0, 1.0, v->dt_s > 0.0 ? v->dt_s : 1.0 / 60.0, v->snap_exposure ? 1.0 : 0.0);
     bool bloom = r->params.bloom_strength > 0.0 && !(v->disabled_passes >> SB_PASS_BLOOM & 1);
     store4(f->post, 1.0, bloom ? r->params.bloom_strength : 0.0, r->params.exposure_compensation_ev, r->params.tonemap);

@@ -48,45 +48,60 @@ struct sb_grading {
     double contrast;        /* each channel 0.18 (c / 0.18)^contrast; 1: none */
 };
 
+/* The exposure's defaults: it adapts down to a moonlit night (the ground
+ * under a full moon is about EV100 -3) and up past sunlit snow (16); under
+ * dusk (EV100 5) it takes a third of a stop off a stop, so a moonlit night
+ * is exposed 2.7 stops under a day's mid grey. */
+#define SB_EARTH_SUN_LUX 128000.0 /* sun_illuminance_lux's default */
+#define SB_EXPOSURE_MIN_EV100 (-5.0)
+#define SB_EXPOSURE_MAX_EV100 18.0
+#define SB_EXPOSURE_DIM_EV100 5.0
+#define SB_EXPOSURE_DIM_STOPS (1.0 / 3.0)
+
 struct sb_renderer_params {
-    uint32_t width, height;          /* 0: 1280 x 720 */
-    uint32_t shadow_size;            /* texels per side of each cascade; 0: 2048 */
-    double shadow_distance_m;        /* where the last cascade ends; 0: 250 */
-    int tonemap;                     /* SB_TONEMAP_AGX (0, the default), _ACES or _GT */
-    double exposure_compensation_ev; /* added to the metered exposure; 0: none */
-    double bloom_strength;           /* 0: 0.15; negative: no bloom */
-    bool no_probes;                  /* light the world with the sky alone even if the pack has probes */
-    bool no_reflections;             /* leave the pack's reflection probes unread (the sky model's specular) */
-    bool no_textures;                /* the world's materials without their textures (their factors alone) */
-    bool no_fog;                     /* leave out the scene's fog */
-    uint32_t fog_tile_px;            /* a froxel's width and height in pixels; 0: 8 */
-    uint32_t fog_slices;             /* froxel slices, [2, 256]; 0: 64 */
-    double fog_far_m;                /* where the froxel volume ends (then the height fog in closed form); 0: 256 */
-    bool no_clouds;                  /* leave out the cloud layer */
-    uint32_t cloud_scale;            /* clouds traced at one pixel in scale x scale a frame: 1, 2 or 4; 0: 2 */
-    uint32_t cloud_steps;            /* view march steps at most, [8, 1024]; 0: 128 */
-    uint32_t cloud_light_steps;      /* light march steps toward the sun, [1, SB_CLOUD_MAX_LIGHT_STEPS]; 0: 6 */
-    uint32_t cloud_shadow_size;      /* texels per side of the clouds' shadow map, [16, 4096]; 0: 512 */
-    int debug;                       /* SB_DEBUG_* (view_gpu.h): the scene pass writes one term; 0: the frame */
-    bool whole_shadow_maps;          /* clear and draw every cascade whole, not only where casters
-                                        project (runtime/shadows.h); the same frame, slower */
-    bool generic_shaders;            /* never the scene's shaders specialised to the pack (no probes, no
-                                        reflection probes) and the frame (aerial perspective from its
-                                        volume alone); the same frame, slower on llvmpipe */
-    enum sb_scene_method scene;      /* how the scene pass finds the world's points */
-    const struct sb_lut3d *grade;    /* a .cube LUT (grade.c), read during sb_renderer_create only; NULL:
-                                        none. It grades the display-referred 8-bit frame, or with
-                                        grade_log the scene-linear one in ACEScct before the tone curve */
-    bool grade_log;                  /* the LUT's input is ACEScct, not the sRGB-encoded frame */
-    struct sb_grading grading;       /* scene-linear grading; zeroed: none */
-    bool purkinje;                   /* the Purkinje shift in dim light (purkinje.c) */
-    double local_contrast;           /* local tone mapping (local_tonemap.c): the base layer's contrast about
-                                        the frame's pivot, (0, 1]; 0 or 1: none */
-    double sun_illuminance_lux;      /* the sun's illuminance above the atmosphere, what makes the pack's
-                                        radiance absolute for the Purkinje shift; 0: 128000 (the earth's) */
-    const float *post_input;         /* width x height x 3 floats in the pack's units, or NULL: every frame
-                                        post-processes this image instead of the lit one (read during
-                                        sb_renderer_create only; non-finite values read as 0) */
+    uint32_t width, height;                        /* 0: 1280 x 720 */
+    uint32_t shadow_size;                          /* texels per side of each cascade; 0: 2048 */
+    double shadow_distance_m;                      /* where the last cascade ends; 0: 250 */
+    int tonemap;                                   /* SB_TONEMAP_AGX (0, the default), _ACES or _GT */
+    double exposure_compensation_ev;               /* added to the metered exposure; 0: none */
+    double exposure_min_ev100, exposure_max_ev100; /* the range the exposure adapts within (EV at ISO 100 of
+                                        the luminance metered, K = 12.5, with sun_illuminance_lux); both 0:
+                                        SB_EXPOSURE_MIN_EV100 to SB_EXPOSURE_MAX_EV100 */
+    double dim_compensation;                       /* stops taken off the exposure a stop the metered luminance is under
+                                                      SB_EXPOSURE_DIM_EV100; 0: SB_EXPOSURE_DIM_STOPS; negative: none */
+    double bloom_strength;                         /* 0: 0.15; negative: no bloom */
+    bool no_probes;                                /* light the world with the sky alone even if the pack has probes */
+    bool no_reflections;          /* leave the pack's reflection probes unread (the sky model's specular) */
+    bool no_textures;             /* the world's materials without their textures (their factors alone) */
+    bool no_fog;                  /* leave out the scene's fog */
+    uint32_t fog_tile_px;         /* a froxel's width and height in pixels; 0: 8 */
+    uint32_t fog_slices;          /* froxel slices, [2, 256]; 0: 64 */
+    double fog_far_m;             /* where the froxel volume ends (then the height fog in closed form); 0: 256 */
+    bool no_clouds;               /* leave out the cloud layer */
+    uint32_t cloud_scale;         /* clouds traced at one pixel in scale x scale a frame: 1, 2 or 4; 0: 2 */
+    uint32_t cloud_steps;         /* view march steps at most, [8, 1024]; 0: 128 */
+    uint32_t cloud_light_steps;   /* light march steps toward the sun, [1, SB_CLOUD_MAX_LIGHT_STEPS]; 0: 6 */
+    uint32_t cloud_shadow_size;   /* texels per side of the clouds' shadow map, [16, 4096]; 0: 512 */
+    int debug;                    /* SB_DEBUG_* (view_gpu.h): the scene pass writes one term; 0: the frame */
+    bool whole_shadow_maps;       /* clear and draw every cascade whole, not only where casters
+                                     project (runtime/shadows.h); the same frame, slower */
+    bool generic_shaders;         /* never the scene's shaders specialised to the pack (no probes, no
+                                     reflection probes) and the frame (aerial perspective from its
+                                     volume alone); the same frame, slower on llvmpipe */
+    enum sb_scene_method scene;   /* how the scene pass finds the world's points */
+    const struct sb_lut3d *grade; /* a .cube LUT (grade.c), read during sb_renderer_create only; NULL:
+                                     none. It grades the display-referred 8-bit frame, or with
+                                     grade_log the scene-linear one in ACEScct before the tone curve */
+    bool grade_log;               /* the LUT's input is ACEScct, not the sRGB-encoded frame */
+    struct sb_grading grading;    /* scene-linear grading; zeroed: none */
+    bool purkinje;                /* the Purkinje shift in dim light (purkinje.c) */
+    double local_contrast;        /* local tone mapping (local_tonemap.c): the base layer's contrast about
+                                     the frame's pivot, (0, 1]; 0 or 1: none */
+    double sun_illuminance_lux;   /* the sun's illuminance above the atmosphere, what makes the pack's
+                                     radiance absolute for the Purkinje shift; 0: 128000 (the earth's) */
+    const float *post_input;      /* width x height x 3 floats in the pack's units, or NULL: every frame
+                                     post-processes this image instead of the lit one (read during
+                                     sb_renderer_create only; non-finite values read as 0) */
 };
 
 /* The grading's colour matrix (rows, linear Rec.709): white balance, then
@@ -107,11 +122,15 @@ void sb_rec709_to_ap1(double m[3][3]);
 
 /* What one frame looks at. Angles in radians; lengths in metres. */
 struct sb_view {
-    double camera_m[3];       /* in the world: y up, the origin on the ground */
-    double yaw, pitch;        /* view direction: azimuth clockwise from -z (north) toward +x, elevation */
-    double fov_y;             /* vertical field of view; 0: 50 degrees */
-    double sun_azimuth;       /* same convention as yaw */
-    double sun_elevation;     /* above the horizon; negative below */
+    double camera_m[3];                  /* in the world: y up, the origin on the ground */
+    double yaw, pitch;                   /* view direction: azimuth clockwise from -z (north) toward +x, elevation */
+    double fov_y;                        /* vertical field of view; 0: 50 degrees */
+    double sun_azimuth;                  /* same convention as yaw */
+    double sun_elevation;                /* above the horizon; negative below */
+    bool moon;                           /* the moon is in the sky (runtime/moon.h): it lights the sky and, with the
+                                            sun down, the world */
+    double moon_azimuth, moon_elevation; /* as the sun's */
+    double moon_distance_km;  /* from the camera; 0: its mean, 384,400 km. Its radius and brightness follow */
     double dt_s;              /* time since the previous frame, for exposure adaptation; 0: 1/60 s */
     bool snap_exposure;       /* a cut: take the metered exposure at once, drop the fog's and clouds' history */
     double time_s;            /* what the fog's noise and the clouds drift with (s) */
@@ -208,6 +227,9 @@ double sb_renderer_stored_scale(const struct sb_renderer *renderer);
  * exposure multiplier, this frame's metered log2 luminance, and the pixels
  * in the metering window. */
 void sb_renderer_exposure(const struct sb_renderer *renderer, float state[4]);
+/* A log2 luminance of the exposure's state (the pack's units) as EV at
+ * ISO 100 (K = 12.5; the pack made absolute by sun_illuminance_lux). */
+double sb_renderer_ev100(const struct sb_renderer *renderer, double log2_luminance);
 
 /* Where a world point lands in the last frame's image (pixels, x right, y
  * down); false when it is behind the camera. */

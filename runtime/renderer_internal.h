@@ -41,6 +41,7 @@ struct sb_renderer {
     unsigned caster_box_count;
     int32_t cascade_clear[SB_CASCADES][4]; /* this frame's texels to clear and draw in each cascade */
     double radiance_scale;                 /* 1 / the sun's largest channel: radiance in units of the sun */
+    double cd_m2_per_unit;                 /* the pack's radiance unit in cd/m^2 (params.sun_illuminance_lux) */
     double frame_scale;                    /* this frame's: what stored radiance is multiplied by, the
                                               radiance scale times the pre-exposure (renderer.c) */
     double previous_frame_scale;           /* the last frame's, which its history was stored with */
@@ -49,6 +50,7 @@ struct sb_renderer {
     double ground_radius_km;
     float thickness_km;                    /* the atmosphere's, as the shaders hold it */
     bool camera_in_atmosphere;             /* this frame's: which sky kernel runs */
+    uint32_t frame_lights;                 /* this frame's lights in the sky (sb_frame_gpu.lights.x) */
     double world_min_m[3], world_max_m[3]; /* the world's box */
     bool aerial_volume_only;               /* this frame's: which scene pipeline draws */
     bool scene_traced;                     /* the scene pass traces (passes/scene.c): no cascades to draw */
@@ -100,6 +102,7 @@ struct sb_renderer {
     uint64_t frame_index;       /* frames rendered before this one */
     struct sb_mat4 view_proj;   /* of the last frame, camera-relative */
     double camera_m[3];
+    double key_direction[3]; /* of the last frame: toward its key light (sb_frame_gpu.lights), world */
 };
 
 /* A pass: hooks called in sb_pass_classes' order, with r->pass its own

@@ -112,6 +112,14 @@ static double hermite(const double *x, const double *y, const double *m, int n, 
            (s3 - s2) * h * m[i + 1];
 }
 
+void sb_sun_path_date(const struct sb_sun_path *path, int *year, int *month, int *day, double *utc_offset_h)
+{
+    *year = path->year ? path->year : 2026;
+    *month = path->year ? path->month : 6;
+    *day = path->year ? path->day : 21;
+    *utc_offset_h = path->has_utc_offset ? path->utc_offset_h : path->longitude_deg / 15.0;
+}
+
 void sb_sun_path_at(const struct sb_sun_path *path, double hour, double *elevation, double *azimuth)
 {
     if (path->key_count >= 2) {
@@ -132,8 +140,9 @@ void sb_sun_path_at(const struct sb_sun_path *path, double hour, double *elevati
         *azimuth = az - 2.0 * M_PI * floor(az / (2.0 * M_PI));
         return;
     }
-    int year = path->year ? path->year : 2026, month = path->year ? path->month : 6, day = path->year ? path->day : 21;
-    double offset = path->has_utc_offset ? path->utc_offset_h : path->longitude_deg / 15.0;
+    int year, month, day;
+    double offset;
+    sb_sun_path_date(path, &year, &month, &day, &offset);
     struct sb_sun_position p;
     sb_sun_position(path->latitude_deg, path->longitude_deg, year, month, day, hour - offset, &p);
     *elevation = p.elevation;

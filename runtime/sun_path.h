@@ -63,6 +63,10 @@ struct sb_sun_path {
     int key_count;                                /* 0: the place's sun; otherwise 2 or more */
 };
 
+/* The date of a path of a place (its zeroed date: 2026-06-21) and its
+ * clock's offset from UTC (hours). */
+void sb_sun_path_date(const struct sb_sun_path *path, int *year, int *month, int *day, double *utc_offset_h);
+
 /* The sun at `hour` (local clock time) on the path. */
 void sb_sun_path_at(const struct sb_sun_path *path, double hour, double *elevation, double *azimuth);
 

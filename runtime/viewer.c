@@ -6,6 +6,7 @@
 #include <string.h>
 
 #include "log.h"
+#include "moon.h"
 #include "pngfile.h"
 #include "text.h"
 
@@ -52,6 +53,18 @@ void sb_viewer_draw_overlay(uint8_t *rgba, uint32_t width, uint32_t height, cons
     }
 }
 
+void sb_view_at_hour(struct sb_view *view, const struct sb_sun_path *path, double hour, bool moon)
+{
+    sb_sun_path_at(path, hour, &view->sun_elevation, &view->sun_azimuth);
+    struct sb_moon_position m;
+    if (moon && sb_moon_path_at(path, hour, &m)) {
+        view->moon = true;
+        view->moon_elevation = m.elevation;
+        view->moon_azimuth = m.azimuth;
+        view->moon_distance_km = SB_MOON_RADIUS_KM / sin(m.angular_radius); /* from the place */
+    }
+}
+
 enum sb_result sb_viewer_run(struct sb_renderer *r, struct sb_window *window, const struct sb_viewer_params *params)
 {
     uint32_t width, height;
@@ -92,7 +105,7 @@ enum sb_result sb_viewer_run(struct sb_renderer *r, struct sb_window *window, co
         /* The sun: by hand, or along the path. */
         if (params->sun_path) {
             hour = fmin(fmax(hour + (in.sun_right - in.sun_left) * HOURS_PER_S * dt, 0.0), 48.0);
-            sb_sun_path_at(params->sun_path, hour, &view.sun_elevation, &view.sun_azimuth);
+            sb_view_at_hour(&view, params->sun_path, hour, params->moon);
         } else {
             view.sun_azimuth += (in.sun_right - in.sun_left) * SUN_AZIMUTH_DEG_S * DEG * dt;
             view.sun_elevation =

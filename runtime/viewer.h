@@ -24,12 +24,17 @@ struct sb_viewer_params {
     struct sb_view view;                /* where the camera and the sun start */
     const struct sb_sun_path *sun_path; /* non-NULL: the sun from the path at `hour` */
     double hour;
+    bool moon;              /* with sun_path: the moon of its place too */
     int frames;             /* 0: until the window closes; N: N frames, each 1/60 s after the last, then close
                                (the headless frames' timing, so frame N is theirs) */
     const char *screenshot; /* with frames: the swapchain's last image as PNG here */
     const char *out_dir;    /* where P writes screenshots */
     bool overlay;           /* start with the timing overlay shown */
 };
+
+/* The sun of `path` at `hour` into `view`, and the moon too where the path
+ * has a place and `moon` is set (otherwise view->moon is left as it is). */
+void sb_view_at_hour(struct sb_view *view, const struct sb_sun_path *path, double hour, bool moon);
 
 /* Run until the window closes (or the frames are done). */
 enum sb_result sb_viewer_run(struct sb_renderer *renderer, struct sb_window *window,

@@ -53,8 +53,7 @@ static void test_meeus(void)
     CHECK(angle_diff_deg(m.longitude, 133.167265 * DEG) < tight, "longitude %.6f", m.longitude / DEG);
     CHECK(fabs(m.latitude / DEG + 3.229126) < tight, "latitude %.6f", m.latitude / DEG);
     CHECK(fabs(m.distance_km - 368409.7) < 0.1, "distance %.2f km", m.distance_km);
-    CHECK(angle_diff_deg(m.right_ascension, 134.688470 * DEG) < tight, "right ascension %.6f",
-          m.right_ascension / DEG);
+    CHECK(angle_diff_deg(m.right_ascension, 134.688470 * DEG) < tight, "right ascension %.6f", m.right_ascension / DEG);
     CHECK(fabs(m.declination / DEG - 13.768368) < tight, "declination %.6f", m.declination / DEG);
     CHECK(tight < MOON_TOLERANCE_DEG, "the issue's bound is the looser");
 
@@ -104,8 +103,8 @@ static void test_eclipses(void)
         double apart = separation_deg(dm, ds);
         printf("%d-%02d-%02d: the moon %.4f degrees from the sun (radii %.4f and 0.267), phase angle %.2f, "
                "moon elevation %.3f\n",
-               eclipses[i].year, eclipses[i].month, eclipses[i].day, apart, m.angular_radius / DEG,
-               m.phase_angle / DEG, m.elevation / DEG);
+               eclipses[i].year, eclipses[i].month, eclipses[i].day, apart, m.angular_radius / DEG, m.phase_angle / DEG,
+               m.elevation / DEG);
         /* Totality: the moon's disk covers the sun's (its radius is the larger by 0.01 degrees). */
         CHECK(apart < 0.05, "%d: the centres %.4f degrees apart", eclipses[i].year, apart);
         CHECK(m.angular_radius / DEG > 0.267, "%d: the moon's radius %.4f does not cover the sun's", eclipses[i].year,

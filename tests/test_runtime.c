@@ -20,6 +20,7 @@
 #include "json.h"
 #include "level.h"
 #include "log.h"
+#include "moon.h"
 #include "pack.h"
 #include "parallel.h"
 #include "physics.h"
@@ -582,34 +583,61 @@ static double exposed_middle(struct sb_renderer *r)
     return exp2(sum / count);
 }
 
+/* Where the meter puts the frame's middle: mid grey, less the dim light's
+ * compensation under dusk (renderer.h). */
+static double expected_middle(struct sb_renderer *r, const float state[4])
+{
+    double ev = sb_renderer_ev100(r, state[0]);
+    return 0.18 * exp2(-SB_EXPOSURE_DIM_STOPS * fmax(SB_EXPOSURE_DIM_EV100 - ev, 0.0));
+}
+
 static void test_exposure(struct sb_renderer *r)
 {
-    /* Noon, dusk (the sun 3 degrees down) and deep civil twilight (8 down,
-     * 2^-12 of noon's light; at -12 degrees the frame is below the meter's
-     * darkest bin, 2^-20 of the sun's units), each a cut. The meter's own
-     * quantisation is 32/254 EV a bin; the middle 80% of the pixels is not
-     * exactly its 10%..90% window mean: a factor 1.5. (That twilight is
-     * stored at full precision, pre-exposure, is test_sky_view's at -12.) */
-    static const double elevations[3] = {30.0, -3.0, -8.0};
-    float states[3][4];
-    double middles[3];
+    /* Noon, dusk (the sun 3 degrees down), deep civil twilight (8 down,
+     * 2^-12 of noon's light) and a moonlit night (the full moon 30 degrees
+     * up, the sun 40 down), each a cut. The meter's own quantisation is
+     * 46/254 EV a bin; the middle 80% of the pixels is not exactly its
+     * 10%..90% window mean: a factor 1.5. (That twilight is stored at full
+     * precision, pre-exposure, is test_sky_view's at -12.) */
+    static const double elevations[4] = {30.0, -3.0, -8.0, -40.0};
+    float states[4][4];
+    double middles[4];
     struct sb_view v = base_view();
-    for (int i = 0; i < 3; i++) {
+    for (int i = 0; i < 4; i++) {
         v.sun_elevation = elevations[i] * DEG;
+        v.moon = i == 3;
+        v.moon_elevation = 30.0 * DEG;
+        v.moon_azimuth = v.sun_azimuth + M_PI;
         if (!render(r, &v))
             return;
         sb_renderer_exposure(r, states[i]);
         middles[i] = exposed_middle(r);
-        CHECK(middles[i] > 0.18 / 1.5 && middles[i] < 0.18 * 1.5,
-              "the sun at %g degrees: the frame ends up at %.3f, within 1.5x of mid grey", elevations[i], middles[i]);
+        double want = expected_middle(r, states[i]);
+        CHECK(middles[i] > want / 1.5 && middles[i] < want * 1.5,
+              "the sun at %g degrees: the frame ends up at %.4f, within 1.5x of %.4f (EV100 %.2f)", elevations[i],
+              middles[i], want, sb_renderer_ev100(r, states[i][0]));
+    }
+    v.moon = false;
+    printf("exposure: EV100 of noon %.2f, dusk %.2f, twilight %.2f, the moonlit night %.2f; exposed middles %.3f "
+           "%.3f %.3f %.4f\n",
+           sb_renderer_ev100(r, states[0][0]), sb_renderer_ev100(r, states[1][0]), sb_renderer_ev100(r, states[2][0]),
+           sb_renderer_ev100(r, states[3][0]), middles[0], middles[1], middles[2], middles[3]);
+    CHECK(middles[3] < 0.5 * middles[0], "the moonlit night is exposed darker than noon: %.4f, noon %.4f", middles[3],
+          middles[0]);
+    /* Without the moon the night is darker than the range: the meter stops at its bottom. */
+    v.sun_elevation = -40.0 * DEG;
+    float dark[4];
+    if (render(r, &v)) {
+        sb_renderer_exposure(r, dark);
+        CHECK(fabs(sb_renderer_ev100(r, dark[0]) - SB_EXPOSURE_MIN_EV100) < 1e-3,
+              "a moonless night adapts to the range's bottom, EV100 %g, not %.4f", SB_EXPOSURE_MIN_EV100,
+              sb_renderer_ev100(r, dark[0]));
     }
     const float *noon_state = states[0];
     CHECK(states[1][1] > 20.0 * noon_state[1], "dusk is exposed %.1fx more than noon (at least 20x)",
           states[1][1] / noon_state[1]);
     CHECK(states[2][1] > 1000.0 * noon_state[1], "twilight is exposed %.0fx more than noon (at least 1000x)",
           states[2][1] / noon_state[1]);
-    printf("exposure: noon %.3g, dusk (-3 degrees) %.3g, twilight (-8) %.3g; exposed middles %.3f %.3f %.3f\n",
-           noon_state[1], states[1][1], states[2][1], middles[0], middles[1], middles[2]);
 
     /* Adaptation: from noon, the dusk view moves the exposure a step of
      * 1 - exp(-dt * 1/s) of the way in log2 each frame. */
@@ -629,6 +657,138 @@ static void test_exposure(struct sb_renderer *r)
     sb_renderer_exposure(r, last);
     CHECK(fabs(last[0] - last[2]) < 0.01, "after 8 s the exposure has adapted: log2 %.4f, metered %.4f", last[0],
           last[2]);
+}
+
+/* ---- The moon ------------------------------------------------------------------------ */
+
+/* The sum of a frame's pixels (pack units), per channel. */
+static void frame_sum(const float *rgb, double out[3])
+{
+    out[0] = out[1] = out[2] = 0.0;
+    for (int i = 0; i < W * H; i++)
+        for (int c = 0; c < 3; c++)
+            out[c] += rgb[3 * i + c];
+}
+
+/*
+ * The moon as skyview draws it, against the sun drawn the same way:
+ * - its disk, looked at through a 0.6-degree field (39 pixels a radius),
+ *   delivers the moon's irradiance (sb_moon_irradiance_ratio, moon.h, tested
+ *   against Meeus in test_moon) in moonlight's colour: the disk's pixels
+ *   summed over the sun's disk's pixels summed, at the same direction, are
+ *   the ratio times the colour, at full moon and at quarter, the quarter lit
+ *   on the sun's side;
+ * - by night the world, the sky and the air are lit by the moon as they
+ *   are by day by a sun in its place, times that ratio and colour, pixel by
+ *   pixel: every pass reads the key light and the lights in the sky.
+ */
+static void test_moonlight(struct sb_renderer *r)
+{
+    const double moon_el = 20.0 * DEG, moon_az = 150.0 * DEG;
+    double moon[3];
+    sb_direction(moon_az, moon_el, moon);
+    const double color[3] = {SB_MOON_COLOR_R, SB_MOON_COLOR_G, SB_MOON_COLOR_B};
+
+    /* The disks. A pixel's solid angle is the same in both frames. */
+    struct sb_view v = base_view();
+    v.yaw = moon_az;
+    v.pitch = moon_el;
+    v.fov_y = 0.6 * DEG;
+    v.sun_azimuth = moon_az;
+    v.sun_elevation = moon_el;
+    if (!render(r, &v))
+        return;
+    float *rgb = frame_rgb(r);
+    double sun_sum[3];
+    frame_sum(rgb, sun_sum);
+    free(rgb);
+    for (int phase = 0; phase < 2; phase++) {
+        v.moon = true;
+        v.moon_azimuth = moon_az;
+        v.moon_elevation = moon_el;
+        /* Full: the sun opposite. Quarter: 90 degrees from the moon, 30 under
+         * the horizon, to the moon's west (left in the frame): cos 90 =
+         * sin(20) sin(-30) + cos(20) cos(30) cos(daz). */
+        v.sun_elevation = phase == 0 ? -moon_el : -30.0 * DEG;
+        double daz = phase == 0 ? M_PI : acos(sin(moon_el) * sin(30.0 * DEG) / (cos(moon_el) * cos(30.0 * DEG)));
+        v.sun_azimuth = moon_az - daz;
+        double sun[3];
+        sb_direction(v.sun_azimuth, v.sun_elevation, sun);
+        double angle = acos(-(sun[0] * moon[0] + sun[1] * moon[1] + sun[2] * moon[2]));
+        double ratio = sb_moon_irradiance_ratio(angle, 384400.0);
+        if (!render(r, &v))
+            return;
+        rgb = frame_rgb(r);
+        check_finite(rgb, "the moon's disk");
+        /* The sun's side of the terminator, which crosses the quarter
+         * moon's centre: the sun projected on the frame (right: east of the
+         * view; up: toward the zenith). */
+        double right_axis[3] = {cos(moon_az), 0.0, sin(moon_az)};
+        double up_axis[3] = {-sin(moon_el) * sin(moon_az), cos(moon_el), sin(moon_el) * cos(moon_az)};
+        double sx = 0.0, sy = 0.0;
+        for (int k = 0; k < 3; k++) {
+            sx += sun[k] * right_axis[k];
+            sy += sun[k] * up_axis[k];
+        }
+        double sum[3], lit = 0.0, unlit = 0.0;
+        frame_sum(rgb, sum);
+        for (int y = 0; y < H; y++)
+            for (int x = 0; x < W; x++) {
+                double side = (x + 0.5 - W / 2.0) * sx + (H / 2.0 - y - 0.5) * sy;
+                *(side > 0.0 ? &lit : &unlit) += luminance(pixel(rgb, x, y));
+            }
+        free(rgb);
+        for (int c = 0; c < 3; c++) {
+            double got = sum[c] / sun_sum[c], want = ratio * color[c];
+            /* The disks' edges cross pixels, 39 and 40 pixels a radius,
+             * where the quarter moon is at its brightest: 1%. */
+            CHECK(fabs(got / want - 1.0) < 0.01, "%s moon, channel %d: the disk gives %.4e of the sun's, not %.4e",
+                  phase ? "quarter" : "full", c, got, want);
+        }
+        printf("moon disk: %s (phase angle %.1f degrees): %.4e of the sun's (%.4e expected, green); the sun's half "
+               "over the other %.1f\n",
+               phase ? "quarter" : "full", angle / DEG, sum[1] / sun_sum[1], ratio * color[1], lit / unlit);
+        if (phase == 1)
+            CHECK(lit > 50.0 * unlit, "the quarter moon is lit toward the sun: that half %.3e, the other %.3e", lit,
+                  unlit);
+    }
+
+    /* The world by night against the world by day. */
+    struct sb_view day = base_view(), night = base_view();
+    day.sun_azimuth = night.moon_azimuth = moon_az;
+    day.sun_elevation = night.moon_elevation = moon_el;
+    night.moon = true;
+    night.sun_elevation = -40.0 * DEG; /* under every altitude's horizon: no twilight */
+    night.sun_azimuth = moon_az + M_PI;
+    double sun_night[3];
+    sb_direction(night.sun_azimuth, night.sun_elevation, sun_night);
+    double ratio = sb_moon_irradiance_ratio(
+        acos(-(sun_night[0] * moon[0] + sun_night[1] * moon[1] + sun_night[2] * moon[2])), 384400.0);
+    float *by_day = NULL, *by_night = NULL;
+    if (render(r, &day))
+        by_day = frame_rgb(r);
+    if (render(r, &night))
+        by_night = frame_rgb(r);
+    if (by_day && by_night) {
+        check_finite(by_night, "moonlight");
+        double worst = 0.0, sum_day = 0.0, sum_night = 0.0;
+        for (int i = 0; i < W * H; i++)
+            for (int c = 0; c < 3; c++) {
+                double want = by_day[3 * i + c] * ratio * color[c];
+                sum_day += want;
+                sum_night += by_night[3 * i + c];
+                /* Both frames stored in halves (2^-11), the second's scale
+                 * 2^18 larger: a few rounding steps a pixel. */
+                worst = fmax(worst, fabs(by_night[3 * i + c] - want) / fmax(want, 1e-3 * ratio));
+            }
+        printf("moonlight: the world by night over by day times the moon's ratio and colour: %.5f overall, worst "
+               "pixel %.2e off\n",
+               sum_night / sum_day, worst);
+        CHECK(fabs(sum_night / sum_day - 1.0) < 2e-3, "by night %.5f of the moonlit day's light", sum_night / sum_day);
+        CHECK(worst < 5e-3, "a pixel by night is %.2e off the day's times the moon's", worst);
+    }
+    free(by_day);
+    free(by_night);
 }
 
 /* ---- psi_ms as skyview reads it ---------------------------------------------------- */
@@ -1002,8 +1162,10 @@ static void test_detail(const char *world_path, const char *layers_dir, const st
     CHECK(inside > 0 && under > 0, "detail probes inside the room (%d) and under the overhang (%d)", inside, under);
     CHECK(detailed[0] / detailed[1] < 2.0 * view, "under the overhang with detail: %.3f of open ground, at most %.3f",
           detailed[0] / detailed[1], 2.0 * view);
-    CHECK(detailed[2] / detailed[1] < 0.01, "inside the closed room with detail: %.4f of open ground; near black "
-          "expected", detailed[2] / detailed[1]);
+    CHECK(detailed[2] / detailed[1] < 0.01,
+          "inside the closed room with detail: %.4f of open ground; near black "
+          "expected",
+          detailed[2] / detailed[1]);
     CHECK(apart > 0.02, "the detail changes the light along the line (%.4f): the seam test can fail", apart);
     CHECK(seam <= apart / 3.0 + seam_layers,
           "no seam where the detail ends: %.4f at most between neighbours, the layouts %.4f apart, the layers' own "
@@ -1081,8 +1243,8 @@ static void leak_ratios(const struct sb_pack *p, const struct sb_world *w, doubl
                    wall_luminance(p, w, south_in, M_PI, 'z', 2.95, SB_DEBUG_AMBIENT),
                    wall_luminance(p, w, east_in, 0.5 * M_PI, 'x', 8.17, SB_DEBUG_AMBIENT)};
     CHECK(outside > 0 && outside_e > 0 && inside >= 0 && e[0] >= 0 && e[1] >= 0 && e[2] >= 0,
-          "the walls' light: outside %g (irradiance %g), inside %g (irradiance %g, %g, %g)", outside, outside_e,
-          inside, e[0], e[1], e[2]);
+          "the walls' light: outside %g (irradiance %g), inside %g (irradiance %g, %g, %g)", outside, outside_e, inside,
+          e[0], e[1], e[2]);
     out[0] = inside / outside;
     out[1] = e[0] / outside_e;
     out[2] = fmax(e[0], fmax(e[1], e[2])) / outside_e;
@@ -1127,7 +1289,8 @@ static void test_leak(const char *dir)
         }
         struct sb_bake_report report;
         struct sb_pack leak_pack;
-        bool ok = sb_bake_scene(vk, scene, pack_dir, NULL, &report) == SB_OK && sb_pack_open(pack_dir, &leak_pack) == SB_OK;
+        bool ok =
+            sb_bake_scene(vk, scene, pack_dir, NULL, &report) == SB_OK && sb_pack_open(pack_dir, &leak_pack) == SB_OK;
         free(scene);
         CHECK(ok, "bake the leak world's probes (layout %d)", layout);
         if (!ok)
@@ -2037,6 +2200,7 @@ int main(int argc, char **argv)
         test_caster_boxes_bounded();
         test_framing(&world);
         test_exposure(r);
+        test_moonlight(r);
         test_multiscattering_refined();
         /* Against a reference that reads the sun's transmittance from the
          * baked LUT as the runtime does, so the LUT's own error (reported)

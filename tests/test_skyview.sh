@@ -246,7 +246,31 @@ check "3 frames of 64 x 36 in a 2 x 2 grid with label strips: 134 x 100" \
 check "a label under the first frame" test "$($stats ink "$tmp/s1/contact_sheet.png" 2 38 64 11 24 24 24)" -gt 20
 check "the fourth cell empty" test "$($stats ink "$tmp/s1/contact_sheet.png" 68 51 64 47 24 24 24)" = 0
 
+# The moon: by the date at night (the full moon of 2026-06-29, 13.5
+# degrees up in the south-south-east at 23 h at 47 N, 8 E), lighting a
+# frame that without it is the range's black; by hand; and the bad
+# combinations.
+night="--time-of-day 23-23.01 --frames 2 --location 47,8 --date 2026-06-29 --encoder png"
+check "a moonlit night" expect_exit 0 "$skyview" "$tmp/pack" -o "$tmp/m1" $small $night
+check "sequence.json places the moon (a sweep writes it)" python3 - "$tmp/m1/sequence.json" <<'PY'
+import json, sys
+f = json.load(open(sys.argv[1]))["frames"][0]
+assert abs(f["moon_elevation_deg"] - 13.5) < 0.2 and abs(f["moon_azimuth_deg"] - 165.9) < 0.3, f
+assert f["sun_elevation_deg"] < -18, f
+PY
+check "the same night without the moon" expect_exit 0 "$skyview" "$tmp/pack" -o "$tmp/m2" $small $night --no-moon
+check "is darker: the moon lights the frame" python3 - "$tmp/m1/frame_0000.png" "$tmp/m2/frame_0000.png" <<PY
+import subprocess, sys
+mean = lambda p: sum(map(float, subprocess.check_output(["python3", "$root/tests/png_stats.py", "mean", p]).split()))
+lit, dark = mean(sys.argv[1]), mean(sys.argv[2])
+assert lit > 30 and lit > 4 * dark, (lit, dark)
+PY
+check "a moon by hand" expect_exit 0 "$skyview" "$tmp/pack" -o "$tmp/m3" $small --sun-elevation -30 --moon 20,150 \
+    --ev-range -6,16 --dim-compensation 0.5
+
 for bad in "--time-of-day 8-6" "--time-of-day 49" "--time-of-day 6-" "--time-of-day 12 --sun-elevation 10" \
+           "--moon 10" "--moon 95,0" "--moon 10,0 --no-moon" "--time-of-day 22 --moon 10,0" "--ev-range 5,2" \
+           "--ev-range -30,10" "--dim-compensation 2" \
            "--location 47,8" "--time-of-day 6-8 --location 91,0" "--time-of-day 6-8 --date 2026-02-30" \
            "--time-of-day 6-8 --sun-keys 6:0:90" "--time-of-day 6-8 --sun-keys 6:0:90,7:5:100 --date 2026-01-01" \
            "--time-of-day 6-8 --frames 1" "--time-of-day 6-8 --bench" "--time-of-day 6 --encoder png" \

@@ -18,11 +18,9 @@
  * rods alone at and below 0.005 cd/m^2. */
 #define PHOTOPIC_CD_M2 5.0
 #define SCOTOPIC_CD_M2 0.005
-#define EARTH_SUN_LUX 128000.0
 
 struct sb_purkinje {
     bool enabled;
-    double cd_m2_per_unit;   /* the pack's radiance unit in cd/m^2 */
     struct sb_buffer params; /* sb_purkinje_gpu */
     VkPipeline kernel;
 };
@@ -33,17 +31,12 @@ static enum sb_result purkinje_create(struct sb_renderer *r)
     if (!p)
         return SB_ERR_NOMEM;
     sb_pass_set_data(r, p);
-    const double *sun = r->pack->scene->atmosphere.solar_irradiance;
-    static const double weights[3] = {SB_LUMINANCE_RGB};
-    double sun_y = weights[0] * sun[0] + weights[1] * sun[1] + weights[2] * sun[2];
-    double lux = r->params.sun_illuminance_lux > 0.0 ? r->params.sun_illuminance_lux : EARTH_SUN_LUX;
-    p->enabled = r->params.purkinje && sun_y > 0.0;
+    p->enabled = r->params.purkinje;
     if (!p->enabled)
         return SB_OK;
     enum sb_result res = sb_renderer_upload(r, NULL, sizeof(struct sb_purkinje_gpu), "Purkinje shift", &p->params);
     if (res)
         return res;
-    p->cd_m2_per_unit = lux / sun_y;
     struct sb_purkinje_gpu *gpu = p->params.mapped;
     gpu->scale[2] = (float)PHOTOPIC_CD_M2;
     gpu->scale[3] = (float)SCOTOPIC_CD_M2;
@@ -70,7 +63,7 @@ static void purkinje_record(struct sb_renderer *r)
         return;
     /* The stored frame to cd/m^2 follows the frame's scale (pre-exposure). */
     struct sb_purkinje_gpu *gpu = p->params.mapped;
-    double scale = p->cd_m2_per_unit / r->frame_scale;
+    double scale = r->cd_m2_per_unit / r->frame_scale;
     gpu->scale[0] = (float)scale;
     gpu->scale[1] = (float)(1.0 / scale);
     sb_renderer_dispatch_frame(r, p->kernel);

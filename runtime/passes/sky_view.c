@@ -1,7 +1,9 @@
 /*
  * The sky-view LUT (Hillaire 2020): the sky's radiance around the camera on
- * a latitude-longitude grid, SB_SKY_VIEW_WIDTH x SB_SKY_VIEW_HEIGHT, which
- * the probes and the sky pass sample; "sky-view" in the graph's table.
+ * a latitude-longitude grid, SB_SKY_VIEW_WIDTH x SB_SKY_VIEW_HEIGHT, a layer
+ * for each light in the sky (the sun's, and at night the moon's, written
+ * only then), which the probes and the sky pass sample; "sky-view" in the
+ * graph's table.
  */
 #include <stdlib.h>
 
@@ -21,7 +23,7 @@ static enum sb_result sky_view_create(struct sb_renderer *r)
         return SB_ERR_NOMEM;
     sb_pass_set_data(r, s);
     enum sb_result res = sb_renderer_texture(
-        r, &s->lut, (const uint32_t[3]){SB_SKY_VIEW_WIDTH, SB_SKY_VIEW_HEIGHT, 1}, 1, 1, SB_HDR_FORMAT,
+        r, &s->lut, (const uint32_t[3]){SB_SKY_VIEW_WIDTH, SB_SKY_VIEW_HEIGHT, 1}, SB_SKY_LIGHTS, 1, SB_HDR_FORMAT,
         VK_IMAGE_USAGE_STORAGE_BIT | VK_IMAGE_USAGE_SAMPLED_BIT | VK_IMAGE_USAGE_TRANSFER_SRC_BIT, "sky-view LUT");
     if (res)
         return res;
@@ -43,7 +45,8 @@ static void sky_view_destroy(struct sb_renderer *r)
 static void sky_view_record(struct sb_renderer *r)
 {
     struct sky_view *s = sb_pass_data(r);
-    sb_renderer_dispatch(r, s->kernel, NULL, (const uint32_t[3]){SB_SKY_VIEW_WIDTH, SB_SKY_VIEW_HEIGHT, 1},
+    uint32_t lights = r->frame_lights;
+    sb_renderer_dispatch(r, s->kernel, NULL, (const uint32_t[3]){SB_SKY_VIEW_WIDTH, SB_SKY_VIEW_HEIGHT, lights},
                          (const uint32_t[3]){SB_WORKGROUP_X, SB_WORKGROUP_Y, 1});
 }
 

@@ -24,21 +24,28 @@ void main()
     float r = length(p);
     float h = max(r - ground_radius(), 0.0);
     float mu = dot(p, d) / r;
-    float mu_s = dot(p, frame.sun_direction.xyz) / r;
-    float nu = dot(d, frame.sun_direction.xyz);
-    vec3 sun = atm.solar_irradiance.rgb;
-    float p_r = phase_rayleigh(nu), p_m = phase_mie(nu);
     /* The volume serves cameras inside the atmosphere; above it, the scene
-     * pass integrates per fragment. */
-    RayIntegrals ri = ray_integrals_begin();
-    float t0 = 0.0;
-    for (int k = 0; k < SB_AERIAL_SIZE; k++) {
-        float w = (float(k) + 0.5) / float(SB_AERIAL_SIZE);
-        float t1 = frame.aerial.x * w * w;
-        integrate_segment(ri, h, mu, mu_s, nu, t0, t1, true);
-        t0 = t1;
-        vec3 L = sun * (ri.sun_rayleigh * p_r + ri.sun_mie * p_m) + ri.ms_rayleigh + ri.ms_mie;
-        imageStore(inscatter_out, ivec3(column, k), vec4(fp16_safe(L * frame.aerial.y), 1.0));
-        imageStore(transmittance_out, ivec3(column, k), vec4(exp(-ri.tau), 1.0));
+     * pass integrates per fragment. Each light in the sky's march adds its
+     * in-scattering to the slices'. */
+    vec3 L[SB_AERIAL_SIZE];
+    for (int i = 0; i < sky_light_count(); i++) {
+        vec3 l = light_direction(i), color = atm.solar_irradiance.rgb * light_color(i);
+        float mu_s = dot(p, l) / r, nu = dot(d, l);
+        float p_r = phase_rayleigh(nu), p_m = phase_mie(nu);
+        vec3 ms_color = light_color(i);
+        RayIntegrals ri = ray_integrals_begin();
+        float t0 = 0.0;
+        for (int k = 0; k < SB_AERIAL_SIZE; k++) {
+            float w = (float(k) + 0.5) / float(SB_AERIAL_SIZE);
+            float t1 = frame.aerial.x * w * w;
+            integrate_segment(ri, h, mu, mu_s, nu, t0, t1, true);
+            t0 = t1;
+            vec3 add = color * (ri.sun_rayleigh * p_r + ri.sun_mie * p_m) + ms_color * (ri.ms_rayleigh + ri.ms_mie);
+            L[k] = i == 0 ? add : L[k] + add;
+            if (i == 0)
+                imageStore(transmittance_out, ivec3(column, k), vec4(exp(-ri.tau), 1.0));
+        }
     }
+    for (int k = 0; k < SB_AERIAL_SIZE; k++)
+        imageStore(inscatter_out, ivec3(column, k), vec4(fp16_safe(L[k] * frame.aerial.y), 1.0));
 }

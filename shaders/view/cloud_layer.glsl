@@ -136,7 +136,7 @@ float cloud_exit_m(float h_km, float mu)
  * `jitter` of its length (the view march's, so frames average it). */
 float cloud_light_depth(vec3 q, float h_km, float mu_s, int steps, float jitter)
 {
-    vec3 l = frame.sun_direction.xyz;
+    vec3 l = key_direction();
     float reach = min(cloud_exit_m(h_km, mu_s), SB_CLOUD_LIGHT_DISTANCE_M);
     float unit = reach / (0.5 * float(steps) * float(steps + 1));
     float tau = 0.0;
@@ -155,8 +155,8 @@ float cloud_light_depth(vec3 q, float h_km, float mu_s, int steps, float jitter)
  * ray and the sun; jitter places the light march's samples. */
 vec3 cloud_light(vec3 q, vec3 up, float h_km, float f, float nu, int light_steps, float jitter)
 {
-    float mu_s = dot(up, frame.sun_direction.xyz);
-    vec3 sun = atm.solar_irradiance.rgb * sun_transmittance(h_km, mu_s);
+    float mu_s = dot(up, key_direction());
+    vec3 sun = atm.solar_irradiance.rgb * key_color() * sun_transmittance(h_km, mu_s);
     float octaves = 0.0;
     if (max(sun.r, max(sun.g, sun.b)) > 0.0) {
         float tau = cloud_light_depth(q, h_km, mu_s, light_steps, jitter);
@@ -167,8 +167,8 @@ vec3 cloud_light(vec3 q, vec3 up, float h_km, float f, float nu, int light_steps
             a *= 0.5;
         }
     }
-    vec3 e_up = ground_sky_irradiance_sample(mu_s);
-    vec3 e_down = atm.ground_albedo.rgb * ground_irradiance_sample(mu_s);
+    vec3 e_up, e_down;
+    sky_irradiance(up, e_up, e_down);
     vec3 ambient = (e_up * mix(0.5, 1.0, f) + e_down * mix(1.0, 0.5, f)) / (2.0 * PI);
     return clouds.albedo.rgb * (sun * octaves + ambient) * frame.aerial.y;
 }
@@ -211,7 +211,7 @@ float cloud_sun_transmittance(vec3 p)
 {
     if (clouds.erosion.z == 0.0)
         return 1.0;
-    vec3 l = frame.sun_direction.xyz;
+    vec3 l = key_direction();
     vec2 g = p.xz - l.xz * (p.y / max(l.y, 0.02));
     vec2 uv = (g - clouds.shadow.xy) / clouds.shadow.z + 0.5;
     return exp(-textureLod(cloud_shadow_map, uv, 0.0).r);

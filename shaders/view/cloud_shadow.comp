@@ -23,7 +23,7 @@ void main()
     vec3 planet = planet_position(offset);
     float r = length(planet);
     float h_km = max(r - ground_radius(), 0.0);
-    float mu_s = dot(planet / r, frame.sun_direction.xyz);
+    float mu_s = dot(planet / r, key_direction());
     float tau = 0.0;
     if (clouds.erosion.z != 0.0 && !ray_hits_ground(h_km, mu_s)) {
         float enter = max(cloud_sphere_hits(h_km, mu_s, clouds.layer.x * 1e-3).y, 0.0) * 1e3;
@@ -31,7 +31,7 @@ void main()
         leave = min(leave, enter + SB_CLOUD_SHADOW_REACH_M);
         int steps = int(clouds.shadow.w);
         float piece = max(leave - enter, 0.0) / float(steps);
-        vec3 l = frame.sun_direction.xyz;
+        vec3 l = key_direction();
         for (int i = 0; i < steps; i++) {
             float s = enter + (float(i) + 0.5) * piece;
             vec3 q = vec3(g.x + l.x * s, altitude_along(h_km, mu_s, s * 1e-3) * 1e3, g.y + l.z * s);

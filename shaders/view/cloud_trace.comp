@@ -56,7 +56,7 @@ void main()
             grow = 2.0 * (length_m - float(n) * first) / (float(n) * float(n - 1));
         float jitter = fract(52.9829189 * fract(dot(vec2(pixel), vec2(0.06711056, 0.00583715))) + clouds.temporal.x);
         float h_c = frame.camera_km.w, mu = dot(normalize(frame.camera_km.xyz), d);
-        float nu = dot(d, frame.sun_direction.xyz);
+        float nu = dot(d, key_direction());
         int light_steps = int(clouds.march.y);
         float t = t0;
         for (int i = 0; i < n; i++) {

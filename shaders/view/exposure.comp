@@ -1,9 +1,10 @@
 #version 450
 /* Auto-exposure from the histogram: the mean log2 luminance of the pixels
  * between the low and high percentiles (so neither the sun nor deep shadow
- * decides), adapted in log2 toward it at exponential speeds per second, then
- * the exposure that maps it to mid grey (0.18) with the compensation. The
- * bins are cleared for the next frame. */
+ * decides), held within the EV range, adapted in log2 toward it at
+ * exponential speeds per second, then the exposure that maps it to mid grey
+ * (0.18) with the compensation, less the dim light's: a night stays darker
+ * than a day, as the eye sees it. The bins are cleared for the next frame. */
 #extension GL_GOOGLE_include_directive : require
 #include "view_gpu.h"
 
@@ -38,14 +39,15 @@ void main()
         sum += in_window * bin_log;
         weight += in_window;
     }
-    float metered = weight > 0.0 ? sum / weight : frame.exposure.x;
+    float metered = clamp(weight > 0.0 ? sum / weight : frame.exposure.x, frame.meter.x, frame.meter.y);
     float adapted = metered;
     if (frame.adaptation.w == 0.0) {
         float previous = exposure.state.x;
         float speed = metered > previous ? frame.adaptation.x : frame.adaptation.y;
         adapted = previous + (metered - previous) * (1.0 - exp(-frame.adaptation.z * speed));
     }
-    exposure.state = vec4(adapted, 0.18 * exp2(frame.post.z - adapted), metered, weight);
+    float dim = frame.meter.z * max(frame.meter.w - adapted, 0.0);
+    exposure.state = vec4(adapted, 0.18 * exp2(frame.post.z - dim - adapted), metered, weight);
     for (uint b = 0u; b < SB_HISTOGRAM_BINS; b++)
         bins[b] = 0u;
 }

@@ -69,7 +69,7 @@ float fog_extinction(vec3 p)
     return sigma;
 }
 
-/* The sun's light reaching world point p (offset from the camera), before
+/* The key light's (the sun's, or the moon's at night) reaching world point p (offset from the camera), before
  * visibility and phase, and the ambient in-scattering per unit scattering:
  * both times the frame's radiance scale. */
 void fog_light(vec3 offset, vec3 p, out vec3 sun, out vec3 ambient)
@@ -78,11 +78,11 @@ void fog_light(vec3 offset, vec3 p, out vec3 sun, out vec3 ambient)
     float r = length(planet);
     vec3 up = planet / r;
     float h = max(r - ground_radius(), 0.0);
-    float mu_s = dot(up, frame.sun_direction.xyz);
+    float mu_s = dot(up, key_direction());
     float tau_sun = height_fog_extinction(p.y) / (fog.medium.z * max(mu_s, 1e-4)); /* H >= 1 m: z > 0 */
-    sun = atm.solar_irradiance.rgb * sun_transmittance(h, mu_s) * (exp(-tau_sun) * frame.aerial.y);
-    vec3 e_up = ground_sky_irradiance_sample(mu_s);
-    vec3 e_down = atm.ground_albedo.rgb * ground_irradiance_sample(mu_s);
+    sun = atm.solar_irradiance.rgb * key_color() * sun_transmittance(h, mu_s) * (exp(-tau_sun) * frame.aerial.y);
+    vec3 e_up, e_down;
+    sky_irradiance(up, e_up, e_down);
 #ifdef SB_FOG_PROBES
     vec3 probe_up, probe_down;
     float coverage;

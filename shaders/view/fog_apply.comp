@@ -51,7 +51,7 @@ void main()
         fog_light(d * far, p_far, sun, ambient);
         float clouds_t = cloud_sun_transmittance(p_far);
         vec3 source =
-            fog.albedo.rgb * (sun * (phase_hg(fog.medium.w, dot(d, frame.sun_direction.xyz)) * clouds_t) + ambient);
+            fog.albedo.rgb * (sun * (phase_hg(fog.medium.w, dot(d, key_direction())) * clouds_t) + ambient);
         inscatter += transmittance * source * (1.0 - exp(-tau));
         transmittance *= exp(-tau);
     }

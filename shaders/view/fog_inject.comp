@@ -28,7 +28,7 @@ vec4 froxel_light(vec3 cell)
         return vec4(0.0);
     vec3 sun, ambient;
     fog_light(offset, p, sun, ambient);
-    float nu = dot(d, frame.sun_direction.xyz);
+    float nu = dot(d, key_direction());
     vec3 light = sun * (phase_hg(fog.medium.w, nu) * sun_visibility(offset, vec3(0.0), false) * cloud_sun_transmittance(p)) + ambient;
     return min(vec4(fog.albedo.rgb * sigma * light, sigma), vec4(65000.0));
 }

@@ -1,6 +1,7 @@
 /*
  * The frame's constants (struct sb_frame_gpu, view_gpu.h), as every view pass
- * reads them: the one declaration of the frame's buffer.
+ * reads them: the one declaration of the frame's buffer, and what it says
+ * of the lights.
  */
 #ifndef SB_FRAME_GLSL
 #define SB_FRAME_GLSL
@@ -10,5 +11,39 @@
 layout(std430, set = 0, binding = SB_VIEW_BINDING_FRAME) readonly buffer FrameBuffer {
     sb_frame_gpu frame;
 };
+
+/* The lights (sb_frame_gpu.lights): the sun (0) and, at night, the moon
+ * (1); their colours multiply the solar irradiance. Every light in the sky
+ * scatters in the atmosphere; the key light alone lights surfaces, fog and
+ * clouds directly and casts shadows. */
+int sky_light_count()
+{
+    return int(frame.lights.x);
+}
+
+vec3 light_direction(int i)
+{
+    return i == 0 ? frame.sun_direction.xyz : frame.moon_direction.xyz;
+}
+
+vec3 light_color(int i)
+{
+    return i == 0 ? vec3(1.0) : frame.moon_light.rgb;
+}
+
+int key_light()
+{
+    return int(frame.lights.y);
+}
+
+vec3 key_direction()
+{
+    return light_direction(key_light());
+}
+
+vec3 key_color()
+{
+    return light_color(key_light());
+}
 
 #endif

@@ -1,7 +1,8 @@
 #version 450
 /* The sky's radiance as order-2 SH, for relighting the probes: the
- * sky-view LUT (the planet's lit ground below the horizon included, the
- * sun's disk not: shadow maps own the sun) over SB_PROBE_SKY_DIRECTIONS
+ * sky-view LUT (a layer a light in the sky; the planet's lit ground below
+ * the horizon included, the sun's and the moon's disks not: a
+ * disk's light is the key light's direct light) over SB_PROBE_SKY_DIRECTIONS
  * spherical Fibonacci directions, or the same integral per direction from
  * the top of the atmosphere for a camera above it. One workgroup; the
  * partial sums are added in a fixed tree order. */
@@ -12,20 +13,25 @@
 #include "probes.glsl"
 
 layout(local_size_x = SB_PROBE_SKY_THREADS) in;
-layout(set = 0, binding = SB_VIEW_BINDING_SKY_VIEW) uniform sampler2D sky_view;
+layout(set = 0, binding = SB_VIEW_BINDING_SKY_VIEW) uniform sampler2DArray sky_view;
 
 shared vec3 partial[SB_PROBE_SKY_THREADS][SB_PROBE_SH];
 
 vec3 radiance(vec3 d)
 {
-    vec3 p = frame.camera_km.xyz;
-    vec3 l = frame.sun_direction.xyz;
-    vec3 up = normalize(p);
-    if (frame.camera_km.w < atmosphere_thickness())
-        return textureLod(sky_view, sky_view_uv_toward(d), 0.0).rgb / frame.aerial.y;
-    /* the world is on the ground: its sky seen from there */
-    float mu = clamp(dot(up, d), -1.0, 1.0), mu_s = clamp(dot(up, l), -1.0, 1.0);
-    return sky_radiance(0.0, mu, mu_s, clamp(dot(d, l), -1.0, 1.0));
+    vec3 up = normalize(frame.camera_km.xyz);
+    bool inside = frame.camera_km.w < atmosphere_thickness();
+    vec3 L = vec3(0.0);
+    for (int i = 0; i < sky_light_count(); i++) {
+        vec3 l = light_direction(i);
+        if (inside) {
+            L += textureLod(sky_view, vec3(sky_view_uv_toward(d, l), float(i)), 0.0).rgb / frame.aerial.y;
+        } else { /* the world is on the ground: its sky seen from there */
+            float mu = clamp(dot(up, d), -1.0, 1.0), mu_s = clamp(dot(up, l), -1.0, 1.0);
+            L += sky_radiance(0.0, mu, mu_s, clamp(dot(d, l), -1.0, 1.0)) * light_color(i);
+        }
+    }
+    return L;
 }
 
 void main()

@@ -2,15 +2,17 @@
  * How skyview lights a point of its world, whether rasterised (scene.frag)
  * or traced (scene_trace.comp): the point lit by the sun and the sky, seen
  * through the air:
- * - the sun: E_sun times the baked transmittance toward it, the sun's
- *   visibility (the caller's: shadow maps or a shadow ray) and the clouds'
- *   shadow map (cloud_layer.glsl);
+ * - the key light (the sun, or the moon at night: frame.glsl): its
+ *   irradiance times the baked transmittance toward it, its visibility (the
+ *   caller's: shadow maps or a shadow ray) and the clouds' shadow map
+ *   (cloud_layer.glsl);
  * - the BRDF: GGX distribution, height-correlated Smith visibility, Schlick
  *   Fresnel, Lambert diffuse (Karis 2013; Filament);
  * - the sky: with probes (probes.glsl), the irradiance they interpolate, the
  *   sky they see and its bounce, for the normal and the mirror direction;
- *   without (or outside their grid), irradiance_ground's sky irradiance on an
- *   upward surface and the ground's bounce for downward ones, blended by
+ *   without (or outside their grid), irradiance_ground's sky irradiance
+ *   (of every light in the sky: view.glsl's sky_irradiance) on an upward
+ *   surface and the ground's bounce for downward ones, blended by
  *   (1 +- n.up) / 2; Karis's analytic environment BRDF for the specular part;
  * - reflections: with the pack's reflection probes (reflections.glsl), the
  *   ambient specular is their prefiltered radiance, parallax-corrected and
@@ -48,7 +50,7 @@ vec4 scene_shade(vec3 offset, vec3 n, vec3 albedo, vec2 metallic_roughness, vec3
                  float visibility)
 {
     vec3 v = -normalize(offset);
-    vec3 l = frame.sun_direction.xyz;
+    vec3 l = key_direction();
     vec3 p = planet_position(offset);
     float r = length(p);
     vec3 up = p / r;
@@ -72,7 +74,7 @@ vec4 scene_shade(vec3 offset, vec3 n, vec3 albedo, vec2 metallic_roughness, vec3
     vec3 F = f0 + (1.0 - f0) * pow(max(1.0 - l_dot_h, 0.0), 5.0); /* pow of a negative is undefined */
     vec3 brdf = diffuse_color / PI + D * V * F;
 
-    vec3 e_sun = atm.solar_irradiance.rgb * sun_transmittance(h, mu_s);
+    vec3 e_sun = atm.solar_irradiance.rgb * key_color() * sun_transmittance(h, mu_s);
     float clouds_t = cloud_sun_transmittance(offset + frame.camera_m.xyz);
     if (frame.size.w == SB_DEBUG_CLOUD_SHADOW)
         return vec4(vec3(clouds_t * frame.aerial.y), 1.0); /* read back divided by the scale */
@@ -81,8 +83,8 @@ vec4 scene_shade(vec3 offset, vec3 n, vec3 albedo, vec2 metallic_roughness, vec3
     vec3 color = brdf * e_sun * (n_dot_l * visibility * clouds_t);
 
     /* The world is low enough to read the ground row of irradiance_ground. */
-    vec3 e_sky = ground_sky_irradiance_sample(mu_s);
-    vec3 e_bounce = atm.ground_albedo.rgb * ground_irradiance_sample(mu_s);
+    vec3 e_sky, e_bounce;
+    sky_irradiance(up, e_sky, e_bounce);
     float n_up = dot(n, up);
     vec3 e_n = e_sky * (0.5 + 0.5 * n_up) + e_bounce * (0.5 - 0.5 * n_up);
     vec3 refl = reflect(-v, n);

@@ -47,7 +47,7 @@ void main()
     vec4 clip = frame.view_proj * vec4(offset, 1.0);
     imageStore(depth_out, pixel, vec4(clip.z / clip.w));
     /* a face turned from the sun gets none of it, shadowed or not */
-    float visibility = dot(n, frame.sun_direction.xyz) > 0.0 ? sun_visibility(offset, n, true) : 0.0;
+    float visibility = dot(n, key_direction()) > 0.0 ? sun_visibility(offset, n, true) : 0.0;
     vec3 albedo = v.albedo.rgb, shading_n = n;
     vec2 metallic_roughness = vec2(v.position.w, v.normal.w);
     vec3 emitted = vec3(0.0);

@@ -1,5 +1,6 @@
 /*
- * The sun's visibility through skyview's cascaded shadow maps, for a point
+ * The key light's visibility (the sun's, or the moon's at night: frame.glsl)
+ * through skyview's cascaded shadow maps, for a point
  * `offset` metres from the camera: the cascade by view depth, a normal offset
  * of frame.shadow.y texels along n (0 for points in the air), the depth
  * compare filtered bilinearly by the sampler (zero gradients: compute
@@ -11,7 +12,7 @@
  *
  * With SB_TRACED_SHADOWS (the traced scene, runtime/scene_trace.c), a
  * shadow ray instead: from the point, lifted off its surface along n,
- * toward the sun's centre through the world's BVH, any caster ending it.
+ * toward the light's centre through the world's BVH, any caster ending it.
  * Exact and hard (no penumbra, no filtering), at every distance.
  */
 #ifndef SB_SHADOWS_GLSL
@@ -31,7 +32,7 @@ float sun_visibility(vec3 offset, vec3 n, bool pcf)
 {
     if (frame.shadow.w == 0.0)
         return 1.0;
-    vec3 l = frame.sun_direction.xyz;
+    vec3 l = key_direction();
     vec3 c = abs(frame.camera_m.xyz), p = offset + frame.camera_m.xyz;
     /* Off the surface, to the side the sun is on, by 1 mm and 4e-6 of the
      * scale of the point's rounding: it was found from the camera at

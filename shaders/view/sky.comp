@@ -1,9 +1,10 @@
 #version 450
 /* The sky behind the world (where the scene left depth 0): the sky-view LUT
- * inside the atmosphere, the same integral per pixel from the top of the
- * atmosphere above it (the LUT's rows cannot hold a planet seen from space),
- * the planet's ground below the horizon, and the sun's disk where the planet
- * does not hide it, seen through the transmittance toward it. Built twice:
+ * inside the atmosphere (a layer a light in the sky), the same integral per
+ * pixel from the top of the atmosphere above it (the LUT's rows cannot hold
+ * a planet seen from space), the planet's ground below the horizon, and the
+ * sun's and the moon's disks where the planet does not hide them, seen
+ * through the transmittance toward them. Built twice:
  * for a camera inside the atmosphere, and with SB_SKY_FROM_SPACE for one
  * above it; the renderer dispatches the one the frame needs, since llvmpipe
  * runs an untaken branch's code too (a quarter of the pass's time there). */
@@ -12,7 +13,7 @@
 #include "view.glsl"
 
 layout(local_size_x = SB_WORKGROUP_X, local_size_y = SB_WORKGROUP_Y) in;
-layout(set = 0, binding = SB_VIEW_BINDING_SKY_VIEW) uniform sampler2D sky_view;
+layout(set = 0, binding = SB_VIEW_BINDING_SKY_VIEW) uniform sampler2DArray sky_view;
 layout(set = 0, binding = SB_VIEW_BINDING_DEPTH) uniform sampler2D scene_depth;
 layout(set = 0, binding = SB_VIEW_BINDING_HDR, rgba16f) uniform image2D hdr;
 
@@ -25,19 +26,19 @@ void main()
         return;
     vec3 d = view_ray((vec2(pixel) + 0.5) / vec2(frame.size.xy));
     vec3 p = frame.camera_km.xyz;
-    vec3 l = frame.sun_direction.xyz;
-    float nu = clamp(dot(d, l), -1.0, 1.0);
+    float nu = clamp(dot(d, frame.sun_direction.xyz), -1.0, 1.0);
 
     vec3 L = vec3(0.0);
-    vec3 sun_t = vec3(0.0); /* transmittance toward the sun along the view, 0 when the planet hides it */
+    vec3 view_t = vec3(0.0); /* transmittance along the view to space, 0 when the planet hides it */
 #ifndef SB_SKY_FROM_SPACE
     {
         vec3 up = normalize(p);
         float h = clamp(frame.camera_km.w, 0.0, atmosphere_thickness()); /* as the LUT was made */
         float mu = clamp(dot(up, d), -1.0, 1.0);
-        L = textureLod(sky_view, sky_view_uv_toward(d), 0.0).rgb;
+        for (int i = 0; i < sky_light_count(); i++)
+            L += textureLod(sky_view, vec3(sky_view_uv_toward(d, light_direction(i)), float(i)), 0.0).rgb;
         if (!ray_hits_ground(h, mu))
-            sun_t = transmittance_lut_sample(h, mu);
+            view_t = transmittance_lut_sample(h, mu);
     }
 #else
     {
@@ -47,15 +48,18 @@ void main()
             float r0 = length(p0);
             float h0 = clamp(r0 - ground_radius(), 0.0, atmosphere_thickness());
             float mu = clamp(dot(p0, d) / r0, -1.0, 1.0);
-            float mu_s = clamp(dot(p0, l) / r0, -1.0, 1.0);
-            L = sky_radiance(h0, mu, mu_s, nu) * frame.aerial.y;
+            for (int i = 0; i < sky_light_count(); i++) {
+                vec3 l = light_direction(i);
+                float mu_s = clamp(dot(p0, l) / r0, -1.0, 1.0);
+                L += sky_radiance(h0, mu, mu_s, clamp(dot(d, l), -1.0, 1.0)) * light_color(i) * frame.aerial.y;
+            }
             if (!ray_hits_ground(h0, mu))
-                sun_t = transmittance_lut_sample(h0, mu);
+                view_t = transmittance_lut_sample(h0, mu);
         } else {
-            sun_t = vec3(1.0);
+            view_t = vec3(1.0);
         }
     }
 #endif
-    L += sun_disk(nu) * sun_t * frame.aerial.y;
+    L += (sun_disk(nu) + moon_disk(d)) * view_t * frame.aerial.y;
     imageStore(hdr, pixel, vec4(fp16_safe(L), 1.0));
 }

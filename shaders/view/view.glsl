@@ -1,6 +1,6 @@
 /*
  * What skyview's passes share: the frame's constants, the sky-view LUT's
- * mapping, the sun disk, and the atmosphere read from the pack (the baked
+ * mapping, the sun's and the moon's disks, the sky's irradiance, and the atmosphere read from the pack (the baked
  * transmittance for the sun, see SB_SUN_TRANSMITTANCE_LUT; psi_ms from its
  * refined form, SB_MULTISCATTERING_REFINED in config.h; both as textures,
  * SB_ATMOSPHERE_TEXTURES in atmosphere.glsl).
@@ -70,12 +70,13 @@ vec2 sky_view_uv(float phi, float theta, float h)
     return vec2(sqrt(clamp(phi / PI, 0.0, 1.0)), v);
 }
 
-/* Where the sky-view LUT holds direction d from the camera (inside the
- * atmosphere): the azimuth from the sun about the zenith, the zenith
- * angle, at the camera's altitude. */
-vec2 sky_view_uv_toward(vec3 d)
+/* Where the sky-view LUT of the light toward l (its layer: frame.glsl's
+ * lights) holds direction d from the camera (inside the atmosphere): the
+ * azimuth from the light about the zenith, the zenith angle, at the
+ * camera's altitude. */
+vec2 sky_view_uv_toward(vec3 d, vec3 l)
 {
-    vec3 up = normalize(frame.camera_km.xyz), l = frame.sun_direction.xyz;
+    vec3 up = normalize(frame.camera_km.xyz);
     float h = clamp(frame.camera_km.w, 0.0, atmosphere_thickness()); /* as the LUT was made */
     float mu = clamp(dot(up, d), -1.0, 1.0), mu_s = clamp(dot(up, l), -1.0, 1.0);
     vec3 d_flat = d - up * mu, l_flat = l - up * mu_s;
@@ -98,6 +99,41 @@ vec3 sun_disk(float cos_angle)
     const float u = 0.6;
     float darkening = (1.0 - u * (1.0 - m)) / (1.0 - u / 3.0);
     return atm.solar_irradiance.rgb / (PI * alpha * alpha) * darkening;
+}
+
+/* The moon's disk along view direction d: radiance where d meets it, zero
+ * elsewhere. Its surface scatters as the lunar regolith does, by Lommel and
+ * Seeliger's mu0 / (mu0 + mu) (mu0: the cosine to the sun, mu: to the
+ * viewer), lit where the sun reaches it, so its phase shows; normalised
+ * (frame.moon_light.w, renderer.c) so the disk delivers the moon's
+ * irradiance. Multiply by the transmittance toward it. */
+vec3 moon_disk(vec3 d)
+{
+    vec3 m = frame.moon_direction.xyz;
+    float alpha = frame.moon_direction.w, c = dot(d, m);
+    if (alpha == 0.0 || c < cos(alpha))
+        return vec3(0.0);
+    vec3 x = (d - m * c) / sin(alpha); /* on the disk, its radius 1 */
+    float mu = sqrt(max(1.0 - dot(x, x), 0.0));
+    float mu0 = dot(x - m * mu, frame.sun_direction.xyz);
+    float shading = mu0 > 0.0 ? mu0 / (mu0 + mu) : 0.0;
+    return atm.solar_irradiance.rgb * frame.moon_light.rgb * (shading * frame.moon_light.w);
+}
+
+/* The sky's irradiance at the ground under every light in the sky, on a
+ * surface facing up (e_up) and, from the lit ground, one facing down
+ * (e_down), for local vertical `up`: irradiance_ground's rows, read at each
+ * light's height. */
+void sky_irradiance(vec3 up, out vec3 e_up, out vec3 e_down)
+{
+    e_up = vec3(0.0);
+    e_down = vec3(0.0);
+    for (int i = 0; i < sky_light_count(); i++) {
+        float mu = dot(up, light_direction(i));
+        e_up += light_color(i) * ground_sky_irradiance_sample(mu);
+        e_down += light_color(i) * ground_irradiance_sample(mu);
+    }
+    e_down *= atm.ground_albedo.rgb;
 }
 
 /* Where a ray from planet-centred p along unit d enters the atmosphere

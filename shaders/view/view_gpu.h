@@ -57,6 +57,7 @@
 
 #define SB_SKY_VIEW_WIDTH 192 /* azimuth from the sun, 0 to pi */
 #define SB_SKY_VIEW_HEIGHT 108 /* zenith angle, the horizon between rows 53 and 54 */
+#define SB_SKY_LIGHTS 2        /* the sun and the moon: the sky-view LUT's layers */
 #define SB_AERIAL_SIZE 32      /* x, y: screen; z: distance slices */
 #define SB_CASCADES 4
 /* The margins of a cascade's casters' box (renderer.c, passes/shadows.c, shadows.glsl): the
@@ -119,6 +120,14 @@ struct sb_frame_gpu {
     SB_VEC4(camera_km);        /* planet-centred camera (km); w: its altitude (km) */
     SB_VEC4(camera_forward);   /* unit view direction, world; w: cos of the sun's angular radius */
     SB_VEC4(sun_direction);    /* unit vector toward the sun, world; w: sun's angular radius (rad) */
+    SB_VEC4(moon_direction);   /* unit vector toward the moon, world; w: its angular radius (rad), 0: no moon */
+    SB_VEC4(moon_light);       /* rgb: the moon's irradiance over the sun's, per channel, above the
+                                  atmosphere; w: 1 / the solid-angle integral of its disk's shading
+                                  (view.glsl's moon_disk) */
+    SB_VEC4(lights);           /* x: the lights that scatter in the sky (1: the sun; 2: the sun and the
+                                  moon); y: the key light, which lights the world, the fog and the clouds
+                                  directly and casts the shadows (0: the sun; 1: the moon, the sun being
+                                  down); zw: unused. frame.glsl reads them */
     SB_VEC4(cascade_ends);     /* view depth (m) where each cascade ends */
     SB_VEC4(cascade_texel);    /* a shadow texel's width (m) in each cascade */
     SB_VEC4(cascade_rect[SB_CASCADES]); /* uv box (min xy, max xy) outside which a cascade has no caster:
@@ -129,6 +138,9 @@ struct sb_frame_gpu {
                                   radiance is multiplied by before storage); zw: unused */
     SB_VEC4(exposure);         /* x: log2 luminance at bin 1, y: log2 range of bins 1..255,
                                   z, w: low and high percentile of the metering window */
+    SB_VEC4(meter);            /* x, y: the adapted log2 luminance's range (the EV range's, in the pack's
+                                  units); z: stops of exposure taken off a stop under w, the log2
+                                  luminance below which the eye no longer sees a mid grey */
     SB_VEC4(adaptation);       /* x: speed to brighter (1/s), y: to darker (1/s), z: dt (s), w: 1 to snap */
     SB_VEC4(post);             /* x: bloom threshold (exposed), y: bloom strength, z: exposure
                                   compensation (EV), w: tone mapper (SB_TONEMAP_*) */
