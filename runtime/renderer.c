@@ -394,6 +394,7 @@ static void fill_frame(struct sb_renderer *r, const struct sb_view *v, struct sb
         sb_mat4_store(&cascades.view_proj[c], f->shadow_view_proj[c]);
         f->cascade_ends[c] = (float)cascades.ends_m[c];
         f->cascade_texel[c] = (float)cascades.texel_m[c];
+        f->cascade_depth_m[c] = (float)(2.0 * cascades.radius_m[c] + cp.caster_margin_m);
         /* Texels to clear and draw: the casters' box and a margin each side
          * that covers what the lookups read (view_gpu.h); they see the sun
          * outside, exactly as if the whole map were cleared and drawn. */

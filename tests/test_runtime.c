@@ -556,6 +556,304 @@ static void test_traced_scene(const struct sb_renderer_params *rp)
     sb_mesh_finish(&casters);
 }
 
+/* ---- Soft shadows ------------------------------------------------------------------------ */
+
+/* The fraction of a uniform disk left uncovered by a straight edge t disk
+ * radii past its centre (-1: all covered, 1: none). */
+static double disk_uncovered(double t)
+{
+    t = fmax(-1.0, fmin(1.0, t));
+    return 1.0 - (acos(t) - t * sqrt(1.0 - t * t)) / M_PI;
+}
+
+/* The t where disk_uncovered is f. */
+static double disk_edge_at(double f)
+{
+    double lo = -1.0, hi = 1.0;
+    for (int i = 0; i < 60; i++) {
+        double mid = 0.5 * (lo + hi);
+        *(disk_uncovered(mid) < f ? &lo : &hi) = mid;
+    }
+    return 0.5 * (lo + hi);
+}
+
+/* A view drawn as a still camera sees it for `frames` frames, the first a cut. */
+static bool render_still(struct sb_renderer *r, const struct sb_view *v, int frames)
+{
+    struct sb_view still = *v;
+    bool ok = true;
+    for (int i = 0; i < frames && ok; i++) {
+        still.snap_exposure = i == 0;
+        ok = render(r, &still);
+    }
+    return ok;
+}
+
+/*
+ * The penumbrae, raster (shadows.glsl, SB_SOFT_SHADOWS) and traced
+ * (scene_trace.comp, SB_SUN_RAYS frames of a still camera):
+ * - against the sun's disk: the test world seen from the default view and
+ *   from above, its shadows at a 2-degree sun and at 30 degrees, each
+ *   surface pixel's visibility against Embree's fraction of 64 rays over
+ *   the disk. No pixel Embree sees wholly lit reads under 0.9 (acne, the
+ *   old stripes at a low sun), none it sees wholly shadowed over 0.1 (light
+ *   through a caster), away from the edges of surfaces (a pixel there is
+ *   partly another surface);
+ * - a 1 m square pole 30 m tall: across its shadow's side at 15 and 30 m
+ *   from its foot, the 10% to 90% width of the penumbra against what a disk
+ *   of the sun's angular radius alpha gives through an edge at distance L,
+ *   2 t90 L tan(alpha) (t90: where a straight edge leaves 90% of a uniform
+ *   disk), within 15%.
+ */
+static void test_soft_shadows(const char *dir, const struct sb_renderer_params *rp)
+{
+    struct sb_mesh all = {0}, casters = {0};
+    struct sb_embree e_all = {0}, e_casters = {0};
+    bool ok = sb_world_mesh(&world, false, &all) == SB_OK && sb_world_mesh(&world, true, &casters) == SB_OK;
+    ok = ok && sb_embree_create(&all, &e_all) && sb_embree_create(&casters, &e_casters);
+    CHECK(ok, "the world in Embree");
+    struct sb_renderer *rr[2] = {NULL, NULL};
+    struct sb_renderer_params p = *rp;
+    p.debug = SB_DEBUG_SUN_VISIBILITY;
+    for (int m = 0; m < 2 && ok; m++) {
+        p.scene = m ? SB_SCENE_TRACED : SB_SCENE_RASTER;
+        ok = sb_renderer_create(vk, &pack, &world, &p, &rr[m]) == SB_OK;
+    }
+    static const char *const method[2] = {"raster", "traced"};
+    const int frames[2] = {1, SB_SUN_RAYS + 4};
+    enum { RAYS = 64 };
+    float *rays = malloc(sizeof(float) * 8 * W * H * (RAYS + 1)), *hits = malloc(sizeof(float) * 4 * W * H * RAYS);
+    uint32_t *ids = malloc(sizeof(uint32_t) * W * H);
+    float *reference = malloc(sizeof(float) * W * H), *depth = malloc(sizeof(float) * W * H);
+    ok = ok && rays && hits && ids && reference && depth;
+    int dark_total = 0;
+    const double alpha = 0.2666 * DEG; /* renderer.c's sun */
+    struct sb_view views[3] = {base_view(), base_view(), base_view()};
+    views[0].sun_elevation = 2.0 * DEG;
+    views[0].sun_azimuth = 100.0 * DEG;
+    views[1].camera_m[1] = 40.0;
+    views[1].pitch = -40.0 * DEG;
+    views[1].sun_elevation = 2.0 * DEG;
+    views[1].sun_azimuth = 200.0 * DEG;
+    views[2].camera_m[1] = 40.0;
+    views[2].pitch = -40.0 * DEG;
+    for (int vi = 0; vi < 3 && ok; vi++) {
+        const struct sb_view *v = &views[vi];
+        float *drawn[2] = {NULL, NULL};
+        for (int m = 0; m < 2 && ok; m++) {
+            ok = render_still(rr[m], v, frames[m]);
+            drawn[m] = ok ? frame_rgb(rr[m]) : NULL;
+        }
+        if (!ok) {
+            free(drawn[0]);
+            break;
+        }
+        struct sb_renderer *r = rr[0];
+        double sun[3], forward[3], e1[3], e2[3];
+        sb_direction(v->sun_azimuth, v->sun_elevation, sun);
+        sb_direction(v->yaw, v->pitch, forward);
+        sb_direction(v->sun_azimuth + 0.5 * M_PI, 0.0, e1); /* across the sun, level */
+        e2[0] = sun[1] * e1[2] - sun[2] * e1[1];
+        e2[1] = sun[2] * e1[0] - sun[0] * e1[2];
+        e2[2] = sun[0] * e1[1] - sun[1] * e1[0];
+        for (int y = 0; y < H; y++)
+            for (int x = 0; x < W; x++) {
+                double d[3], px[2] = {x + 0.5, y + 0.5};
+                sb_renderer_pixel_ray(r, px, d);
+                float *ray = rays + 8 * (y * W + x);
+                for (int i = 0; i < 3; i++) {
+                    ray[i] = (float)v->camera_m[i];
+                    ray[4 + i] = (float)d[i];
+                }
+                ray[3] = (float)(0.1 / (d[0] * forward[0] + d[1] * forward[1] + d[2] * forward[2]));
+                ray[7] = 1e30f;
+            }
+        sb_embree_cast(&e_all, rays, W * H, hits);
+        /* every surface point's rays over the sun's disk */
+        float *disk = rays + 8 * W * H;
+        for (int i = 0; i < W * H; i++) {
+            uint32_t t;
+            memcpy(&t, &hits[4 * i + 1], sizeof(t));
+            ids[i] = t == SB_BVH_MISS ? SB_BVH_MISS : t & ~SB_BVH_BACK_FACE;
+            const float *ray = rays + 8 * i;
+            double p_[3], camera = 0.0, t_hit = ids[i] != SB_BVH_MISS ? hits[4 * i] : 0.0;
+            for (int k = 0; k < 3; k++) {
+                p_[k] = ray[k] + (double)ray[4 + k] * t_hit;
+                camera = fmax(camera, fabs(v->camera_m[k]));
+            }
+            const float *n = ids[i] != SB_BVH_MISS ? world.vertices[3 * ids[i]].normal : (const float[3]){0, 1, 0};
+            depth[i] = (float)(t_hit * (ray[4] * forward[0] + ray[5] * forward[1] + ray[6] * forward[2]));
+            double lift = 1e-3 + 4e-6 * (camera + t_hit);
+            for (int j = 0; j < RAYS; j++) {
+                double rad = sqrt((j + 0.5) / RAYS) * tan(alpha), a = j * 2.39996323, dd[3], len = 0.0;
+                for (int k = 0; k < 3; k++) {
+                    dd[k] = sun[k] + rad * (cos(a) * e1[k] + sin(a) * e2[k]);
+                    len += dd[k] * dd[k];
+                }
+                float *q = disk + 8 * ((size_t)i * RAYS + j);
+                for (int k = 0; k < 3; k++) {
+                    q[k] = (float)(p_[k] + n[k] * lift);
+                    q[4 + k] = (float)(dd[k] / sqrt(len));
+                }
+                q[3] = 0.0f;
+                q[7] = ids[i] != SB_BVH_MISS ? (float)SB_TRACE_FAR_M : 0.0f;
+            }
+        }
+        sb_embree_cast(&e_casters, disk, W * H * RAYS, hits);
+        for (int i = 0; i < W * H; i++) {
+            int open = 0;
+            for (int j = 0; j < RAYS; j++) {
+                uint32_t t;
+                memcpy(&t, &hits[4 * ((size_t)i * RAYS + j) + 1], sizeof(t));
+                open += t == SB_BVH_MISS;
+            }
+            reference[i] = (float)open / RAYS;
+        }
+        for (int m = 0; m < 2; m++) {
+            const float *raster = drawn[m];
+            int acne = 0, leaks = 0, lit = 0, dark = 0, penumbra = 0, far = 0;
+            double error = 0.0;
+            for (int y = 1; y < H - 1; y++)
+                for (int x = 1; x < W - 1; x++) {
+                    int i = y * W + x;
+                    if (ids[i] == SB_BVH_MISS)
+                        continue;
+                    const float *n = world.vertices[3 * ids[i]].normal;
+                    if (n[0] * sun[0] + n[1] * sun[1] + n[2] * sun[2] < sin(2.0 * alpha))
+                        continue; /* turned from the light: its visibility is not read */
+                    if (m == 0 && depth[i] > 0.95 * 250.0) {
+                        far++; /* past the last cascade (shadow_distance_m), and its blend band: no map */
+                        continue;
+                    }
+                    /* away from the edges of surfaces, and whole: the same
+                     * reference over the 3 x 3 pixels around (a map's texel
+                     * may span a pixel or two) */
+                    bool edge = false, whole = true;
+                    for (int j = -1; j <= 1; j++)
+                        for (int k = -1; k <= 1; k++) {
+                            int u = x + k, w = y + j;
+                            if (u < 0 || w < 0 || u >= W || w >= H)
+                                continue;
+                            edge |= ids[w * W + u] != ids[i];
+                            whole &= reference[w * W + u] == reference[i];
+                        }
+                    if (edge)
+                        continue;
+                    float got = raster[3 * i + 1], want = reference[i];
+                    if (!whole && (want == 0.0f || want == 1.0f)) {
+                        penumbra++;
+                        error += fabs(got - want);
+                    } else if (want == 1.0f) {
+                        lit++;
+                        acne += got < 0.9f;
+                    } else if (want == 0.0f) {
+                        dark++;
+                        leaks += got > 0.1f;
+                    } else {
+                        penumbra++;
+                        error += fabs(got - want);
+                    }
+                }
+            printf("soft shadows, %s, view %d (sun %.0f degrees): %d wholly lit pixels, %d under 0.9; %d wholly "
+                   "shadowed, %d over 0.1; %d in penumbrae, mean error %.3f; %d past the cascades\n",
+                   method[m], vi, v->sun_elevation / DEG, lit, acne, dark, leaks, penumbra,
+                   penumbra ? error / penumbra : 0.0, far);
+            dark_total += dark;
+            CHECK(acne == 0, "%s, view %d: %d wholly lit pixels read shadowed (acne)", method[m], vi, acne);
+            /* The maps' texels at a grazing light, 50 to 100 m away, let a
+             * little light into 6 of view 1's 355 (the same 6, to the
+             * digit, with the 3 x 3 filter alone): 2% for the raster. */
+            CHECK(m == 0 ? leaks <= dark / 50 : leaks == 0, "%s, view %d: %d of %d wholly shadowed pixels read lit",
+                  method[m], vi, leaks, dark);
+            CHECK(lit > W * H / 10, "view %d: %d lit pixels to compare", vi, lit);
+        }
+        free(drawn[0]);
+        free(drawn[1]);
+    }
+    free(rays);
+    free(hits);
+    free(ids);
+    free(reference);
+    free(depth);
+    CHECK(dark_total > 100, "%d wholly shadowed pixels compared", dark_total);
+    for (int m = 0; m < 2; m++)
+        sb_renderer_destroy(&rr[m]);
+    sb_embree_destroy(&e_all);
+    sb_embree_destroy(&e_casters);
+    sb_mesh_finish(&all);
+    sb_mesh_finish(&casters);
+
+    /* The pole. The sun in the east, 30 degrees up: the shadow runs west
+     * along -x, its side along z = 0.5. Looking straight down (north up,
+     * so a frame's rows run along +z) over the side, 0.9 m across. */
+    char world_path[400];
+    snprintf(world_path, sizeof(world_path), "%s/pole-world.json", dir);
+    FILE *f = fopen(world_path, "w");
+    CHECK(f &&
+              fputs("{\"version\": 1, \"ground\": {\"size_m\": 500, \"albedo\": [0.3, 0.3, 0.3]},\n"
+                    " \"boxes\": [{\"center_m\": [0, 15, 0], \"size_m\": [1, 30, 1], \"albedo\": [0.5, 0.5, 0.5]}]}\n",
+                    f) >= 0 &&
+              fclose(f) == 0,
+          "write %s", world_path);
+    struct sb_world pole;
+    if (!f || sb_world_load(world_path, NULL, &pole) != SB_OK) {
+        CHECK(false, "the pole's world loads");
+        return;
+    }
+    p.shadow_size = 2048;
+    for (int m = 0; m < 2; m++) {
+        struct sb_renderer *r = NULL;
+        p.scene = m ? SB_SCENE_TRACED : SB_SCENE_RASTER;
+        if (sb_renderer_create(vk, &pack, &pole, &p, &r) != SB_OK) {
+            CHECK(false, "the pole's renderer");
+            break;
+        }
+        const double elevation = 30.0 * DEG, height = 8.0, half_span = 0.45;
+        const double t90 = disk_edge_at(0.9), t10 = disk_edge_at(0.1);
+        static const double distances[2] = {15.0, 30.0};
+        for (int k = 0; k < 2; k++) {
+            struct sb_view v = base_view();
+            v.camera_m[0] = -distances[k];
+            v.camera_m[1] = height;
+            v.camera_m[2] = 0.5;
+            v.yaw = 0.0;
+            v.pitch = -90.0 * DEG;
+            v.fov_y = 2.0 * atan(half_span / height);
+            v.sun_azimuth = 90.0 * DEG;
+            v.sun_elevation = elevation;
+            if (!render_still(r, &v, frames[m]))
+                break;
+            float *rgb = frame_rgb(r);
+            /* each row's mean over the middle 80 columns (0.8 m along the shadow) */
+            double row[H], z[H];
+            for (int y = 0; y < H; y++) {
+                row[y] = 0.0;
+                for (int x = W / 2 - 40; x < W / 2 + 40; x++)
+                    row[y] += pixel(rgb, x, y)[1] / 80.0;
+                z[y] = 0.5 + (y + 0.5 - H / 2.0) / (H / 2.0) * half_span;
+            }
+            free(rgb);
+            double z10 = NAN, z90 = NAN;
+            for (int y = 0; y + 1 < H; y++) {
+                if (row[y] < 0.1 && row[y + 1] >= 0.1)
+                    z10 = z[y] + (0.1 - row[y]) / (row[y + 1] - row[y]) * (z[y + 1] - z[y]);
+                if (row[y] < 0.9 && row[y + 1] >= 0.9)
+                    z90 = z[y] + (0.9 - row[y]) / (row[y + 1] - row[y]) * (z[y + 1] - z[y]);
+            }
+            double L = distances[k] / cos(elevation);
+            double want = (t90 - t10) * L * tan(alpha), got = z90 - z10;
+            printf(
+                "penumbra, %s, at %.0f m from the pole (edge %.1f m away): 10-90%% width %.4f m, a disk gives %.4f m "
+                "(%+.1f%%); its middle at z %.3f\n",
+                method[m], distances[k], L, got, want, 100.0 * (got / want - 1.0), 0.5 * (z10 + z90));
+            CHECK(fabs(got / want - 1.0) < 0.15, "%s: the penumbra %.0f m from the pole is %.4f m wide, not %.4f",
+                  method[m], distances[k], got, want);
+        }
+        sb_renderer_destroy(&r);
+    }
+    sb_world_finish(&pole);
+}
+
 static int compare_doubles(const void *a, const void *b)
 {
     double x = *(const double *)a, y = *(const double *)b;
@@ -2194,6 +2492,7 @@ int main(int argc, char **argv)
         test_shadow_boxes(r, &rp);
         test_specialised_shaders(r, &rp);
         test_traced_scene(&rp);
+        test_soft_shadows(dir, &rp);
         test_textures(&rp);
         test_emissive(&rp);
         test_instanced_world(dir, &rp);

@@ -9,10 +9,11 @@
 #include "renderer_internal.h"
 
 #include "aerial_perspective.spv.h"
+#include "aerial_perspective_moon.spv.h"
 
 struct aerial {
     struct sb_texture scattering, transmittance;
-    VkPipeline kernel;
+    VkPipeline kernel[2]; /* by day, and with the moon in the sky */
 };
 
 static enum sb_result aerial_create(struct sb_renderer *r)
@@ -34,8 +35,12 @@ static enum sb_result aerial_create(struct sb_renderer *r)
     sb_pass_use(r, SB_VIEW_BINDING_AERIAL_OUT, sb_graph_image(r, "aerial", &a->scattering), SB_USE_STORE);
     sb_pass_use(r, SB_VIEW_BINDING_AERIAL_T_OUT, sb_graph_image(r, "aerial transmittance", &a->transmittance),
                 SB_USE_STORE);
-    return sb_renderer_kernel(r, sb_spv_aerial_perspective, sizeof(sb_spv_aerial_perspective), "aerial perspective",
-                              &a->kernel);
+    res = sb_renderer_kernel(r, sb_spv_aerial_perspective, sizeof(sb_spv_aerial_perspective), "aerial perspective",
+                             &a->kernel[0]);
+    if (!res)
+        res = sb_renderer_kernel(r, sb_spv_aerial_perspective_moon, sizeof(sb_spv_aerial_perspective_moon),
+                                 "aerial perspective (the moon)", &a->kernel[1]);
+    return res;
 }
 
 static void aerial_destroy(struct sb_renderer *r)
@@ -44,14 +49,15 @@ static void aerial_destroy(struct sb_renderer *r)
     if (!a)
         return;
     struct sb_texture *const textures[] = {&a->scattering, &a->transmittance};
-    sb_renderer_release(r, &a->kernel, 1, textures, 2);
+    sb_renderer_release(r, a->kernel, 2, textures, 2);
     free(a);
 }
 
 static void aerial_record(struct sb_renderer *r)
 {
     struct aerial *a = sb_pass_data(r);
-    sb_renderer_dispatch(r, a->kernel, NULL, (const uint32_t[3]){SB_AERIAL_SIZE, SB_AERIAL_SIZE, 1},
+    sb_renderer_dispatch(r, a->kernel[r->frame_lights > 1], NULL,
+                         (const uint32_t[3]){SB_AERIAL_SIZE, SB_AERIAL_SIZE, 1},
                          (const uint32_t[3]){SB_WORKGROUP_X, SB_WORKGROUP_Y, 1});
 }
 

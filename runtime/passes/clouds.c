@@ -23,6 +23,7 @@
 #include "cloud_resolve.spv.h"
 #include "cloud_shadow.spv.h"
 #include "cloud_trace.spv.h"
+#include "cloud_trace_moon.spv.h"
 
 #define CLOUD_FORMAT VK_FORMAT_R16G16B16A16_SFLOAT
 #define HISTORY_WEIGHT 0.8         /* the last frame's share where a pixel is traced again */
@@ -39,7 +40,7 @@ struct sb_clouds {
     struct sb_texture shape, detail, curl, weather;
     struct sb_texture shadow, trace, depth;
     struct sb_texture out[2]; /* a history: this frame's clouds at full resolution, and the last frame's */
-    VkPipeline shadow_kernel, trace_kernel, resolve_kernel;
+    VkPipeline shadow_kernel, trace_kernel[2], resolve_kernel; /* the trace's by day, and with the moon */
     struct sb_history history_state; /* the last frame, for reprojection */
     uint64_t history_frames;         /* frames since the history began */
 };
@@ -166,7 +167,7 @@ static void clouds_destroy(struct sb_renderer *r)
     struct sb_clouds *c = layer(r);
     if (!c)
         return;
-    const VkPipeline pipelines[] = {c->shadow_kernel, c->trace_kernel, c->resolve_kernel};
+    const VkPipeline pipelines[] = {c->shadow_kernel, c->trace_kernel[0], c->trace_kernel[1], c->resolve_kernel};
     struct sb_texture *const textures[] = {&c->shape, &c->detail, &c->curl,   &c->weather, &c->shadow,
                                            &c->trace, &c->depth,  &c->out[0], &c->out[1]};
     sb_renderer_release(r, pipelines, sizeof(pipelines) / sizeof(pipelines[0]), textures,
@@ -264,7 +265,7 @@ static void clouds_record(struct sb_renderer *r)
     if (!c->enabled)
         return;
     const uint32_t group[3] = {SB_WORKGROUP_X, SB_WORKGROUP_Y, 1};
-    sb_renderer_dispatch(r, c->trace_kernel, NULL, (const uint32_t[3]){c->trace_size[0], c->trace_size[1], 1}, group);
+    sb_renderer_dispatch(r, c->trace_kernel[r->frame_lights > 1], NULL, (const uint32_t[3]){c->trace_size[0], c->trace_size[1], 1}, group);
     sb_renderer_barrier(r->cmd);
     sb_renderer_dispatch_frame(r, c->resolve_kernel);
 }
@@ -290,7 +291,10 @@ static enum sb_result clouds_pass_create(struct sb_renderer *r)
     sb_pass_use(r, SB_VIEW_BINDING_CLOUD_OUT, resolved, SB_USE_STORE);
     sb_pass_sample(r, SB_VIEW_BINDING_CLOUD_HISTORY, SB_PREVIOUS(resolved), NULL);
     enum sb_result res =
-        sb_renderer_kernel(r, sb_spv_cloud_trace, sizeof(sb_spv_cloud_trace), "cloud trace", &c->trace_kernel);
+        sb_renderer_kernel(r, sb_spv_cloud_trace, sizeof(sb_spv_cloud_trace), "cloud trace", &c->trace_kernel[0]);
+    if (!res)
+        res = sb_renderer_kernel(r, sb_spv_cloud_trace_moon, sizeof(sb_spv_cloud_trace_moon), "cloud trace (the moon)",
+                                 &c->trace_kernel[1]);
     if (!res)
         res = sb_renderer_kernel(r, sb_spv_cloud_resolve, sizeof(sb_spv_cloud_resolve), "cloud resolve",
                                  &c->resolve_kernel);

@@ -13,10 +13,11 @@
  * with a one-line fragment shader, and the cascades 0.37 ms
  * (docs/skyview.md). llvmpipe rasterises well and traces slowly, so a CPU
  * device rasterises. The traced frame differs from the raster one only in
- * its shadows (hard and exact at every distance, where the maps are
- * filtered and end at shadow_distance_m) and in the last bits of each
- * point's position; test_runtime holds the two together and the shadows to
- * Embree.
+ * its shadows (exact at every distance, the penumbra the mean of a ray a
+ * frame over the light's disk, kept in the "sun visibility" history, where
+ * the maps' penumbrae are estimated and end at shadow_distance_m) and in the
+ * last bits of each point's position; test_runtime holds the two together
+ * and the shadows to Embree.
  *
  * The pack's reflection probes are uploaded here: "reflections" and
  * "reflection cubes" in the graph's table.
@@ -26,6 +27,7 @@
 #include <string.h>
 
 #include "clouds_gpu.h"
+#include "history.h"
 #include "image.h"
 #include "log.h"
 #include "physics.h"
@@ -47,7 +49,11 @@
 
 struct scene {
     struct sb_buffer reflections, cubes; /* sb_reflections_gpu, its probes and the DFG; the cubes */
-    uint32_t reflection_count;           /* reflection probes the scene reads (0: none) */
+    /* Traced: the key light's visibility over the frames (its penumbrae), and what reprojects it. */
+    struct sb_texture sun_history[2];
+    struct sb_buffer history; /* sb_scene_history_gpu */
+    struct sb_history history_state;
+    uint32_t reflection_count; /* reflection probes the scene reads (0: none) */
     /* Generic, and with aerial perspective from its volume alone (aerial.glsl). */
     VkPipeline raster[2], traced[2];
 };
@@ -132,6 +138,18 @@ static enum sb_result upload_reflections(struct sb_renderer *r, struct scene *s)
 /* The traced scene writes every pixel of the frame and its depth. */
 static enum sb_result create_traced(struct sb_renderer *r, struct scene *s)
 {
+    enum sb_result made = SB_OK;
+    for (int i = 0; i < 2 && !made; i++)
+        made = sb_renderer_texture(r, &s->sun_history[i], (const uint32_t[3]){r->width, r->height, 1}, 1, 1,
+                                   SB_HDR_FORMAT, VK_IMAGE_USAGE_STORAGE_BIT, "sun visibility");
+    if (!made)
+        made = sb_renderer_upload(r, NULL, sizeof(struct sb_scene_history_gpu), "scene history", &s->history);
+    if (made)
+        return made;
+    sb_resource sun = sb_graph_history(r, "sun visibility", s->sun_history);
+    sb_pass_use(r, SB_VIEW_BINDING_SUN_HISTORY_OUT, sun, SB_USE_OVERWRITE);
+    sb_pass_use(r, SB_VIEW_BINDING_SUN_HISTORY, SB_PREVIOUS(sun), SB_USE_LOAD);
+    sb_pass_use(r, SB_VIEW_BINDING_SCENE_HISTORY, sb_graph_buffer(r, "scene history", &s->history), SB_USE_LOAD);
     sb_pass_use(r, SB_VIEW_BINDING_HDR, sb_pass_find(r, "hdr"), SB_USE_OVERWRITE);
     sb_pass_use(r, SB_VIEW_BINDING_DEPTH_OUT, sb_pass_find(r, "depth"), SB_USE_OVERWRITE);
     sb_pass_use(r, SB_VIEW_BINDING_BVH_NODES, sb_pass_find(r, "bvh nodes"), SB_USE_LOAD);
@@ -140,9 +158,9 @@ static enum sb_result create_traced(struct sb_renderer *r, struct scene *s)
         enum sb_result res = sb_renderer_kernel(r, sb_spv_scene_trace_instanced, sizeof(sb_spv_scene_trace_instanced),
                                                 "scene traced (instances)", &s->traced[0]);
         if (!res)
-            res = sb_renderer_kernel(r, sb_spv_scene_trace_volume_instanced,
-                                     sizeof(sb_spv_scene_trace_volume_instanced),
-                                     "scene traced (instances, aerial volume only)", &s->traced[1]);
+            res =
+                sb_renderer_kernel(r, sb_spv_scene_trace_volume_instanced, sizeof(sb_spv_scene_trace_volume_instanced),
+                                   "scene traced (instances, aerial volume only)", &s->traced[1]);
         return res;
     }
     enum sb_result res =
@@ -156,6 +174,7 @@ static enum sb_result create_traced(struct sb_renderer *r, struct scene *s)
 static enum sb_result create_raster(struct sb_renderer *r, struct scene *s)
 {
     sb_pass_sample(r, SB_VIEW_BINDING_SHADOW, sb_pass_find(r, "shadow cascades"), r->shadow_compare);
+    sb_pass_sample(r, SB_VIEW_BINDING_SHADOW_DEPTH, sb_pass_find(r, "shadow cascades"), r->nearest);
     sb_pass_use(r, SB_NO_BINDING, sb_pass_find(r, "hdr"), SB_USE_COLOR_TARGET);
     sb_pass_use(r, SB_NO_BINDING, sb_pass_find(r, "depth"), SB_USE_DEPTH_TARGET);
     /* scene.frag's specialization: what the pack holds */
@@ -224,7 +243,9 @@ static void scene_destroy(struct sb_renderer *r)
     if (!s)
         return;
     const VkPipeline pipelines[] = {s->raster[0], s->raster[1], s->traced[0], s->traced[1]};
-    sb_renderer_release(r, pipelines, 4, NULL, 0);
+    struct sb_texture *textures[2] = {&s->sun_history[0], &s->sun_history[1]};
+    sb_renderer_release(r, pipelines, 4, textures, 2);
+    sb_buffer_destroy(r->vk, &s->history);
     sb_buffer_destroy(r->vk, &s->reflections);
     sb_buffer_destroy(r->vk, &s->cubes);
     free(s);
@@ -234,6 +255,14 @@ static void scene_record(struct sb_renderer *r)
 {
     struct scene *s = sb_pass_data(r);
     if (r->scene_traced) {
+        struct sb_history_step step;
+        sb_history_advance(&s->history_state, r, &step);
+        struct sb_scene_history_gpu *g = s->history.mapped;
+        sb_mat4_store(&step.previous_view_proj, g->previous_view_proj);
+        for (int k = 0; k < 3; k++)
+            g->camera_motion_m[k] = (float)step.camera_motion_m[k];
+        g->camera_motion_m[3] = step.keep ? 1.0f : 0.0f;
+        g->frame[0] = (uint32_t)r->frame_index;
         sb_renderer_dispatch_frame(r, s->traced[r->aerial_volume_only ? 1 : 0]);
         return;
     }

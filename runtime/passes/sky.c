@@ -9,9 +9,11 @@
 
 #include "sky.spv.h"
 #include "sky_from_space.spv.h"
+#include "sky_from_space_moon.spv.h"
+#include "sky_moon.spv.h"
 
 struct sky {
-    VkPipeline inside, from_space;
+    VkPipeline inside[2], from_space[2]; /* by day, and with the moon in the sky */
 };
 
 static enum sb_result sky_create(struct sb_renderer *r)
@@ -24,10 +26,15 @@ static enum sb_result sky_create(struct sb_renderer *r)
     sb_pass_sample(r, SB_VIEW_BINDING_SKY_VIEW, sb_pass_find(r, "sky-view"), NULL);
     sb_pass_use(r, SB_VIEW_BINDING_HDR, sb_pass_find(r, "hdr"), SB_USE_LOAD_STORE);
     sb_pass_sample(r, SB_VIEW_BINDING_DEPTH, sb_pass_find(r, "depth"), r->nearest);
-    enum sb_result res = sb_renderer_kernel(r, sb_spv_sky, sizeof(sb_spv_sky), "sky", &s->inside);
+    enum sb_result res = sb_renderer_kernel(r, sb_spv_sky, sizeof(sb_spv_sky), "sky", &s->inside[0]);
     if (!res)
         res = sb_renderer_kernel(r, sb_spv_sky_from_space, sizeof(sb_spv_sky_from_space), "sky from space",
-                                 &s->from_space);
+                                 &s->from_space[0]);
+    if (!res)
+        res = sb_renderer_kernel(r, sb_spv_sky_moon, sizeof(sb_spv_sky_moon), "sky (the moon)", &s->inside[1]);
+    if (!res)
+        res = sb_renderer_kernel(r, sb_spv_sky_from_space_moon, sizeof(sb_spv_sky_from_space_moon),
+                                 "sky from space (the moon)", &s->from_space[1]);
     return res;
 }
 
@@ -36,14 +43,16 @@ static void sky_destroy(struct sb_renderer *r)
     struct sky *s = sb_pass_data(r);
     if (!s)
         return;
-    sb_renderer_release(r, (const VkPipeline[]){s->inside, s->from_space}, 2, NULL, 0);
+    sb_renderer_release(r, (const VkPipeline[]){s->inside[0], s->inside[1], s->from_space[0], s->from_space[1]}, 4,
+                        NULL, 0);
     free(s);
 }
 
 static void sky_record(struct sb_renderer *r)
 {
     struct sky *s = sb_pass_data(r);
-    sb_renderer_dispatch_frame(r, r->camera_in_atmosphere ? s->inside : s->from_space);
+    bool moon = r->frame_lights > 1;
+    sb_renderer_dispatch_frame(r, r->camera_in_atmosphere ? s->inside[moon] : s->from_space[moon]);
 }
 
 const struct sb_pass_class sb_pass_sky = {

@@ -51,15 +51,22 @@ void aerial_perspective(vec2 uv, vec3 offset, out vec3 inscatter, out vec3 trans
     float r0 = length(p0);
     float h0 = max(r0 - ground_radius(), 0.0);
     float mu = dot(p0, d) / r0;
-    vec3 L = vec3(0.0);
-    for (int i = 0; i < sky_light_count(); i++) {
-        vec3 l = light_direction(i);
-        float mu_s = dot(p0, l) / r0, nu = dot(d, l);
-        RayIntegrals ri = ray_integrals_begin();
+    vec3 l = frame.sun_direction.xyz;
+    float mu_s = dot(p0, l) / r0, nu = dot(d, l);
+    RayIntegrals ri = ray_integrals_begin();
+    integrate_ray_to(ri, h0, mu, mu_s, nu, d_km - entry, true);
+    vec3 L = atm.solar_irradiance.rgb * (ri.sun_rayleigh * phase_rayleigh(nu) + ri.sun_mie * phase_mie(nu)) +
+             ri.ms_rayleigh + ri.ms_mie;
+    transmittance = ri.transmittance;
+    for (int i = 0; i < moon_lights(); i++) {
+        l = frame.moon_direction.xyz;
+        mu_s = dot(p0, l) / r0;
+        nu = dot(d, l);
+        ri = ray_integrals_begin();
         integrate_ray_to(ri, h0, mu, mu_s, nu, d_km - entry, true);
         L += (atm.solar_irradiance.rgb * (ri.sun_rayleigh * phase_rayleigh(nu) + ri.sun_mie * phase_mie(nu)) +
-              ri.ms_rayleigh + ri.ms_mie) * light_color(i);
-        transmittance = ri.transmittance;
+              ri.ms_rayleigh + ri.ms_mie) *
+             frame.moon_light.rgb;
     }
     inscatter = L * frame.aerial.y;
 #endif

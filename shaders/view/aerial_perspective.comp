@@ -7,6 +7,9 @@
  * Gauss-Legendre 4 (integrate_segment), so the slices share one integral.
  * The planet's shadow is included; shadows of the world are not. */
 #extension GL_GOOGLE_include_directive : require
+#ifndef SB_MOON
+#define SB_MOONLESS /* the day's kernel; SB_MOON the night's (frame.glsl's moon_lights) */
+#endif
 #include "view_gpu.h"
 #include "view.glsl"
 
@@ -25,27 +28,25 @@ void main()
     float h = max(r - ground_radius(), 0.0);
     float mu = dot(p, d) / r;
     /* The volume serves cameras inside the atmosphere; above it, the scene
-     * pass integrates per fragment. Each light in the sky's march adds its
-     * in-scattering to the slices'. */
-    vec3 L[SB_AERIAL_SIZE];
-    for (int i = 0; i < sky_light_count(); i++) {
-        vec3 l = light_direction(i), color = atm.solar_irradiance.rgb * light_color(i);
-        float mu_s = dot(p, l) / r, nu = dot(d, l);
-        float p_r = phase_rayleigh(nu), p_m = phase_mie(nu);
-        vec3 ms_color = light_color(i);
-        RayIntegrals ri = ray_integrals_begin();
-        float t0 = 0.0;
-        for (int k = 0; k < SB_AERIAL_SIZE; k++) {
-            float w = (float(k) + 0.5) / float(SB_AERIAL_SIZE);
-            float t1 = frame.aerial.x * w * w;
-            integrate_segment(ri, h, mu, mu_s, nu, t0, t1, true);
-            t0 = t1;
-            vec3 add = color * (ri.sun_rayleigh * p_r + ri.sun_mie * p_m) + ms_color * (ri.ms_rayleigh + ri.ms_mie);
-            L[k] = i == 0 ? add : L[k] + add;
-            if (i == 0)
-                imageStore(transmittance_out, ivec3(column, k), vec4(exp(-ri.tau), 1.0));
+     * pass integrates per fragment. The moon, when it is in the sky, adds
+     * its march's in-scattering to each slice. */
+    vec3 l = frame.sun_direction.xyz, m = frame.moon_direction.xyz;
+    float mu_s = dot(p, l) / r, nu = dot(d, l), mu_m = dot(p, m) / r, nu_m = dot(d, m);
+    vec3 sun = atm.solar_irradiance.rgb, moon = sun * frame.moon_light.rgb;
+    float p_r = phase_rayleigh(nu), p_m = phase_mie(nu), q_r = phase_rayleigh(nu_m), q_m = phase_mie(nu_m);
+    RayIntegrals ri = ray_integrals_begin(), rm = ray_integrals_begin();
+    float t0 = 0.0;
+    for (int k = 0; k < SB_AERIAL_SIZE; k++) {
+        float w = (float(k) + 0.5) / float(SB_AERIAL_SIZE);
+        float t1 = frame.aerial.x * w * w;
+        integrate_segment(ri, h, mu, mu_s, nu, t0, t1, true);
+        vec3 L = sun * (ri.sun_rayleigh * p_r + ri.sun_mie * p_m) + ri.ms_rayleigh + ri.ms_mie;
+        for (int i = 0; i < moon_lights(); i++) {
+            integrate_segment(rm, h, mu, mu_m, nu_m, t0, t1, true);
+            L += moon * (rm.sun_rayleigh * q_r + rm.sun_mie * q_m) + frame.moon_light.rgb * (rm.ms_rayleigh + rm.ms_mie);
         }
+        t0 = t1;
+        imageStore(inscatter_out, ivec3(column, k), vec4(fp16_safe(L * frame.aerial.y), 1.0));
+        imageStore(transmittance_out, ivec3(column, k), vec4(exp(-ri.tau), 1.0));
     }
-    for (int k = 0; k < SB_AERIAL_SIZE; k++)
-        imageStore(inscatter_out, ivec3(column, k), vec4(fp16_safe(L[k] * frame.aerial.y), 1.0));
 }

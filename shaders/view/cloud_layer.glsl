@@ -129,14 +129,13 @@ float cloud_exit_m(float h_km, float mu)
     return max(t, 0.0) * 1e3;
 }
 
-/* The optical depth toward the sun from q (altitude h_km, the sun at
+/* The optical depth toward the key light (unit l) from q (altitude h_km, the light at
  * cosine mu_s there) to the layer's edge or SB_CLOUD_LIGHT_DISTANCE_M, over
  * `steps` pieces growing linearly (piece k is k + 1 units long: fine near
  * the point, where the light's attenuation matters most), each read at
  * `jitter` of its length (the view march's, so frames average it). */
-float cloud_light_depth(vec3 q, float h_km, float mu_s, int steps, float jitter)
+float cloud_light_depth(vec3 q, vec3 l, float h_km, float mu_s, int steps, float jitter)
 {
-    vec3 l = key_direction();
     float reach = min(cloud_exit_m(h_km, mu_s), SB_CLOUD_LIGHT_DISTANCE_M);
     float unit = reach / (0.5 * float(steps) * float(steps + 1));
     float tau = 0.0;
@@ -151,15 +150,17 @@ float cloud_light_depth(vec3 q, float h_km, float mu_s, int steps, float jitter)
 
 /* The light a point scatters toward the viewer per unit scattering
  * (albedo included), scaled like the frame: `up` is its local vertical,
- * h_km its altitude, f its height fraction, nu the cosine between the view
- * ray and the sun; jitter places the light march's samples. */
-vec3 cloud_light(vec3 q, vec3 up, float h_km, float f, float nu, int light_steps, float jitter)
+ * l and key the key light's direction and irradiance above the atmosphere
+ * (the frame's, read once by the caller), h_km its altitude, f its height
+ * fraction, nu the cosine between the view ray and the light; jitter places
+ * the light march's samples. */
+vec3 cloud_light(vec3 q, vec3 up, vec3 l, vec3 key, float h_km, float f, float nu, int light_steps, float jitter)
 {
-    float mu_s = dot(up, key_direction());
-    vec3 sun = atm.solar_irradiance.rgb * key_color() * sun_transmittance(h_km, mu_s);
+    float mu_s = dot(up, l);
+    vec3 sun = key * sun_transmittance(h_km, mu_s);
     float octaves = 0.0;
     if (max(sun.r, max(sun.g, sun.b)) > 0.0) {
-        float tau = cloud_light_depth(q, h_km, mu_s, light_steps, jitter);
+        float tau = cloud_light_depth(q, l, h_km, mu_s, light_steps, jitter);
         float a = 1.0;
         for (int i = 0; i < int(clouds.phase.w); i++) {
             float p = mix(phase_hg(clouds.phase.y * a, nu), phase_hg(clouds.phase.x * a, nu), clouds.phase.z);

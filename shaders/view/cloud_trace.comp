@@ -11,6 +11,9 @@
  * clouds scatters AP_S (1 - T) over what they hide: AP_T S + AP_S (1 - T)),
  * and that distance, for reprojection. */
 #extension GL_GOOGLE_include_directive : require
+#ifndef SB_MOON
+#define SB_MOONLESS /* the day's kernel; SB_MOON the night's (frame.glsl's moon_lights) */
+#endif
 #include "view_gpu.h"
 #include "view.glsl"
 #include "aerial.glsl"
@@ -56,7 +59,8 @@ void main()
             grow = 2.0 * (length_m - float(n) * first) / (float(n) * float(n - 1));
         float jitter = fract(52.9829189 * fract(dot(vec2(pixel), vec2(0.06711056, 0.00583715))) + clouds.temporal.x);
         float h_c = frame.camera_km.w, mu = dot(normalize(frame.camera_km.xyz), d);
-        float nu = dot(d, key_direction());
+        vec3 l = key_direction(), key = atm.solar_irradiance.rgb * key_color(); /* the frame's, once */
+        float nu = dot(d, l);
         int light_steps = int(clouds.march.y);
         float t = t0;
         for (int i = 0; i < n; i++) {
@@ -70,7 +74,7 @@ void main()
                 continue;
             vec3 up = normalize(planet_position(d * at));
             float f = (q.y - clouds.layer.x) * clouds.layer.z;
-            vec3 light = cloud_light(q, up, h_km, f, nu, light_steps, jitter);
+            vec3 light = cloud_light(q, up, l, key, h_km, f, nu, light_steps, jitter);
             float absorbed = T * (1.0 - exp(-density * clouds.layer.w * dt));
             S += light * absorbed;
             weighted_m += absorbed * at;

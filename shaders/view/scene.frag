@@ -1,10 +1,12 @@
 #version 450
 /* The world rasterised: scene_shading.glsl lights each fragment, with the
- * sun's visibility from the cascaded shadow maps (normal offset, 3x3
- * comparison PCF, a blend band between cascades: shadows.glsl). */
+ * key light's visibility from the cascaded shadow maps (normal offset,
+ * penumbrae by the light's disk or a 3x3 comparison PCF, a blend band
+ * between cascades: shadows.glsl). */
 #extension GL_GOOGLE_include_directive : require
 #include "view_gpu.h"
 #include "scene_shading.glsl"
+#define SB_SOFT_SHADOWS
 #include "shadows.glsl"
 #include "material.glsl"
 

@@ -1,8 +1,9 @@
 #version 450
 /* The world traced: one ray a pixel through the world's BVH (bvh.glsl)
  * from the camera through the pixel's centre, where the rasteriser samples
- * too, lit by scene_shading.glsl with a shadow ray for the sun's visibility
- * (shadows.glsl, SB_TRACED_SHADOWS). It writes what the raster scene pass
+ * too, lit by scene_shading.glsl with a shadow ray for the key light's
+ * visibility (shadows.glsl, SB_TRACED_SHADOWS), toward a new point of its
+ * disk each frame, their mean kept over frames (soft_sun). It writes what the raster scene pass
  * writes: the lit radiance, zero where no triangle is hit (the sky pass
  * fills those), and the depth as the rasteriser's reverse-Z projection
  * would (0 for the sky). For GPUs whose rasteriser is their weak part
@@ -19,6 +20,49 @@
 layout(local_size_x = SB_WORKGROUP_X, local_size_y = SB_WORKGROUP_Y) in;
 layout(set = 0, binding = SB_VIEW_BINDING_HDR, rgba16f) uniform writeonly image2D hdr;
 layout(set = 0, binding = SB_VIEW_BINDING_DEPTH_OUT, r32f) uniform writeonly image2D depth_out;
+layout(set = 0, binding = SB_VIEW_BINDING_SUN_HISTORY, rgba16f) uniform readonly image2D sun_history;
+layout(set = 0, binding = SB_VIEW_BINDING_SUN_HISTORY_OUT, rgba16f) uniform writeonly image2D sun_history_out;
+layout(std430, set = 0, binding = SB_VIEW_BINDING_SCENE_HISTORY) readonly buffer SceneHistory {
+    sb_scene_history_gpu history;
+};
+
+/*
+ * The key light's visibility with its penumbra: this frame's ray toward a
+ * point of the light's disk, averaged with the rays of the frames before
+ * that saw the same point (reprojected into the last frame, and the
+ * distance it kept there within 1%), at most SB_SUN_RAYS of them. A point
+ * seen anew starts from the disk's centre: its first frame is the hard
+ * shadow, exact; the points over the disk follow in Vogel's spiral, turned
+ * by a per-pixel noise, and once SB_SUN_RAYS are kept each frame replaces
+ * the oldest in the mean's weight.
+ */
+float soft_sun(ivec2 pixel, vec3 offset, vec3 n)
+{
+    float distance_m = length(offset);
+    float mean = 0.0, kept = 0.0;
+    vec3 before = offset + history.camera_motion_m.xyz;
+    vec4 clip = history.previous_view_proj * vec4(before, 1.0);
+    if (history.camera_motion_m.w != 0.0 && clip.w > 0.0) {
+        ivec2 q = ivec2(floor((clip.xy / clip.w * 0.5 + 0.5) * vec2(frame.size.xy)));
+        if (all(greaterThanEqual(q, ivec2(0))) && all(lessThan(q, ivec2(frame.size.xy)))) {
+            vec4 h = imageLoad(sun_history, q);
+            float was = length(before);
+            if (abs(h.z - was) <= 0.01 * was) {
+                mean = h.x;
+                kept = h.y;
+            }
+        }
+    }
+    float v = 0.0;
+    if (dot(n, key_direction()) > 0.0) { /* a face turned from the light gets none of it */
+        int k = kept < float(SB_SUN_RAYS) ? int(kept) : 1 + int(history.frame.x % uint(SB_SUN_RAYS - 1));
+        v = disk_visibility(offset, n, k, SB_SUN_RAYS, pixel_turn(vec2(pixel)));
+    }
+    kept = min(kept + 1.0, float(SB_SUN_RAYS));
+    mean += (v - mean) / kept;
+    imageStore(sun_history_out, pixel, vec4(mean, kept, distance_m, 0.0));
+    return mean;
+}
 
 void main()
 {
@@ -33,6 +77,7 @@ void main()
     if (hit.triangle == SB_BVH_MISS) {
         imageStore(hdr, pixel, vec4(0.0));
         imageStore(depth_out, pixel, vec4(0.0));
+        imageStore(sun_history_out, pixel, vec4(0.0, 0.0, -1.0, 0.0));
         return;
     }
     sb_vertex_gpu v = vertices[3u * (hit.triangle & ~SB_BVH_BACK_FACE)];
@@ -46,8 +91,7 @@ void main()
 #endif
     vec4 clip = frame.view_proj * vec4(offset, 1.0);
     imageStore(depth_out, pixel, vec4(clip.z / clip.w));
-    /* a face turned from the sun gets none of it, shadowed or not */
-    float visibility = dot(n, key_direction()) > 0.0 ? sun_visibility(offset, n, true) : 0.0;
+    float visibility = soft_sun(pixel, offset, n);
     vec3 albedo = v.albedo.rgb, shading_n = n;
     vec2 metallic_roughness = vec2(v.position.w, v.normal.w);
     vec3 emitted = vec3(0.0);

@@ -4,16 +4,20 @@
  * `offset` metres from the camera: the cascade by view depth, a normal offset
  * of frame.shadow.y texels along n (0 for points in the air), the depth
  * compare filtered bilinearly by the sampler (zero gradients: compute
- * shaders have none, and the maps have one level), then 3 x 3 taps with pcf (the
- * scene) or one (the fog, whose jitter and history filter it), and a blend
- * band toward the next cascade. 1 beyond the last cascade, and outside the
- * box of a cascade's casters, where the map was neither cleared nor drawn
+ * shaders have none, and the maps have one level), then with pcf (the
+ * scene) the penumbra of the light's disk where SB_SOFT_SHADOWS asks for it
+ * (soft_visibility) or 3 x 3 taps, or one tap (the fog, whose jitter and
+ * history filter it), and a blend band toward the next cascade. 1 beyond the
+ * last cascade, and outside the box of a cascade's casters (and the
+ * penumbra's reach past it), where the map was neither cleared nor drawn
  * (frame.cascade_rect; runtime/shadows.h).
  *
  * With SB_TRACED_SHADOWS (the traced scene, runtime/scene_trace.c), a
  * shadow ray instead: from the point, lifted off its surface along n,
- * toward the light's centre through the world's BVH, any caster ending it.
- * Exact and hard (no penumbra, no filtering), at every distance.
+ * toward the light's centre through the world's BVH, any caster ending it,
+ * exact at every distance; the scene traces toward points over the light's
+ * disk, a new one each frame (disk_visibility), and keeps their mean
+ * (scene_trace.comp): the penumbra.
  */
 #ifndef SB_SHADOWS_GLSL
 #define SB_SHADOWS_GLSL
@@ -21,20 +25,39 @@
 #include "view_gpu.h"
 #include "frame.glsl"
 
+/* The key light's angular radius (radians). */
+float key_radius()
+{
+    return key_light() == 0 ? frame.sun_direction.w : frame.moon_direction.w;
+}
+
+/* Point i of n on Vogel's spiral, spread evenly over the unit disk, turned
+ * by `turn` (radians). */
+vec2 vogel(int i, int n, float turn)
+{
+    float r = sqrt((float(i) + 0.5) / float(n));
+    float a = float(i) * 2.39996323 + turn; /* the golden angle */
+    return r * vec2(cos(a), sin(a));
+}
+
+/* A per-pixel turn in [0, 2 pi): interleaved gradient noise (Jimenez 2014). */
+float pixel_turn(vec2 pixel)
+{
+    return 6.2831853 * fract(52.9829189 * fract(dot(floor(pixel), vec2(0.06711056, 0.00583715))));
+}
+
 #ifdef SB_TRACED_SHADOWS
 layout(std430, set = 0, binding = SB_VIEW_BINDING_BVH_NODES) readonly buffer BvhNodes { vec4 bvh_nodes[]; };
 layout(std430, set = 0, binding = SB_VIEW_BINDING_BVH_TRIANGLES) readonly buffer BvhTriangles { vec4 bvh_triangles[]; };
 #define BVH_ANY_HIT_MATERIAL_0_PASSES /* receivers only (a ground) cast no shadow, as in the maps */
 #include "bvh.glsl"
 
-/* `pcf` is the raster's: a ray needs no filter. */
-float sun_visibility(vec3 offset, vec3 n, bool pcf)
+/* A shadow ray from the point `offset` m from the camera toward unit l: 1
+ * when no caster ends it. */
+float shadow_ray(vec3 offset, vec3 n, vec3 l)
 {
-    if (frame.shadow.w == 0.0)
-        return 1.0;
-    vec3 l = key_direction();
     vec3 c = abs(frame.camera_m.xyz), p = offset + frame.camera_m.xyz;
-    /* Off the surface, to the side the sun is on, by 1 mm and 4e-6 of the
+    /* Off the surface, to the side the light is on, by 1 mm and 4e-6 of the
      * scale of the point's rounding: it was found from the camera at
      * `offset` (a ray's t) and placed in the world (fp32 steps of |p| <=
      * |camera| + |offset|), so the lift stays a fixed fraction of a pixel's
@@ -43,9 +66,112 @@ float sun_visibility(vec3 offset, vec3 n, bool pcf)
     vec3 o = p + n * (dot(n, l) < 0.0 ? -lift : lift);
     return bvh_trace(o, l, 0.0, SB_TRACE_FAR_M, true).triangle == SB_BVH_MISS ? 1.0 : 0.0;
 }
+
+/* Toward the key light's centre. `pcf` is the raster's: a ray needs no filter. */
+float sun_visibility(vec3 offset, vec3 n, bool pcf)
+{
+    if (frame.shadow.w == 0.0)
+        return 1.0;
+    return shadow_ray(offset, n, key_direction());
+}
+
+/* A ray toward point k of n on the key light's disk (Vogel's spiral, turned
+ * by `turn`), k = 0 its centre. */
+float disk_visibility(vec3 offset, vec3 n, int k, int count, float turn)
+{
+    if (frame.shadow.w == 0.0)
+        return 1.0;
+    vec3 l = key_direction();
+    if (k == 0)
+        return shadow_ray(offset, n, l);
+    vec3 e1 = normalize(cross(l, abs(l.y) < 0.9 ? vec3(0.0, 1.0, 0.0) : vec3(1.0, 0.0, 0.0))), e2 = cross(l, e1);
+    vec2 o = vogel(k, count, turn) * tan(key_radius());
+    return shadow_ray(offset, n, normalize(l + o.x * e1 + o.y * e2));
+}
 #else
 
 layout(set = 0, binding = SB_VIEW_BINDING_SHADOW) uniform sampler2DArrayShadow shadow_map;
+
+#ifdef SB_SOFT_SHADOWS
+/*
+ * Penumbrae (percentage-closer soft shadows, Fernando 2005), for the
+ * scene: the key light is a disk of angular radius alpha, so a blocker d
+ * metres before the receiver blurs its edge over d tan(alpha) each side.
+ * A blocker search over the disk of map texels from which a blocker within
+ * the cascade's depth could reach the point (at most
+ * SB_SHADOW_SEARCH_TEXELS), SB_SHADOW_SEARCH_TAPS gathers of 2 x 2 texels,
+ * gives the mean blocker depth, then SB_SHADOW_FILTER_TAPS bilinear comparisons over a
+ * disk of the penumbra's radius: a straight edge at one distance then reads
+ * the fraction of the light's disk it leaves uncovered, its true profile.
+ * The taps lie on Vogel's spiral turned by a per-pixel noise. Each tap is
+ * compared against the receiver's plane through the point (its normal in
+ * the map's space), not its depth at the centre, so that a wide filter on
+ * a surface sloped to the light does not shadow itself (the acne at a low
+ * light). Penumbrae under a texel take the 4-tap filter below.
+ */
+layout(set = 0, binding = SB_VIEW_BINDING_SHADOW_DEPTH) uniform sampler2DArray shadow_depth;
+
+/* The receiver's depth (the map's 0 to 1) a uv step away, on the plane
+ * through the point with normal n: the cascade's clip space is an affine map
+ * M of the world, so the plane's normal there is M^-T n, and for M = S R (a
+ * rotation, then scales) that is S^-2 (M n). A plane steeper than 10 texels
+ * of depth a texel is grazing the light: its slope is held there (the normal
+ * offset covers the rest), so that a tap on it does not compare against a
+ * depth far from any surface. */
+vec2 receiver_slope(int c, vec3 n, float texel_m, float range_m)
+{
+    mat3 m = mat3(frame.shadow_view_proj[c]);
+    vec3 mn = m * n;
+    vec3 s2 = vec3(dot(vec3(m[0][0], m[1][0], m[2][0]), vec3(m[0][0], m[1][0], m[2][0])),
+                   dot(vec3(m[0][1], m[1][1], m[2][1]), vec3(m[0][1], m[1][1], m[2][1])),
+                   dot(vec3(m[0][2], m[1][2], m[2][2]), vec3(m[0][2], m[1][2], m[2][2])));
+    vec3 nc = mn / s2;
+    if (abs(nc.z) < 1e-20)
+        return vec2(0.0);
+    /* uv = clip.xy / 2 + 1/2: a uv step is two clip steps */
+    vec2 slope = -2.0 * nc.xy / nc.z;
+    float limit = 10.0 * texel_m * frame.shadow.z / range_m, length_ = length(slope);
+    return length_ > limit ? slope * (limit / length_) : slope;
+}
+
+float soft_visibility(int c, vec3 offset, vec3 n, vec3 s, vec2 uv)
+{
+    float size = frame.shadow.z, texel_m = frame.cascade_texel[c], range_m = frame.cascade_depth_m[c];
+    float tan_a = tan(key_radius());
+    vec2 slope = receiver_slope(c, n, texel_m, range_m);
+    vec4 clip = frame.view_proj * vec4(offset, 1.0);
+    vec2 px = (clip.xy / clip.w * 0.5 + 0.5) * vec2(frame.size.xy);
+    float turn = pixel_turn(px);
+    /* the map's own quantum and the raster's depth bias: what a blocker must be nearer by */
+    const float epsilon = 2.0 / 65535.0;
+
+    float search = min(range_m * tan_a / texel_m, float(SB_SHADOW_SEARCH_TEXELS)) / size;
+    float blockers = 0.0, depth_sum = 0.0;
+    vec4 rect = frame.cascade_rect[c];
+    for (int i = 0; i < SB_SHADOW_SEARCH_TAPS; i++) {
+        vec2 o = vogel(i, SB_SHADOW_SEARCH_TAPS, turn) * search, q = uv + o;
+        if (any(lessThan(q, rect.xy)) || any(greaterThan(q, rect.zw)))
+            continue; /* outside the casters' box: none */
+        vec4 z = textureGather(shadow_depth, vec3(q, float(c)), 0); /* the 2 x 2 texels around q */
+        vec4 blocking = vec4(lessThan(z, vec4(s.z + dot(slope, o) - epsilon)));
+        blockers += dot(blocking, vec4(1.0));
+        depth_sum += dot(blocking, z);
+    }
+    if (blockers == 0.0)
+        return 1.0;
+    float distance_m = max(s.z - depth_sum / blockers, 0.0) * range_m;
+    float radius = min(distance_m * tan_a / texel_m, float(SB_SHADOW_SEARCH_TEXELS)) / size;
+    if (radius * size < 1.0)
+        return -1.0; /* a penumbra under a texel: the fixed filter */
+    float sum = 0.0;
+    for (int i = 0; i < SB_SHADOW_FILTER_TAPS; i++) {
+        vec2 o = vogel(i, SB_SHADOW_FILTER_TAPS, turn) * radius, q = uv + o;
+        bool outside = any(lessThan(q, rect.xy)) || any(greaterThan(q, rect.zw));
+        sum += outside ? 1.0 : textureGrad(shadow_map, vec4(q, float(c), s.z + dot(slope, o)), vec2(0.0), vec2(0.0));
+    }
+    return sum / float(SB_SHADOW_FILTER_TAPS);
+}
+#endif
 
 float cascade_visibility(int c, vec3 offset, vec3 n, bool pcf)
 {
@@ -54,10 +180,26 @@ float cascade_visibility(int c, vec3 offset, vec3 n, bool pcf)
     vec3 s = clip.xyz / clip.w;
     vec2 uv = s.xy * 0.5 + 0.5;
     vec4 rect = frame.cascade_rect[c];
-    if (any(lessThan(uv, max(rect.xy, vec2(0.0)))) || any(greaterThan(uv, min(rect.zw, vec2(1.0)))) || s.z > 1.0)
+    /* A penumbra reaches past the casters' box by its filter's radius. */
+    float reach = 0.0;
+#ifdef SB_SOFT_SHADOWS
+    if (pcf)
+        reach = float(SB_SHADOW_SEARCH_TEXELS) / frame.shadow.z;
+#endif
+    if (any(lessThan(uv, max(rect.xy - reach, vec2(0.0)))) || any(greaterThan(uv, min(rect.zw + reach, vec2(1.0)))) ||
+        s.z > 1.0)
         return 1.0;
     if (!pcf)
         return textureGrad(shadow_map, vec4(uv, float(c), s.z), vec2(0.0), vec2(0.0));
+#ifdef SB_SOFT_SHADOWS
+    if (dot(n, key_direction()) <= 0.0)
+        return 0.0; /* turned from the light: none of it, and no search */
+    float soft = soft_visibility(c, offset, n, s, uv);
+    if (soft >= 0.0)
+        return soft;
+    if (any(lessThan(uv, rect.xy)) || any(greaterThan(uv, rect.zw)))
+        return 1.0; /* outside the box, and no penumbra reaches here */
+#endif
     /* 3 x 3 bilinear taps a texel apart weigh the 4 x 4 texels from
      * base - 1 by (1 - f, 1, 1, f) / 3 in each axis (f: the point's
      * fraction past texel base). Two bilinear taps give the same weights,

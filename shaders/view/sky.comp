@@ -9,6 +9,9 @@
  * above it; the renderer dispatches the one the frame needs, since llvmpipe
  * runs an untaken branch's code too (a quarter of the pass's time there). */
 #extension GL_GOOGLE_include_directive : require
+#ifndef SB_MOON
+#define SB_MOONLESS /* the day's kernel; SB_MOON the night's (frame.glsl's moon_lights) */
+#endif
 #include "view_gpu.h"
 #include "view.glsl"
 
@@ -35,8 +38,9 @@ void main()
         vec3 up = normalize(p);
         float h = clamp(frame.camera_km.w, 0.0, atmosphere_thickness()); /* as the LUT was made */
         float mu = clamp(dot(up, d), -1.0, 1.0);
-        for (int i = 0; i < sky_light_count(); i++)
-            L += textureLod(sky_view, vec3(sky_view_uv_toward(d, light_direction(i)), float(i)), 0.0).rgb;
+        L = textureLod(sky_view, vec3(sky_view_uv_toward(d, frame.sun_direction.xyz), 0.0), 0.0).rgb;
+        for (int i = 0; i < moon_lights(); i++)
+            L += textureLod(sky_view, vec3(sky_view_uv_toward(d, frame.moon_direction.xyz), 1.0), 0.0).rgb;
         if (!ray_hits_ground(h, mu))
             view_t = transmittance_lut_sample(h, mu);
     }
@@ -60,6 +64,9 @@ void main()
         }
     }
 #endif
-    L += (sun_disk(nu) + moon_disk(d)) * view_t * frame.aerial.y;
+    vec3 disks = sun_disk(nu);
+    for (int i = 0; i < int(frame.moon_direction.w > 0.0); i++)
+        disks += moon_disk(d);
+    L += disks * view_t * frame.aerial.y;
     imageStore(hdr, pixel, vec4(fp16_safe(L), 1.0));
 }

@@ -126,12 +126,13 @@ vec3 moon_disk(vec3 d)
  * light's height. */
 void sky_irradiance(vec3 up, out vec3 e_up, out vec3 e_down)
 {
-    e_up = vec3(0.0);
-    e_down = vec3(0.0);
-    for (int i = 0; i < sky_light_count(); i++) {
-        float mu = dot(up, light_direction(i));
-        e_up += light_color(i) * ground_sky_irradiance_sample(mu);
-        e_down += light_color(i) * ground_irradiance_sample(mu);
+    float mu = dot(up, frame.sun_direction.xyz);
+    e_up = ground_sky_irradiance_sample(mu);
+    e_down = ground_irradiance_sample(mu);
+    for (int i = 0; i < moon_lights(); i++) {
+        mu = dot(up, frame.moon_direction.xyz);
+        e_up += frame.moon_light.rgb * ground_sky_irradiance_sample(mu);
+        e_down += frame.moon_light.rgb * ground_irradiance_sample(mu);
     }
     e_down *= atm.ground_albedo.rgb;
 }

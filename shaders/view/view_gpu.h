@@ -39,6 +39,23 @@
 #define SB_VIEW_BINDING_INSTANCES 53        /* struct sb_instance_gpu[]: an instanced world's placed copies */
 #define SB_VIEW_BINDING_VISIBLE 54          /* uint[]: the instances each raster draw draws (this frame's cull) */
 #define SB_VIEW_BINDING_EMISSIVE 55         /* struct sb_emissive_gpu[]: the world's materials that emit */
+#define SB_VIEW_BINDING_SHADOW_DEPTH 58     /* sampler2DArray: the cascades' depths, for the soft shadows' search */
+#define SB_VIEW_BINDING_SUN_HISTORY 59      /* image2D rgba16f: the traced scene's key-light visibility, last frame's */
+#define SB_VIEW_BINDING_SUN_HISTORY_OUT 60  /* image2D rgba16f: the same, this frame's: x the mean of the rays of the
+                                               frames kept, y how many (at most SB_SUN_RAYS), z the point's
+                                               distance from the camera (m) */
+#define SB_VIEW_BINDING_SCENE_HISTORY 61    /* struct sb_scene_history_gpu */
+/* The traced scene's penumbrae: a ray a frame toward a point of the key
+ * light's disk, the mean of the last SB_SUN_RAYS kept (scene_trace.comp). */
+#define SB_SUN_RAYS 32
+
+/* What the traced scene's penumbrae read of the last frame. */
+struct sb_scene_history_gpu {
+    SB_MAT4(previous_view_proj); /* the last frame's camera-relative world to clip */
+    SB_VEC4(camera_motion_m);    /* xyz: this frame's camera minus the last's (m); w: 1 when the history holds */
+    SB_UVEC4(frame);             /* x: frames drawn before this one */
+};
+
 /* A shadow ray's reach: past any two points of a world (4 x SB_MESH_MAX_EXTENT_M, geometry/mesh.h). */
 #define SB_TRACE_FAR_M 4.0e4
 
@@ -73,6 +90,13 @@
 _Static_assert(2 * SB_SHADOW_CLEAR_MARGIN_TEXELS >= 2 * SB_SHADOW_RECT_MARGIN_TEXELS + SB_SHADOW_FILTER_REACH_HALF_TEXELS,
                "the cleared margin covers what the filter reads past the lookups' box");
 #endif
+/* The scene's soft shadows (shadows.glsl, SB_SOFT_SHADOWS): gathers of the
+ * blocker search and taps of the filter, and the widest either reaches (texels;
+ * a tap outside the casters' box, where the map was neither cleared nor
+ * drawn, reads no caster, as the lookups do). */
+#define SB_SHADOW_SEARCH_TAPS 6
+#define SB_SHADOW_FILTER_TAPS 8
+#define SB_SHADOW_SEARCH_TEXELS 24
 #define SB_HISTOGRAM_BINS 256
 #define SB_BLOOM_MAX_LEVELS 6
 
@@ -130,6 +154,7 @@ struct sb_frame_gpu {
                                   down); zw: unused. frame.glsl reads them */
     SB_VEC4(cascade_ends);     /* view depth (m) where each cascade ends */
     SB_VEC4(cascade_texel);    /* a shadow texel's width (m) in each cascade */
+    SB_VEC4(cascade_depth_m);  /* the depth each cascade's map spans, 0 to 1 (m) */
     SB_VEC4(cascade_rect[SB_CASCADES]); /* uv box (min xy, max xy) outside which a cascade has no caster:
                                            lookups there see the sun without reading the map */
     SB_VEC4(shadow);           /* x: blend band (fraction of a cascade), y: normal offset (texels),
