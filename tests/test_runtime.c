@@ -419,13 +419,34 @@ static bool pixel_edge(const uint32_t *ids, const uint8_t *lit, int x, int y)
     return false;
 }
 
+/* The test world in Embree: every triangle (what a camera sees) and its
+ * casters (what a shadow ray meets; the ground receives only). */
+struct world_rays {
+    struct sb_mesh all_mesh, caster_mesh;
+    struct sb_embree all, casters;
+};
+
+static bool world_rays_init(struct world_rays *e)
+{
+    bool ok =
+        sb_world_mesh(&world, false, &e->all_mesh) == SB_OK && sb_world_mesh(&world, true, &e->caster_mesh) == SB_OK;
+    ok = ok && sb_embree_create(&e->all_mesh, &e->all) && sb_embree_create(&e->caster_mesh, &e->casters);
+    CHECK(ok, "the world in Embree");
+    return ok;
+}
+
+static void world_rays_finish(struct world_rays *e)
+{
+    sb_embree_destroy(&e->all);
+    sb_embree_destroy(&e->casters);
+    sb_mesh_finish(&e->all_mesh);
+    sb_mesh_finish(&e->caster_mesh);
+}
+
 static void test_traced_scene(const struct sb_renderer_params *rp)
 {
-    struct sb_mesh all = {0}, casters = {0};
-    struct sb_embree e_all = {0}, e_casters = {0};
-    bool ok = sb_world_mesh(&world, false, &all) == SB_OK && sb_world_mesh(&world, true, &casters) == SB_OK;
-    ok = ok && sb_embree_create(&all, &e_all) && sb_embree_create(&casters, &e_casters);
-    CHECK(ok, "the world in Embree");
+    struct world_rays e = {0};
+    bool ok = world_rays_init(&e);
     struct sb_renderer *rr[4] = {NULL}; /* raster, traced; each also writing the sun's visibility */
     for (int k = 0; k < 4 && ok; k++) {
         struct sb_renderer_params p = *rp;
@@ -473,7 +494,7 @@ static void test_traced_scene(const struct sb_renderer_params *rp)
                     (float)(0.1 / (d[0] * forward[0] + d[1] * forward[1] + d[2] * forward[2])); /* the near plane */
                 ray[7] = 1e30f;
             }
-        sb_embree_cast(&e_all, rays, W * H, hits);
+        sb_embree_cast(&e.all, rays, W * H, hits);
         for (int i = 0; i < W * H; i++) {
             uint32_t t;
             memcpy(&t, &hits[4 * i + 1], sizeof(t));
@@ -498,7 +519,7 @@ static void test_traced_scene(const struct sb_renderer_params *rp)
             ray[3] = 0.0f;
             ray[7] = n_l > 0.0 ? (float)SB_TRACE_FAR_M : 0.0f;
         }
-        sb_embree_cast(&e_casters, rays, W * H, shadow_hits);
+        sb_embree_cast(&e.casters, rays, W * H, shadow_hits);
         for (int i = 0; i < W * H; i++) {
             uint32_t t;
             memcpy(&t, &shadow_hits[4 * i + 1], sizeof(t));
@@ -550,10 +571,7 @@ static void test_traced_scene(const struct sb_renderer_params *rp)
     free(lit);
     for (int k = 0; k < 4; k++)
         sb_renderer_destroy(&rr[k]);
-    sb_embree_destroy(&e_all);
-    sb_embree_destroy(&e_casters);
-    sb_mesh_finish(&all);
-    sb_mesh_finish(&casters);
+    world_rays_finish(&e);
 }
 
 /* ---- Soft shadows ------------------------------------------------------------------------ */
@@ -607,11 +625,8 @@ static bool render_still(struct sb_renderer *r, const struct sb_view *v, int fra
  */
 static void test_soft_shadows(const char *dir, const struct sb_renderer_params *rp)
 {
-    struct sb_mesh all = {0}, casters = {0};
-    struct sb_embree e_all = {0}, e_casters = {0};
-    bool ok = sb_world_mesh(&world, false, &all) == SB_OK && sb_world_mesh(&world, true, &casters) == SB_OK;
-    ok = ok && sb_embree_create(&all, &e_all) && sb_embree_create(&casters, &e_casters);
-    CHECK(ok, "the world in Embree");
+    struct world_rays e = {0};
+    bool ok = world_rays_init(&e);
     struct sb_renderer *rr[2] = {NULL, NULL};
     struct sb_renderer_params p = *rp;
     p.debug = SB_DEBUG_SUN_VISIBILITY;
@@ -668,7 +683,7 @@ static void test_soft_shadows(const char *dir, const struct sb_renderer_params *
                 ray[3] = (float)(0.1 / (d[0] * forward[0] + d[1] * forward[1] + d[2] * forward[2]));
                 ray[7] = 1e30f;
             }
-        sb_embree_cast(&e_all, rays, W * H, hits);
+        sb_embree_cast(&e.all, rays, W * H, hits);
         /* every surface point's rays over the sun's disk */
         float *disk = rays + 8 * W * H;
         for (int i = 0; i < W * H; i++) {
@@ -699,7 +714,7 @@ static void test_soft_shadows(const char *dir, const struct sb_renderer_params *
                 q[7] = ids[i] != SB_BVH_MISS ? (float)SB_TRACE_FAR_M : 0.0f;
             }
         }
-        sb_embree_cast(&e_casters, disk, W * H * RAYS, hits);
+        sb_embree_cast(&e.casters, disk, W * H * RAYS, hits);
         for (int i = 0; i < W * H; i++) {
             int open = 0;
             for (int j = 0; j < RAYS; j++) {
@@ -778,10 +793,7 @@ static void test_soft_shadows(const char *dir, const struct sb_renderer_params *
     CHECK(dark_total > 100, "%d wholly shadowed pixels compared", dark_total);
     for (int m = 0; m < 2; m++)
         sb_renderer_destroy(&rr[m]);
-    sb_embree_destroy(&e_all);
-    sb_embree_destroy(&e_casters);
-    sb_mesh_finish(&all);
-    sb_mesh_finish(&casters);
+    world_rays_finish(&e);
 
     /* The pole. The sun in the east, 30 degrees up: the shadow runs west
      * along -x, its side along z = 0.5. Looking straight down (north up,
