@@ -20,7 +20,9 @@
 #include "texture.h"
 #include "transform.h"
 
-_Static_assert(SB_TRACE_FAR_M >= 3.5 * SB_MESH_MAX_EXTENT_M, "a shadow ray crosses any world");
+/* In integers (2 x far >= 7 x extent): a floating comparison is no C
+ * constant expression, and clang refuses it. */
+_Static_assert(2 * (long)SB_TRACE_FAR_M >= 7 * (long)SB_MESH_MAX_EXTENT_M, "a shadow ray crosses any world");
 
 /* ---- Creation ------------------------------------------------------------------ */
 
