@@ -290,39 +290,22 @@ static void store4(float dst[4], double x, double y, double z, double w)
  * dark limb. Over the visible hemisphere by the angle theta from the disk's
  * centre (a disk radius sin theta, its area element sin theta cos theta
  * dtheta dphi, smooth to the limb) and the angle phi around it: midpoints,
- * 64 x 128, within 1e-3 of the integral at any phase.
+ * 64 x 128, within 1e-3 of the integral at any phase (the sun-moon-viewer
+ * angle, radians; 0: full).
  */
-static double moon_disk_integral(const double sun[3], const double moon[3], double radius)
+static double moon_disk_integral(double phase, double radius)
 {
-    double e1[3], e2[3];
-    double ref[3] = {0.0, 1.0, 0.0};
-    if (fabs(moon[1]) > 0.9) {
-        ref[1] = 0.0;
-        ref[0] = 1.0;
-    }
-    e1[0] = moon[1] * ref[2] - moon[2] * ref[1]; /* moon x ref, then moon x e1 */
-    e1[1] = moon[2] * ref[0] - moon[0] * ref[2];
-    e1[2] = moon[0] * ref[1] - moon[1] * ref[0];
-    double len = sqrt(e1[0] * e1[0] + e1[1] * e1[1] + e1[2] * e1[2]);
-    for (int k = 0; k < 3; k++)
-        e1[k] /= len;
-    e2[0] = moon[1] * e1[2] - moon[2] * e1[1];
-    e2[1] = moon[2] * e1[0] - moon[0] * e1[2];
-    e2[2] = moon[0] * e1[1] - moon[1] * e1[0];
-    /* the sun in the disk's frame */
-    double s1 = 0.0, s2 = 0.0, s3 = 0.0;
-    for (int k = 0; k < 3; k++) {
-        s1 += sun[k] * e1[k];
-        s2 += sun[k] * e2[k];
-        s3 -= sun[k] * moon[k];
-    }
+    /* The shading is symmetric about the line to the moon: the sun is taken
+     * in the plane of the disk's first axis, at the phase angle from the
+     * viewer (s3 its cosine toward the viewer, s1 its sine across). */
+    double s1 = sin(phase), s3 = cos(phase);
     enum { THETA = 64, PHI = 128 };
     double sum = 0.0;
     for (int j = 0; j < THETA; j++) {
         double theta = (j + 0.5) * (0.5 * M_PI / THETA), r = sin(theta), mu = cos(theta);
         for (int i = 0; i < PHI; i++) {
             double phi = (i + 0.5) * (2.0 * M_PI / PHI);
-            double mu0 = r * (cos(phi) * s1 + sin(phi) * s2) + mu * s3;
+            double mu0 = r * cos(phi) * s1 + mu * s3;
             if (mu0 > 0.0)
                 sum += mu0 / (mu0 + mu) * r * mu;
         }
@@ -378,7 +361,7 @@ static void fill_frame(struct sb_renderer *r, const struct sb_view *v, struct sb
         double radius = asin(fmin(SB_MOON_RADIUS_KM / distance, 1.0));
         double phase = acos(fmin(fmax(-(sun[0] * moon[0] + sun[1] * moon[1] + sun[2] * moon[2]), -1.0), 1.0));
         double ratio = sb_moon_irradiance_ratio(phase, distance);
-        double shading = moon_disk_integral(sun, moon, radius);
+        double shading = moon_disk_integral(phase, radius);
         store4(f->moon_direction, moon[0], moon[1], moon[2], radius);
         store4(f->moon_light, ratio * SB_MOON_COLOR_R, ratio * SB_MOON_COLOR_G, ratio * SB_MOON_COLOR_B,
                shading > 0.0 ? 1.0 / shading : 0.0);

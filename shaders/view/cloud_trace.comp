@@ -57,7 +57,7 @@ void main()
             first = length_m / float(max(n, 1));
         else
             grow = 2.0 * (length_m - float(n) * first) / (float(n) * float(n - 1));
-        float jitter = fract(52.9829189 * fract(dot(vec2(pixel), vec2(0.06711056, 0.00583715))) + clouds.temporal.x);
+        float jitter = fract(interleaved_noise(vec2(pixel)) + clouds.temporal.x);
         float h_c = frame.camera_km.w, mu = dot(normalize(frame.camera_km.xyz), d);
         vec3 l = key_direction(), key = atm.solar_irradiance.rgb * key_color(); /* the frame's, once */
         float nu = dot(d, l);

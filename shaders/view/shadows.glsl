@@ -23,7 +23,7 @@
 #define SB_SHADOWS_GLSL
 
 #include "view_gpu.h"
-#include "frame.glsl"
+#include "view.glsl"
 
 /* The key light's angular radius (radians). */
 float key_radius()
@@ -40,10 +40,10 @@ vec2 vogel(int i, int n, float turn)
     return r * vec2(cos(a), sin(a));
 }
 
-/* A per-pixel turn in [0, 2 pi): interleaved gradient noise (Jimenez 2014). */
+/* A per-pixel turn in [0, 2 pi). */
 float pixel_turn(vec2 pixel)
 {
-    return 6.2831853 * fract(52.9829189 * fract(dot(floor(pixel), vec2(0.06711056, 0.00583715))));
+    return 6.2831853 * interleaved_noise(pixel);
 }
 
 #ifdef SB_TRACED_SHADOWS

@@ -22,6 +22,13 @@ layout(push_constant) uniform ViewPush {
     sb_view_push pc;
 };
 
+/* Interleaved gradient noise (Jimenez 2014) of a pixel, in [0, 1): a
+ * different value for each neighbour, their mean over any 3 x 3 near 1/2. */
+float interleaved_noise(vec2 pixel)
+{
+    return fract(52.9829189 * fract(dot(floor(pixel), vec2(0.06711056, 0.00583715))));
+}
+
 /* The unit view ray from the camera through uv of the frame (0 to 1, x
  * right, y down; a pixel's centre is at (pixel + 0.5) / size). */
 vec3 view_ray(vec2 uv)
