@@ -1640,6 +1640,81 @@ static void test_leak(const char *dir)
     sb_world_finish(&w);
 }
 
+/* The mean SB_DEBUG_ENV_SPECULAR luminance at `count` points of the frame
+ * from camera (yaw 0, pitch -15 degrees): the ambient specular alone. */
+static double env_specular(struct sb_renderer *r, const double camera[3], const double (*at)[3], int count)
+{
+    struct sb_view v = base_view();
+    memcpy(v.camera_m, camera, sizeof(v.camera_m));
+    v.pitch = -15.0 * DEG;
+    if (!render(r, &v))
+        return NAN;
+    float *rgb = frame_rgb(r);
+    check_finite(rgb, "the ambient specular");
+    double sum = 0.0;
+    for (int k = 0; k < count; k++)
+        sum += ground_luminance(r, rgb, at[k], "a point of the specular test") / count;
+    free(rgb);
+    return sum;
+}
+
+/*
+ * Specular occlusion: the probe world's pack with a sky-only reflection
+ * cube. Inside the closed room (its floor, roughness 0.9, and its north
+ * wall, 0.5) the cube's sky is hidden from every probe, so the ambient
+ * specular falls below 5% of what the same surfaces reflect without the
+ * probes (the open sky's radiance, as every surface reflected it before);
+ * open ground keeps the sky's within 15% (the probes' L2 visibility blurs
+ * the horizon, as their irradiance's does: test_probes's open-ground bound).
+ */
+static void test_specular_occlusion(const char *world_path, const char *pack_dir, const struct sb_world *w)
+{
+    char dir[440];
+    snprintf(dir, sizeof(dir), "%s-specular", pack_dir);
+    struct sb_scene *scene = probe_scene(world_path);
+    scene->view = (struct sb_scene_view){.altitude_km = 0.002, .sun_elevation_deg = 30, .sun_azimuth_deg = 150};
+    scene->wants[SB_PRODUCT_DFG] = scene->wants[SB_PRODUCT_REFLECTION_PROBES] = true;
+    scene->has_reflections = true;
+    sb_reflection_params_default(&scene->reflections);
+    scene->reflections.face_size = 32;
+    scene->reflections.samples = 128;
+    scene->reflections.ambient_rays = 16;
+    struct sb_bake_report report;
+    struct sb_pack specular_pack;
+    bool ok = sb_bake_scene(vk, scene, dir, NULL, &report) == SB_OK && sb_pack_open(dir, &specular_pack) == SB_OK;
+    free(scene);
+    CHECK(ok, "bake the probes with a sky cube");
+    if (!ok)
+        return;
+    static const double room[3] = {8.0, 1.5, -10.0}, open[3] = {-14.0, 1.5, -5.0};
+    static const double floor_in[3][3] = {{8, 0, -13}, {7, 0, -13.5}, {9, 0, -12.8}},
+                        wall_in[3][3] = {{8, 2.2, -15.2}, {6.5, 2.0, -15.2}, {9.5, 2.4, -15.2}},
+                        floor_open[3][3] = {{-14, 0, -7.5}, {-14.5, 0, -7}, {-13.5, 0, -8}};
+    double got[2][3]; /* with the probes, without: the room's floor, its wall, open ground */
+    for (int pass = 0; pass < 2; pass++) {
+        struct sb_renderer *r = NULL;
+        struct sb_renderer_params rp = {
+            .width = W, .height = H, .shadow_size = 512, .no_probes = pass == 1, .debug = SB_DEBUG_ENV_SPECULAR};
+        got[pass][0] = got[pass][1] = got[pass][2] = NAN;
+        CHECK(sb_renderer_create(vk, &specular_pack, w, &rp, &r) == SB_OK, "renderer");
+        if (r) {
+            got[pass][0] = env_specular(r, room, floor_in, 3);
+            got[pass][1] = env_specular(r, room, wall_in, 3);
+            got[pass][2] = env_specular(r, open, floor_open, 3);
+        }
+        sb_renderer_destroy(&r);
+    }
+    double floor = got[0][0] / got[1][0], wall = got[0][1] / got[1][1], ground = got[0][2] / got[1][2];
+    printf("specular occlusion: inside the closed room the floor reflects %.4f and the north wall %.4f of the open "
+           "sky's radiance (the sky cube's, without the probes); open ground %.3f of it\n",
+           floor, wall, ground);
+    CHECK(got[1][0] > 0 && got[1][1] > 0 && got[1][2] > 0, "the sky cube lights every surface without the probes");
+    CHECK(floor < 0.05 && wall < 0.05,
+          "the closed room reflects %.4f (floor) and %.4f (wall) of the open sky: under 5%%", floor, wall);
+    CHECK(fabs(ground - 1.0) < 0.15, "open ground reflects %.3f of the open sky's radiance", ground);
+    sb_pack_close(&specular_pack);
+}
+
 static void test_probes(const char *dir)
 {
     char world_path[400], pack_dir[400];
@@ -1669,6 +1744,7 @@ static void test_probes(const char *dir)
             probe_views(r, pass == 0 ? lit : sky);
         sb_renderer_destroy(&r);
     }
+    test_specular_occlusion(world_path, pack_dir, &w);
     /* A point 1.8 m under the middle of an 8 m square sees 1 - F of the
      * sky, cosine weighted: F = (4 / pi) s atan(s), s = A / sqrt(1 + A^2),
      * A = 4 / 1.8: 0.14 of a uniform sky. L2 smooths the square's edge,

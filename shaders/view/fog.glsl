@@ -84,11 +84,11 @@ void fog_light(vec3 offset, vec3 p, out vec3 sun, out vec3 ambient)
     vec3 e_up, e_down;
     sky_irradiance(up, e_up, e_down);
 #ifdef SB_FOG_PROBES
-    vec3 probe_up, probe_down;
+    probe_sample light;
     float coverage;
-    probe_lookup(p, vec3(0.0, 1.0, 0.0), vec3(0.0, -1.0, 0.0), probe_up, probe_down, coverage);
-    e_up = mix(e_up, probe_up, coverage);
-    e_down = mix(e_down, probe_down, coverage);
+    probe_lookup(p, vec3(0.0, 1.0, 0.0), vec3(0.0, -1.0, 0.0), light, coverage);
+    e_up = mix(e_up, light.e_n, coverage);
+    e_down = mix(e_down, light.e_r, coverage);
 #endif
     ambient = (e_up + e_down) * (frame.aerial.y / (2.0 * PI));
 }

@@ -77,13 +77,24 @@ float probe_sees(uint mask, vec3 lattice, vec3 q, float spacing)
     return seen;
 }
 
-/* Probe `index`'s irradiance along n and r (yn, yr: their SH bases), added
- * with weight w times DDGI's wrap of the direction from pos toward it and
- * `visible` (probe_sees, at least 0.05 so that a point no probe sees
- * still gets light; 1 for a probe without a sight mask), a product under
- * 0.2 crushed toward 0 as DDGI does; an invalid probe adds nothing. */
+/* What the probes around a point give (probe_lookup): the irradiance
+ * along the normal and along the mirror direction, and the sky
+ * visibility's bands 0 and 1 (sh 0, then y, z, x, as the probes store
+ * them), weighted sums until normalised. */
+struct probe_sample {
+    vec3 e_n;
+    vec3 e_r;
+    vec4 sky;
+};
+
+/* Probe `index`'s irradiance along n and r (yn, yr: their SH bases), and
+ * its sky visibility's bands 0 and 1 (as stored: sh 0, then y, z, x),
+ * added with weight w times DDGI's wrap of the direction from pos toward
+ * it and `visible` (probe_sees, at least 0.05 so that a point no probe
+ * sees still gets light; 1 for a probe without a sight mask), a product
+ * under 0.2 crushed toward 0 as DDGI does; an invalid probe adds nothing. */
 void probe_add(uint index, float w, float visible, vec3 pos, vec3 n, float yn[SB_PROBE_SH], float yr[SB_PROBE_SH],
-               inout vec3 e_n, inout vec3 e_r, inout float wsum)
+               inout probe_sample sum, inout float wsum)
 {
     vec4 where = probe_data[probe_record(index)];
     if (w <= 0.0 || where.w == 0.0)
@@ -101,8 +112,9 @@ void probe_add(uint index, float w, float visible, vec3 pos, vec3 n, float yn[SB
         sn += e * yn[k];
         sr += e * yr[k];
     }
-    e_n += w * max(sn, vec3(0.0));
-    e_r += w * max(sr, vec3(0.0));
+    sum.e_n += w * max(sn, vec3(0.0));
+    sum.e_r += w * max(sr, vec3(0.0));
+    sum.sky += w * probe_data[probe_record(index) + 1u];
     wsum += w;
 }
 
@@ -120,10 +132,9 @@ float probe_layer(int l)
  * corners it has (valid or not), 1 inside it, falling to 0 over the last
  * lattice step out of it; 0 where none of its corners is valid.
  */
-float probe_detail(vec3 pos, vec3 n, float yn[SB_PROBE_SH], float yr[SB_PROBE_SH], out vec3 e_n, out vec3 e_r)
+float probe_detail(vec3 pos, vec3 n, float yn[SB_PROBE_SH], float yr[SB_PROBE_SH], out probe_sample sum)
 {
-    e_n = vec3(0.0);
-    e_r = vec3(0.0);
+    sum = probe_sample(vec3(0.0), vec3(0.0), vec4(0.0));
     if (probes.detail.w == 0u)
         return 0.0;
     float s = probes.detail_origin_m.w;
@@ -152,14 +163,13 @@ float probe_detail(vec3 pos, vec3 n, float yn[SB_PROBE_SH], float yr[SB_PROBE_SH
             visible = max(probe_sees(column.w + local, probes.detail_origin_m.xyz + vec3(at) * s, pos + n * (0.25 * s), s),
                           0.05);
         present += w;
-        probe_add(column.z + local, w, visible, pos, n, yn, yr, e_n, e_r, wsum);
+        probe_add(column.z + local, w, visible, pos, n, yn, yr, sum, wsum);
     }
     if (wsum <= 1e-6) {
-        e_n = e_r = vec3(0.0);
+        sum = probe_sample(vec3(0.0), vec3(0.0), vec4(0.0));
         return 0.0;
     }
-    e_n /= wsum;
-    e_r /= wsum;
+    sum = probe_sample(sum.e_n / wsum, sum.e_r / wsum, sum.sky / wsum);
     return present;
 }
 
@@ -167,11 +177,10 @@ float probe_detail(vec3 pos, vec3 n, float yn[SB_PROBE_SH], float yr[SB_PROBE_SH
  * The grid's irradiance at pos (the layers' or the uniform grid's) and its
  * coverage, as probe_lookup says.
  */
-void probe_grid(vec3 pos, vec3 n, float yn[SB_PROBE_SH], float yr[SB_PROBE_SH], out vec3 e_n, out vec3 e_r,
+void probe_grid(vec3 pos, vec3 n, float yn[SB_PROBE_SH], float yr[SB_PROBE_SH], out probe_sample sum,
                 out float coverage)
 {
-    e_n = vec3(0.0);
-    e_r = vec3(0.0);
+    sum = probe_sample(vec3(0.0), vec3(0.0), vec4(0.0));
     coverage = 0.0;
     if (probes.grid.x == 0u)
         return;
@@ -206,16 +215,15 @@ void probe_grid(vec3 pos, vec3 n, float yn[SB_PROBE_SH], float yr[SB_PROBE_SH], 
             float above = max(dy - probe_layer(layers - 1), 0.0) / spacing.y;
             float vfade = clamp(1.0 - above, 0.0, 1.0);
             column_cover += w * vfade;
-            probe_add(column + probes.grid.x * uint(l), w * vfade * (1.0 - fl), 1.0, pos, n, yn, yr, e_n, e_r, wsum);
+            probe_add(column + probes.grid.x * uint(l), w * vfade * (1.0 - fl), 1.0, pos, n, yn, yr, sum, wsum);
             if (layers > 1)
-                probe_add(column + probes.grid.x * uint(l + 1), w * vfade * fl, 1.0, pos, n, yn, yr, e_n, e_r, wsum);
+                probe_add(column + probes.grid.x * uint(l + 1), w * vfade * fl, 1.0, pos, n, yn, yr, sum, wsum);
         }
         if (wsum <= 1e-6) {
-            e_n = e_r = vec3(0.0);
+            sum = probe_sample(vec3(0.0), vec3(0.0), vec4(0.0));
             return;
         }
-        e_n /= wsum;
-        e_r /= wsum;
+        sum = probe_sample(sum.e_n / wsum, sum.e_r / wsum, sum.sky / wsum);
         coverage = fade * column_cover;
         return;
     }
@@ -234,14 +242,13 @@ void probe_grid(vec3 pos, vec3 n, float yn[SB_PROBE_SH], float yr[SB_PROBE_SH], 
         uvec3 at = uvec3(min(base + o, last));
         vec3 tri = mix(1.0 - f, f, o);
         uint index = at.x + probes.grid.x * (at.y + probes.grid.y * at.z);
-        probe_add(index, tri.x * tri.y * tri.z, 1.0, pos, n, yn, yr, e_n, e_r, wsum);
+        probe_add(index, tri.x * tri.y * tri.z, 1.0, pos, n, yn, yr, sum, wsum);
     }
     if (wsum <= 1e-6) {
-        e_n = e_r = vec3(0.0);
+        sum = probe_sample(vec3(0.0), vec3(0.0), vec4(0.0));
         return;
     }
-    e_n /= wsum;
-    e_r /= wsum;
+    sum = probe_sample(sum.e_n / wsum, sum.e_r / wsum, sum.sky / wsum);
     coverage = fade;
 }
 
@@ -266,38 +273,64 @@ void probe_grid(vec3 pos, vec3 n, float yn[SB_PROBE_SH], float yr[SB_PROBE_SH], 
  * pos's height over that column's surface (below the lowest, the lowest;
  * above the top, the top, fading to nothing over the y spacing).
  */
-void probe_lookup(vec3 pos, vec3 n, vec3 r, out vec3 e_n, out vec3 e_r, out float coverage)
+void probe_lookup(vec3 pos, vec3 n, vec3 r, out probe_sample light, out float coverage)
 {
-    e_n = vec3(0.0);
-    e_r = vec3(0.0);
+    light = probe_sample(vec3(0.0), vec3(0.0), vec4(0.0));
     coverage = 0.0;
     if (probes.grid.w == 0u)
         return;
     float yn[SB_PROBE_SH], yr[SB_PROBE_SH];
     sh9_basis(n, yn);
     sh9_basis(r, yr);
-    vec3 detail_n, detail_r;
-    float detail = probe_detail(pos, n, yn, yr, detail_n, detail_r);
+    probe_sample detail_light;
+    float detail = probe_detail(pos, n, yn, yr, detail_light);
     if (detail >= 1.0 - 1e-6) {
-        e_n = detail_n;
-        e_r = detail_r;
+        light = detail_light;
         coverage = 1.0;
         return;
     }
-    vec3 grid_n, grid_r;
+    probe_sample grid_light;
     float grid;
-    probe_grid(pos, n, yn, yr, grid_n, grid_r, grid);
+    probe_grid(pos, n, yn, yr, grid_light, grid);
     if (detail <= 0.0) { /* the grid's alone, as it was */
-        e_n = grid_n;
-        e_r = grid_r;
+        light = grid_light;
         coverage = grid;
         return;
     }
     coverage = detail + (1.0 - detail) * grid;
     if (coverage <= 1e-6)
         return;
-    e_n = (detail * detail_n + (1.0 - detail) * grid * grid_n) / coverage;
-    e_r = (detail * detail_r + (1.0 - detail) * grid * grid_r) / coverage;
+    float a = detail / coverage, b = (1.0 - detail) * grid / coverage;
+    light = probe_sample(a * detail_light.e_n + b * grid_light.e_n, a * detail_light.e_r + b * grid_light.e_r,
+                         a * detail_light.sky + b * grid_light.sky);
+}
+
+/*
+ * Specular occlusion (Oat and Sander 2007's ambient aperture): the share
+ * of a GGX lobe around the mirror direction r that reaches the sky, from
+ * the probes' visibility (probe_sample.sky: sh 0, then y, z, x). The
+ * visible sky as a cone: its solid angle from band 0 (Omega = 2 sqrt(pi)
+ * v0), its axis along band 1; the lobe as the cone that holds half of
+ * GGX's energy at normal incidence (the half vector's median angle
+ * atan(alpha), doubled by the reflection). The share is the two cones'
+ * intersection over the lobe's, the intersection their smaller cone's
+ * solid angle faded by a smoothstep over the axes' angle from where one
+ * holds the other to where they part. 1 - cos x is written 2 sin^2(x/2),
+ * exact for the small lobes of smooth surfaces.
+ */
+float probe_specular_occlusion(vec4 sky, vec3 r, float roughness)
+{
+    float omega = 3.5449077018110318 * clamp(sky.x, 0.0, 3.5449077018110318); /* 2 sqrt(pi) v0, to 4 pi */
+    float aperture = 2.0 * asin(sqrt(clamp(omega / (4.0 * PI), 0.0, 1.0))); /* 2 pi (1 - cos a) = omega */
+    float a = roughness * roughness;
+    float lobe = min(2.0 * atan(a), 0.5 * PI);
+    vec3 axis = sky.wyz; /* x, y, z */
+    float len = length(axis);
+    float apart = len > 1e-6 ? acos(clamp(dot(axis / len, r), -1.0, 1.0)) : 0.0;
+    float inner = abs(aperture - lobe), outer = aperture + lobe;
+    float overlap = 1.0 - smoothstep(0.0, 1.0, (apart - inner) / max(outer - inner, 1e-6));
+    float smaller = sin(0.5 * min(aperture, lobe)), whole = sin(0.5 * lobe);
+    return clamp(smaller * smaller / max(whole * whole, 1e-12) * overlap, 0.0, 1.0);
 }
 #endif
 

@@ -85,9 +85,13 @@ vec3 reflection_parallax(uint i, vec3 pos, vec3 r)
 
 /* The prefiltered radiance a surface at pos with roughness r sees along
  * the mirror direction refl: the boxes that hold pos, each parallax-
- * corrected, normalised where they overlap, the sky-only cube for the rest. */
-vec3 reflection_radiance(vec3 pos, vec3 refl, float r)
+ * corrected, normalised where they overlap, the sky-only cube for the
+ * rest, of which only the share sky_seen (specular occlusion) reaches the
+ * sky; *hidden is the weight left to what hides the sky there (the
+ * caller's radiance of it). */
+vec3 reflection_radiance(vec3 pos, vec3 refl, float r, float sky_seen, out float hidden)
 {
+    hidden = 0.0;
     vec3 sum = vec3(0.0);
     float weight = 0.0;
     for (uint i = 1u; i < reflections.info.z; i++) {
@@ -99,7 +103,8 @@ vec3 reflection_radiance(vec3 pos, vec3 refl, float r)
     }
     if (weight > 1.0)
         return sum / weight;
-    return sum + (1.0 - weight) * reflection_sample(0u, refl, r);
+    hidden = (1.0 - weight) * (1.0 - sky_seen);
+    return sum + (1.0 - weight) * sky_seen * reflection_sample(0u, refl, r);
 }
 
 #endif

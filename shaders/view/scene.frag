@@ -33,6 +33,6 @@ void main()
         material_textures(in_uv, footprint, in_images, vec4(in_tangent, in_normal_map), albedo, metallic_roughness,
                           shading_n);
     vec3 emitted = material_emitted(in_emission, in_uv, footprint);
-    out_color = scene_shade(in_offset, shading_n, albedo, metallic_roughness, emitted,
+    out_color = scene_shade(in_offset, shading_n, n, albedo, metallic_roughness, emitted,
                             gl_FragCoord.xy / vec2(frame.size.xy), sun_visibility(in_offset, n, true));
 }

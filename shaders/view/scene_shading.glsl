@@ -21,6 +21,12 @@
  *   cubes were captured under, scaled by the sky's irradiance now over
  *   then (the sun's own specular is the analytic term above, never in the
  *   cubes);
+ * - specular occlusion: the share of the sky-only cube's reflection that a
+ *   point's probes see the sky in (probe_specular_occlusion); the rest is
+ *   the probes' own light along the mirror direction, so the inside of a
+ *   closed room stops reflecting the open sky (the cubes of scene probes
+ *   hold their geometry already); and Filament's horizon occlusion for
+ *   normal-mapped mirror directions that point under the surface;
  * - aerial perspective: the volume inside its range, else the same
  *   integral per fragment (cameras above the atmosphere, far geometry). */
 #ifndef SB_SCENE_SHADING_GLSL
@@ -43,10 +49,11 @@ layout(constant_id = 1) const bool SB_SCENE_REFLECTIONS = true; /* reflections.i
 
 /* The radiance (times frame.aerial.y) that reaches the camera from the
  * point `offset` m from it, or the debug term frame.size.w asks for: unit
- * normal n, linear albedo, (metallic, perceptual roughness), where the
+ * shading normal n (a normal map's), the surface's own ng (interpolated),
+ * linear albedo, (metallic, perceptual roughness), where the
  * point is in the frame (0 to 1: the aerial perspective volume's uv) and
  * the sun's visibility there. */
-vec4 scene_shade(vec3 offset, vec3 n, vec3 albedo, vec2 metallic_roughness, vec3 emitted, vec2 screen_uv,
+vec4 scene_shade(vec3 offset, vec3 n, vec3 ng, vec3 albedo, vec2 metallic_roughness, vec3 emitted, vec2 screen_uv,
                  float visibility)
 {
     vec3 v = -normalize(offset);
@@ -90,12 +97,14 @@ vec4 scene_shade(vec3 offset, vec3 n, vec3 albedo, vec2 metallic_roughness, vec3
     vec3 refl = reflect(-v, n);
     float r_up = dot(refl, up);
     vec3 l_env = (e_sky * (0.5 + 0.5 * r_up) + e_bounce * (0.5 - 0.5 * r_up)) / PI;
-    vec3 probe_n, probe_r;
-    float coverage;
+    float sky_seen = 1.0;
     if (SB_SCENE_PROBES) {
-        probe_lookup(offset + frame.camera_m.xyz, n, refl, probe_n, probe_r, coverage);
-        e_n = mix(e_n, probe_n, coverage);
-        l_env = mix(l_env, probe_r / PI, coverage);
+        probe_sample light;
+        float coverage;
+        probe_lookup(offset + frame.camera_m.xyz, n, refl, light, coverage);
+        e_n = mix(e_n, light.e_n, coverage);
+        l_env = mix(l_env, light.e_r / PI, coverage);
+        sky_seen = mix(1.0, probe_specular_occlusion(light.sky, refl, roughness), coverage);
     }
     if (frame.size.w == SB_DEBUG_AMBIENT)
         return vec4(fp16_safe(e_n * frame.aerial.y), 1.0);
@@ -106,7 +115,8 @@ vec4 scene_shade(vec3 offset, vec3 n, vec3 albedo, vec2 metallic_roughness, vec3
     vec3 specular = (f0 * env_ab.x + env_ab.y) * l_env;
     if (SB_SCENE_REFLECTIONS && reflections.info.z > 0u) {
         vec3 world_p = offset + frame.camera_m.xyz;
-        vec3 env = reflection_radiance(world_p, refl, roughness);
+        float hidden;
+        vec3 env = reflection_radiance(world_p, refl, roughness, sky_seen, hidden);
         vec2 dfg = reflections.info.w != 0u ? reflection_dfg(n_dot_v, roughness) : vec2(env_ab.y, env_ab.x + env_ab.y);
         vec3 energy = 1.0 + f0 * (1.0 / max(dfg.y, 1e-3) - 1.0);
         if (dot(reflections.baked_sun.xyz, l) < 0.99996) { /* another sun: by the sky's light now over then */
@@ -114,7 +124,14 @@ vec4 scene_shade(vec3 offset, vec3 n, vec3 albedo, vec2 metallic_roughness, vec3
             float now = dot(e_sky, vec3(SB_LUMINANCE_RGB));
             env *= then > 0.0 ? clamp(now / then, 0.0, 16.0) : 1.0;
         }
+        env += hidden * l_env; /* where the sky is hidden, the probes' light along refl */
         specular = env * (dfg.x + f0 * (dfg.y - dfg.x)) * energy;
+    }
+    {
+        /* Horizon occlusion (Filament): a normal map's mirror direction
+         * below the surface's own horizon sees the surface, not the sky. */
+        float horizon = min(1.0 + dot(refl, ng), 1.0);
+        specular *= horizon * horizon;
     }
     if (frame.size.w == SB_DEBUG_ENV_SPECULAR)
         return vec4(fp16_safe(specular * frame.aerial.y), 1.0);

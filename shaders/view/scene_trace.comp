@@ -121,5 +121,5 @@ void main()
                           shading_n);
         emitted = material_emitted(v.albedo.w, tex, footprint);
     }
-    imageStore(hdr, pixel, scene_shade(offset, shading_n, albedo, metallic_roughness, emitted, uv, visibility));
+    imageStore(hdr, pixel, scene_shade(offset, shading_n, n, albedo, metallic_roughness, emitted, uv, visibility));
 }
