@@ -122,9 +122,9 @@ static enum sb_result capture(struct sb_vk *vk, const struct sb_atmosphere_param
     cp.sun[2] = -cos(el) * cos(az);
     struct sb_capture_inputs sky = {.atmosphere = atm},
                              world = {.atmosphere = atm, .rc = rc, .surfaces = &surfaces};
-    if (!res && !(res = sb_reflection_capture(vk, &sky, &cp, level0, NULL))) {
+    if (!res && !(res = sb_reflection_capture(vk, &sky, &cp, level0, NULL, NULL))) {
         sb_reflection_sh(level0, n, 0, cp.sky_sh);
-        res = sb_reflection_capture(vk, &world, &cp, level0, ms);
+        res = sb_reflection_capture(vk, &world, &cp, level0, NULL, ms);
     }
     sb_surfaces_destroy(vk, &surfaces);
     sb_raycaster_destroy(&rc);

@@ -8,23 +8,10 @@
 #include "cube.h"
 #include "exr.h"
 #include "log.h"
+#include "physics.h"
 #include "reflection_capture.spv.h"
 #include "reflection_prefilter.spv.h"
 #include "sh.h"
-
-double sb_reflection_level_roughness(uint32_t level, uint32_t levels)
-{
-    if (levels < 2 || !level)
-        return 0.0;
-    double t = (double)level / (levels - 1);
-    return 1.0 - sqrt(fmax(1.0 - t, 0.0));
-}
-
-uint32_t sb_reflection_level_samples(uint32_t samples, uint32_t level)
-{
-    uint64_t s = level ? (uint64_t)samples << (level - 1) : 0;
-    return s < SB_REFLECTION_MAX_SAMPLES ? (uint32_t)s : SB_REFLECTION_MAX_SAMPLES;
-}
 
 void sb_reflection_kernels_destroy(struct sb_vk *vk, struct sb_reflection_kernels *k)
 {
@@ -64,7 +51,7 @@ static enum sb_result pipeline_for(struct sb_vk *vk, struct sb_pipeline *cached,
 }
 
 enum sb_result sb_reflection_capture(struct sb_vk *vk, const struct sb_capture_inputs *in,
-                                     const struct sb_capture_params *p, float *out, double *gpu_ms)
+                                     const struct sb_capture_params *p, float *out, float *surfaces, double *gpu_ms)
 {
     uint32_t n = p->face_size;
     struct sb_capture_push pc = {
@@ -75,13 +62,15 @@ enum sb_result sb_reflection_capture(struct sb_vk *vk, const struct sb_capture_i
         .ambient_rays = p->ambient_rays,
         .tmin_m = 1e-4f,
     };
-    struct sb_buffer result = {0}, sky = {0}, dummy = {0};
+    struct sb_buffer result = {0}, sky = {0}, dummy = {0}, relight = {0};
     struct sb_pipeline temp = {0}, *pipeline = NULL;
     const struct sb_pipeline_params pp = sb_reflection_capture_kernel();
     enum sb_result res;
     if ((res = sb_buffer_create(vk, (VkDeviceSize)6 * n * n * 4 * sizeof(float), "reflection capture", &result)) ||
         (res = sb_buffer_create(vk, SB_PROBE_SH * 4 * sizeof(float), "sky sh", &sky)) ||
         (res = sb_buffer_create(vk, 64, "no world", &dummy)) ||
+        (res = sb_buffer_create(vk, (VkDeviceSize)6 * n * n * SB_RELIGHT_VEC4S * 4 * sizeof(float), "relight surfaces",
+                                &relight)) ||
         (res = pipeline_for(vk, in->kernels ? &in->kernels->capture : NULL, &pp, &temp, &pipeline)))
         goto done;
     float *s = sky.mapped;
@@ -93,6 +82,7 @@ enum sb_result sb_reflection_capture(struct sb_vk *vk, const struct sb_capture_i
         [SB_CAPTURE_BINDING_NODES] = in->rc ? &in->rc->nodes : &dummy,
         [SB_CAPTURE_BINDING_TRIANGLES] = in->rc ? &in->rc->triangles : &dummy,
         [SB_CAPTURE_BINDING_SKY_SH] = &sky,
+        [SB_CAPTURE_BINDING_SURFACES_OUT] = &relight,
     };
     if (in->rc)
         sb_surfaces_bindings(in->surfaces, &bindings[SB_CAPTURE_BINDING_SURFACE]);
@@ -115,6 +105,8 @@ enum sb_result sb_reflection_capture(struct sb_vk *vk, const struct sb_capture_i
     }
     if (!res)
         res = sb_buffer_read(vk, &result, out);
+    if (!res && surfaces)
+        res = sb_buffer_read(vk, &relight, surfaces);
     if (gpu_ms)
         *gpu_ms = total;
 done:
@@ -122,6 +114,7 @@ done:
     sb_buffer_destroy(vk, &result);
     sb_buffer_destroy(vk, &sky);
     sb_buffer_destroy(vk, &dummy);
+    sb_buffer_destroy(vk, &relight);
     return res;
 }
 
@@ -177,17 +170,12 @@ enum sb_result sb_reflection_prefilter(struct sb_vk *vk, const float *level0, ui
         double ms = 0;
         pc.level = l;
         pc.samples = params->constant_samples ? samples : sb_reflection_level_samples(samples, l);
-        /* About 16 samples an invocation: the wide levels' few samples
-         * would otherwise leave most of a workgroup idle. */
-        pc.threads_per_texel = 1;
-        while (pc.threads_per_texel < SB_PREFILTER_THREADS && pc.threads_per_texel * 16 < pc.samples)
-            pc.threads_per_texel *= 2;
-        uint64_t texels_per_group = SB_PREFILTER_THREADS / pc.threads_per_texel;
-        uint64_t groups = (6ull * m * m + texels_per_group - 1) / texels_per_group;
-        pc.groups_x = groups < 65535 ? (uint32_t)groups : 65535;
+        uint32_t groups[2];
+        sb_prefilter_layout(pc.samples, 6ull * m * m, SB_PREFILTER_THREADS, &pc.threads_per_texel, groups);
+        pc.groups_x = groups[0];
         pc.roughness = (float)sb_reflection_level_roughness(l, levels);
         pc.out_offset = (uint32_t)sb_cube_level_offset(n, l);
-        res = sb_dispatch(vk, pipeline, &pc, pc.groups_x, (uint32_t)((groups + pc.groups_x - 1) / pc.groups_x), 1, &ms);
+        res = sb_dispatch(vk, pipeline, &pc, groups[0], groups[1], 1, &ms);
         total += ms;
     }
     if (!res)

@@ -16,18 +16,6 @@
 #include "raycast.h"
 #include "surfaces.h"
 
-/* The perceptual roughness mip `level` of `levels` holds: Filament's
- * mapping, level / (levels - 1) = r (2 - r), which spends more levels on
- * smooth surfaces (a runtime's lod = (levels - 1) r (2 - r)). */
-double sb_reflection_level_roughness(uint32_t level, uint32_t levels);
-
-/* The GGX samples a texel of `level` gets from the scene's `samples`: the
- * level above 0's, doubling with each level (rough levels are cheap, their
- * texels few, and their lobes wide), at most SB_REFLECTION_MAX_SAMPLES.
- * Costs about twice level 1's. */
-#define SB_REFLECTION_MAX_SAMPLES 16384
-uint32_t sb_reflection_level_samples(uint32_t samples, uint32_t level);
-
 /* The two kernels' pipelines, kept across the probes of a bake (creating
  * them takes seconds on some drivers); zero-initialise, destroy once. */
 struct sb_reflection_kernels {
@@ -40,7 +28,7 @@ void sb_reflection_kernels_destroy(struct sb_vk *vk, struct sb_reflection_kernel
 struct sb_capture_inputs {
     struct sb_atmosphere_baker *atmosphere;
     struct sb_raycaster *rc;
-    const struct sb_surfaces *surfaces; /* what the BVH's triangles are (with rc) */
+    const struct sb_surfaces *surfaces;    /* what the BVH's triangles are (with rc) */
     struct sb_reflection_kernels *kernels; /* may be NULL: made for the call */
 };
 
@@ -58,9 +46,13 @@ struct sb_pipeline_params sb_reflection_capture_kernel(void);
 struct sb_pipeline_params sb_reflection_prefilter_kernel(void);
 
 /* Level 0 of a probe's cube, one rgba texel each (rgb radiance; a = 1
- * where the ray met a back face), 6 n^2 texels into out. */
+ * where the ray met a back face), 6 n^2 texels into out; and, when
+ * `surfaces` is not NULL, SB_RELIGHT_VEC4S vec4s a texel of what
+ * relighting needs (config.h: albedo, distance, normal, the sky's
+ * transfer). */
 enum sb_result sb_reflection_capture(struct sb_vk *vk, const struct sb_capture_inputs *in,
-                                     const struct sb_capture_params *params, float *out, double *gpu_ms);
+                                     const struct sb_capture_params *params, float *out, float *surfaces,
+                                     double *gpu_ms);
 
 /* How a cube is prefiltered: skybake's way (zero but `samples`), or the
  * published ones the bench compares with. */

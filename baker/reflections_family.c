@@ -17,15 +17,16 @@
 #include "exr.h"
 #include "family.h"
 #include "json.h"
+#include "level.h"
 #include "load.h"
 #include "log.h"
-#include "level.h"
 #include "mesh.h"
 #include "probes.h"
 #include "reflection.h"
 
 #define DFG_RECIPE 1
-#define CUBES_RECIPE 1
+#define CUBES_RECIPE 2 /* 2: the sky's light through each texel's transfer, clamped once */
+#define SURFACES_RECIPE 1
 #define PROBES_RECIPE 1
 /* More of a probe's view in back faces than this: inside geometry. */
 #define INSIDE_FRACTION 0.25
@@ -45,7 +46,8 @@ struct reflection_state {
 
 static bool wants_cubes(const struct sb_scene *scene)
 {
-    return scene->wants[SB_PRODUCT_REFLECTION_CUBES] || scene->wants[SB_PRODUCT_REFLECTION_PROBES];
+    return scene->wants[SB_PRODUCT_REFLECTION_CUBES] || scene->wants[SB_PRODUCT_REFLECTION_PROBES] ||
+           scene->wants[SB_PRODUCT_REFLECTION_SURFACES];
 }
 
 static enum sb_result reflection_create(struct sb_vk *vk, const struct sb_scene *scene, void **out)
@@ -85,7 +87,7 @@ static void reflection_destroy(void **state)
 
 static uint32_t reflection_depends_on(enum sb_product_id id)
 {
-    if (id == SB_PRODUCT_REFLECTION_CUBES)
+    if (id == SB_PRODUCT_REFLECTION_CUBES || id == SB_PRODUCT_REFLECTION_SURFACES) /* the capture's atmosphere */
         return 1u << SB_PRODUCT_TRANSMITTANCE | 1u << SB_PRODUCT_MULTISCATTERING | 1u << SB_PRODUCT_IRRADIANCE_GROUND;
     return id == SB_PRODUCT_REFLECTION_PROBES ? 1u << SB_PRODUCT_REFLECTION_CUBES : 0;
 }
@@ -111,6 +113,15 @@ static void reflection_key(void *state, const struct sb_scene *scene, enum sb_pr
         return;
     }
     sb_reflection_code_hash(code);
+    if (id == SB_PRODUCT_REFLECTION_SURFACES) { /* the cubes' key without the sun, the sky and the prefilter */
+        sb_key_add(key, " recipe %d face %u ambient %u world %s code %s", SURFACES_RECIPE, p->face_size,
+                   p->ambient_rays, st->has_world ? st->mesh_hash : "none", code);
+        if (st->has_world)
+            sb_key_add(key, " bvh %d", SB_BVH_VERSION);
+        for (int i = 0; i < p->probe_count; i++)
+            sb_key_add3(key, "at", p->probes[i].position_m);
+        return;
+    }
     sb_key_add(key, " recipe %d face %u samples %u ambient %u altitude_km=%a sun=%a,%a world %s code %s", CUBES_RECIPE,
                p->face_size, p->samples, p->ambient_rays, scene->view.altitude_km, scene->view.sun_elevation_deg,
                scene->view.sun_azimuth_deg, st->has_world ? st->mesh_hash : "none", code);
@@ -141,12 +152,11 @@ static void probe_position(const struct sb_scene *scene, int i, double out[3])
     }
 }
 
-static enum sb_result bake_cubes(struct reflection_state *st, struct sb_vk *vk, const struct sb_scene *scene,
-                                 const struct sb_image baked[SB_PRODUCT_COUNT], struct sb_image *image,
-                                 struct sb_artifact *a)
+/* The capture's inputs on the device: the atmosphere's LUTs, the world's
+ * BVH and surfaces (once for the family's products). */
+static enum sb_result capture_inputs(struct reflection_state *st, struct sb_vk *vk, const struct sb_scene *scene,
+                                     const struct sb_image baked[SB_PRODUCT_COUNT])
 {
-    const struct sb_reflection_params *p = &scene->reflections;
-    uint32_t n = p->face_size, levels = sb_cube_levels(n), cubes = 1 + (uint32_t)p->probe_count;
     enum sb_result res = SB_OK;
     double t0 = 1e3 * sb_now_s();
     if (!st->atmosphere) {
@@ -159,9 +169,21 @@ static enum sb_result bake_cubes(struct reflection_state *st, struct sb_vk *vk, 
     if (!res && st->has_world && !st->rc && !(res = sb_level_build_bvh(st->level, &st->bvh)) &&
         !(res = sb_raycaster_create(vk, &st->bvh, &st->rc)))
         res = sb_surfaces_create_level(vk, st->level, &st->surfaces);
+    if (!res)
+        sb_debug("reflections: the atmosphere's LUTs and the BVH on the device in %.1f ms", 1e3 * sb_now_s() - t0);
+    st->vk = vk;
+    return res;
+}
+
+static enum sb_result bake_cubes(struct reflection_state *st, struct sb_vk *vk, const struct sb_scene *scene,
+                                 const struct sb_image baked[SB_PRODUCT_COUNT], struct sb_image *image,
+                                 struct sb_artifact *a)
+{
+    const struct sb_reflection_params *p = &scene->reflections;
+    uint32_t n = p->face_size, levels = sb_cube_levels(n), cubes = 1 + (uint32_t)p->probe_count;
+    enum sb_result res = capture_inputs(st, vk, scene, baked);
     if (res)
         return res;
-    sb_debug("reflection_cubes: the atmosphere's LUTs and the BVH on the device in %.1f ms", 1e3 * sb_now_s() - t0);
     uint64_t chain = sb_cube_level_offset(n, levels);
     float *level0 = malloc((size_t)6 * n * n * 4 * sizeof(float));
     float *filtered = malloc(chain * 4 * sizeof(float));
@@ -179,7 +201,6 @@ static enum sb_result bake_cubes(struct reflection_state *st, struct sb_vk *vk, 
         for (int k = 0; k < 3; k++)
             cp.origin_m[k] = (float)at[k];
         cp.altitude_km = fmax(at[1], 0.0) * 1e-3;
-        st->vk = vk;
         struct sb_capture_inputs in = {
             .atmosphere = st->atmosphere,
             .rc = i ? st->rc : NULL,
@@ -187,7 +208,7 @@ static enum sb_result bake_cubes(struct reflection_state *st, struct sb_vk *vk, 
             .kernels = &st->kernels,
         };
         double t1 = 1e3 * sb_now_s();
-        if ((res = sb_reflection_capture(vk, &in, &cp, level0, &ms)))
+        if ((res = sb_reflection_capture(vk, &in, &cp, level0, NULL, &ms)))
             break;
         sb_debug("reflection_cubes: probe %u captured in %.1f ms (%.3f ms on the device)", i, 1e3 * sb_now_s() - t1,
                  ms);
@@ -236,6 +257,78 @@ done:
         sb_image_finish(image);
     free(level0);
     free(filtered);
+    return res;
+}
+
+/*
+ * What relights the cubes (docs/pack.md): each cube's level 0 captured
+ * again, its surfaces kept (albedo, distance, normal toward the probe, the
+ * sky's transfer); the levels below are means of 2 x 2 texels (OpenEXR's
+ * cube chain; a runtime reads level 0). Nothing in it depends on the sun.
+ */
+static enum sb_result bake_surfaces(struct reflection_state *st, struct sb_vk *vk, const struct sb_scene *scene,
+                                    const struct sb_image baked[SB_PRODUCT_COUNT], struct sb_image *image,
+                                    struct sb_artifact *a)
+{
+    const struct sb_reflection_params *p = &scene->reflections;
+    uint32_t n = p->face_size, levels = sb_cube_levels(n), cubes = 1 + (uint32_t)p->probe_count;
+    const uint32_t channels = 4 * SB_RELIGHT_VEC4S;
+    enum sb_result res = capture_inputs(st, vk, scene, baked);
+    if (res)
+        return res;
+    float *level0 = malloc((size_t)6 * n * n * 4 * sizeof(float));
+    float *surfaces = malloc((size_t)6 * n * n * channels * sizeof(float));
+    if (!level0 || !surfaces || (res = sb_image_init_levels(image, n, 6 * n, cubes, channels, levels))) {
+        res = res ? res : SB_ERR_NOMEM;
+        goto done;
+    }
+    sb_image_set_channel_names(image, sb_product_format(SB_PRODUCT_REFLECTION_SURFACES)->channel_names);
+    struct sb_capture_params cp = {.face_size = n, .ambient_rays = p->ambient_rays};
+    sun_direction(scene, cp.sun);
+    double gpu_ms = 0;
+    for (uint32_t i = 0; i < cubes && !res; i++) {
+        double at[3], ms = 0;
+        probe_position(scene, (int)i, at);
+        for (int k = 0; k < 3; k++)
+            cp.origin_m[k] = (float)at[k];
+        cp.altitude_km = fmax(at[1], 0.0) * 1e-3;
+        struct sb_capture_inputs in = {
+            .atmosphere = st->atmosphere, .rc = i ? st->rc : NULL, .surfaces = &st->surfaces, .kernels = &st->kernels};
+        if ((res = sb_reflection_capture(vk, &in, &cp, level0, surfaces, &ms)))
+            break;
+        gpu_ms += ms;
+        /* the GPU's vec4s are the channels in order (config.h) */
+        memcpy(image->data + (size_t)i * 6 * n * n * channels, surfaces, (size_t)6 * n * n * channels * sizeof(float));
+        for (uint32_t l = 1; l < levels; l++) {
+            uint32_t m = n >> l;
+            const float *src = image->data + sb_image_level_offset(image, l - 1) + (size_t)i * 6 * 4 * m * m * channels;
+            float *dst = image->data + sb_image_level_offset(image, l) + (size_t)i * 6 * m * m * channels;
+            for (uint32_t f = 0; f < 6; f++)
+                for (uint32_t y = 0; y < m; y++)
+                    for (uint32_t x = 0; x < m; x++)
+                        for (uint32_t c = 0; c < channels; c++) {
+                            const float *q = src + (((size_t)f * 2 * m + 2 * y) * 2 * m + 2 * x) * channels + c;
+                            size_t row = (size_t)2 * m * channels;
+                            double sum = (double)q[0] + q[channels] + q[row] + q[row + channels];
+                            dst[(((size_t)f * m + y) * m + x) * channels + c] = (float)(0.25 * sum);
+                        }
+        }
+        sb_info("reflection_surfaces: probe %u of %u", i + 1, cubes);
+    }
+    if (res)
+        goto done;
+    a->gpu_ms = gpu_ms;
+    snprintf(a->settings_json, sizeof(a->settings_json),
+             "{\"face_size\":%u,\"cubes\":%u,\"ambient_rays\":%u,\"transfer\":\"order-2 SH of the clamped cosine "
+             "over the escaping directions: E_sky = sum_k T_k L_k\",\"levels\":\"means of 2x2 (level 0 is read)\"}",
+             n, cubes, p->ambient_rays);
+    if (st->has_world)
+        sb_artifact_set_world(a, st->mesh_hash, st->path);
+done:
+    if (res)
+        sb_image_finish(image);
+    free(level0);
+    free(surfaces);
     return res;
 }
 
@@ -291,6 +384,8 @@ static enum sb_result reflection_bake(void *state, struct sb_vk *vk, const struc
         return bake_cubes(state, vk, scene, baked, image, a);
     if (id == SB_PRODUCT_REFLECTION_PROBES)
         return bake_probes(scene, &baked[SB_PRODUCT_REFLECTION_CUBES], image, a);
+    if (id == SB_PRODUCT_REFLECTION_SURFACES)
+        return bake_surfaces(state, vk, scene, baked, image, a);
     enum sb_result res = sb_dfg_bake(vk, image, &a->gpu_ms);
     if (!res)
         snprintf(a->settings_json, sizeof(a->settings_json),
@@ -307,7 +402,7 @@ static uint32_t reflection_kernels(void *state, const struct sb_scene *scene, en
     uint32_t n = 0;
     if (id == SB_PRODUCT_DFG)
         out[n++] = sb_dfg_kernel();
-    if (id != SB_PRODUCT_REFLECTION_CUBES)
+    if (id != SB_PRODUCT_REFLECTION_CUBES && id != SB_PRODUCT_REFLECTION_SURFACES)
         return n;
     if (st->has_world)
         n += sb_surfaces_level_kernels(st->level, true, out);

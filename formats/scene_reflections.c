@@ -137,7 +137,7 @@ static cJSON *reflections_section_json(const struct sb_scene *scene)
 static void reflections_product_shape(const struct sb_scene *scene, enum sb_product_id id, uint32_t shape[3])
 {
     uint32_t n = scene->reflections.face_size, cubes = 1 + (uint32_t)scene->reflections.probe_count;
-    if (id == SB_PRODUCT_REFLECTION_CUBES) {
+    if (id == SB_PRODUCT_REFLECTION_CUBES || id == SB_PRODUCT_REFLECTION_SURFACES) {
         shape[0] = n;
         shape[1] = 6 * n;
         shape[2] = cubes;

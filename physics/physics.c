@@ -160,3 +160,30 @@ void sb_gauss_legendre_node(int k, int n, double a, double b, double *x, double 
     *x = 0.5 * (a + b) - 0.5 * (b - a) * z;
     *w = (b - a) / ((1 - z * z) * dp * dp);
 }
+
+double sb_reflection_level_roughness(uint32_t level, uint32_t levels)
+{
+    if (levels < 2 || !level)
+        return 0.0;
+    double t = (double)level / (levels - 1);
+    return 1.0 - sqrt(fmax(1.0 - t, 0.0));
+}
+
+uint32_t sb_reflection_level_samples(uint32_t samples, uint32_t level)
+{
+    uint64_t s = level ? (uint64_t)samples << (level - 1) : 0;
+    return s < SB_REFLECTION_MAX_SAMPLES ? (uint32_t)s : SB_REFLECTION_MAX_SAMPLES;
+}
+
+void sb_prefilter_layout(uint32_t samples, uint64_t texels, uint32_t threads, uint32_t *threads_per_texel,
+                         uint32_t groups[2])
+{
+    uint32_t tpt = 1;
+    while (tpt < threads && tpt * 16 < samples)
+        tpt *= 2;
+    uint64_t per_group = threads / tpt;
+    uint64_t count = (texels + per_group - 1) / per_group;
+    groups[0] = count < 65535 ? (uint32_t)count : 65535;
+    groups[1] = (uint32_t)((count + groups[0] - 1) / groups[0]);
+    *threads_per_texel = tpt;
+}

@@ -63,4 +63,25 @@ int sb_cubic_taps(double f, int n, double w[4]);
 size_t sb_multiscattering_refined_float_count(void);
 void sb_multiscattering_refined_fill(const struct sb_image *image, float *dst);
 
+/* Reflection cubes (docs/reflections.md), prefiltered by the bake and by
+ * skyview's relight alike (prefilter.glsl). The perceptual roughness mip
+ * `level` of `levels` holds: Filament's mapping, level / (levels - 1) =
+ * r (2 - r), which spends more levels on smooth surfaces (a runtime's lod
+ * = (levels - 1) r (2 - r)). */
+double sb_reflection_level_roughness(uint32_t level, uint32_t levels);
+
+/* The GGX samples a texel of `level` gets from the scene's `samples`: the
+ * level above 0's, doubling with each level (rough levels are cheap, their
+ * texels few, and their lobes wide), at most SB_REFLECTION_MAX_SAMPLES.
+ * Costs about twice level 1's. */
+#define SB_REFLECTION_MAX_SAMPLES 16384
+uint32_t sb_reflection_level_samples(uint32_t samples, uint32_t level);
+
+/* A prefilter dispatch's layout for `texels` texels of `samples` samples:
+ * about 16 samples an invocation (a power of two of them a texel, at most
+ * `threads` a workgroup: the wide levels' few samples would otherwise
+ * leave most of a workgroup idle), and the workgroups as x by y. */
+void sb_prefilter_layout(uint32_t samples, uint64_t texels, uint32_t threads, uint32_t *threads_per_texel,
+                         uint32_t groups[2]);
+
 #endif

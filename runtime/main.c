@@ -83,6 +83,12 @@ static void usage(FILE *f)
                "                          sky-visibility probes\n"
                "  --no-reflections        the sky model's ambient specular, ignoring the pack's\n"
                "                          reflection probes\n"
+               "  --baked-reflections     the reflection cubes as baked (scaled by the sky's light\n"
+               "                          under another sun), though the pack could relight them\n"
+               "  --relight N             reflection cubes relit a frame at most as the sun moves\n"
+               "                          (default 2; a still relights every one)\n"
+               "  --relight-always        relight that many every frame, the sun moving or not:\n"
+               "                          what a day's sweep costs, for --bench\n"
                "  --no-textures           the world's materials without their images (their\n"
                "                          colours and factors alone)\n"
                "  --no-fog                leave out the scene's fog\n"
@@ -408,6 +414,11 @@ static int parse_options(int argc, char **argv, struct options *o)
         } else if (!strcmp(a, "--frames") && next) {
             ok = parse_number(argv[++i], 1, 100000, &v) && v == floor(v);
             o->frames = (int)v;
+        } else if (!strcmp(a, "--relight") && next) {
+            ok = parse_number(argv[++i], 1, 64, &v) && v == floor(v);
+            o->params.relight_cubes = (uint32_t)v;
+        } else if (!strcmp(a, "--relight-always")) {
+            o->params.relight_always = true;
         } else if (!strcmp(a, "--warmup") && next) {
             ok = parse_number(argv[++i], 0, 10000, &v) && v == floor(v);
             o->warmup = (int)v;
@@ -566,6 +577,8 @@ static int parse_options(int argc, char **argv, struct options *o)
             o->params.no_probes = true;
         else if (!strcmp(a, "--no-reflections"))
             o->params.no_reflections = true;
+        else if (!strcmp(a, "--baked-reflections"))
+            o->params.baked_reflections = true;
         else if (!strcmp(a, "--no-textures"))
             o->params.no_textures = true;
         else if (!strcmp(a, "--no-fog"))

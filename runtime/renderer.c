@@ -45,7 +45,7 @@ static void add_resources(struct sb_renderer *r)
     };
     for (size_t i = 0; i < sizeof(buffers) / sizeof(buffers[0]); i++)
         sb_graph_buffer(r, buffers[i].name, buffers[i].buffer);
-    if (r->scene_traced) {
+    if (r->world_bvh) {
         sb_graph_buffer(r, "bvh nodes", &r->bvh_nodes);
         sb_graph_buffer(r, "bvh triangles", &r->bvh_triangles);
     }
@@ -147,6 +147,7 @@ enum sb_result sb_renderer_create(struct sb_vk *vk, const struct sb_pack *pack, 
         while (r->bloom_levels < SB_BLOOM_MAX_LEVELS && (shorter >> (r->bloom_levels + 1)) >= 4)
             r->bloom_levels++;
     r->scene_traced = scene_traced(&r->params, vk, world->vertex_count);
+    r->world_bvh = r->scene_traced || sb_reflections_relightable(pack, &r->params, world);
     if ((res = sb_atmosphere_upload(r, pack)))
         goto cleanup;
     res = sb_world_upload(r, world);

@@ -72,6 +72,12 @@ struct sb_renderer_params {
     double bloom_strength;                         /* 0: 0.15; negative: no bloom */
     bool no_probes;                                /* light the world with the sky alone even if the pack has probes */
     bool no_reflections;          /* leave the pack's reflection probes unread (the sky model's specular) */
+    bool baked_reflections;       /* read the cubes as baked, scaled by the sky's light under another sun,
+                                     though the pack's reflection_surfaces could relight them */
+    uint32_t relight_cubes;       /* reflection cubes relit a frame at most when the lights move (0: 2);
+                                     a frame that snaps relights every stale one */
+    bool relight_always;          /* relight relight_cubes cubes every frame, whether the lights moved or not:
+                                     what a moving sun costs, for benchmarks */
     bool no_textures;             /* the world's materials without their textures (their factors alone) */
     bool no_fog;                  /* leave out the scene's fog */
     uint32_t fog_tile_px;         /* a froxel's width and height in pixels; 0: 8 */
@@ -152,6 +158,7 @@ struct sb_view {
 enum sb_pass {
     SB_PASS_SKY_VIEW,
     SB_PASS_PROBES,
+    SB_PASS_REFLECTIONS,
     SB_PASS_AERIAL_PERSPECTIVE,
     SB_PASS_SHADOWS,
     SB_PASS_CLOUD_SHADOW,
@@ -170,8 +177,8 @@ enum sb_pass {
     SB_PASS_COUNT,
 };
 
-/* "sky-view", "probes", "aerial perspective", "shadows", "cloud shadow", "fog", "scene", "sky", "clouds",
- * "fog apply", "purkinje", "exposure", "local tonemap", "grade linear", "bloom", "tonemap", "grade". */
+/* "sky-view", "probes", "reflections", "aerial perspective", "shadows", "cloud shadow", "fog", "scene", "sky",
+ * "clouds", "fog apply", "purkinje", "exposure", "local tonemap", "grade linear", "bloom", "tonemap", "grade". */
 const char *sb_pass_name(enum sb_pass pass);
 
 /* The switches a viewer offers, from the passes' table: one for each
@@ -239,5 +246,12 @@ bool sb_renderer_project(const struct sb_renderer *renderer, const double world_
  * right, y down; a pixel's centre is at its index plus one half), from the
  * camera; the reverse of sb_renderer_project. */
 void sb_renderer_pixel_ray(const struct sb_renderer *renderer, const double pixel[2], double direction[3]);
+
+/* The reflection cubes as the scene pass read them in the last frame
+ * (relit where the pack has reflection_surfaces), or NULL without any:
+ * cube by cube, each its chain level by level (faces as OpenEXR lays
+ * them), 4 floats a texel (rgb, 0), in the pack's units. */
+const float *sb_renderer_reflection_cubes(const struct sb_renderer *r, uint32_t *count, uint32_t *face_size,
+                                          uint32_t *levels);
 
 #endif

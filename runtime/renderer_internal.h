@@ -54,14 +54,18 @@ struct sb_renderer {
     double world_min_m[3], world_max_m[3]; /* the world's box */
     bool aerial_volume_only;               /* this frame's: which scene pipeline draws */
     bool scene_traced;                     /* the scene pass traces (passes/scene.c): no cascades to draw */
+    bool world_bvh;                        /* the world's BVH is on the device: traced, or relighting */
     uint32_t probe_count;                  /* grid probes the probes pass lights (0: none), set by it */
+    uint32_t reflection_count;             /* reflection cubes the scene reads (0: none), set by the
+                                              reflections pass */
 
     /* The renderer's resources, in the graph's table under their names. */
     struct sb_buffer atmosphere;                                         /* "atmosphere" */
     struct sb_texture transmittance, multiscattering, irradiance_ground; /* "transmittance", ...: RGBA32F, the
                                                                             LUT; the refined and lookup forms */
     struct sb_buffer frame, vertices, exposure;                          /* "frame", "vertices", "exposure" */
-    struct sb_buffer bvh_nodes, bvh_triangles; /* "bvh nodes", "bvh triangles": the world's BVH when traced */
+    struct sb_buffer bvh_nodes, bvh_triangles; /* "bvh nodes", "bvh triangles": the world's BVH when traced
+                                                  or relighting reflections */
     struct sb_texel_set textures;              /* "texture records", "texels": the world's textures */
     struct sb_buffer instances;                /* "instances": sb_instance_gpu[] (one zero when none) */
     struct sb_buffer emissive;                 /* "emissive": sb_emissive_gpu[] (one zero when none) */
@@ -131,6 +135,12 @@ struct sb_pass_class {
 
 /* A frame's passes, in order (passes/passes.c). */
 extern const struct sb_pass_class *const sb_pass_classes[SB_PASS_COUNT];
+
+/* Whether the pack's reflection_surfaces relight its cubes in this
+ * renderer (passes/reflections.c): the probes pass then lights the sky's
+ * SH, and the world's BVH is uploaded for the sun's shadows. */
+bool sb_reflections_relightable(const struct sb_pack *pack, const struct sb_renderer_params *params,
+                                const struct sb_world *world);
 
 /* ---- What a pass calls (pass.c) ---- */
 

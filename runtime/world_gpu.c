@@ -148,7 +148,8 @@ static enum sb_result build_instanced_bvh(const struct sb_world *world, struct s
     return res;
 }
 
-/* The world's BVH (geometry/bvh.h), which the traced scene and the fog's shadow rays walk. */
+/* The world's BVH (geometry/bvh.h), which the traced scene, the fog's shadow rays and the reflections'
+ * relight walk. */
 static enum sb_result upload_bvh(struct sb_renderer *r, const struct sb_world *world)
 {
     struct sb_bvh bvh = {0};
@@ -169,11 +170,10 @@ static enum sb_result upload_bvh(struct sb_renderer *r, const struct sb_world *w
         res = sb_renderer_upload(r, bvh.triangles, bvh.triangle_count * sizeof(*bvh.triangles), "world BVH triangles",
                                  &r->bvh_triangles);
     if (!res && bvh.instance_count)
-        sb_info("scene traced: %u triangles placed %u times, a BVH of two levels, %u nodes", bvh.triangle_count,
+        sb_info("the world's BVH: %u triangles placed %u times, two levels, %u nodes", bvh.triangle_count,
                 bvh.instance_count, bvh.node_count);
     else if (!res)
-        sb_info("scene traced: %u triangles, a BVH of %u nodes, %u deep", bvh.triangle_count, bvh.node_count,
-                bvh.depth);
+        sb_info("the world's BVH: %u triangles, %u nodes, %u deep", bvh.triangle_count, bvh.node_count, bvh.depth);
     sb_bvh_finish(&bvh);
     return res;
 }
@@ -281,7 +281,7 @@ enum sb_result sb_world_upload(struct sb_renderer *r, const struct sb_world *wor
         res = upload_emissive(r, world);
     if (!res)
         res = upload_instances(r, world);
-    if (!res && r->scene_traced)
+    if (!res && r->world_bvh)
         res = upload_bvh(r, world);
     return res;
 }

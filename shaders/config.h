@@ -490,7 +490,14 @@ struct sb_probe_sight_push {
 #define SB_CAPTURE_BINDING_TRIANGLES 6
 #define SB_CAPTURE_BINDING_SKY_SH 7    /* 9 vec4: the sky's radiance in order-2 SH, rgb */
 #define SB_CAPTURE_BINDING_SURFACE 8   /* the surfaces' four (surface.glsl) */
-#define SB_CAPTURE_BINDING_COUNT (SB_CAPTURE_BINDING_SURFACE + SB_SURFACE_BINDING_COUNT)
+/* What relighting needs, SB_RELIGHT_VEC4S a texel: (albedo rgb, distance
+ * m, 0 where the ray leaves the world), (the normal toward the probe,
+ * transfer 0), (transfer 1-4), (transfer 5-8); the transfer T_k is the
+ * order-2 SH of the sky's visibility from the surface point times the
+ * clamped cosine, so that the sky's irradiance there is sum_k T_k L_k */
+#define SB_CAPTURE_BINDING_SURFACES_OUT (SB_CAPTURE_BINDING_SURFACE + SB_SURFACE_BINDING_COUNT)
+#define SB_CAPTURE_BINDING_COUNT (SB_CAPTURE_BINDING_SURFACES_OUT + 1)
+#define SB_RELIGHT_VEC4S 4
 
 struct sb_capture_push {
     SB_VEC4(origin_m);      /* the probe; w: its altitude, km */
@@ -502,7 +509,8 @@ struct sb_capture_push {
     /* one pass: the sphere set's directions [first_direction,
      * first_direction + SB_CAPTURE_PASS_DIRECTIONS), added to the passes'
      * before when `accumulate` (lavapipe's loop limit: config.h,
-     * SB_BOUNCE_PASS_DIRECTIONS); the sky and the sun in the first */
+     * SB_BOUNCE_PASS_DIRECTIONS); the sun in the first, the sky's light
+     * through the accumulated transfer in the last */
     SB_UINT first_direction;
     SB_UINT accumulate;
 };

@@ -77,7 +77,7 @@ static inline enum sb_result write_synthetic_pack(const char *dir, const char *n
                                 .probes = {.explicit_count = probes ? shape[0] : 0, .ray_count = 64}};
         snprintf(a.file, sizeof(a.file), "%s.%s", f->name, f->extension);
         snprintf(a.parameterization, sizeof(a.parameterization), "%s", f->parameterization);
-        if (f->family == SB_FAMILY_PROBES || p == SB_PRODUCT_REFLECTION_CUBES)
+        if (f->family == SB_FAMILY_PROBES || p == SB_PRODUCT_REFLECTION_CUBES || p == SB_PRODUCT_REFLECTION_SURFACES)
             sb_artifact_set_world(&a, SYNTHETIC_WORLD_HASH, SYNTHETIC_WORLD_PATH);
         res = sb_pack_writer_add_image(w, &a, &image);
         if (images)

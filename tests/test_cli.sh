@@ -66,7 +66,7 @@ check "info --json" expect_exit 0 "$skybake" info "$tmp/a" --json
 check "info --json has the manifest's hashes" test "$(hashes "$tmp/out" | tr -d ' ,\t')" = "$(hashes "$tmp/a/manifest.json" | tr -d ' ,\t')"
 check "info needs a pack" expect_exit 2 "$skybake" info
 check "info refuses what is not a pack" expect_exit 2 "$skybake" info "$root/data"
-check "manifest has format_version 12" grep -Eq '"format_version":[[:space:]]*12,' "$tmp/a/manifest.json"
+check "manifest has format_version 13" grep -Eq '"format_version":[[:space:]]*13,' "$tmp/a/manifest.json"
 check "no cloud products unless asked for" test ! -e "$tmp/a/cloud_shape.vdb"
 
 # verify: exit 0 when all holds; else 1, naming every problem.

@@ -727,6 +727,10 @@ static void edit_version_11(cJSON *r)
 {
     cJSON_ReplaceItemInObject(r, "format_version", cJSON_CreateNumber(11));
 }
+static void edit_version_12(cJSON *r)
+{
+    cJSON_ReplaceItemInObject(r, "format_version", cJSON_CreateNumber(12));
+}
 /* What version 1 wrote: no cloud products (in the scene or the pack), no
  * file_hash; the scene's hash recomputed for the scene without clouds. */
 static void edit_make_version_1(cJSON *r)
@@ -943,13 +947,18 @@ static void test_pack_reader(void)
         {"one flipped byte in the compressed pixels, vouched for", NULL, FLIP_BYTE, SB_ERR_EXR, true},
         {"format version 1, as version 1 wrote it", edit_make_version_1,
          "rm cloud_shape.vdb cloud_detail.vdb cloud_curl.exr weather.exr sky_visibility.sbprobes sky_bounce.sbprobes "
-         "dfg.exr reflection_cubes.exr reflection_probes.sbprobes sun_bounce.sbprobes",
+         "dfg.exr reflection_cubes.exr reflection_probes.sbprobes sun_bounce.sbprobes reflection_surfaces.exr",
          SB_OK, false},
         {"format version 2 listing sky_visibility", edit_version_2, NULL, SB_ERR_UNKNOWN_PRODUCT, false},
         {"format version 3 listing sky_bounce", edit_version_3, NULL, SB_ERR_UNKNOWN_PRODUCT, false},
         {"format version 4 listing dfg", edit_version_4, NULL, SB_ERR_UNKNOWN_PRODUCT, false},
         {"format version 5 listing reflection_cubes", edit_version_5, NULL, SB_ERR_UNKNOWN_PRODUCT, false},
         {"format version 11 listing sun_bounce", edit_version_11, NULL, SB_ERR_UNKNOWN_PRODUCT, false},
+        {"format version 12 listing reflection_surfaces", edit_version_12, NULL, SB_ERR_UNKNOWN_PRODUCT, false},
+        {"surfaces file truncated, vouched for", NULL,
+         "head -c 4000 reflection_surfaces.exr > t && mv t reflection_surfaces.exr", SB_ERR_EXR, true},
+        {"surfaces replaced by the cubes' file, vouched for", NULL, "cp reflection_cubes.exr reflection_surfaces.exr",
+         SB_ERR_BAD_IMAGE, true},
         {"truncated sun bounce file, vouched for", NULL,
          "head -c 300 sun_bounce.sbprobes > t && mv t sun_bounce.sbprobes", SB_ERR_BAD_IMAGE, true},
         {"cube file truncated, vouched for", NULL, "head -c 4000 reflection_cubes.exr > t && mv t reflection_cubes.exr",
@@ -1473,8 +1482,7 @@ static void test_probes(void)
     CHECK(sb_image_round_to_half(&detailed, &not_half) == SB_OK, "round to binary16");
     CHECK(sb_probes_write(path, &bricks, &detailed, true) == SB_OK &&
               sb_probes_read(path, SB_SKY_VISIBILITY_CHANNELS, 1000, &got, &back) == SB_OK && got.half && got.sight &&
-              !memcmp(got.sight, sight, sizeof(sight)) &&
-              !memcmp(back.data, detailed.data, sizeof(float) * nd * ch),
+              !memcmp(got.sight, sight, sizeof(sight)) && !memcmp(back.data, detailed.data, sizeof(float) * nd * ch),
           "binary16 with detail: the round trip is exact");
     sb_probe_layout_finish(&got);
     sb_image_finish(&back);

@@ -230,23 +230,23 @@ int main(void)
     struct sb_capture_inputs sky_in = {.atmosphere = atm};
     struct sb_capture_inputs world_in = {
         .atmosphere = atm, .rc = rc, .surfaces = &surfaces};
-    CHECK(sb_reflection_capture(vk, &sky_in, &cp, sky, NULL) == SB_OK, "sky capture");
+    CHECK(sb_reflection_capture(vk, &sky_in, &cp, sky, NULL, NULL) == SB_OK, "sky capture");
     sb_reflection_sh(sky, N, 0, cp.sky_sh);
-    CHECK(sb_reflection_capture(vk, &world_in, &cp, level0, NULL) == SB_OK, "world capture");
+    CHECK(sb_reflection_capture(vk, &world_in, &cp, level0, NULL, NULL) == SB_OK, "world capture");
     /* Seen from 100 m up, nothing is above: the +y face is the sky's own
      * capture there, bit for bit; from 1.5 m, the -y face is all ground. */
     struct sb_capture_params high = cp;
     high.origin_m[1] = 100;
     high.altitude_km = 0.1;
-    CHECK(sb_reflection_capture(vk, &sky_in, &high, sky, NULL) == SB_OK, "sky capture, high");
-    CHECK(sb_reflection_capture(vk, &world_in, &high, again, NULL) == SB_OK, "world capture, high");
+    CHECK(sb_reflection_capture(vk, &sky_in, &high, sky, NULL, NULL) == SB_OK, "sky capture, high");
+    CHECK(sb_reflection_capture(vk, &world_in, &high, again, NULL, NULL) == SB_OK, "world capture, high");
     CHECK(!memcmp(sky + 4 * 2 * N * N, again + 4 * 2 * N * N, (size_t)N * N * 4 * sizeof(float)),
           "+y from 100 m: the world's capture is not the sky's");
     int down_ground = 0;
     for (uint32_t t = 0; t < N * N; t++)
         down_ground += level0[4 * (3 * N * N + t)] != sky[4 * (3 * N * N + t)];
     CHECK(down_ground == N * N, "-y: %d of %d texels see the ground", down_ground, N * N);
-    CHECK(sb_reflection_capture(vk, &world_in, &cp, again, NULL) == SB_OK, "world capture again");
+    CHECK(sb_reflection_capture(vk, &world_in, &cp, again, NULL, NULL) == SB_OK, "world capture again");
     CHECK(!memcmp(level0, again, (size_t)6 * N * N * 4 * sizeof(float)), "two captures differ");
     int finite = 1;
     for (size_t t = 0; t < (size_t)6 * N * N * 4; t++)
@@ -259,7 +259,7 @@ int main(void)
     {
         struct sb_capture_params many = cp;
         many.ambient_rays = 1024;
-        CHECK(sb_reflection_capture(vk, &world_in, &many, again, NULL) == SB_OK, "world capture, 1024 ambient rays");
+        CHECK(sb_reflection_capture(vk, &world_in, &many, again, NULL, NULL) == SB_OK, "world capture, 1024 ambient rays");
         double sum_a = 0, sum_b = 0;
         for (size_t t = (size_t)3 * N * N; t < (size_t)4 * N * N; t++) {
             sum_a += level0[4 * t] + level0[4 * t + 1] + level0[4 * t + 2];
@@ -312,7 +312,7 @@ int main(void)
                       sb_surfaces_create(vk, &floors[f], 1, &fs) == SB_OK,
                   "floor %d", f);
             struct sb_capture_inputs in = {.atmosphere = atm, .rc = frc, .surfaces = &fs};
-            CHECK(sb_reflection_capture(vk, &in, &over, seen[f], NULL) == SB_OK, "capture over floor %d", f);
+            CHECK(sb_reflection_capture(vk, &in, &over, seen[f], NULL, NULL) == SB_OK, "capture over floor %d", f);
             sb_surfaces_destroy(vk, &fs);
             sb_raycaster_destroy(&frc);
             sb_bvh_finish(&fb);

@@ -5,13 +5,14 @@
  */
 #include "renderer_internal.h"
 
-extern const struct sb_pass_class sb_pass_sky_view, sb_pass_probes, sb_pass_aerial_perspective, sb_pass_shadows,
+extern const struct sb_pass_class sb_pass_sky_view, sb_pass_probes, sb_pass_reflections, sb_pass_aerial_perspective, sb_pass_shadows,
     sb_pass_cloud_shadow, sb_pass_fog, sb_pass_scene, sb_pass_sky, sb_pass_clouds, sb_pass_fog_apply, sb_pass_purkinje,
     sb_pass_exposure, sb_pass_local_tonemap, sb_pass_grade_linear, sb_pass_bloom, sb_pass_tonemap, sb_pass_grade;
 
 const struct sb_pass_class *const sb_pass_classes[SB_PASS_COUNT] = {
     [SB_PASS_SKY_VIEW] = &sb_pass_sky_view,
     [SB_PASS_PROBES] = &sb_pass_probes,
+    [SB_PASS_REFLECTIONS] = &sb_pass_reflections,
     [SB_PASS_AERIAL_PERSPECTIVE] = &sb_pass_aerial_perspective,
     [SB_PASS_SHADOWS] = &sb_pass_shadows,
     [SB_PASS_CLOUD_SHADOW] = &sb_pass_cloud_shadow,

@@ -23,6 +23,7 @@ struct probes {
     struct sb_buffer detail;        /* the detail's table of brick columns (one absent one without) */
     struct sb_buffer sight;         /* the detail probes' sight masks (one word without) */
     VkPipeline sky_kernel, light_kernel;
+    bool sky_only; /* no probes: the sky's SH alone, for the reflections' relight */
 };
 
 /* The world's mean albedo, weighted by area: the bounce model's surfaces.
@@ -244,7 +245,8 @@ static enum sb_result upload_probes(struct sb_renderer *r, struct probes *s)
     if (layout->detail_count)
         sb_info("probes: detail %.3g m apart, %u probes in %u brick columns%s", (double)layout->detail_spacing_m,
                 layout->detail_count, layout->column_count,
-                layout->sight ? ", each seen only where it sees" : " (without sight masks: light may leak through walls)");
+                layout->sight ? ", each seen only where it sees"
+                              : " (without sight masks: light may leak through walls)");
     return SB_OK;
 }
 
@@ -261,14 +263,15 @@ static enum sb_result probes_create(struct sb_renderer *r)
     sb_resource light = sb_graph_buffer(r, "probe light", &s->light);
     sb_graph_buffer(r, "probe detail", &s->detail);
     sb_graph_buffer(r, "probe sight", &s->sight);
-    if (!r->probe_count)
+    s->sky_only = !r->probe_count && sb_reflections_relightable(r->pack, &r->params, r->world);
+    if (!r->probe_count && !s->sky_only) /* the sky's SH is lit for the probes, or for the reflections' relight */
         return SB_OK;
     sb_pass_read_atmosphere(r);
     sb_pass_sample(r, SB_VIEW_BINDING_SKY_VIEW, sb_pass_find(r, "sky-view"), NULL);
     sb_pass_use(r, SB_VIEW_BINDING_PROBES, probes, SB_USE_LOAD);
     sb_pass_use(r, SB_VIEW_BINDING_PROBE_LIGHT, light, SB_USE_LOAD_STORE);
     res = sb_renderer_kernel(r, sb_spv_probe_sky, sizeof(sb_spv_probe_sky), "probe sky", &s->sky_kernel);
-    if (!res)
+    if (!res && r->probe_count)
         res = sb_renderer_kernel(r, sb_spv_probe_light, sizeof(sb_spv_probe_light), "probe light", &s->light_kernel);
     return res;
 }
@@ -289,9 +292,11 @@ static void probes_destroy(struct sb_renderer *r)
 static void probes_record(struct sb_renderer *r)
 {
     struct probes *s = sb_pass_data(r);
-    if (!r->probe_count)
+    if (!r->probe_count && !s->sky_only)
         return;
     sb_renderer_dispatch(r, s->sky_kernel, NULL, (const uint32_t[3]){1, 1, 1}, (const uint32_t[3]){1, 1, 1});
+    if (!r->probe_count)
+        return;
     sb_renderer_barrier(r->cmd);
     sb_renderer_dispatch(r, s->light_kernel, NULL, (const uint32_t[3]){r->probe_count, 1, 1},
                          (const uint32_t[3]){SB_PROBE_THREADS, 1, 1});

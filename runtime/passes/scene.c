@@ -19,8 +19,7 @@
  * last bits of each point's position; test_runtime holds the two together
  * and the shadows to Embree.
  *
- * The pack's reflection probes are uploaded here: "reflections" and
- * "reflection cubes" in the graph's table.
+ * The reflection probes are the reflections pass's (passes/reflections.c).
  */
 #include <math.h>
 #include <stdlib.h>
@@ -48,92 +47,13 @@
 #include "scene_vert_instanced.spv.h"
 
 struct scene {
-    struct sb_buffer reflections, cubes; /* sb_reflections_gpu, its probes and the DFG; the cubes */
     /* Traced: the key light's visibility over the frames (its penumbrae), and what reprojects it. */
     struct sb_texture sun_history[2];
     struct sb_buffer history; /* sb_scene_history_gpu */
     struct sb_history history_state;
-    uint32_t reflection_count; /* reflection probes the scene reads (0: none) */
     /* Generic, and with aerial perspective from its volume alone (aerial.glsl). */
     VkPipeline raster[2], traced[2];
 };
-
-/*
- * The pack's reflection probes (reflections.glsl), or none: the cubes
- * reordered from the pack's level-major image to one chain a cube, the
- * probes' positions and boxes, and the DFG LUT when the pack has it (else
- * the shader's analytic fit). The sky-only cube's irradiance on an upward
- * surface, for relighting under another sun.
- */
-static enum sb_result upload_reflections(struct sb_renderer *r, struct scene *s)
-{
-    const struct sb_pack *pack = r->pack;
-    const struct sb_image *cubes = &pack->images[SB_PRODUCT_REFLECTION_CUBES];
-    const struct sb_image *records = &pack->images[SB_PRODUCT_REFLECTION_PROBES];
-    bool use = pack->present[SB_PRODUCT_REFLECTION_CUBES] && pack->present[SB_PRODUCT_REFLECTION_PROBES] &&
-               !r->params.no_reflections && records->width == cubes->depth && cubes->levels < 16; /* [3].w: the chain */
-    bool dfg = use && pack->present[SB_PRODUCT_DFG];
-    uint32_t count = use ? cubes->depth : 0, n = use ? cubes->width : 1, levels = use ? cubes->levels : 1;
-    uint64_t chain = 0;
-    for (uint32_t l = 0; l < levels; l++)
-        chain += 6ull * sb_image_level_size(n, l) * sb_image_level_size(n, l);
-    size_t header_vec4s = (sizeof(struct sb_reflections_gpu) + 15) / 16;
-    size_t vec4s = header_vec4s + 3 * (size_t)count + (dfg ? (size_t)SB_DFG_SIZE * SB_DFG_SIZE : 0);
-    enum sb_result res = sb_renderer_upload(r, NULL, vec4s * 16, "reflection probes", &s->reflections);
-    if (!res)
-        res = sb_renderer_upload(r, NULL, (use ? chain * count : 1) * 16, "reflection cubes", &s->cubes);
-    if (res || !use)
-        return res;
-    struct sb_reflections_gpu *g = s->reflections.mapped;
-    g->info[0] = n;
-    g->info[1] = levels;
-    g->info[2] = count;
-    s->reflection_count = count;
-    g->info[3] = dfg;
-    double el = pack->scene->view.sun_elevation_deg * M_PI / 180, az = pack->scene->view.sun_azimuth_deg * M_PI / 180;
-    double sun[3];
-    sb_direction(az, el, sun);
-    for (int k = 0; k < 3; k++)
-        g->baked_sun[k] = (float)sun[k];
-    /* The sky-only cube's irradiance SH (its record's channels 9 on, k then rgb) at +y. */
-    const double up[3] = {0, 1, 0};
-    for (int c = 0; c < 3; c++) {
-        double coefficients[SB_PROBE_SH];
-        for (int k = 0; k < SB_PROBE_SH; k++)
-            coefficients[k] = records->data[9 + 3 * k + c];
-        g->baked_sky_up[c] = (float)sb_sh9_eval(coefficients, up);
-    }
-    uint64_t at = 0;
-    for (uint32_t l = 0; l < levels; l++) {
-        g->level_offsets[l / 4][l % 4] = (uint32_t)at;
-        at += 6ull * sb_image_level_size(n, l) * sb_image_level_size(n, l);
-    }
-    g->level_offsets[3][3] = (uint32_t)chain;
-    float *data = (float *)s->reflections.mapped + 4 * header_vec4s;
-    for (uint32_t i = 0; i < count; i++)
-        for (int k = 0; k < 9; k++) /* position, box min, box max: the record's first nine channels */
-            data[12 * i + 4 * (k / 3) + k % 3] = records->data[(size_t)i * records->channel_count + k];
-    if (dfg) {
-        const struct sb_image *lut = &pack->images[SB_PRODUCT_DFG];
-        float *d = data + 12 * (size_t)count;
-        for (size_t t = 0; t < (size_t)SB_DFG_SIZE * SB_DFG_SIZE; t++) {
-            d[4 * t] = lut->data[2 * t];
-            d[4 * t + 1] = lut->data[2 * t + 1];
-        }
-    }
-    float *texels = s->cubes.mapped;
-    for (uint32_t l = 0; l < levels; l++) {
-        uint32_t m = sb_image_level_size(n, l);
-        const float *src = cubes->data + sb_image_level_offset(cubes, l);
-        for (uint32_t i = 0; i < count; i++)
-            for (size_t t = 0; t < 6ull * m * m; t++) {
-                float *o = texels + 4 * (i * chain + g->level_offsets[l / 4][l % 4] + t);
-                memcpy(o, src + 3 * ((size_t)i * 6 * m * m + t), 3 * sizeof(float));
-            }
-    }
-    sb_info("reflections: %u cubes of %u^2, %u levels%s", count, n, levels, dfg ? ", the DFG LUT" : "");
-    return SB_OK;
-}
 
 /* The traced scene writes every pixel of the frame and its depth. */
 static enum sb_result create_traced(struct sb_renderer *r, struct scene *s)
@@ -179,7 +99,7 @@ static enum sb_result create_raster(struct sb_renderer *r, struct scene *s)
     sb_pass_use(r, SB_NO_BINDING, sb_pass_find(r, "depth"), SB_USE_DEPTH_TARGET);
     /* scene.frag's specialization: what the pack holds */
     bool generic = r->params.generic_shaders;
-    const VkBool32 has[2] = {generic || r->probe_count > 0, generic || s->reflection_count > 0};
+    const VkBool32 has[2] = {generic || r->probe_count > 0, generic || r->reflection_count > 0};
     const VkSpecializationMapEntry entries[2] = {
         {.constantID = 0, .offset = 0, .size = sizeof(VkBool32)},
         {.constantID = 1, .offset = sizeof(VkBool32), .size = sizeof(VkBool32)},
@@ -214,9 +134,6 @@ static enum sb_result scene_create(struct sb_renderer *r)
     if (!s)
         return SB_ERR_NOMEM;
     sb_pass_set_data(r, s);
-    enum sb_result res = upload_reflections(r, s);
-    if (res)
-        return res;
     sb_pass_read_atmosphere(r);
     sb_pass_use(r, SB_VIEW_BINDING_VERTICES, sb_pass_find(r, "vertices"), SB_USE_LOAD);
     sb_pass_use(r, SB_VIEW_BINDING_TEXTURES, sb_pass_find(r, "texture records"), SB_USE_LOAD);
@@ -230,8 +147,8 @@ static enum sb_result scene_create(struct sb_renderer *r)
     sb_pass_sample(r, SB_VIEW_BINDING_AERIAL, sb_pass_find(r, "aerial"), NULL);
     sb_pass_sample(r, SB_VIEW_BINDING_AERIAL_T, sb_pass_find(r, "aerial transmittance"), NULL);
     sb_pass_read_probes(r);
-    sb_pass_use(r, SB_VIEW_BINDING_REFLECTIONS, sb_graph_buffer(r, "reflections", &s->reflections), SB_USE_LOAD);
-    sb_pass_use(r, SB_VIEW_BINDING_REFLECTION_CUBES, sb_graph_buffer(r, "reflection cubes", &s->cubes), SB_USE_LOAD);
+    sb_pass_use(r, SB_VIEW_BINDING_REFLECTIONS, sb_pass_find(r, "reflections"), SB_USE_LOAD);
+    sb_pass_use(r, SB_VIEW_BINDING_REFLECTION_CUBES, sb_pass_find(r, "reflection cubes"), SB_USE_LOAD);
     sb_pass_use(r, SB_VIEW_BINDING_CLOUDS, sb_pass_find(r, "clouds"), SB_USE_LOAD);
     sb_pass_sample(r, SB_VIEW_BINDING_CLOUD_SHADOW, sb_pass_find(r, "cloud shadow"), NULL);
     return r->scene_traced ? create_traced(r, s) : create_raster(r, s);
@@ -246,8 +163,6 @@ static void scene_destroy(struct sb_renderer *r)
     struct sb_texture *textures[2] = {&s->sun_history[0], &s->sun_history[1]};
     sb_renderer_release(r, pipelines, 4, textures, 2);
     sb_buffer_destroy(r->vk, &s->history);
-    sb_buffer_destroy(r->vk, &s->reflections);
-    sb_buffer_destroy(r->vk, &s->cubes);
     free(s);
 }
 

@@ -321,9 +321,9 @@ void probe_lookup(vec3 pos, vec3 n, vec3 r, out probe_sample light, out float co
 float probe_specular_occlusion(vec4 sky, vec3 r, float roughness)
 {
     float omega = 3.5449077018110318 * clamp(sky.x, 0.0, 3.5449077018110318); /* 2 sqrt(pi) v0, to 4 pi */
-    float aperture = 2.0 * asin(sqrt(clamp(omega / (4.0 * PI), 0.0, 1.0))); /* 2 pi (1 - cos a) = omega */
+    float aperture = 2.0 * asin(sqrt(clamp(omega / 12.566370614359172, 0.0, 1.0))); /* 2 pi (1 - cos a) = omega */
     float a = roughness * roughness;
-    float lobe = min(2.0 * atan(a), 0.5 * PI);
+    float lobe = min(2.0 * atan(a), 1.5707963267948966);
     vec3 axis = sky.wyz; /* x, y, z */
     float len = length(axis);
     float apart = len > 1e-6 ? acos(clamp(dot(axis / len, r), -1.0, 1.0)) : 0.0;

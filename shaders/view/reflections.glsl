@@ -17,7 +17,11 @@ layout(std430, set = 0, binding = SB_VIEW_BINDING_REFLECTIONS) readonly buffer R
     sb_reflections_gpu reflections;
     vec4 reflection_data[];
 };
+#ifdef REFLECTION_CUBES_WRITABLE
+layout(std430, set = 0, binding = SB_VIEW_BINDING_REFLECTION_CUBES) buffer ReflectionCubes {
+#else
 layout(std430, set = 0, binding = SB_VIEW_BINDING_REFLECTION_CUBES) readonly buffer ReflectionCubes {
+#endif
     vec4 cube_texels[];
 };
 

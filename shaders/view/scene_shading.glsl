@@ -17,10 +17,11 @@
  * - reflections: with the pack's reflection probes (reflections.glsl), the
  *   ambient specular is their prefiltered radiance, parallax-corrected and
  *   blended, times the DFG LUT's split sum x + f0 (y - x) and Filament's
- *   energy compensation 1 + f0 (1 / y - 1); under another sun than the
- *   cubes were captured under, scaled by the sky's irradiance now over
- *   then (the sun's own specular is the analytic term above, never in the
- *   cubes);
+ *   energy compensation 1 + f0 (1 / y - 1); relit for this frame's
+ *   lights where the pack has their surfaces (passes/reflections.c), else,
+ *   under another sun than the cubes were captured under, scaled by the
+ *   sky's irradiance now over then (the sun's own specular is the analytic
+ *   term above, never in the cubes);
  * - specular occlusion: the share of the sky-only cube's reflection that a
  *   point's probes see the sky in (probe_specular_occlusion); the rest is
  *   the probes' own light along the mirror direction, so the inside of a
@@ -119,7 +120,8 @@ vec4 scene_shade(vec3 offset, vec3 n, vec3 ng, vec3 albedo, vec2 metallic_roughn
         vec3 env = reflection_radiance(world_p, refl, roughness, sky_seen, hidden);
         vec2 dfg = reflections.info.w != 0u ? reflection_dfg(n_dot_v, roughness) : vec2(env_ab.y, env_ab.x + env_ab.y);
         vec3 energy = 1.0 + f0 * (1.0 / max(dfg.y, 1e-3) - 1.0);
-        if (dot(reflections.baked_sun.xyz, l) < 0.99996) { /* another sun: by the sky's light now over then */
+        /* another sun, where nothing relights the cubes: by the sky's light now over then */
+        if (reflections.baked_sun.w == 0.0 && dot(reflections.baked_sun.xyz, l) < 0.99996) {
             float then = dot(reflections.baked_sky_up.rgb, vec3(SB_LUMINANCE_RGB));
             float now = dot(e_sky, vec3(SB_LUMINANCE_RGB));
             env *= then > 0.0 ? clamp(now / then, 0.0, 16.0) : 1.0;

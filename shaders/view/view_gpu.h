@@ -187,7 +187,7 @@ struct sb_view_push {
     SB_UINT cascade;     /* shadow.vert: the cascade drawn */
     SB_UINT level;       /* bloom: the mip level written */
     SB_UINT first_level; /* bloom_down: 1 when reading the frame (threshold and Karis average) */
-    SB_UINT pad;
+    SB_UINT item;        /* reflection relight: the cube relit */
 };
 
 #endif
