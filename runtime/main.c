@@ -81,6 +81,8 @@ static void usage(FILE *f)
                "                          against, else the built-in data/worlds/test.json)\n"
                "  --no-probes             light the world with the sky alone, ignoring the pack's\n"
                "                          sky-visibility probes\n"
+               "  --no-contact-shadows    the raster scene's shadows from the cascades alone,\n"
+               "                          without the screen-space contact shadows\n"
                "  --no-reflections        the sky model's ambient specular, ignoring the pack's\n"
                "                          reflection probes\n"
                "  --baked-reflections     the reflection cubes as baked (scaled by the sky's light\n"
@@ -157,11 +159,12 @@ static void usage(FILE *f)
                "a window (GLFW; headless is the default):\n"
                "  --window                show the frames in a window, interactively: W A S D Q E\n"
                "                          fly (Shift faster), drag the mouse to look, arrow keys\n"
-               "                          move the sun (with --time-of-day H, the hour), 1 to 7\n"
-               "                          switch fog, clouds, Purkinje, local tone mapping,\n"
-               "                          scene-linear grading, bloom, the LUT; H the timing\n"
-               "                          overlay, P a screenshot into OUT_DIR (default .), Esc\n"
-               "                          quits. With --frames N: N frames as headless, then close\n"
+               "                          move the sun (with --time-of-day H, the hour), 1 to 8\n"
+               "                          switch fog, contact shadows, clouds, Purkinje, local\n"
+               "                          tone mapping, scene-linear grading, bloom, the LUT; H\n"
+               "                          the timing overlay, P a screenshot into OUT_DIR\n"
+               "                          (default .), Esc quits. With --frames N: N frames as\n"
+               "                          headless, then close\n"
                "  --screenshot FILE       with --window --frames N: the swapchain's last image as\n"
                "                          PNG\n"
                "  --no-overlay            start without the timing overlay\n"
@@ -575,6 +578,8 @@ static int parse_options(int argc, char **argv, struct options *o)
             o->hdr = true;
         else if (!strcmp(a, "--no-probes"))
             o->params.no_probes = true;
+        else if (!strcmp(a, "--no-contact-shadows"))
+            o->params.no_contact_shadows = true;
         else if (!strcmp(a, "--no-reflections"))
             o->params.no_reflections = true;
         else if (!strcmp(a, "--baked-reflections"))

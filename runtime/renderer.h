@@ -72,6 +72,8 @@ struct sb_renderer_params {
     double bloom_strength;                         /* 0: 0.15; negative: no bloom */
     bool no_probes;                                /* light the world with the sky alone even if the pack has probes */
     bool no_reflections;          /* leave the pack's reflection probes unread (the sky model's specular) */
+    bool no_contact_shadows;      /* the raster scene's shadows from the cascades alone (no screen-space
+                                     contact shadows) */
     bool baked_reflections;       /* read the cubes as baked, scaled by the sky's light under another sun,
                                      though the pack's reflection_surfaces could relight them */
     uint32_t relight_cubes;       /* reflection cubes relit a frame at most when the lights move (0: 2);
@@ -164,6 +166,7 @@ enum sb_pass {
     SB_PASS_CLOUD_SHADOW,
     SB_PASS_FOG,
     SB_PASS_SCENE,
+    SB_PASS_CONTACT_SHADOWS,
     SB_PASS_SKY,
     SB_PASS_CLOUDS,
     SB_PASS_FOG_APPLY,
@@ -177,8 +180,9 @@ enum sb_pass {
     SB_PASS_COUNT,
 };
 
-/* "sky-view", "probes", "reflections", "aerial perspective", "shadows", "cloud shadow", "fog", "scene", "sky",
- * "clouds", "fog apply", "purkinje", "exposure", "local tonemap", "grade linear", "bloom", "tonemap", "grade". */
+/* "sky-view", "probes", "reflections", "aerial perspective", "shadows", "cloud shadow", "fog", "scene",
+ * "contact shadows", "sky", "clouds", "fog apply", "purkinje", "exposure", "local tonemap", "grade linear",
+ * "bloom", "tonemap", "grade". */
 const char *sb_pass_name(enum sb_pass pass);
 
 /* The switches a viewer offers, from the passes' table: one for each

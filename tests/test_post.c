@@ -602,7 +602,7 @@ static void test_purkinje(void)
 /* ---- Passes a view leaves out ------------------------------------------------------ */
 
 /* sb_view.disabled_passes: a frame without the Purkinje shift, local tone
- * mapping, scene-linear grading and bloom, by the view's choice, is the
+ * mapping, scene-linear grading, bloom and contact shadows, by the view's choice, is the
  * frame of a renderer made without them, bit for bit; with them it is not
  * (dusk, so that every one changes it). */
 static void test_disabled_passes(void)
@@ -612,12 +612,14 @@ static void test_disabled_passes(void)
     with.local_contrast = 0.7;
     with.grading = (struct sb_grading){.enabled = true, .white_balance_k = 5000.0, .saturation = 1.2, .contrast = 1.1};
     without.bloom_strength = -1.0;
+    without.no_contact_shadows = true;
     struct frame *left_out = malloc(sizeof(*left_out)), *made_without = malloc(sizeof(*made_without));
     struct frame *all = malloc(sizeof(*all));
     struct sb_view v = view_at(-5.0);
     struct sb_view off = v;
     off.disabled_passes = 1u << SB_PASS_PURKINJE | 1u << SB_PASS_LOCAL_TONEMAP | 1u << SB_PASS_GRADE_LINEAR |
-                          1u << SB_PASS_BLOOM | 1u << SB_PASS_SCENE; /* the scene is not optional: drawn anyway */
+                          1u << SB_PASS_BLOOM | 1u << SB_PASS_CONTACT_SHADOWS |
+                          1u << SB_PASS_SCENE; /* the scene is not optional: drawn anyway */
     if (render(&with, &off, left_out, "the passes left out") && render(&without, &v, made_without, "made without") &&
         render(&with, &v, all, "with them")) {
         CHECK(!memcmp(left_out->ldr, made_without->ldr, sizeof(left_out->ldr)) &&
@@ -630,12 +632,13 @@ static void test_disabled_passes(void)
     free(all);
 }
 
-/* The viewer's keys 1 to 7, from the passes' table, are the switches
+/* The viewer's keys 1 to 8, from the passes' table, are the switches
  * docs/skyview.md lists, in its order. */
 static void test_toggles(void)
 {
     static const uint32_t documented[] = {
         1u << SB_PASS_FOG | 1u << SB_PASS_FOG_APPLY,
+        1u << SB_PASS_CONTACT_SHADOWS,
         1u << SB_PASS_CLOUDS,
         1u << SB_PASS_PURKINJE,
         1u << SB_PASS_LOCAL_TONEMAP,

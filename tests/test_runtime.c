@@ -2072,6 +2072,127 @@ static void test_relit_reflections(const char *dir, const char *world_path)
     sb_pack_close(&relit);
 }
 
+/* ---- Contact shadows ------------------------------------------------------------ */
+
+#define CONTACT_W 640
+#define CONTACT_H 360
+/* Small casters on open ground, 4 to 20 m ahead of a camera 1.6 m up
+ * looking north: cubes of 0.1, 0.2 and 0.3 m, planks 3 and 5 cm tall. */
+static const char pebble_world[] =
+    "{\"version\": 1, \"ground\": {\"size_m\": 400, \"albedo\": [0.4, 0.4, 0.4], \"roughness\": 0.9},\n"
+    " \"boxes\": [\n"
+    "  {\"center_m\": [-0.6, 0.05, -4], \"size_m\": [0.1, 0.1, 0.1], \"albedo\": [0.6, 0.5, 0.4]},\n"
+    "  {\"center_m\": [0.6, 0.015, -4.5], \"size_m\": [0.6, 0.03, 0.15], \"albedo\": [0.6, 0.5, 0.4]},\n"
+    "  {\"center_m\": [-0.8, 0.1, -9], \"size_m\": [0.2, 0.2, 0.2], \"albedo\": [0.6, 0.5, 0.4]},\n"
+    "  {\"center_m\": [1.0, 0.025, -10], \"size_m\": [1.0, 0.05, 0.3], \"albedo\": [0.6, 0.5, 0.4]},\n"
+    "  {\"center_m\": [0, 0.15, -20], \"size_m\": [0.3, 0.3, 0.3], \"albedo\": [0.6, 0.5, 0.4]}]}\n";
+
+/* The luminance of each pixel of a CONTACT_W x CONTACT_H frame into out. */
+static bool contact_frame(struct sb_renderer *r, const struct sb_view *v, double *out)
+{
+    float *rgb = malloc(sizeof(float) * 3 * CONTACT_W * CONTACT_H);
+    bool ok = rgb && render(r, v);
+    if (ok)
+        sb_renderer_hdr(r, rgb);
+    for (int i = 0; ok && i < CONTACT_W * CONTACT_H; i++)
+        out[i] = luminance(rgb + 3 * i);
+    free(rgb);
+    return ok;
+}
+
+/*
+ * Contact shadows (contact_shadows.comp) on the raster path against the
+ * traced scene, whose shadow rays are exact for any caster: the pebble
+ * world under the sun at 20 degrees, then at 2. Where the traced sun
+ * visibility is 0 (the traced frame's shadows), the raster frame's
+ * luminance error against the traced frame, summed, with the contact
+ * shadows at most half of it without (they find the shadows of the small
+ * casters near the camera, which the maps' texels and bias lose); where it
+ * is 1, the contact shadows darken no pixel by more than 3% (no
+ * self-shadowing, at 2 degrees too). Both away from the traced shadows'
+ * edges (a pixel: the sun's disk, which the traced first frame leaves out
+ * and the contact shadows' fade spreads).
+ */
+static void test_contact_shadows(const char *dir)
+{
+    char path[400];
+    snprintf(path, sizeof(path), "%s/pebble-world.json", dir);
+    FILE *f = fopen(path, "w");
+    struct sb_world w;
+    bool ok = f && fputs(pebble_world, f) >= 0 && fclose(f) == 0 && sb_world_load(path, NULL, &w) == SB_OK;
+    CHECK(ok, "the pebble world loads");
+    if (!ok)
+        return;
+    size_t n = (size_t)CONTACT_W * CONTACT_H;
+    double *lum[4];
+    struct sb_renderer *r[4] = {NULL, NULL, NULL, NULL};
+    for (int m = 0; m < 4; m++) { /* raster without, with; traced; its sun visibility */
+        struct sb_renderer_params p = {.width = CONTACT_W,
+                                       .height = CONTACT_H,
+                                       .shadow_size = 2048,
+                                       .scene = m >= 2 ? SB_SCENE_TRACED : SB_SCENE_RASTER,
+                                       .no_contact_shadows = m == 0,
+                                       .debug = m == 3 ? SB_DEBUG_SUN_VISIBILITY : SB_DEBUG_NONE};
+        lum[m] = malloc(sizeof(double) * n);
+        ok = ok && sb_renderer_create(vk, &pack, &w, &p, &r[m]) == SB_OK;
+    }
+    CHECK(ok, "the renderers");
+    static const double suns[2] = {20.0, 2.0};
+    for (int s = 0; s < 2 && ok; s++) {
+        struct sb_view v = base_view();
+        v.camera_m[0] = 0.0;
+        v.camera_m[1] = 1.6;
+        v.camera_m[2] = 0.0;
+        v.pitch = -21.0 * DEG; /* the two nearest casters, 4 m ahead */
+        v.fov_y = 20.0 * DEG;
+        v.sun_elevation = suns[s] * DEG;
+        v.sun_azimuth = 150.0 * DEG;
+        for (int m = 0; m < 4 && ok; m++)
+            ok = contact_frame(r[m], &v, lum[m]);
+        if (!ok)
+            break;
+        double error[2] = {0, 0}, shade = 0;
+        int shadowed = 0, lit = 0, darkened = 0;
+        for (size_t i = 0; i < n; i++) { /* all ground: the horizon is out of the frame */
+            double visibility = lum[3][i] / luminance((const float[3]){1, 1, 1});
+            int x = (int)(i % CONTACT_W);
+            bool edge = false; /* a traced shadow's edge is a pixel wide at most (its penumbra) */
+            for (int d = -1; d <= 1; d++)
+                for (int e = -CONTACT_W; e <= CONTACT_W && i + d + e < n && x + d >= 0 && x + d < CONTACT_W;
+                     e += CONTACT_W)
+                    edge |= (lum[3][i + d + e] < 0.5 * luminance((const float[3]){1, 1, 1})) != (visibility < 0.5);
+            if (edge)
+                continue;
+            if (visibility < 0.5) {
+                shadowed++;
+                shade += lum[2][i];
+                for (int m = 0; m < 2; m++)
+                    error[m] += fabs(lum[m][i] - lum[2][i]);
+            } else {
+                lit++;
+                darkened += lum[1][i] < 0.97 * lum[0][i];
+            }
+        }
+        printf("contact shadows, the sun at %.0f degrees: over the %d pixels the traced shadows hold, the raster "
+               "frame's error %.3f of their light with contact shadows, %.3f without; of %d traced-lit pixels, %d "
+               "darkened by them\n",
+               suns[s], shadowed, error[1] / shade, error[0] / shade, lit, darkened);
+        CHECK(shadowed > 100, "%d shadowed pixels to compare", shadowed);
+        if (s == 0)
+            CHECK(error[1] <= 0.5 * error[0],
+                  "with contact shadows the raster's error in the shadows is %.3f, "
+                  "without %.3f: at most half expected",
+                  error[1] / shade, error[0] / shade);
+        CHECK(darkened == 0, "sun %.0f degrees: contact shadows darken %d pixels the traced frame has lit", suns[s],
+              darkened);
+    }
+    for (int m = 0; m < 4; m++) {
+        sb_renderer_destroy(&r[m]);
+        free(lum[m]);
+    }
+    sb_world_finish(&w);
+}
+
 /* ---- Froxel fog ------------------------------------------------------------------ */
 
 #define FOG_W 160
@@ -2691,6 +2812,7 @@ int main(int argc, char **argv)
         test_specialised_shaders(r, &rp);
         test_traced_scene(&rp);
         test_soft_shadows(dir, &rp);
+        test_contact_shadows(dir);
         test_textures(&rp);
         test_emissive(&rp);
         test_instanced_world(dir, &rp);

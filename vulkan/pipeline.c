@@ -86,7 +86,8 @@ enum sb_result sb_compute_pipeline_compile(struct sb_vk *vk, VkPipelineLayout la
                 .pName = "main",
             },
         .layout = layout,
-        .flags = VK_PIPELINE_CREATE_DISPATCH_BASE_BIT | (vk->statistics ? VK_PIPELINE_CREATE_CAPTURE_STATISTICS_BIT_KHR : 0),
+        .flags =
+            VK_PIPELINE_CREATE_DISPATCH_BASE_BIT | (vk->statistics ? VK_PIPELINE_CREATE_CAPTURE_STATISTICS_BIT_KHR : 0),
     };
     VK(vkCreateComputePipelines(vk->device, VK_NULL_HANDLE, 1, &info, NULL, pipeline));
 cleanup:
@@ -172,15 +173,16 @@ enum sb_result sb_graphics_pipeline_create(struct sb_vk *vk, const struct sb_gra
         .depthWriteEnable = VK_TRUE,
         .depthCompareOp = p->depth_compare,
     };
-    VkPipelineColorBlendAttachmentState blend_attachment = {
-        .colorWriteMask =
-            VK_COLOR_COMPONENT_R_BIT | VK_COLOR_COMPONENT_G_BIT | VK_COLOR_COMPONENT_B_BIT | VK_COLOR_COMPONENT_A_BIT,
-    };
-    bool color = p->color_format != VK_FORMAT_UNDEFINED;
+    const VkColorComponentFlags rgba =
+        VK_COLOR_COMPONENT_R_BIT | VK_COLOR_COMPONENT_G_BIT | VK_COLOR_COMPONENT_B_BIT | VK_COLOR_COMPONENT_A_BIT;
+    const VkPipelineColorBlendAttachmentState blend_attachments[2] = {{.colorWriteMask = rgba},
+                                                                      {.colorWriteMask = rgba}};
+    const VkFormat color_formats[2] = {p->color_format, p->color_format2};
+    uint32_t colors = p->color_format == VK_FORMAT_UNDEFINED ? 0 : p->color_format2 == VK_FORMAT_UNDEFINED ? 1 : 2;
     VkPipelineColorBlendStateCreateInfo blend = {
         .sType = VK_STRUCTURE_TYPE_PIPELINE_COLOR_BLEND_STATE_CREATE_INFO,
-        .attachmentCount = color ? 1 : 0,
-        .pAttachments = &blend_attachment,
+        .attachmentCount = colors,
+        .pAttachments = blend_attachments,
     };
     const VkDynamicState dynamic_states[] = {VK_DYNAMIC_STATE_VIEWPORT, VK_DYNAMIC_STATE_SCISSOR};
     VkPipelineDynamicStateCreateInfo dynamic = {
@@ -190,8 +192,8 @@ enum sb_result sb_graphics_pipeline_create(struct sb_vk *vk, const struct sb_gra
     };
     VkPipelineRenderingCreateInfo rendering = {
         .sType = VK_STRUCTURE_TYPE_PIPELINE_RENDERING_CREATE_INFO,
-        .colorAttachmentCount = color ? 1 : 0,
-        .pColorAttachmentFormats = &p->color_format,
+        .colorAttachmentCount = colors,
+        .pColorAttachmentFormats = color_formats,
         .depthAttachmentFormat = p->depth_format,
     };
     VkGraphicsPipelineCreateInfo info = {

@@ -27,8 +27,9 @@ struct sb_graphics_pipeline_params {
     size_t vertex_size;             /* bytes */
     const uint32_t *fragment_spirv; /* NULL: depth only */
     size_t fragment_size;
-    VkFormat color_format; /* VK_FORMAT_UNDEFINED (0): no colour attachment */
-    VkFormat depth_format; /* the depth attachment's format; it is always written */
+    VkFormat color_format;  /* VK_FORMAT_UNDEFINED (0): no colour attachment */
+    VkFormat color_format2; /* a second colour attachment's (location 1), or 0 */
+    VkFormat depth_format;  /* the depth attachment's format; it is always written */
     VkCompareOp depth_compare;
     VkCullModeFlags cull_mode; /* 0: none; front faces are counter-clockwise */
     bool depth_clamp;          /* clamp instead of clipping at near and far (needs vk->depth_clamp) */

@@ -6,7 +6,7 @@
 #include "renderer_internal.h"
 
 extern const struct sb_pass_class sb_pass_sky_view, sb_pass_probes, sb_pass_reflections, sb_pass_aerial_perspective, sb_pass_shadows,
-    sb_pass_cloud_shadow, sb_pass_fog, sb_pass_scene, sb_pass_sky, sb_pass_clouds, sb_pass_fog_apply, sb_pass_purkinje,
+    sb_pass_cloud_shadow, sb_pass_fog, sb_pass_scene, sb_pass_contact_shadows, sb_pass_sky, sb_pass_clouds, sb_pass_fog_apply, sb_pass_purkinje,
     sb_pass_exposure, sb_pass_local_tonemap, sb_pass_grade_linear, sb_pass_bloom, sb_pass_tonemap, sb_pass_grade;
 
 const struct sb_pass_class *const sb_pass_classes[SB_PASS_COUNT] = {
@@ -18,6 +18,7 @@ const struct sb_pass_class *const sb_pass_classes[SB_PASS_COUNT] = {
     [SB_PASS_CLOUD_SHADOW] = &sb_pass_cloud_shadow,
     [SB_PASS_FOG] = &sb_pass_fog,
     [SB_PASS_SCENE] = &sb_pass_scene,
+    [SB_PASS_CONTACT_SHADOWS] = &sb_pass_contact_shadows,
     [SB_PASS_SKY] = &sb_pass_sky,
     [SB_PASS_CLOUDS] = &sb_pass_clouds,
     [SB_PASS_FOG_APPLY] = &sb_pass_fog_apply,

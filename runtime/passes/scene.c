@@ -49,6 +49,9 @@
 struct scene {
     /* Traced: the key light's visibility over the frames (its penumbrae), and what reprojects it. */
     struct sb_texture sun_history[2];
+    /* Rasterised: the key light's direct share of each pixel (scene.frag),
+     * which the contact shadows take back where they find a caster. */
+    struct sb_texture key_light;
     struct sb_buffer history; /* sb_scene_history_gpu */
     struct sb_history history_state;
     /* Generic, and with aerial perspective from its volume alone (aerial.glsl). */
@@ -93,9 +96,15 @@ static enum sb_result create_traced(struct sb_renderer *r, struct scene *s)
 
 static enum sb_result create_raster(struct sb_renderer *r, struct scene *s)
 {
+    enum sb_result made =
+        sb_renderer_texture(r, &s->key_light, (const uint32_t[3]){r->width, r->height, 1}, 1, 1, SB_HDR_FORMAT,
+                            VK_IMAGE_USAGE_COLOR_ATTACHMENT_BIT | VK_IMAGE_USAGE_STORAGE_BIT, "key light");
+    if (made)
+        return made;
     sb_pass_sample(r, SB_VIEW_BINDING_SHADOW, sb_pass_find(r, "shadow cascades"), r->shadow_compare);
     sb_pass_sample(r, SB_VIEW_BINDING_SHADOW_DEPTH, sb_pass_find(r, "shadow cascades"), r->nearest);
     sb_pass_use(r, SB_NO_BINDING, sb_pass_find(r, "hdr"), SB_USE_COLOR_TARGET);
+    sb_pass_use(r, SB_NO_BINDING, sb_graph_image(r, "key light", &s->key_light), SB_USE_COLOR_TARGET);
     sb_pass_use(r, SB_NO_BINDING, sb_pass_find(r, "depth"), SB_USE_DEPTH_TARGET);
     /* scene.frag's specialization: what the pack holds */
     bool generic = r->params.generic_shaders;
@@ -113,6 +122,7 @@ static enum sb_result create_raster(struct sb_renderer *r, struct scene *s)
         .fragment_spirv = sb_spv_scene_frag,
         .fragment_size = sizeof(sb_spv_scene_frag),
         .color_format = SB_HDR_FORMAT,
+        .color_format2 = SB_HDR_FORMAT,
         .depth_format = SB_DEPTH_FORMAT,
         .depth_compare = VK_COMPARE_OP_GREATER, /* reverse Z */
         .name = "scene",
@@ -160,8 +170,8 @@ static void scene_destroy(struct sb_renderer *r)
     if (!s)
         return;
     const VkPipeline pipelines[] = {s->raster[0], s->raster[1], s->traced[0], s->traced[1]};
-    struct sb_texture *textures[2] = {&s->sun_history[0], &s->sun_history[1]};
-    sb_renderer_release(r, pipelines, 4, textures, 2);
+    struct sb_texture *textures[3] = {&s->sun_history[0], &s->sun_history[1], &s->key_light};
+    sb_renderer_release(r, pipelines, 4, textures, 3);
     sb_buffer_destroy(r->vk, &s->history);
     free(s);
 }
@@ -181,12 +191,21 @@ static void scene_record(struct sb_renderer *r)
         sb_renderer_dispatch_frame(r, s->traced[r->aerial_volume_only ? 1 : 0]);
         return;
     }
-    VkRenderingAttachmentInfo color = {
-        .sType = VK_STRUCTURE_TYPE_RENDERING_ATTACHMENT_INFO,
-        .imageView = r->hdr.view,
-        .imageLayout = VK_IMAGE_LAYOUT_COLOR_ATTACHMENT_OPTIMAL,
-        .loadOp = VK_ATTACHMENT_LOAD_OP_CLEAR,
-        .storeOp = VK_ATTACHMENT_STORE_OP_STORE,
+    VkRenderingAttachmentInfo color[2] = {
+        {
+            .sType = VK_STRUCTURE_TYPE_RENDERING_ATTACHMENT_INFO,
+            .imageView = r->hdr.view,
+            .imageLayout = VK_IMAGE_LAYOUT_COLOR_ATTACHMENT_OPTIMAL,
+            .loadOp = VK_ATTACHMENT_LOAD_OP_CLEAR,
+            .storeOp = VK_ATTACHMENT_STORE_OP_STORE,
+        },
+        {
+            .sType = VK_STRUCTURE_TYPE_RENDERING_ATTACHMENT_INFO,
+            .imageView = s->key_light.view,
+            .imageLayout = VK_IMAGE_LAYOUT_COLOR_ATTACHMENT_OPTIMAL,
+            .loadOp = VK_ATTACHMENT_LOAD_OP_CLEAR,
+            .storeOp = VK_ATTACHMENT_STORE_OP_STORE,
+        },
     };
     VkRenderingAttachmentInfo depth = {
         .sType = VK_STRUCTURE_TYPE_RENDERING_ATTACHMENT_INFO,
@@ -200,8 +219,8 @@ static void scene_record(struct sb_renderer *r)
         .sType = VK_STRUCTURE_TYPE_RENDERING_INFO,
         .renderArea = {{0, 0}, {r->width, r->height}},
         .layerCount = 1,
-        .colorAttachmentCount = 1,
-        .pColorAttachments = &color,
+        .colorAttachmentCount = 2,
+        .pColorAttachments = color,
         .pDepthAttachment = &depth,
     };
     vkCmdBeginRendering(r->cmd, &info);

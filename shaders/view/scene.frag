@@ -20,6 +20,7 @@ layout(location = 6) in vec3 in_tangent;
 layout(location = 7) flat in float in_normal_map;
 layout(location = 8) flat in float in_emission;
 layout(location = 0) out vec4 out_color;
+layout(location = 1) out vec4 out_key; /* the key light's direct share, for the contact shadows */
 
 void main()
 {
@@ -33,6 +34,8 @@ void main()
         material_textures(in_uv, footprint, in_images, vec4(in_tangent, in_normal_map), albedo, metallic_roughness,
                           shading_n);
     vec3 emitted = material_emitted(in_emission, in_uv, footprint);
+    vec3 key_part;
     out_color = scene_shade(in_offset, shading_n, n, albedo, metallic_roughness, emitted,
-                            gl_FragCoord.xy / vec2(frame.size.xy), sun_visibility(in_offset, n, true));
+                            gl_FragCoord.xy / vec2(frame.size.xy), sun_visibility(in_offset, n, true), key_part);
+    out_key = vec4(key_part, 0.0);
 }

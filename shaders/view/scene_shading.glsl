@@ -53,10 +53,12 @@ layout(constant_id = 1) const bool SB_SCENE_REFLECTIONS = true; /* reflections.i
  * shading normal n (a normal map's), the surface's own ng (interpolated),
  * linear albedo, (metallic, perceptual roughness), where the
  * point is in the frame (0 to 1: the aerial perspective volume's uv) and
- * the sun's visibility there. */
+ * the sun's visibility there; key_part: the key light's direct share of
+ * the result (0 in the debug terms), which contact shadows take back. */
 vec4 scene_shade(vec3 offset, vec3 n, vec3 ng, vec3 albedo, vec2 metallic_roughness, vec3 emitted, vec2 screen_uv,
-                 float visibility)
+                 float visibility, out vec3 key_part)
 {
+    key_part = vec3(0.0);
     vec3 v = -normalize(offset);
     vec3 l = key_direction();
     vec3 p = planet_position(offset);
@@ -88,7 +90,8 @@ vec4 scene_shade(vec3 offset, vec3 n, vec3 ng, vec3 albedo, vec2 metallic_roughn
         return vec4(vec3(clouds_t * frame.aerial.y), 1.0); /* read back divided by the scale */
     if (frame.size.w == SB_DEBUG_SUN_VISIBILITY)
         return vec4(vec3(visibility * frame.aerial.y), 1.0);
-    vec3 color = brdf * e_sun * (n_dot_l * visibility * clouds_t);
+    vec3 direct = brdf * e_sun * (n_dot_l * visibility * clouds_t);
+    vec3 color = direct;
 
     /* The world is low enough to read the ground row of irradiance_ground. */
     vec3 e_sky, e_bounce;
@@ -141,6 +144,7 @@ vec4 scene_shade(vec3 offset, vec3 n, vec3 ng, vec3 albedo, vec2 metallic_roughn
 
     vec3 inscatter, transmittance;
     aerial_perspective(screen_uv, offset, inscatter, transmittance);
+    key_part = fp16_safe(direct * frame.aerial.y * transmittance);
     return vec4(fp16_safe(color * frame.aerial.y * transmittance + inscatter), 1.0);
 }
 

@@ -121,5 +121,6 @@ void main()
                           shading_n);
         emitted = material_emitted(v.albedo.w, tex, footprint);
     }
-    imageStore(hdr, pixel, scene_shade(offset, shading_n, n, albedo, metallic_roughness, emitted, uv, visibility));
+    vec3 key_part; /* the traced shadows are exact: no contact shadows */
+    imageStore(hdr, pixel, scene_shade(offset, shading_n, n, albedo, metallic_roughness, emitted, uv, visibility, key_part));
 }

@@ -45,6 +45,18 @@
                                                frames kept, y how many (at most SB_SUN_RAYS), z the point's
                                                distance from the camera (m) */
 #define SB_VIEW_BINDING_SCENE_HISTORY 61    /* struct sb_scene_history_gpu */
+#define SB_VIEW_BINDING_KEY_LIGHT 65        /* image2D rgba16f: the raster scene's key light direct share a pixel */
+/* Contact shadows (contact_shadows.comp): steps and reach of the march
+ * toward the key light (a fraction of the pixel's distance, at most
+ * SB_CONTACT_MAX_M), the thickness a surface is taken to have behind the
+ * depth buffer, and the bias (a fraction of the distance) under which a
+ * step is the pixel's own surface. */
+#define SB_CONTACT_STEPS 16
+#define SB_CONTACT_REACH 0.1
+#define SB_CONTACT_MAX_M 1.0
+#define SB_CONTACT_THICKNESS 0.01
+#define SB_CONTACT_MIN_THICKNESS_M 0.05
+#define SB_CONTACT_BIAS 0.002
 /* The traced scene's penumbrae: a ray a frame toward a point of the key
  * light's disk, the mean of the last SB_SUN_RAYS kept (scene_trace.comp). */
 #define SB_SUN_RAYS 32
