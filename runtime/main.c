@@ -81,6 +81,8 @@ static void usage(FILE *f)
                "                          against, else the built-in data/worlds/test.json)\n"
                "  --no-probes             light the world with the sky alone, ignoring the pack's\n"
                "                          sky-visibility probes\n"
+               "  --no-far-shadows        raster: nothing shadowed past the last cascade (no far\n"
+               "                          map over the world's casters)\n"
                "  --no-contact-shadows    the raster scene's shadows from the cascades alone,\n"
                "                          without the screen-space contact shadows\n"
                "  --no-reflections        the sky model's ambient specular, ignoring the pack's\n"
@@ -578,6 +580,8 @@ static int parse_options(int argc, char **argv, struct options *o)
             o->hdr = true;
         else if (!strcmp(a, "--no-probes"))
             o->params.no_probes = true;
+        else if (!strcmp(a, "--no-far-shadows"))
+            o->params.no_far_shadows = true;
         else if (!strcmp(a, "--no-contact-shadows"))
             o->params.no_contact_shadows = true;
         else if (!strcmp(a, "--no-reflections"))

@@ -374,8 +374,23 @@ static void fill_frame(struct sb_renderer *r, const struct sb_view *v, struct sb
 
     struct sb_cascades cascades;
     sb_cascades_compute(&cp, v->camera_m, forward, r->key_direction, &cascades);
+    /* The far map past the last cascade (raster): the casters over the
+     * world, along the key light; drawn whole, or not at all. */
+    struct sb_mat4 far;
+    double far_texel = 0.0, far_depth = 0.0;
+    bool far_drawn =
+        !r->scene_traced && !r->params.no_far_shadows &&
+        sb_far_shadow_compute(v->camera_m, r->key_direction, r->caster_boxes, r->caster_box_count, r->world_min_m,
+                              r->world_max_m, r->params.shadow_size, &far, &far_texel, &far_depth);
+    int32_t *far_clear = r->cascade_clear[SB_CASCADES];
+    far_clear[0] = far_clear[1] = 0;
+    far_clear[2] = far_clear[3] = far_drawn ? (int32_t)r->params.shadow_size : 0;
+    if (!far_drawn)
+        memset(&far, 0, sizeof(far));
+    sb_mat4_store(&far, f->far_view_proj);
+    store4(f->far_shadow, far_texel, far_depth, 0.0, far_drawn ? 1.0 : 0.0);
     if (r->draw_group_count)
-        sb_world_cull(r, &cascades);
+        sb_world_cull(r, &cascades, far_drawn ? &far : NULL);
     for (int c = 0; c < SB_CASCADES; c++) {
         sb_mat4_store(&cascades.view_proj[c], f->shadow_view_proj[c]);
         f->cascade_ends[c] = (float)cascades.ends_m[c];

@@ -91,6 +91,7 @@ struct sb_renderer_params {
     uint32_t cloud_light_steps;   /* light march steps toward the sun, [1, SB_CLOUD_MAX_LIGHT_STEPS]; 0: 6 */
     uint32_t cloud_shadow_size;   /* texels per side of the clouds' shadow map, [16, 4096]; 0: 512 */
     int debug;                    /* SB_DEBUG_* (view_gpu.h): the scene pass writes one term; 0: the frame */
+    bool no_far_shadows;          /* raster: nothing shadowed past the last cascade (no far map) */
     bool whole_shadow_maps;       /* clear and draw every cascade whole, not only where casters
                                      project (runtime/shadows.h); the same frame, slower */
     bool generic_shaders;         /* never the scene's shaders specialised to the pack (no probes, no

@@ -39,14 +39,15 @@ struct sb_renderer {
     uint32_t vertex_count, caster_first_vertex;
     struct sb_caster_box *caster_boxes; /* shadows.h */
     unsigned caster_box_count;
-    int32_t cascade_clear[SB_CASCADES][4]; /* this frame's texels to clear and draw in each cascade */
-    double radiance_scale;                 /* 1 / the sun's largest channel: radiance in units of the sun */
-    double cd_m2_per_unit;                 /* the pack's radiance unit in cd/m^2 (params.sun_illuminance_lux) */
-    double frame_scale;                    /* this frame's: what stored radiance is multiplied by, the
-                                              radiance scale times the pre-exposure (renderer.c) */
-    double previous_frame_scale;           /* the last frame's, which its history was stored with */
-    double next_frame_scale;               /* the next frame's, from this frame's exposure */
-    double readback_scale;                 /* the frame scale of the last frame read back */
+    int32_t cascade_clear[SB_CASCADES + 1][4]; /* this frame's texels to clear and draw in each cascade, then
+                                                  in the far map (layer SB_CASCADES) */
+    double radiance_scale;                     /* 1 / the sun's largest channel: radiance in units of the sun */
+    double cd_m2_per_unit;                     /* the pack's radiance unit in cd/m^2 (params.sun_illuminance_lux) */
+    double frame_scale;                        /* this frame's: what stored radiance is multiplied by, the
+                                                  radiance scale times the pre-exposure (renderer.c) */
+    double previous_frame_scale;               /* the last frame's, which its history was stored with */
+    double next_frame_scale;                   /* the next frame's, from this frame's exposure */
+    double readback_scale;                     /* the frame scale of the last frame read back */
     double ground_radius_km;
     float thickness_km;                    /* the atmosphere's, as the shaders hold it */
     bool camera_in_atmosphere;             /* this frame's: which sky kernel runs */
@@ -81,7 +82,7 @@ struct sb_renderer {
     struct sb_buffer visible;
     struct sb_visible_range {
         uint32_t first, count;      /* in the visible buffer */
-    } * visible_ranges;             /* [(1 + SB_CASCADES) x draw_group_count] */
+    } * visible_ranges;             /* [(2 + SB_CASCADES) x draw_group_count]: the frame, each cascade, the far map */
     double (*instance_boxes)[2][3]; /* each instance's box in the world, and its casters' */
     double (*caster_instance_boxes)[2][3];
     struct sb_texture hdr, depth, ldr;                 /* "hdr", "depth", "ldr": the frame */
@@ -213,15 +214,16 @@ enum sb_result sb_atmosphere_upload(struct sb_renderer *r, const struct sb_pack 
 void sb_pass_read_probes(struct sb_renderer *r);
 
 /* world_gpu.c: the world's vertices, textures, emitting materials,
- * instances and their draws, and its BVH when r->scene_traced, into the
+ * instances and their draws, and its BVH when r->world_bvh, into the
  * renderer's buffers ("vertices", ...), with its box and its casters'
  * boxes; released by sb_world_release (which accepts a partial upload).
  * sb_world_cull fills this frame's lists of visible instances (an
- * instanced world's; r->view_proj and r->camera_m set). */
+ * instanced world's; r->view_proj and r->camera_m set), the far map's
+ * with `far` (NULL: none). */
 struct sb_world;
 enum sb_result sb_world_upload(struct sb_renderer *r, const struct sb_world *world);
 void sb_world_release(struct sb_renderer *r);
-void sb_world_cull(struct sb_renderer *r, const struct sb_cascades *cascades);
+void sb_world_cull(struct sb_renderer *r, const struct sb_cascades *cascades, const struct sb_mat4 *far);
 
 /* grading.c: the scene-linear grading's GPU form; a .cube LUT (NULL: a
  * stand-in) as lut3d.glsl reads it, in a buffer of its own. */

@@ -2,6 +2,7 @@
 
 #include <math.h>
 #include <stdlib.h>
+#include <string.h>
 
 void sb_cascades_compute(const struct sb_cascade_params *p, const double camera_m[3], const double forward[3],
                          const double sun[3], struct sb_cascades *out)
@@ -123,4 +124,62 @@ void sb_cascade_caster_rect(const struct sb_mat4 *view_proj, const double camera
     }
     if (rect[0] >= rect[2] || rect[1] >= rect[3])
         rect[0] = rect[1] = rect[2] = rect[3] = 0;
+}
+
+bool sb_far_shadow_compute(const double camera_m[3], const double light[3], const struct sb_caster_box *boxes,
+                           unsigned count, const double world_min[3], const double world_max[3], unsigned map_size,
+                           struct sb_mat4 *view_proj, double *texel_m, double *depth_m)
+{
+    if (!count || !map_size)
+        return false;
+    /* the light's frame: e1 level (or along x under a light overhead), e2 = l x e1 */
+    double e1[3] = {-light[2], 0.0, light[0]}, len = sqrt(e1[0] * e1[0] + e1[2] * e1[2]);
+    if (len < 1e-6) {
+        e1[0] = 1.0;
+        e1[2] = 0.0;
+    } else {
+        e1[0] /= len;
+        e1[2] /= len;
+    }
+    double e2[3] = {light[1] * e1[2] - light[2] * e1[1], light[2] * e1[0] - light[0] * e1[2],
+                    light[0] * e1[1] - light[1] * e1[0]};
+    double lo[3] = {INFINITY, INFINITY, INFINITY}, hi[3] = {-INFINITY, -INFINITY, -INFINITY};
+    const double *axes[3] = {e1, e2, light};
+    for (unsigned b = 0; b <= count; b++) { /* the casters' boxes across; the world's too along the light */
+        const double *mn = b < count ? boxes[b].min : world_min, *mx = b < count ? boxes[b].max : world_max;
+        for (int corner = 0; corner < 8; corner++) {
+            double p[3] = {(corner & 1 ? mx : mn)[0], (corner & 2 ? mx : mn)[1], (corner & 4 ? mx : mn)[2]};
+            for (int a = b < count ? 0 : 2; a < 3; a++) {
+                double d = p[0] * axes[a][0] + p[1] * axes[a][1] + p[2] * axes[a][2];
+                lo[a] = fmin(lo[a], d);
+                hi[a] = fmax(hi[a], d);
+            }
+        }
+    }
+    /* square texels, two to spare each side */
+    double span = fmax(fmax(hi[0] - lo[0], hi[1] - lo[1]), 1e-3);
+    double texel = span / (map_size - 4.0);
+    for (int a = 0; a < 2; a++) {
+        double mid = 0.5 * (lo[a] + hi[a]);
+        lo[a] = mid - 0.5 * map_size * texel;
+        hi[a] = mid + 0.5 * map_size * texel;
+    }
+    double depth = fmax(hi[2] - lo[2], 1e-3) + 2.0; /* a metre past each end */
+    hi[2] += 1.0;
+    memset(view_proj, 0, sizeof(*view_proj));
+    for (int a = 0; a < 2; a++) { /* clip = 2 (x.e - lo) / span - 1, x = offset + camera */
+        double scale = 2.0 / (hi[a] - lo[a]);
+        double at = camera_m[0] * axes[a][0] + camera_m[1] * axes[a][1] + camera_m[2] * axes[a][2];
+        for (int k = 0; k < 3; k++)
+            view_proj->m[4 * k + a] = scale * axes[a][k];
+        view_proj->m[12 + a] = scale * (at - lo[a]) - 1.0;
+    }
+    double at = camera_m[0] * light[0] + camera_m[1] * light[1] + camera_m[2] * light[2];
+    for (int k = 0; k < 3; k++) /* depth 0 nearest the light */
+        view_proj->m[4 * k + 2] = -light[k] / depth;
+    view_proj->m[14] = (hi[2] - at) / depth;
+    view_proj->m[15] = 1.0;
+    *texel_m = texel;
+    *depth_m = depth;
+    return true;
 }

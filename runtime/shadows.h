@@ -56,6 +56,18 @@ struct sb_caster_box {
     double min[3], max[3]; /* world, m */
 };
 
+/*
+ * The far map, which shadows what lies past the last cascade: an
+ * orthographic view along the light over the casters' boxes (across) and
+ * the world's box (along), fixed in the world, so that it neither swims
+ * nor needs drawing as the camera moves; its matrix takes offsets from
+ * camera_m as the cascades' do. Returns false with no casters (nothing to
+ * draw; every lookup sees the light).
+ */
+bool sb_far_shadow_compute(const double camera_m[3], const double light[3], const struct sb_caster_box *boxes,
+                           unsigned count, const double world_min[3], const double world_max[3], unsigned map_size,
+                           struct sb_mat4 *view_proj, double *texel_m, double *depth_m);
+
 /* The boxes of vertices[first, end) (a triangle list; the world's casters).
  * Returns how many, or 0 with *out NULL on no casters or no memory (*out is
  * NULL then; failed set when it was the memory). */

@@ -186,12 +186,12 @@ static enum sb_result upload_instances(struct sb_renderer *r, const struct sb_wo
     enum sb_result res =
         sb_renderer_upload(r, world->instances, n * sizeof(struct sb_instance_gpu), "instances", &r->instances);
     if (!res)
-        res = sb_renderer_upload(r, NULL, (size_t)(1 + SB_CASCADES) * n * sizeof(uint32_t), "visible instances",
+        res = sb_renderer_upload(r, NULL, (size_t)(2 + SB_CASCADES) * n * sizeof(uint32_t), "visible instances",
                                  &r->visible);
     if (res || !world->instance_count)
         return res;
     r->draw_groups = calloc(world->mesh_count, sizeof(*r->draw_groups));
-    r->visible_ranges = calloc((size_t)(1 + SB_CASCADES) * world->mesh_count, sizeof(*r->visible_ranges));
+    r->visible_ranges = calloc((size_t)(2 + SB_CASCADES) * world->mesh_count, sizeof(*r->visible_ranges));
     r->instance_boxes = calloc(n, sizeof(*r->instance_boxes));
     r->caster_instance_boxes = calloc(n, sizeof(*r->caster_instance_boxes));
     if (!r->draw_groups || !r->visible_ranges || !r->instance_boxes || !r->caster_instance_boxes)
@@ -248,20 +248,22 @@ static bool box_outside(const struct sb_mat4 *view_proj, const double camera_m[3
 }
 
 /* This frame's lists of the instances each raster draw draws: those whose
- * box the frame can see, and for each cascade those whose casters' box
- * falls on its map (runtime/passes/scene.c and shadows.c draw them). */
-void sb_world_cull(struct sb_renderer *r, const struct sb_cascades *cascades)
+ * box the frame can see, and for each cascade and the far map (when `far`)
+ * those whose casters' box falls on its map (runtime/passes/scene.c and
+ * shadows.c draw them). */
+void sb_world_cull(struct sb_renderer *r, const struct sb_cascades *cascades, const struct sb_mat4 *far)
 {
     uint32_t *visible = r->visible.mapped, at = 0;
-    for (int list = 0; list <= SB_CASCADES; list++)
+    for (int list = 0; list <= SB_CASCADES + 1; list++)
         for (uint32_t g = 0; g < r->draw_group_count; g++) {
             const struct sb_draw_group *d = &r->draw_groups[g];
             struct sb_visible_range *range = &r->visible_ranges[list * r->draw_group_count + g];
             range->first = at;
             for (uint32_t i = d->first_instance; i < d->first_instance + d->instance_count; i++) {
+                const struct sb_mat4 *map = list <= SB_CASCADES ? &cascades->view_proj[list - 1] : far;
                 bool out = list == 0 ? box_outside(&r->view_proj, r->camera_m, r->instance_boxes[i], SB_NEAR_M)
-                                     : box_outside(&cascades->view_proj[list - 1], r->camera_m,
-                                                   r->caster_instance_boxes[i], 0.0);
+                           : !map    ? true
+                                     : box_outside(map, r->camera_m, r->caster_instance_boxes[i], 0.0);
                 if (!out)
                     visible[at++] = i;
             }

@@ -643,7 +643,7 @@ static void test_soft_shadows(const char *dir, const struct sb_renderer_params *
     ok = ok && rays && hits && ids && reference && depth;
     int dark_total = 0;
     const double alpha = 0.2666 * DEG; /* renderer.c's sun */
-    struct sb_view views[3] = {base_view(), base_view(), base_view()};
+    struct sb_view views[4] = {base_view(), base_view(), base_view(), base_view()};
     views[0].sun_elevation = 2.0 * DEG;
     views[0].sun_azimuth = 100.0 * DEG;
     views[1].camera_m[1] = 40.0;
@@ -652,7 +652,12 @@ static void test_soft_shadows(const char *dir, const struct sb_renderer_params *
     views[1].sun_azimuth = 200.0 * DEG;
     views[2].camera_m[1] = 40.0;
     views[2].pitch = -40.0 * DEG;
-    for (int vi = 0; vi < 3 && ok; vi++) {
+    views[3].camera_m[1] = 40.0; /* the world 330 m away, past the cascades: the far map's */
+    views[3].camera_m[2] = 330.0;
+    views[3].pitch = -7.0 * DEG;
+    views[3].fov_y = 8.0 * DEG;
+    views[3].sun_elevation = 10.0 * DEG;
+    for (int vi = 0; vi < 4 && ok; vi++) {
         const struct sb_view *v = &views[vi];
         float *drawn[2] = {NULL, NULL};
         for (int m = 0; m < 2 && ok; m++) {
@@ -735,11 +740,8 @@ static void test_soft_shadows(const char *dir, const struct sb_renderer_params *
                         continue;
                     const float *n = world.vertices[3 * ids[i]].normal;
                     if (n[0] * sun[0] + n[1] * sun[1] + n[2] * sun[2] < sin(2.0 * alpha))
-                        continue; /* turned from the light: its visibility is not read */
-                    if (m == 0 && depth[i] > 0.95 * 250.0) {
-                        far++; /* past the last cascade (shadow_distance_m), and its blend band: no map */
-                        continue;
-                    }
+                        continue;                             /* turned from the light: its visibility is not read */
+                    far += m == 0 && depth[i] > 0.95 * 250.0; /* past the last cascade: the far map */
                     /* away from the edges of surfaces, and whole: the same
                      * reference over the 3 x 3 pixels around (a map's texel
                      * may span a pixel or two) */
@@ -770,7 +772,7 @@ static void test_soft_shadows(const char *dir, const struct sb_renderer_params *
                     }
                 }
             printf("soft shadows, %s, view %d (sun %.0f degrees): %d wholly lit pixels, %d under 0.9; %d wholly "
-                   "shadowed, %d over 0.1; %d in penumbrae, mean error %.3f; %d past the cascades\n",
+                   "shadowed, %d over 0.1; %d in penumbrae, mean error %.3f; %d past the cascades (the far map)\n",
                    method[m], vi, v->sun_elevation / DEG, lit, acne, dark, leaks, penumbra,
                    penumbra ? error / penumbra : 0.0, far);
             dark_total += dark;
@@ -781,6 +783,8 @@ static void test_soft_shadows(const char *dir, const struct sb_renderer_params *
             CHECK(m == 0 ? leaks <= dark / 50 : leaks == 0, "%s, view %d: %d of %d wholly shadowed pixels read lit",
                   method[m], vi, leaks, dark);
             CHECK(lit > W * H / 10, "view %d: %d lit pixels to compare", vi, lit);
+            CHECK(vi != 3 || m != 0 || (far > W * H / 4 && dark > 10),
+                  "view 3: %d pixels past the cascades compared (the far map), %d of them wholly shadowed", far, dark);
         }
         free(drawn[0]);
         free(drawn[1]);

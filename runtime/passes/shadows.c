@@ -2,8 +2,9 @@
  * The sun's cascaded shadow maps (runtime/shadows.h has their fitting): the
  * casters drawn into SB_CASCADES layers of depth, each cleared and drawn
  * only where casters project (and a margin that covers what the lookups
- * read), which the scene and the fog sample; "shadow cascades" in the
- * graph's table. A traced scene casts shadow rays instead, and this pass
+ * read), then the far map past the last cascade, every caster over the
+ * world, into one more layer; which the scene and the fog sample; "shadow
+ * cascades" in the graph's table. A traced scene casts shadow rays instead, and this pass
  * has nothing to do.
  */
 #include <stdlib.h>
@@ -34,9 +35,9 @@ static enum sb_result shadows_create(struct sb_renderer *r)
         return SB_ERR_NOMEM;
     sb_pass_set_data(r, s);
     uint32_t n = r->params.shadow_size;
-    enum sb_result res = sb_renderer_texture(r, &s->maps, (const uint32_t[3]){n, n, 1}, SB_CASCADES, 1, SHADOW_FORMAT,
-                                             VK_IMAGE_USAGE_DEPTH_STENCIL_ATTACHMENT_BIT | VK_IMAGE_USAGE_SAMPLED_BIT,
-                                             "shadow cascades");
+    enum sb_result res = sb_renderer_texture(
+        r, &s->maps, (const uint32_t[3]){n, n, 1}, SB_CASCADES + 1, 1, SHADOW_FORMAT,
+        VK_IMAGE_USAGE_DEPTH_STENCIL_ATTACHMENT_BIT | VK_IMAGE_USAGE_SAMPLED_BIT, "shadow cascades");
     if (res)
         return res;
     sb_pass_use(r, SB_VIEW_BINDING_FRAME, sb_pass_find(r, "frame"), SB_USE_LOAD);
@@ -78,7 +79,7 @@ static void shadows_record(struct sb_renderer *r)
     uint32_t n = r->params.shadow_size;
     sb_renderer_bind_graphics(r, s->pipeline, NULL);
     const VkPipelineLayout layout = r->graph.passes[r->pass].layout;
-    for (uint32_t c = 0; c < SB_CASCADES; c++) {
+    for (uint32_t c = 0; c <= SB_CASCADES; c++) { /* the cascades, then the far map */
         const int32_t *clear = r->cascade_clear[c];
         if (clear[0] >= clear[2] || clear[1] >= clear[3])
             continue;

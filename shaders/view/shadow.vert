@@ -19,5 +19,6 @@ void main()
 #else
     vec3 offset = vertex_offset(v);
 #endif
-    gl_Position = frame.shadow_view_proj[pc.cascade] * vec4(offset, 1.0);
+    mat4 m = pc.cascade < SB_CASCADES ? frame.shadow_view_proj[pc.cascade] : frame.far_view_proj; /* the far map */
+    gl_Position = m * vec4(offset, 1.0);
 }

@@ -92,6 +92,23 @@ float disk_visibility(vec3 offset, vec3 n, int k, int count, float turn)
 
 layout(set = 0, binding = SB_VIEW_BINDING_SHADOW) uniform sampler2DArrayShadow shadow_map;
 
+/* Map c's matrix, texel (m) and casters' uv box: a cascade's, or for c =
+ * SB_CASCADES the far map's (fitted to the casters: its whole). */
+mat4 shadow_matrix(int c)
+{
+    return c < SB_CASCADES ? frame.shadow_view_proj[c] : frame.far_view_proj;
+}
+
+float shadow_texel(int c)
+{
+    return c < SB_CASCADES ? frame.cascade_texel[c] : frame.far_shadow.x;
+}
+
+vec4 shadow_rect(int c)
+{
+    return c < SB_CASCADES ? frame.cascade_rect[c] : vec4(0.0, 0.0, 1.0, 1.0);
+}
+
 #ifdef SB_SOFT_SHADOWS
 /*
  * Penumbrae (percentage-closer soft shadows, Fernando 2005), for the
@@ -175,15 +192,15 @@ float soft_visibility(int c, vec3 offset, vec3 n, vec3 s, vec2 uv)
 
 float cascade_visibility(int c, vec3 offset, vec3 n, bool pcf)
 {
-    vec3 p = offset + n * (frame.cascade_texel[c] * frame.shadow.y);
-    vec4 clip = frame.shadow_view_proj[c] * vec4(p, 1.0);
+    vec3 p = offset + n * (shadow_texel(c) * frame.shadow.y);
+    vec4 clip = shadow_matrix(c) * vec4(p, 1.0);
     vec3 s = clip.xyz / clip.w;
     vec2 uv = s.xy * 0.5 + 0.5;
-    vec4 rect = frame.cascade_rect[c];
+    vec4 rect = shadow_rect(c);
     /* A penumbra reaches past the casters' box by its filter's radius. */
     float reach = 0.0;
 #ifdef SB_SOFT_SHADOWS
-    if (pcf)
+    if (pcf && c < SB_CASCADES)
         reach = float(SB_SHADOW_SEARCH_TEXELS) / frame.shadow.z;
 #endif
     if (any(lessThan(uv, max(rect.xy - reach, vec2(0.0)))) || any(greaterThan(uv, min(rect.zw + reach, vec2(1.0)))) ||
@@ -194,7 +211,7 @@ float cascade_visibility(int c, vec3 offset, vec3 n, bool pcf)
 #ifdef SB_SOFT_SHADOWS
     if (dot(n, key_direction()) <= 0.0)
         return 0.0; /* turned from the light: none of it, and no search */
-    float soft = soft_visibility(c, offset, n, s, uv);
+    float soft = c < SB_CASCADES ? soft_visibility(c, offset, n, s, uv) : -1.0; /* the far map: the 3 x 3 filter */
     if (soft >= 0.0)
         return soft;
     if (any(lessThan(uv, rect.xy)) || any(greaterThan(uv, rect.zw)))
@@ -225,21 +242,22 @@ float sun_visibility(vec3 offset, vec3 n, bool pcf)
     if (frame.shadow.w == 0.0)
         return 1.0;
     float depth = dot(offset, frame.camera_forward.xyz);
-    int c = 0;
+    /* past the last cascade, the far map where it is drawn */
+    int c = 0, maps = frame.far_shadow.w > 0.0 ? SB_CASCADES + 1 : SB_CASCADES;
     while (c < SB_CASCADES && depth > frame.cascade_ends[c])
         c++;
     if (c == SB_CASCADES)
-        return 1.0;
+        return maps > SB_CASCADES ? cascade_visibility(c, offset, n, pcf) : 1.0;
     float begin = c == 0 ? 0.0 : frame.cascade_ends[c - 1];
     float band = frame.shadow.x * (frame.cascade_ends[c] - begin);
     float f = band > 0.0 ? (depth - (frame.cascade_ends[c] - band)) / band : 0.0;
-    /* In the band, toward the next cascade, or out of the shadows past the
-     * last. The next cascade is read in a loop's second turn, not in a
+    /* In the band, toward the next cascade, or the far map past the last
+     * (out of the shadows without one). The next cascade is read in a loop's second turn, not in a
      * branch: llvmpipe runs a branch's code whether or not an invocation
      * takes it, but ends a loop when none of its SIMD group goes on, and
      * few groups meet a band (lavapipe's scene pass 46 -> 41 ms at 640 x 360). */
     float visibility = 1.0, next = 1.0;
-    int last = f > 0.0 && c + 1 < SB_CASCADES ? c + 1 : c;
+    int last = f > 0.0 && c + 1 < maps ? c + 1 : c;
     for (int k = c; k <= last; k++) {
         float v = cascade_visibility(k, offset, n, pcf);
         if (k == c)

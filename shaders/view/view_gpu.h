@@ -169,6 +169,9 @@ struct sb_frame_gpu {
     SB_VEC4(cascade_depth_m);  /* the depth each cascade's map spans, 0 to 1 (m) */
     SB_VEC4(cascade_rect[SB_CASCADES]); /* uv box (min xy, max xy) outside which a cascade has no caster:
                                            lookups there see the sun without reading the map */
+    SB_MAT4(far_view_proj);    /* camera-relative world (m) to the far map's clip (layer SB_CASCADES of
+                                  the cascades' image), fixed in the world: past the last cascade */
+    SB_VEC4(far_shadow);       /* x: the far map's texel (m), y: the depth it spans (m), w: 1 when drawn */
     SB_VEC4(shadow);           /* x: blend band (fraction of a cascade), y: normal offset (texels),
                                   z: shadow map size (texels), w: 1 to use shadows */
     SB_VEC4(aerial);           /* x: the volume's far distance (km); y: radiance scale (what the frame's
