@@ -4,9 +4,9 @@
  * toward the key light through the depth buffer, SB_CONTACT_STEPS steps
  * over a reach of SB_CONTACT_REACH of the pixel's distance (at most
  * SB_CONTACT_MAX_M), jittered per pixel. A step whose point lies behind
- * the depth buffer's surface by less than a thickness (SB_CONTACT_THICKNESS
- * of its distance, at least SB_CONTACT_MIN_THICKNESS_M) is in a caster's
- * shadow: the caster the cascades' texels and bias miss (a leg on a floor,
+ * the depth buffer's surface (in view depth) by less than a thickness
+ * (SB_CONTACT_THICKNESS of its depth, at least SB_CONTACT_MIN_THICKNESS_M)
+ * is in a caster's shadow: the caster the cascades' texels and bias miss (a leg on a floor,
  * a book on a table). Where a step finds one, the key light's direct share
  * of the pixel (scene.frag's second target) is taken back, faded over the
  * reach's last quarter. */
@@ -37,32 +37,33 @@ void main()
         return;
     vec2 size = vec2(frame.size.xy);
     vec3 p = point_at((vec2(pixel) + 0.5) / size, depth);
-    float distance = length(p);
-    float reach = min(SB_CONTACT_REACH * distance, SB_CONTACT_MAX_M);
-    vec3 l = key_direction();
+    float reach = min(SB_CONTACT_REACH * length(p), SB_CONTACT_MAX_M);
+    /* the march in clip space, where it is linear: a step's w is its view
+     * depth, and a depth d of the buffer (reverse Z, infinitely far) lies
+     * at view depth near / d */
+    vec4 c0 = frame.view_proj * vec4(p, 1.0), c1 = frame.view_proj * vec4(key_direction() * reach, 0.0);
+    float near = frame.camera_m.w;
     float jitter = interleaved_noise(vec2(pixel));
     float shadow = 0.0;
     for (int i = 0; i < SB_CONTACT_STEPS; i++) {
         float t = (float(i) + jitter) / float(SB_CONTACT_STEPS);
-        vec3 q = p + l * (t * reach);
-        vec4 clip = frame.view_proj * vec4(q, 1.0);
-        if (clip.w <= 0.0)
+        vec4 clip = c0 + t * c1;
+        if (clip.w <= near)
             break;
         vec2 uv = clip.xy / clip.w * 0.5 + 0.5;
         if (any(lessThan(uv, vec2(0.0))) || any(greaterThanEqual(uv, vec2(1.0))))
             break;
-        /* the 2 x 2 depths around q: q must lie behind the farthest of
-         * them (a surface seen at a grazing angle spans a range of depths
-         * within a pixel, which a single texel would take for a caster)
-         * and within the thickness of the nearest */
+        /* the 2 x 2 depths around the step: it must lie behind the
+         * farthest of them (a surface seen at a grazing angle spans a
+         * range of depths within a pixel, which a single texel would take
+         * for a caster) and within the thickness of the nearest */
         vec4 seen = textureGather(scene_depth, uv, 0);
         float farthest = min(min(seen.x, seen.y), min(seen.z, seen.w));
         float nearest = max(max(seen.x, seen.y), max(seen.z, seen.w));
         if (farthest <= 0.0)
             continue;
-        float dq = length(q);
-        float behind = dq - length(point_at(uv, farthest)), inside = dq - length(point_at(uv, nearest));
-        if (behind > SB_CONTACT_BIAS * dq && inside < max(SB_CONTACT_THICKNESS * dq, SB_CONTACT_MIN_THICKNESS_M)) {
+        float z = clip.w, behind = z - near / farthest, inside = z - near / nearest;
+        if (behind > SB_CONTACT_BIAS * z && inside < max(SB_CONTACT_THICKNESS * z, SB_CONTACT_MIN_THICKNESS_M)) {
             shadow = clamp((1.0 - t) * 4.0, 0.0, 1.0);
             break;
         }
