@@ -175,6 +175,22 @@ static enum sb_result capture_inputs(struct reflection_state *st, struct sb_vk *
     return res;
 }
 
+/* Cube i's level 0 (and its surfaces, when not NULL) captured at its
+ * probe (0: the sky-only probe at the view's altitude, the sky alone). */
+static enum sb_result capture_probe(struct reflection_state *st, struct sb_vk *vk, const struct sb_scene *scene,
+                                    uint32_t i, struct sb_capture_params *cp, float *level0, float *surfaces,
+                                    double *ms)
+{
+    double at[3];
+    probe_position(scene, (int)i, at);
+    for (int k = 0; k < 3; k++)
+        cp->origin_m[k] = (float)at[k];
+    cp->altitude_km = fmax(at[1], 0.0) * 1e-3;
+    struct sb_capture_inputs in = {
+        .atmosphere = st->atmosphere, .rc = i ? st->rc : NULL, .surfaces = &st->surfaces, .kernels = &st->kernels};
+    return sb_reflection_capture(vk, &in, cp, level0, surfaces, ms);
+}
+
 static enum sb_result bake_cubes(struct reflection_state *st, struct sb_vk *vk, const struct sb_scene *scene,
                                  const struct sb_image baked[SB_PRODUCT_COUNT], struct sb_image *image,
                                  struct sb_artifact *a)
@@ -198,17 +214,8 @@ static enum sb_result bake_cubes(struct reflection_state *st, struct sb_vk *vk, 
     for (uint32_t i = 0; i < cubes && !res; i++) {
         double at[3], ms = 0;
         probe_position(scene, (int)i, at);
-        for (int k = 0; k < 3; k++)
-            cp.origin_m[k] = (float)at[k];
-        cp.altitude_km = fmax(at[1], 0.0) * 1e-3;
-        struct sb_capture_inputs in = {
-            .atmosphere = st->atmosphere,
-            .rc = i ? st->rc : NULL,
-            .surfaces = &st->surfaces,
-            .kernels = &st->kernels,
-        };
         double t1 = 1e3 * sb_now_s();
-        if ((res = sb_reflection_capture(vk, &in, &cp, level0, NULL, &ms)))
+        if ((res = capture_probe(st, vk, scene, i, &cp, level0, NULL, &ms)))
             break;
         sb_debug("reflection_cubes: probe %u captured in %.1f ms (%.3f ms on the device)", i, 1e3 * sb_now_s() - t1,
                  ms);
@@ -287,14 +294,8 @@ static enum sb_result bake_surfaces(struct reflection_state *st, struct sb_vk *v
     sun_direction(scene, cp.sun);
     double gpu_ms = 0;
     for (uint32_t i = 0; i < cubes && !res; i++) {
-        double at[3], ms = 0;
-        probe_position(scene, (int)i, at);
-        for (int k = 0; k < 3; k++)
-            cp.origin_m[k] = (float)at[k];
-        cp.altitude_km = fmax(at[1], 0.0) * 1e-3;
-        struct sb_capture_inputs in = {
-            .atmosphere = st->atmosphere, .rc = i ? st->rc : NULL, .surfaces = &st->surfaces, .kernels = &st->kernels};
-        if ((res = sb_reflection_capture(vk, &in, &cp, level0, surfaces, &ms)))
+        double ms = 0;
+        if ((res = capture_probe(st, vk, scene, i, &cp, level0, surfaces, &ms)))
             break;
         gpu_ms += ms;
         /* the GPU's vec4s are the channels in order (config.h) */
