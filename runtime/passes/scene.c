@@ -38,7 +38,9 @@
 #include "sh.h"
 
 #include "scene_frag.spv.h"
+#include "scene_frag_key.spv.h"
 #include "scene_frag_volume.spv.h"
+#include "scene_frag_volume_key.spv.h"
 #include "scene_trace.spv.h"
 #include "scene_trace_instanced.spv.h"
 #include "scene_trace_volume.spv.h"
@@ -96,15 +98,20 @@ static enum sb_result create_traced(struct sb_renderer *r, struct scene *s)
 
 static enum sb_result create_raster(struct sb_renderer *r, struct scene *s)
 {
+    /* the key light's share for the contact shadows: a second target, which
+     * cost llvmpipe a fifth of the pass, so only when they are on */
+    bool key = !r->params.no_contact_shadows;
     enum sb_result made =
-        sb_renderer_texture(r, &s->key_light, (const uint32_t[3]){r->width, r->height, 1}, 1, 1, SB_HDR_FORMAT,
-                            VK_IMAGE_USAGE_COLOR_ATTACHMENT_BIT | VK_IMAGE_USAGE_STORAGE_BIT, "key light");
+        key ? sb_renderer_texture(r, &s->key_light, (const uint32_t[3]){r->width, r->height, 1}, 1, 1, SB_HDR_FORMAT,
+                                  VK_IMAGE_USAGE_COLOR_ATTACHMENT_BIT | VK_IMAGE_USAGE_STORAGE_BIT, "key light")
+            : SB_OK;
     if (made)
         return made;
     sb_pass_sample(r, SB_VIEW_BINDING_SHADOW, sb_pass_find(r, "shadow cascades"), r->shadow_compare);
     sb_pass_sample(r, SB_VIEW_BINDING_SHADOW_DEPTH, sb_pass_find(r, "shadow cascades"), r->nearest);
     sb_pass_use(r, SB_NO_BINDING, sb_pass_find(r, "hdr"), SB_USE_COLOR_TARGET);
-    sb_pass_use(r, SB_NO_BINDING, sb_graph_image(r, "key light", &s->key_light), SB_USE_COLOR_TARGET);
+    if (key)
+        sb_pass_use(r, SB_NO_BINDING, sb_graph_image(r, "key light", &s->key_light), SB_USE_COLOR_TARGET);
     sb_pass_use(r, SB_NO_BINDING, sb_pass_find(r, "depth"), SB_USE_DEPTH_TARGET);
     /* scene.frag's specialization: what the pack holds */
     bool generic = r->params.generic_shaders;
@@ -119,10 +126,10 @@ static enum sb_result create_raster(struct sb_renderer *r, struct scene *s)
         .fragment_specialization = &specialization,
         .vertex_spirv = r->draw_group_count ? sb_spv_scene_vert_instanced : sb_spv_scene_vert,
         .vertex_size = r->draw_group_count ? sizeof(sb_spv_scene_vert_instanced) : sizeof(sb_spv_scene_vert),
-        .fragment_spirv = sb_spv_scene_frag,
-        .fragment_size = sizeof(sb_spv_scene_frag),
+        .fragment_spirv = key ? sb_spv_scene_frag_key : sb_spv_scene_frag,
+        .fragment_size = key ? sizeof(sb_spv_scene_frag_key) : sizeof(sb_spv_scene_frag),
         .color_format = SB_HDR_FORMAT,
-        .color_format2 = SB_HDR_FORMAT,
+        .color_format2 = key ? SB_HDR_FORMAT : VK_FORMAT_UNDEFINED,
         .depth_format = SB_DEPTH_FORMAT,
         .depth_compare = VK_COMPARE_OP_GREATER, /* reverse Z */
         .name = "scene",
@@ -130,8 +137,8 @@ static enum sb_result create_raster(struct sb_renderer *r, struct scene *s)
     enum sb_result res = sb_pass_layout(r, &params.layout);
     if (!res)
         res = sb_graphics_pipeline_create(r->vk, &params, &s->raster[0]);
-    params.fragment_spirv = sb_spv_scene_frag_volume;
-    params.fragment_size = sizeof(sb_spv_scene_frag_volume);
+    params.fragment_spirv = key ? sb_spv_scene_frag_volume_key : sb_spv_scene_frag_volume;
+    params.fragment_size = key ? sizeof(sb_spv_scene_frag_volume_key) : sizeof(sb_spv_scene_frag_volume);
     params.name = "scene (aerial volume only)";
     if (!res)
         res = sb_graphics_pipeline_create(r->vk, &params, &s->raster[1]);
@@ -219,7 +226,7 @@ static void scene_record(struct sb_renderer *r)
         .sType = VK_STRUCTURE_TYPE_RENDERING_INFO,
         .renderArea = {{0, 0}, {r->width, r->height}},
         .layerCount = 1,
-        .colorAttachmentCount = 2,
+        .colorAttachmentCount = s->key_light.image ? 2 : 1,
         .pColorAttachments = color,
         .pDepthAttachment = &depth,
     };

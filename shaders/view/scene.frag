@@ -20,7 +20,9 @@ layout(location = 6) in vec3 in_tangent;
 layout(location = 7) flat in float in_normal_map;
 layout(location = 8) flat in float in_emission;
 layout(location = 0) out vec4 out_color;
+#ifdef SB_KEY_TARGET
 layout(location = 1) out vec4 out_key; /* the key light's direct share, for the contact shadows */
+#endif
 
 void main()
 {
@@ -37,5 +39,7 @@ void main()
     vec3 key_part;
     out_color = scene_shade(in_offset, shading_n, n, albedo, metallic_roughness, emitted,
                             gl_FragCoord.xy / vec2(frame.size.xy), sun_visibility(in_offset, n, true), key_part);
+#ifdef SB_KEY_TARGET
     out_key = vec4(key_part, 0.0);
+#endif
 }
