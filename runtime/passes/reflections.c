@@ -48,9 +48,11 @@ struct reflections {
     struct sb_buffer reflections, cubes; /* sb_reflections_gpu, its probes and the DFG; the cubes */
     struct sb_buffer surfaces, chain, relight;
     uint32_t count, levels, face_size;
-    bool relit;         /* the pack's surfaces relight the cubes */
-    struct lights *lit; /* what each cube is lit for */
-    uint32_t next;      /* the cube the turns start from */
+    uint64_t chain_texels; /* a cube's, every level */
+    double baked_sun[3];   /* the sun the cubes were captured under */
+    bool relit;            /* the pack's surfaces relight the cubes */
+    struct lights *lit;    /* what each cube is lit for */
+    uint32_t next;         /* the cube the turns start from */
     VkPipeline relight_kernel, chain_kernel, filter_kernel;
 };
 
@@ -71,9 +73,11 @@ static enum sb_result upload_reflections(struct sb_renderer *r, struct reflectio
                cubes->levels < SB_RELIGHT_MAX_LEVELS; /* [3].w: the chain */
     bool dfg = use && pack->present[SB_PRODUCT_DFG];
     uint32_t count = use ? cubes->depth : 0, n = use ? cubes->width : 1, levels = use ? cubes->levels : 1;
-    uint64_t chain = 0;
-    for (uint32_t l = 0; l < levels; l++)
+    uint64_t chain = 0, level_offsets[SB_RELIGHT_MAX_LEVELS];
+    for (uint32_t l = 0; l < levels; l++) {
+        level_offsets[l] = chain;
         chain += 6ull * sb_image_level_size(n, l) * sb_image_level_size(n, l);
+    }
     size_t header_vec4s = (sizeof(struct sb_reflections_gpu) + 15) / 16;
     size_t vec4s = header_vec4s + 3 * (size_t)count + (dfg ? (size_t)SB_DFG_SIZE * SB_DFG_SIZE : 0);
     enum sb_result res = sb_renderer_upload(r, NULL, vec4s * 16, "reflection probes", &s->reflections);
@@ -88,12 +92,12 @@ static enum sb_result upload_reflections(struct sb_renderer *r, struct reflectio
     s->count = r->reflection_count = count;
     s->levels = levels;
     s->face_size = n;
+    s->chain_texels = chain;
     g->info[3] = dfg;
-    double el = pack->scene->view.sun_elevation_deg * M_PI / 180, az = pack->scene->view.sun_azimuth_deg * M_PI / 180;
-    double sun[3];
-    sb_direction(az, el, sun);
+    sb_direction(pack->scene->view.sun_azimuth_deg * M_PI / 180, pack->scene->view.sun_elevation_deg * M_PI / 180,
+                 s->baked_sun);
     for (int k = 0; k < 3; k++)
-        g->baked_sun[k] = (float)sun[k];
+        g->baked_sun[k] = (float)s->baked_sun[k];
     /* The sky-only cube's irradiance SH (its record's channels 9 on, k then rgb) at +y. */
     const double up[3] = {0, 1, 0};
     for (int c = 0; c < 3; c++) {
@@ -102,11 +106,8 @@ static enum sb_result upload_reflections(struct sb_renderer *r, struct reflectio
             coefficients[k] = records->data[9 + 3 * k + c];
         g->baked_sky_up[c] = (float)sb_sh9_eval(coefficients, up);
     }
-    uint64_t at = 0;
-    for (uint32_t l = 0; l < levels; l++) {
-        g->level_offsets[l / 4][l % 4] = (uint32_t)at;
-        at += 6ull * sb_image_level_size(n, l) * sb_image_level_size(n, l);
-    }
+    for (uint32_t l = 0; l < levels; l++)
+        g->level_offsets[l / 4][l % 4] = (uint32_t)level_offsets[l];
     g->level_offsets[3][3] = (uint32_t)chain;
     float *data = (float *)s->reflections.mapped + 4 * header_vec4s;
     for (uint32_t i = 0; i < count; i++)
@@ -152,13 +153,11 @@ bool sb_reflections_relightable(const struct sb_pack *pack, const struct sb_rend
 static enum sb_result upload_relight(struct sb_renderer *r, struct reflections *s)
 {
     const struct sb_image *surfaces = &r->pack->images[SB_PRODUCT_REFLECTION_SURFACES];
-    size_t texels = 6ull * s->face_size * s->face_size, chain = 0;
-    for (uint32_t l = 0; l < s->levels; l++)
-        chain += 6ull * sb_image_level_size(s->face_size, l) * sb_image_level_size(s->face_size, l);
+    size_t texels = 6ull * s->face_size * s->face_size;
     enum sb_result res = sb_renderer_upload(r, NULL, (s->relit ? texels * s->count * SB_RELIGHT_VEC4S : 1) * 16,
                                             "reflection surfaces", &s->surfaces);
     if (!res)
-        res = sb_renderer_upload(r, NULL, (s->relit ? chain : 1) * 16, "reflection chain", &s->chain);
+        res = sb_renderer_upload(r, NULL, (s->relit ? s->chain_texels : 1) * 16, "reflection chain", &s->chain);
     if (!res)
         res = sb_renderer_upload(r, NULL, sizeof(struct sb_relight_gpu), "relight", &s->relight);
     if (res || !s->relit)
@@ -182,10 +181,8 @@ static enum sb_result upload_relight(struct sb_renderer *r, struct reflections *
     s->lit = calloc(s->count, sizeof(*s->lit));
     if (!s->lit)
         return SB_ERR_NOMEM;
-    /* as baked: the scene's sun alone */
-    const struct sb_scene_view *view = &r->pack->scene->view;
-    for (uint32_t i = 0; i < s->count; i++) {
-        sb_direction(view->sun_azimuth_deg * M_PI / 180, view->sun_elevation_deg * M_PI / 180, s->lit[i].sun);
+    for (uint32_t i = 0; i < s->count; i++) { /* as baked: the scene's sun alone */
+        memcpy(s->lit[i].sun, s->baked_sun, sizeof(s->baked_sun));
         s->lit[i].count = 1;
     }
     ((struct sb_reflections_gpu *)s->reflections.mapped)->baked_sun[3] = 1.0f;
@@ -201,6 +198,10 @@ static enum sb_result reflections_create(struct sb_renderer *r)
     sb_pass_set_data(r, s);
     enum sb_result res = upload_reflections(r, s);
     s->relit = !res && s->count && sb_reflections_relightable(r->pack, &r->params, r->world);
+    if (!res && s->count && !s->relit && r->pack->present[SB_PRODUCT_REFLECTION_SURFACES] &&
+        !r->params.baked_reflections)
+        sb_warn("the pack's reflection_surfaces do not fit its reflection_cubes or the world has no triangles to "
+                "shadow: the cubes as baked, scaled under another sun");
     if (!res)
         res = upload_relight(r, s);
     if (res)

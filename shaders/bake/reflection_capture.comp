@@ -37,6 +37,7 @@ layout(push_constant) uniform Push { sb_capture_push pc; };
 #include "sh.glsl"
 #define SURFACE_BINDING SB_CAPTURE_BINDING_SURFACE
 #include "surface.glsl"
+#include "relight.glsl"
 
 vec3 sky(float h, vec3 d)
 {
@@ -55,15 +56,10 @@ void surface(vec3 origin, vec3 d, BvhHit hit, out vec3 rho, out vec3 n, out vec3
     // a texel's cone: 2 / n radians across at a face's centre
     rho = surface_albedo(hit, hit.t * 2.0 / float(pc.face_size), abs(dot(n, d)));
     vec3 x = origin + d * hit.t;
-    float eps = 1e-4 + 2e-6 * max(abs(x.x), max(abs(x.y), abs(x.z)));
+    float eps = relight_lift(x);
     vec3 from = x + n * eps;
-    vec3 s = pc.sun_direction.xyz;
-    float h = clamp(pc.origin_m.w + (x.y - origin.y) * 1e-3, 0.0, atmosphere_thickness());
-    e_sun = vec3(0.0);
-    float ns = dot(n, s);
     uint first = pc.first_direction, sphere = 2u * pc.ambient_rays;
-    if (first == 0u && ns > 0.0 && bvh_trace(from, s, eps, 1e30, true).triangle == SB_BVH_MISS)
-        e_sun = atm.solar_irradiance.rgb * sun_transmittance(h, clamp(s.y, -1.0, 1.0)) * ns;
+    e_sun = first == 0u ? relight_light(x, n, relight_altitude(origin, x), pc.sun_direction.xyz) : vec3(0.0);
     for (int k = 0; k < SB_PROBE_SH; k++)
         t[k] = 0.0;
     for (uint i = first; i < min(first + SB_CAPTURE_PASS_DIRECTIONS, sphere); i++) {
@@ -123,12 +119,7 @@ void main()
     surfaces[at + 1u] = vec4(normal, t0.x);
     surfaces[at + 2u] = vec4(t0.yzw, t1.x);
     surfaces[at + 3u] = vec4(t1.yzw, t8);
-    if (last) { // the sky's light through the whole transfer
-        float y[SB_PROBE_SH] = float[SB_PROBE_SH](t0.x, t0.y, t0.z, t0.w, t1.x, t1.y, t1.z, t1.w, t8);
-        vec3 e_sky = vec3(0.0);
-        for (int k = 0; k < SB_PROBE_SH; k++)
-            e_sky += sky_sh[k].rgb * y[k];
-        lit.rgb += rho / PI * max(e_sky, vec3(0.0));
-    }
+    if (last) // the sky's light through the whole transfer
+        lit.rgb += rho / PI * relight_sky(float[SB_PROBE_SH](t0.x, t0.y, t0.z, t0.w, t1.x, t1.y, t1.z, t1.w, t8));
     radiance[texel] = lit;
 }

@@ -31,6 +31,7 @@ layout(std430, set = 0, binding = SB_VIEW_BINDING_BVH_NODES) readonly buffer Bvh
 layout(std430, set = 0, binding = SB_VIEW_BINDING_BVH_TRIANGLES) readonly buffer BvhTriangles { vec4 bvh_triangles[]; };
 #define BVH_ANY_HIT_MATERIAL_0_PASSES /* receivers only (a ground) cast no shadow, as in the scene */
 #include "bvh.glsl"
+#include "relight.glsl"
 
 void main()
 {
@@ -46,25 +47,11 @@ void main()
     if (g0.w <= 0.0) {
         L = sky_light_radiance(d);
     } else {
-        vec3 probe = reflection_data[3u * cube].xyz, normal = g1.xyz;
-        float transfer[SB_PROBE_SH] = float[SB_PROBE_SH](g1.w, g2.x, g2.y, g2.z, g2.w, g3.x, g3.y, g3.z, g3.w);
-        vec3 e_sky = vec3(0.0);
-        for (int k = 0; k < SB_PROBE_SH; k++)
-            e_sky += sky_sh[k].rgb * transfer[k];
-        vec3 e = max(e_sky, vec3(0.0));
-        vec3 x = probe + d * g0.w;
-        /* the bake's lift off the surface and its altitude: the probe's, km above the ground, and the way up */
-        float eps = 1e-4 + 2e-6 * max(abs(x.x), max(abs(x.y), abs(x.z)));
-        float h = clamp(max(probe.y, 0.0) * 1e-3 + (x.y - probe.y) * 1e-3, 0.0, atmosphere_thickness());
-        for (int i = 0; i < sky_light_count(); i++) {
-            vec3 l = light_direction(i);
-            float nl = dot(normal, l);
-            if (nl <= 0.0)
-                continue;
-            vec3 t = sun_transmittance(h, clamp(l.y, -1.0, 1.0));
-            if (max(t.r, max(t.g, t.b)) > 0.0 && bvh_trace(x + normal * eps, l, eps, 1e30, true).triangle == SB_BVH_MISS)
-                e += atm.solar_irradiance.rgb * light_color(i) * t * nl;
-        }
+        vec3 probe = reflection_data[3u * cube].xyz, x = probe + d * g0.w;
+        vec3 e = relight_sky(float[SB_PROBE_SH](g1.w, g2.x, g2.y, g2.z, g2.w, g3.x, g3.y, g3.z, g3.w));
+        float h = relight_altitude(probe, x);
+        for (int i = 0; i < sky_light_count(); i++)
+            e += light_color(i) * relight_light(x, g1.xyz, h, light_direction(i));
         L = g0.rgb / PI * e;
     }
     cube_texels[cube * reflections.level_offsets[3].w + texel] = vec4(L, 0.0);

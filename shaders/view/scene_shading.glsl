@@ -132,12 +132,10 @@ vec4 scene_shade(vec3 offset, vec3 n, vec3 ng, vec3 albedo, vec2 metallic_roughn
         env += hidden * l_env; /* where the sky is hidden, the probes' light along refl */
         specular = env * (dfg.x + f0 * (dfg.y - dfg.x)) * energy;
     }
-    {
-        /* Horizon occlusion (Filament): a normal map's mirror direction
-         * below the surface's own horizon sees the surface, not the sky. */
-        float horizon = min(1.0 + dot(refl, ng), 1.0);
-        specular *= horizon * horizon;
-    }
+    /* Horizon occlusion (Filament): a normal map's mirror direction below
+     * the surface's own horizon sees the surface, not the sky. */
+    float horizon = min(1.0 + dot(refl, ng), 1.0);
+    specular *= horizon * horizon;
     if (frame.size.w == SB_DEBUG_ENV_SPECULAR)
         return vec4(fp16_safe(specular * frame.aerial.y), 1.0);
     color += diffuse_color / PI * e_n + specular + emitted;

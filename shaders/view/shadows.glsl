@@ -252,10 +252,11 @@ float sun_visibility(vec3 offset, vec3 n, bool pcf)
     float band = frame.shadow.x * (frame.cascade_ends[c] - begin);
     float f = band > 0.0 ? (depth - (frame.cascade_ends[c] - band)) / band : 0.0;
     /* In the band, toward the next cascade, or the far map past the last
-     * (out of the shadows without one). The next cascade is read in a loop's second turn, not in a
-     * branch: llvmpipe runs a branch's code whether or not an invocation
-     * takes it, but ends a loop when none of its SIMD group goes on, and
-     * few groups meet a band (lavapipe's scene pass 46 -> 41 ms at 640 x 360). */
+     * (out of the shadows without one). The next map is read in a loop's
+     * second turn, not in a branch: llvmpipe runs a branch's code whether
+     * or not an invocation takes it, but ends a loop when none of its SIMD
+     * group goes on, and few groups meet a band (lavapipe's scene pass 46
+     * -> 41 ms at 640 x 360). */
     float visibility = 1.0, next = 1.0;
     int last = f > 0.0 && c + 1 < maps ? c + 1 : c;
     for (int k = c; k <= last; k++) {
