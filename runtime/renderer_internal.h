@@ -70,6 +70,7 @@ struct sb_renderer {
     struct sb_texel_set textures;              /* "texture records", "texels": the world's textures */
     struct sb_buffer instances;                /* "instances": sb_instance_gpu[] (one zero when none) */
     struct sb_buffer emissive;                 /* "emissive": sb_emissive_gpu[] (one zero when none) */
+    uint32_t emissive_count;                   /* the world's emitting materials */
     /* An instanced world's draws, a mesh each: its vertices in its own
      * space and its instances [first_instance, + instance_count). */
     struct sb_draw_group {

@@ -93,6 +93,7 @@ static enum sb_result upload_emissive(struct sb_renderer *r, const struct sb_wor
     struct sb_emissive_gpu *e = r->emissive.mapped;
     if (!res && !world->emissive_count)
         memset(e, 0, sizeof(*e));
+    r->emissive_count = world->emissive_count;
     for (uint32_t i = 0; !res && r->params.no_textures && i < world->emissive_count; i++)
         e[i].radiance[3] = 0.0f;
     return res;

@@ -113,15 +113,16 @@ static enum sb_result create_raster(struct sb_renderer *r, struct scene *s)
     if (key)
         sb_pass_use(r, SB_NO_BINDING, sb_graph_image(r, "key light", &s->key_light), SB_USE_COLOR_TARGET);
     sb_pass_use(r, SB_NO_BINDING, sb_pass_find(r, "depth"), SB_USE_DEPTH_TARGET);
-    /* scene.frag's specialization: what the pack holds */
+    /* scene.frag's specialization: what the pack and the world hold */
     bool generic = r->params.generic_shaders;
-    const VkBool32 has[2] = {generic || r->probe_count > 0, generic || r->reflection_count > 0};
-    const VkSpecializationMapEntry entries[2] = {
-        {.constantID = 0, .offset = 0, .size = sizeof(VkBool32)},
-        {.constantID = 1, .offset = sizeof(VkBool32), .size = sizeof(VkBool32)},
-    };
+    const VkBool32 has[4] = {generic || r->probe_count > 0, generic || r->reflection_count > 0,
+                             generic || r->textures.count > 0, generic || r->emissive_count > 0};
+    VkSpecializationMapEntry entries[4];
+    for (uint32_t i = 0; i < 4; i++)
+        entries[i] =
+            (VkSpecializationMapEntry){.constantID = i, .offset = i * sizeof(VkBool32), .size = sizeof(VkBool32)};
     const VkSpecializationInfo specialization = {
-        .mapEntryCount = 2, .pMapEntries = entries, .dataSize = sizeof(has), .pData = has};
+        .mapEntryCount = 4, .pMapEntries = entries, .dataSize = sizeof(has), .pData = has};
     struct sb_graphics_pipeline_params params = {
         .fragment_specialization = &specialization,
         .vertex_spirv = r->draw_group_count ? sb_spv_scene_vert_instanced : sb_spv_scene_vert,

@@ -32,10 +32,10 @@ void main()
     vec3 albedo = in_albedo;
     vec2 metallic_roughness = in_metallic_roughness;
     vec3 shading_n = n;
-    if (in_images != vec2(0.0) || in_normal_map != 0.0)
+    if (SB_SCENE_TEXTURES && (in_images != vec2(0.0) || in_normal_map != 0.0))
         material_textures(in_uv, footprint, in_images, vec4(in_tangent, in_normal_map), albedo, metallic_roughness,
                           shading_n);
-    vec3 emitted = material_emitted(in_emission, in_uv, footprint);
+    vec3 emitted = SB_SCENE_EMISSION ? material_emitted(in_emission, in_uv, footprint) : vec3(0.0);
     vec3 key_part;
     out_color = scene_shade(in_offset, shading_n, n, albedo, metallic_roughness, emitted,
                             gl_FragCoord.xy / vec2(frame.size.xy), sun_visibility(in_offset, n, true), key_part);
