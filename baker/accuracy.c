@@ -47,8 +47,8 @@ static void evaluate(void *user, int i)
     double *out = ref->values + (size_t)i * ref->channels;
     double r, mu;
     if (ref->id == SB_PRODUCT_TRANSMITTANCE) {
-        double u = ref->lookup ? ref->us[i] : (ref->xs[i] + 0.5) / ref->width;
-        double v = ref->lookup ? ref->vs[i] : (ref->ys[i] + 0.5) / ref->height;
+        double u = ref->lookup ? ref->us[i] : texel_unit(ref->xs[i], ref->width);
+        double v = ref->lookup ? ref->vs[i] : texel_unit(ref->ys[i], ref->height);
         sb_ref_transmittance_geometry(p, u, v, &r, &mu);
         sb_ref_transmittance(p, r, mu, 8, out);
         return;

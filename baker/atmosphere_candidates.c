@@ -51,8 +51,8 @@ static const struct sb_atmosphere_candidate transmittance_sweep[] = {
         .quadrature = SB_QUADRATURE_GAUSS_LEGENDRE, .samples = 8, .subdivisions = 1, .width = w, .height = h           \
     }
 static const struct sb_atmosphere_candidate resolution_sweep[] = {
-    {RES(64, 16), NULL, true},   {RES(128, 32), NULL, true},    {RES(256, 64), NULL, true},
-    {RES(512, 128), NULL, true}, {RES(1024, 256), NULL, false},
+    {RES(40, 25), NULL, true},   {RES(80, 50), NULL, true},   {RES(256, 64), NULL, true},
+    {RES(160, 100), NULL, true}, {RES(320, 200), NULL, true}, {RES(640, 400), NULL, false},
 };
 #define DIRS(m, p)                                                                                                     \
     {                                                                                                                  \

@@ -202,7 +202,7 @@ void sb_ref_transmittance_geometry(const struct sb_atmosphere_params *p, double 
     double rho = H * x_r;
     double r = sqrt(rho * rho + R * R);
     double d_min = top - r, d_max = rho + H;
-    double d = d_min + x_mu * (d_max - d_min);
+    double d = d_max - (1.0 - x_mu) * (1.0 - x_mu) * (d_max - d_min);
     double mu = d == 0.0 ? 1.0 : (H * H - rho * rho - d * d) / (2.0 * r * d);
     *r_out = r;
     *mu_out = fmax(-1.0, fmin(1.0, mu));
@@ -214,7 +214,7 @@ void sb_ref_transmittance_coords(const struct sb_atmosphere_params *p, double r,
     double H = sqrt(top * top - R * R);
     double rho = sqrt(fmax(r * r - R * R, 0.0));
     double d = dist_top(p, r, mu), d_min = top - r, d_max = rho + H;
-    *x_mu = d_max > d_min ? (d - d_min) / (d_max - d_min) : 0.0;
+    *x_mu = d_max > d_min ? 1.0 - sqrt(fmin(fmax((d_max - d) / (d_max - d_min), 0.0), 1.0)) : 0.0;
     *x_r = rho / H;
 }
 
@@ -272,21 +272,28 @@ struct ray_sums {
     double t_end;
 };
 
+/* A texel's optical depth, as the lookup form holds it (physics.h). */
+static double depth_of(float t)
+{
+    return -log(fmax((double)t, 1e-30));
+}
+
 void sb_ref_transmittance_lookup(const struct sb_atmosphere_params *p, const struct sb_image *lut, double r, double mu,
                                  double out[3])
 {
     double x_mu, x_r;
     sb_ref_transmittance_coords(p, r, mu, &x_mu, &x_r);
     int w = (int)lut->width, h = (int)lut->height;
-    double fx = fmin(fmax(x_mu * w - 0.5, 0.0), w - 1.0), fy = fmin(fmax(x_r * h - 0.5, 0.0), h - 1.0);
+    double fx = fmin(fmax(x_mu * (w - 1), 0.0), w - 1.0), fy = fmin(fmax(x_r * (h - 1), 0.0), h - 1.0);
     int x0 = (int)fx < w - 2 ? (int)fx : w - 2, y0 = (int)fy < h - 2 ? (int)fy : h - 2;
     double ax = fx - x0, ay = fy - y0;
     for (int c = 0; c < 3; c++) {
         const float *d = lut->data;
         size_t nc = lut->channel_count;
-        double v00 = d[((size_t)y0 * w + x0) * nc + c], v10 = d[((size_t)y0 * w + x0 + 1) * nc + c];
-        double v01 = d[((size_t)(y0 + 1) * w + x0) * nc + c], v11 = d[((size_t)(y0 + 1) * w + x0 + 1) * nc + c];
-        out[c] = (v00 * (1 - ax) + v10 * ax) * (1 - ay) + (v01 * (1 - ax) + v11 * ax) * ay;
+        double v00 = depth_of(d[((size_t)y0 * w + x0) * nc + c]), v10 = depth_of(d[((size_t)y0 * w + x0 + 1) * nc + c]);
+        double v01 = depth_of(d[((size_t)(y0 + 1) * w + x0) * nc + c]);
+        double v11 = depth_of(d[((size_t)(y0 + 1) * w + x0 + 1) * nc + c]);
+        out[c] = exp(-((v00 * (1 - ax) + v10 * ax) * (1 - ay) + (v01 * (1 - ax) + v11 * ax) * ay));
     }
 }
 

@@ -38,7 +38,8 @@ void sb_ref_optical_depth(const struct sb_atmosphere_params *p, double r, double
                           int subdivisions, double out[3]);
 
 /* (r, mu) at unit coordinates (x_mu, x_r) of the transmittance LUT
- * (Hillaire 2020; texel (x, y) of W x H is at ((x + 0.5) / W, (y + 0.5) / H)). */
+ * (transmittance-subtexel-horizon-v2, docs/pack.md: texel (x, y) of W x H
+ * is at (x / (W - 1), y / (H - 1))). */
 void sb_ref_transmittance_geometry(const struct sb_atmosphere_params *p, double x_mu, double x_r, double *r,
                                    double *mu);
 
@@ -46,7 +47,8 @@ void sb_ref_transmittance_geometry(const struct sb_atmosphere_params *p, double 
 void sb_ref_transmittance_coords(const struct sb_atmosphere_params *p, double r, double mu, double *x_mu, double *x_r);
 
 /* A baked transmittance LUT (any size) read at (r, mu) as the runtime reads
- * it: bilinear between texel centres, clamped at the edges; in fp64. */
+ * it: its optical depth (-ln T, T floored at 1e-30) bilinear between texels,
+ * clamped at the edges, then exp; in fp64. */
 void sb_ref_transmittance_lookup(const struct sb_atmosphere_params *p, const struct sb_image *lut, double r, double mu,
                                  double out[3]);
 

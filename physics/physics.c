@@ -52,6 +52,8 @@ void sb_atmosphere_gpu_pack(const struct sb_atmosphere_params *p, struct sb_atmo
 size_t sb_lookup_float_count(enum sb_product_id id)
 {
     switch (id) {
+    case SB_PRODUCT_TRANSMITTANCE:
+        return (size_t)SB_TRANSMITTANCE_WIDTH * SB_TRANSMITTANCE_HEIGHT * 3;
     case SB_PRODUCT_MULTISCATTERING:
         return (size_t)SB_MULTISCATTERING_LOOKUP_TEXELS * 4;
     case SB_PRODUCT_IRRADIANCE_GROUND:
@@ -68,7 +70,11 @@ static float log_floor(double v)
 
 void sb_lookup_fill(enum sb_product_id id, const struct sb_image *image, float *dst)
 {
-    if (id == SB_PRODUCT_MULTISCATTERING) {
+    if (id == SB_PRODUCT_TRANSMITTANCE) {
+        size_t n = (size_t)image->width * image->height * 3;
+        for (size_t i = 0; i < n; i++)
+            dst[i] = -log_floor(image->data[i]);
+    } else if (id == SB_PRODUCT_MULTISCATTERING) {
         int n = SB_MULTISCATTERING_SIZE;
         for (int j = -1; j <= n; j++)
             for (int i = -1; i <= n; i++) {

@@ -29,6 +29,9 @@ int sb_atmosphere_levels(const struct sb_atmosphere_params *params, double level
 
 /*
  * The lookup form of a baked product (config.h), which shaders read:
+ * - transmittance: its optical depth, -ln(max(T, 1e-30)) per texel and
+ *   channel, in the LUT's layout (transmittance_lut_sample interpolates it
+ *   and takes one exponential);
  * - multiscattering: ln(max(psi, 1e-30)) per texel and channel, padded to
  *   four floats a texel (the fourth 0), with a ghost texel on every side
  *   repeating the edge (SB_MULTISCATTERING_LOOKUP_TEXELS texels, rows of

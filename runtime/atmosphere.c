@@ -69,9 +69,16 @@ enum sb_result sb_atmosphere_upload(struct sb_renderer *r, const struct sb_pack 
     const struct sb_image *t = &pack->images[SB_PRODUCT_TRANSMITTANCE];
     enum sb_result res = sb_renderer_upload(r, &gpu, sizeof(gpu), "atmosphere parameters", &r->atmosphere);
     /* Each as RGBA32F (atmosphere.glsl, SB_ATMOSPHERE_TEXTURES): the
-     * transmittance LUT; psi_ms refined; the ground irradiance's lookup form. */
-    if (!res)
-        res = upload_rgba32f(r, t->data, t->channel_count, t->width, t->height, "transmittance", &r->transmittance);
+     * transmittance LUT's and the ground irradiance's lookup forms; psi_ms
+     * refined. */
+    float *depth = res ? NULL : malloc(sb_lookup_float_count(SB_PRODUCT_TRANSMITTANCE) * sizeof(float));
+    if (!res && !depth)
+        res = SB_ERR_NOMEM;
+    if (!res) {
+        sb_lookup_fill(SB_PRODUCT_TRANSMITTANCE, t, depth);
+        res = upload_rgba32f(r, depth, 3, t->width, t->height, "transmittance (optical depth)", &r->transmittance);
+    }
+    free(depth);
     float *refined = res ? NULL : malloc(sb_multiscattering_refined_float_count() * sizeof(float));
     if (!res && !refined)
         res = SB_ERR_NOMEM;

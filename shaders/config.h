@@ -125,8 +125,8 @@
 #define SB_RINGS_COLUMN (SB_RINGS_ROWS * SB_RINGS_ANGLES + SB_RINGS_GROUND)
 
 /* Product sizes and channel counts of format version 1. */
-#define SB_TRANSMITTANCE_WIDTH 256
-#define SB_TRANSMITTANCE_HEIGHT 64
+#define SB_TRANSMITTANCE_WIDTH 160 /* 256 x 64 before the mapping of transmittance-subtexel-horizon-v2: 2% fewer texels */
+#define SB_TRANSMITTANCE_HEIGHT 100
 #define SB_TRANSMITTANCE_CHANNELS 3
 #define SB_MULTISCATTERING_SIZE 32
 #define SB_MULTISCATTERING_CHANNELS 3

@@ -38,7 +38,7 @@ check "naming the helper and SKYBAKE_LIBEXEC_DIR" grep -q "cannot find the helpe
 for kind in shared static; do
     check "the $kind example loads the pack" expect_exit 0 env LD_LIBRARY_PATH="$build/formats" \
         SKYBAKE_LIBEXEC_DIR="$([ $kind = static ] && echo "$build/formats")" "$tmp/example_$kind" "$tmp/pack"
-    check "the $kind example reads the transmittance" grep -q "^transmittance 256x64x1 x3 first value 0\.[0-9]* hash $hash" "$tmp/out"
+    check "the $kind example reads the transmittance" grep -q "^transmittance 160x100x1 x3 first value 0\.[0-9]* hash $hash" "$tmp/out"
     check "the $kind example reads the volume (OpenVDB)" grep -q "^cloud_detail 16x16x16 x3 first value 0\.[0-9]* hash $volume_hash" "$tmp/out"
 done
 echo x >"$tmp/pack/stray"

@@ -20,13 +20,13 @@ void main()
     uvec2 texel = gl_GlobalInvocationID.xy;
     if (texel.x >= pc.width || texel.y >= pc.height)
         return;
-    float rho, e;
-    transmittance_unit_ray((vec2(texel) + 0.5) / vec2(pc.width, pc.height), rho, e);
+    /* texel i of n at i / (n - 1) */
+    uvec2 last = uvec2(pc.width, pc.height) - 1u;
+    TransmittanceRay ray = transmittance_unit_ray_split(vec2(texel) / vec2(last), vec2(last - texel) / vec2(last));
 #if SB_GL_ORDER > 0
-    vec3 tau = optical_depth_to_top_gl(rho, e, int(pc.subdivisions));
+    vec3 tau = optical_depth_to_top_gl(ray, int(pc.subdivisions));
 #else
-    vec3 tau = optical_depth_to_top_uniform(rho, e, int(pc.samples),
-                                            pc.quadrature == SB_QUADRATURE_UNIFORM_0_3 ? 0.3 : 0.5,
+    vec3 tau = optical_depth_to_top_uniform(ray, int(pc.samples), pc.quadrature == SB_QUADRATURE_UNIFORM_0_3 ? 0.3 : 0.5,
                                             pc.quadrature == SB_QUADRATURE_TRAPEZOID);
 #endif
     vec3 t = exp(-tau);

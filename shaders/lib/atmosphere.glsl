@@ -283,25 +283,69 @@ vec3 path_segment_depth(float hb, float rb, float sb, float t0, float t1, int su
 }
 
 /*
- * The ray of the transmittance LUT given rho (horizon distance of its
- * origin) and e = d_max - d, as an ascending path: a downward ray is folded
- * at its tangent point, whose altitude hb, radius rb it starts from (sb = 0)
- * after running `fold` down to it; an upward ray starts at its origin (fold
- * 0, sb = r mu). Returns the path's length above the base, t_end; the ray's
+ * A ray from inside the atmosphere to its top, as the transmittance
+ * quadrature takes it: rho, its origin's horizon distance; g = H - rho
+ * (H^2 - rho^2 = top^2 - r^2 = g (H + rho)); d, its length; and e = d_max -
+ * d, d_max = rho + H being the horizon ray's. Each is computed where it
+ * does not cancel: d and e are both kept because near the horizon d is
+ * nearly d_max (only e holds the ray's place), and for a short ray from the
+ * top e is nearly d_max (only d does; the top row of the LUT, where a
+ * 28 km ray had lost 4 m of its fold from e alone).
+ */
+struct TransmittanceRay {
+    float rho, g, d, e;
+};
+
+/* The ray from altitude h with view cosine mu (missing the ground). */
+TransmittanceRay transmittance_ray(float h, float mu)
+{
+    TransmittanceRay ray;
+    float H = horizon_top(), r = ground_radius() + h, s = r * mu;
+    ray.rho = horizon_distance(h);
+    float above = max(atmosphere_thickness() - h, 0.0) * (top_radius() + r); /* top^2 - r^2 */
+    ray.g = above / (H + ray.rho);
+    ray.d = distance_to_top(h, mu);
+    /* with d + s = sqrt(s^2 + H^2 - rho^2): (rho + H + s)^2 - (d + s)^2 =
+     * 2 (rho + H)(rho + s), and rho + s >= 0 on the rays that miss the ground */
+    ray.e = 2.0 * (ray.rho + H) * max(ray.rho + s, 0.0) / (ray.rho + H + s + sqrt(s * s + above));
+    return ray;
+}
+
+/* r mu at the ray's origin, from top^2 = r^2 + 2 r mu d + d^2: in e where
+ * e is the shorter (its terms cancel least there), else in d. */
+float transmittance_ray_s0(TransmittanceRay ray)
+{
+    float H = horizon_top(), rho = ray.rho;
+    float num = ray.e < ray.d ? (2.0 * (H + rho)) * (ray.e - rho) - ray.e * ray.e : ray.g * (H + rho) - ray.d * ray.d;
+    return num / (2.0 * ray.d);
+}
+
+/* top - r, the shortest ray's length (looking up). */
+float transmittance_ray_d_min(TransmittanceRay ray)
+{
+    float R = ground_radius(), H = horizon_top();
+    return ray.g * (H + ray.rho) / (top_radius() + sqrt(ray.rho * ray.rho + R * R));
+}
+
+/*
+ * A transmittance ray as an ascending path: a downward ray is folded at its
+ * tangent point, whose altitude hb, radius rb it starts from (sb = 0) after
+ * running `fold` down to it; an upward ray starts at its origin (fold 0, sb
+ * = r mu). Returns the path's length above the base, t_end; the ray's
  * length is fold + t_end. Returns -1 for an empty ray (at the top, looking
  * along it or up).
  */
-float transmittance_path(float rho, float e, out float hb, out float rb, out float sb, out float fold)
+float transmittance_path(TransmittanceRay ray, out float hb, out float rb, out float sb, out float fold)
 {
     float R = ground_radius(), H = horizon_top();
+    float rho = ray.rho, d = ray.d, e = ray.e;
     float r = sqrt(rho * rho + R * R);
-    float d = rho + H - e;
     hb = rb = sb = fold = 0.0;
     if (d <= 0.0)
         return -1.0;
-    float s0 = ((2.0 * (H + rho)) * (e - rho) - e * e) / (2.0 * d); /* r mu */
+    float s0 = transmittance_ray_s0(ray);
     if (s0 < 0.0) {
-        float del = e * (2.0 * H - e) / (2.0 * d); /* rho + s0, exactly */
+        float del = e * (ray.g + d) / (2.0 * d); /* rho + s0, exactly: (2H - e) e / (2d), 2H - e = g + d */
         float q = max((2.0 * rho - del) * del, 0.0); /* r_min^2 - R^2 */
         rb = sqrt(R * R + q);
         hb = q / (rb + R);
@@ -345,10 +389,10 @@ float next_boundary(float a)
  * `subdivisions` sub-pieces. On the earth the defaults (8, 1) take at most
  * 40 density samples (five pieces).
  */
-vec3 optical_depth_to_top_gl(float rho, float e, int subdivisions)
+vec3 optical_depth_to_top_gl(TransmittanceRay ray, int subdivisions)
 {
     float hb, rb, sb, fold;
-    float t_end = transmittance_path(rho, e, hb, rb, sb, fold);
+    float t_end = transmittance_path(ray, hb, rb, sb, fold);
     if (t_end < 0.0)
         return vec3(0.0);
 
@@ -375,9 +419,9 @@ vec3 optical_depth_to_top_gl(float rho, float e, int subdivisions)
     return tau;
 }
 
-vec3 optical_depth_to_top(float rho, float e)
+vec3 optical_depth_to_top(TransmittanceRay ray)
 {
-    return optical_depth_to_top_gl(rho, e, 1);
+    return optical_depth_to_top_gl(ray, 1);
 }
 
 /*
@@ -388,10 +432,10 @@ vec3 optical_depth_to_top(float rho, float e)
  * steps). Positions come from the same folded path, so only the quadrature
  * differs from optical_depth_to_top_gl.
  */
-vec3 optical_depth_to_top_uniform(float rho, float e, int steps, float offset, bool trapezoid)
+vec3 optical_depth_to_top_uniform(TransmittanceRay ray, int steps, float offset, bool trapezoid)
 {
     float hb, rb, sb, fold;
-    float t_end = transmittance_path(rho, e, hb, rb, sb, fold);
+    float t_end = transmittance_path(ray, hb, rb, sb, fold);
     if (t_end < 0.0)
         return vec3(0.0);
     float length_ = fold + t_end, dt = length_ / float(steps);
@@ -406,52 +450,62 @@ vec3 optical_depth_to_top_uniform(float rho, float e, int steps, float offset, b
 }
 
 /* The transmittance LUT's coordinates in unit range for a point and direction
- * whose ray does not hit the ground. */
+ * whose ray does not hit the ground: x_r = rho / H (Bruneton's), and x_mu =
+ * 1 - sqrt((d_max - d) / (d_max - d_min)), which crowds the texels toward
+ * the horizon (x_mu = 1), where the optical depth climbs fastest: Bruneton's
+ * linear x_mu = (d - d_min) / (d_max - d_min) left the 256 x 64 LUT 3.7e-2
+ * off between texels there, this 1.1e-2 (docs/accuracy.md). */
 vec2 transmittance_unit_coords(float h, float mu)
 {
-    float rho = horizon_distance(h);
-    float d = distance_to_top(h, mu);
-    float d_min = atmosphere_thickness() - h;
-    float d_max = rho + horizon_top();
-    float x_mu = (d - d_min) / max(d_max - d_min, 1e-30);
-    return vec2(x_mu, rho / horizon_top());
+    TransmittanceRay ray = transmittance_ray(h, mu);
+    float H = horizon_top();
+    float span = ray.rho + H - transmittance_ray_d_min(ray); /* d_max - d_min */
+    float x_mu = 1.0 - sqrt(clamp(ray.e / max(span, 1e-30), 0.0, 1.0));
+    return vec2(x_mu, ray.rho / H);
 }
 
-/* The ray of the transmittance LUT at unit coordinates x, as the quadrature
- * takes it: rho and e = d_max - d. */
-void transmittance_unit_ray(vec2 x, out float rho, out float e)
+/* The ray of the transmittance LUT at unit coordinates x, given with their
+ * complements xc = 1 - x: e = xc_mu^2 (d_max - d_min), d = d_min + x_mu (1
+ * + xc_mu) (d_max - d_min), rho = H x_r, g = H xc_r. A texel's complements
+ * come exact from its integers: 1 - x rounded from a rounded x lost up to
+ * 2.4e-6 of 1 - x_mu at the LUT's last columns, and that much of e moved a
+ * grazing ray's optical depth by 1.3e-5 in the thick atmosphere. */
+TransmittanceRay transmittance_unit_ray_split(vec2 x, vec2 xc)
 {
-    float R = ground_radius(), H = horizon_top();
-    rho = H * x.y;
-    float r = sqrt(rho * rho + R * R);
-    float h = rho * rho / (r + R);
-    /* d_max - d_min = rho + H - (top - r), with top - r = thickness - h */
-    e = (1.0 - x.x) * (rho + H - (atmosphere_thickness() - h));
+    TransmittanceRay ray;
+    float H = horizon_top();
+    ray.rho = H * x.y;
+    ray.g = H * xc.y;
+    float d_min = transmittance_ray_d_min(ray), span = ray.rho + H - d_min;
+    ray.e = xc.x * xc.x * span;
+    ray.d = d_min + x.x * (1.0 + xc.x) * span;
+    return ray;
+}
+
+TransmittanceRay transmittance_unit_ray(vec2 x)
+{
+    return transmittance_unit_ray_split(x, 1.0 - x);
 }
 
 /* The same ray as altitude and view cosine (the inverse of transmittance_unit_coords). */
 void transmittance_unit_geometry(vec2 x, out float h, out float mu)
 {
-    float rho, e;
-    transmittance_unit_ray(x, rho, e);
+    TransmittanceRay ray = transmittance_unit_ray(x);
     float R = ground_radius(), H = horizon_top();
-    float r = sqrt(rho * rho + R * R);
-    float d = rho + H - e;
-    h = rho * rho / (r + R);
-    mu = d > 0.0 ? clamp(((2.0 * (H + rho)) * (e - rho) - e * e) / (2.0 * d * r), -1.0, 1.0) : 1.0;
+    float r = sqrt(ray.rho * ray.rho + R * R);
+    h = ray.rho * ray.rho / (r + R);
+    mu = ray.d > 0.0 ? clamp(transmittance_ray_s0(ray) / r, -1.0, 1.0) : 1.0;
 }
 
 /* Exact transmittance to the top by the quadrature above. */
 vec3 transmittance_to_top(float h, float mu)
 {
-    float rho = horizon_distance(h);
-    float e = rho + horizon_top() - distance_to_top(h, mu);
-    return exp(-optical_depth_to_top(rho, max(e, 0.0)));
+    return exp(-optical_depth_to_top(transmittance_ray(h, mu)));
 }
 
-/* Texel (x, y) of the transmittance LUT: skyview's texture, or the bakes'
- * interleaved buffer. */
-vec3 transmittance_texel(int x, int y)
+/* The optical depth at texel (x, y) of the transmittance LUT, its lookup
+ * form (physics.h): skyview's texture, or the bakes' interleaved buffer. */
+vec3 transmittance_depth_texel(int x, int y)
 {
 #ifdef SB_ATMOSPHERE_TEXTURES
     return texelFetch(transmittance_texture, ivec2(x, y), 0).rgb;
@@ -461,15 +515,20 @@ vec3 transmittance_texel(int x, int y)
 #endif
 }
 
-/* The transmittance LUT read bilinearly, its texel centres at (i + 0.5) / size. */
+/* The transmittance LUT read bilinearly in its optical depth (then one
+ * exponential), texel i of n at i / (n - 1): the first and last on the
+ * domain's edges, the horizon and the ground among them. Bilinear in T
+ * itself, which falls exponentially toward the horizon, was 3.3e-2 off
+ * between texels where this is 5.8e-3 (docs/accuracy.md). */
 vec3 transmittance_lut_sample(float h, float mu)
 {
     const ivec2 size = ivec2(SB_TRANSMITTANCE_WIDTH, SB_TRANSMITTANCE_HEIGHT);
-    vec2 s = clamp(transmittance_unit_coords(h, mu) * vec2(size) - 0.5, vec2(0.0), vec2(size - 1));
+    vec2 s = clamp(transmittance_unit_coords(h, mu) * vec2(size - 1), vec2(0.0), vec2(size - 1));
     ivec2 i = min(ivec2(s), size - 2);
     vec2 a = s - vec2(i);
-    return mix(mix(transmittance_texel(i.x, i.y), transmittance_texel(i.x + 1, i.y), a.x),
-               mix(transmittance_texel(i.x, i.y + 1), transmittance_texel(i.x + 1, i.y + 1), a.x), a.y);
+    return exp(-mix(mix(transmittance_depth_texel(i.x, i.y), transmittance_depth_texel(i.x + 1, i.y), a.x),
+                    mix(transmittance_depth_texel(i.x, i.y + 1), transmittance_depth_texel(i.x + 1, i.y + 1), a.x),
+                    a.y));
 }
 
 /* ---- Multiple-scattering LUT and irradiance LUTs -------------------------------- */
