@@ -594,8 +594,9 @@ static enum sb_result read_artifact_entry(const cJSON *entry, int index, struct 
         return SB_ERR_UNSAFE_PATH;
     }
     if (strcmp(a->parameterization, format->parameterization) != 0) {
-        sb_error("%s: %sparameterization: \"%s\", but %s is \"%s\"", source, where, a->parameterization, name,
-                 format->parameterization);
+        sb_error("%s: %sparameterization: \"%s\", but this build's %s is \"%s\" (docs/pack.md): bake the pack "
+                 "again",
+                 source, where, a->parameterization, name, format->parameterization);
         return SB_ERR_BAD_IMAGE;
     }
     if (!scene && !format->width) {

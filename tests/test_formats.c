@@ -802,6 +802,11 @@ static void edit_width(cJSON *r)
 {
     cJSON_ReplaceItemInObject(artifact(r, 0), "width", cJSON_CreateNumber(255));
 }
+/* a pack baked before the transmittance's mapping changed (docs/pack.md) */
+static void edit_old_mapping(cJSON *r)
+{
+    set_string(artifact(r, 0), "parameterization", "transmittance-hillaire2020-v1");
+}
 static void edit_huge(cJSON *r)
 {
     cJSON_ReplaceItemInObject(artifact(r, 0), "height", cJSON_CreateNumber(1e12));
@@ -985,6 +990,7 @@ static void test_pack_reader(void)
         {"volume's pixel type", edit_volume_pixel_type, NULL, SB_ERR_BAD_IMAGE, false},
         {"scene's cloud size edited", edit_cloud_size, NULL, SB_ERR_BAD_IMAGE, false},
         {"width differs from the product's", edit_width, NULL, SB_ERR_BAD_IMAGE, false},
+        {"the transmittance's mapping before v2", edit_old_mapping, NULL, SB_ERR_BAD_IMAGE, false},
         {"absurd height", edit_huge, NULL, SB_ERR_BAD_IMAGE, false},
         {"channels of the wrong type", edit_channels, NULL, SB_ERR_WRONG_TYPE, false},
         {"pixel type", edit_pixel_type, NULL, SB_ERR_BAD_IMAGE, false},
