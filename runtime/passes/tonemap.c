@@ -5,6 +5,8 @@
 #include "renderer_internal.h"
 
 #include "tonemap.spv.h"
+#include "tonemap_aces.spv.h"
+#include "tonemap_gt.spv.h"
 
 static enum sb_result tonemap_create(struct sb_renderer *r)
 {
@@ -16,7 +18,12 @@ static enum sb_result tonemap_create(struct sb_renderer *r)
     sb_pass_sample(r, SB_VIEW_BINDING_BLOOM, bloom, NULL);
     sb_pass_set_view(r, 0, SB_VIEW_BINDING_BLOOM, chain->subview_count ? chain->subviews[0] : chain->view);
     sb_pass_use(r, SB_VIEW_BINDING_LDR, sb_pass_find(r, "ldr"), SB_USE_STORE);
-    return sb_pass_frame_kernel(r, sb_spv_tonemap, sizeof(sb_spv_tonemap), "tonemap");
+    /* the renderer's curve, built alone (tonemap.comp) */
+    if (r->params.tonemap == SB_TONEMAP_ACES)
+        return sb_pass_frame_kernel(r, sb_spv_tonemap_aces, sizeof(sb_spv_tonemap_aces), "tonemap (ACES)");
+    if (r->params.tonemap == SB_TONEMAP_GT)
+        return sb_pass_frame_kernel(r, sb_spv_tonemap_gt, sizeof(sb_spv_tonemap_gt), "tonemap (GT)");
+    return sb_pass_frame_kernel(r, sb_spv_tonemap, sizeof(sb_spv_tonemap), "tonemap (AgX)");
 }
 
 const struct sb_pass_class sb_pass_tonemap = {

@@ -7,9 +7,15 @@
  * - ACES: Hill's fit of the RRT + sRGB ODT (input matrix, rational curve,
  *   output matrix).
  * - GT (Uchimura 2017): toe, linear section, shoulder; defaults P = 1, a = 1,
- *   m = 0.22, l = 0.4, c = 1.33, b = 0. */
+ *   m = 0.22, l = 0.4, c = 1.33, b = 0.
+ * Built once a curve (SB_TONEMAP_OP, AgX by default; passes/tonemap.c
+ * dispatches the renderer's): llvmpipe runs the code of every arm of a
+ * choice made at run time (the pass 5.0 -> 3.8 ms at 640 x 360). */
 #extension GL_GOOGLE_include_directive : require
 #include "view_gpu.h"
+#ifndef SB_TONEMAP_OP
+#define SB_TONEMAP_OP SB_TONEMAP_AGX
+#endif
 
 layout(local_size_x = SB_WORKGROUP_X, local_size_y = SB_WORKGROUP_Y) in;
 #include "frame.glsl"
@@ -79,7 +85,6 @@ void main()
         vec2 uv = (vec2(pixel) + 0.5) / vec2(frame.size.xy);
         c += textureLod(bloom, uv, 0.0).rgb * (frame.post.y / float(frame.size.z));
     }
-    uint op = uint(frame.post.w);
-    c = op == SB_TONEMAP_ACES ? aces(c) : (op == SB_TONEMAP_GT ? gt(c) : agx(c));
+    c = SB_TONEMAP_OP == SB_TONEMAP_ACES ? aces(c) : (SB_TONEMAP_OP == SB_TONEMAP_GT ? gt(c) : agx(c));
     imageStore(ldr, pixel, vec4(srgb_encode(c), 1.0));
 }
