@@ -2,110 +2,21 @@
  * Colour grading's science, for two passes (passes/grade_linear.c on the
  * exposed scene-linear frame, passes/grade.c on the display-referred one):
  * white balance along the Planckian locus, saturation, contrast, the
- * matrices to and from ACES AP1, made here in double precision; and the
- * LUT as the shaders read it (lut3d.glsl).
+ * matrices to and from ACES AP1 (physics/colour.h), in double precision;
+ * and the LUT as the shaders read it (lut3d.glsl).
  */
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
 
+#include "colour.h"
 #include "grading_gpu.h"
 #include "lut3d.h"
 #include "renderer_internal.h"
 
 typedef double mat3[3][3];
 
-static void mul3(const mat3 a, const mat3 b, mat3 out)
-{
-    mat3 t;
-    for (int i = 0; i < 3; i++)
-        for (int j = 0; j < 3; j++)
-            t[i][j] = a[i][0] * b[0][j] + a[i][1] * b[1][j] + a[i][2] * b[2][j];
-    memcpy(out, t, sizeof(t));
-}
-
-static void apply3(const mat3 m, const double v[3], double out[3])
-{
-    double t[3];
-    for (int i = 0; i < 3; i++)
-        t[i] = m[i][0] * v[0] + m[i][1] * v[1] + m[i][2] * v[2];
-    memcpy(out, t, sizeof(t));
-}
-
-static void invert3(const mat3 m, mat3 out)
-{
-    double c00 = m[1][1] * m[2][2] - m[1][2] * m[2][1], c01 = m[1][2] * m[2][0] - m[1][0] * m[2][2],
-           c02 = m[1][0] * m[2][1] - m[1][1] * m[2][0];
-    double det = m[0][0] * c00 + m[0][1] * c01 + m[0][2] * c02;
-    mat3 t = {
-        {c00 / det, (m[0][2] * m[2][1] - m[0][1] * m[2][2]) / det, (m[0][1] * m[1][2] - m[0][2] * m[1][1]) / det},
-        {c01 / det, (m[0][0] * m[2][2] - m[0][2] * m[2][0]) / det, (m[0][2] * m[1][0] - m[0][0] * m[1][2]) / det},
-        {c02 / det, (m[0][1] * m[2][0] - m[0][0] * m[2][1]) / det, (m[0][0] * m[1][1] - m[0][1] * m[1][0]) / det},
-    };
-    memcpy(out, t, sizeof(t));
-}
-
-static void xy_to_xyz(const double xy[2], double xyz[3])
-{
-    xyz[0] = xy[0] / xy[1];
-    xyz[1] = 1.0;
-    xyz[2] = (1.0 - xy[0] - xy[1]) / xy[1];
-}
-
-/* RGB to XYZ for primaries r, g, b and white w (CIE 1931 xy): the
- * primaries' XYZ columns, each scaled so that RGB (1, 1, 1) is w at Y = 1. */
-static void rgb_to_xyz(const double p[4][2], mat3 out)
-{
-    mat3 m;
-    for (int j = 0; j < 3; j++) {
-        double c[3];
-        xy_to_xyz(p[j], c);
-        for (int i = 0; i < 3; i++)
-            m[i][j] = c[i];
-    }
-    mat3 inv;
-    invert3(m, inv);
-    double w[3], s[3];
-    xy_to_xyz(p[3], w);
-    apply3(inv, w, s);
-    for (int i = 0; i < 3; i++)
-        for (int j = 0; j < 3; j++)
-            out[i][j] = m[i][j] * s[j];
-}
-
-static const double rec709[4][2] = {{0.64, 0.33}, {0.30, 0.60}, {0.15, 0.06}, {0.3127, 0.3290}};
-static const double ap1[4][2] = {{0.713, 0.293}, {0.165, 0.830}, {0.128, 0.044}, {0.32168, 0.33767}};
-
-/* Bradford's von Kries adaptation of XYZ from white `from` to `to` (xy). */
-static void bradford(const double from[2], const double to[2], mat3 out)
-{
-    static const mat3 b = {{0.8951, 0.2664, -0.1614}, {-0.7502, 1.7135, 0.0367}, {0.0389, -0.0685, 1.0296}};
-    double wf[3], wt[3], lf[3], lt[3];
-    xy_to_xyz(from, wf);
-    xy_to_xyz(to, wt);
-    apply3(b, wf, lf);
-    apply3(b, wt, lt);
-    mat3 d = {{lt[0] / lf[0], 0, 0}, {0, lt[1] / lf[1], 0}, {0, 0, lt[2] / lf[2]}}, inv;
-    invert3(b, inv);
-    mul3(d, b, out);
-    mul3(inv, out, out);
-}
-
-void sb_rec709_to_xyz(double m[3][3])
-{
-    rgb_to_xyz(rec709, m);
-}
-
-void sb_rec709_to_ap1(double m[3][3])
-{
-    mat3 to_xyz, ap1_to_xyz, from_xyz, cat;
-    rgb_to_xyz(rec709, to_xyz);
-    rgb_to_xyz(ap1, ap1_to_xyz);
-    invert3(ap1_to_xyz, from_xyz);
-    bradford(rec709[3], ap1[3], cat);
-    mul3(cat, to_xyz, m);
-    mul3(from_xyz, m, m);
-}
+static const double rec709[4][2] = {SB_REC709_PRIMARIES};
 
 /* The Planckian locus in CIE 1960 uv (Krystek 1985, 1000 to 15000 K). */
 static void planck_uv(double t, double uv[2])
@@ -165,17 +76,17 @@ void sb_grading_matrix(const struct sb_grading *g, double m[3][3])
     mat3 to_xyz, from_xyz, cat, wb;
     double white[2];
     sb_grading_white(g->white_balance_k, g->tint, white);
-    rgb_to_xyz(rec709, to_xyz);
-    invert3(to_xyz, from_xyz);
-    bradford(white, rec709[3], cat);
-    mul3(cat, to_xyz, wb);
-    mul3(from_xyz, wb, wb);
+    sb_primaries_to_xyz(rec709, to_xyz);
+    sb_mat3_invert(to_xyz, from_xyz);
+    sb_bradford(white, rec709[3], cat);
+    sb_mat3_mul(cat, to_xyz, wb);
+    sb_mat3_mul(from_xyz, wb, wb);
     /* saturation about Y: s I + (1 - s) 1 w^T, w the luminance row */
     mat3 sat;
     for (int i = 0; i < 3; i++)
         for (int j = 0; j < 3; j++)
             sat[i][j] = (1.0 - g->saturation) * to_xyz[1][j] + (i == j ? g->saturation : 0.0);
-    mul3(sat, wb, m);
+    sb_mat3_mul(sat, wb, m);
 }
 
 bool sb_grading_is_neutral(const struct sb_grading *g)
@@ -201,7 +112,7 @@ void sb_grading_gpu_fill(const struct sb_grading *grading, struct sb_grading_gpu
     gpu->tone[0] = neutral ? 1.0f : (float)grading->contrast;
     gpu->tone[1] = 0.18f;
     sb_rec709_to_ap1(m);
-    invert3(m, inv);
+    sb_mat3_invert(m, inv);
     store_rows(m, gpu->to_ap1);
     store_rows(inv, gpu->from_ap1);
 }

@@ -121,9 +121,7 @@ void sb_grading_white(double kelvin, double tint, double xy[2]);
 bool sb_grading_is_neutral(const struct sb_grading *grading);
 /* The Planckian locus (CIE 1931 xy; Krystek's approximation, 1000 to 15000 K). */
 void sb_planckian_xy(double kelvin, double xy[2]);
-/* Linear Rec.709 to CIE XYZ, and to ACES AP1 (D65 to D60 by Bradford); rows. */
-void sb_rec709_to_xyz(double m[3][3]);
-void sb_rec709_to_ap1(double m[3][3]);
+/* Linear Rec.709 to CIE XYZ and to ACES AP1: physics/colour.h. */
 
 /* The fog's and clouds' history is dropped when the sun moves more than
  * this between two frames (degrees): their lighting would lag behind it. */

@@ -15,6 +15,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "colour.h"
 #include "harness_view.h"
 #include "harness_vk.h"
 #include "log.h"
