@@ -94,3 +94,66 @@ void sb_rec709_to_ap1(mat3 m)
     sb_mat3_mul(cat, to_xyz, m);
     sb_mat3_mul(from_xyz, m, m);
 }
+
+/* CIELAB's f: a cube root above (6/29)^3, a line below. */
+static double lab_f(double t)
+{
+    const double d = 6.0 / 29.0;
+    return t > d * d * d ? cbrt(t) : t / (3.0 * d * d) + 4.0 / 29.0;
+}
+
+void sb_xyz_to_lab(const double xyz[3], const double white[3], double lab[3])
+{
+    double fx = lab_f(xyz[0] / white[0]), fy = lab_f(xyz[1] / white[1]), fz = lab_f(xyz[2] / white[2]);
+    lab[0] = 116.0 * fy - 16.0;
+    lab[1] = 500.0 * (fx - fy);
+    lab[2] = 200.0 * (fy - fz);
+}
+
+/* A hue angle in degrees, [0, 360); 0 for a neutral colour. */
+static double hue_deg(double b, double a)
+{
+    if (a == 0.0 && b == 0.0)
+        return 0.0;
+    double h = atan2(b, a) * (180.0 / M_PI);
+    return h < 0.0 ? h + 360.0 : h;
+}
+
+double sb_ciede2000(const double lab1[3], const double lab2[3])
+{
+    const double deg = M_PI / 180.0, pow25_7 = 6103515625.0; /* 25^7 */
+    double c1 = hypot(lab1[1], lab1[2]), c2 = hypot(lab2[1], lab2[2]);
+    double c_mean = 0.5 * (c1 + c2), c7 = pow(c_mean, 7.0);
+    double g = 0.5 * (1.0 - sqrt(c7 / (c7 + pow25_7)));
+    double a1 = (1.0 + g) * lab1[1], a2 = (1.0 + g) * lab2[1];
+    double cp1 = hypot(a1, lab1[2]), cp2 = hypot(a2, lab2[2]);
+    double hp1 = hue_deg(lab1[2], a1), hp2 = hue_deg(lab2[2], a2);
+
+    double dl = lab2[0] - lab1[0], dc = cp2 - cp1, dh = 0.0;
+    if (cp1 * cp2 != 0.0) {
+        dh = hp2 - hp1;
+        if (dh > 180.0)
+            dh -= 360.0;
+        else if (dh < -180.0)
+            dh += 360.0;
+    }
+    double dH = 2.0 * sqrt(cp1 * cp2) * sin(0.5 * dh * deg);
+
+    double l_mean = 0.5 * (lab1[0] + lab2[0]), cp_mean = 0.5 * (cp1 + cp2), hp_mean = hp1 + hp2;
+    if (cp1 * cp2 != 0.0) {
+        if (fabs(hp1 - hp2) <= 180.0)
+            hp_mean *= 0.5;
+        else
+            hp_mean = hp_mean < 360.0 ? 0.5 * (hp_mean + 360.0) : 0.5 * (hp_mean - 360.0);
+    }
+    double t = 1.0 - 0.17 * cos((hp_mean - 30.0) * deg) + 0.24 * cos(2.0 * hp_mean * deg) +
+               0.32 * cos((3.0 * hp_mean + 6.0) * deg) - 0.20 * cos((4.0 * hp_mean - 63.0) * deg);
+    double d_theta = 30.0 * exp(-((hp_mean - 275.0) / 25.0) * ((hp_mean - 275.0) / 25.0));
+    double cp7 = pow(cp_mean, 7.0);
+    double r_c = 2.0 * sqrt(cp7 / (cp7 + pow25_7));
+    double l50 = (l_mean - 50.0) * (l_mean - 50.0);
+    double s_l = 1.0 + 0.015 * l50 / sqrt(20.0 + l50), s_c = 1.0 + 0.045 * cp_mean, s_h = 1.0 + 0.015 * cp_mean * t;
+    double r_t = -sin(2.0 * d_theta * deg) * r_c;
+    double tl = dl / s_l, tc = dc / s_c, th = dH / s_h;
+    return sqrt(tl * tl + tc * tc + th * th + r_t * tc * th);
+}

@@ -1,7 +1,8 @@
 /*
  * Colour science in fp64, for the runtime's grading and the baker's colour
  * measurements: 3 x 3 matrices, RGB spaces from their primaries, Bradford's
- * chromatic adaptation. Pure functions, thread safe.
+ * chromatic adaptation, CIELAB and the CIEDE2000 colour difference. Pure
+ * functions, thread safe.
  */
 #ifndef SB_PHYSICS_COLOUR_H
 #define SB_PHYSICS_COLOUR_H
@@ -31,5 +32,13 @@ void sb_bradford(const double from[2], const double to[2], double out[3][3]);
 /* Linear Rec.709 to XYZ (D65); to ACES AP1 (its white, Bradford-adapted). */
 void sb_rec709_to_xyz(double m[3][3]);
 void sb_rec709_to_ap1(double m[3][3]);
+
+/* CIELAB of XYZ against the reference white `white` (XYZ, its Y the
+ * luminance that is L* = 100). */
+void sb_xyz_to_lab(const double xyz[3], const double white[3], double lab[3]);
+
+/* The CIEDE2000 difference between two CIELAB colours (Sharma, Wu and
+ * Dalal 2005, with k_L = k_C = k_H = 1). */
+double sb_ciede2000(const double lab1[3], const double lab2[3]);
 
 #endif
