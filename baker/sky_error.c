@@ -8,6 +8,7 @@
 
 #include "atmosphere.h"
 #include "atmosphere_ref.h"
+#include "colour.h"
 #include "json.h"
 #include "log.h"
 #include "parallel.h"
@@ -81,6 +82,52 @@ static void run_one(void *user, int index)
     dir->std_error[channel] = traced.std_error;
 }
 
+/* A view's rgb as CIELAB (sb_sky_error_sun's colour fields). */
+static void view_lab(const double m[3][3], const double white[3], const double rgb[3], double lab[3])
+{
+    double xyz[3];
+    sb_mat3_apply(m, rgb, xyz);
+    sb_xyz_to_lab(xyz, white, lab);
+}
+
+static void summarise_colour(struct sb_sky_error_sun *sun)
+{
+    double m[3][3], white[3], y_max = 0;
+    sb_rec709_to_xyz(m);
+    for (int d = 0; d < SB_SKY_ERROR_DIRECTIONS; d++) {
+        const double *pt = sun->directions[d].path_traced;
+        if (!sun->directions[d].ground)
+            y_max = fmax(y_max, m[1][0] * pt[0] + m[1][1] * pt[1] + m[1][2] * pt[2]);
+    }
+    sb_mat3_apply(m, (const double[3]){y_max, y_max, y_max}, white);
+    sun->de_mean = sun->de_max = sun->de_noise = 0;
+    sun->de_worst_direction = 0;
+    int n = 0;
+    for (int d = 0; y_max > 0 && d < SB_SKY_ERROR_DIRECTIONS; d++) {
+        const struct sb_sky_error_direction *dir = &sun->directions[d];
+        if (dir->ground)
+            continue;
+        double ours[3], ref[3];
+        view_lab(m, white, dir->skybake, ours);
+        view_lab(m, white, dir->path_traced, ref);
+        double de = sb_ciede2000(ours, ref);
+        sun->de_mean += de;
+        if (de > sun->de_max || n == 0) {
+            sun->de_max = de;
+            sun->de_worst_direction = d;
+        }
+        n++;
+        for (int c = 0; c < 3; c++)
+            for (int sign = -1; sign <= 1; sign += 2) {
+                double moved[3] = {dir->path_traced[0], dir->path_traced[1], dir->path_traced[2]}, lab[3];
+                moved[c] = fmax(moved[c] + sign * 2 * dir->std_error[c], 0.0);
+                view_lab(m, white, moved, lab);
+                sun->de_noise = fmax(sun->de_noise, sb_ciede2000(lab, ref));
+            }
+    }
+    sun->de_mean = n ? sun->de_mean / n : 0;
+}
+
 static void summarise(struct sb_sky_error_sun *sun)
 {
     double floor[3] = {0, 0, 0};
@@ -114,6 +161,7 @@ static void summarise(struct sb_sky_error_sun *sun)
     sun->rms_rel = n ? sqrt(sum2 / n) : 0;
     sun->mean_rel = n ? sum / n : 0;
     sun->multiple_share = lit ? share / lit : 0;
+    summarise_colour(sun);
 }
 
 enum sb_result sb_sky_error_run(struct sb_vk *vk, const char *scene_name, const struct sb_scene *scene,
@@ -194,6 +242,9 @@ void sb_sky_error_print(const struct sb_sky_error_report *reports, int count, bo
                 cJSON_AddNumberToObject(so, "mean_rel", sun->mean_rel);
                 cJSON_AddNumberToObject(so, "noise", sun->noise);
                 cJSON_AddNumberToObject(so, "multiple_share", sun->multiple_share);
+                cJSON_AddNumberToObject(so, "ciede2000_mean", sun->de_mean);
+                cJSON_AddNumberToObject(so, "ciede2000_max", sun->de_max);
+                cJSON_AddNumberToObject(so, "ciede2000_noise", sun->de_noise);
                 cJSON *dirs = cJSON_AddArrayToObject(so, "directions");
                 for (int d = 0; d < SB_SKY_ERROR_DIRECTIONS; d++) {
                     const struct sb_sky_error_direction *dir = &sun->directions[d];
@@ -225,6 +276,15 @@ void sb_sky_error_print(const struct sb_sky_error_report *reports, int count, bo
             printf("  %8.4g %9.3g %9.3g %+9.2g %9.2g %8.1f%%  %g, %g deg, %s\n", sun->elevation_deg, sun->max_rel,
                    sun->rms_rel, sun->mean_rel, sun->noise, 100 * sun->multiple_share, w->zenith_deg, w->azimuth_deg,
                    channel_name(sun->worst_channel));
+        }
+        printf(
+            "  colour, CIEDE2000 over the views of the sky (linear Rec.709, D65 at the brightest view's luminance):\n");
+        printf("  %8s %9s %9s %9s  %s\n", "sun deg", "mean", "max", "noise", "worst at (zenith, azimuth from the sun)");
+        for (int s = 0; s < r->sun_count; s++) {
+            const struct sb_sky_error_sun *sun = &r->suns[s];
+            const struct sb_sky_error_direction *w = &sun->directions[sun->de_worst_direction];
+            printf("  %8.4g %9.3g %9.3g %9.2g  %g, %g deg\n", sun->elevation_deg, sun->de_mean, sun->de_max,
+                   sun->de_noise, w->zenith_deg, w->azimuth_deg);
         }
     }
 }

@@ -9,7 +9,10 @@
  * over a fixed set of view directions from the scene's camera altitude, for
  * each of a list of sun elevations. What it measures is the multiple-
  * scattering approximation itself: the LUTs' own errors against fp64 are
- * bench's business and 1e-3 or less.
+ * bench's business and 1e-3 or less. Its colour too: CIEDE2000 between the
+ * two skies, each rgb as the runtime shows it (linear Rec.709), against
+ * the same three-wavelength path tracer (the spectral truth is issue 50's
+ * next step).
  */
 #ifndef SB_BAKER_SKY_ERROR_H
 #define SB_BAKER_SKY_ERROR_H
@@ -47,7 +50,14 @@ struct sb_sky_error_sun {
      * 1e-3 of the sun's brightest value in that channel): */
     double max_rel, rms_rel, mean_rel; /* mean_rel is signed: skybake above the reference > 0 */
     int worst_direction, worst_channel;
-    double noise;          /* the largest 2 standard errors, relative */
+    double noise; /* the largest 2 standard errors, relative */
+    /* Colour: CIEDE2000 between the two skies over the views of the sky (not
+     * the ground), each rgb taken as linear Rec.709 as the runtime shows
+     * it, in CIELAB against D65 at the luminance of the path tracer's
+     * brightest view of that sun (an exposure for the sky): */
+    double de_mean, de_max;
+    int de_worst_direction;
+    double de_noise;       /* the largest CIEDE2000 that 2 standard errors of one channel make */
     double multiple_share; /* mean of 1 - single / path traced over the views of the sky (not
                               the ground): how much light the higher orders bring */
 };
