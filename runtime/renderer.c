@@ -464,7 +464,7 @@ static void fill_frame(struct sb_renderer *r, const struct sb_view *v, struct sb
     store4(f->meter, ev_lo + to_log_units, ev_hi + to_log_units, dim, SB_EXPOSURE_DIM_EV100 + to_log_units);
     store4(f->adaptation, 3.0, 1.0, v->dt_s > 0.0 ? v->dt_s : 1.0 / 60.0, v->snap_exposure ? 1.0 : 0.0);
     bool bloom = r->params.bloom_strength > 0.0 && !(v->disabled_passes >> SB_PASS_BLOOM & 1);
-    store4(f->post, 1.0, bloom ? r->params.bloom_strength : 0.0, r->params.exposure_compensation_ev, r->params.tonemap);
+    store4(f->post, 1.0, bloom ? r->params.bloom_strength : 0.0, r->params.exposure_compensation_ev, 0.0);
     f->size[0] = r->width;
     f->size[1] = r->height;
     f->size[2] = bloom ? r->bloom_levels : 0; /* none: the tone curve reads no bloom (never written this frame) */

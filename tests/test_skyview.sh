@@ -67,6 +67,13 @@ check "data/worlds/colonnade.json (docs/fog.md's shafts) loads" expect_exit 0 "$
 check "three frames, each tone mapper" expect_exit 0 "$skyview" "$tmp/pack" -o "$tmp/g" $small --frames 3 --tonemap gt
 check "frame_0002.png" test -s "$tmp/g/frame_0002.png"
 check "aces" expect_exit 0 "$skyview" "$tmp/pack" -o "$tmp/g" $small --tonemap aces --no-bloom
+# each curve is its own kernel (passes/tonemap.c): the one asked for draws
+for t in agx aces gt; do
+    check "--tonemap $t" expect_exit 0 "$skyview" "$tmp/pack" -o "$tmp/tm_$t" $small --tonemap "$t"
+done
+check "the three tone curves draw three frames" sh -c "! cmp -s '$tmp/tm_agx/frame_0000.png' '$tmp/tm_aces/frame_0000.png' &&
+    ! cmp -s '$tmp/tm_agx/frame_0000.png' '$tmp/tm_gt/frame_0000.png' &&
+    ! cmp -s '$tmp/tm_aces/frame_0000.png' '$tmp/tm_gt/frame_0000.png'"
 check "camera above the atmosphere" expect_exit 0 "$skyview" "$tmp/pack" -o "$tmp/g" $small --camera 0,1000000,0,0,-60,60
 # A camera in a world's valley, 5 m under the planet's ground (the test
 # level's terrain goes 12 m under it): the sky as from the ground itself,

@@ -296,18 +296,26 @@ struct TransmittanceRay {
     float rho, g, d, e;
 };
 
+/* e = d_max - d of the ray with horizon distance rho, s = r mu and above =
+ * top^2 - r^2, without the cancellation of the two near the horizon: with
+ * d + s = sqrt(s^2 + H^2 - rho^2), (rho + H + s)^2 - (d + s)^2 = 2 (rho +
+ * H)(rho + s), and rho + s >= 0 on the rays that miss the ground. */
+float transmittance_ray_e(float rho, float s, float above)
+{
+    float H = horizon_top();
+    return 2.0 * (rho + H) * max(rho + s, 0.0) / (rho + H + s + sqrt(s * s + above));
+}
+
 /* The ray from altitude h with view cosine mu (missing the ground). */
 TransmittanceRay transmittance_ray(float h, float mu)
 {
     TransmittanceRay ray;
-    float H = horizon_top(), r = ground_radius() + h, s = r * mu;
+    float r = ground_radius() + h;
     ray.rho = horizon_distance(h);
     float above = max(atmosphere_thickness() - h, 0.0) * (top_radius() + r); /* top^2 - r^2 */
-    ray.g = above / (H + ray.rho);
+    ray.g = above / (horizon_top() + ray.rho);
     ray.d = distance_to_top(h, mu);
-    /* with d + s = sqrt(s^2 + H^2 - rho^2): (rho + H + s)^2 - (d + s)^2 =
-     * 2 (rho + H)(rho + s), and rho + s >= 0 on the rays that miss the ground */
-    ray.e = 2.0 * (ray.rho + H) * max(ray.rho + s, 0.0) / (ray.rho + H + s + sqrt(s * s + above));
+    ray.e = transmittance_ray_e(ray.rho, r * mu, above);
     return ray;
 }
 
@@ -457,11 +465,13 @@ vec3 optical_depth_to_top_uniform(TransmittanceRay ray, int steps, float offset,
  * off between texels there, this 1.1e-2 (docs/accuracy.md). */
 vec2 transmittance_unit_coords(float h, float mu)
 {
-    TransmittanceRay ray = transmittance_ray(h, mu);
-    float H = horizon_top();
-    float span = ray.rho + H - transmittance_ray_d_min(ray); /* d_max - d_min */
-    float x_mu = 1.0 - sqrt(clamp(ray.e / max(span, 1e-30), 0.0, 1.0));
-    return vec2(x_mu, ray.rho / H);
+    /* e and d_max - d_min alone: every lookup of the runtime's comes here */
+    float H = horizon_top(), r = ground_radius() + h, rho = horizon_distance(h);
+    float above = max(atmosphere_thickness() - h, 0.0) * (top_radius() + r); /* top^2 - r^2 */
+    float e = transmittance_ray_e(rho, r * mu, above);
+    float span = rho + H - above / (top_radius() + r); /* d_max - d_min, d_min = top - r */
+    float x_mu = 1.0 - sqrt(clamp(e / max(span, 1e-30), 0.0, 1.0));
+    return vec2(x_mu, rho / H);
 }
 
 /* The ray of the transmittance LUT at unit coordinates x, given with their

@@ -246,7 +246,8 @@ float cascade_visibility(int c, vec3 offset, vec3 n, bool pcf)
     if (dot(n, key_direction()) <= 0.0)
         return 0.0; /* turned from the light: none of it, and no search */
     if (c < SB_CASCADES)
-        return soft_visibility(c, offset, n, s, uv); /* the far map takes the fixed filter */
+        return soft_visibility(c, offset, n, s, uv);
+    /* the far map: the fixed filter */
 #endif
     float sum = 0.0;
     for (int i = 0; i < 4; i++) {

@@ -112,7 +112,7 @@ _Static_assert(2 * SB_SHADOW_CLEAR_MARGIN_TEXELS >= 2 * SB_SHADOW_RECT_MARGIN_TE
 #define SB_HISTOGRAM_BINS 256
 #define SB_BLOOM_MAX_LEVELS 6
 
-/* Tone mappers, sb_frame_gpu.post.w. */
+/* Tone mappers: sb_renderer_params.tonemap, the tonemap pass's kernel (tonemap.comp's SB_TONEMAP_OP). */
 #define SB_TONEMAP_AGX 0
 #define SB_TONEMAP_ACES 1
 #define SB_TONEMAP_GT 2
@@ -183,7 +183,7 @@ struct sb_frame_gpu {
                                   luminance below which the eye no longer sees a mid grey */
     SB_VEC4(adaptation);       /* x: speed to brighter (1/s), y: to darker (1/s), z: dt (s), w: 1 to snap */
     SB_VEC4(post);             /* x: bloom threshold (exposed), y: bloom strength, z: exposure
-                                  compensation (EV), w: tone mapper (SB_TONEMAP_*) */
+                                  compensation (EV), w: 0 (the tone curve is the kernel's) */
     SB_UVEC4(size);            /* xy: frame size; z: bloom levels; w: SB_DEBUG_* */
 };
 
