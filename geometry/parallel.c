@@ -2,6 +2,7 @@
 
 #include <pthread.h>
 #include <stdbool.h>
+#include <stdint.h>
 #include <unistd.h>
 
 /*
@@ -45,11 +46,14 @@ static void run_job(void)
     }
 }
 
+/* arg: the generation when the thread was made. A thread made for a job
+ * may first take the lock after the job was posted; reading the generation
+ * then would take the job for one already seen, and leave it to the
+ * caller alone. */
 static void *worker(void *arg)
 {
-    (void)arg;
+    unsigned seen = (unsigned)(uintptr_t)arg;
     pthread_mutex_lock(&pool.lock);
-    unsigned seen = pool.generation;
     for (;;) {
         while (!pool.quit && pool.generation == seen)
             pthread_cond_wait(&pool.work, &pool.lock);
@@ -101,7 +105,7 @@ void sb_parallel_for(int count, void (*fn)(void *user, int index), void *user)
         if (pool.started)
             stop_pool();
         while (pool.started < want &&
-               pthread_create(&pool.threads[pool.started], NULL, worker, NULL) == 0)
+               pthread_create(&pool.threads[pool.started], NULL, worker, (void *)(uintptr_t)pool.generation) == 0)
             pool.started++;
     }
     pool.busy = true;
