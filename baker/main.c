@@ -38,7 +38,7 @@ static void usage(FILE *f)
 {
     fprintf(f, "usage: skybake bake SCENE -o OUT_DIR [options]\n"
                "       skybake bench [SCENE] [--product NAME]... [--json] [-o DIR] [--repeat N] [--quick]\n"
-               "       skybake sky-error [SCENE]... [--paths N] [--seed N] [--sun DEG]... [--json]\n"
+               "       skybake sky-error [SCENE]... [--paths N] [--spectral-paths N] [--seed N] [--sun DEG]... [--json]\n"
                "       skybake info PACK [--json]\n"
                "       skybake verify PACK [--json]\n"
                "       skybake diff A B [--tol REL] [--floor F] [--json]\n"
@@ -105,8 +105,10 @@ static void usage(FILE *f)
                "an fp64 path tracer with every scattering order, per sun elevation (default\n"
                "90 30 10 2 -4, or each --sun DEG) over 16 view directions from the scene's\n"
                "camera altitude (docs/accuracy.md): its radiance error, and its colour's as\n"
-               "CIEDE2000. --paths N per direction and channel (default 16384); --seed N\n"
-               "(default 1).\n"
+               "CIEDE2000 against the same path tracer and against the path tracer at 48\n"
+               "wavelengths, 360 to 830 nm, through the CIE 1931 observer. --paths N per\n"
+               "direction and channel (default 16384); --spectral-paths N per direction and\n"
+               "wavelength (default N / 16); --seed N (default 1).\n"
                "\n"
                "info: what PACK holds (products, sizes, settings and errors, hashes, device,\n"
                "version), after verifying all of it; exit 2 if it is not a valid pack.\n"
@@ -425,6 +427,12 @@ static int cmd_sky_error(int argc, char **argv)
                 return EXIT_USAGE;
             }
             params.paths = (int)v;
+        } else if (!strcmp(a, "--spectral-paths") && i + 1 < argc) {
+            if (!parse_number(argv[++i], 32, 1e8, &v) || v != floor(v)) {
+                fprintf(stderr, "skybake: sky-error: --spectral-paths takes an integer from 32 to 1e8\n");
+                return EXIT_USAGE;
+            }
+            params.spectral_paths = (int)v;
         } else if (!strcmp(a, "--seed") && i + 1 < argc) {
             if (!parse_number(argv[++i], 0, 9007199254740992.0, &v) || v != floor(v)) {
                 fprintf(stderr, "skybake: sky-error: --seed takes an integer from 0 to 2^53\n");

@@ -48,18 +48,26 @@ static void direction_angles(const struct sb_atmosphere_params *p, double altitu
     *zenith = 180 - from_nadir;
 }
 
+#define TRIPLES (SB_SPECTRUM_COUNT / 3) /* the spectral trace's wavelengths, three a medium */
+
 struct job {
     const struct sb_atmosphere_params *params;
     const struct sb_image *luts;
     const struct sb_sky_error_params *settings;
     struct sb_sky_error_report *report;
+    /* the scene at wavelengths 3 t, 3 t + 1 and 3 t + 2 of the grid, as channels */
+    struct sb_atmosphere_params spectral[TRIPLES];
 };
 
-/* One (sun, direction, channel). */
+/* One (sun, direction, channel), then one (sun, direction, wavelength
+ * triple) of the spectral trace. */
 static void run_one(void *user, int index)
 {
     struct job *job = user;
-    int channel = index % 3, d = index / 3 % SB_SKY_ERROR_DIRECTIONS, s = index / 3 / SB_SKY_ERROR_DIRECTIONS;
+    int rgb_jobs = job->report->sun_count * SB_SKY_ERROR_DIRECTIONS * 3;
+    bool spectral = index >= rgb_jobs;
+    int per_view = spectral ? TRIPLES : 3, i = spectral ? index - rgb_jobs : index;
+    int channel = i % per_view, d = i / per_view % SB_SKY_ERROR_DIRECTIONS, s = i / per_view / SB_SKY_ERROR_DIRECTIONS;
     struct sb_sky_error_sun *sun = &job->report->suns[s];
     struct sb_sky_error_direction *dir = &sun->directions[d];
     double zenith = dir->zenith_deg * SKY_PI / 180, azimuth = dir->azimuth_deg * SKY_PI / 180;
@@ -67,6 +75,18 @@ static void run_one(void *user, int index)
     double mu = cos(zenith), mu_s = sin(elevation);
     double nu = fmax(-1.0, fmin(1.0, sin(zenith) * cos(elevation) * cos(azimuth) + mu * mu_s));
     double h = job->report->altitude_km, R = job->params->ground_radius_km, r = R + h;
+    struct sb_pathtrace_view view = {h, mu, mu_s, nu};
+    if (spectral) {
+        /* seeds apart from the three channels' streams */
+        struct sb_pathtrace_params params = {.seed = job->settings->seed ^ 0x5bd1e9955bd1e995ull,
+                                             .paths = job->report->spectral_paths};
+        for (int c = 0; c < 3; c++) {
+            struct sb_pathtrace_result traced = sb_pathtrace_radiance(&job->spectral[channel], &view, c, &params);
+            dir->spectral[3 * channel + c] = traced.radiance;
+            dir->spectral_error[3 * channel + c] = traced.std_error;
+        }
+        return;
+    }
     if (channel == 0) {
         dir->ground = mu < 0 && r * r * (mu * mu - 1) + R * R >= 0;
         sb_ref_sky_radiance(job->params, h, mu, mu_s, nu, &job->luts[SB_PRODUCT_TRANSMITTANCE],
@@ -75,7 +95,6 @@ static void run_one(void *user, int index)
         sb_ref_sky_radiance(job->params, h, mu, mu_s, nu, &job->luts[SB_PRODUCT_TRANSMITTANCE], NULL, NULL, NULL,
                             dir->single);
     }
-    struct sb_pathtrace_view view = {h, mu, mu_s, nu};
     struct sb_pathtrace_params params = {.seed = job->settings->seed, .paths = job->report->paths};
     struct sb_pathtrace_result traced = sb_pathtrace_radiance(job->params, &view, channel, &params);
     dir->path_traced[channel] = traced.radiance;
@@ -128,7 +147,105 @@ static void summarise_colour(struct sb_sky_error_sun *sun)
     sun->de_mean = n ? sun->de_mean / n : 0;
 }
 
-static void summarise(struct sb_sky_error_sun *sun)
+/* The spectral trace read at n of its wavelengths (SB_SKY_ERROR_WAVELENGTHS_*):
+ * the transfer (radiance over the sun's spectrum) linear between them. */
+static void subset_xyz(const struct sb_sky_error_direction *dir, int n, double xyz[3])
+{
+    int index[12];
+    for (int i = 0; i < n; i++)
+        index[i] = (int)lround(i * 43.0 / (n - 1)) + 2; /* 380 to 810 nm */
+    double spectrum[SB_SPECTRUM_COUNT];
+    for (int k = 0, j = 0; k < SB_SPECTRUM_COUNT; k++) {
+        while (j + 2 < n && index[j + 1] <= k)
+            j++;
+        double f = fmin(fmax((double)(k - index[j]) / (index[j + 1] - index[j]), 0.0), 1.0);
+        double lo = dir->spectral[index[j]] / sb_solar_spectrum(sb_spectrum_nm(index[j]));
+        double hi = dir->spectral[index[j + 1]] / sb_solar_spectrum(sb_spectrum_nm(index[j + 1]));
+        spectrum[k] = (lo + f * (hi - lo)) * sb_solar_spectrum(sb_spectrum_nm(k));
+    }
+    sb_spectrum_to_xyz(spectrum, xyz);
+}
+
+/* Each view's rgb in a scheme. */
+static void scheme_rgb(const struct sb_sky_error_direction *dir, int scheme, const double convert[3][3],
+                       const double sun_to_rgb[3][3], double rgb[3])
+{
+    if (scheme == SB_SKY_ERROR_WAVELENGTHS_6 || scheme == SB_SKY_ERROR_WAVELENGTHS_12) {
+        double xyz[3];
+        subset_xyz(dir, scheme == SB_SKY_ERROR_WAVELENGTHS_6 ? 6 : 12, xyz);
+        sb_mat3_apply(sun_to_rgb, xyz, rgb);
+        return;
+    }
+    bool traced = scheme == SB_SKY_ERROR_TRACED_PRIMARIES || scheme == SB_SKY_ERROR_TRACED_CONVERTED;
+    const double *v = traced ? dir->path_traced : dir->skybake;
+    if (scheme == SB_SKY_ERROR_CONVERTED || scheme == SB_SKY_ERROR_TRACED_CONVERTED)
+        sb_mat3_apply(convert, v, rgb);
+    else
+        memcpy(rgb, v, 3 * sizeof(double));
+}
+
+static void summarise_spectral(struct sb_sky_error_sun *sun, const double solar[3])
+{
+    double to_xyz[3][3], sun_to_rgb[3][3], convert[3][3], white[3], ref_rgb[SB_SKY_ERROR_DIRECTIONS][3];
+    double sigma[SB_SKY_ERROR_DIRECTIONS][3], y_max = 0;
+    sb_rec709_to_xyz(to_xyz);
+    sb_sun_xyz_to_rec709(solar, sun_to_rgb);
+    sb_channels_to_rec709(solar, convert);
+    for (int d = 0; d < SB_SKY_ERROR_DIRECTIONS; d++) {
+        const struct sb_sky_error_direction *dir = &sun->directions[d];
+        double xyz[3], var[3] = {0, 0, 0};
+        sb_spectrum_to_xyz(dir->spectral, xyz);
+        for (int k = 0; k < SB_SPECTRUM_COUNT; k++) {
+            double cmf[3];
+            sb_cie1931_xyz(sb_spectrum_nm(k), cmf);
+            for (int c = 0; c < 3; c++)
+                var[c] += pow(SB_SPECTRUM_STEP_NM * cmf[c] * dir->spectral_error[k], 2);
+        }
+        for (int c = 0; c < 3; c++)
+            sigma[d][c] = sqrt(var[c]);
+        sb_mat3_apply(sun_to_rgb, xyz, ref_rgb[d]);
+        if (!dir->ground)
+            y_max =
+                fmax(y_max, to_xyz[1][0] * ref_rgb[d][0] + to_xyz[1][1] * ref_rgb[d][1] + to_xyz[1][2] * ref_rgb[d][2]);
+    }
+    sb_mat3_apply(to_xyz, (const double[3]){y_max, y_max, y_max}, white);
+    memset(sun->spectral, 0, sizeof(sun->spectral));
+    sun->spectral_noise = 0;
+    int n = 0;
+    for (int d = 0; y_max > 0 && d < SB_SKY_ERROR_DIRECTIONS; d++) {
+        const struct sb_sky_error_direction *dir = &sun->directions[d];
+        if (dir->ground)
+            continue;
+        double ref[3], lab[3], rgb[3];
+        view_lab(to_xyz, white, ref_rgb[d], ref);
+        for (int scheme = 0; scheme < SB_SKY_ERROR_SCHEME_COUNT; scheme++) {
+            struct sb_sky_error_colour *stats = &sun->spectral[scheme];
+            scheme_rgb(dir, scheme, convert, sun_to_rgb, rgb);
+            view_lab(to_xyz, white, rgb, lab);
+            double de = sb_ciede2000(lab, ref);
+            stats->mean += de;
+            if (de > stats->max || n == 0) {
+                stats->max = de;
+                stats->worst_direction = d;
+            }
+        }
+        n++;
+        double xyz[3];
+        sb_spectrum_to_xyz(dir->spectral, xyz);
+        for (int c = 0; c < 3; c++)
+            for (int sign = -1; sign <= 1; sign += 2) {
+                double moved[3] = {xyz[0], xyz[1], xyz[2]};
+                moved[c] = fmax(moved[c] + sign * 2 * sigma[d][c], 0.0);
+                sb_mat3_apply(sun_to_rgb, moved, rgb);
+                view_lab(to_xyz, white, rgb, lab);
+                sun->spectral_noise = fmax(sun->spectral_noise, sb_ciede2000(lab, ref));
+            }
+    }
+    for (int scheme = 0; n && scheme < SB_SKY_ERROR_SCHEME_COUNT; scheme++)
+        sun->spectral[scheme].mean /= n;
+}
+
+static void summarise(struct sb_sky_error_sun *sun, const double solar[3])
 {
     double floor[3] = {0, 0, 0};
     for (int d = 0; d < SB_SKY_ERROR_DIRECTIONS; d++)
@@ -162,6 +279,7 @@ static void summarise(struct sb_sky_error_sun *sun)
     sun->mean_rel = n ? sum / n : 0;
     sun->multiple_share = lit ? share / lit : 0;
     summarise_colour(sun);
+    summarise_spectral(sun, solar);
 }
 
 enum sb_result sb_sky_error_run(struct sb_vk *vk, const char *scene_name, const struct sb_scene *scene,
@@ -171,6 +289,9 @@ enum sb_result sb_sky_error_run(struct sb_vk *vk, const char *scene_name, const 
     snprintf(report->scene, sizeof(report->scene), "%s", scene_name);
     report->altitude_km = scene->view.altitude_km;
     report->paths = params->paths > 0 ? params->paths : 16384;
+    report->spectral_paths = params->spectral_paths > 0 ? params->spectral_paths : report->paths / 16;
+    if (report->spectral_paths < 32)
+        report->spectral_paths = 32;
     report->sun_count = params->sun_count > 0 ? params->sun_count : (int)(sizeof(default_suns) / sizeof(double));
     if (report->sun_count > SB_SKY_ERROR_MAX_SUNS)
         report->sun_count = SB_SKY_ERROR_MAX_SUNS;
@@ -196,14 +317,21 @@ enum sb_result sb_sky_error_run(struct sb_vk *vk, const char *scene_name, const 
         goto done;
     }
 
-    sb_info("%s: path tracing %d suns x %d directions x 3 channels, %d paths each", scene_name, report->sun_count,
-            SB_SKY_ERROR_DIRECTIONS, report->paths);
-    struct job job = {&scene->atmosphere, luts, params, report};
+    sb_info("%s: path tracing %d suns x %d directions x 3 channels, %d paths each, and x %d wavelengths, %d paths "
+            "each",
+            scene_name, report->sun_count, SB_SKY_ERROR_DIRECTIONS, report->paths, SB_SPECTRUM_COUNT,
+            report->spectral_paths);
+    struct job job = {.params = &scene->atmosphere, .luts = luts, .settings = params, .report = report};
+    for (int t = 0; t < TRIPLES; t++) {
+        job.spectral[t] = scene->atmosphere;
+        for (int c = 0; c < 3; c++)
+            sb_atmosphere_at_wavelength(&scene->atmosphere, sb_spectrum_nm(3 * t + c), c, &job.spectral[t]);
+    }
     double t0 = sb_now_s();
-    sb_parallel_for(report->sun_count * SB_SKY_ERROR_DIRECTIONS * 3, run_one, &job);
+    sb_parallel_for(report->sun_count * SB_SKY_ERROR_DIRECTIONS * (3 + TRIPLES), run_one, &job);
     report->path_trace_s = sb_now_s() - t0;
     for (int s = 0; s < report->sun_count; s++)
-        summarise(&report->suns[s]);
+        summarise(&report->suns[s], scene->atmosphere.solar_irradiance);
 
 done:
     for (int i = 0; i < SB_ATMOSPHERE_PRODUCT_COUNT; i++)
@@ -215,6 +343,9 @@ static const char *channel_name(int c)
 {
     return c == 0 ? "red" : c == 1 ? "green" : "blue";
 }
+
+static const char *const scheme_names[SB_SKY_ERROR_SCHEME_COUNT] = {
+    "primaries", "converted", "traced_primaries", "traced_converted", "wavelengths_6", "wavelengths_12"};
 
 static cJSON *triple(const double v[3])
 {
@@ -231,6 +362,7 @@ void sb_sky_error_print(const struct sb_sky_error_report *reports, int count, bo
             cJSON_AddStringToObject(o, "scene", r->scene);
             cJSON_AddNumberToObject(o, "altitude_km", r->altitude_km);
             cJSON_AddNumberToObject(o, "paths", r->paths);
+            cJSON_AddNumberToObject(o, "spectral_paths", r->spectral_paths);
             cJSON_AddNumberToObject(o, "path_trace_s", r->path_trace_s);
             cJSON *suns = cJSON_AddArrayToObject(o, "suns");
             for (int s = 0; s < r->sun_count; s++) {
@@ -245,6 +377,13 @@ void sb_sky_error_print(const struct sb_sky_error_report *reports, int count, bo
                 cJSON_AddNumberToObject(so, "ciede2000_mean", sun->de_mean);
                 cJSON_AddNumberToObject(so, "ciede2000_max", sun->de_max);
                 cJSON_AddNumberToObject(so, "ciede2000_noise", sun->de_noise);
+                cJSON *spectral = cJSON_AddObjectToObject(so, "spectral");
+                for (int k = 0; k < SB_SKY_ERROR_SCHEME_COUNT; k++) {
+                    cJSON *scheme = cJSON_AddObjectToObject(spectral, scheme_names[k]);
+                    cJSON_AddNumberToObject(scheme, "ciede2000_mean", sun->spectral[k].mean);
+                    cJSON_AddNumberToObject(scheme, "ciede2000_max", sun->spectral[k].max);
+                }
+                cJSON_AddNumberToObject(spectral, "ciede2000_noise", sun->spectral_noise);
                 cJSON *dirs = cJSON_AddArrayToObject(so, "directions");
                 for (int d = 0; d < SB_SKY_ERROR_DIRECTIONS; d++) {
                     const struct sb_sky_error_direction *dir = &sun->directions[d];
@@ -255,6 +394,9 @@ void sb_sky_error_print(const struct sb_sky_error_report *reports, int count, bo
                     cJSON_AddItemToObject(dobj, "single", triple(dir->single));
                     cJSON_AddItemToObject(dobj, "path_traced", triple(dir->path_traced));
                     cJSON_AddItemToObject(dobj, "std_error", triple(dir->std_error));
+                    cJSON_AddItemToObject(dobj, "spectral", cJSON_CreateDoubleArray(dir->spectral, SB_SPECTRUM_COUNT));
+                    cJSON_AddItemToObject(dobj, "spectral_std_error",
+                                          cJSON_CreateDoubleArray(dir->spectral_error, SB_SPECTRUM_COUNT));
                     cJSON_AddItemToArray(dirs, dobj);
                 }
                 cJSON_AddItemToArray(suns, so);
@@ -285,6 +427,19 @@ void sb_sky_error_print(const struct sb_sky_error_report *reports, int count, bo
             const struct sb_sky_error_direction *w = &sun->directions[sun->de_worst_direction];
             printf("  %8.4g %9.3g %9.3g %9.2g  %g, %g deg\n", sun->elevation_deg, sun->de_mean, sun->de_max,
                    sun->de_noise, w->zenith_deg, w->azimuth_deg);
+        }
+        printf("  colour against the spectral path tracer (%d wavelengths, 360 to 830 nm, %d paths each; CIEDE2000 "
+               "mean / max):\n  skybake's sky and the three-channel path tracer's, each read as Rec.709 primaries or\n"
+               "  converted (sb_channels_to_rec709); the spectral trace itself read at 6 and 12 wavelengths:\n",
+               SB_SPECTRUM_COUNT, r->spectral_paths);
+        printf("  %8s %15s %15s %15s %15s %15s %15s %9s\n", "sun deg", "primaries", "converted", "traced prim.",
+               "traced conv.", "6 wavelengths", "12 wavelengths", "noise");
+        for (int s = 0; s < r->sun_count; s++) {
+            const struct sb_sky_error_sun *sun = &r->suns[s];
+            printf("  %8.4g", sun->elevation_deg);
+            for (int k = 0; k < SB_SKY_ERROR_SCHEME_COUNT; k++)
+                printf(" %7.2f / %5.2f", sun->spectral[k].mean, sun->spectral[k].max);
+            printf(" %9.2g\n", sun->spectral_noise);
         }
     }
 }

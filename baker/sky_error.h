@@ -11,8 +11,14 @@
  * scattering approximation itself: the LUTs' own errors against fp64 are
  * bench's business and 1e-3 or less. Its colour too: CIEDE2000 between the
  * two skies, each rgb as the runtime shows it (linear Rec.709), against
- * the same three-wavelength path tracer (the spectral truth is issue 50's
- * next step).
+ * the same three-wavelength path tracer (the model's colour error alone),
+ * and against the spectral truth: the path tracer at the 48 wavelengths
+ * of physics/spectrum.h, 360 to 830 nm, the scene read at each by
+ * spectrum.h's rules, integrated against the CIE 1931 observer and taken
+ * to Rec.709 under the measured sun adapted to the scene's
+ * (sb_sun_xyz_to_rec709). Each three-channel sky is measured against it
+ * read two ways: as Rec.709 primaries (the runtime today) and through
+ * sb_channels_to_rec709 (the three channels as samples of a spectrum).
  */
 #ifndef SB_BAKER_SKY_ERROR_H
 #define SB_BAKER_SKY_ERROR_H
@@ -22,25 +28,49 @@
 
 #include "context.h"
 #include "scene.h"
+#include "spectrum.h"
 
 #define SB_SKY_ERROR_MAX_SUNS 16
 #define SB_SKY_ERROR_DIRECTIONS 16
 
 struct sb_sky_error_params {
-    int paths;     /* per direction and channel; 0: 16384 */
-    uint64_t seed; /* the path tracer's */
-    int sun_count; /* 0: 90, 30, 10, 2 and -4 degrees */
+    int paths;          /* per direction and channel; 0: 16384 */
+    int spectral_paths; /* per direction and wavelength; 0: paths / 16 (the same work as the
+                           three channels' trace), at least 32 */
+    uint64_t seed;      /* the path tracer's */
+    int sun_count;      /* 0: 90, 30, 10, 2 and -4 degrees */
     double sun_elevation_deg[SB_SKY_ERROR_MAX_SUNS];
 };
 
 /* One view direction: zenith angle and azimuth from the sun, in degrees. */
 struct sb_sky_error_direction {
     double zenith_deg, azimuth_deg;
-    bool ground;           /* the view ends on the ground */
-    double skybake[3];     /* the runtime's model on the baked LUTs */
-    double single[3];      /* its single scattering alone (no ground light) */
-    double path_traced[3]; /* the reference */
-    double std_error[3];   /* the reference's standard error */
+    bool ground;                              /* the view ends on the ground */
+    double skybake[3];                        /* the runtime's model on the baked LUTs */
+    double single[3];                         /* its single scattering alone (no ground light) */
+    double path_traced[3];                    /* the reference */
+    double std_error[3];                      /* the reference's standard error */
+    double spectral[SB_SPECTRUM_COUNT];       /* the spectral path tracer, per wavelength */
+    double spectral_error[SB_SPECTRUM_COUNT]; /* its standard error */
+};
+
+/* How the three-channel skies are read as colour against the spectral one. */
+enum sb_sky_error_scheme {
+    SB_SKY_ERROR_PRIMARIES,        /* skybake's sky, its channels as Rec.709 primaries */
+    SB_SKY_ERROR_CONVERTED,        /* skybake's sky through sb_channels_to_rec709 */
+    SB_SKY_ERROR_TRACED_PRIMARIES, /* the three-channel path tracer's, as primaries */
+    SB_SKY_ERROR_TRACED_CONVERTED, /* the three-channel path tracer's, converted */
+    /* The spectral trace itself read at 6 or 12 of its wavelengths, evenly
+     * spread from 380 to 810 nm, linear between them and flat beyond: the
+     * error of a runtime of that many wavelengths whose light were exact */
+    SB_SKY_ERROR_WAVELENGTHS_6,
+    SB_SKY_ERROR_WAVELENGTHS_12,
+    SB_SKY_ERROR_SCHEME_COUNT,
+};
+
+struct sb_sky_error_colour {
+    double mean, max; /* CIEDE2000 over the views of the sky */
+    int worst_direction;
 };
 
 struct sb_sky_error_sun {
@@ -60,15 +90,20 @@ struct sb_sky_error_sun {
     double de_noise;       /* the largest CIEDE2000 that 2 standard errors of one channel make */
     double multiple_share; /* mean of 1 - single / path traced over the views of the sky (not
                               the ground): how much light the higher orders bring */
+    /* Against the spectral path tracer (CIELAB against D65 at its brightest
+     * view of the sky): */
+    struct sb_sky_error_colour spectral[SB_SKY_ERROR_SCHEME_COUNT];
+    double spectral_noise; /* the largest CIEDE2000 that 2 standard errors of X, Y or Z make */
 };
 
 struct sb_sky_error_report {
     char scene[256];
     double altitude_km;
     int paths;
+    int spectral_paths;
     int sun_count;
     struct sb_sky_error_sun suns[SB_SKY_ERROR_MAX_SUNS];
-    double path_trace_s; /* wall time of the path tracer */
+    double path_trace_s; /* wall time of the path tracer, three channels and spectral */
 };
 
 /* Bake and compare; the report is the caller's (no resources to free). */

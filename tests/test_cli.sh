@@ -313,10 +313,14 @@ check "the cloud table names the reference" grep -q "CPU reference on one core" 
 check "sky-error runs" expect_exit 0 "$skybake" sky-error "$scene" --paths 64 --sun 30 --sun -4 --json -q
 check "sky-error reports both suns" test "$(grep -c '"elevation_deg"' "$tmp/out")" = 2
 check "sky-error reports 16 directions per sun" test "$(grep -c '"zenith_deg"' "$tmp/out")" = 32
-check "sky-error reports each sun's colour error" test "$(grep -c '"ciede2000_mean"' "$tmp/out")" = 2
+# per sun: against the three-channel path tracer and, six ways, the spectral one
+check "sky-error reports each sun's colour error" test "$(grep -c '"ciede2000_mean"' "$tmp/out")" = 14
+check "sky-error reports the colour against the spectral path tracer" \
+    test "$(grep -c '"traced_converted"' "$tmp/out")" = 2
+check "sky-error reports each view's spectrum" test "$(grep -c '"spectral_std_error"' "$tmp/out")" = 32
 # cJSON writes NaN and Inf as null
 check "sky-error values are finite" test -z "$(grep -Ei 'nan|inf|null' "$tmp/out")"
-for bad in '--paths 8' '--paths x' '--paths 100.5' '--sun 91' '--sun' '--seed -1'; do
+for bad in '--paths 8' '--paths x' '--paths 100.5' '--spectral-paths 8' '--sun 91' '--sun' '--seed -1'; do
     # shellcheck disable=SC2086 # split on purpose
     check "sky-error refuses $bad" expect_exit 2 "$skybake" sky-error "$scene" $bad
 done

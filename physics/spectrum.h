@@ -1,0 +1,79 @@
+/*
+ * Spectra, for the spectral reference of the sky (sky-error) and for the
+ * runtime's colour: the CIE 1931 2-degree observer, the sun's spectral
+ * irradiance above the atmosphere, ozone's absorption cross-section, a
+ * scene's atmosphere at any wavelength, and what skybake's three channels
+ * stand for. fp64; pure functions, thread safe.
+ *
+ * A scene gives its media at three channels. They stand for the
+ * wavelengths sb_channel_nm (680, 550 and 440 nm: Bruneton 2017's and
+ * Hillaire 2020's, whose earth values the earth preset holds). The spectral
+ * model of a scene reads them as samples of spectra:
+ * - Rayleigh's and Mie's coefficients: a power law in wavelength through
+ *   each pair of neighbouring channels (Rayleigh's lambda^-4 and
+ *   Angstrom's law for aerosols reproduced exactly), the end pairs' law
+ *   beyond 440 and 680 nm;
+ * - ozone: the measured cross-section times one number density, the least
+ *   squares fit to the three channels (exact for the earth preset);
+ * - the ground's albedo: linear in wavelength between the channels, flat
+ *   beyond;
+ * - the sun: the measured spectrum (its colour is then adapted to the
+ *   scene's solar_irradiance, taken as linear Rec.709: sb_sun_xyz_to_rec709).
+ */
+#ifndef SB_PHYSICS_SPECTRUM_H
+#define SB_PHYSICS_SPECTRUM_H
+
+#include "scene.h"
+
+#define SB_SPECTRUM_FIRST_NM 360.0
+#define SB_SPECTRUM_STEP_NM 10.0
+#define SB_SPECTRUM_COUNT 48 /* 360, 370, ..., 830 nm */
+
+/* The wavelength each channel stands for, nm: red, green, blue. */
+extern const double sb_channel_nm[3];
+
+/* Wavelength k of the spectral grid, nm. */
+double sb_spectrum_nm(int k);
+
+/* The CIE 1931 2-degree colour matching functions at nm (linear between the
+ * 5 nm table's rows; 0 outside 360 to 830 nm). */
+void sb_cie1931_xyz(double nm, double xyz[3]);
+
+/* The sun's spectral irradiance above the atmosphere, W m^-2 nm^-1, and
+ * ozone's absorption cross-section, m^2 (10 nm bins, linear between them;
+ * 0 outside 360 to 830 nm). */
+double sb_solar_spectrum(double nm);
+double sb_ozone_cross_section(double nm);
+
+/* CIE XYZ of a spectrum sampled on the grid (10 nm a sample). */
+void sb_spectrum_to_xyz(const double spectrum[SB_SPECTRUM_COUNT], double xyz[3]);
+
+/* The ozone number density (per km per m^2 of cross-section) that fits the
+ * scene's three channels best (least squares). */
+double sb_ozone_density_fit(const struct sb_atmosphere_params *p);
+
+/* Channel c of *out made the scene's media, ground and sun at wavelength nm
+ * (the rules above); the geometry and the rest of *out are left alone. */
+void sb_atmosphere_at_wavelength(const struct sb_atmosphere_params *p, double nm, int c,
+                                 struct sb_atmosphere_params *out);
+
+/* XYZ of the sun's spectrum above the atmosphere (sb_spectrum_to_xyz). */
+void sb_sun_white(double xyz[3]);
+
+/* XYZ under the measured sun to the runtime's linear Rec.709: Bradford's
+ * adaptation from the sun's white to D65, then each channel scaled so that
+ * the sun above the atmosphere comes out as the scene's solar_irradiance. */
+void sb_sun_xyz_to_rec709(const double solar_rgb[3], double m[3][3]);
+
+/*
+ * The three-channel colour scheme: the matrix that takes skybake's three
+ * channels of a radiance (the transfer at 680, 550 and 440 nm times the
+ * scene's solar_irradiance) to the linear Rec.709 that its spectrum shows,
+ * the transfer read linearly in wavelength between the channels (flat
+ * beyond) under the measured sun, through the CIE observer and
+ * sb_sun_xyz_to_rec709. The sun itself, and any grey transfer, is left as
+ * it is: m (solar_rgb) = solar_rgb.
+ */
+void sb_channels_to_rec709(const double solar_rgb[3], double m[3][3]);
+
+#endif
