@@ -57,6 +57,9 @@ struct job {
     struct sb_sky_error_report *report;
     /* the scene at wavelengths 3 t, 3 t + 1 and 3 t + 2 of the grid, as channels */
     struct sb_atmosphere_params spectral[TRIPLES];
+    /* the scene at SB_SKY_ERROR_SKYBAKE_12's wavelengths, three a medium, and its LUTs */
+    struct sb_atmosphere_params twelve[4];
+    const struct sb_image (*twelve_luts)[SB_PRODUCT_COUNT];
 };
 
 /* One (sun, direction, channel), then one (sun, direction, wavelength
@@ -94,6 +97,14 @@ static void run_one(void *user, int index)
                             dir->skybake);
         sb_ref_sky_radiance(job->params, h, mu, mu_s, nu, &job->luts[SB_PRODUCT_TRANSMITTANCE], NULL, NULL, NULL,
                             dir->single);
+        for (int t = 0; t < 4; t++) {
+            const struct sb_image *l = job->twelve_luts[t];
+            double rgb[3];
+            sb_ref_sky_radiance(&job->twelve[t], h, mu, mu_s, nu, &l[SB_PRODUCT_TRANSMITTANCE],
+                                &l[SB_PRODUCT_MULTISCATTERING], &l[SB_PRODUCT_IRRADIANCE_GROUND], NULL, rgb);
+            for (int c = 0; c < 3; c++)
+                dir->skybake_12[3 * t + c] = rgb[c];
+        }
     }
     struct sb_pathtrace_params params = {.seed = job->settings->seed, .paths = job->report->paths};
     struct sb_pathtrace_result traced = sb_pathtrace_radiance(job->params, &view, channel, &params);
@@ -147,20 +158,25 @@ static void summarise_colour(struct sb_sky_error_sun *sun)
     sun->de_mean = n ? sun->de_mean / n : 0;
 }
 
-/* The spectral trace read at n of its wavelengths (SB_SKY_ERROR_WAVELENGTHS_*):
- * the transfer (radiance over the sun's spectrum) linear between them. */
-static void subset_xyz(const struct sb_sky_error_direction *dir, int n, double xyz[3])
+/* Wavelength i of n spread evenly over the grid from 380 to 810 nm. */
+static int subset_index(int i, int n)
 {
-    int index[12];
-    for (int i = 0; i < n; i++)
-        index[i] = (int)lround(i * 43.0 / (n - 1)) + 2; /* 380 to 810 nm */
+    return (int)lround(i * 43.0 / (n - 1)) + 2;
+}
+
+/* XYZ of radiances at n of the grid's wavelengths (subset_index): the
+ * transfer (radiance over the sun's spectrum) linear between them, flat
+ * beyond. */
+static void subset_xyz(const double *radiance, int n, double xyz[3])
+{
     double spectrum[SB_SPECTRUM_COUNT];
     for (int k = 0, j = 0; k < SB_SPECTRUM_COUNT; k++) {
-        while (j + 2 < n && index[j + 1] <= k)
+        while (j + 2 < n && subset_index(j + 1, n) <= k)
             j++;
-        double f = fmin(fmax((double)(k - index[j]) / (index[j + 1] - index[j]), 0.0), 1.0);
-        double lo = dir->spectral[index[j]] / sb_solar_spectrum(sb_spectrum_nm(index[j]));
-        double hi = dir->spectral[index[j + 1]] / sb_solar_spectrum(sb_spectrum_nm(index[j + 1]));
+        int a = subset_index(j, n), b = subset_index(j + 1, n);
+        double f = fmin(fmax((double)(k - a) / (b - a), 0.0), 1.0);
+        double lo = radiance[j] / sb_solar_spectrum(sb_spectrum_nm(a));
+        double hi = radiance[j + 1] / sb_solar_spectrum(sb_spectrum_nm(b));
         spectrum[k] = (lo + f * (hi - lo)) * sb_solar_spectrum(sb_spectrum_nm(k));
     }
     sb_spectrum_to_xyz(spectrum, xyz);
@@ -170,9 +186,13 @@ static void subset_xyz(const struct sb_sky_error_direction *dir, int n, double x
 static void scheme_rgb(const struct sb_sky_error_direction *dir, int scheme, const double convert[3][3],
                        const double sun_to_rgb[3][3], double rgb[3])
 {
-    if (scheme == SB_SKY_ERROR_WAVELENGTHS_6 || scheme == SB_SKY_ERROR_WAVELENGTHS_12) {
-        double xyz[3];
-        subset_xyz(dir, scheme == SB_SKY_ERROR_WAVELENGTHS_6 ? 6 : 12, xyz);
+    if (scheme == SB_SKY_ERROR_WAVELENGTHS_6 || scheme == SB_SKY_ERROR_WAVELENGTHS_12 ||
+        scheme == SB_SKY_ERROR_SKYBAKE_12) {
+        int n = scheme == SB_SKY_ERROR_WAVELENGTHS_6 ? 6 : 12;
+        double picked[12], xyz[3];
+        for (int i = 0; i < n; i++)
+            picked[i] = scheme == SB_SKY_ERROR_SKYBAKE_12 ? dir->skybake_12[i] : dir->spectral[subset_index(i, n)];
+        subset_xyz(picked, n, xyz);
         sb_mat3_apply(sun_to_rgb, xyz, rgb);
         return;
     }
@@ -303,15 +323,28 @@ enum sb_result sb_sky_error_run(struct sb_vk *vk, const char *scene_name, const 
                              &sun->directions[d].azimuth_deg);
     }
 
-    /* The products the sky reads, baked as a default bake bakes them. */
-    struct sb_image luts[SB_PRODUCT_COUNT] = {0};
-    struct sb_atmosphere_baker *baker = NULL;
-    enum sb_result res = sb_atmosphere_baker_create(vk, &scene->atmosphere, &baker);
-    const enum sb_product_id needed[] = {SB_PRODUCT_TRANSMITTANCE, SB_PRODUCT_MULTISCATTERING,
-                                         SB_PRODUCT_IRRADIANCE_GROUND};
-    for (size_t i = 0; i < sizeof(needed) / sizeof(needed[0]) && !res; i++)
-        res = sb_atmosphere_bake(baker, needed[i], NULL, &luts[needed[i]], NULL, NULL);
-    sb_atmosphere_baker_destroy(&baker);
+    /* The products the sky reads, baked as a default bake bakes them: for
+     * the scene's three channels, and for 12 wavelengths, three a bake. */
+    struct job job = {0};
+    struct sb_image luts[SB_PRODUCT_COUNT] = {0}, twelve_luts[4][SB_PRODUCT_COUNT] = {{{0}}};
+    for (int t = 0; t < 4; t++) {
+        job.twelve[t] = scene->atmosphere;
+        for (int c = 0; c < 3; c++)
+            sb_atmosphere_at_wavelength(&scene->atmosphere, sb_spectrum_nm(subset_index(3 * t + c, 12)), c,
+                                        &job.twelve[t]);
+    }
+    enum sb_result res = SB_OK;
+    for (int b = 0; b < 5 && !res; b++) {
+        const struct sb_atmosphere_params *params_b = b == 0 ? &scene->atmosphere : &job.twelve[b - 1];
+        struct sb_image *out = b == 0 ? luts : twelve_luts[b - 1];
+        struct sb_atmosphere_baker *baker = NULL;
+        res = sb_atmosphere_baker_create(vk, params_b, &baker);
+        const enum sb_product_id needed[] = {SB_PRODUCT_TRANSMITTANCE, SB_PRODUCT_MULTISCATTERING,
+                                             SB_PRODUCT_IRRADIANCE_GROUND};
+        for (size_t i = 0; i < sizeof(needed) / sizeof(needed[0]) && !res; i++)
+            res = sb_atmosphere_bake(baker, needed[i], NULL, &out[needed[i]], NULL, NULL);
+        sb_atmosphere_baker_destroy(&baker);
+    }
     if (res) {
         sb_error("%s: baking the sky's LUTs failed (%s)", scene_name, sb_result_name(res));
         goto done;
@@ -321,7 +354,11 @@ enum sb_result sb_sky_error_run(struct sb_vk *vk, const char *scene_name, const 
             "each",
             scene_name, report->sun_count, SB_SKY_ERROR_DIRECTIONS, report->paths, SB_SPECTRUM_COUNT,
             report->spectral_paths);
-    struct job job = {.params = &scene->atmosphere, .luts = luts, .settings = params, .report = report};
+    job.params = &scene->atmosphere;
+    job.luts = luts;
+    job.settings = params;
+    job.report = report;
+    job.twelve_luts = (const struct sb_image(*)[SB_PRODUCT_COUNT])twelve_luts;
     for (int t = 0; t < TRIPLES; t++) {
         job.spectral[t] = scene->atmosphere;
         for (int c = 0; c < 3; c++)
@@ -334,8 +371,11 @@ enum sb_result sb_sky_error_run(struct sb_vk *vk, const char *scene_name, const 
         summarise(&report->suns[s], scene->atmosphere.solar_irradiance);
 
 done:
-    for (int i = 0; i < SB_ATMOSPHERE_PRODUCT_COUNT; i++)
+    for (int i = 0; i < SB_ATMOSPHERE_PRODUCT_COUNT; i++) {
         sb_image_finish(&luts[i]);
+        for (int t = 0; t < 4; t++)
+            sb_image_finish(&twelve_luts[t][i]);
+    }
     return res;
 }
 
@@ -345,7 +385,7 @@ static const char *channel_name(int c)
 }
 
 static const char *const scheme_names[SB_SKY_ERROR_SCHEME_COUNT] = {
-    "primaries", "converted", "traced_primaries", "traced_converted", "wavelengths_6", "wavelengths_12"};
+    "primaries", "converted", "traced_primaries", "traced_converted", "wavelengths_6", "wavelengths_12", "skybake_12"};
 
 static cJSON *triple(const double v[3])
 {
@@ -430,10 +470,11 @@ void sb_sky_error_print(const struct sb_sky_error_report *reports, int count, bo
         }
         printf("  colour against the spectral path tracer (%d wavelengths, 360 to 830 nm, %d paths each; CIEDE2000 "
                "mean / max):\n  skybake's sky and the three-channel path tracer's, each read as Rec.709 primaries or\n"
-               "  converted (sb_channels_to_rec709); the spectral trace itself read at 6 and 12 wavelengths:\n",
+               "  converted (sb_channels_to_rec709); the spectral trace itself read at 6 and 12 wavelengths;\n"
+               "  skybake's model at 12 wavelengths:\n",
                SB_SPECTRUM_COUNT, r->spectral_paths);
-        printf("  %8s %15s %15s %15s %15s %15s %15s %9s\n", "sun deg", "primaries", "converted", "traced prim.",
-               "traced conv.", "6 wavelengths", "12 wavelengths", "noise");
+        printf("  %8s %15s %15s %15s %15s %15s %15s %15s %9s\n", "sun deg", "primaries", "converted", "traced prim.",
+               "traced conv.", "6 wavelengths", "12 wavelengths", "skybake at 12", "noise");
         for (int s = 0; s < r->sun_count; s++) {
             const struct sb_sky_error_sun *sun = &r->suns[s];
             printf("  %8.4g", sun->elevation_deg);

@@ -50,6 +50,7 @@ struct sb_sky_error_direction {
     double single[3];                         /* its single scattering alone (no ground light) */
     double path_traced[3];                    /* the reference */
     double std_error[3];                      /* the reference's standard error */
+    double skybake_12[12];                    /* skybake's model at SB_SKY_ERROR_SKYBAKE_12's wavelengths */
     double spectral[SB_SPECTRUM_COUNT];       /* the spectral path tracer, per wavelength */
     double spectral_error[SB_SPECTRUM_COUNT]; /* its standard error */
 };
@@ -65,6 +66,9 @@ enum sb_sky_error_scheme {
      * error of a runtime of that many wavelengths whose light were exact */
     SB_SKY_ERROR_WAVELENGTHS_6,
     SB_SKY_ERROR_WAVELENGTHS_12,
+    /* skybake's model (its LUTs baked for each wavelength, read as the
+     * runtime reads them) at those 12 wavelengths, linear between them */
+    SB_SKY_ERROR_SKYBAKE_12,
     SB_SKY_ERROR_SCHEME_COUNT,
 };
 

@@ -313,8 +313,8 @@ check "the cloud table names the reference" grep -q "CPU reference on one core" 
 check "sky-error runs" expect_exit 0 "$skybake" sky-error "$scene" --paths 64 --sun 30 --sun -4 --json -q
 check "sky-error reports both suns" test "$(grep -c '"elevation_deg"' "$tmp/out")" = 2
 check "sky-error reports 16 directions per sun" test "$(grep -c '"zenith_deg"' "$tmp/out")" = 32
-# per sun: against the three-channel path tracer and, six ways, the spectral one
-check "sky-error reports each sun's colour error" test "$(grep -c '"ciede2000_mean"' "$tmp/out")" = 14
+# per sun: against the three-channel path tracer and, seven ways, the spectral one
+check "sky-error reports each sun's colour error" test "$(grep -c '"ciede2000_mean"' "$tmp/out")" = 16
 check "sky-error reports the colour against the spectral path tracer" \
     test "$(grep -c '"traced_converted"' "$tmp/out")" = 2
 check "sky-error reports each view's spectrum" test "$(grep -c '"spectral_std_error"' "$tmp/out")" = 32
