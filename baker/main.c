@@ -38,7 +38,8 @@ static void usage(FILE *f)
 {
     fprintf(f, "usage: skybake bake SCENE -o OUT_DIR [options]\n"
                "       skybake bench [SCENE] [--product NAME]... [--json] [-o DIR] [--repeat N] [--quick]\n"
-               "       skybake sky-error [SCENE]... [--paths N] [--spectral-paths N] [--seed N] [--sun DEG]... [--json]\n"
+               "       skybake sky-error [SCENE]... [--paths N] [--spectral-paths N] [--orders] [--seed N] [--sun DEG]...\n"
+               "                 [--json]\n"
                "       skybake info PACK [--json]\n"
                "       skybake verify PACK [--json]\n"
                "       skybake diff A B [--tol REL] [--floor F] [--json]\n"
@@ -108,7 +109,9 @@ static void usage(FILE *f)
                "CIEDE2000 against the same path tracer and against the path tracer at 48\n"
                "wavelengths, 360 to 830 nm, through the CIE 1931 observer. --paths N per\n"
                "direction and channel (default 16384); --spectral-paths N per direction and\n"
-               "wavelength (default N / 16); --seed N (default 1).\n"
+               "wavelength (default N / 16); --seed N (default 1). --orders: also the sky\n"
+               "with multiple scattering by orders, from its fp64 reference (a minute a\n"
+               "scene on 2 cores).\n"
                "\n"
                "info: what PACK holds (products, sizes, settings and errors, hashes, device,\n"
                "version), after verifying all of it; exit 2 if it is not a valid pack.\n"
@@ -433,6 +436,8 @@ static int cmd_sky_error(int argc, char **argv)
                 return EXIT_USAGE;
             }
             params.spectral_paths = (int)v;
+        } else if (!strcmp(a, "--orders")) {
+            params.orders = true;
         } else if (!strcmp(a, "--seed") && i + 1 < argc) {
             if (!parse_number(argv[++i], 0, 9007199254740992.0, &v) || v != floor(v)) {
                 fprintf(stderr, "skybake: sky-error: --seed takes an integer from 0 to 2^53\n");

@@ -11,6 +11,7 @@
 #include "colour.h"
 #include "json.h"
 #include "log.h"
+#include "orders_ref.h"
 #include "parallel.h"
 #include "pathtrace.h"
 
@@ -60,6 +61,7 @@ struct job {
     /* the scene at SB_SKY_ERROR_SKYBAKE_12's wavelengths, three a medium, and its LUTs */
     struct sb_atmosphere_params twelve[4];
     const struct sb_image (*twelve_luts)[SB_PRODUCT_COUNT];
+    const struct sb_orders_ref *orders; /* NULL unless asked */
 };
 
 /* One (sun, direction, channel), then one (sun, direction, wavelength
@@ -97,6 +99,8 @@ static void run_one(void *user, int index)
                             dir->skybake);
         sb_ref_sky_radiance(job->params, h, mu, mu_s, nu, &job->luts[SB_PRODUCT_TRANSMITTANCE], NULL, NULL, NULL,
                             dir->single);
+        if (job->orders)
+            sb_orders_ref_sky(job->orders, h, mu, mu_s, nu, dir->orders, NULL);
         for (int t = 0; t < 4; t++) {
             const struct sb_image *l = job->twelve_luts[t];
             double rgb[3];
@@ -296,6 +300,21 @@ static void summarise(struct sb_sky_error_sun *sun, const double solar[3])
             }
         }
     sun->rms_rel = n ? sqrt(sum2 / n) : 0;
+    double o_sum = 0, o_sum2 = 0;
+    sun->orders_max_rel = 0;
+    for (int d = 0; d < SB_SKY_ERROR_DIRECTIONS; d++)
+        for (int c = 0; c < 3; c++) {
+            const struct sb_sky_error_direction *dir = &sun->directions[d];
+            double ref = fmax(dir->path_traced[c], floor[c]);
+            if (!(ref > 0))
+                continue;
+            double rel = (dir->orders[c] - dir->path_traced[c]) / ref;
+            sun->orders_max_rel = fmax(sun->orders_max_rel, fabs(rel));
+            o_sum += rel;
+            o_sum2 += rel * rel;
+        }
+    sun->orders_rms_rel = n ? sqrt(o_sum2 / n) : 0;
+    sun->orders_mean_rel = n ? o_sum / n : 0;
     sun->mean_rel = n ? sum / n : 0;
     sun->multiple_share = lit ? share / lit : 0;
     summarise_colour(sun);
@@ -354,6 +373,19 @@ enum sb_result sb_sky_error_run(struct sb_vk *vk, const char *scene_name, const 
             "each",
             scene_name, report->sun_count, SB_SKY_ERROR_DIRECTIONS, report->paths, SB_SPECTRUM_COUNT,
             report->spectral_paths);
+    struct sb_orders_ref *orders = NULL;
+    if (params->orders) {
+        double t_orders = sb_now_s();
+        orders = sb_orders_ref_create(&scene->atmosphere, NULL);
+        if (!orders) {
+            res = SB_ERR_NOMEM;
+            sb_error("%s: the orders' reference: out of memory", scene_name);
+            goto done;
+        }
+        report->orders = sb_orders_ref_orders(orders);
+        report->orders_s = sb_now_s() - t_orders;
+        job.orders = orders;
+    }
     job.params = &scene->atmosphere;
     job.luts = luts;
     job.settings = params;
@@ -371,6 +403,7 @@ enum sb_result sb_sky_error_run(struct sb_vk *vk, const char *scene_name, const 
         summarise(&report->suns[s], scene->atmosphere.solar_irradiance);
 
 done:
+    sb_orders_ref_destroy(&orders);
     for (int i = 0; i < SB_ATMOSPHERE_PRODUCT_COUNT; i++) {
         sb_image_finish(&luts[i]);
         for (int t = 0; t < 4; t++)
@@ -414,6 +447,11 @@ void sb_sky_error_print(const struct sb_sky_error_report *reports, int count, bo
                 cJSON_AddNumberToObject(so, "mean_rel", sun->mean_rel);
                 cJSON_AddNumberToObject(so, "noise", sun->noise);
                 cJSON_AddNumberToObject(so, "multiple_share", sun->multiple_share);
+                if (r->orders) {
+                    cJSON_AddNumberToObject(so, "orders_max_rel", sun->orders_max_rel);
+                    cJSON_AddNumberToObject(so, "orders_rms_rel", sun->orders_rms_rel);
+                    cJSON_AddNumberToObject(so, "orders_mean_rel", sun->orders_mean_rel);
+                }
                 cJSON_AddNumberToObject(so, "ciede2000_mean", sun->de_mean);
                 cJSON_AddNumberToObject(so, "ciede2000_max", sun->de_max);
                 cJSON_AddNumberToObject(so, "ciede2000_noise", sun->de_noise);
@@ -458,6 +496,16 @@ void sb_sky_error_print(const struct sb_sky_error_report *reports, int count, bo
             printf("  %8.4g %9.3g %9.3g %+9.2g %9.2g %8.1f%%  %g, %g deg, %s\n", sun->elevation_deg, sun->max_rel,
                    sun->rms_rel, sun->mean_rel, sun->noise, 100 * sun->multiple_share, w->zenith_deg, w->azimuth_deg,
                    channel_name(sun->worst_channel));
+        }
+        if (r->orders) {
+            printf("  with multiple scattering by orders (fp64 reference, %d orders, %.1f s):\n", r->orders,
+                   r->orders_s);
+            printf("  %8s %9s %9s %9s\n", "sun deg", "max rel", "rms rel", "mean rel");
+            for (int s = 0; s < r->sun_count; s++) {
+                const struct sb_sky_error_sun *sun = &r->suns[s];
+                printf("  %8.4g %9.3g %9.3g %+9.2g\n", sun->elevation_deg, sun->orders_max_rel, sun->orders_rms_rel,
+                       sun->orders_mean_rel);
+            }
         }
         printf(
             "  colour, CIEDE2000 over the views of the sky (linear Rec.709, D65 at the brightest view's luminance):\n");

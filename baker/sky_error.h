@@ -38,6 +38,7 @@ struct sb_sky_error_params {
     int spectral_paths; /* per direction and wavelength; 0: paths / 16 (the same work as the
                            three channels' trace), at least 32 */
     uint64_t seed;      /* the path tracer's */
+    bool orders;        /* also the sky with multiple scattering by orders (orders_ref.h) */
     int sun_count;      /* 0: 90, 30, 10, 2 and -4 degrees */
     double sun_elevation_deg[SB_SKY_ERROR_MAX_SUNS];
 };
@@ -50,6 +51,7 @@ struct sb_sky_error_direction {
     double single[3];                         /* its single scattering alone (no ground light) */
     double path_traced[3];                    /* the reference */
     double std_error[3];                      /* the reference's standard error */
+    double orders[3];                         /* the sky with orders 2 and up from orders_ref.h */
     double skybake_12[12];                    /* skybake's model at SB_SKY_ERROR_SKYBAKE_12's wavelengths */
     double spectral[SB_SPECTRUM_COUNT];       /* the spectral path tracer, per wavelength */
     double spectral_error[SB_SPECTRUM_COUNT]; /* its standard error */
@@ -84,7 +86,8 @@ struct sb_sky_error_sun {
      * 1e-3 of the sun's brightest value in that channel): */
     double max_rel, rms_rel, mean_rel; /* mean_rel is signed: skybake above the reference > 0 */
     int worst_direction, worst_channel;
-    double noise; /* the largest 2 standard errors, relative */
+    double noise;                                           /* the largest 2 standard errors, relative */
+    double orders_max_rel, orders_rms_rel, orders_mean_rel; /* the same for the orders' sky */
     /* Colour: CIEDE2000 between the two skies over the views of the sky (not
      * the ground), each rgb taken as linear Rec.709 as the runtime shows
      * it, in CIELAB against D65 at the luminance of the path tracer's
@@ -108,6 +111,8 @@ struct sb_sky_error_report {
     int sun_count;
     struct sb_sky_error_sun suns[SB_SKY_ERROR_MAX_SUNS];
     double path_trace_s; /* wall time of the path tracer, three channels and spectral */
+    int orders;          /* with params.orders: the orders the reference summed, */
+    double orders_s;     /* and its wall time */
 };
 
 /* Bake and compare; the report is the caller's (no resources to free). */

@@ -1,0 +1,75 @@
+/*
+ * Multiple scattering by orders in fp64 (Bruneton and Neyret 2008, as
+ * Bruneton 2017 restates it): the reference of issue 50's orders product,
+ * written from the definitions, not from the GPU kernels.
+ *
+ * The table holds, on a grid of (r, mu, mu_s, nu), the radiance reaching r
+ * along the view (cosine mu to the vertical) from light scattered two times
+ * or more in the air on its way there, summed over orders 2 to N; ground
+ * bounces count as orders too (a ground bounce then a scattering is
+ * order 2). Order k at a point is the integral along the view ray of the
+ * transmittance times the scattering density J_k, the phase-weighted
+ * integral over the sphere of order k - 1's radiance at that point (the
+ * ground's, where a direction ends on it: albedo / pi times its irradiance
+ * of order k - 2, the direct sun being order 0). Orders are added until one
+ * adds less than `tolerance` of what is there anywhere on the grid, or
+ * `max_order` is reached. The ground's irradiance of every order is kept
+ * too, so that a view that ends on the ground can be lit by all of it.
+ *
+ * The grid (all nodes on the edges of their ranges):
+ * - r: altitudes in a geometric progression from the ground to the top, the
+ *   first step a quarter of the smaller scale height (the nodes follow the
+ *   air however thick the atmosphere);
+ * - mu: two halves, rays that end on the ground and rays that leave the
+ *   atmosphere, each uniform in the ray's length between its extremes
+ *   (straight down or up, and the horizon), as Bruneton's mapping;
+ * - mu_s: half the nodes uniform from -H / top (H = sqrt(top^2 - R^2):
+ *   below it no point of the atmosphere sees the sun) to 0.1, the rest on
+ *   to 1; read linearly, but geometrically between two nodes below the
+ *   horizon, where twilight falls exponentially;
+ * - nu: the sun's azimuth about the vertical from the view's, uniform over
+ *   [0, pi] (every node a real direction).
+ * Between nodes, multilinear otherwise. The density's integral over the
+ * sphere takes Rayleigh's part on Gauss-Legendre nodes on either side of
+ * the horizon, and Mie's at quantiles of Henyey-Greenstein's scattering
+ * angle about the view (weighted by Cornette-Shanks over it), so that a
+ * narrow forward peak (g = 0.99) is resolved. The sun's transmittance and the views' come
+ * from an fp64 table of the optical depth to the top (1024 x 256, the
+ * transmittance LUT's mapping, bilinear in depth), within 2e-4 of exact.
+ * The sun is a point: its light stops where the planet hides its centre,
+ * as in the path tracer.
+ */
+#ifndef SB_BAKER_ORDERS_REF_H
+#define SB_BAKER_ORDERS_REF_H
+
+#include <stdbool.h>
+
+#include "scene.h"
+
+struct sb_orders_settings {
+    int r, mu, mu_s, nu; /* nodes; 0: 16, 64, 24, 8 (mu even) */
+    int max_order;       /* 0: 16 */
+    double tolerance;    /* 0: 1e-3 */
+};
+
+struct sb_orders_ref; /* opaque */
+
+/* Compute the orders; NULL on failure (memory). Uses every core. */
+struct sb_orders_ref *sb_orders_ref_create(const struct sb_atmosphere_params *p, const struct sb_orders_settings *s);
+void sb_orders_ref_destroy(struct sb_orders_ref **ref);
+
+/* The orders computed, and the largest share of the last one (what it
+ * added over what was there, at the node where that was largest). */
+int sb_orders_ref_orders(const struct sb_orders_ref *ref);
+double sb_orders_ref_last_share(const struct sb_orders_ref *ref);
+
+/* The sky's radiance seen from altitude h (km) along (mu, mu_s, nu), in
+ * solar_irradiance's unit per steradian: single scattering integrated
+ * exactly, orders 2 and up from the table, and where the view ends on the
+ * ground the ground lit by the sun and every order of the sky. Above the
+ * atmosphere the view starts where it enters it. `multiple`, when not
+ * NULL, receives the orders' share alone. */
+void sb_orders_ref_sky(const struct sb_orders_ref *ref, double h, double mu, double mu_s, double nu, double out[3],
+                       double multiple[3]);
+
+#endif
