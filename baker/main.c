@@ -38,8 +38,8 @@ static void usage(FILE *f)
 {
     fprintf(f, "usage: skybake bake SCENE -o OUT_DIR [options]\n"
                "       skybake bench [SCENE] [--product NAME]... [--json] [-o DIR] [--repeat N] [--quick]\n"
-               "       skybake sky-error [SCENE]... [--paths N] [--spectral-paths N] [--orders] [--seed N] [--sun DEG]...\n"
-               "                 [--json]\n"
+               "       skybake sky-error [SCENE]... [--paths N] [--spectral-paths N] [--orders] [--orders-grid R,MU,MUS,NU]\n"
+               "                 [--seed N] [--sun DEG]... [--json]\n"
                "       skybake info PACK [--json]\n"
                "       skybake verify PACK [--json]\n"
                "       skybake diff A B [--tol REL] [--floor F] [--json]\n"
@@ -111,7 +111,8 @@ static void usage(FILE *f)
                "direction and channel (default 16384); --spectral-paths N per direction and\n"
                "wavelength (default N / 16); --seed N (default 1). --orders: also the sky\n"
                "with multiple scattering by orders, from its fp64 reference (a minute a\n"
-               "scene on 2 cores).\n"
+               "scene on 2 cores), --orders-grid R,MU,MUS,NU on a grid of its nodes\n"
+               "(default 16,64,24,8).\n"
                "\n"
                "info: what PACK holds (products, sizes, settings and errors, hashes, device,\n"
                "version), after verifying all of it; exit 2 if it is not a valid pack.\n"
@@ -437,6 +438,17 @@ static int cmd_sky_error(int argc, char **argv)
             }
             params.spectral_paths = (int)v;
         } else if (!strcmp(a, "--orders")) {
+            params.orders = true;
+        } else if (!strcmp(a, "--orders-grid") && i + 1 < argc) {
+            struct sb_orders_settings *g = &params.orders_grid;
+            char tail;
+            if (sscanf(argv[++i], "%d,%d,%d,%d%c", &g->r, &g->mu, &g->mu_s, &g->nu, &tail) != 4 || g->r < 2 ||
+                g->r > 64 || g->mu < 4 || g->mu > 1024 || g->mu % 2 || g->mu_s < 4 || g->mu_s > 256 || g->nu < 2 ||
+                g->nu > 64) {
+                fprintf(stderr, "skybake: sky-error: --orders-grid takes R,MU,MUS,NU: nodes in altitude (2 to 64), view "
+                                "cosine (even, 4 to 1024), sun cosine (4 to 256) and azimuth (2 to 64)\n");
+                return EXIT_USAGE;
+            }
             params.orders = true;
         } else if (!strcmp(a, "--seed") && i + 1 < argc) {
             if (!parse_number(argv[++i], 0, 9007199254740992.0, &v) || v != floor(v)) {

@@ -376,7 +376,7 @@ enum sb_result sb_sky_error_run(struct sb_vk *vk, const char *scene_name, const 
     struct sb_orders_ref *orders = NULL;
     if (params->orders) {
         double t_orders = sb_now_s();
-        orders = sb_orders_ref_create(&scene->atmosphere, NULL);
+        orders = sb_orders_ref_create(&scene->atmosphere, &params->orders_grid);
         if (!orders) {
             res = SB_ERR_NOMEM;
             sb_error("%s: the orders' reference: out of memory", scene_name);
@@ -472,6 +472,8 @@ void sb_sky_error_print(const struct sb_sky_error_report *reports, int count, bo
                     cJSON_AddItemToObject(dobj, "single", triple(dir->single));
                     cJSON_AddItemToObject(dobj, "path_traced", triple(dir->path_traced));
                     cJSON_AddItemToObject(dobj, "std_error", triple(dir->std_error));
+                    if (r->orders)
+                        cJSON_AddItemToObject(dobj, "orders", triple(dir->orders));
                     cJSON_AddItemToObject(dobj, "spectral", cJSON_CreateDoubleArray(dir->spectral, SB_SPECTRUM_COUNT));
                     cJSON_AddItemToObject(dobj, "spectral_std_error",
                                           cJSON_CreateDoubleArray(dir->spectral_error, SB_SPECTRUM_COUNT));

@@ -27,6 +27,7 @@
 #include <stdint.h>
 
 #include "context.h"
+#include "orders_ref.h"
 #include "scene.h"
 #include "spectrum.h"
 
@@ -34,12 +35,13 @@
 #define SB_SKY_ERROR_DIRECTIONS 16
 
 struct sb_sky_error_params {
-    int paths;          /* per direction and channel; 0: 16384 */
-    int spectral_paths; /* per direction and wavelength; 0: paths / 16 (the same work as the
-                           three channels' trace), at least 32 */
-    uint64_t seed;      /* the path tracer's */
-    bool orders;        /* also the sky with multiple scattering by orders (orders_ref.h) */
-    int sun_count;      /* 0: 90, 30, 10, 2 and -4 degrees */
+    int paths;                             /* per direction and channel; 0: 16384 */
+    int spectral_paths;                    /* per direction and wavelength; 0: paths / 16 (the same work as the
+                                              three channels' trace), at least 32 */
+    uint64_t seed;                         /* the path tracer's */
+    bool orders;                           /* also the sky with multiple scattering by orders (orders_ref.h), */
+    struct sb_orders_settings orders_grid; /* on this grid (zeros: the default) */
+    int sun_count;                         /* 0: 90, 30, 10, 2 and -4 degrees */
     double sun_elevation_deg[SB_SKY_ERROR_MAX_SUNS];
 };
 

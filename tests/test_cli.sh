@@ -320,7 +320,8 @@ check "sky-error reports the colour against the spectral path tracer" \
 check "sky-error reports each view's spectrum" test "$(grep -c '"spectral_std_error"' "$tmp/out")" = 32
 # cJSON writes NaN and Inf as null
 check "sky-error values are finite" test -z "$(grep -Ei 'nan|inf|null' "$tmp/out")"
-for bad in '--paths 8' '--paths x' '--paths 100.5' '--spectral-paths 8' '--sun 91' '--sun' '--seed -1'; do
+for bad in '--paths 8' '--paths x' '--paths 100.5' '--spectral-paths 8' '--orders-grid 3,5,4,4' \
+    '--orders-grid 16,64,24' '--sun 91' '--sun' '--seed -1'; do
     # shellcheck disable=SC2086 # split on purpose
     check "sky-error refuses $bad" expect_exit 2 "$skybake" sky-error "$scene" $bad
 done
