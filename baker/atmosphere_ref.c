@@ -52,11 +52,7 @@ static void gl_init(void)
 
 /* ---- Medium ------------------------------------------------------------------ */
 
-struct medium {
-    double rayleigh[3], mie[3], extinction[3];
-};
-
-static void medium(const struct sb_atmosphere_params *p, double h, struct medium *m)
+void sb_ref_medium(const struct sb_atmosphere_params *p, double h, struct sb_ref_medium *m)
 {
     double dr = exp(-h / p->rayleigh_scale_height_km);
     double dm = exp(-h / p->mie_scale_height_km);
@@ -71,12 +67,12 @@ static void medium(const struct sb_atmosphere_params *p, double h, struct medium
     }
 }
 
-static double phase_rayleigh(double nu)
+double sb_ref_phase_rayleigh(double nu)
 {
     return 3.0 / (16.0 * REF_PI) * (1.0 + nu * nu);
 }
 
-static double phase_mie(double g, double nu)
+double sb_ref_phase_mie(double g, double nu)
 {
     double k = 3.0 / (8.0 * REF_PI) * (1.0 - g * g) / (2.0 + g * g);
     return k * (1.0 + nu * nu) / pow(1.0 + g * g - 2.0 * g * nu, 1.5);
@@ -177,8 +173,8 @@ void sb_ref_optical_depth(const struct sb_atmosphere_params *p, double r, double
             double a = br[i] + s * step, half = 0.5 * step;
             for (int k = 0; k < 16; k++) {
                 double t = a + half * (1.0 + gl16.x[k]);
-                struct medium md;
-                medium(p, radius_at(r, mu, t) - p->ground_radius_km, &md);
+                struct sb_ref_medium md;
+                sb_ref_medium(p, radius_at(r, mu, t) - p->ground_radius_km, &md);
                 for (int c = 0; c < 3; c++)
                     out[c] += half * gl16.w[k] * md.extinction[c];
             }
@@ -342,14 +338,14 @@ static void integrate_ray(const struct sb_atmosphere_params *p, double r0, doubl
         double half = 0.5 * (br[s + 1] - br[s]);
         if (half <= 0)
             continue;
-        struct medium m[8];
+        struct sb_ref_medium m[8];
         double sun[8][3], psi[8][3];
         for (int j = 0; j < 8; j++) {
             double t = br[s] + half * (1 + gl8.x[j]);
             double rt = radius_at(r0, mu, t);
             double h = fmax(rt - R, 0.0);
             double mus = fmax(-1.0, fmin(1.0, (r0 * mu_s + t * nu) / rt));
-            medium(p, h, &m[j]);
+            sb_ref_medium(p, h, &m[j]);
             if (hits_ground(p, rt, mus)) {
                 sun[j][0] = sun[j][1] = sun[j][2] = 0;
             } else if (t_lut) {
@@ -793,9 +789,10 @@ void sb_ref_irradiance_ground(const struct sb_atmosphere_params *p, double h, do
         const struct direction *d = &dirs[i];
         struct ray_sums rs;
         integrate_ray(p, r, d->mu, mu_s, d->nu, false, ms_lut, NULL, &q, &rs);
-        double w = d->weight * d->mu, mie = phase_mie(p->mie_g, d->nu) * (1 - cap_window(p, false, d->nu));
+        double w = d->weight * d->mu, mie = sb_ref_phase_mie(p->mie_g, d->nu) * (1 - cap_window(p, false, d->nu));
         for (int c = 0; c < 3; c++)
-            sky[c] += w * (p->solar_irradiance[c] * (rs.sun_rayleigh[c] * phase_rayleigh(d->nu) + rs.sun_mie[c] * mie) +
+            sky[c] += w * (p->solar_irradiance[c] *
+                               (rs.sun_rayleigh[c] * sb_ref_phase_rayleigh(d->nu) + rs.sun_mie[c] * mie) +
                            rs.ms_rayleigh[c] + rs.ms_mie[c]);
     }
     free(dirs);
@@ -816,7 +813,7 @@ void sb_ref_irradiance_sky(const struct sb_atmosphere_params *p, double h, doubl
     for (int i = 0; i < n; i++) {
         const struct direction *d = &dirs[i];
         double w = d->weight / (4 * REF_PI), nu = d->nu;
-        double mie = phase_mie(p->mie_g, nu) * (1 - cap_window(p, true, nu));
+        double mie = sb_ref_phase_mie(p->mie_g, nu) * (1 - cap_window(p, true, nu));
         struct ray_sums rs;
         integrate_ray(p, r, d->mu, mu_s, nu, d->ground, ms_lut, NULL, &q, &rs);
         double eg[3] = {0};
@@ -825,7 +822,7 @@ void sb_ref_irradiance_sky(const struct sb_atmosphere_params *p, double h, doubl
             lut_log_cubic(ig_lut, mu_sp * 0.5 + 0.5, 0.0, 3, eg); /* direct + sky */
         }
         for (int c = 0; c < 3; c++) {
-            out[c] += w * (p->solar_irradiance[c] * rs.sun_rayleigh[c] * phase_rayleigh(nu) + rs.ms_rayleigh[c]);
+            out[c] += w * (p->solar_irradiance[c] * rs.sun_rayleigh[c] * sb_ref_phase_rayleigh(nu) + rs.ms_rayleigh[c]);
             out[3 + c] += w * (p->solar_irradiance[c] * rs.sun_mie[c] * mie + rs.ms_mie[c]);
             if (d->ground)
                 out[6 + c] += w * rs.transmittance[c] * p->ground_albedo[c] / REF_PI * eg[c];
@@ -867,7 +864,7 @@ void sb_ref_sky_radiance(const struct sb_atmosphere_params *p, double h, double 
     }
     for (int c = 0; c < 3; c++) {
         out[c] = p->solar_irradiance[c] *
-                     (rs.sun_rayleigh[c] * phase_rayleigh(nu) + rs.sun_mie[c] * phase_mie(p->mie_g, nu)) +
+                     (rs.sun_rayleigh[c] * sb_ref_phase_rayleigh(nu) + rs.sun_mie[c] * sb_ref_phase_mie(p->mie_g, nu)) +
                  rs.ms_rayleigh[c] + rs.ms_mie[c];
         if (ground && ig_lut)
             out[c] += rs.transmittance[c] * p->ground_albedo[c] / REF_PI * eg[c];

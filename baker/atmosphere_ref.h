@@ -28,6 +28,18 @@ struct sb_ref_quality {
  * fp64 rounding). */
 void sb_ref_transmittance(const struct sb_atmosphere_params *p, double r, double mu, int subdivisions, double out[3]);
 
+/* The media at altitude h (km), per km: Rayleigh's and Mie's scattering,
+ * and the extinction with Mie's and ozone's absorption. */
+struct sb_ref_medium {
+    double rayleigh[3], mie[3], extinction[3];
+};
+void sb_ref_medium(const struct sb_atmosphere_params *p, double h, struct sb_ref_medium *m);
+
+/* The phase functions at the cosine nu of the scattering angle: Rayleigh's,
+ * and Cornette-Shanks's with asymmetry g. */
+double sb_ref_phase_rayleigh(double nu);
+double sb_ref_phase_mie(double g, double nu);
+
 /* The n-point Gauss-Legendre rule on [a, b]: nodes x[n] ascending, weights w[n]. */
 void sb_ref_gauss_legendre(int n, double a, double b, double *x, double *w);
 

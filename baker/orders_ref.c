@@ -44,34 +44,7 @@ struct sb_orders_ref {
     double gl_mie_x[MIE_U], gl_mie_w[MIE_U];
 };
 
-/* ---- The medium and the optical depth ------------------------------------------ */
-
-struct medium {
-    double rayleigh[3], mie[3], extinction[3];
-};
-
-static void medium_at(const struct sb_atmosphere_params *p, double h, struct medium *m)
-{
-    double dr = exp(-h / p->rayleigh_scale_height_km), dm = exp(-h / p->mie_scale_height_km);
-    double oz = fmax(0.0, 1.0 - fabs(h - p->ozone_center_km) / p->ozone_half_width_km);
-    for (int c = 0; c < 3; c++) {
-        m->rayleigh[c] = p->rayleigh_scattering_per_km[c] * dr;
-        m->mie[c] = p->mie_scattering_per_km[c] * dm;
-        m->extinction[c] = m->rayleigh[c] + (p->mie_scattering_per_km[c] + p->mie_absorption_per_km[c]) * dm +
-                           p->ozone_absorption_per_km[c] * oz;
-    }
-}
-
-static double phase_rayleigh(double nu)
-{
-    return 3.0 / (16.0 * ORD_PI) * (1.0 + nu * nu);
-}
-
-static double phase_mie(double g, double nu)
-{
-    double d = 1.0 + g * g - 2.0 * g * nu;
-    return 3.0 / (8.0 * ORD_PI) * (1.0 - g * g) * (1.0 + nu * nu) / ((2.0 + g * g) * d * sqrt(d));
-}
+/* ---- The optical depth -------------------------------------------------------- */
 
 static double clamp1(double x)
 {
@@ -351,10 +324,10 @@ static void single_along(const struct sb_orders_ref *o, double r, double mu, boo
             double t = 0.5 * (a + b) + 0.5 * (b - a) * o->gl_ray_x[k], w = 0.5 * (b - a) * o->gl_ray_w[k];
             double rt = sqrt(fmax(r * r + t * t + 2 * r * mu * t, 0.0)), mu_s_t = clamp1((r * mu_s + t * nu) / rt);
             double tv[3], ts[3];
-            struct medium m;
+            struct sb_ref_medium m;
             transmittance_along(o, r, mu, ground, t, tv);
             sunlight(o, rt, mu_s_t, ts);
-            medium_at(&o->p, fmax(rt - o->R, 0.0), &m);
+            sb_ref_medium(&o->p, fmax(rt - o->R, 0.0), &m);
             for (int c = 0; c < 3; c++) {
                 ray[c] += w * tv[c] * ts[c] * m.rayleigh[c];
                 mie[c] += w * tv[c] * ts[c] * m.mie[c];
@@ -425,7 +398,7 @@ static void previous_radiance(const struct sb_orders_ref *o, int k, double r, do
         double a[3], b[3];
         lookup(o, o->single_r, r, mu, mu_s, nu, ground, a);
         lookup(o, o->single_m, r, mu, mu_s, nu, ground, b);
-        double pr = phase_rayleigh(nu), pm = phase_mie(o->p.mie_g, nu);
+        double pr = sb_ref_phase_rayleigh(nu), pm = sb_ref_phase_mie(o->p.mie_g, nu);
         for (int c = 0; c < 3; c++)
             out[c] = pr * a[c] + pm * b[c];
     } else {
@@ -457,8 +430,8 @@ static void density_row(void *user, int row)
         double sv = sqrt(fmax(1 - mu * mu, 0.0)), ss = sqrt(fmax(1 - mu_s * mu_s, 0.0));
         double phi_s = ORD_PI * (double)(i % (size_t)o->nnu) / (o->nnu - 1);
         double view[3] = {sv, 0.0, mu}, sun[3] = {ss * cos(phi_s), ss * sin(phi_s), mu_s};
-        struct medium m;
-        medium_at(&o->p, fmax(r - o->R, 0.0), &m);
+        struct sb_ref_medium m;
+        sb_ref_medium(&o->p, fmax(r - o->R, 0.0), &m);
         double horizon = -sqrt(fmax(r * r - o->R * o->R, 0.0)) / r, j[3] = {0, 0, 0};
         for (int side = 0; side < 2; side++) {
             int n = side ? SPHERE_SKY : SPHERE_GROUND;
@@ -473,7 +446,7 @@ static void density_row(void *user, int row)
                     double nu_in = clamp1(in[0] * sun[0] + in[1] * sun[1] + in[2] * sun[2]);
                     double cos_scatter = clamp1(in[0] * view[0] + in[1] * view[1] + in[2] * view[2]), l[3];
                     previous_radiance(o, job->k, r, mu_in, mu_s, nu_in, job->ground_previous, l);
-                    double w = w_mu * 2 * ORD_PI / SPHERE_PHI * phase_rayleigh(cos_scatter);
+                    double w = w_mu * 2 * ORD_PI / SPHERE_PHI * sb_ref_phase_rayleigh(cos_scatter);
                     for (int c = 0; c < 3; c++)
                         j[c] += w * m.rayleigh[c] * l[c];
                 }
@@ -487,12 +460,12 @@ static void density_row(void *user, int row)
             double u = 0.5 + 0.5 * o->gl_mie_x[q], w_u = 0.5 * o->gl_mie_w[q], c_s, ratio;
             if (fabs(g) < 1e-3) {
                 c_s = 2 * u - 1;
-                ratio = 4 * ORD_PI * phase_mie(g, c_s);
+                ratio = 4 * ORD_PI * sb_ref_phase_mie(g, c_s);
             } else {
                 double k = (1 - g * g) / (1 - g + 2 * g * u);
                 c_s = clamp1((1 + g * g - k * k) / (2 * g));
                 double d = 1 + g * g - 2 * g * c_s;
-                ratio = phase_mie(g, c_s) / ((1 - g * g) / (4 * ORD_PI * d * sqrt(d)));
+                ratio = sb_ref_phase_mie(g, c_s) / ((1 - g * g) / (4 * ORD_PI * d * sqrt(d)));
             }
             double s_s = sqrt(fmax(1 - c_s * c_s, 0.0));
             for (int f = 0; f < MIE_PHI; f++) {
@@ -557,7 +530,7 @@ static void ground_row(void *user, int ims)
                 lookup(o, o->single_r, r, mu, mu_s, nu, false, a);
                 lookup(o, o->single_m, r, mu, mu_s, nu, false, b);
                 for (int c = 0; c < 3; c++)
-                    l[c] = phase_rayleigh(nu) * a[c] + phase_mie(o->p.mie_g, nu) * b[c];
+                    l[c] = sb_ref_phase_rayleigh(nu) * a[c] + sb_ref_phase_mie(o->p.mie_g, nu) * b[c];
             } else {
                 lookup(o, o->order, r, mu, mu_s, nu, false, l);
             }
@@ -693,7 +666,7 @@ void sb_orders_ref_sky(const struct sb_orders_ref *o, double h, double mu, doubl
     single_along(o, r, mu, ground, mu_s, nu, ray, mie);
     lookup(o, o->sum, r, mu, mu_s, nu, ground, ms);
     for (int c = 0; c < 3; c++)
-        out[c] = phase_rayleigh(nu) * ray[c] + phase_mie(o->p.mie_g, nu) * mie[c] + ms[c];
+        out[c] = sb_ref_phase_rayleigh(nu) * ray[c] + sb_ref_phase_mie(o->p.mie_g, nu) * mie[c] + ms[c];
     if (multiple)
         memcpy(multiple, ms, sizeof(ms));
     if (ground) {
