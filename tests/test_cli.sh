@@ -320,6 +320,12 @@ check "sky-error reports the colour against the spectral path tracer" \
 check "sky-error reports each view's spectrum" test "$(grep -c '"spectral_std_error"' "$tmp/out")" = 32
 # cJSON writes NaN and Inf as null
 check "sky-error values are finite" test -z "$(grep -Ei 'nan|inf|null' "$tmp/out")"
+# the orders' reference on a small grid: its section, every view's sky
+check "sky-error --orders runs" expect_exit 0 "$skybake" sky-error "$scene" --paths 64 --sun 30 --orders-grid 4,8,4,4 \
+    --json -q
+check "sky-error --orders reports the orders' error" test "$(grep -c '"orders_rms_rel"' "$tmp/out")" = 1
+check "sky-error --orders reports each view's sky" test "$(grep -c '"orders"' "$tmp/out")" = 16
+check "sky-error --orders values are finite" test -z "$(grep -Ei 'nan|inf|null' "$tmp/out")"
 for bad in '--paths 8' '--paths x' '--paths 100.5' '--spectral-paths 8' '--orders-grid 3,5,4,4' \
     '--orders-grid 16,64,24' '--sun 91' '--sun' '--seed -1'; do
     # shellcheck disable=SC2086 # split on purpose
