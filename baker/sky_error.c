@@ -124,6 +124,37 @@ static void view_lab(const double m[3][3], const double white[3], const double r
     sb_xyz_to_lab(xyz, white, lab);
 }
 
+/* The colour statistics: a view's difference added (view n of those counted). */
+static void colour_add(struct sb_sky_error_colour *stats, double de, int direction, int n)
+{
+    stats->mean += de;
+    if (de > stats->max || n == 0) {
+        stats->max = de;
+        stats->worst_direction = direction;
+    }
+}
+
+/* The largest CIEDE2000 from the reference's `ref` (Lab) that moving one
+ * component of `base` by 2 `sigma` makes, base taken to linear Rec.709 by
+ * `to_rgb` (NULL: it is). */
+static double colour_noise(const double base[3], const double sigma[3], const double to_rgb[3][3],
+                           const double to_xyz[3][3], const double white[3], const double ref[3])
+{
+    double worst = 0.0;
+    for (int c = 0; c < 3; c++)
+        for (int sign = -1; sign <= 1; sign += 2) {
+            double moved[3] = {base[0], base[1], base[2]}, rgb[3], lab[3];
+            moved[c] = fmax(moved[c] + sign * 2 * sigma[c], 0.0);
+            if (to_rgb)
+                sb_mat3_apply(to_rgb, moved, rgb);
+            else
+                memcpy(rgb, moved, sizeof(rgb));
+            view_lab(to_xyz, white, rgb, lab);
+            worst = fmax(worst, sb_ciede2000(lab, ref));
+        }
+    return worst;
+}
+
 static void summarise_colour(struct sb_sky_error_sun *sun)
 {
     double m[3][3], white[3], y_max = 0;
@@ -134,8 +165,8 @@ static void summarise_colour(struct sb_sky_error_sun *sun)
             y_max = fmax(y_max, m[1][0] * pt[0] + m[1][1] * pt[1] + m[1][2] * pt[2]);
     }
     sb_mat3_apply(m, (const double[3]){y_max, y_max, y_max}, white);
-    sun->de_mean = sun->de_max = sun->de_noise = 0;
-    sun->de_worst_direction = 0;
+    struct sb_sky_error_colour stats = {0};
+    sun->de_noise = 0;
     int n = 0;
     for (int d = 0; y_max > 0 && d < SB_SKY_ERROR_DIRECTIONS; d++) {
         const struct sb_sky_error_direction *dir = &sun->directions[d];
@@ -144,22 +175,12 @@ static void summarise_colour(struct sb_sky_error_sun *sun)
         double ours[3], ref[3];
         view_lab(m, white, dir->skybake, ours);
         view_lab(m, white, dir->path_traced, ref);
-        double de = sb_ciede2000(ours, ref);
-        sun->de_mean += de;
-        if (de > sun->de_max || n == 0) {
-            sun->de_max = de;
-            sun->de_worst_direction = d;
-        }
-        n++;
-        for (int c = 0; c < 3; c++)
-            for (int sign = -1; sign <= 1; sign += 2) {
-                double moved[3] = {dir->path_traced[0], dir->path_traced[1], dir->path_traced[2]}, lab[3];
-                moved[c] = fmax(moved[c] + sign * 2 * dir->std_error[c], 0.0);
-                view_lab(m, white, moved, lab);
-                sun->de_noise = fmax(sun->de_noise, sb_ciede2000(lab, ref));
-            }
+        colour_add(&stats, sb_ciede2000(ours, ref), d, n++);
+        sun->de_noise = fmax(sun->de_noise, colour_noise(dir->path_traced, dir->std_error, NULL, m, white, ref));
     }
-    sun->de_mean = n ? sun->de_mean / n : 0;
+    sun->de_mean = n ? stats.mean / n : 0;
+    sun->de_max = stats.max;
+    sun->de_worst_direction = stats.worst_direction;
 }
 
 /* Wavelength i of n spread evenly over the grid from 380 to 810 nm. */
@@ -243,27 +264,14 @@ static void summarise_spectral(struct sb_sky_error_sun *sun, const double solar[
         double ref[3], lab[3], rgb[3];
         view_lab(to_xyz, white, ref_rgb[d], ref);
         for (int scheme = 0; scheme < SB_SKY_ERROR_SCHEME_COUNT; scheme++) {
-            struct sb_sky_error_colour *stats = &sun->spectral[scheme];
             scheme_rgb(dir, scheme, convert, sun_to_rgb, rgb);
             view_lab(to_xyz, white, rgb, lab);
-            double de = sb_ciede2000(lab, ref);
-            stats->mean += de;
-            if (de > stats->max || n == 0) {
-                stats->max = de;
-                stats->worst_direction = d;
-            }
+            colour_add(&sun->spectral[scheme], sb_ciede2000(lab, ref), d, n);
         }
         n++;
         double xyz[3];
         sb_spectrum_to_xyz(dir->spectral, xyz);
-        for (int c = 0; c < 3; c++)
-            for (int sign = -1; sign <= 1; sign += 2) {
-                double moved[3] = {xyz[0], xyz[1], xyz[2]};
-                moved[c] = fmax(moved[c] + sign * 2 * sigma[d][c], 0.0);
-                sb_mat3_apply(sun_to_rgb, moved, rgb);
-                view_lab(to_xyz, white, rgb, lab);
-                sun->spectral_noise = fmax(sun->spectral_noise, sb_ciede2000(lab, ref));
-            }
+        sun->spectral_noise = fmax(sun->spectral_noise, colour_noise(xyz, sigma[d], sun_to_rgb, to_xyz, white, ref));
     }
     for (int scheme = 0; n && scheme < SB_SKY_ERROR_SCHEME_COUNT; scheme++)
         sun->spectral[scheme].mean /= n;
