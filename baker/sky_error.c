@@ -277,53 +277,58 @@ static void summarise_spectral(struct sb_sky_error_sun *sun, const double solar[
         sun->spectral[scheme].mean /= n;
 }
 
-static void summarise(struct sb_sky_error_sun *sun, const double solar[3])
+/* The relative error over directions and channels of skybake's sky, or of
+ * the orders' (`orders`), against the path tracer (floored at `floor`). */
+static void radiance_error(const struct sb_sky_error_sun *sun, const double floor[3], bool orders, double *max_rel,
+                           double *rms_rel, double *mean_rel, int *worst_direction, int *worst_channel)
 {
-    double floor[3] = {0, 0, 0};
-    for (int d = 0; d < SB_SKY_ERROR_DIRECTIONS; d++)
-        for (int c = 0; c < 3; c++)
-            floor[c] = fmax(floor[c], 1e-3 * sun->directions[d].path_traced[c]);
-    double sum2 = 0, sum = 0, share = 0;
-    int n = 0, lit = 0;
-    sun->max_rel = sun->noise = 0;
+    double sum = 0, sum2 = 0;
+    int n = 0;
+    *max_rel = 0;
     for (int d = 0; d < SB_SKY_ERROR_DIRECTIONS; d++)
         for (int c = 0; c < 3; c++) {
             const struct sb_sky_error_direction *dir = &sun->directions[d];
             double ref = fmax(dir->path_traced[c], floor[c]);
             if (!(ref > 0))
                 continue;
-            double rel = (dir->skybake[c] - dir->path_traced[c]) / ref;
-            if (fabs(rel) > sun->max_rel || n == 0) {
-                sun->max_rel = fabs(rel);
-                sun->worst_direction = d;
-                sun->worst_channel = c;
+            double rel = ((orders ? dir->orders : dir->skybake)[c] - dir->path_traced[c]) / ref;
+            if (fabs(rel) > *max_rel || n == 0) {
+                *max_rel = fabs(rel);
+                *worst_direction = d;
+                *worst_channel = c;
             }
             sum += rel;
             sum2 += rel * rel;
-            sun->noise = fmax(sun->noise, 2 * dir->std_error[c] / ref);
             n++;
+        }
+    *rms_rel = n ? sqrt(sum2 / n) : 0;
+    *mean_rel = n ? sum / n : 0;
+}
+
+static void summarise(struct sb_sky_error_sun *sun, const double solar[3])
+{
+    double floor[3] = {0, 0, 0}, share = 0;
+    for (int d = 0; d < SB_SKY_ERROR_DIRECTIONS; d++)
+        for (int c = 0; c < 3; c++)
+            floor[c] = fmax(floor[c], 1e-3 * sun->directions[d].path_traced[c]);
+    int lit = 0, unused_d, unused_c;
+    sun->noise = 0;
+    for (int d = 0; d < SB_SKY_ERROR_DIRECTIONS; d++)
+        for (int c = 0; c < 3; c++) {
+            const struct sb_sky_error_direction *dir = &sun->directions[d];
+            double ref = fmax(dir->path_traced[c], floor[c]);
+            if (!(ref > 0))
+                continue;
+            sun->noise = fmax(sun->noise, 2 * dir->std_error[c] / ref);
             if (!dir->ground && dir->path_traced[c] > 0) {
                 share += 1 - dir->single[c] / dir->path_traced[c];
                 lit++;
             }
         }
-    sun->rms_rel = n ? sqrt(sum2 / n) : 0;
-    double o_sum = 0, o_sum2 = 0;
-    sun->orders_max_rel = 0;
-    for (int d = 0; d < SB_SKY_ERROR_DIRECTIONS; d++)
-        for (int c = 0; c < 3; c++) {
-            const struct sb_sky_error_direction *dir = &sun->directions[d];
-            double ref = fmax(dir->path_traced[c], floor[c]);
-            if (!(ref > 0))
-                continue;
-            double rel = (dir->orders[c] - dir->path_traced[c]) / ref;
-            sun->orders_max_rel = fmax(sun->orders_max_rel, fabs(rel));
-            o_sum += rel;
-            o_sum2 += rel * rel;
-        }
-    sun->orders_rms_rel = n ? sqrt(o_sum2 / n) : 0;
-    sun->orders_mean_rel = n ? o_sum / n : 0;
-    sun->mean_rel = n ? sum / n : 0;
+    radiance_error(sun, floor, false, &sun->max_rel, &sun->rms_rel, &sun->mean_rel, &sun->worst_direction,
+                   &sun->worst_channel);
+    radiance_error(sun, floor, true, &sun->orders_max_rel, &sun->orders_rms_rel, &sun->orders_mean_rel, &unused_d,
+                   &unused_c);
     sun->multiple_share = lit ? share / lit : 0;
     summarise_colour(sun);
     summarise_spectral(sun, solar);
