@@ -166,19 +166,23 @@ static void summarise_colour(struct sb_sky_error_sun *sun)
     }
     sb_mat3_apply(m, (const double[3]){y_max, y_max, y_max}, white);
     struct sb_sky_error_colour stats = {0};
+    sun->orders_colour = stats;
     sun->de_noise = 0;
     int n = 0;
     for (int d = 0; y_max > 0 && d < SB_SKY_ERROR_DIRECTIONS; d++) {
         const struct sb_sky_error_direction *dir = &sun->directions[d];
         if (dir->ground)
             continue;
-        double ours[3], ref[3];
+        double ours[3], ref[3], orders[3];
         view_lab(m, white, dir->skybake, ours);
         view_lab(m, white, dir->path_traced, ref);
+        view_lab(m, white, dir->orders, orders);
+        colour_add(&sun->orders_colour, sb_ciede2000(orders, ref), d, n);
         colour_add(&stats, sb_ciede2000(ours, ref), d, n++);
         sun->de_noise = fmax(sun->de_noise, colour_noise(dir->path_traced, dir->std_error, NULL, m, white, ref));
     }
     sun->de_mean = n ? stats.mean / n : 0;
+    sun->orders_colour.mean = n ? sun->orders_colour.mean / n : 0;
     sun->de_max = stats.max;
     sun->de_worst_direction = stats.worst_direction;
 }
@@ -464,6 +468,8 @@ void sb_sky_error_print(const struct sb_sky_error_report *reports, int count, bo
                     cJSON_AddNumberToObject(so, "orders_max_rel", sun->orders_max_rel);
                     cJSON_AddNumberToObject(so, "orders_rms_rel", sun->orders_rms_rel);
                     cJSON_AddNumberToObject(so, "orders_mean_rel", sun->orders_mean_rel);
+                    cJSON_AddNumberToObject(so, "orders_ciede2000_mean", sun->orders_colour.mean);
+                    cJSON_AddNumberToObject(so, "orders_ciede2000_max", sun->orders_colour.max);
                 }
                 cJSON_AddNumberToObject(so, "ciede2000_mean", sun->de_mean);
                 cJSON_AddNumberToObject(so, "ciede2000_max", sun->de_max);
@@ -515,11 +521,11 @@ void sb_sky_error_print(const struct sb_sky_error_report *reports, int count, bo
         if (r->orders) {
             printf("  with multiple scattering by orders (fp64 reference, %d orders, %.1f s):\n", r->orders,
                    r->orders_s);
-            printf("  %8s %9s %9s %9s\n", "sun deg", "max rel", "rms rel", "mean rel");
+            printf("  %8s %9s %9s %9s %15s\n", "sun deg", "max rel", "rms rel", "mean rel", "CIEDE2000");
             for (int s = 0; s < r->sun_count; s++) {
                 const struct sb_sky_error_sun *sun = &r->suns[s];
-                printf("  %8.4g %9.3g %9.3g %+9.2g\n", sun->elevation_deg, sun->orders_max_rel, sun->orders_rms_rel,
-                       sun->orders_mean_rel);
+                printf("  %8.4g %9.3g %9.3g %+9.2g %7.2f / %5.2f\n", sun->elevation_deg, sun->orders_max_rel,
+                       sun->orders_rms_rel, sun->orders_mean_rel, sun->orders_colour.mean, sun->orders_colour.max);
             }
         }
         printf(

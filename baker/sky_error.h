@@ -90,6 +90,7 @@ struct sb_sky_error_sun {
     int worst_direction, worst_channel;
     double noise;                                           /* the largest 2 standard errors, relative */
     double orders_max_rel, orders_rms_rel, orders_mean_rel; /* the same for the orders' sky */
+    struct sb_sky_error_colour orders_colour;               /* its CIEDE2000 against the path tracer, as de_* */
     /* Colour: CIEDE2000 between the two skies over the views of the sky (not
      * the ground), each rgb taken as linear Rec.709 as the runtime shows
      * it, in CIELAB against D65 at the luminance of the path tracer's

@@ -324,6 +324,7 @@ check "sky-error values are finite" test -z "$(grep -Ei 'nan|inf|null' "$tmp/out
 check "sky-error --orders runs" expect_exit 0 "$skybake" sky-error "$scene" --paths 64 --sun 30 --orders-grid 4,8,4,4 \
     --json -q
 check "sky-error --orders reports the orders' error" test "$(grep -c '"orders_rms_rel"' "$tmp/out")" = 1
+check "sky-error --orders reports the orders' colour" test "$(grep -c '"orders_ciede2000_mean"' "$tmp/out")" = 1
 check "sky-error --orders reports each view's sky" test "$(grep -c '"orders"' "$tmp/out")" = 16
 check "sky-error --orders values are finite" test -z "$(grep -Ei 'nan|inf|null' "$tmp/out")"
 for bad in '--paths 8' '--paths x' '--paths 100.5' '--spectral-paths 8' '--orders-grid 3,5,4,4' \
