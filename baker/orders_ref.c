@@ -5,12 +5,13 @@
 #include <string.h>
 
 #include "atmosphere_ref.h"
+#include "log.h"
 #include "parallel.h"
 #include "physics.h"
 
 #define ORD_PI 3.14159265358979323846
 #define DEPTH_W 1024 /* the optical-depth table: x_mu */
-#define DEPTH_H 256  /* x_r */
+#define DEPTH_H 1024 /* x_r */
 #define GL_RAY 4     /* Gauss-Legendre nodes per piece of a ray */
 #define MAX_PIECES (2 * SB_MAX_LEVELS + 4)
 #define SPHERE_GROUND 8 /* the density's directions: cos(zenith) toward the ground */
@@ -20,13 +21,19 @@
 #define HEMI_PHI 32
 #define MIE_U 16   /* the density's Mie part: quantiles of Henyey-Greenstein's scattering angle */
 #define MIE_PHI 16 /* and azimuths about the view */
-#define MAX_R 64
+
+/* count altitudes from 0 to Z, the first step `first` (or an even spacing,
+ * if that is finer): h_i = Z (q^i - 1) / (q^n - 1), n = count - 1. */
+struct progression {
+    double Z, q;
+    int n;
+};
 
 struct sb_orders_ref {
     struct sb_atmosphere_params p;
     int nr, nmu, nmus, nnu;
     double R, top, H, mu_s_min;
-    double heights[MAX_R]; /* the r nodes' altitudes */
+    struct progression heights; /* the r nodes' altitudes */
     double levels[SB_MAX_LEVELS];
     int level_count;
     double *depth; /* DEPTH_W x DEPTH_H x 3: optical depth to the top */
@@ -43,6 +50,40 @@ struct sb_orders_ref {
     double gl_hemi_x[HEMI_MU], gl_hemi_w[HEMI_MU];
     double gl_mie_x[MIE_U], gl_mie_w[MIE_U];
 };
+
+/* ---- Altitudes in a geometric progression ----------------------------------- */
+
+static struct progression progression_make(double Z, double first, int count)
+{
+    struct progression g = {Z, 1.0, count - 1};
+    if (first * g.n >= Z * (1 - 1e-12))
+        return g;
+    double lo = 1.0, hi = 1e3; /* q with (q^n - 1) / (q - 1) = Z / first */
+    for (int i = 0; i < 200; i++) {
+        double q = 0.5 * (lo + hi);
+        if ((pow(q, g.n) - 1) / (q - 1) < Z / first)
+            lo = q;
+        else
+            hi = q;
+    }
+    g.q = 0.5 * (lo + hi);
+    return g;
+}
+
+static double progression_at(const struct progression *g, int i)
+{
+    if (i >= g->n)
+        return g->Z;
+    return g->q == 1.0 ? g->Z * i / g->n : g->Z * (pow(g->q, i) - 1) / (pow(g->q, g->n) - 1);
+}
+
+/* The continuous index of altitude h, clamped to [0, n]. */
+static double progression_index(const struct progression *g, double h)
+{
+    h = fmin(fmax(h, 0.0), g->Z);
+    double i = g->q == 1.0 ? h / g->Z * g->n : log1p(h / g->Z * (pow(g->q, g->n) - 1)) / log(g->q);
+    return fmin(fmax(i, 0.0), (double)g->n);
+}
 
 /* ---- The optical depth -------------------------------------------------------- */
 
@@ -172,28 +213,7 @@ static size_t node_count(const struct sb_orders_ref *o)
 
 static double radius_of(const struct sb_orders_ref *o, int ir)
 {
-    return o->R + o->heights[ir];
-}
-
-/* Altitudes in a geometric progression from a first step of a quarter of
- * the smaller scale height (or an even spacing, if that is finer) to the
- * top: the nodes follow the air, however thick the atmosphere. */
-static void make_heights(struct sb_orders_ref *o)
-{
-    double Z = o->top - o->R, n = o->nr - 1;
-    double step = fmin(0.25 * fmin(o->p.rayleigh_scale_height_km, o->p.mie_scale_height_km), Z / n);
-    double lo = 1.0, hi = 1e3; /* q with (q^n - 1) / (q - 1) = Z / step */
-    for (int i = 0; i < 200 && step * n < Z * (1 - 1e-12); i++) {
-        double q = 0.5 * (lo + hi);
-        if ((pow(q, n) - 1) / (q - 1) < Z / step)
-            lo = q;
-        else
-            hi = q;
-    }
-    double q = 0.5 * (lo + hi);
-    for (int i = 0; i < o->nr; i++)
-        o->heights[i] = step * n >= Z * (1 - 1e-12) ? Z * i / n : Z * (pow(q, i) - 1) / (pow(q, n) - 1);
-    o->heights[o->nr - 1] = Z;
+    return o->R + progression_at(&o->heights, ir);
 }
 
 /* mu at node imu of radius r: the first half ends on the ground. */
@@ -272,11 +292,9 @@ static double blend_mu_s(double a, double b, double f, bool twilight)
 static void lookup(const struct sb_orders_ref *o, const double *table, double r, double mu, double mu_s, double nu,
                    bool ground, double out[3])
 {
-    double h = fmin(fmax(r - o->R, 0.0), o->top - o->R);
-    int ir = 0;
-    while (ir < o->nr - 2 && o->heights[ir + 1] <= h)
-        ir++;
-    double ar = fmin(fmax((h - o->heights[ir]) / (o->heights[ir + 1] - o->heights[ir]), 0.0), 1.0);
+    double fr = progression_index(&o->heights, r - o->R);
+    int ir = fr < o->nr - 2 ? (int)fr : o->nr - 2;
+    double ar = fr - ir;
     double fmus = mu_s_coord(o, mu_s);
     int ims = fmus < o->nmus - 2 ? (int)fmus : o->nmus - 2;
     double as = fmus - ims;
@@ -556,9 +574,8 @@ struct sb_orders_ref *sb_orders_ref_create(const struct sb_atmosphere_params *p,
     o->R = p->ground_radius_km;
     o->top = p->top_radius_km;
     o->H = sqrt(o->top * o->top - o->R * o->R);
-    if (o->nr > MAX_R)
-        o->nr = MAX_R;
-    make_heights(o);
+    double scale = fmin(p->rayleigh_scale_height_km, p->mie_scale_height_km);
+    o->heights = progression_make(o->top - o->R, 0.25 * scale, o->nr);
     o->mu_s_min = -o->H / o->top;
     o->level_count = sb_atmosphere_levels(p, o->levels);
     sb_ref_gauss_legendre(GL_RAY, -1, 1, o->gl_ray_x, o->gl_ray_w);
@@ -583,6 +600,7 @@ struct sb_orders_ref *sb_orders_ref_create(const struct sb_atmosphere_params *p,
     o->ground = block + 18 * n;
     o->ground_order = o->ground + 3 * o->nmus;
 
+    sb_status("multiple scattering by orders: single scattering");
     sb_parallel_for(DEPTH_H, depth_row, o);
     int rows = o->nr * o->nmu;
     sb_parallel_for(rows, single_row, o);
@@ -598,6 +616,7 @@ struct sb_orders_ref *sb_orders_ref_create(const struct sb_atmosphere_params *p,
     size_t ground_bytes = 3 * (size_t)o->nmus * sizeof(double);
     memcpy(e1, o->ground_order, ground_bytes);
     for (int k = 2; k <= max_order; k++) {
+        sb_status("multiple scattering by orders: order %d", k);
         /* the ground seen at a view's end is lit by orders up to k - 1 (its
          * reflection is order k) */
         for (int i = 0; i < 3 * o->nmus; i++)
@@ -622,6 +641,7 @@ struct sb_orders_ref *sb_orders_ref_create(const struct sb_atmosphere_params *p,
             break;
     }
     free(e1);
+    sb_status(NULL);
     return o;
 }
 

@@ -11,9 +11,9 @@
  * transmittance times the scattering density J_k, the phase-weighted
  * integral over the sphere of order k - 1's radiance at that point (the
  * ground's, where a direction ends on it: albedo / pi times its irradiance
- * of order k - 2, the direct sun being order 0). Orders are added until one
- * adds less than `tolerance` of what is there anywhere on the grid, or
- * `max_order` is reached. The ground's irradiance of every order is kept
+ * of order k - 2, the direct sun being order 0). Orders are added until
+ * an order's largest value on the grid is under `tolerance` of the sum's
+ * largest, or `max_order` is reached. The ground's irradiance of every order is kept
  * too, so that a view that ends on the ground can be lit by all of it.
  *
  * The grid (all nodes on the edges of their ranges):
@@ -33,9 +33,12 @@
  * sphere takes Rayleigh's part on Gauss-Legendre nodes on either side of
  * the horizon, and Mie's at quantiles of Henyey-Greenstein's scattering
  * angle about the view (weighted by Cornette-Shanks over it), so that a
- * narrow forward peak (g = 0.99) is resolved. The sun's transmittance and the views' come
- * from an fp64 table of the optical depth to the top (1024 x 256, the
- * transmittance LUT's mapping, bilinear in depth), within 2e-4 of exact.
+ * narrow forward peak (g = 0.99) is resolved. The sun's transmittance and
+ * the views' come from an fp64 table of the optical depth to the top
+ * (1024 x 1024, the transmittance LUT's mapping, bilinear in depth): T
+ * within 1.3e-4 of exact for the earth, 5e-6 for mars and 3.3e-3 for the
+ * thick atmosphere (the worst of 2e5 random rays; 256 rows gave 6.7e-4,
+ * 1.8e-5 and 2.2e-2).
  * The sun is a point: its light stops where the planet hides its centre,
  * as in the path tracer.
  */
