@@ -62,18 +62,21 @@ struct job {
     struct sb_atmosphere_params twelve[4];
     const struct sb_image (*twelve_luts)[SB_PRODUCT_COUNT];
     const struct sb_orders_ref *orders; /* NULL unless asked */
+    int sun;                            /* the sun being traced */
 };
 
-/* One (sun, direction, channel), then one (sun, direction, wavelength
- * triple) of the spectral trace. */
+#define JOBS_PER_SUN (SB_SKY_ERROR_DIRECTIONS * (3 + TRIPLES))
+
+/* Of the job's sun: one (direction, channel), then one (direction,
+ * wavelength triple) of the spectral trace. */
 static void run_one(void *user, int index)
 {
     struct job *job = user;
-    int rgb_jobs = job->report->sun_count * SB_SKY_ERROR_DIRECTIONS * 3;
+    int rgb_jobs = SB_SKY_ERROR_DIRECTIONS * 3;
     bool spectral = index >= rgb_jobs;
     int per_view = spectral ? TRIPLES : 3, i = spectral ? index - rgb_jobs : index;
-    int channel = i % per_view, d = i / per_view % SB_SKY_ERROR_DIRECTIONS, s = i / per_view / SB_SKY_ERROR_DIRECTIONS;
-    struct sb_sky_error_sun *sun = &job->report->suns[s];
+    int channel = i % per_view, d = i / per_view;
+    struct sb_sky_error_sun *sun = &job->report->suns[job->sun];
     struct sb_sky_error_direction *dir = &sun->directions[d];
     double zenith = dir->zenith_deg * SKY_PI / 180, azimuth = dir->azimuth_deg * SKY_PI / 180;
     double elevation = sun->elevation_deg * SKY_PI / 180;
@@ -414,7 +417,11 @@ enum sb_result sb_sky_error_run(struct sb_vk *vk, const char *scene_name, const 
             sb_atmosphere_at_wavelength(&scene->atmosphere, sb_spectrum_nm(3 * t + c), c, &job.spectral[t]);
     }
     double t0 = sb_now_s();
-    sb_parallel_for(report->sun_count * SB_SKY_ERROR_DIRECTIONS * (3 + TRIPLES), run_one, &job);
+    sb_progress("sky-error: suns path traced", 0, (unsigned)report->sun_count);
+    for (job.sun = 0; job.sun < report->sun_count; job.sun++) {
+        sb_parallel_for(JOBS_PER_SUN, run_one, &job);
+        sb_progress("sky-error: suns path traced", (unsigned)job.sun + 1, (unsigned)report->sun_count);
+    }
     report->path_trace_s = sb_now_s() - t0;
     for (int s = 0; s < report->sun_count; s++)
         summarise(&report->suns[s], scene->atmosphere.solar_irradiance);
