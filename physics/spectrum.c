@@ -248,12 +248,13 @@ void sb_sun_white(double xyz[3])
 
 void sb_sun_xyz_to_rec709(const double solar_rgb[3], double m[3][3])
 {
-    double white[3], xy[2], d65[2] = {0.3127, 0.3290}, cat[3][3], to_xyz[3][3], from_xyz[3][3];
+    static const double rec709[4][2] = {SB_REC709_PRIMARIES};
+    double white[3], xy[2], cat[3][3], to_xyz[3][3], from_xyz[3][3];
     sb_sun_white(white);
     double sum = white[0] + white[1] + white[2];
     xy[0] = white[0] / sum;
     xy[1] = white[1] / sum;
-    sb_bradford(xy, d65, cat);
+    sb_bradford(xy, rec709[3], cat);
     sb_rec709_to_xyz(to_xyz);
     sb_mat3_invert(to_xyz, from_xyz);
     sb_mat3_mul(from_xyz, cat, m);
