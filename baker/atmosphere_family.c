@@ -11,6 +11,7 @@
 #include "atmosphere.h"
 #include "family.h"
 #include "log.h"
+#include "orders.h"
 
 /*
  * Bake product `id` with the cheapest setting (device-independent cost,
@@ -99,15 +100,99 @@ static void key_params(enum sb_product_id id, const struct sb_atmosphere_params 
         sb_key_add(key, " mie_g=%a", p->mie_g);
 }
 
+#define BIT(p) (1u << (p))
+
+/* The orders read transmittance; under a tolerance, they are measured
+ * against Hillaire's LUTs, which they read too. */
 static uint32_t atmosphere_depends_on(enum sb_product_id id)
 {
+    if (id == SB_PRODUCT_ORDERS)
+        return BIT(SB_PRODUCT_TRANSMITTANCE) | BIT(SB_PRODUCT_MULTISCATTERING) | BIT(SB_PRODUCT_IRRADIANCE_GROUND);
     return sb_atmosphere_product(id)->depends_on;
+}
+
+static const struct sb_orders_settings orders_grid = {
+    .r = SB_ORDERS_R, .mu = SB_ORDERS_MU, .mu_s = SB_ORDERS_MU_S, .nu = SB_ORDERS_NU};
+
+/* The suns a tolerance is measured at: the scene's, or the day's when it
+ * gives no view (sky-error's from noon to a low sun). */
+static int orders_suns(const struct sb_scene *scene, double suns[4])
+{
+    static const double day[4] = {90, 30, 10, 2};
+    if (scene->has_view) {
+        suns[0] = scene->view.sun_elevation_deg;
+        return 1;
+    }
+    memcpy(suns, day, sizeof(day));
+    return 4;
+}
+
+static void orders_key(const struct sb_scene *scene, struct sb_key_text *key)
+{
+    struct sb_orders_settings s = sb_orders_settings_resolve(&orders_grid);
+    char code[SB_HASH_HEX_SIZE];
+    sb_key_add(key, " grid %dx%dx%dx%d orders %d until %a", s.r, s.mu, s.mu_s, s.nu, s.max_order, s.tolerance);
+    if (scene->tolerance[SB_PRODUCT_ORDERS] > 0) {
+        double suns[4];
+        int n = orders_suns(scene, suns);
+        sb_key_add(key, " tolerance %a at altitude %a", scene->tolerance[SB_PRODUCT_ORDERS], scene->view.altitude_km);
+        for (int i = 0; i < n; i++)
+            sb_key_add(key, " sun %a", suns[i]);
+    }
+    sb_orders_code_hash(code);
+    sb_key_add(key, " code %s", code);
+}
+
+/*
+ * Bake the orders; under a tolerance, decline them (an empty image) where
+ * Hillaire's multiple scattering is within it of them, rms over
+ * sky-error's views at the scene's suns.
+ */
+static enum sb_result orders_bake(struct sb_atmosphere_baker *baker, struct sb_vk *vk, const struct sb_scene *scene,
+                                  const struct sb_image baked[SB_PRODUCT_COUNT], struct sb_image *image,
+                                  struct sb_artifact *a)
+{
+    struct sb_orders_result r;
+    enum sb_result res = sb_orders_bake(vk, baker, &scene->atmosphere, &orders_grid, image, &r);
+    if (res)
+        return res;
+    a->gpu_ms = r.gpu_ms;
+    struct sb_orders_settings s = sb_orders_settings_resolve(&orders_grid);
+    snprintf(a->settings_json, sizeof(a->settings_json),
+             "{\"r\":%d,\"mu\":%d,\"mu_s\":%d,\"nu\":%d,\"height_ratio\":%.17g,\"orders\":%d,\"last_share\":%.6g,"
+             "\"until\":%.17g}",
+             s.r, s.mu, s.mu_s, s.nu, sb_orders_height_ratio(&scene->atmosphere, s.r), r.orders, r.last_share,
+             s.tolerance);
+    double tolerance = scene->tolerance[SB_PRODUCT_ORDERS];
+    if (tolerance <= 0)
+        return SB_OK;
+    double suns[4], rms, worst;
+    int n = orders_suns(scene, suns);
+    sb_orders_hillaire_error(&scene->atmosphere, baked, image, scene->view.altitude_km, suns, n, &rms, &worst);
+    sb_settings_json_add(a->settings_json, sizeof(a->settings_json),
+                         ",\"tolerance\":%.17g,\"hillaire\":{\"rms_rel\":%.6g,\"max_rel\":%.6g,\"suns\":%d}", tolerance,
+                         rms, worst, n);
+    if (rms <= tolerance) {
+        sb_info("orders: Hillaire's multiple scattering is within tolerance %g of them (rms %.3g, worst %.3g over "
+                "%d sun%s): not needed",
+                tolerance, rms, worst, n, n > 1 ? "s" : "");
+        sb_image_finish(image);
+    } else {
+        sb_info("orders: Hillaire's multiple scattering is %.3g rms off them (worst %.3g), beyond tolerance %g: "
+                "baked",
+                rms, worst, tolerance);
+    }
+    return SB_OK;
 }
 
 static void atmosphere_key(void *state, const struct sb_scene *scene, enum sb_product_id id, struct sb_key_text *key)
 {
     char settings[1024], code[SB_HASH_HEX_SIZE];
     key_params(id, &scene->atmosphere, key);
+    if (id == SB_PRODUCT_ORDERS) {
+        orders_key(scene, key);
+        return;
+    }
     if (scene->tolerance[id] > 0) {
         sb_key_add(key, " tolerance=%a candidates", scene->tolerance[id]);
         struct sb_atmosphere_settings candidates[SB_ATMOSPHERE_MAX_CANDIDATES];
@@ -144,6 +229,8 @@ static enum sb_result atmosphere_bake(void *state, struct sb_vk *vk, const struc
                                       struct sb_image *image, struct sb_artifact *a)
 {
     struct sb_atmosphere_baker *baker = state;
+    if (id == SB_PRODUCT_ORDERS)
+        return orders_bake(baker, vk, scene, baked, image, a);
     struct sb_atmosphere_settings used;
     struct sb_error error;
     char probe[96];
@@ -164,6 +251,8 @@ static enum sb_result atmosphere_bake(void *state, struct sb_vk *vk, const struc
 
 static enum sb_result atmosphere_adopt(void *state, enum sb_product_id id, const struct sb_image *image)
 {
+    if (id == SB_PRODUCT_ORDERS) /* no product reads it */
+        return SB_OK;
     return sb_atmosphere_adopt(state, id, image);
 }
 
@@ -171,6 +260,8 @@ static uint32_t atmosphere_kernels(void *state, const struct sb_scene *scene, en
                                    struct sb_pipeline_params out[SB_FAMILY_KERNELS_MAX])
 {
     _Static_assert(SB_ATMOSPHERE_KERNELS_MAX <= SB_FAMILY_KERNELS_MAX, "room for the atmosphere's kernels");
+    if (id == SB_PRODUCT_ORDERS)
+        return sb_orders_kernels(out);
     /* to a tolerance, the candidates bake cheapest first: the first's */
     struct sb_atmosphere_settings candidates[SB_ATMOSPHERE_MAX_CANDIDATES];
     bool first = scene->tolerance[id] > 0 && sb_atmosphere_candidates(id, candidates) > 0;

@@ -252,6 +252,10 @@ enum sb_result sb_bake_scene(struct sb_vk *vk, const struct sb_scene *scene, con
             goto cleanup;
         }
         a->bake_ms = 1e3 * sb_now_s() - t0;
+        if (!image->data) { /* declined under the scene's tolerance (family.h): not in the pack */
+            sb_probe_layout_finish(&a->probes);
+            continue;
+        }
         double added = sb_now_s();
         res = sb_pack_writer_add_image(writer, a, image);
         sb_debug("%s: written and hashed in %.1f ms", sb_product_name(id), 1e3 * (sb_now_s() - added));

@@ -40,7 +40,10 @@ struct sb_family_baker {
     /* Bake `id` into *image (values as the pack's file stores them) and
      * fill the artifact's settings_json and gpu_ms (and, for a product
      * baked against the world, sb_artifact_set_world). baked[] holds every
-     * product of lower id that this bake made or reused. */
+     * product of lower id that this bake made or reused. A product that a
+     * scene's tolerance makes unneeded (the orders, where Hillaire's LUT
+     * is within it) returns SB_OK with *image left empty: the pack goes
+     * without it, and no product may read it. */
     enum sb_result (*bake)(void *state, struct sb_vk *vk, const struct sb_scene *scene, enum sb_product_id id,
                            const struct sb_image baked[SB_PRODUCT_COUNT], struct sb_image *image,
                            struct sb_artifact *artifact);

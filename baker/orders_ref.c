@@ -5,6 +5,7 @@
 #include <string.h>
 
 #include "atmosphere_ref.h"
+#include "config.h"
 #include "log.h"
 #include "parallel.h"
 #include "physics.h"
@@ -247,7 +248,7 @@ static double mu_coord(const struct sb_orders_ref *o, double r, double mu, bool 
 
 /* mu_s at node imus: half the nodes from mu_s_min to 0.1 (twilight and a
  * low sun, where the sky changes fastest), the rest on to 1. */
-#define MU_S_SPLIT 0.1
+#define MU_S_SPLIT SB_ORDERS_MU_S_SPLIT
 static double mu_s_of(const struct sb_orders_ref *o, int imus)
 {
     int low = o->nmus / 2;
@@ -288,9 +289,10 @@ static double blend_mu_s(double a, double b, double f, bool twilight)
     return twilight && a > 0.0 && b > 0.0 ? a * pow(b / a, f) : a + f * (b - a);
 }
 
-/* A table (rgb per node) read at (r, mu, mu_s, nu), multilinear. */
-static void lookup(const struct sb_orders_ref *o, const double *table, double r, double mu, double mu_s, double nu,
-                   bool ground, double out[3])
+/* A table (rgb per node, fp64 or, with table NULL, fp32) read at (r, mu,
+ * mu_s, nu), multilinear. */
+static void lookup_any(const struct sb_orders_ref *o, const double *table, const float *ftable, double r, double mu,
+                       double mu_s, double nu, bool ground, double out[3])
 {
     double fr = progression_index(&o->heights, r - o->R);
     int ir = fr < o->nr - 2 ? (int)fr : o->nr - 2;
@@ -317,12 +319,20 @@ static void lookup(const struct sb_orders_ref *o, const double *table, double r,
                 double w = wr * (dm ? am : 1 - am) * (dn ? an : 1 - an);
                 if (w == 0.0)
                     continue;
-                const double *v0 = &table[3 * node_index(o, ir + dr, im + dm, ims, inu + dn)];
-                const double *v1 = &table[3 * node_index(o, ir + dr, im + dm, ims + 1, inu + dn)];
-                for (int c = 0; c < 3; c++)
-                    out[c] += w * blend_mu_s(v0[c], v1[c], as, twilight);
+                size_t i0 = 3 * node_index(o, ir + dr, im + dm, ims, inu + dn);
+                size_t i1 = 3 * node_index(o, ir + dr, im + dm, ims + 1, inu + dn);
+                for (int c = 0; c < 3; c++) {
+                    double v0 = table ? table[i0 + c] : ftable[i0 + c], v1 = table ? table[i1 + c] : ftable[i1 + c];
+                    out[c] += w * blend_mu_s(v0, v1, as, twilight);
+                }
             }
     }
+}
+
+static void lookup(const struct sb_orders_ref *o, const double *table, double r, double mu, double mu_s, double nu,
+                   bool ground, double out[3])
+{
+    lookup_any(o, table, NULL, r, mu, mu_s, nu, ground, out);
 }
 
 /* ---- Single scattering -------------------------------------------------------- */
@@ -559,23 +569,43 @@ static void ground_row(void *user, int ims)
     memcpy(&o->ground_order[3 * ims], e, sizeof(e));
 }
 
-struct sb_orders_ref *sb_orders_ref_create(const struct sb_atmosphere_params *p, const struct sb_orders_settings *s)
+struct sb_orders_settings sb_orders_settings_resolve(const struct sb_orders_settings *s)
 {
-    struct sb_orders_ref *o = calloc(1, sizeof(*o));
-    if (!o)
-        return NULL;
+    struct sb_orders_settings out = {
+        .r = s && s->r > 1 ? s->r : 16,
+        .mu = s && s->mu > 3 ? (s->mu + 1) / 2 * 2 : 64,
+        .mu_s = s && s->mu_s > 1 ? s->mu_s : 24,
+        .nu = s && s->nu > 1 ? s->nu : 8,
+        .max_order = s && s->max_order > 1 ? s->max_order : 16,
+        .tolerance = s && s->tolerance > 0 ? s->tolerance : 1e-3,
+    };
+    return out;
+}
+
+static struct progression heights_of(const struct sb_atmosphere_params *p, int nr)
+{
+    double scale = fmin(p->rayleigh_scale_height_km, p->mie_scale_height_km);
+    return progression_make(p->top_radius_km - p->ground_radius_km, 0.25 * scale, nr);
+}
+
+double sb_orders_height_ratio(const struct sb_atmosphere_params *p, int nr)
+{
+    return heights_of(p, nr).q;
+}
+
+/* The grid and the quadratures, no table. */
+static void grid_init(struct sb_orders_ref *o, const struct sb_atmosphere_params *p,
+                      const struct sb_orders_settings *set)
+{
     o->p = *p;
-    o->nr = s && s->r > 1 ? s->r : 16;
-    o->nmu = s && s->mu > 3 ? (s->mu + 1) / 2 * 2 : 64;
-    o->nmus = s && s->mu_s > 1 ? s->mu_s : 24;
-    o->nnu = s && s->nu > 1 ? s->nu : 8;
-    int max_order = s && s->max_order > 1 ? s->max_order : 16;
-    double tolerance = s && s->tolerance > 0 ? s->tolerance : 1e-3;
+    o->nr = set->r;
+    o->nmu = set->mu;
+    o->nmus = set->mu_s;
+    o->nnu = set->nu;
     o->R = p->ground_radius_km;
     o->top = p->top_radius_km;
     o->H = sqrt(o->top * o->top - o->R * o->R);
-    double scale = fmin(p->rayleigh_scale_height_km, p->mie_scale_height_km);
-    o->heights = progression_make(o->top - o->R, 0.25 * scale, o->nr);
+    o->heights = heights_of(p, o->nr);
     o->mu_s_min = -o->H / o->top;
     o->level_count = sb_atmosphere_levels(p, o->levels);
     sb_ref_gauss_legendre(GL_RAY, -1, 1, o->gl_ray_x, o->gl_ray_w);
@@ -583,6 +613,27 @@ struct sb_orders_ref *sb_orders_ref_create(const struct sb_atmosphere_params *p,
     sb_ref_gauss_legendre(SPHERE_SKY, -1, 1, o->gl_sky_x, o->gl_sky_w);
     sb_ref_gauss_legendre(HEMI_MU, -1, 1, o->gl_hemi_x, o->gl_hemi_w);
     sb_ref_gauss_legendre(MIE_U, -1, 1, o->gl_mie_x, o->gl_mie_w);
+}
+
+struct sb_orders_ref *sb_orders_grid_create(const struct sb_atmosphere_params *p, const struct sb_orders_settings *s)
+{
+    struct sb_orders_ref *o = calloc(1, sizeof(*o));
+    if (!o)
+        return NULL;
+    struct sb_orders_settings set = sb_orders_settings_resolve(s);
+    grid_init(o, p, &set);
+    return o;
+}
+
+struct sb_orders_ref *sb_orders_ref_create(const struct sb_atmosphere_params *p, const struct sb_orders_settings *s)
+{
+    struct sb_orders_ref *o = calloc(1, sizeof(*o));
+    if (!o)
+        return NULL;
+    struct sb_orders_settings set = sb_orders_settings_resolve(s);
+    grid_init(o, p, &set);
+    int max_order = set.max_order;
+    double tolerance = set.tolerance;
     size_t n = node_count(o);
     o->depth = malloc((size_t)DEPTH_W * DEPTH_H * 3 * sizeof(double));
     double *block = calloc(6 * 3 * n + 2 * 3 * (size_t)o->nmus, sizeof(double));
@@ -665,6 +716,50 @@ double sb_orders_ref_last_share(const struct sb_orders_ref *ref)
     return ref->last_share;
 }
 
+void sb_orders_ref_node(const struct sb_orders_ref *o, int ir, int imu, int imus, int inu, double out[3])
+{
+    memcpy(out, &o->sum[3 * node_index(o, ir, imu, imus, inu)], 3 * sizeof(double));
+}
+
+/* A view from above the atmosphere as the one from where it enters it;
+ * false where it misses. */
+static bool enter_atmosphere(const struct sb_orders_ref *o, double *r, double *mu, double *mu_s, double nu)
+{
+    if (*r <= o->top)
+        return true;
+    double b = *r * *mu, disc = b * b - (*r - o->top) * (*r + o->top);
+    if (*mu >= 0.0 || disc < 0.0)
+        return false;
+    double t = (*r - o->top) * (*r + o->top) / (-b + sqrt(disc));
+    *mu = clamp1((*r * *mu + t) / o->top);
+    *mu_s = clamp1((*r * *mu_s + t * nu) / o->top);
+    *r = o->top;
+    return true;
+}
+
+void sb_orders_table_read(const struct sb_orders_ref *o, const float *table, double h, double mu, double mu_s,
+                          double nu, double out[3])
+{
+    double r = o->R + fmax(h, 0.0);
+    out[0] = out[1] = out[2] = 0.0;
+    if (enter_atmosphere(o, &r, &mu, &mu_s, nu))
+        lookup_any(o, NULL, table, r, mu, mu_s, nu, hits_ground(o, r, mu), out);
+}
+
+void sb_orders_ref_ground(const struct sb_orders_ref *o, int imus, double out[3])
+{
+    memcpy(out, &o->ground[3 * imus], 3 * sizeof(double));
+}
+
+void sb_orders_table_ground(const struct sb_orders_ref *o, const float *table, double mu_s, double out[3])
+{
+    const float *row = table + 3 * node_count(o); /* the row after the nodes, nu values a mu_s node */
+    double f = mu_s_coord(o, mu_s);
+    int i = f < o->nmus - 2 ? (int)f : o->nmus - 2;
+    for (int c = 0; c < 3; c++)
+        out[c] = blend_mu_s(row[3 * i * o->nnu + c], row[3 * (i + 1) * o->nnu + c], f - i, mu_s_of(o, i + 1) <= 0.0);
+}
+
 void sb_orders_ref_sky(const struct sb_orders_ref *o, double h, double mu, double mu_s, double nu, double out[3],
                        double multiple[3])
 {
@@ -672,15 +767,8 @@ void sb_orders_ref_sky(const struct sb_orders_ref *o, double h, double mu, doubl
     out[0] = out[1] = out[2] = 0.0;
     if (multiple)
         multiple[0] = multiple[1] = multiple[2] = 0.0;
-    if (r > o->top) {
-        double b = r * mu, disc = b * b - (r - o->top) * (r + o->top);
-        if (mu >= 0.0 || disc < 0.0)
-            return;
-        double t = (r - o->top) * (r + o->top) / (-b + sqrt(disc));
-        mu = clamp1((r * mu + t) / o->top);
-        mu_s = clamp1((r * mu_s + t * nu) / o->top);
-        r = o->top;
-    }
+    if (!enter_atmosphere(o, &r, &mu, &mu_s, nu))
+        return;
     double ray[3], mie[3], ms[3];
     bool ground = hits_ground(o, r, mu);
     single_along(o, r, mu, ground, mu_s, nu, ray, mie);

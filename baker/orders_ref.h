@@ -55,7 +55,30 @@ struct sb_orders_settings {
     double tolerance;    /* 0: 1e-3 */
 };
 
+/* The settings with their defaults filled in (mu even). */
+struct sb_orders_settings sb_orders_settings_resolve(const struct sb_orders_settings *s);
+
+/* The altitudes of the r nodes: h_i = Z (q^i - 1) / (q^n - 1), n = nr - 1,
+ * Z the atmosphere's thickness, the first step a quarter of the smaller
+ * scale height (q = 1: uniform, where that would be coarser). Returns q. */
+double sb_orders_height_ratio(const struct sb_atmosphere_params *p, int nr);
+
 struct sb_orders_ref; /* opaque */
+
+/* The grid alone, to read a table of it (sb_orders_table_read): what the
+ * orders product's image holds; destroyed as a reference is. NULL on
+ * failure (memory). */
+struct sb_orders_ref *sb_orders_grid_create(const struct sb_atmosphere_params *p, const struct sb_orders_settings *s);
+
+/* Orders 2 and up seen from altitude h along (mu, mu_s, nu), read from
+ * `table` (rgb a node, the product's texel order) as the reference reads
+ * its own. */
+void sb_orders_table_read(const struct sb_orders_ref *grid, const float *table, double h, double mu, double mu_s,
+                          double nu, double out[3]);
+
+/* The ground's irradiance from the sky at sun cosine mu_s, read from the
+ * row after the table's nodes (the orders product's last row). */
+void sb_orders_table_ground(const struct sb_orders_ref *grid, const float *table, double mu_s, double out[3]);
 
 /* Compute the orders; NULL on failure (memory). Uses every core. */
 struct sb_orders_ref *sb_orders_ref_create(const struct sb_atmosphere_params *p, const struct sb_orders_settings *s);
@@ -65,6 +88,12 @@ void sb_orders_ref_destroy(struct sb_orders_ref **ref);
  * added over what was there, at the node where that was largest). */
 int sb_orders_ref_orders(const struct sb_orders_ref *ref);
 double sb_orders_ref_last_share(const struct sb_orders_ref *ref);
+
+/* Orders 2 and up at node (ir, imu, imus, inu), the table itself. */
+void sb_orders_ref_node(const struct sb_orders_ref *ref, int ir, int imu, int imus, int inu, double out[3]);
+
+/* The ground's irradiance from the sky, orders 1 to N - 1, at mu_s node imus. */
+void sb_orders_ref_ground(const struct sb_orders_ref *ref, int imus, double out[3]);
 
 /* The sky's radiance seen from altitude h (km) along (mu, mu_s, nu), in
  * solar_irradiance's unit per steradian: single scattering integrated

@@ -11,6 +11,7 @@
 #include "colour.h"
 #include "json.h"
 #include "log.h"
+#include "orders.h"
 #include "orders_ref.h"
 #include "parallel.h"
 #include "pathtrace.h"
@@ -26,8 +27,7 @@ static const double zenith_deg[] = {30, 60, 80, 87, 120};
 static const double azimuth_deg[] = {0, 90, 180};
 static const double default_suns[] = {90, 30, 10, 2, -4};
 
-static void direction_angles(const struct sb_atmosphere_params *p, double altitude_km, int i, double *zenith,
-                             double *azimuth)
+void sb_sky_error_view(const struct sb_atmosphere_params *p, double altitude_km, int i, double *zenith, double *azimuth)
 {
     double R = p->ground_radius_km, r = R + altitude_km;
     bool space = r > p->top_radius_km;
@@ -62,6 +62,7 @@ struct job {
     struct sb_atmosphere_params twelve[4];
     const struct sb_image (*twelve_luts)[SB_PRODUCT_COUNT];
     const struct sb_orders_ref *orders; /* NULL unless asked */
+    const struct sb_orders_ref *grid;   /* the orders product's grid */
     int sun;                            /* the sun being traced */
 };
 
@@ -102,6 +103,8 @@ static void run_one(void *user, int index)
                             dir->skybake);
         sb_ref_sky_radiance(job->params, h, mu, mu_s, nu, &job->luts[SB_PRODUCT_TRANSMITTANCE], NULL, NULL, NULL,
                             dir->single);
+        sb_orders_product_sky(job->params, job->grid, &job->luts[SB_PRODUCT_ORDERS],
+                              &job->luts[SB_PRODUCT_TRANSMITTANCE], h, mu, mu_s, nu, dir->product);
         if (job->orders)
             sb_orders_ref_sky(job->orders, h, mu, mu_s, nu, dir->orders, NULL);
         for (int t = 0; t < 4; t++) {
@@ -169,23 +172,26 @@ static void summarise_colour(struct sb_sky_error_sun *sun)
     }
     sb_mat3_apply(m, (const double[3]){y_max, y_max, y_max}, white);
     struct sb_sky_error_colour stats = {0};
-    sun->orders_colour = stats;
+    sun->orders_colour = sun->product_colour = stats;
     sun->de_noise = 0;
     int n = 0;
     for (int d = 0; y_max > 0 && d < SB_SKY_ERROR_DIRECTIONS; d++) {
         const struct sb_sky_error_direction *dir = &sun->directions[d];
         if (dir->ground)
             continue;
-        double ours[3], ref[3], orders[3];
+        double ours[3], ref[3], orders[3], product[3];
         view_lab(m, white, dir->skybake, ours);
         view_lab(m, white, dir->path_traced, ref);
         view_lab(m, white, dir->orders, orders);
+        view_lab(m, white, dir->product, product);
         colour_add(&sun->orders_colour, sb_ciede2000(orders, ref), d, n);
+        colour_add(&sun->product_colour, sb_ciede2000(product, ref), d, n);
         colour_add(&stats, sb_ciede2000(ours, ref), d, n++);
         sun->de_noise = fmax(sun->de_noise, colour_noise(dir->path_traced, dir->std_error, NULL, m, white, ref));
     }
     sun->de_mean = n ? stats.mean / n : 0;
     sun->orders_colour.mean = n ? sun->orders_colour.mean / n : 0;
+    sun->product_colour.mean = n ? sun->product_colour.mean / n : 0;
     sun->de_max = stats.max;
     sun->de_worst_direction = stats.worst_direction;
 }
@@ -286,7 +292,14 @@ static void summarise_spectral(struct sb_sky_error_sun *sun, const double solar[
 
 /* The relative error over directions and channels of skybake's sky, or of
  * the orders' (`orders`), against the path tracer (floored at `floor`). */
-static void radiance_error(const struct sb_sky_error_sun *sun, const double floor[3], bool orders, double *max_rel,
+enum sky { SKY_SKYBAKE, SKY_ORDERS, SKY_PRODUCT };
+
+static const double *sky_of(const struct sb_sky_error_direction *dir, enum sky which)
+{
+    return which == SKY_ORDERS ? dir->orders : which == SKY_PRODUCT ? dir->product : dir->skybake;
+}
+
+static void radiance_error(const struct sb_sky_error_sun *sun, const double floor[3], enum sky which, double *max_rel,
                            double *rms_rel, double *mean_rel, int *worst_direction, int *worst_channel)
 {
     double sum = 0, sum2 = 0;
@@ -298,7 +311,7 @@ static void radiance_error(const struct sb_sky_error_sun *sun, const double floo
             double ref = fmax(dir->path_traced[c], floor[c]);
             if (!(ref > 0))
                 continue;
-            double rel = ((orders ? dir->orders : dir->skybake)[c] - dir->path_traced[c]) / ref;
+            double rel = (sky_of(dir, which)[c] - dir->path_traced[c]) / ref;
             if (fabs(rel) > *max_rel || n == 0) {
                 *max_rel = fabs(rel);
                 *worst_direction = d;
@@ -332,10 +345,12 @@ static void summarise(struct sb_sky_error_sun *sun, const double solar[3])
                 lit++;
             }
         }
-    radiance_error(sun, floor, false, &sun->max_rel, &sun->rms_rel, &sun->mean_rel, &sun->worst_direction,
+    radiance_error(sun, floor, SKY_SKYBAKE, &sun->max_rel, &sun->rms_rel, &sun->mean_rel, &sun->worst_direction,
                    &sun->worst_channel);
-    radiance_error(sun, floor, true, &sun->orders_max_rel, &sun->orders_rms_rel, &sun->orders_mean_rel, &unused_d,
+    radiance_error(sun, floor, SKY_ORDERS, &sun->orders_max_rel, &sun->orders_rms_rel, &sun->orders_mean_rel, &unused_d,
                    &unused_c);
+    radiance_error(sun, floor, SKY_PRODUCT, &sun->product_max_rel, &sun->product_rms_rel, &sun->product_mean_rel,
+                   &unused_d, &unused_c);
     sun->multiple_share = lit ? share / lit : 0;
     summarise_colour(sun);
     summarise_spectral(sun, solar);
@@ -358,8 +373,8 @@ enum sb_result sb_sky_error_run(struct sb_vk *vk, const char *scene_name, const 
         struct sb_sky_error_sun *sun = &report->suns[s];
         sun->elevation_deg = params->sun_count > 0 ? params->sun_elevation_deg[s] : default_suns[s];
         for (int d = 0; d < SB_SKY_ERROR_DIRECTIONS; d++)
-            direction_angles(&scene->atmosphere, report->altitude_km, d, &sun->directions[d].zenith_deg,
-                             &sun->directions[d].azimuth_deg);
+            sb_sky_error_view(&scene->atmosphere, report->altitude_km, d, &sun->directions[d].zenith_deg,
+                              &sun->directions[d].azimuth_deg);
     }
 
     /* The products the sky reads, baked as a default bake bakes them: for
@@ -373,6 +388,12 @@ enum sb_result sb_sky_error_run(struct sb_vk *vk, const char *scene_name, const 
                                         &job.twelve[t]);
     }
     enum sb_result res = SB_OK;
+    const struct sb_orders_settings product_grid = {
+        .r = SB_ORDERS_R, .mu = SB_ORDERS_MU, .mu_s = SB_ORDERS_MU_S, .nu = SB_ORDERS_NU};
+    struct sb_orders_ref *grid = sb_orders_grid_create(&scene->atmosphere, &product_grid);
+    if (!grid)
+        res = SB_ERR_NOMEM;
+    job.grid = grid;
     for (int b = 0; b < 5 && !res; b++) {
         const struct sb_atmosphere_params *params_b = b == 0 ? &scene->atmosphere : &job.twelve[b - 1];
         struct sb_image *out = b == 0 ? luts : twelve_luts[b - 1];
@@ -382,6 +403,12 @@ enum sb_result sb_sky_error_run(struct sb_vk *vk, const char *scene_name, const 
                                              SB_PRODUCT_IRRADIANCE_GROUND};
         for (size_t i = 0; i < sizeof(needed) / sizeof(needed[0]) && !res; i++)
             res = sb_atmosphere_bake(baker, needed[i], NULL, &out[needed[i]], NULL, NULL);
+        if (b == 0 && !res) { /* the orders product, as a bake makes it */
+            struct sb_orders_result orders_result;
+            res = sb_orders_bake(vk, baker, params_b, &product_grid, &out[SB_PRODUCT_ORDERS], &orders_result);
+            report->product_orders = orders_result.orders;
+            report->product_gpu_ms = orders_result.gpu_ms;
+        }
         sb_atmosphere_baker_destroy(&baker);
     }
     if (res) {
@@ -428,6 +455,8 @@ enum sb_result sb_sky_error_run(struct sb_vk *vk, const char *scene_name, const 
 
 done:
     sb_orders_ref_destroy(&orders);
+    sb_orders_ref_destroy(&grid);
+    sb_image_finish(&luts[SB_PRODUCT_ORDERS]);
     for (int i = 0; i < SB_ATMOSPHERE_PRODUCT_COUNT; i++) {
         sb_image_finish(&luts[i]);
         for (int t = 0; t < 4; t++)
@@ -461,6 +490,7 @@ void sb_sky_error_print(const struct sb_sky_error_report *reports, int count, bo
             cJSON_AddNumberToObject(o, "paths", r->paths);
             cJSON_AddNumberToObject(o, "spectral_paths", r->spectral_paths);
             cJSON_AddNumberToObject(o, "path_trace_s", r->path_trace_s);
+            cJSON_AddNumberToObject(o, "product_orders", r->product_orders);
             cJSON *suns = cJSON_AddArrayToObject(o, "suns");
             for (int s = 0; s < r->sun_count; s++) {
                 const struct sb_sky_error_sun *sun = &r->suns[s];
@@ -478,6 +508,11 @@ void sb_sky_error_print(const struct sb_sky_error_report *reports, int count, bo
                     cJSON_AddNumberToObject(so, "orders_ciede2000_mean", sun->orders_colour.mean);
                     cJSON_AddNumberToObject(so, "orders_ciede2000_max", sun->orders_colour.max);
                 }
+                cJSON_AddNumberToObject(so, "product_max_rel", sun->product_max_rel);
+                cJSON_AddNumberToObject(so, "product_rms_rel", sun->product_rms_rel);
+                cJSON_AddNumberToObject(so, "product_mean_rel", sun->product_mean_rel);
+                cJSON_AddNumberToObject(so, "product_ciede2000_mean", sun->product_colour.mean);
+                cJSON_AddNumberToObject(so, "product_ciede2000_max", sun->product_colour.max);
                 cJSON_AddNumberToObject(so, "ciede2000_mean", sun->de_mean);
                 cJSON_AddNumberToObject(so, "ciede2000_max", sun->de_max);
                 cJSON_AddNumberToObject(so, "ciede2000_noise", sun->de_noise);
@@ -500,6 +535,7 @@ void sb_sky_error_print(const struct sb_sky_error_report *reports, int count, bo
                     cJSON_AddItemToObject(dobj, "std_error", triple(dir->std_error));
                     if (r->orders)
                         cJSON_AddItemToObject(dobj, "orders", triple(dir->orders));
+                    cJSON_AddItemToObject(dobj, "product", triple(dir->product));
                     cJSON_AddItemToObject(dobj, "spectral", cJSON_CreateDoubleArray(dir->spectral, SB_SPECTRUM_COUNT));
                     cJSON_AddItemToObject(dobj, "spectral_std_error",
                                           cJSON_CreateDoubleArray(dir->spectral_error, SB_SPECTRUM_COUNT));
@@ -524,6 +560,14 @@ void sb_sky_error_print(const struct sb_sky_error_report *reports, int count, bo
             printf("  %8.4g %9.3g %9.3g %+9.2g %9.2g %8.1f%%  %g, %g deg, %s\n", sun->elevation_deg, sun->max_rel,
                    sun->rms_rel, sun->mean_rel, sun->noise, 100 * sun->multiple_share, w->zenith_deg, w->azimuth_deg,
                    channel_name(sun->worst_channel));
+        }
+        printf("  with the orders product (%d orders; %dx%dx%dx%d nodes), as skybake shows it:\n", r->product_orders,
+               SB_ORDERS_R, SB_ORDERS_MU, SB_ORDERS_MU_S, SB_ORDERS_NU);
+        printf("  %8s %9s %9s %9s %15s\n", "sun deg", "max rel", "rms rel", "mean rel", "CIEDE2000");
+        for (int s = 0; s < r->sun_count; s++) {
+            const struct sb_sky_error_sun *sun = &r->suns[s];
+            printf("  %8.4g %9.3g %9.3g %+9.2g %7.2f / %5.2f\n", sun->elevation_deg, sun->product_max_rel,
+                   sun->product_rms_rel, sun->product_mean_rel, sun->product_colour.mean, sun->product_colour.max);
         }
         if (r->orders) {
             printf("  with multiple scattering by orders (fp64 reference, %d orders, %.1f s):\n", r->orders,

@@ -34,6 +34,11 @@
 #define SB_SKY_ERROR_MAX_SUNS 16
 #define SB_SKY_ERROR_DIRECTIONS 16
 
+/* View i (< SB_SKY_ERROR_DIRECTIONS) of the tables from altitude_km: its
+ * zenith angle and its azimuth from the sun's, in degrees. */
+void sb_sky_error_view(const struct sb_atmosphere_params *p, double altitude_km, int i, double *zenith_deg,
+                       double *azimuth_deg);
+
 struct sb_sky_error_params {
     int paths;                             /* per direction and channel; 0: 16384 */
     int spectral_paths;                    /* per direction and wavelength; 0: paths / 16 (the same work as the
@@ -54,6 +59,7 @@ struct sb_sky_error_direction {
     double path_traced[3];                    /* the reference */
     double std_error[3];                      /* the reference's standard error */
     double orders[3];                         /* the sky with orders 2 and up from orders_ref.h */
+    double product[3];                        /* skybake's sky with the orders product (orders.h) */
     double skybake_12[12];                    /* skybake's model at SB_SKY_ERROR_SKYBAKE_12's wavelengths */
     double spectral[SB_SPECTRUM_COUNT];       /* the spectral path tracer, per wavelength */
     double spectral_error[SB_SPECTRUM_COUNT]; /* its standard error */
@@ -88,9 +94,11 @@ struct sb_sky_error_sun {
      * 1e-3 of the sun's brightest value in that channel): */
     double max_rel, rms_rel, mean_rel; /* mean_rel is signed: skybake above the reference > 0 */
     int worst_direction, worst_channel;
-    double noise;                                           /* the largest 2 standard errors, relative */
-    double orders_max_rel, orders_rms_rel, orders_mean_rel; /* the same for the orders' sky */
-    struct sb_sky_error_colour orders_colour;               /* its CIEDE2000 against the path tracer, as de_* */
+    double noise;                                              /* the largest 2 standard errors, relative */
+    double orders_max_rel, orders_rms_rel, orders_mean_rel;    /* the same for the orders' sky */
+    struct sb_sky_error_colour orders_colour;                  /* its CIEDE2000 against the path tracer, as de_* */
+    double product_max_rel, product_rms_rel, product_mean_rel; /* the same for the orders product's sky */
+    struct sb_sky_error_colour product_colour;
     /* Colour: CIEDE2000 between the two skies over the views of the sky (not
      * the ground), each rgb taken as linear Rec.709 as the runtime shows
      * it, in CIELAB against D65 at the luminance of the path tracer's
@@ -116,6 +124,8 @@ struct sb_sky_error_report {
     double path_trace_s; /* wall time of the path tracer, three channels and spectral */
     int orders;          /* with params.orders: the orders the reference summed, */
     double orders_s;     /* and its wall time */
+    int product_orders;  /* the orders product's orders */
+    double product_gpu_ms;
 };
 
 /* Bake and compare; the report is the caller's (no resources to free). */

@@ -754,8 +754,8 @@ static enum sb_result read_artifact_image(const char *dir, int dir_fd, struct sb
             res = SB_ERR_PROBES;
         }
         if (!res && a->probes.sight && pack->format_version < 9) {
-            sb_error("%s: %s: sight masks of detail probes, which format version %d cannot hold (9 and later)",
-                     path, name, pack->format_version);
+            sb_error("%s: %s: sight masks of detail probes, which format version %d cannot hold (9 and later)", path,
+                     name, pack->format_version);
             res = SB_ERR_PROBES;
         }
         if (!res && a->probes.tile_count && pack->format_version < 11) {
@@ -783,6 +783,14 @@ static enum sb_result read_artifact_image(const char *dir, int dir_fd, struct sb
         sb_error("%s: %s: holds NaN or Inf", path, name);
         return SB_ERR_NUMERIC;
     }
+    for (uint64_t i = 0, n = sb_image_float_count(image); format->nonnegative && i < n; i++)
+        if (image->data[i] < 0) {
+            uint64_t texel = i / image->channel_count;
+            sb_error("%s: %s: texel (%llu, %llu) channel %s is %g, and the product is a radiance (>= 0)", path, name,
+                     (unsigned long long)(texel % image->width), (unsigned long long)(texel / image->width),
+                     image->channel_names[i % image->channel_count], image->data[i]);
+            return SB_ERR_NUMERIC;
+        }
     char hash[SB_HASH_HEX_SIZE];
     if (format->storage == SB_STORAGE_PROBES)
         sb_probes_content_hash(image, &a->probes, hash);

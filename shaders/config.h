@@ -143,6 +143,13 @@
 #define SB_IRRADIANCE_GROUND_CHANNELS 6 /* direct.rgb, sky.rgb */
 #define SB_IRRADIANCE_SKY_CHANNELS 9    /* rayleigh.rgb, mie.rgb, ground.rgb */
 
+/* The orders product's grid (format version 14; baker/orders_ref.h):
+ * nodes in r, mu (two halves), mu_s and nu. */
+#define SB_ORDERS_R 16
+#define SB_ORDERS_MU 64
+#define SB_ORDERS_MU_S 24
+#define SB_ORDERS_NU 8
+
 /* Gauss-Legendre order of one segment of a ray integral (see atmosphere.glsl). */
 #define SB_RAY_GL_ORDER 4
 /* Upper bound on the altitude levels that cut a ray into segments. */
@@ -539,5 +546,42 @@ struct sb_prefilter_push {
     SB_UINT pad0, pad1;
     SB_UVEC4(source_offsets[SB_PREFILTER_MAX_LEVELS / 4]); /* each source level's first texel */
 };
+
+
+/* Multiple scattering by orders (bake/orders.comp, baker/orders.h): orders
+ * 2 and up on the grid of baker/orders_ref.h, nodes indexed
+ * ((ir * nmu + imu) * nmus + imus) * nnu + inu, one vec4 (rgb) a node.
+ * The orders' kernels bind the atmosphere's parameters and transmittance
+ * LUT as the atmosphere bakes do (SB_BINDING_ATMOSPHERE,
+ * SB_BINDING_TRANSMITTANCE; 2 to 7 unused), then their tables. */
+#define SB_ORDERS_BINDING_SINGLE 8   /* single scattering without its phase: Rayleigh's n nodes, then Mie's */
+#define SB_ORDERS_BINDING_PREVIOUS 9 /* the last order computed */
+#define SB_ORDERS_BINDING_DENSITY 10 /* this order's scattering density */
+#define SB_ORDERS_BINDING_SUM 11     /* orders 2 to k: the product */
+#define SB_ORDERS_BINDING_GROUND 12  /* the ground's irradiance of order j at mu_s node i: vec4 [j * nmus + i] */
+#define SB_ORDERS_BINDING_STATS 13   /* uint: the largest value of this order, of the sum (float bits) */
+#define SB_ORDERS_BINDING_COUNT 14
+/* The density's directions at a node (orders.comp): Gauss-Legendre in
+ * cos(zenith) below and above the horizon, midpoints in azimuth from the
+ * sun's over [0, pi] (each standing for its mirror image too). */
+#define SB_ORDERS_DIRECTIONS_GROUND 8
+#define SB_ORDERS_DIRECTIONS_SKY 16
+#define SB_ORDERS_DIRECTIONS_PHI 8
+#define SB_ORDERS_DIRECTIONS \
+    ((SB_ORDERS_DIRECTIONS_GROUND + SB_ORDERS_DIRECTIONS_SKY) * SB_ORDERS_DIRECTIONS_PHI)
+#define SB_ORDERS_THREADS 64
+/* The most orders a bake computes, and the most nodes in each dimension. */
+#define SB_ORDERS_MAX_ORDER 32
+#define SB_ORDERS_MAX_NODES 256
+
+struct sb_orders_push {
+    SB_UVEC4(size);    /* nodes in r, mu (even: two halves), mu_s, nu */
+    SB_VEC4(heights);  /* the altitudes' progression: q, ln q, q^n - 1 (n = size.x - 1), thickness */
+    SB_VEC4(mu_s);     /* the lowest mu_s node, the split (SB_ORDERS_MU_S_SPLIT), unused, unused */
+    SB_UINT order;     /* k, the order being computed (2 and up) */
+    SB_UINT pad0, pad1, pad2;
+};
+/* mu_s nodes: half of them from the lowest to this, the rest on to 1. */
+#define SB_ORDERS_MU_S_SPLIT 0.1
 
 #endif

@@ -731,6 +731,10 @@ static void edit_version_12(cJSON *r)
 {
     cJSON_ReplaceItemInObject(r, "format_version", cJSON_CreateNumber(12));
 }
+static void edit_version_13(cJSON *r)
+{
+    cJSON_ReplaceItemInObject(r, "format_version", cJSON_CreateNumber(13));
+}
 /* What version 1 wrote: no cloud products (in the scene or the pack), no
  * file_hash; the scene's hash recomputed for the scene without clouds. */
 static void edit_make_version_1(cJSON *r)
@@ -741,7 +745,7 @@ static void edit_make_version_1(cJSON *r)
         cJSON *a = cJSON_GetArrayItem(artifacts, i);
         enum sb_product_id id;
         if (sb_product_from_name(cJSON_GetObjectItem(a, "name")->valuestring, &id) &&
-            sb_product_format(id)->family != SB_FAMILY_ATMOSPHERE)
+            sb_product_format(id)->since_version > 1)
             cJSON_DeleteItemFromArray(artifacts, i);
         else
             cJSON_DeleteItemFromObject(a, "file_hash");
@@ -901,6 +905,16 @@ static void test_pack_reader(void)
     nan_image.data[100] = NAN;
     CHECK(sb_exr_write(nan_path, &nan_image, NULL, 0) == SB_OK, "write an EXR holding NaN");
     sb_image_finish(&nan_image);
+    /* the orders' table with an infinite node, and with a negative one */
+    for (int k = 0; k < 2; k++) {
+        snprintf(nan_path, sizeof(nan_path), "%s/%s.exr", pack_root, k ? "orders_negative" : "orders_inf");
+        sb_image_init(&nan_image, images[SB_PRODUCT_ORDERS].width, images[SB_PRODUCT_ORDERS].height, 3);
+        sb_image_set_channel_names(&nan_image, "r,g,b");
+        nan_image.data[3 * 777 + 1] = k ? -1.0f : INFINITY;
+        CHECK(sb_exr_write(nan_path, &nan_image, NULL, 0) == SB_OK, "write an orders table holding %s",
+              k ? "a negative value" : "Inf");
+        sb_image_finish(&nan_image);
+    }
 
     struct sb_pack *pack = calloc(1, sizeof(*pack));
     CHECK(sb_pack_open(good, pack) == SB_OK, "a pack just written opens");
@@ -952,7 +966,8 @@ static void test_pack_reader(void)
         {"one flipped byte in the compressed pixels, vouched for", NULL, FLIP_BYTE, SB_ERR_EXR, true},
         {"format version 1, as version 1 wrote it", edit_make_version_1,
          "rm cloud_shape.vdb cloud_detail.vdb cloud_curl.exr weather.exr sky_visibility.sbprobes sky_bounce.sbprobes "
-         "dfg.exr reflection_cubes.exr reflection_probes.sbprobes sun_bounce.sbprobes reflection_surfaces.exr",
+         "dfg.exr reflection_cubes.exr reflection_probes.sbprobes sun_bounce.sbprobes reflection_surfaces.exr "
+         "orders.exr",
          SB_OK, false},
         {"format version 2 listing sky_visibility", edit_version_2, NULL, SB_ERR_UNKNOWN_PRODUCT, false},
         {"format version 3 listing sky_bounce", edit_version_3, NULL, SB_ERR_UNKNOWN_PRODUCT, false},
@@ -960,6 +975,13 @@ static void test_pack_reader(void)
         {"format version 5 listing reflection_cubes", edit_version_5, NULL, SB_ERR_UNKNOWN_PRODUCT, false},
         {"format version 11 listing sun_bounce", edit_version_11, NULL, SB_ERR_UNKNOWN_PRODUCT, false},
         {"format version 12 listing reflection_surfaces", edit_version_12, NULL, SB_ERR_UNKNOWN_PRODUCT, false},
+        {"format version 13 listing orders", edit_version_13, NULL, SB_ERR_UNKNOWN_PRODUCT, false},
+        {"orders truncated, vouched for", NULL, "head -c 3000 orders.exr > t && mv t orders.exr", SB_ERR_EXR, true},
+        {"orders replaced by the transmittance's file, vouched for", NULL, "cp transmittance.exr orders.exr",
+         SB_ERR_BAD_IMAGE, true},
+        {"orders holding Inf, vouched for", NULL, "cp ../orders_inf.exr orders.exr", SB_ERR_NUMERIC, true},
+        {"orders holding a negative radiance, vouched for", NULL, "cp ../orders_negative.exr orders.exr",
+         SB_ERR_NUMERIC, true},
         {"surfaces file truncated, vouched for", NULL,
          "head -c 4000 reflection_surfaces.exr > t && mv t reflection_surfaces.exr", SB_ERR_EXR, true},
         {"surfaces replaced by the cubes' file, vouched for", NULL, "cp reflection_cubes.exr reflection_surfaces.exr",

@@ -1,0 +1,262 @@
+#include "orders.h"
+
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "atmosphere_ref.h"
+#include "config.h"
+#include "log.h"
+#include "orders_density.spv.h"
+#include "orders_scatter.spv.h"
+#include "orders_single.spv.h"
+#include "sky_error.h"
+
+#define KERNEL(stage)                                                                                                  \
+    {                                                                                                                  \
+        .spirv = sb_spv_orders_##stage, .spirv_size = sizeof(sb_spv_orders_##stage),                                   \
+        .binding_count = SB_ORDERS_BINDING_COUNT, .push_size = sizeof(struct sb_orders_push),                          \
+        .name = "orders " #stage,                                                                                      \
+    }
+enum { SINGLE, DENSITY, SCATTER, KERNEL_COUNT };
+static const struct sb_pipeline_params kernels[KERNEL_COUNT] = {KERNEL(single), KERNEL(density), KERNEL(scatter)};
+#undef KERNEL
+
+uint32_t sb_orders_kernels(struct sb_pipeline_params out[KERNEL_COUNT])
+{
+    memcpy(out, kernels, sizeof(kernels));
+    return KERNEL_COUNT;
+}
+
+void sb_orders_code_hash(char out[SB_HASH_HEX_SIZE])
+{
+    char text[KERNEL_COUNT * SB_HASH_HEX_SIZE + 64];
+    size_t n = 0;
+    for (int i = 0; i < KERNEL_COUNT; i++) {
+        sb_hash_bytes(kernels[i].spirv, kernels[i].spirv_size, text + n);
+        n += SB_HASH_HEX_SIZE - 1;
+    }
+    snprintf(text + n, sizeof(text) - n, " directions %d %d %d", SB_ORDERS_DIRECTIONS_GROUND, SB_ORDERS_DIRECTIONS_SKY,
+             SB_ORDERS_DIRECTIONS_PHI);
+    sb_hash_bytes(text, strlen(text), out);
+}
+
+void sb_orders_push_make(const struct sb_atmosphere_params *p, const struct sb_orders_settings *s,
+                         struct sb_orders_push *push)
+{
+    struct sb_orders_settings set = sb_orders_settings_resolve(s);
+    double q = sb_orders_height_ratio(p, set.r), R = p->ground_radius_km, top = p->top_radius_km;
+    memset(push, 0, sizeof(*push));
+    push->size[0] = (uint32_t)set.r;
+    push->size[1] = (uint32_t)set.mu;
+    push->size[2] = (uint32_t)set.mu_s;
+    push->size[3] = (uint32_t)set.nu;
+    push->heights[0] = (float)q;
+    push->heights[1] = (float)log(q);
+    push->heights[2] = (float)(pow(q, set.r - 1) - 1.0);
+    push->heights[3] = (float)(top - R);
+    push->mu_s[0] = (float)(-sqrt(top * top - R * R) / top);
+    push->mu_s[1] = (float)SB_ORDERS_MU_S_SPLIT;
+}
+
+static bool grid_ok(const struct sb_orders_settings *s)
+{
+    int n[4] = {s->r, s->mu, s->mu_s, s->nu};
+    for (int i = 0; i < 4; i++)
+        if (n[i] < 2 || n[i] > SB_ORDERS_MAX_NODES)
+            return false;
+    return s->mu >= 4 && s->max_order >= 2 && s->max_order <= SB_ORDERS_MAX_ORDER && s->tolerance > 0 &&
+           s->tolerance < 1;
+}
+
+static float float_of(uint32_t bits)
+{
+    float f;
+    memcpy(&f, &bits, sizeof(f));
+    return f;
+}
+
+enum sb_result sb_orders_bake(struct sb_vk *vk, struct sb_atmosphere_baker *baker, const struct sb_atmosphere_params *p,
+                              const struct sb_orders_settings *settings, struct sb_image *image,
+                              struct sb_orders_result *result)
+{
+    struct sb_orders_settings s = sb_orders_settings_resolve(settings);
+    memset(result, 0, sizeof(*result));
+    if (!grid_ok(&s)) {
+        sb_error("orders: the grid must have 2 to %d nodes a dimension (mu even, at least 4) and 2 to %d orders "
+                 "under a tolerance in (0, 1); got %dx%dx%dx%d, %d orders, %g",
+                 SB_ORDERS_MAX_NODES, SB_ORDERS_MAX_ORDER, s.r, s.mu, s.mu_s, s.nu, s.max_order, s.tolerance);
+        return SB_ERR_USAGE;
+    }
+    struct sb_orders_push push;
+    sb_orders_push_make(p, &s, &push);
+    size_t n = (size_t)s.r * s.mu * s.mu_s * s.nu, vec4 = 4 * sizeof(float);
+    struct sb_buffer single = {0}, previous = {0}, density = {0}, sum = {0}, ground = {0}, stats = {0}, dummy = {0};
+    struct sb_pipeline pipelines[KERNEL_COUNT] = {0};
+    float *table = NULL;
+    enum sb_result res;
+    if ((res = sb_image_init(image, (uint32_t)(s.mu_s * s.nu), (uint32_t)(s.r * s.mu + 1), 3)) ||
+        (res = sb_buffer_create(vk, 2 * n * vec4, "orders single", &single)) ||
+        (res = sb_buffer_create(vk, n * vec4, "orders previous", &previous)) ||
+        (res = sb_buffer_create(vk, n * vec4, "orders density", &density)) ||
+        (res = sb_buffer_create(vk, n * vec4, "orders sum", &sum)) ||
+        (res = sb_buffer_create(vk, (size_t)(SB_ORDERS_MAX_ORDER + 1) * s.mu_s * vec4, "orders ground", &ground)) ||
+        (res = sb_buffer_create(vk, 16, "orders stats", &stats)) ||
+        (res = sb_buffer_create(vk, 16, "orders unused", &dummy)))
+        goto done;
+    sb_image_set_channel_names(image, "r,g,b");
+    const struct sb_buffer *bindings[SB_ORDERS_BINDING_COUNT];
+    for (int i = 0; i < SB_ORDERS_BINDING_COUNT; i++)
+        bindings[i] = &dummy;
+    sb_atmosphere_bind_inputs(baker, bindings);
+    bindings[SB_BINDING_MULTISCATTERING] = bindings[SB_BINDING_IRRADIANCE_GROUND] = &dummy;
+    bindings[SB_ORDERS_BINDING_SINGLE] = &single;
+    bindings[SB_ORDERS_BINDING_PREVIOUS] = &previous;
+    bindings[SB_ORDERS_BINDING_DENSITY] = &density;
+    bindings[SB_ORDERS_BINDING_SUM] = &sum;
+    bindings[SB_ORDERS_BINDING_GROUND] = &ground;
+    bindings[SB_ORDERS_BINDING_STATS] = &stats;
+    for (int k = 0; k < KERNEL_COUNT; k++) {
+        if ((res = sb_pipeline_create(vk, &kernels[k], &pipelines[k])))
+            goto done;
+        sb_pipeline_bind(vk, &pipelines[k], bindings);
+    }
+    uint32_t node_groups = (uint32_t)((n + SB_ORDERS_THREADS - 1) / SB_ORDERS_THREADS);
+    double ms = 0;
+    if ((res = sb_dispatch(vk, &pipelines[SINGLE], &push, node_groups, 1, 1, &ms)))
+        goto done;
+    result->gpu_ms += ms;
+    for (int k = 2; k <= s.max_order; k++) {
+        sb_status("orders: order %d", k);
+        push.order = (uint32_t)k;
+        memset(stats.mapped, 0, 16);
+        if ((res = sb_dispatch(vk, &pipelines[DENSITY], &push, (uint32_t)s.r, (uint32_t)s.mu_s, 1, &ms)))
+            goto done;
+        result->gpu_ms += ms;
+        double density_ms = ms;
+        if ((res = sb_dispatch(vk, &pipelines[SCATTER], &push, node_groups, 1, 1, &ms)))
+            goto done;
+        result->gpu_ms += ms;
+        const uint32_t *largest = stats.mapped;
+        float order_max = float_of(largest[0]), sum_max = float_of(largest[1]);
+        result->orders = k;
+        result->last_share = sum_max > 0 ? order_max / sum_max : 0.0;
+        sb_debug("orders: order %d: largest %.4g, the sum's %.4g (share %.3g); density %.1f ms, scatter %.1f ms", k,
+                 order_max, sum_max, result->last_share, density_ms, ms);
+        if (!isfinite(order_max) || !isfinite(sum_max)) {
+            sb_error("orders: order %d is not finite; nothing was baked", k);
+            res = SB_ERR_NUMERIC;
+            goto done;
+        }
+        if (result->last_share < s.tolerance)
+            break;
+    }
+    if (result->last_share >= s.tolerance)
+        sb_warn("orders: order %d still adds %.3g of the sum's largest value (tolerance %g)", result->orders,
+                result->last_share, s.tolerance);
+    size_t ground_floats = (size_t)(SB_ORDERS_MAX_ORDER + 1) * s.mu_s * 4;
+    if (!(table = malloc(n * vec4 + ground_floats * sizeof(float)))) {
+        res = SB_ERR_NOMEM;
+        goto done;
+    }
+    if ((res = sb_buffer_read(vk, &sum, table)) || (res = sb_buffer_read(vk, &ground, table + 4 * n)))
+        goto done;
+    /* the last row: the ground's irradiance from the sky, orders 1 to N - 1
+     * (order j's is in the ground buffer's row j), the same at every nu */
+    for (int i = 0; i < s.mu_s; i++)
+        for (int c = 0; c < 3; c++) {
+            double e = 0;
+            for (int j = 1; j < result->orders; j++)
+                e += table[4 * (n + (size_t)j * s.mu_s + i) + c];
+            for (int k = 0; k < s.nu; k++)
+                image->data[3 * (n + (size_t)i * s.nu + k) + c] = (float)e;
+        }
+    for (size_t i = 0; i < n + (size_t)s.mu_s * s.nu; i++)
+        for (int c = 0; c < 3; c++) {
+            float v = i < n ? table[4 * i + c] : image->data[3 * i + c];
+            if (!isfinite(v) || v < 0) {
+                sb_error("orders: node %zu channel %d is %g; nothing was baked", i, c, v);
+                res = SB_ERR_NUMERIC;
+                goto done;
+            }
+            image->data[3 * i + c] = v;
+        }
+done:
+    sb_status(NULL);
+    free(table);
+    for (int k = 0; k < KERNEL_COUNT; k++)
+        sb_pipeline_destroy(vk, &pipelines[k]);
+    struct sb_buffer *buffers[] = {&single, &previous, &density, &sum, &ground, &stats, &dummy};
+    for (size_t i = 0; i < sizeof(buffers) / sizeof(buffers[0]); i++)
+        sb_buffer_destroy(vk, buffers[i]);
+    if (res)
+        sb_image_finish(image);
+    return res;
+}
+
+void sb_orders_product_sky(const struct sb_atmosphere_params *p, const struct sb_orders_ref *grid,
+                           const struct sb_image *orders, const struct sb_image *transmittance, double h, double mu,
+                           double mu_s, double nu, double out[3])
+{
+    double ms[3], e_sky[3];
+    sb_ref_sky_radiance(p, h, mu, mu_s, nu, transmittance, NULL, NULL, NULL, out);
+    sb_orders_table_read(grid, orders->data, h, mu, mu_s, nu, ms);
+    double R = p->ground_radius_km, top = p->top_radius_km, r = R + fmax(h, 0.0);
+    for (int c = 0; c < 3; c++)
+        out[c] += ms[c];
+    double disc = r * r * (mu * mu - 1.0) + R * R;
+    if (mu >= 0.0 || disc < 0.0)
+        return;
+    /* the ground where the view ends, lit by the sun and by every order of the sky */
+    double d = -r * mu - sqrt(disc), t_in = 0.0;
+    if (r > top)
+        t_in = -r * mu - sqrt(fmax(r * r * (mu * mu - 1.0) + top * top, 0.0));
+    double depth[3], sun[3], mu_s_g = fmax(-1.0, fmin(1.0, (r * mu_s + d * nu) / R));
+    sb_ref_optical_depth(p, r, mu, t_in, d, 2, depth);
+    sb_ref_transmittance_lookup(p, transmittance, R, mu_s_g, sun);
+    sb_orders_table_ground(grid, orders->data, mu_s_g, e_sky);
+    for (int c = 0; c < 3; c++) {
+        double direct = p->solar_irradiance[c] * sun[c] * fmax(mu_s_g, 0.0);
+        out[c] += exp(-depth[c]) * p->ground_albedo[c] / M_PI * (direct + e_sky[c]);
+    }
+}
+
+void sb_orders_hillaire_error(const struct sb_atmosphere_params *p, const struct sb_image baked[SB_PRODUCT_COUNT],
+                              const struct sb_image *orders, double altitude_km, const double *suns_deg, int sun_count,
+                              double *rms, double *worst)
+{
+    const struct sb_orders_settings grid = {
+        .r = SB_ORDERS_R, .mu = SB_ORDERS_MU, .mu_s = SB_ORDERS_MU_S, .nu = SB_ORDERS_NU};
+    struct sb_orders_ref *g = sb_orders_grid_create(p, &grid);
+    double sum2 = 0, largest = 0;
+    int n = 0;
+    for (int s = 0; g && s < sun_count; s++) {
+        double el = suns_deg[s] * M_PI / 180, hillaire[SB_SKY_ERROR_DIRECTIONS][3], exact[SB_SKY_ERROR_DIRECTIONS][3];
+        double brightest[3] = {0, 0, 0};
+        for (int d = 0; d < SB_SKY_ERROR_DIRECTIONS; d++) {
+            double zen, az;
+            sb_sky_error_view(p, altitude_km, d, &zen, &az);
+            zen *= M_PI / 180;
+            az *= M_PI / 180;
+            double mu = cos(zen), mu_s = sin(el);
+            double nu = fmax(-1.0, fmin(1.0, sin(zen) * cos(el) * cos(az) + mu * mu_s));
+            const struct sb_image *t = &baked[SB_PRODUCT_TRANSMITTANCE], *ig = &baked[SB_PRODUCT_IRRADIANCE_GROUND];
+            sb_ref_sky_radiance(p, altitude_km, mu, mu_s, nu, t, &baked[SB_PRODUCT_MULTISCATTERING], ig, NULL,
+                                hillaire[d]);
+            sb_orders_product_sky(p, g, orders, t, altitude_km, mu, mu_s, nu, exact[d]);
+            for (int c = 0; c < 3; c++)
+                brightest[c] = fmax(brightest[c], exact[d][c]);
+        }
+        for (int d = 0; d < SB_SKY_ERROR_DIRECTIONS; d++)
+            for (int c = 0; c < 3; c++) {
+                double e = (hillaire[d][c] - exact[d][c]) / fmax(exact[d][c], 1e-3 * brightest[c]);
+                sum2 += e * e;
+                largest = fmax(largest, fabs(e));
+                n++;
+            }
+    }
+    sb_orders_ref_destroy(&g);
+    *rms = n ? sqrt(sum2 / n) : 0;
+    *worst = largest;
+}

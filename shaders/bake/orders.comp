@@ -1,0 +1,223 @@
+#version 450
+// Multiple scattering by orders (Bruneton and Neyret 2008; baker/orders.h),
+// one of three stages a build (SB_ORDERS_STAGE):
+// 0 single: a node an invocation, single scattering along its view without
+//   the phase functions, Rayleigh's and Mie's apart (atmosphere.glsl's
+//   integrate_ray, the sun read from the transmittance LUT);
+// 1 density: a workgroup a (r, mu_s) pair. It reads order k - 1's radiance
+//   at SB_ORDERS_DIRECTIONS directions about the point (the single
+//   scattering tables with their phase functions for k = 2, else the last
+//   order's, plus the ground lit by order k - 2 where a direction ends on
+//   it) into workgroup memory, then gives each of its (mu, nu) nodes order
+//   k's scattering density: Rayleigh's and Mie's phase functions against
+//   those directions, Mie's normalised by its own sum (so that however
+//   narrow its peak, a uniform sky is integrated exactly). Workgroups at
+//   the ground also integrate the upper hemisphere into the ground's
+//   irradiance of order k - 1;
+// 2 scatter: a node an invocation, order k along its view, the density
+//   integrated with the transmittance by atmosphere.glsl's segments; adds
+//   it to the sum and keeps the largest values.
+#extension GL_GOOGLE_include_directive : require
+#define SB_SUN_TRANSMITTANCE_LUT
+#include "config.h"
+#include "atmosphere.glsl"
+#include "orders.glsl"
+
+layout(local_size_x = SB_ORDERS_THREADS) in;
+
+layout(std430, set = 0, binding = SB_ORDERS_BINDING_SINGLE) buffer SingleBuffer { vec4 single_table[]; };
+layout(std430, set = 0, binding = SB_ORDERS_BINDING_PREVIOUS) buffer PreviousBuffer { vec4 previous_table[]; };
+layout(std430, set = 0, binding = SB_ORDERS_BINDING_DENSITY) buffer DensityBuffer { vec4 density_table[]; };
+layout(std430, set = 0, binding = SB_ORDERS_BINDING_SUM) buffer SumBuffer { vec4 sum_table[]; };
+layout(std430, set = 0, binding = SB_ORDERS_BINDING_GROUND) buffer GroundBuffer { vec4 ground_table[]; };
+layout(std430, set = 0, binding = SB_ORDERS_BINDING_STATS) buffer StatsBuffer { uint stats[]; };
+
+/* A node's view. */
+void node_view(uint index, out float h, out float mu, out float mu_s, out float nu, out bool ground)
+{
+    uvec4 n = orders_node(index);
+    h = orders_altitude(n.x);
+    mu = orders_mu(h, n.y);
+    mu_s = orders_mu_s(n.z);
+    nu = orders_nu(mu, mu_s, PI * float(n.w) / float(orders.size.w - 1u));
+    ground = n.y < orders.size.y / 2u;
+}
+
+#if SB_ORDERS_STAGE == 0
+
+void main()
+{
+    uint i = gl_GlobalInvocationID.x, n = orders_node_count();
+    if (i >= n)
+        return;
+    float h, mu, mu_s, nu;
+    bool ground;
+    node_view(i, h, mu, mu_s, nu, ground);
+    vec3 rayleigh = vec3(0.0), mie = vec3(0.0);
+    if (!(ground && h <= 0.0)) { /* on the ground looking into it: no air */
+        RayIntegrals ri = integrate_ray(h, mu, mu_s, nu, ground, false);
+        rayleigh = ri.sun_rayleigh * atm.solar_irradiance.rgb;
+        mie = ri.sun_mie * atm.solar_irradiance.rgb;
+    }
+    single_table[i] = vec4(rayleigh, 0.0);
+    single_table[n + i] = vec4(mie, 0.0);
+}
+
+#elif SB_ORDERS_STAGE == 1
+
+#define SINGLE_RAYLEIGH(i) single_table[i].rgb
+#define SINGLE_MIE(i) single_table[orders_node_count() + (i)].rgb
+#define PREVIOUS(i) previous_table[i].rgb
+SB_ORDERS_READ(read_single_rayleigh, SINGLE_RAYLEIGH)
+SB_ORDERS_READ(read_single_mie, SINGLE_MIE)
+SB_ORDERS_READ(read_previous, PREVIOUS)
+
+shared vec4 dir_radiance[SB_ORDERS_DIRECTIONS]; /* rgb; w: the direction's weight */
+shared vec4 dir_vector[SB_ORDERS_DIRECTIONS];   /* cos(zenith), sin(zenith), azimuth from the sun's */
+
+/* The ground's irradiance of order j at sun cosine mu_s (j = 0: the sun's). */
+vec3 ground_irradiance(uint j, float mu_s)
+{
+    if (j == 0u)
+        return atm.solar_irradiance.rgb * sun_transmittance(0.0, mu_s) * max(mu_s, 0.0);
+    float f = orders_mu_s_coord(mu_s);
+    uint i = min(uint(f), orders.size.z - 2u), row = j * orders.size.z;
+    return orders_blend_mu_s(ground_table[row + i].rgb, ground_table[row + i + 1u].rgb, f - float(i),
+                             orders_mu_s(i + 1u) <= 0.0);
+}
+
+/* Transmittance from altitude h along mu (ending on the ground) to the ground. */
+vec3 transmittance_to_ground(float h, float mu, float d)
+{
+    float r = ground_radius() + h;
+    float mu_g = clamp((r * mu + d) / ground_radius(), -1.0, 1.0);
+    /* the reversed ray from the ground point up through x, over the one from x up */
+    vec3 a = transmittance_lut_sample(0.0, -mu_g), b = transmittance_lut_sample(h, -mu);
+    return min(a / max(b, vec3(1e-30)), vec3(1.0));
+}
+
+/* Order k - 1's radiance reaching altitude h from direction (mu_in, nu_in). */
+vec3 previous_radiance(float h, float mu_in, float mu_s, float nu_in)
+{
+    bool ground = ray_hits_ground(h, mu_in);
+    OrdersCell c = orders_cell(h, mu_in, mu_s, nu_in, ground);
+    vec3 L;
+    if (orders.order == 2u)
+        L = phase_rayleigh(nu_in) * read_single_rayleigh(c) + phase_mie(nu_in) * read_single_mie(c);
+    else
+        L = read_previous(c);
+    if (ground) {
+        float d = distance_to_ground(h, mu_in), r = ground_radius() + h;
+        float mu_s_g = clamp((r * mu_s + d * nu_in) / ground_radius(), -1.0, 1.0);
+        L += transmittance_to_ground(h, mu_in, d) * atm.ground_albedo.rgb / PI
+           * ground_irradiance(orders.order - 2u, mu_s_g);
+    }
+    return L;
+}
+
+/* Cornette-Shanks without pow: k (1 + c^2) d^-1.5 (phase_mie's form). */
+float phase_mie_fast(float c, float g, float ag, float k)
+{
+    float d = max((1.0 - ag) * (1.0 - ag) + 2.0 * ag * (g >= 0.0 ? 1.0 - c : 1.0 + c), 1e-12);
+    return k * (1.0 + c * c) * inversesqrt(d) / d;
+}
+
+void main()
+{
+    uint ir = gl_WorkGroupID.x, ims = gl_WorkGroupID.y, t = gl_LocalInvocationID.x;
+    float h = orders_altitude(ir), mu_s = orders_mu_s(ims), r = ground_radius() + h;
+    float ss = sqrt(max(1.0 - mu_s * mu_s, 0.0));
+    float horizon = -horizon_distance(h) / r;
+    const uint per_phi = SB_ORDERS_DIRECTIONS_GROUND + SB_ORDERS_DIRECTIONS_SKY;
+    for (uint d = t; d < SB_ORDERS_DIRECTIONS; d += SB_ORDERS_THREADS) {
+        uint q = d / SB_ORDERS_DIRECTIONS_PHI, f = d % SB_ORDERS_DIRECTIONS_PHI;
+        bool sky = q >= SB_ORDERS_DIRECTIONS_GROUND;
+        float mu_in, w_mu;
+        if (sky)
+            gauss_legendre(int(q - SB_ORDERS_DIRECTIONS_GROUND), SB_ORDERS_DIRECTIONS_SKY, horizon, 1.0, mu_in, w_mu);
+        else
+            gauss_legendre(int(q), SB_ORDERS_DIRECTIONS_GROUND, -1.0, horizon, mu_in, w_mu);
+        float phi = PI * (float(f) + 0.5) / float(SB_ORDERS_DIRECTIONS_PHI);
+        float s_in = sqrt(max(1.0 - mu_in * mu_in, 0.0));
+        float nu_in = clamp(mu_in * mu_s + s_in * ss * cos(phi), -1.0, 1.0);
+        vec3 L = previous_radiance(h, mu_in, mu_s, nu_in);
+        dir_radiance[d] = vec4(L, w_mu * PI / float(SB_ORDERS_DIRECTIONS_PHI));
+        dir_vector[d] = vec4(mu_in, s_in, phi, 0.0);
+    }
+    barrier();
+    /* the ground's irradiance of order k - 1, from the upper hemisphere
+     * (the horizon is at mu = 0 there); both mirror images */
+    if (ir == 0u && t == 0u) {
+        vec3 e = vec3(0.0);
+        for (uint d = SB_ORDERS_DIRECTIONS_GROUND * SB_ORDERS_DIRECTIONS_PHI; d < SB_ORDERS_DIRECTIONS; d++)
+            e += 2.0 * dir_radiance[d].w * dir_vector[d].x * dir_radiance[d].rgb;
+        ground_table[(orders.order - 1u) * orders.size.z + ims] = vec4(e, 0.0);
+    }
+    Medium m = medium_at(h);
+    float g = atm.mie_extinction.w, ag = abs(g), k_mie = 3.0 / (8.0 * PI) * (1.0 - g * g) / (2.0 + g * g);
+    uint per_slice = orders.size.y * orders.size.w;
+    for (uint j = t; j < per_slice; j += SB_ORDERS_THREADS) {
+        uint imu = j / orders.size.w, inu = j % orders.size.w;
+        float mu = orders_mu(h, imu), sv = sqrt(max(1.0 - mu * mu, 0.0));
+        float phi_s = PI * float(inu) / float(orders.size.w - 1u);
+        vec3 rayleigh = vec3(0.0), mie = vec3(0.0);
+        float mie_weight = 0.0;
+        for (uint d = 0u; d < SB_ORDERS_DIRECTIONS; d++) {
+            vec4 v = dir_vector[d], L = dir_radiance[d];
+            float a = mu * v.x, b = sv * v.y;
+            float c_plus = clamp(a + b * cos(v.z - phi_s), -1.0, 1.0);
+            float c_minus = clamp(a + b * cos(v.z + phi_s), -1.0, 1.0);
+            float pr = phase_rayleigh(c_plus) + phase_rayleigh(c_minus);
+            float pm = phase_mie_fast(c_plus, g, ag, k_mie) + phase_mie_fast(c_minus, g, ag, k_mie);
+            rayleigh += (L.w * pr) * L.rgb;
+            mie += (L.w * pm) * L.rgb;
+            mie_weight += L.w * pm;
+        }
+        vec3 J = m.scattering_rayleigh * rayleigh + m.scattering_mie * mie / max(mie_weight, 1e-30);
+        density_table[orders_index(ir, imu, ims, inu)] = vec4(J, 0.0);
+    }
+}
+
+#else
+
+#define DENSITY(i) density_table[i].rgb
+SB_ORDERS_READ(read_density, DENSITY)
+
+void main()
+{
+    uint i = gl_GlobalInvocationID.x, n = orders_node_count();
+    if (i >= n)
+        return;
+    float h, mu, mu_s, nu;
+    bool ground;
+    node_view(i, h, mu, mu_s, nu, ground);
+    vec3 L = vec3(0.0);
+    if (!(ground && h <= 0.0)) {
+        float t_end = ground ? distance_to_ground(h, mu) : distance_to_top(h, mu), r0 = ground_radius() + h;
+        RayCuts cuts = ray_cuts(h, mu, mu_s, nu);
+        vec3 tau = vec3(0.0);
+        for (float t0 = 0.0; t0 < t_end;) {
+            float t1 = ray_next_cut(cuts, t0, t_end), half_len = 0.5 * (t1 - t0);
+            float ts[4], hs[4];
+            Medium m[4];
+            vec3 tw[4];
+            ray_segment_nodes(h, mu, t0, t1, ts, hs, m);
+            ray_node_weights(tau, half_len, m, tw);
+            for (int k = 0; k < 4; k++) {
+                float r = ground_radius() + hs[k];
+                float mu_k = clamp((r0 * mu + ts[k]) / r, -1.0, 1.0);
+                float mu_s_k = clamp((r0 * mu_s + ts[k] * nu) / r, -1.0, 1.0);
+                L += tw[k] * read_density(orders_cell(hs[k], mu_k, mu_s_k, nu, ground));
+            }
+            ray_advance(tau, half_len, m);
+            t0 = t1;
+        }
+    }
+    previous_table[i] = vec4(L, 0.0);
+    vec3 sum = sum_table[i].rgb + L;
+    sum_table[i] = vec4(sum, 0.0);
+    atomicMax(stats[0], floatBitsToUint(max(L.r, max(L.g, L.b))));
+    atomicMax(stats[1], floatBitsToUint(max(sum.r, max(sum.g, sum.b))));
+}
+
+#endif

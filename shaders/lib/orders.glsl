@@ -1,0 +1,175 @@
+// The grid of multiple scattering by orders (config.h's sb_orders_push;
+// baker/orders_ref.h states it and holds its fp64 twin): a node's
+// (r, mu, mu_s, nu), a point's continuous node coordinates, and the
+// multilinear read of a table of nodes. The grid is `orders`, an
+// sb_orders_push: the push constants, unless the includer defines
+// SB_ORDERS_GRID_DECLARED and declares `orders` itself.
+#ifndef SB_ORDERS_GLSL
+#define SB_ORDERS_GLSL
+
+#include "config.h"
+#include "atmosphere.glsl"
+
+#ifndef SB_ORDERS_GRID_DECLARED
+layout(push_constant) uniform OrdersPush { sb_orders_push orders; };
+#endif
+
+uint orders_node_count() { return orders.size.x * orders.size.y * orders.size.z * orders.size.w; }
+
+/* Node (ir, imu, imus, inu) of a flat index. */
+uvec4 orders_node(uint index)
+{
+    uvec4 s = orders.size;
+    return uvec4(index / (s.w * s.z * s.y), index / (s.w * s.z) % s.y, index / s.w % s.z, index % s.w);
+}
+
+uint orders_index(uint ir, uint imu, uint imus, uint inu)
+{
+    return ((ir * orders.size.y + imu) * orders.size.z + imus) * orders.size.w + inu;
+}
+
+/* Altitude of r node i: h_i = Z (q^i - 1) / (q^n - 1), or uniform for q = 1. */
+float orders_altitude(uint i)
+{
+    float n = float(orders.size.x - 1u), Z = orders.heights.w;
+    if (i >= orders.size.x - 1u)
+        return Z;
+    return orders.heights.x == 1.0 ? Z * float(i) / n : Z * (exp(orders.heights.y * float(i)) - 1.0) / orders.heights.z;
+}
+
+/* The continuous r node index of altitude h. */
+float orders_altitude_coord(float h)
+{
+    float n = float(orders.size.x - 1u), Z = orders.heights.w;
+    h = clamp(h, 0.0, Z);
+    float i = orders.heights.x == 1.0 ? h / Z * n : log(1.0 + h / Z * orders.heights.z) / orders.heights.y;
+    return clamp(i, 0.0, n);
+}
+
+/* mu at node imu at altitude h: the first half of the nodes end on the
+ * ground, uniform in the ray's length between straight down and the
+ * horizon; the second leave the atmosphere, from straight up to the
+ * horizon. */
+float orders_mu(float h, uint imu)
+{
+    uint half_count = orders.size.y / 2u;
+    float R = ground_radius(), r = R + h, rho = horizon_distance(h), H = horizon_top();
+    if (imu < half_count) {
+        float x = float(imu) / float(half_count - 1u), d = h + x * (rho - h);
+        return d <= 0.0 ? -1.0 : clamp(-(rho * rho + d * d) / (2.0 * r * d), -1.0, 1.0);
+    }
+    float x = float(imu - half_count) / float(half_count - 1u), d_min = atmosphere_thickness() - h;
+    float d = d_min + x * (rho + H - d_min);
+    return d <= 0.0 ? 1.0 : clamp((H * H - rho * rho - d * d) / (2.0 * r * d), -1.0, 1.0);
+}
+
+/* The continuous mu node index of (h, mu) in the half `ground` says. */
+float orders_mu_coord(float h, float mu, bool ground)
+{
+    float half_count = float(orders.size.y / 2u);
+    float rho = horizon_distance(h), H = horizon_top();
+    if (ground) {
+        float d_min = h, d_max = rho, d = distance_to_ground(h, mu);
+        float x = d_max > d_min ? (d - d_min) / (d_max - d_min) : 0.0;
+        return clamp(x, 0.0, 1.0) * (half_count - 1.0);
+    }
+    float d_min = max(atmosphere_thickness() - h, 0.0), d_max = rho + H, d = distance_to_top(h, mu);
+    float x = d_max > d_min ? (d - d_min) / (d_max - d_min) : 0.0;
+    return half_count + clamp(x, 0.0, 1.0) * (half_count - 1.0);
+}
+
+/* mu_s at node imus: half the nodes from the lowest (below it no point of
+ * the atmosphere sees the sun) to SB_ORDERS_MU_S_SPLIT, the rest on to 1. */
+float orders_mu_s(uint imus)
+{
+    uint low = orders.size.z / 2u;
+    float lo = orders.mu_s.x, split = orders.mu_s.y;
+    if (imus <= low)
+        return lo + (split - lo) * float(imus) / float(low);
+    return split + (1.0 - split) * float(imus - low) / float(orders.size.z - 1u - low);
+}
+
+float orders_mu_s_coord(float mu_s)
+{
+    uint low = orders.size.z / 2u;
+    float lo = orders.mu_s.x, split = orders.mu_s.y;
+    mu_s = clamp(mu_s, lo, 1.0);
+    if (mu_s <= split)
+        return (mu_s - lo) / (split - lo) * float(low);
+    return float(low) + (mu_s - split) / (1.0 - split) * float(orders.size.z - 1u - low);
+}
+
+/* The sun's azimuth about the vertical from the view's, in [0, pi]. */
+float orders_phi(float mu, float mu_s, float nu)
+{
+    float s = sqrt(max((1.0 - mu * mu) * (1.0 - mu_s * mu_s), 0.0));
+    return s > 1e-6 ? acos_precise(clamp((nu - mu * mu_s) / s, -1.0, 1.0)) : 0.0;
+}
+
+float orders_nu(float mu, float mu_s, float phi)
+{
+    return clamp(mu * mu_s + sqrt(max((1.0 - mu * mu) * (1.0 - mu_s * mu_s), 0.0)) * cos(phi), -1.0, 1.0);
+}
+
+/* Between two mu_s nodes: linear by day; geometric where both lie below
+ * the horizon and are positive (twilight falls exponentially there). */
+vec3 orders_blend_mu_s(vec3 a, vec3 b, float f, bool twilight)
+{
+    vec3 lin = mix(a, b, f);
+    if (!twilight)
+        return lin;
+    /* a select, not arithmetic: where a node is 0 the power is not a number */
+    bvec3 pos = greaterThan(min(a, b), vec3(0.0));
+    vec3 geo = a * pow(max(b, vec3(1e-30)) / max(a, vec3(1e-30)), vec3(f));
+    return mix(lin, geo, pos);
+}
+
+/* The corner nodes and weights of the multilinear read at (h, mu, mu_s, nu). */
+struct OrdersCell {
+    uint base; /* node (ir, im, ims, inu) */
+    vec3 a;    /* fractions in r, mu, nu */
+    float as;  /* fraction in mu_s */
+    bool twilight;
+};
+
+OrdersCell orders_cell(float h, float mu, float mu_s, float nu, bool ground)
+{
+    uvec4 s = orders.size;
+    OrdersCell c;
+    float fr = orders_altitude_coord(h);
+    uint ir = min(uint(fr), s.x - 2u);
+    float fs = orders_mu_s_coord(mu_s);
+    uint ims = min(uint(fs), s.z - 2u);
+    float fn = orders_phi(mu, mu_s, nu) / PI * float(s.w - 1u);
+    uint inu = min(uint(fn), s.w - 2u);
+    uint lo = ground ? 0u : s.y / 2u;
+    float fm = orders_mu_coord(h, mu, ground);
+    uint im = min(uint(fm), lo + s.y / 2u - 2u);
+    c.base = orders_index(ir, im, ims, inu);
+    c.a = vec3(fr - float(ir), fm - float(im), fn - float(inu));
+    c.as = fs - float(ims);
+    c.twilight = orders_mu_s(ims + 1u) <= 0.0;
+    return c;
+}
+
+/* A function `name`(OrdersCell) reading a table of nodes through TABLE(i)
+ * (a vec3 at node i): linear in r, mu and nu, geometric in mu_s below the
+ * horizon. */
+#define SB_ORDERS_READ(name, TABLE)                                                               \
+    vec3 name(OrdersCell c)                                                                       \
+    {                                                                                             \
+        uvec4 s = orders.size;                                                                    \
+        uint sr = s.y * s.z * s.w, sm = s.z * s.w, ss = s.w;                                      \
+        vec3 out_value = vec3(0.0);                                                               \
+        for (uint dr = 0u; dr < 2u; dr++)                                                         \
+            for (uint dm = 0u; dm < 2u; dm++)                                                     \
+                for (uint dn = 0u; dn < 2u; dn++) {                                               \
+                    float w = (dr == 1u ? c.a.x : 1.0 - c.a.x) * (dm == 1u ? c.a.y : 1.0 - c.a.y) \
+                            * (dn == 1u ? c.a.z : 1.0 - c.a.z);                                   \
+                    uint i = c.base + dr * sr + dm * sm + dn;                                     \
+                    out_value += w * orders_blend_mu_s(TABLE(i), TABLE(i + ss), c.as, c.twilight); \
+                }                                                                                 \
+        return out_value;                                                                         \
+    }
+
+#endif
