@@ -11,6 +11,7 @@
 #include "orders_density.spv.h"
 #include "orders_scatter.spv.h"
 #include "orders_single.spv.h"
+#include "physics.h"
 #include "sky_error.h"
 
 #define KERNEL(stage)                                                                                                  \
@@ -40,24 +41,6 @@ void sb_orders_code_hash(char out[SB_HASH_HEX_SIZE])
     snprintf(text + n, sizeof(text) - n, " directions %d %d %d", SB_ORDERS_DIRECTIONS_GROUND, SB_ORDERS_DIRECTIONS_SKY,
              SB_ORDERS_DIRECTIONS_PHI);
     sb_hash_bytes(text, strlen(text), out);
-}
-
-void sb_orders_push_make(const struct sb_atmosphere_params *p, const struct sb_orders_settings *s,
-                         struct sb_orders_push *push)
-{
-    struct sb_orders_settings set = sb_orders_settings_resolve(s);
-    double q = sb_orders_height_ratio(p, set.r), R = p->ground_radius_km, top = p->top_radius_km;
-    memset(push, 0, sizeof(*push));
-    push->size[0] = (uint32_t)set.r;
-    push->size[1] = (uint32_t)set.mu;
-    push->size[2] = (uint32_t)set.mu_s;
-    push->size[3] = (uint32_t)set.nu;
-    push->heights[0] = (float)q;
-    push->heights[1] = (float)log(q);
-    push->heights[2] = (float)(pow(q, set.r - 1) - 1.0);
-    push->heights[3] = (float)(top - R);
-    push->mu_s[0] = (float)(-sqrt(top * top - R * R) / top);
-    push->mu_s[1] = (float)SB_ORDERS_MU_S_SPLIT;
 }
 
 static bool grid_ok(const struct sb_orders_settings *s)
@@ -90,7 +73,7 @@ enum sb_result sb_orders_bake(struct sb_vk *vk, struct sb_atmosphere_baker *bake
         return SB_ERR_USAGE;
     }
     struct sb_orders_push push;
-    sb_orders_push_make(p, &s, &push);
+    sb_orders_grid_pack(p, s.r, s.mu, s.mu_s, s.nu, &push);
     size_t n = (size_t)s.r * s.mu * s.mu_s * s.nu, vec4 = 4 * sizeof(float);
     struct sb_buffer single = {0}, previous = {0}, density = {0}, sum = {0}, ground = {0}, stats = {0}, dummy = {0};
     struct sb_pipeline pipelines[KERNEL_COUNT] = {0};

@@ -30,10 +30,6 @@ struct sb_orders_result {
     double gpu_ms;
 };
 
-/* The grid's parameters as the kernels take them (config.h). */
-void sb_orders_push_make(const struct sb_atmosphere_params *p, const struct sb_orders_settings *s,
-                         struct sb_orders_push *push);
-
 /* Bake with `baker`'s parameters and transmittance LUT (baked or adopted
  * before): SB_ERR_USAGE for a grid outside 2 to SB_ORDERS_MAX_NODES a
  * dimension (mu at least 4) or orders outside 2 to SB_ORDERS_MAX_ORDER. */

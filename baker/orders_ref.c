@@ -54,23 +54,6 @@ struct sb_orders_ref {
 
 /* ---- Altitudes in a geometric progression ----------------------------------- */
 
-static struct progression progression_make(double Z, double first, int count)
-{
-    struct progression g = {Z, 1.0, count - 1};
-    if (first * g.n >= Z * (1 - 1e-12))
-        return g;
-    double lo = 1.0, hi = 1e3; /* q with (q^n - 1) / (q - 1) = Z / first */
-    for (int i = 0; i < 200; i++) {
-        double q = 0.5 * (lo + hi);
-        if ((pow(q, g.n) - 1) / (q - 1) < Z / first)
-            lo = q;
-        else
-            hi = q;
-    }
-    g.q = 0.5 * (lo + hi);
-    return g;
-}
-
 static double progression_at(const struct progression *g, int i)
 {
     if (i >= g->n)
@@ -584,13 +567,7 @@ struct sb_orders_settings sb_orders_settings_resolve(const struct sb_orders_sett
 
 static struct progression heights_of(const struct sb_atmosphere_params *p, int nr)
 {
-    double scale = fmin(p->rayleigh_scale_height_km, p->mie_scale_height_km);
-    return progression_make(p->top_radius_km - p->ground_radius_km, 0.25 * scale, nr);
-}
-
-double sb_orders_height_ratio(const struct sb_atmosphere_params *p, int nr)
-{
-    return heights_of(p, nr).q;
+    return (struct progression){p->top_radius_km - p->ground_radius_km, sb_orders_height_ratio(p, nr), nr - 1};
 }
 
 /* The grid and the quadratures, no table. */

@@ -58,11 +58,6 @@ struct sb_orders_settings {
 /* The settings with their defaults filled in (mu even). */
 struct sb_orders_settings sb_orders_settings_resolve(const struct sb_orders_settings *s);
 
-/* The altitudes of the r nodes: h_i = Z (q^i - 1) / (q^n - 1), n = nr - 1,
- * Z the atmosphere's thickness, the first step a quarter of the smaller
- * scale height (q = 1: uniform, where that would be coarser). Returns q. */
-double sb_orders_height_ratio(const struct sb_atmosphere_params *p, int nr);
-
 struct sb_orders_ref; /* opaque */
 
 /* The grid alone, to read a table of it (sb_orders_table_read): what the

@@ -61,7 +61,6 @@ struct sb_product_format {
     int half_since;         /* a probe product stored as float16 from this format version on, float32 before; 0 */
     const char *extension;  /* of its file: "exr", "vdb" */
     bool nonnegative;       /* every value >= 0 (a radiance): a reader refuses a negative one */
-    bool opt_in;            /* baked only when a scene's "products" names it, not with its family's defaults */
     enum sb_family family;
 };
 

@@ -232,8 +232,7 @@ static enum sb_result parse_root(const cJSON *root, struct sb_scene *scene, cons
     }
     if (!have_products)
         for (int p = 0; p < SB_PRODUCT_COUNT; p++)
-            scene->wants[p] = sb_family_format(sb_product_format((enum sb_product_id)p)->family)->default_products &&
-                              !sb_product_format((enum sb_product_id)p)->opt_in;
+            scene->wants[p] = sb_family_format(sb_product_format((enum sb_product_id)p)->family)->default_products;
     for (int f = 0; f < SB_FAMILY_COUNT; f++) {
         const struct sb_family_format *family = sb_family_format((enum sb_family)f);
         if (family->validate && (res = family->validate(scene, source)))

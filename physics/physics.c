@@ -23,6 +23,41 @@ static void put3(float dst[4], const double src[3], double w)
     dst[3] = (float)w;
 }
 
+double sb_orders_height_ratio(const struct sb_atmosphere_params *p, int nr)
+{
+    double Z = p->top_radius_km - p->ground_radius_km;
+    double first = 0.25 * fmin(p->rayleigh_scale_height_km, p->mie_scale_height_km);
+    int n = nr - 1;
+    if (n < 1 || first * n >= Z * (1 - 1e-12))
+        return 1.0;
+    double lo = 1.0, hi = 1e3; /* q with (q^n - 1) / (q - 1) = Z / first, by bisection */
+    for (int i = 0; i < 200; i++) {
+        double q = 0.5 * (lo + hi);
+        if ((pow(q, n) - 1) / (q - 1) < Z / first)
+            lo = q;
+        else
+            hi = q;
+    }
+    return 0.5 * (lo + hi);
+}
+
+void sb_orders_grid_pack(const struct sb_atmosphere_params *p, int nr, int nmu, int nmus, int nnu,
+                         struct sb_orders_push *out)
+{
+    double q = sb_orders_height_ratio(p, nr), R = p->ground_radius_km, top = p->top_radius_km;
+    memset(out, 0, sizeof(*out));
+    out->size[0] = (uint32_t)nr;
+    out->size[1] = (uint32_t)nmu;
+    out->size[2] = (uint32_t)nmus;
+    out->size[3] = (uint32_t)nnu;
+    out->heights[0] = (float)q;
+    out->heights[1] = (float)log(q);
+    out->heights[2] = (float)(pow(q, nr - 1) - 1.0);
+    out->heights[3] = (float)(top - R);
+    out->mu_s[0] = (float)(-sqrt(top * top - R * R) / top);
+    out->mu_s[1] = (float)SB_ORDERS_MU_S_SPLIT;
+}
+
 void sb_atmosphere_gpu_pack(const struct sb_atmosphere_params *p, struct sb_atmosphere_gpu *g)
 {
     memset(g, 0, sizeof(*g));

@@ -22,6 +22,17 @@ void sb_gauss_legendre_node(int k, int n, double a, double b, double *x, double 
 /* Fill the std430 image of the parameters (config.h) from validated ones. */
 void sb_atmosphere_gpu_pack(const struct sb_atmosphere_params *params, struct sb_atmosphere_gpu *gpu);
 
+/* The orders' grid (baker/orders_ref.h states it): the ratio q of its
+ * altitudes' geometric progression, h_i = Z (q^i - 1) / (q^n - 1) over the
+ * atmosphere's thickness Z with n = nr - 1, the first step a quarter of the
+ * smaller scale height (q = 1: uniform, where that would be coarser). */
+double sb_orders_height_ratio(const struct sb_atmosphere_params *params, int nr);
+
+/* The grid of nr x nmu x nmus x nnu nodes as the orders' kernels and
+ * skyview's passes take it (config.h's sb_orders_push; order 0). */
+void sb_orders_grid_pack(const struct sb_atmosphere_params *params, int nr, int nmu, int nmus, int nnu,
+                         struct sb_orders_push *out);
+
 /* The altitude levels (km, ascending) that cut rays into segments: geometric
  * by sqrt(2) from half the smallest scale height, below the top. Returns
  * their number, at most SB_MAX_LEVELS. */

@@ -8,6 +8,7 @@
 #include <assert.h>
 #include <math.h>
 #include <stdlib.h>
+#include <string.h>
 
 #include "log.h"
 #include "physics.h"
@@ -88,6 +89,24 @@ enum sb_result sb_atmosphere_upload(struct sb_renderer *r, const struct sb_pack 
                              "multiscattering (refined)", &r->multiscattering);
     }
     free(refined);
+    /* The orders product, where the pack has it (every view kernel is
+     * specialized on it: pass.c), else a 1 x 1 stand-in nothing reads. */
+    const struct sb_image *orders = &pack->images[SB_PRODUCT_ORDERS];
+    r->has_orders = !res && pack->present[SB_PRODUCT_ORDERS];
+    memset(&r->orders_grid, 0, sizeof(r->orders_grid));
+    if (r->has_orders) {
+        sb_orders_grid_pack(atm, SB_ORDERS_R, SB_ORDERS_MU, SB_ORDERS_MU_S, SB_ORDERS_NU, &r->orders_grid);
+        res = upload_rgba32f(r, orders->data, 3, orders->width, orders->height, "orders", &r->orders);
+    } else if (!res) {
+        const float none[3] = {0, 0, 0};
+        res = upload_rgba32f(r, none, 3, 1, 1, "orders (none)", &r->orders);
+    }
+    r->specialization_entry =
+        (VkSpecializationMapEntry){.constantID = SB_VIEW_CONSTANT_ORDERS, .offset = 0, .size = sizeof(VkBool32)};
+    r->specialization = (VkSpecializationInfo){.mapEntryCount = 1,
+                                               .pMapEntries = &r->specialization_entry,
+                                               .dataSize = sizeof(VkBool32),
+                                               .pData = &r->has_orders};
     float ground[SB_IRRADIANCE_WIDTH * 2 * 3]; /* two rows (physics.h) */
     assert(sb_lookup_float_count(SB_PRODUCT_IRRADIANCE_GROUND) == sizeof(ground) / sizeof(ground[0]));
     if (!res) {

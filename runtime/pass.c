@@ -39,6 +39,7 @@ void sb_pass_read_atmosphere(struct sb_renderer *r)
     sb_pass_sample(r, SB_BINDING_TRANSMITTANCE, sb_pass_find(r, "transmittance"), r->nearest);
     sb_pass_sample(r, SB_BINDING_MULTISCATTERING, sb_pass_find(r, "multiscattering"), r->nearest);
     sb_pass_sample(r, SB_BINDING_IRRADIANCE_GROUND, sb_pass_find(r, "irradiance ground"), r->nearest);
+    sb_pass_sample(r, SB_VIEW_BINDING_ORDERS, sb_pass_find(r, "orders"), r->nearest);
     sb_pass_use(r, SB_VIEW_BINDING_FRAME, sb_pass_find(r, "frame"), SB_USE_LOAD);
 }
 
@@ -98,7 +99,7 @@ enum sb_result sb_renderer_kernel(struct sb_renderer *r, const uint32_t *spirv, 
 {
     VkPipelineLayout layout;
     enum sb_result res = sb_pass_layout(r, &layout);
-    return res ? res : sb_compute_pipeline_create(r->vk, layout, spirv, spirv_size, name, pipeline);
+    return res ? res : sb_compute_pipeline_create(r->vk, layout, spirv, spirv_size, &r->specialization, name, pipeline);
 }
 
 void sb_renderer_release(struct sb_renderer *r, const VkPipeline *pipelines, size_t pipeline_count,

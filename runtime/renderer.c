@@ -52,6 +52,7 @@ static void add_resources(struct sb_renderer *r)
     sb_graph_image(r, "transmittance", &r->transmittance);
     sb_graph_image(r, "multiscattering", &r->multiscattering);
     sb_graph_image(r, "irradiance ground", &r->irradiance_ground);
+    sb_graph_image(r, "orders", &r->orders);
     sb_graph_image(r, "depth", &r->depth);
     r->hdr_id = sb_graph_image(r, "hdr", &r->hdr);
     r->ldr_id = sb_graph_image(r, "ldr", &r->ldr);
@@ -174,6 +175,9 @@ enum sb_result sb_renderer_create(struct sb_vk *vk, const struct sb_pack *pack, 
         res = sb_renderer_upload(r, NULL, (size_t)SB_SKY_VIEW_WIDTH * SB_SKY_VIEW_HEIGHT * 8, "sky-view readback",
                                  &r->read_sky_view);
     if (!res)
+        res = sb_renderer_upload(r, NULL, (size_t)SB_AERIAL_SIZE * SB_AERIAL_SIZE * SB_AERIAL_SIZE * 8,
+                                 "aerial readback", &r->read_aerial);
+    if (!res)
         res = create_images(r);
     r->graph.passes = calloc(SB_PASS_COUNT, sizeof(*r->graph.passes));
     if (!res && !r->graph.passes)
@@ -204,6 +208,7 @@ enum sb_result sb_renderer_create(struct sb_vk *vk, const struct sb_pack *pack, 
         res =
             sb_renderer_upload(r, NULL, (size_t)r->width * r->height * 8, "post-processed HDR readback", &r->read_post);
     r->sky_view_id = sb_graph_find(r, "sky-view");
+    r->aerial_id = sb_graph_find(r, "aerial");
     if (!res)
         res = sb_graph_write_sets(r);
     if (res)
@@ -260,11 +265,11 @@ void sb_renderer_destroy(struct sb_renderer **pr)
         vkDestroySampler(d, r->shadow_compare, NULL);
     if (r->repeat)
         vkDestroySampler(d, r->repeat, NULL);
-    struct sb_texture *const textures[] = {&r->transmittance, &r->multiscattering, &r->irradiance_ground,
-                                           &r->hdr,           &r->depth,           &r->ldr};
+    struct sb_texture *const textures[] = {
+        &r->transmittance, &r->multiscattering, &r->irradiance_ground, &r->orders, &r->hdr, &r->depth, &r->ldr};
     sb_renderer_release(r, NULL, 0, textures, sizeof(textures) / sizeof(textures[0]));
-    struct sb_buffer *buffers[] = {&r->atmosphere, &r->frame,     &r->exposure,   &r->read_ldr,
-                                   &r->read_hdr,   &r->read_post, &r->post_input, &r->read_sky_view};
+    struct sb_buffer *buffers[] = {&r->atmosphere, &r->frame,      &r->exposure,      &r->read_ldr,   &r->read_hdr,
+                                   &r->read_post,  &r->post_input, &r->read_sky_view, &r->read_aerial};
     for (size_t i = 0; i < sizeof(buffers) / sizeof(buffers[0]); i++)
         sb_buffer_destroy(vk, buffers[i]);
     sb_world_release(r);
@@ -469,6 +474,9 @@ static void fill_frame(struct sb_renderer *r, const struct sb_view *v, struct sb
     f->size[1] = r->height;
     f->size[2] = bloom ? r->bloom_levels : 0; /* none: the tone curve reads no bloom (never written this frame) */
     f->size[3] = (uint32_t)r->params.debug;
+    memcpy(f->orders_size, r->orders_grid.size, sizeof(f->orders_size));
+    memcpy(f->orders_heights, r->orders_grid.heights, sizeof(f->orders_heights));
+    memcpy(f->orders_mu_s, r->orders_grid.mu_s, sizeof(f->orders_mu_s));
 }
 
 /* A readback: the whole of an image into a host-visible buffer. */
@@ -477,7 +485,7 @@ static void copy_image(struct sb_renderer *r, sb_resource image, const struct sb
     const struct sb_texture *t = sb_graph_texture(r, image);
     VkBufferImageCopy region = {
         .imageSubresource = {VK_IMAGE_ASPECT_COLOR_BIT, 0, 0, 1},
-        .imageExtent = {t->width, t->height, 1},
+        .imageExtent = {t->width, t->height, t->depth ? t->depth : 1},
     };
     sb_graph_access(r, image, SB_USE_COPY_SRC);
     vkCmdCopyImageToBuffer(r->cmd, t->image, VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL, b->buffer, 1, &region);
@@ -626,6 +634,8 @@ static enum sb_result render_once(struct sb_renderer *r, const struct sb_view *v
         if (r->post_in_place)
             copy_image(r, r->hdr_id, &r->read_post);
         copy_image(r, r->sky_view_id, &r->read_sky_view);
+        if (r->aerial_id)
+            copy_image(r, r->aerial_id, &r->read_aerial);
     }
     sb_graph_end_frame(r);
     VkMemoryBarrier to_host = {
@@ -703,6 +713,12 @@ void sb_renderer_post_hdr(const struct sb_renderer *r, float *rgb)
 void sb_renderer_sky_view(const struct sb_renderer *r, float *rgb)
 {
     halves_to_rgb(r->read_sky_view.mapped, (size_t)SB_SKY_VIEW_WIDTH * SB_SKY_VIEW_HEIGHT, r->readback_scale, rgb);
+}
+
+void sb_renderer_aerial(const struct sb_renderer *r, float *rgb)
+{
+    size_t texels = (size_t)SB_AERIAL_SIZE * SB_AERIAL_SIZE * SB_AERIAL_SIZE;
+    halves_to_rgb(r->read_aerial.mapped, texels, r->readback_scale, rgb);
 }
 
 void sb_renderer_exposure(const struct sb_renderer *r, float state[4])

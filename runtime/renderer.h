@@ -227,6 +227,10 @@ const uint8_t *sb_renderer_ldr(const struct sb_renderer *renderer);
 void sb_renderer_hdr(const struct sb_renderer *renderer, float *rgb);
 void sb_renderer_post_hdr(const struct sb_renderer *renderer, float *rgb);
 void sb_renderer_sky_view(const struct sb_renderer *renderer, float *rgb);
+/* The aerial-perspective volume's in-scattered radiance, SB_AERIAL_SIZE^3
+ * rgb texels (x, y: the screen's columns, z: the distance slices), in the
+ * pack's units: its last frame read back (zeros until one was). */
+void sb_renderer_aerial(const struct sb_renderer *renderer, float *rgb);
 
 /* What the last frame read back was stored at in the HDR target: radiance
  * in the pack's units times this is the half it held (pre-exposure; the

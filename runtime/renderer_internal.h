@@ -64,13 +64,18 @@ struct sb_renderer {
     struct sb_buffer atmosphere;                                         /* "atmosphere" */
     struct sb_texture transmittance, multiscattering, irradiance_ground; /* "transmittance", ...: RGBA32F, the
                                                                             LUT; the refined and lookup forms */
-    struct sb_buffer frame, vertices, exposure;                          /* "frame", "vertices", "exposure" */
-    struct sb_buffer bvh_nodes, bvh_triangles; /* "bvh nodes", "bvh triangles": the world's BVH when traced
-                                                  or relighting reflections */
-    struct sb_texel_set textures;              /* "texture records", "texels": the world's textures */
-    struct sb_buffer instances;                /* "instances": sb_instance_gpu[] (one zero when none) */
-    struct sb_buffer emissive;                 /* "emissive": sb_emissive_gpu[] (one zero when none) */
-    uint32_t emissive_count;                   /* the world's emitting materials */
+    struct sb_texture orders;            /* "orders": the orders product as RGBA32F, or a 1 x 1 stand-in */
+    struct sb_orders_push orders_grid;   /* its grid (zeros: the pack has none) */
+    VkSpecializationInfo specialization; /* every view kernel's (SB_VIEW_CONSTANT_ORDERS, pass.c) */
+    VkSpecializationMapEntry specialization_entry;
+    VkBool32 has_orders;
+    struct sb_buffer frame, vertices, exposure; /* "frame", "vertices", "exposure" */
+    struct sb_buffer bvh_nodes, bvh_triangles;  /* "bvh nodes", "bvh triangles": the world's BVH when traced
+                                                   or relighting reflections */
+    struct sb_texel_set textures;               /* "texture records", "texels": the world's textures */
+    struct sb_buffer instances;                 /* "instances": sb_instance_gpu[] (one zero when none) */
+    struct sb_buffer emissive;                  /* "emissive": sb_emissive_gpu[] (one zero when none) */
+    uint32_t emissive_count;                    /* the world's emitting materials */
     /* An instanced world's draws, a mesh each: its vertices in its own
      * space and its instances [first_instance, + instance_count). */
     struct sb_draw_group {
@@ -89,7 +94,7 @@ struct sb_renderer {
     struct sb_texture hdr, depth, ldr;                 /* "hdr", "depth", "ldr": the frame */
     VkSampler linear, nearest, shadow_compare, repeat; /* repeat: linear, wrapping (tileable noise) */
 
-    struct sb_buffer read_ldr, read_hdr, read_sky_view;
+    struct sb_buffer read_ldr, read_hdr, read_sky_view, read_aerial;
     struct sb_buffer read_post;  /* the HDR frame after post-processing, when post_in_place */
     bool post_in_place;          /* a post-processing pass writes the HDR frame (from the graph) */
     int first_post;              /* the first post-processing pass: the lit frame is whole before it */
@@ -99,7 +104,7 @@ struct sb_renderer {
     int pass;                       /* the pass being created or recorded */
     const char *pass_name;          /* its name */
     void *pass_data[SB_PASS_COUNT]; /* what each pass keeps (sb_pass_data) */
-    sb_resource hdr_id, ldr_id, sky_view_id;
+    sb_resource hdr_id, ldr_id, sky_view_id, aerial_id;
 
     VkQueryPool queries;
     VkCommandBuffer cmd;

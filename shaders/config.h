@@ -148,7 +148,7 @@
 #define SB_ORDERS_R 16
 #define SB_ORDERS_MU 64
 #define SB_ORDERS_MU_S 24
-#define SB_ORDERS_NU 8
+#define SB_ORDERS_NU 4
 
 /* Gauss-Legendre order of one segment of a ray integral (see atmosphere.glsl). */
 #define SB_RAY_GL_ORDER 4

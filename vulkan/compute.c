@@ -193,7 +193,7 @@ static void *prepare_thread(void *user)
     for (uint32_t i; (i = atomic_fetch_add(&job->next, 1)) < vk->prepared_count;) {
         struct sb_prepared_pipeline *k = &vk->prepared[i];
         if (create_layouts(vk, &k->params, &k->set_layout, &k->layout) ||
-            sb_compute_pipeline_compile(vk, k->layout, k->params.spirv, k->params.spirv_size, &k->pipeline))
+            sb_compute_pipeline_compile(vk, k->layout, k->params.spirv, k->params.spirv_size, NULL, &k->pipeline))
             k->pipeline = VK_NULL_HANDLE; /* sb_pipeline_create compiles it again */
     }
     return NULL;
@@ -263,7 +263,7 @@ enum sb_result sb_pipeline_create(struct sb_vk *vk, const struct sb_pipeline_par
     p->push_size = params->push_size;
     if (!take_prepared(vk, params, p) &&
         ((res = create_layouts(vk, params, &p->set_layout, &p->layout)) ||
-         (res = sb_compute_pipeline_create(vk, p->layout, params->spirv, params->spirv_size, params->name,
+         (res = sb_compute_pipeline_create(vk, p->layout, params->spirv, params->spirv_size, NULL, params->name,
                                            &p->pipeline))))
         goto cleanup;
 

@@ -69,7 +69,8 @@ static void log_statistics(struct sb_vk *vk, VkPipeline pipeline, const char *na
 }
 
 enum sb_result sb_compute_pipeline_compile(struct sb_vk *vk, VkPipelineLayout layout, const uint32_t *spirv,
-                                           size_t spirv_size, VkPipeline *pipeline)
+                                           size_t spirv_size, const VkSpecializationInfo *specialization,
+                                           VkPipeline *pipeline)
 {
     VkShaderModule module = VK_NULL_HANDLE;
     *pipeline = VK_NULL_HANDLE;
@@ -84,6 +85,7 @@ enum sb_result sb_compute_pipeline_compile(struct sb_vk *vk, VkPipelineLayout la
                 .stage = VK_SHADER_STAGE_COMPUTE_BIT,
                 .module = module,
                 .pName = "main",
+                .pSpecializationInfo = specialization,
             },
         .layout = layout,
         .flags =
@@ -103,10 +105,11 @@ void sb_compute_pipeline_named(struct sb_vk *vk, VkPipeline pipeline, const char
 }
 
 enum sb_result sb_compute_pipeline_create(struct sb_vk *vk, VkPipelineLayout layout, const uint32_t *spirv,
-                                          size_t spirv_size, const char *name, VkPipeline *pipeline)
+                                          size_t spirv_size, const VkSpecializationInfo *specialization,
+                                          const char *name, VkPipeline *pipeline)
 {
     double t0 = sb_now_s();
-    enum sb_result res = sb_compute_pipeline_compile(vk, layout, spirv, spirv_size, pipeline);
+    enum sb_result res = sb_compute_pipeline_compile(vk, layout, spirv, spirv_size, specialization, pipeline);
     if (res)
         return res;
     sb_debug("pipeline %s: compiled in %.1f ms", name, 1e3 * (sb_now_s() - t0));

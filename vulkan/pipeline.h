@@ -12,13 +12,17 @@
 
 #include "context.h"
 
-/* A compute pipeline from SPIR-V (entry point "main"); `name` is its debug name. */
+/* A compute pipeline from SPIR-V (entry point "main"), its specialization
+ * constants set by `specialization` (NULL: the shader's defaults); `name`
+ * is its debug name. */
 enum sb_result sb_compute_pipeline_create(struct sb_vk *vk, VkPipelineLayout layout, const uint32_t *spirv,
-                                          size_t spirv_size, const char *name, VkPipeline *pipeline);
+                                          size_t spirv_size, const VkSpecializationInfo *specialization,
+                                          const char *name, VkPipeline *pipeline);
 /* Its two halves: the compile alone (safe on any thread), then the name
  * and, with sb_vk_params.statistics, the driver's statistics logged. */
 enum sb_result sb_compute_pipeline_compile(struct sb_vk *vk, VkPipelineLayout layout, const uint32_t *spirv,
-                                           size_t spirv_size, VkPipeline *pipeline);
+                                           size_t spirv_size, const VkSpecializationInfo *specialization,
+                                           VkPipeline *pipeline);
 void sb_compute_pipeline_named(struct sb_vk *vk, VkPipeline pipeline, const char *name);
 
 struct sb_graphics_pipeline_params {

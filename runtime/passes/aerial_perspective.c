@@ -24,8 +24,10 @@ static enum sb_result aerial_create(struct sb_renderer *r)
     sb_pass_set_data(r, a);
     const uint32_t size[3] = {SB_AERIAL_SIZE, SB_AERIAL_SIZE, SB_AERIAL_SIZE};
     const VkImageUsageFlags usage = VK_IMAGE_USAGE_STORAGE_BIT | VK_IMAGE_USAGE_SAMPLED_BIT;
+    /* the in-scattering is read back with the frame (sb_renderer_aerial) */
     enum sb_result res =
-        sb_renderer_texture(r, &a->scattering, size, 1, 1, SB_HDR_FORMAT, usage, "aerial perspective in-scattering");
+        sb_renderer_texture(r, &a->scattering, size, 1, 1, SB_HDR_FORMAT, usage | VK_IMAGE_USAGE_TRANSFER_SRC_BIT,
+                            "aerial perspective in-scattering");
     if (!res)
         res = sb_renderer_texture(r, &a->transmittance, size, 1, 1, SB_HDR_FORMAT, usage,
                                   "aerial perspective transmittance");

@@ -115,14 +115,15 @@ static enum sb_result create_raster(struct sb_renderer *r, struct scene *s)
     sb_pass_use(r, SB_NO_BINDING, sb_pass_find(r, "depth"), SB_USE_DEPTH_TARGET);
     /* scene.frag's specialization: what the pack and the world hold */
     bool generic = r->params.generic_shaders;
-    const VkBool32 has[4] = {generic || r->probe_count > 0, generic || r->reflection_count > 0,
-                             generic || r->textures.count > 0, generic || r->emissive_count > 0};
-    VkSpecializationMapEntry entries[4];
-    for (uint32_t i = 0; i < 4; i++)
-        entries[i] =
-            (VkSpecializationMapEntry){.constantID = i, .offset = i * sizeof(VkBool32), .size = sizeof(VkBool32)};
+    const VkBool32 has[5] = {generic || r->probe_count > 0, generic || r->reflection_count > 0,
+                             generic || r->textures.count > 0, generic || r->emissive_count > 0, r->has_orders};
+    VkSpecializationMapEntry entries[5];
+    for (uint32_t i = 0; i < 5; i++) /* the last, every view kernel's: the orders (pass.c) */
+        entries[i] = (VkSpecializationMapEntry){.constantID = i < 4 ? i : SB_VIEW_CONSTANT_ORDERS,
+                                                .offset = i * sizeof(VkBool32),
+                                                .size = sizeof(VkBool32)};
     const VkSpecializationInfo specialization = {
-        .mapEntryCount = 4, .pMapEntries = entries, .dataSize = sizeof(has), .pData = has};
+        .mapEntryCount = 5, .pMapEntries = entries, .dataSize = sizeof(has), .pData = has};
     struct sb_graphics_pipeline_params params = {
         .fragment_specialization = &specialization,
         .vertex_spirv = r->draw_group_count ? sb_spv_scene_vert_instanced : sb_spv_scene_vert,

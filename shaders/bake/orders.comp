@@ -194,7 +194,7 @@ void main()
     vec3 L = vec3(0.0);
     if (!(ground && h <= 0.0)) {
         float t_end = ground ? distance_to_ground(h, mu) : distance_to_top(h, mu), r0 = ground_radius() + h;
-        RayCuts cuts = ray_cuts(h, mu, mu_s, nu);
+        RayCuts cuts = ray_level_cuts(h, mu); /* the density has no shadow edge of its own */
         vec3 tau = vec3(0.0);
         for (float t0 = 0.0; t0 < t_end;) {
             float t1 = ray_next_cut(cuts, t0, t_end), half_len = 0.5 * (t1 - t0);

@@ -2,8 +2,9 @@
 // baker/orders_ref.h states it and holds its fp64 twin): a node's
 // (r, mu, mu_s, nu), a point's continuous node coordinates, and the
 // multilinear read of a table of nodes. The grid is `orders`, an
-// sb_orders_push: the push constants, unless the includer defines
-// SB_ORDERS_GRID_DECLARED and declares `orders` itself.
+// sb_orders_push in the push constants, unless the includer defines
+// SB_ORDERS_GRID_DECLARED and SB_ORDERS_GRID_SIZE, SB_ORDERS_GRID_HEIGHTS and
+// SB_ORDERS_GRID_MU_S (its fields) itself.
 #ifndef SB_ORDERS_GLSL
 #define SB_ORDERS_GLSL
 
@@ -12,37 +13,40 @@
 
 #ifndef SB_ORDERS_GRID_DECLARED
 layout(push_constant) uniform OrdersPush { sb_orders_push orders; };
+#define SB_ORDERS_GRID_SIZE orders.size
+#define SB_ORDERS_GRID_HEIGHTS orders.heights
+#define SB_ORDERS_GRID_MU_S orders.mu_s
 #endif
 
-uint orders_node_count() { return orders.size.x * orders.size.y * orders.size.z * orders.size.w; }
+uint orders_node_count() { return SB_ORDERS_GRID_SIZE.x * SB_ORDERS_GRID_SIZE.y * SB_ORDERS_GRID_SIZE.z * SB_ORDERS_GRID_SIZE.w; }
 
 /* Node (ir, imu, imus, inu) of a flat index. */
 uvec4 orders_node(uint index)
 {
-    uvec4 s = orders.size;
+    uvec4 s = SB_ORDERS_GRID_SIZE;
     return uvec4(index / (s.w * s.z * s.y), index / (s.w * s.z) % s.y, index / s.w % s.z, index % s.w);
 }
 
 uint orders_index(uint ir, uint imu, uint imus, uint inu)
 {
-    return ((ir * orders.size.y + imu) * orders.size.z + imus) * orders.size.w + inu;
+    return ((ir * SB_ORDERS_GRID_SIZE.y + imu) * SB_ORDERS_GRID_SIZE.z + imus) * SB_ORDERS_GRID_SIZE.w + inu;
 }
 
 /* Altitude of r node i: h_i = Z (q^i - 1) / (q^n - 1), or uniform for q = 1. */
 float orders_altitude(uint i)
 {
-    float n = float(orders.size.x - 1u), Z = orders.heights.w;
-    if (i >= orders.size.x - 1u)
+    float n = float(SB_ORDERS_GRID_SIZE.x - 1u), Z = SB_ORDERS_GRID_HEIGHTS.w;
+    if (i >= SB_ORDERS_GRID_SIZE.x - 1u)
         return Z;
-    return orders.heights.x == 1.0 ? Z * float(i) / n : Z * (exp(orders.heights.y * float(i)) - 1.0) / orders.heights.z;
+    return SB_ORDERS_GRID_HEIGHTS.x == 1.0 ? Z * float(i) / n : Z * (exp(SB_ORDERS_GRID_HEIGHTS.y * float(i)) - 1.0) / SB_ORDERS_GRID_HEIGHTS.z;
 }
 
 /* The continuous r node index of altitude h. */
 float orders_altitude_coord(float h)
 {
-    float n = float(orders.size.x - 1u), Z = orders.heights.w;
+    float n = float(SB_ORDERS_GRID_SIZE.x - 1u), Z = SB_ORDERS_GRID_HEIGHTS.w;
     h = clamp(h, 0.0, Z);
-    float i = orders.heights.x == 1.0 ? h / Z * n : log(1.0 + h / Z * orders.heights.z) / orders.heights.y;
+    float i = SB_ORDERS_GRID_HEIGHTS.x == 1.0 ? h / Z * n : log(1.0 + h / Z * SB_ORDERS_GRID_HEIGHTS.z) / SB_ORDERS_GRID_HEIGHTS.y;
     return clamp(i, 0.0, n);
 }
 
@@ -52,7 +56,7 @@ float orders_altitude_coord(float h)
  * horizon. */
 float orders_mu(float h, uint imu)
 {
-    uint half_count = orders.size.y / 2u;
+    uint half_count = SB_ORDERS_GRID_SIZE.y / 2u;
     float R = ground_radius(), r = R + h, rho = horizon_distance(h), H = horizon_top();
     if (imu < half_count) {
         float x = float(imu) / float(half_count - 1u), d = h + x * (rho - h);
@@ -66,7 +70,7 @@ float orders_mu(float h, uint imu)
 /* The continuous mu node index of (h, mu) in the half `ground` says. */
 float orders_mu_coord(float h, float mu, bool ground)
 {
-    float half_count = float(orders.size.y / 2u);
+    float half_count = float(SB_ORDERS_GRID_SIZE.y / 2u);
     float rho = horizon_distance(h), H = horizon_top();
     if (ground) {
         float d_min = h, d_max = rho, d = distance_to_ground(h, mu);
@@ -82,21 +86,21 @@ float orders_mu_coord(float h, float mu, bool ground)
  * the atmosphere sees the sun) to SB_ORDERS_MU_S_SPLIT, the rest on to 1. */
 float orders_mu_s(uint imus)
 {
-    uint low = orders.size.z / 2u;
-    float lo = orders.mu_s.x, split = orders.mu_s.y;
+    uint low = SB_ORDERS_GRID_SIZE.z / 2u;
+    float lo = SB_ORDERS_GRID_MU_S.x, split = SB_ORDERS_GRID_MU_S.y;
     if (imus <= low)
         return lo + (split - lo) * float(imus) / float(low);
-    return split + (1.0 - split) * float(imus - low) / float(orders.size.z - 1u - low);
+    return split + (1.0 - split) * float(imus - low) / float(SB_ORDERS_GRID_SIZE.z - 1u - low);
 }
 
 float orders_mu_s_coord(float mu_s)
 {
-    uint low = orders.size.z / 2u;
-    float lo = orders.mu_s.x, split = orders.mu_s.y;
+    uint low = SB_ORDERS_GRID_SIZE.z / 2u;
+    float lo = SB_ORDERS_GRID_MU_S.x, split = SB_ORDERS_GRID_MU_S.y;
     mu_s = clamp(mu_s, lo, 1.0);
     if (mu_s <= split)
         return (mu_s - lo) / (split - lo) * float(low);
-    return float(low) + (mu_s - split) / (1.0 - split) * float(orders.size.z - 1u - low);
+    return float(low) + (mu_s - split) / (1.0 - split) * float(SB_ORDERS_GRID_SIZE.z - 1u - low);
 }
 
 /* The sun's azimuth about the vertical from the view's, in [0, pi]. */
@@ -134,7 +138,7 @@ struct OrdersCell {
 
 OrdersCell orders_cell(float h, float mu, float mu_s, float nu, bool ground)
 {
-    uvec4 s = orders.size;
+    uvec4 s = SB_ORDERS_GRID_SIZE;
     OrdersCell c;
     float fr = orders_altitude_coord(h);
     uint ir = min(uint(fr), s.x - 2u);
@@ -158,7 +162,7 @@ OrdersCell orders_cell(float h, float mu, float mu_s, float nu, bool ground)
 #define SB_ORDERS_READ(name, TABLE)                                                               \
     vec3 name(OrdersCell c)                                                                       \
     {                                                                                             \
-        uvec4 s = orders.size;                                                                    \
+        uvec4 s = SB_ORDERS_GRID_SIZE;                                                                    \
         uint sr = s.y * s.z * s.w, sm = s.z * s.w, ss = s.w;                                      \
         vec3 out_value = vec3(0.0);                                                               \
         for (uint dr = 0u; dr < 2u; dr++)                                                         \

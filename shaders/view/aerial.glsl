@@ -53,20 +53,25 @@ void aerial_perspective(vec2 uv, vec3 offset, out vec3 inscatter, out vec3 trans
     float mu = dot(p0, d) / r0;
     vec3 l = frame.sun_direction.xyz;
     float mu_s = dot(p0, l) / r0, nu = dot(d, l);
+    bool ms = !orders_present(); /* else orders 2 and up from the orders product */
     RayIntegrals ri = ray_integrals_begin();
-    integrate_ray_to(ri, h0, mu, mu_s, nu, d_km - entry, true);
+    integrate_ray_to(ri, h0, mu, mu_s, nu, d_km - entry, ms);
     vec3 L = atm.solar_irradiance.rgb * (ri.sun_rayleigh * phase_rayleigh(nu) + ri.sun_mie * phase_mie(nu)) +
              ri.ms_rayleigh + ri.ms_mie;
+    if (!ms)
+        L += orders_between(h0, mu, mu_s, nu, d_km - entry, ri.transmittance);
     transmittance = ri.transmittance;
     for (int i = 0; i < moon_lights(); i++) {
         l = frame.moon_direction.xyz;
         mu_s = dot(p0, l) / r0;
         nu = dot(d, l);
         ri = ray_integrals_begin();
-        integrate_ray_to(ri, h0, mu, mu_s, nu, d_km - entry, true);
-        L += (atm.solar_irradiance.rgb * (ri.sun_rayleigh * phase_rayleigh(nu) + ri.sun_mie * phase_mie(nu)) +
-              ri.ms_rayleigh + ri.ms_mie) *
-             frame.moon_light.rgb;
+        integrate_ray_to(ri, h0, mu, mu_s, nu, d_km - entry, ms);
+        vec3 Lm = atm.solar_irradiance.rgb * (ri.sun_rayleigh * phase_rayleigh(nu) + ri.sun_mie * phase_mie(nu)) +
+                  ri.ms_rayleigh + ri.ms_mie;
+        if (!ms)
+            Lm += orders_between(h0, mu, mu_s, nu, d_km - entry, ri.transmittance);
+        L += Lm * frame.moon_light.rgb;
     }
     inscatter = L * frame.aerial.y;
 #endif

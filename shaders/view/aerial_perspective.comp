@@ -35,15 +35,22 @@ void main()
     vec3 sun = atm.solar_irradiance.rgb, moon = sun * frame.moon_light.rgb;
     float p_r = phase_rayleigh(nu), p_m = phase_mie(nu), q_r = phase_rayleigh(nu_m), q_m = phase_mie(nu_m);
     RayIntegrals ri = ray_integrals_begin(), rm = ray_integrals_begin();
+    /* with the orders product, orders 2 and up between the eye and each
+     * slice from the table (orders_between) instead of psi_ms's march */
+    bool ms = !orders_present();
     float t0 = 0.0;
     for (int k = 0; k < SB_AERIAL_SIZE; k++) {
         float w = (float(k) + 0.5) / float(SB_AERIAL_SIZE);
         float t1 = frame.aerial.x * w * w;
-        integrate_segment(ri, h, mu, mu_s, nu, t0, t1, true);
+        integrate_segment(ri, h, mu, mu_s, nu, t0, t1, ms);
         vec3 L = sun * (ri.sun_rayleigh * p_r + ri.sun_mie * p_m) + ri.ms_rayleigh + ri.ms_mie;
+        if (!ms)
+            L += orders_between(h, mu, mu_s, nu, t1, exp(-ri.tau));
         for (int i = 0; i < moon_lights(); i++) {
-            integrate_segment(rm, h, mu, mu_m, nu_m, t0, t1, true);
+            integrate_segment(rm, h, mu, mu_m, nu_m, t0, t1, ms);
             L += moon * (rm.sun_rayleigh * q_r + rm.sun_mie * q_m) + frame.moon_light.rgb * (rm.ms_rayleigh + rm.ms_mie);
+            if (!ms)
+                L += frame.moon_light.rgb * orders_between(h, mu, mu_m, nu_m, t1, exp(-rm.tau));
         }
         t0 = t1;
         imageStore(inscatter_out, ivec3(column, k), vec4(fp16_safe(L * frame.aerial.y), 1.0));

@@ -13,10 +13,62 @@
 #define SB_SUN_TRANSMITTANCE_LUT
 #define SB_MULTISCATTERING_REFINED
 #define SB_ATMOSPHERE_TEXTURES
+#define SB_ORDERS_TEXTURE
 #include "atmosphere.glsl"
+
+/* True when the pack has the orders product (runtime/pass.c specializes
+ * every kernel): orders 2 and up come from it, not from psi_ms. */
+layout(constant_id = SB_VIEW_CONSTANT_ORDERS) const bool SB_VIEW_ORDERS = false;
+bool orders_present() { return SB_VIEW_ORDERS; }
+
 #include "sky_radiance.glsl"
 
 #include "frame.glsl"
+
+/* The orders product (config.h; baker/orders.h), its grid in the frame's
+ * constants, its texels read one by one (orders.glsl's multilinear read). */
+#define SB_ORDERS_GRID_DECLARED
+#define SB_ORDERS_GRID_SIZE frame.orders_size
+#define SB_ORDERS_GRID_HEIGHTS frame.orders_heights
+#define SB_ORDERS_GRID_MU_S frame.orders_mu_s
+#include "orders.glsl"
+
+layout(set = 0, binding = SB_VIEW_BINDING_ORDERS) uniform sampler2D orders_texture;
+
+vec3 orders_texel(uint i)
+{
+    uint w = SB_ORDERS_GRID_SIZE.z * SB_ORDERS_GRID_SIZE.w;
+    return texelFetch(orders_texture, ivec2(int(i % w), int(i / w)), 0).rgb;
+}
+
+#define SB_ORDERS_TEXEL(i) orders_texel(i)
+SB_ORDERS_READ(orders_read, SB_ORDERS_TEXEL)
+
+vec3 orders_sky(float h, float mu, float mu_s, float nu, bool ground)
+{
+    return orders_read(orders_cell(h, mu, mu_s, nu, ground));
+}
+
+/* The ground's irradiance from the sky (the table's last row). */
+vec3 orders_ground_sky(float mu_s)
+{
+    float f = orders_mu_s_coord(mu_s);
+    uint i = min(uint(f), SB_ORDERS_GRID_SIZE.z - 2u), base = orders_node_count();
+    return orders_blend_mu_s(orders_texel(base + i * SB_ORDERS_GRID_SIZE.w), orders_texel(base + (i + 1u) * SB_ORDERS_GRID_SIZE.w),
+                             f - float(i), orders_mu_s(i + 1u) <= 0.0);
+}
+
+/* Orders 2 and up scattered into the view from altitude h (cosine mu, the
+ * light's mu_s and nu) between the eye and distance t on it, whose
+ * transmittance is t_to: the whole view's minus what lies beyond t, seen
+ * through it (Bruneton's). */
+vec3 orders_between(float h, float mu, float mu_s, float nu, float t, vec3 t_to)
+{
+    bool ground = ray_hits_ground(h, mu);
+    float r0 = ground_radius() + h, h1 = altitude_along(h, mu, t), r1 = ground_radius() + h1;
+    float mu1 = clamp((r0 * mu + t) / r1, -1.0, 1.0), mu_s1 = clamp((r0 * mu_s + t * nu) / r1, -1.0, 1.0);
+    return max(orders_sky(h, mu, mu_s, nu, ground) - t_to * orders_sky(h1, mu1, mu_s1, nu, ground), vec3(0.0));
+}
 
 layout(push_constant) uniform ViewPush {
     sb_view_push pc;

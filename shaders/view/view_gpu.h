@@ -46,6 +46,12 @@
                                                distance from the camera (m) */
 #define SB_VIEW_BINDING_SCENE_HISTORY 61    /* struct sb_scene_history_gpu */
 #define SB_VIEW_BINDING_KEY_LIGHT 65        /* image2D rgba16f: the raster scene's key light direct share a pixel */
+#define SB_VIEW_BINDING_ORDERS 66           /* sampler2D: the orders product (config.h), its image's texels as RGBA32F,
+                                               texelFetch'd; a 1 x 1 stand-in when the pack has none */
+/* The specialization constant every view kernel takes (runtime/pass.c):
+ * true when the pack has the orders product, which then gives orders 2
+ * and up instead of Hillaire's psi_ms (view.glsl). */
+#define SB_VIEW_CONSTANT_ORDERS 8
 /* Contact shadows (contact_shadows.comp): steps and reach of the march
  * toward the key light (a fraction of the pixel's distance, at most
  * SB_CONTACT_MAX_M), the thickness a surface is taken to have behind the
@@ -185,6 +191,9 @@ struct sb_frame_gpu {
     SB_VEC4(post);             /* x: bloom threshold (exposed), y: bloom strength, z: exposure
                                   compensation (EV), w: 0 (the tone curve is the kernel's) */
     SB_UVEC4(size);            /* xy: frame size; z: bloom levels; w: SB_DEBUG_* */
+    SB_UVEC4(orders_size);     /* the orders product's grid (config.h's sb_orders_push: size, heights, */
+    SB_VEC4(orders_heights);   /* mu_s); zeros when the pack has none */
+    SB_VEC4(orders_mu_s);
 };
 
 /* What exposure.comp keeps between frames, after the histogram's bins. */
