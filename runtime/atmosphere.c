@@ -93,6 +93,14 @@ enum sb_result sb_atmosphere_upload(struct sb_renderer *r, const struct sb_pack 
      * specialized on it: pass.c), else a 1 x 1 stand-in nothing reads. */
     const struct sb_image *orders = &pack->images[SB_PRODUCT_ORDERS];
     r->has_orders = !res && pack->present[SB_PRODUCT_ORDERS];
+    VkFormatProperties rgba32f;
+    vkGetPhysicalDeviceFormatProperties(r->vk->physical_device, VK_FORMAT_R32G32B32A32_SFLOAT, &rgba32f);
+    if (r->has_orders && !(rgba32f.optimalTilingFeatures & VK_FORMAT_FEATURE_SAMPLED_IMAGE_FILTER_LINEAR_BIT)) {
+        /* optional in Vulkan; the shaders read the orders bilinearly (view.glsl) */
+        sb_warn("skyview: this device cannot filter RGBA32F textures: the pack's orders are not used (Hillaire's "
+                "multiple scattering instead)");
+        r->has_orders = false;
+    }
     memset(&r->orders_grid, 0, sizeof(r->orders_grid));
     if (r->has_orders) {
         sb_orders_grid_pack(atm, SB_ORDERS_R, SB_ORDERS_MU, SB_ORDERS_MU_S, SB_ORDERS_NU, &r->orders_grid);

@@ -39,7 +39,8 @@ void sb_pass_read_atmosphere(struct sb_renderer *r)
     sb_pass_sample(r, SB_BINDING_TRANSMITTANCE, sb_pass_find(r, "transmittance"), r->nearest);
     sb_pass_sample(r, SB_BINDING_MULTISCATTERING, sb_pass_find(r, "multiscattering"), r->nearest);
     sb_pass_sample(r, SB_BINDING_IRRADIANCE_GROUND, sb_pass_find(r, "irradiance ground"), r->nearest);
-    sb_pass_sample(r, SB_VIEW_BINDING_ORDERS, sb_pass_find(r, "orders"), r->nearest);
+    /* bilinear in mu and nu by the sampler (view.glsl's orders_sky) */
+    sb_pass_sample(r, SB_VIEW_BINDING_ORDERS, sb_pass_find(r, "orders"), r->linear);
     sb_pass_use(r, SB_VIEW_BINDING_FRAME, sb_pass_find(r, "frame"), SB_USE_LOAD);
 }
 

@@ -59,7 +59,7 @@ void aerial_perspective(vec2 uv, vec3 offset, out vec3 inscatter, out vec3 trans
     vec3 L = atm.solar_irradiance.rgb * (ri.sun_rayleigh * phase_rayleigh(nu) + ri.sun_mie * phase_mie(nu)) +
              ri.ms_rayleigh + ri.ms_mie;
     if (!ms)
-        L += orders_between(h0, mu, mu_s, nu, d_km - entry, ri.transmittance);
+        L += orders_between(orders_eye(h0, mu, mu_s, nu), h0, mu, mu_s, nu, d_km - entry, ri.transmittance);
     transmittance = ri.transmittance;
     for (int i = 0; i < moon_lights(); i++) {
         l = frame.moon_direction.xyz;
@@ -70,7 +70,7 @@ void aerial_perspective(vec2 uv, vec3 offset, out vec3 inscatter, out vec3 trans
         vec3 Lm = atm.solar_irradiance.rgb * (ri.sun_rayleigh * phase_rayleigh(nu) + ri.sun_mie * phase_mie(nu)) +
                   ri.ms_rayleigh + ri.ms_mie;
         if (!ms)
-            Lm += orders_between(h0, mu, mu_s, nu, d_km - entry, ri.transmittance);
+            Lm += orders_between(orders_eye(h0, mu, mu_s, nu), h0, mu, mu_s, nu, d_km - entry, ri.transmittance);
         L += Lm * frame.moon_light.rgb;
     }
     inscatter = L * frame.aerial.y;

@@ -38,6 +38,9 @@ void main()
     /* with the orders product, orders 2 and up between the eye and each
      * slice from the table (orders_between) instead of psi_ms's march */
     bool ms = !orders_present();
+    vec3 eye = ms ? vec3(0.0) : orders_eye(h, mu, mu_s, nu), eye_m = vec3(0.0);
+    for (int i = 0; i < moon_lights() && !ms; i++)
+        eye_m = orders_eye(h, mu, mu_m, nu_m);
     float t0 = 0.0;
     for (int k = 0; k < SB_AERIAL_SIZE; k++) {
         float w = (float(k) + 0.5) / float(SB_AERIAL_SIZE);
@@ -45,12 +48,12 @@ void main()
         integrate_segment(ri, h, mu, mu_s, nu, t0, t1, ms);
         vec3 L = sun * (ri.sun_rayleigh * p_r + ri.sun_mie * p_m) + ri.ms_rayleigh + ri.ms_mie;
         if (!ms)
-            L += orders_between(h, mu, mu_s, nu, t1, exp(-ri.tau));
+            L += orders_between(eye, h, mu, mu_s, nu, t1, exp(-ri.tau));
         for (int i = 0; i < moon_lights(); i++) {
             integrate_segment(rm, h, mu, mu_m, nu_m, t0, t1, ms);
             L += moon * (rm.sun_rayleigh * q_r + rm.sun_mie * q_m) + frame.moon_light.rgb * (rm.ms_rayleigh + rm.ms_mie);
             if (!ms)
-                L += frame.moon_light.rgb * orders_between(h, mu, mu_m, nu_m, t1, exp(-rm.tau));
+                L += frame.moon_light.rgb * orders_between(eye_m, h, mu, mu_m, nu_m, t1, exp(-rm.tau));
         }
         t0 = t1;
         imageStore(inscatter_out, ivec3(column, k), vec4(fp16_safe(L * frame.aerial.y), 1.0));

@@ -46,8 +46,8 @@
                                                distance from the camera (m) */
 #define SB_VIEW_BINDING_SCENE_HISTORY 61    /* struct sb_scene_history_gpu */
 #define SB_VIEW_BINDING_KEY_LIGHT 65        /* image2D rgba16f: the raster scene's key light direct share a pixel */
-#define SB_VIEW_BINDING_ORDERS 66           /* sampler2D: the orders product (config.h), its image's texels as RGBA32F,
-                                               texelFetch'd; a 1 x 1 stand-in when the pack has none */
+#define SB_VIEW_BINDING_ORDERS 66           /* sampler2D (linear): the orders product (config.h), its image's texels as RGBA32F,
+                                               filtered in mu and nu (view.glsl); a 1 x 1 stand-in without it */
 /* The specialization constant every view kernel takes (runtime/pass.c):
  * true when the pack has the orders product, which then gives orders 2
  * and up instead of Hillaire's psi_ms (view.glsl). */
