@@ -111,9 +111,6 @@ static uint32_t atmosphere_depends_on(enum sb_product_id id)
     return sb_atmosphere_product(id)->depends_on;
 }
 
-static const struct sb_orders_settings orders_grid = {
-    .r = SB_ORDERS_R, .mu = SB_ORDERS_MU, .mu_s = SB_ORDERS_MU_S, .nu = SB_ORDERS_NU};
-
 /* The suns a tolerance is measured at: the scene's, or the day's when it
  * gives no view (sky-error's from noon to a low sun). */
 static int orders_suns(const struct sb_scene *scene, double suns[4])
@@ -129,7 +126,7 @@ static int orders_suns(const struct sb_scene *scene, double suns[4])
 
 static void orders_key(const struct sb_scene *scene, struct sb_key_text *key)
 {
-    struct sb_orders_settings s = sb_orders_settings_resolve(&orders_grid);
+    struct sb_orders_settings s = sb_orders_settings_resolve(&sb_orders_product_grid);
     char code[SB_HASH_HEX_SIZE];
     sb_key_add(key, " grid %dx%dx%dx%d orders %d until %a", s.r, s.mu, s.mu_s, s.nu, s.max_order, s.tolerance);
     if (scene->tolerance[SB_PRODUCT_ORDERS] > 0) {
@@ -153,11 +150,11 @@ static enum sb_result orders_bake(struct sb_atmosphere_baker *baker, struct sb_v
                                   struct sb_artifact *a)
 {
     struct sb_orders_result r;
-    enum sb_result res = sb_orders_bake(vk, baker, &scene->atmosphere, &orders_grid, image, &r);
+    enum sb_result res = sb_orders_bake(vk, baker, &scene->atmosphere, &sb_orders_product_grid, image, &r);
     if (res)
         return res;
     a->gpu_ms = r.gpu_ms;
-    struct sb_orders_settings s = sb_orders_settings_resolve(&orders_grid);
+    struct sb_orders_settings s = sb_orders_settings_resolve(&sb_orders_product_grid);
     snprintf(a->settings_json, sizeof(a->settings_json),
              "{\"r\":%d,\"mu\":%d,\"mu_s\":%d,\"nu\":%d,\"height_ratio\":%.17g,\"orders\":%d,\"last_share\":%.6g,"
              "\"until\":%.17g}",

@@ -24,6 +24,9 @@ enum { SINGLE, DENSITY, SCATTER, KERNEL_COUNT };
 static const struct sb_pipeline_params kernels[KERNEL_COUNT] = {KERNEL(single), KERNEL(density), KERNEL(scatter)};
 #undef KERNEL
 
+const struct sb_orders_settings sb_orders_product_grid = {
+    .r = SB_ORDERS_R, .mu = SB_ORDERS_MU, .mu_s = SB_ORDERS_MU_S, .nu = SB_ORDERS_NU};
+
 uint32_t sb_orders_kernels(struct sb_pipeline_params out[KERNEL_COUNT])
 {
     memcpy(out, kernels, sizeof(kernels));
@@ -209,9 +212,7 @@ void sb_orders_hillaire_error(const struct sb_atmosphere_params *p, const struct
                               const struct sb_image *orders, double altitude_km, const double *suns_deg, int sun_count,
                               double *rms, double *worst)
 {
-    const struct sb_orders_settings grid = {
-        .r = SB_ORDERS_R, .mu = SB_ORDERS_MU, .mu_s = SB_ORDERS_MU_S, .nu = SB_ORDERS_NU};
-    struct sb_orders_ref *g = sb_orders_grid_create(p, &grid);
+    struct sb_orders_ref *g = sb_orders_grid_create(p, &sb_orders_product_grid);
     double sum2 = 0, largest = 0;
     int n = 0;
     for (int s = 0; g && s < sun_count; s++) {

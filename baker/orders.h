@@ -24,6 +24,9 @@
 #include "image.h"
 #include "orders_ref.h"
 
+/* The product's grid (config.h's SB_ORDERS_*, format version 14). */
+extern const struct sb_orders_settings sb_orders_product_grid;
+
 struct sb_orders_result {
     int orders;        /* the last order computed */
     double last_share; /* its largest value over the sum's */

@@ -388,9 +388,7 @@ enum sb_result sb_sky_error_run(struct sb_vk *vk, const char *scene_name, const 
                                         &job.twelve[t]);
     }
     enum sb_result res = SB_OK;
-    const struct sb_orders_settings product_grid = {
-        .r = SB_ORDERS_R, .mu = SB_ORDERS_MU, .mu_s = SB_ORDERS_MU_S, .nu = SB_ORDERS_NU};
-    struct sb_orders_ref *grid = sb_orders_grid_create(&scene->atmosphere, &product_grid);
+    struct sb_orders_ref *grid = sb_orders_grid_create(&scene->atmosphere, &sb_orders_product_grid);
     if (!grid)
         res = SB_ERR_NOMEM;
     job.grid = grid;
@@ -405,7 +403,7 @@ enum sb_result sb_sky_error_run(struct sb_vk *vk, const char *scene_name, const 
             res = sb_atmosphere_bake(baker, needed[i], NULL, &out[needed[i]], NULL, NULL);
         if (b == 0 && !res) { /* the orders product, as a bake makes it */
             struct sb_orders_result orders_result;
-            res = sb_orders_bake(vk, baker, params_b, &product_grid, &out[SB_PRODUCT_ORDERS], &orders_result);
+            res = sb_orders_bake(vk, baker, params_b, &sb_orders_product_grid, &out[SB_PRODUCT_ORDERS], &orders_result);
             report->product_orders = orders_result.orders;
             report->product_gpu_ms = orders_result.gpu_ms;
         }

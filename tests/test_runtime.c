@@ -1186,7 +1186,20 @@ struct sky_case {
 
 /* The pack the sky-view is compared on, and with the orders product, its grid. */
 static const struct sb_pack *sky_pack;
-static const struct sb_orders_ref *sky_orders;
+static struct sb_orders_ref *sky_orders;
+
+/* Compare on pack p from now on (sky_compare_end ends it). */
+static void sky_compare_begin(const struct sb_pack *p)
+{
+    sky_pack = p;
+    sky_orders =
+        p->present[SB_PRODUCT_ORDERS] ? sb_orders_grid_create(&p->scene->atmosphere, &sb_orders_product_grid) : NULL;
+}
+
+static void sky_compare_end(void)
+{
+    sb_orders_ref_destroy(&sky_orders);
+}
 
 static void sky_reference(void *user, int i)
 {
@@ -1215,12 +1228,8 @@ static void test_sky_view_of(struct sb_renderer *r, const struct sb_pack *p, dou
         return;
     float *lut = malloc(sizeof(float) * 3 * SB_SKY_VIEW_WIDTH * SB_SKY_VIEW_HEIGHT);
     sb_renderer_sky_view(r, lut);
-    sky_pack = p;
-    const struct sb_orders_settings grid = {
-        .r = SB_ORDERS_R, .mu = SB_ORDERS_MU, .mu_s = SB_ORDERS_MU_S, .nu = SB_ORDERS_NU};
-    struct sb_orders_ref *orders =
-        p->present[SB_PRODUCT_ORDERS] ? sb_orders_grid_create(&p->scene->atmosphere, &grid) : NULL;
-    sky_orders = orders;
+    sky_compare_begin(p);
+    bool orders = sky_orders != NULL;
     double h = v.camera_m[1] * 1e-3, R = p->scene->atmosphere.ground_radius_km;
     double mu_s = sin(v.sun_elevation);
     /* The mapping written down in shaders/view.glsl, implemented again. */
@@ -1272,8 +1281,7 @@ static void test_sky_view_of(struct sb_renderer *r, const struct sb_pack *p, dou
     }
     CHECK(worst <= tolerance, "sky-view LUT with the sun at %g deg within %g of fp64 (max %.3g)%s", sun_elevation_deg,
           tolerance, worst, orders ? ", with the orders" : "");
-    sb_orders_ref_destroy(&orders);
-    sky_orders = NULL;
+    sky_compare_end();
     free(cases);
     free(lut);
 }
@@ -1352,12 +1360,8 @@ static void test_aerial_of(struct sb_renderer *r, const struct sb_pack *p, doubl
     size_t texels = (size_t)SB_AERIAL_SIZE * SB_AERIAL_SIZE * SB_AERIAL_SIZE;
     float *volume = malloc(texels * 3 * sizeof(float));
     sb_renderer_aerial(r, volume);
-    sky_pack = p;
-    const struct sb_orders_settings grid = {
-        .r = SB_ORDERS_R, .mu = SB_ORDERS_MU, .mu_s = SB_ORDERS_MU_S, .nu = SB_ORDERS_NU};
-    struct sb_orders_ref *orders =
-        p->present[SB_PRODUCT_ORDERS] ? sb_orders_grid_create(&p->scene->atmosphere, &grid) : NULL;
-    sky_orders = orders;
+    sky_compare_begin(p);
+    bool orders = sky_orders != NULL;
     double sun[3];
     sb_direction(v.sun_azimuth, v.sun_elevation, sun);
     static const int columns[][2] = {{4, 4}, {16, 4}, {28, 4}, {8, 10}, {24, 12}, {16, 14}};
@@ -1399,8 +1403,7 @@ static void test_aerial_of(struct sb_renderer *r, const struct sb_pack *p, doubl
            w->ref[worst_c]);
     CHECK(worst <= tolerance, "aerial perspective with the sun at %g deg within %g of fp64 (max %.3g)%s",
           sun_elevation_deg, tolerance, worst, orders ? ", with the orders" : "");
-    sb_orders_ref_destroy(&orders);
-    sky_orders = NULL;
+    sky_compare_end();
     free(volume);
 }
 
