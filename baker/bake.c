@@ -253,6 +253,7 @@ enum sb_result sb_bake_scene(struct sb_vk *vk, const struct sb_scene *scene, con
         }
         a->bake_ms = 1e3 * sb_now_s() - t0;
         if (!image->data) { /* declined under the scene's tolerance (family.h): not in the pack */
+            report->declined |= 1u << p;
             sb_probe_layout_finish(&a->probes);
             continue;
         }

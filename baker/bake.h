@@ -20,7 +20,7 @@
 #include "pack.h"
 #include "scene.h"
 
-#define SB_BAKE_MAX_FROM 16                       /* --from packs */
+#define SB_BAKE_MAX_FROM 16                        /* --from packs */
 #define SB_BAKE_MAX_SOURCES (1 + SB_BAKE_MAX_FROM) /* the pack there, then those */
 
 struct sb_bake_options {
@@ -36,6 +36,7 @@ struct sb_bake_report {
     struct sb_artifact artifacts[SB_PRODUCT_COUNT];
     uint32_t shapes[SB_PRODUCT_COUNT][4]; /* width, height, depth, channels */
     bool reused[SB_PRODUCT_COUNT];        /* per artifact: taken from the pack there before */
+    uint32_t declined; /* products the scene's tolerance made unneeded, left out of the pack (bit mask) */
 };
 
 /* Products to bake: the scene's requests closed over dependencies (bit mask). */

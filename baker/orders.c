@@ -216,15 +216,11 @@ void sb_orders_hillaire_error(const struct sb_atmosphere_params *p, const struct
     double sum2 = 0, largest = 0;
     int n = 0;
     for (int s = 0; g && s < sun_count; s++) {
-        double el = suns_deg[s] * M_PI / 180, hillaire[SB_SKY_ERROR_DIRECTIONS][3], exact[SB_SKY_ERROR_DIRECTIONS][3];
-        double brightest[3] = {0, 0, 0};
+        double hillaire[SB_SKY_ERROR_DIRECTIONS][3], exact[SB_SKY_ERROR_DIRECTIONS][3], brightest[3] = {0, 0, 0};
         for (int d = 0; d < SB_SKY_ERROR_DIRECTIONS; d++) {
-            double zen, az;
+            double zen, az, mu, mu_s, nu;
             sb_sky_error_view(p, altitude_km, d, &zen, &az);
-            zen *= M_PI / 180;
-            az *= M_PI / 180;
-            double mu = cos(zen), mu_s = sin(el);
-            double nu = fmax(-1.0, fmin(1.0, sin(zen) * cos(el) * cos(az) + mu * mu_s));
+            sb_sky_error_cosines(zen, az, suns_deg[s], &mu, &mu_s, &nu);
             const struct sb_image *t = &baked[SB_PRODUCT_TRANSMITTANCE], *ig = &baked[SB_PRODUCT_IRRADIANCE_GROUND];
             sb_ref_sky_radiance(p, altitude_km, mu, mu_s, nu, t, &baked[SB_PRODUCT_MULTISCATTERING], ig, NULL,
                                 hillaire[d]);

@@ -23,8 +23,8 @@
 #define MIE_U 16   /* the density's Mie part: quantiles of Henyey-Greenstein's scattering angle */
 #define MIE_PHI 16 /* and azimuths about the view */
 
-/* count altitudes from 0 to Z, the first step `first` (or an even spacing,
- * if that is finer): h_i = Z (q^i - 1) / (q^n - 1), n = count - 1. */
+/* n + 1 altitudes from 0 to Z: h_i = Z (q^i - 1) / (q^n - 1), or Z i / n
+ * for q = 1 (q: sb_orders_height_ratio). */
 struct progression {
     double Z, q;
     int n;
@@ -604,11 +604,10 @@ struct sb_orders_ref *sb_orders_grid_create(const struct sb_atmosphere_params *p
 
 struct sb_orders_ref *sb_orders_ref_create(const struct sb_atmosphere_params *p, const struct sb_orders_settings *s)
 {
-    struct sb_orders_ref *o = calloc(1, sizeof(*o));
+    struct sb_orders_ref *o = sb_orders_grid_create(p, s);
     if (!o)
         return NULL;
     struct sb_orders_settings set = sb_orders_settings_resolve(s);
-    grid_init(o, p, &set);
     int max_order = set.max_order;
     double tolerance = set.tolerance;
     size_t n = node_count(o);

@@ -70,6 +70,16 @@ struct job {
 
 /* Of the job's sun: one (direction, channel), then one (direction,
  * wavelength triple) of the spectral trace. */
+void sb_sky_error_cosines(double zenith_angle_deg, double azimuth_from_sun_deg, double elevation_deg, double *mu,
+                          double *mu_s, double *nu)
+{
+    double zenith = zenith_angle_deg * SKY_PI / 180, azimuth = azimuth_from_sun_deg * SKY_PI / 180;
+    double elevation = elevation_deg * SKY_PI / 180;
+    *mu = cos(zenith);
+    *mu_s = sin(elevation);
+    *nu = fmax(-1.0, fmin(1.0, sin(zenith) * cos(elevation) * cos(azimuth) + *mu * *mu_s));
+}
+
 static void run_one(void *user, int index)
 {
     struct job *job = user;
@@ -79,10 +89,8 @@ static void run_one(void *user, int index)
     int channel = i % per_view, d = i / per_view;
     struct sb_sky_error_sun *sun = &job->report->suns[job->sun];
     struct sb_sky_error_direction *dir = &sun->directions[d];
-    double zenith = dir->zenith_deg * SKY_PI / 180, azimuth = dir->azimuth_deg * SKY_PI / 180;
-    double elevation = sun->elevation_deg * SKY_PI / 180;
-    double mu = cos(zenith), mu_s = sin(elevation);
-    double nu = fmax(-1.0, fmin(1.0, sin(zenith) * cos(elevation) * cos(azimuth) + mu * mu_s));
+    double mu, mu_s, nu;
+    sb_sky_error_cosines(dir->zenith_deg, dir->azimuth_deg, sun->elevation_deg, &mu, &mu_s, &nu);
     double h = job->report->altitude_km, R = job->params->ground_radius_km, r = R + h;
     struct sb_pathtrace_view view = {h, mu, mu_s, nu};
     if (spectral) {

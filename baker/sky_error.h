@@ -39,6 +39,11 @@
 void sb_sky_error_view(const struct sb_atmosphere_params *p, double altitude_km, int i, double *zenith_deg,
                        double *azimuth_deg);
 
+/* A view's cosines from its zenith angle, its azimuth from the sun's and the
+ * sun's elevation (degrees): mu (view), mu_s (sun), nu (view-sun). */
+void sb_sky_error_cosines(double zenith_deg, double azimuth_deg, double elevation_deg, double *mu, double *mu_s,
+                          double *nu);
+
 struct sb_sky_error_params {
     int paths;                             /* per direction and channel; 0: 16384 */
     int spectral_paths;                    /* per direction and wavelength; 0: paths / 16 (the same work as the

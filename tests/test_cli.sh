@@ -320,6 +320,12 @@ printf '{"atmosphere":{"preset":"earth","mie_scattering_per_km":0.07992,"mie_abs
 check "the earth at noon under a 5% tolerance bakes" expect_exit 0 "$skybake" bake "$tmp/orders_earth.json" -o "$tmp/orders_earth"
 check "and says why it goes without the orders" grep -q "orders: Hillaire's multiple scattering is within tolerance 0.05" "$tmp/out" "$tmp/err"
 check "the earth keeps Hillaire's LUT" test ! -e "$tmp/orders_earth/orders.exr"
+check "--json names what was left out" expect_exit 0 "$skybake" bake "$tmp/orders_earth.json" -o "$tmp/orders_earth2" --json -q
+check "as declined" python3 -c '
+import json, sys
+r = json.load(open(sys.argv[1]))
+sys.exit(0 if r["declined"] == ["orders"] and "orders" not in [a["name"] for a in r["artifacts"]] else 1)
+' "$tmp/out"
 check "the haze over the day under a 5% tolerance bakes" expect_exit 0 "$skybake" bake "$tmp/orders_haze.json" -o "$tmp/orders_haze"
 check "its pack verifies without them" expect_exit 0 "$skybake" verify "$tmp/orders_earth"
 check "the haze gets the orders" test -s "$tmp/orders_haze/orders.exr"

@@ -80,10 +80,9 @@ vec3 ground_irradiance(uint j, float mu_s)
 {
     if (j == 0u)
         return atm.solar_irradiance.rgb * sun_transmittance(0.0, mu_s) * max(mu_s, 0.0);
-    float f = orders_mu_s_coord(mu_s);
-    uint i = min(uint(f), orders.size.z - 2u), row = j * orders.size.z;
-    return orders_blend_mu_s(ground_table[row + i].rgb, ground_table[row + i + 1u].rgb, f - float(i),
-                             orders_mu_s(i + 1u) <= 0.0);
+    OrdersMuS c = orders_mu_s_cell(mu_s);
+    uint k = j * orders.size.z + c.i;
+    return orders_blend_mu_s(ground_table[k].rgb, ground_table[k + 1u].rgb, c.f, c.twilight);
 }
 
 /* Transmittance from altitude h along mu (ending on the ground) to the ground. */
@@ -128,7 +127,6 @@ void main()
     float h = orders_altitude(ir), mu_s = orders_mu_s(ims), r = ground_radius() + h;
     float ss = sqrt(max(1.0 - mu_s * mu_s, 0.0));
     float horizon = -horizon_distance(h) / r;
-    const uint per_phi = SB_ORDERS_DIRECTIONS_GROUND + SB_ORDERS_DIRECTIONS_SKY;
     for (uint d = t; d < SB_ORDERS_DIRECTIONS; d += SB_ORDERS_THREADS) {
         uint q = d / SB_ORDERS_DIRECTIONS_PHI, f = d % SB_ORDERS_DIRECTIONS_PHI;
         bool sky = q >= SB_ORDERS_DIRECTIONS_GROUND;

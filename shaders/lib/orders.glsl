@@ -18,7 +18,11 @@ layout(push_constant) uniform OrdersPush { sb_orders_push orders; };
 #define SB_ORDERS_GRID_MU_S orders.mu_s
 #endif
 
-uint orders_node_count() { return SB_ORDERS_GRID_SIZE.x * SB_ORDERS_GRID_SIZE.y * SB_ORDERS_GRID_SIZE.z * SB_ORDERS_GRID_SIZE.w; }
+uint orders_node_count()
+{
+    uvec4 s = SB_ORDERS_GRID_SIZE;
+    return s.x * s.y * s.z * s.w;
+}
 
 /* Node (ir, imu, imus, inu) of a flat index. */
 uvec4 orders_node(uint index)
@@ -38,7 +42,8 @@ float orders_altitude(uint i)
     float n = float(SB_ORDERS_GRID_SIZE.x - 1u), Z = SB_ORDERS_GRID_HEIGHTS.w;
     if (i >= SB_ORDERS_GRID_SIZE.x - 1u)
         return Z;
-    return SB_ORDERS_GRID_HEIGHTS.x == 1.0 ? Z * float(i) / n : Z * (exp(SB_ORDERS_GRID_HEIGHTS.y * float(i)) - 1.0) / SB_ORDERS_GRID_HEIGHTS.z;
+    vec4 q = SB_ORDERS_GRID_HEIGHTS;
+    return q.x == 1.0 ? Z * float(i) / n : Z * (exp(q.y * float(i)) - 1.0) / q.z;
 }
 
 /* The continuous r node index of altitude h. */
@@ -46,7 +51,8 @@ float orders_altitude_coord(float h)
 {
     float n = float(SB_ORDERS_GRID_SIZE.x - 1u), Z = SB_ORDERS_GRID_HEIGHTS.w;
     h = clamp(h, 0.0, Z);
-    float i = SB_ORDERS_GRID_HEIGHTS.x == 1.0 ? h / Z * n : log(1.0 + h / Z * SB_ORDERS_GRID_HEIGHTS.z) / SB_ORDERS_GRID_HEIGHTS.y;
+    vec4 q = SB_ORDERS_GRID_HEIGHTS;
+    float i = q.x == 1.0 ? h / Z * n : log(1.0 + h / Z * q.z) / q.y;
     return clamp(i, 0.0, n);
 }
 
@@ -128,6 +134,21 @@ vec3 orders_blend_mu_s(vec3 a, vec3 b, float f, bool twilight)
     return mix(lin, geo, pos);
 }
 
+/* Where mu_s falls between two nodes: the lower node, the fraction to the
+ * next, and whether both lie below the horizon (orders_blend_mu_s). */
+struct OrdersMuS {
+    uint i;
+    float f;
+    bool twilight;
+};
+
+OrdersMuS orders_mu_s_cell(float mu_s)
+{
+    float fs = orders_mu_s_coord(mu_s);
+    uint i = min(uint(fs), SB_ORDERS_GRID_SIZE.z - 2u);
+    return OrdersMuS(i, fs - float(i), orders_mu_s(i + 1u) <= 0.0);
+}
+
 /* The corner nodes and weights of the multilinear read at (h, mu, mu_s, nu). */
 struct OrdersCell {
     uint base; /* node (ir, im, ims, inu) */
@@ -142,17 +163,16 @@ OrdersCell orders_cell(float h, float mu, float mu_s, float nu, bool ground)
     OrdersCell c;
     float fr = orders_altitude_coord(h);
     uint ir = min(uint(fr), s.x - 2u);
-    float fs = orders_mu_s_coord(mu_s);
-    uint ims = min(uint(fs), s.z - 2u);
+    OrdersMuS ms = orders_mu_s_cell(mu_s);
     float fn = orders_phi(mu, mu_s, nu) / PI * float(s.w - 1u);
     uint inu = min(uint(fn), s.w - 2u);
     uint lo = ground ? 0u : s.y / 2u;
     float fm = orders_mu_coord(h, mu, ground);
     uint im = min(uint(fm), lo + s.y / 2u - 2u);
-    c.base = orders_index(ir, im, ims, inu);
+    c.base = orders_index(ir, im, ms.i, inu);
     c.a = vec3(fr - float(ir), fm - float(im), fn - float(inu));
-    c.as = fs - float(ims);
-    c.twilight = orders_mu_s(ims + 1u) <= 0.0;
+    c.as = ms.f;
+    c.twilight = ms.twilight;
     return c;
 }
 

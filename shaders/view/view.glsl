@@ -26,7 +26,7 @@ bool orders_present() { return SB_VIEW_ORDERS; }
 #include "frame.glsl"
 
 /* The orders product (config.h; baker/orders.h), its grid in the frame's
- * constants, its texels read one by one (orders.glsl's multilinear read). */
+ * constants (orders.glsl). */
 #define SB_ORDERS_GRID_DECLARED
 #define SB_ORDERS_GRID_SIZE frame.orders_size
 #define SB_ORDERS_GRID_HEIGHTS frame.orders_heights
@@ -53,8 +53,8 @@ vec3 orders_sky(float h, float mu, float mu_s, float nu, bool ground)
     float x = float(n.z * s.w + n.w) + c.a.z + 0.5, y = float(n.x * s.y + n.y) + c.a.y + 0.5;
     vec2 step_s = vec2(float(s.w), 0.0), step_r = vec2(0.0, float(s.y));
     vec2 p = vec2(x, y);
-    vec3 v0 = mix(textureLod(orders_texture, p * texel, 0.0).rgb, textureLod(orders_texture, (p + step_r) * texel, 0.0).rgb,
-                  c.a.x);
+    vec3 v0 = mix(textureLod(orders_texture, p * texel, 0.0).rgb,
+                  textureLod(orders_texture, (p + step_r) * texel, 0.0).rgb, c.a.x);
     vec3 v1 = mix(textureLod(orders_texture, (p + step_s) * texel, 0.0).rgb,
                   textureLod(orders_texture, (p + step_s + step_r) * texel, 0.0).rgb, c.a.x);
     return orders_blend_mu_s(v0, v1, c.as, c.twilight);
@@ -63,10 +63,9 @@ vec3 orders_sky(float h, float mu, float mu_s, float nu, bool ground)
 /* The ground's irradiance from the sky (the table's last row). */
 vec3 orders_ground_sky(float mu_s)
 {
-    float f = orders_mu_s_coord(mu_s);
-    uint i = min(uint(f), SB_ORDERS_GRID_SIZE.z - 2u), base = orders_node_count();
-    return orders_blend_mu_s(orders_texel(base + i * SB_ORDERS_GRID_SIZE.w), orders_texel(base + (i + 1u) * SB_ORDERS_GRID_SIZE.w),
-                             f - float(i), orders_mu_s(i + 1u) <= 0.0);
+    OrdersMuS c = orders_mu_s_cell(mu_s);
+    uint k = orders_node_count() + c.i * SB_ORDERS_GRID_SIZE.w; /* a row of nu texels a mu_s node */
+    return orders_blend_mu_s(orders_texel(k), orders_texel(k + SB_ORDERS_GRID_SIZE.w), c.f, c.twilight);
 }
 
 /* Orders 2 and up scattered into the view from altitude h (cosine mu, the
