@@ -5,6 +5,7 @@
  */
 #include <math.h>
 #include <stdio.h>
+#include <stdlib.h>
 #include <string.h>
 
 #include "accuracy.h"
@@ -12,6 +13,15 @@
 #include "family.h"
 #include "log.h"
 #include "orders.h"
+#include "spectral.h"
+#include "spectrum.h"
+
+/* The family's state: the scene's baker, and its bands' for the spectral
+ * products (made when the first is baked). */
+struct atmosphere_state {
+    struct sb_atmosphere_baker *baker;
+    struct sb_spectral *spectral;
+};
 
 /*
  * Bake product `id` with the cheapest setting (device-independent cost,
@@ -106,9 +116,20 @@ static void key_params(enum sb_product_id id, const struct sb_atmosphere_params 
  * against Hillaire's LUTs, which they read too. */
 static uint32_t atmosphere_depends_on(enum sb_product_id id)
 {
-    if (id == SB_PRODUCT_ORDERS)
+    switch (id) {
+    case SB_PRODUCT_ORDERS:
         return BIT(SB_PRODUCT_TRANSMITTANCE) | BIT(SB_PRODUCT_MULTISCATTERING) | BIT(SB_PRODUCT_IRRADIANCE_GROUND);
-    return sb_atmosphere_product(id)->depends_on;
+    /* The spectral products bake what they read for themselves
+     * (spectral.h); a runtime draws the three together. */
+    case SB_PRODUCT_SPECTRAL_TRANSMITTANCE:
+        return 0;
+    case SB_PRODUCT_SPECTRAL_IRRADIANCE_GROUND:
+        return BIT(SB_PRODUCT_SPECTRAL_TRANSMITTANCE);
+    case SB_PRODUCT_SPECTRAL_ORDERS:
+        return BIT(SB_PRODUCT_SPECTRAL_TRANSMITTANCE) | BIT(SB_PRODUCT_SPECTRAL_IRRADIANCE_GROUND);
+    default:
+        return sb_atmosphere_product(id)->depends_on;
+    }
 }
 
 /* The suns a tolerance is measured at: the scene's, or the day's when it
@@ -182,9 +203,40 @@ static enum sb_result orders_bake(struct sb_atmosphere_baker *baker, struct sb_v
     return SB_OK;
 }
 
+/* A spectral product's: each band's scene (what the spectrum's tables
+ * made of the scene's), and the three-channel bake's settings and kernels. */
+static void spectral_key(const struct sb_scene *scene, enum sb_product_id id, struct sb_key_text *key)
+{
+    enum sb_product_id base = sb_spectral_base(id);
+    for (int b = 0; b < SB_SPECTRAL_BANDS; b++) {
+        struct sb_atmosphere_params band;
+        sb_spectral_band(&scene->atmosphere, b, &band);
+        sb_key_add(key, " band %d at %a %a %a nm", b, sb_spectral_nm(3 * b), sb_spectral_nm(3 * b + 1),
+                   sb_spectral_nm(3 * b + 2));
+        key_params(SB_PRODUCT_IRRADIANCE_SKY, &band, key);
+    }
+    char settings[1024], code[SB_HASH_HEX_SIZE];
+    if (base == SB_PRODUCT_ORDERS) {
+        struct sb_orders_settings s = sb_orders_settings_resolve(&sb_orders_product_grid);
+        sb_key_add(key, " grid %dx%dx%dx%d orders %d until %a", s.r, s.mu, s.mu_s, s.nu, s.max_order, s.tolerance);
+        sb_orders_code_hash(code);
+        sb_key_add(key, " code %s", code);
+    }
+    /* the LUTs each band's bake of `base` reads, and its own */
+    for (enum sb_product_id p = SB_PRODUCT_TRANSMITTANCE; p <= SB_PRODUCT_IRRADIANCE_GROUND && p <= base; p++) {
+        sb_atmosphere_settings_json(p, &sb_atmosphere_product(p)->defaults, settings, sizeof(settings));
+        sb_atmosphere_code_hash(p, code);
+        sb_key_add(key, " %s defaults %s code %s", sb_product_name(p), settings, code);
+    }
+}
+
 static void atmosphere_key(void *state, const struct sb_scene *scene, enum sb_product_id id, struct sb_key_text *key)
 {
     char settings[1024], code[SB_HASH_HEX_SIZE];
+    if (sb_spectral_base(id) != SB_PRODUCT_COUNT) {
+        spectral_key(scene, id, key);
+        return;
+    }
     key_params(id, &scene->atmosphere, key);
     if (id == SB_PRODUCT_ORDERS) {
         orders_key(scene, key);
@@ -208,24 +260,55 @@ static void atmosphere_key(void *state, const struct sb_scene *scene, enum sb_pr
 
 static enum sb_result atmosphere_create(struct sb_vk *vk, const struct sb_scene *scene, void **state)
 {
-    struct sb_atmosphere_baker *baker = NULL;
-    enum sb_result res = sb_atmosphere_baker_create(vk, &scene->atmosphere, &baker);
-    *state = baker;
-    return res;
+    struct atmosphere_state *s = calloc(1, sizeof(*s));
+    *state = s;
+    if (!s)
+        return SB_ERR_NOMEM;
+    return sb_atmosphere_baker_create(vk, &scene->atmosphere, &s->baker);
 }
 
 static void atmosphere_destroy(void **state)
 {
-    struct sb_atmosphere_baker *baker = *state;
-    sb_atmosphere_baker_destroy(&baker);
+    struct atmosphere_state *s = *state;
+    if (s) {
+        sb_atmosphere_baker_destroy(&s->baker);
+        sb_spectral_destroy(&s->spectral);
+        free(s);
+    }
     *state = NULL;
+}
+
+static enum sb_result spectral_bake(struct atmosphere_state *state, struct sb_vk *vk, const struct sb_scene *scene,
+                                    enum sb_product_id id, struct sb_image *image, struct sb_artifact *a)
+{
+    enum sb_result res = SB_OK;
+    if (!state->spectral && (res = sb_spectral_create(vk, &scene->atmosphere, &state->spectral)))
+        return res;
+    struct sb_orders_result orders;
+    if ((res = sb_spectral_bake(state->spectral, id, image, &a->gpu_ms, &orders)))
+        return res;
+    char nm[128] = "";
+    for (int i = 0, n = 0; i < SB_SPECTRAL_WAVELENGTHS; i++)
+        n += snprintf(nm + n, sizeof(nm) - (size_t)n, "%s%g", i ? "," : "", sb_spectral_nm(i));
+    snprintf(a->settings_json, sizeof(a->settings_json), "{\"bands\":%d,\"nm\":[%s]}", SB_SPECTRAL_BANDS, nm);
+    if (sb_spectral_base(id) == SB_PRODUCT_ORDERS) {
+        struct sb_orders_settings s = sb_orders_settings_resolve(&sb_orders_product_grid);
+        sb_settings_json_add(a->settings_json, sizeof(a->settings_json),
+                             ",\"r\":%d,\"mu\":%d,\"mu_s\":%d,\"nu\":%d,\"orders\":%d,\"last_share\":%.6g,"
+                             "\"until\":%.17g",
+                             s.r, s.mu, s.mu_s, s.nu, orders.orders, orders.last_share, s.tolerance);
+    }
+    return SB_OK;
 }
 
 static enum sb_result atmosphere_bake(void *state, struct sb_vk *vk, const struct sb_scene *scene,
                                       enum sb_product_id id, const struct sb_image baked[SB_PRODUCT_COUNT],
                                       struct sb_image *image, struct sb_artifact *a)
 {
-    struct sb_atmosphere_baker *baker = state;
+    struct atmosphere_state *st = state;
+    struct sb_atmosphere_baker *baker = st->baker;
+    if (sb_spectral_base(id) != SB_PRODUCT_COUNT)
+        return spectral_bake(st, vk, scene, id, image, a);
     if (id == SB_PRODUCT_ORDERS)
         return orders_bake(baker, vk, scene, baked, image, a);
     struct sb_atmosphere_settings used;
@@ -248,21 +331,26 @@ static enum sb_result atmosphere_bake(void *state, struct sb_vk *vk, const struc
 
 static enum sb_result atmosphere_adopt(void *state, enum sb_product_id id, const struct sb_image *image)
 {
-    if (id == SB_PRODUCT_ORDERS) /* no product reads it */
+    /* no product reads the orders; the spectral products bake what they read */
+    if (id == SB_PRODUCT_ORDERS || sb_spectral_base(id) != SB_PRODUCT_COUNT)
         return SB_OK;
-    return sb_atmosphere_adopt(state, id, image);
+    return sb_atmosphere_adopt(((struct atmosphere_state *)state)->baker, id, image);
 }
 
 static uint32_t atmosphere_kernels(void *state, const struct sb_scene *scene, enum sb_product_id id,
                                    struct sb_pipeline_params out[SB_FAMILY_KERNELS_MAX])
 {
     _Static_assert(SB_ATMOSPHERE_KERNELS_MAX <= SB_FAMILY_KERNELS_MAX, "room for the atmosphere's kernels");
+    struct atmosphere_state *st = state;
+    enum sb_product_id base = sb_spectral_base(id);
+    if (base != SB_PRODUCT_COUNT) /* the three-channel kernels, for each band */
+        return base == SB_PRODUCT_ORDERS ? sb_orders_kernels(out) : sb_atmosphere_kernels(st->baker, base, NULL, out);
     if (id == SB_PRODUCT_ORDERS)
         return sb_orders_kernels(out);
     /* to a tolerance, the candidates bake cheapest first: the first's */
     struct sb_atmosphere_settings candidates[SB_ATMOSPHERE_MAX_CANDIDATES];
     bool first = scene->tolerance[id] > 0 && sb_atmosphere_candidates(id, candidates) > 0;
-    return sb_atmosphere_kernels(state, id, first ? &candidates[0] : NULL, out);
+    return sb_atmosphere_kernels(st->baker, id, first ? &candidates[0] : NULL, out);
 }
 
 const struct sb_family_baker sb_atmosphere_family = {

@@ -15,6 +15,7 @@
 #include "orders_ref.h"
 #include "parallel.h"
 #include "pathtrace.h"
+#include "spectral.h"
 
 #define SKY_PI 3.14159265358979323846
 
@@ -58,9 +59,10 @@ struct job {
     struct sb_sky_error_report *report;
     /* the scene at wavelengths 3 t, 3 t + 1 and 3 t + 2 of the grid, as channels */
     struct sb_atmosphere_params spectral[TRIPLES];
-    /* the scene at SB_SKY_ERROR_SKYBAKE_12's wavelengths, three a medium, and its LUTs */
-    struct sb_atmosphere_params twelve[4];
-    const struct sb_image (*twelve_luts)[SB_PRODUCT_COUNT];
+    /* the scene at the 12 wavelengths, a band of three at a time, and each
+     * band's LUTs: transmittance, multiscattering, irradiance_ground, orders */
+    const struct sb_atmosphere_params *band[SB_SPECTRAL_BANDS];
+    const struct sb_image *band_luts[SB_SPECTRAL_BANDS][4];
     const struct sb_orders_ref *orders; /* NULL unless asked */
     const struct sb_orders_ref *grid;   /* the orders product's grid */
     int sun;                            /* the sun being traced */
@@ -115,13 +117,15 @@ static void run_one(void *user, int index)
                               &job->luts[SB_PRODUCT_TRANSMITTANCE], h, mu, mu_s, nu, dir->product);
         if (job->orders)
             sb_orders_ref_sky(job->orders, h, mu, mu_s, nu, dir->orders, NULL);
-        for (int t = 0; t < 4; t++) {
-            const struct sb_image *l = job->twelve_luts[t];
-            double rgb[3];
-            sb_ref_sky_radiance(&job->twelve[t], h, mu, mu_s, nu, &l[SB_PRODUCT_TRANSMITTANCE],
-                                &l[SB_PRODUCT_MULTISCATTERING], &l[SB_PRODUCT_IRRADIANCE_GROUND], NULL, rgb);
-            for (int c = 0; c < 3; c++)
-                dir->skybake_12[3 * t + c] = rgb[c];
+        for (int b = 0; b < SB_SPECTRAL_BANDS; b++) {
+            const struct sb_image *const *l = job->band_luts[b];
+            double rgb[3], product[3];
+            sb_ref_sky_radiance(job->band[b], h, mu, mu_s, nu, l[0], l[1], l[2], NULL, rgb);
+            sb_orders_product_sky(job->band[b], job->grid, l[3], l[0], h, mu, mu_s, nu, product);
+            for (int c = 0; c < 3; c++) {
+                dir->skybake_12[3 * b + c] = rgb[c];
+                dir->product_12[3 * b + c] = product[c];
+            }
         }
     }
     struct sb_pathtrace_params params = {.seed = job->settings->seed, .paths = job->report->paths};
@@ -204,46 +208,47 @@ static void summarise_colour(struct sb_sky_error_sun *sun)
     sun->de_worst_direction = stats.worst_direction;
 }
 
-/* Wavelength i of n spread evenly over the grid from 380 to 810 nm. */
+/* Wavelength i of n spread evenly over the grid from 380 to 810 nm (an
+ * index of the grid). */
 static int subset_index(int i, int n)
 {
     return (int)lround(i * 43.0 / (n - 1)) + 2;
-}
-
-/* XYZ of radiances at n of the grid's wavelengths (subset_index): the
- * transfer (radiance over the sun's spectrum) linear between them, flat
- * beyond. */
-static void subset_xyz(const double *radiance, int n, double xyz[3])
-{
-    double spectrum[SB_SPECTRUM_COUNT];
-    for (int k = 0, j = 0; k < SB_SPECTRUM_COUNT; k++) {
-        while (j + 2 < n && subset_index(j + 1, n) <= k)
-            j++;
-        int a = subset_index(j, n), b = subset_index(j + 1, n);
-        double f = fmin(fmax((double)(k - a) / (b - a), 0.0), 1.0);
-        double lo = radiance[j] / sb_solar_spectrum(sb_spectrum_nm(a));
-        double hi = radiance[j + 1] / sb_solar_spectrum(sb_spectrum_nm(b));
-        spectrum[k] = (lo + f * (hi - lo)) * sb_solar_spectrum(sb_spectrum_nm(k));
-    }
-    sb_spectrum_to_xyz(spectrum, xyz);
 }
 
 /* Each view's rgb in a scheme. */
 static void scheme_rgb(const struct sb_sky_error_direction *dir, int scheme, const double convert[3][3],
                        const double sun_to_rgb[3][3], double rgb[3])
 {
-    if (scheme == SB_SKY_ERROR_WAVELENGTHS_6 || scheme == SB_SKY_ERROR_WAVELENGTHS_12 ||
-        scheme == SB_SKY_ERROR_SKYBAKE_12) {
-        int n = scheme == SB_SKY_ERROR_WAVELENGTHS_6 ? 6 : 12;
-        double picked[12], xyz[3];
-        for (int i = 0; i < n; i++)
-            picked[i] = scheme == SB_SKY_ERROR_SKYBAKE_12 ? dir->skybake_12[i] : dir->spectral[subset_index(i, n)];
-        subset_xyz(picked, n, xyz);
+    double picked[SB_SPECTRAL_WAVELENGTHS], nm[SB_SPECTRAL_WAVELENGTHS], xyz[3];
+    int n = 0;
+    switch (scheme) {
+    case SB_SKY_ERROR_WAVELENGTHS_6:
+        for (; n < 6; n++) {
+            nm[n] = sb_spectrum_nm(subset_index(n, 6));
+            picked[n] = dir->spectral[subset_index(n, 6)];
+        }
+        break;
+    case SB_SKY_ERROR_WAVELENGTHS_12:
+    case SB_SKY_ERROR_SKYBAKE_12:
+    case SB_SKY_ERROR_PRODUCT_12:
+        for (; n < SB_SPECTRAL_WAVELENGTHS; n++) {
+            nm[n] = sb_spectral_nm(n);
+            int k = (int)lround((nm[n] - SB_SPECTRUM_FIRST_NM) / SB_SPECTRUM_STEP_NM);
+            picked[n] = scheme == SB_SKY_ERROR_SKYBAKE_12   ? dir->skybake_12[n]
+                        : scheme == SB_SKY_ERROR_PRODUCT_12 ? dir->product_12[n]
+                                                            : dir->spectral[k];
+        }
+        break;
+    }
+    if (n) {
+        sb_samples_to_xyz(picked, nm, n, xyz);
         sb_mat3_apply(sun_to_rgb, xyz, rgb);
         return;
     }
     bool traced = scheme == SB_SKY_ERROR_TRACED_PRIMARIES || scheme == SB_SKY_ERROR_TRACED_CONVERTED;
-    const double *v = traced ? dir->path_traced : dir->skybake;
+    const double *v = traced                                     ? dir->path_traced
+                      : scheme == SB_SKY_ERROR_PRODUCT_PRIMARIES ? dir->product
+                                                                 : dir->skybake;
     if (scheme == SB_SKY_ERROR_CONVERTED || scheme == SB_SKY_ERROR_TRACED_CONVERTED)
         sb_mat3_apply(convert, v, rgb);
     else
@@ -386,36 +391,37 @@ enum sb_result sb_sky_error_run(struct sb_vk *vk, const char *scene_name, const 
     }
 
     /* The products the sky reads, baked as a default bake bakes them: for
-     * the scene's three channels, and for 12 wavelengths, three a bake. */
+     * the scene's three channels, and for the 12 wavelengths as the
+     * spectral products bake them, a band of three at a time. */
     struct job job = {0};
-    struct sb_image luts[SB_PRODUCT_COUNT] = {0}, twelve_luts[4][SB_PRODUCT_COUNT] = {{{0}}};
-    for (int t = 0; t < 4; t++) {
-        job.twelve[t] = scene->atmosphere;
-        for (int c = 0; c < 3; c++)
-            sb_atmosphere_at_wavelength(&scene->atmosphere, sb_spectrum_nm(subset_index(3 * t + c, 12)), c,
-                                        &job.twelve[t]);
-    }
-    enum sb_result res = SB_OK;
+    struct sb_image luts[SB_PRODUCT_COUNT] = {0};
+    struct sb_spectral *spectral = NULL;
+    struct sb_atmosphere_baker *baker = NULL;
     struct sb_orders_ref *grid = sb_orders_grid_create(&scene->atmosphere, &sb_orders_product_grid);
-    if (!grid)
-        res = SB_ERR_NOMEM;
+    enum sb_result res = grid ? SB_OK : SB_ERR_NOMEM;
     job.grid = grid;
-    for (int b = 0; b < 5 && !res; b++) {
-        const struct sb_atmosphere_params *params_b = b == 0 ? &scene->atmosphere : &job.twelve[b - 1];
-        struct sb_image *out = b == 0 ? luts : twelve_luts[b - 1];
-        struct sb_atmosphere_baker *baker = NULL;
-        res = sb_atmosphere_baker_create(vk, params_b, &baker);
-        const enum sb_product_id needed[] = {SB_PRODUCT_TRANSMITTANCE, SB_PRODUCT_MULTISCATTERING,
-                                             SB_PRODUCT_IRRADIANCE_GROUND};
-        for (size_t i = 0; i < sizeof(needed) / sizeof(needed[0]) && !res; i++)
-            res = sb_atmosphere_bake(baker, needed[i], NULL, &out[needed[i]], NULL, NULL);
-        if (b == 0 && !res) { /* the orders product, as a bake makes it */
-            struct sb_orders_result orders_result;
-            res = sb_orders_bake(vk, baker, params_b, &sb_orders_product_grid, &out[SB_PRODUCT_ORDERS], &orders_result);
-            report->product_orders = orders_result.orders;
-            report->product_gpu_ms = orders_result.gpu_ms;
-        }
-        sb_atmosphere_baker_destroy(&baker);
+    if (!res)
+        res = sb_atmosphere_baker_create(vk, &scene->atmosphere, &baker);
+    const enum sb_product_id needed[] = {SB_PRODUCT_TRANSMITTANCE, SB_PRODUCT_MULTISCATTERING,
+                                         SB_PRODUCT_IRRADIANCE_GROUND};
+    for (size_t i = 0; i < sizeof(needed) / sizeof(needed[0]) && !res; i++)
+        res = sb_atmosphere_bake(baker, needed[i], NULL, &luts[needed[i]], NULL, NULL);
+    if (!res) { /* the orders product, as a bake makes it */
+        struct sb_orders_result orders_result;
+        res = sb_orders_bake(vk, baker, &scene->atmosphere, &sb_orders_product_grid, &luts[SB_PRODUCT_ORDERS],
+                             &orders_result);
+        report->product_orders = orders_result.orders;
+        report->product_gpu_ms = orders_result.gpu_ms;
+    }
+    sb_atmosphere_baker_destroy(&baker);
+    if (!res)
+        res = sb_spectral_create(vk, &scene->atmosphere, &spectral);
+    static const enum sb_product_id band_needed[4] = {SB_PRODUCT_TRANSMITTANCE, SB_PRODUCT_MULTISCATTERING,
+                                                      SB_PRODUCT_IRRADIANCE_GROUND, SB_PRODUCT_ORDERS};
+    for (int b = 0; b < SB_SPECTRAL_BANDS && !res; b++) {
+        job.band[b] = sb_spectral_band_params(spectral, b);
+        for (int i = 0; i < 4 && !res; i++)
+            res = sb_spectral_band_lut(spectral, b, band_needed[i], &job.band_luts[b][i], NULL);
     }
     if (res) {
         sb_error("%s: baking the sky's LUTs failed (%s)", scene_name, sb_result_name(res));
@@ -443,7 +449,6 @@ enum sb_result sb_sky_error_run(struct sb_vk *vk, const char *scene_name, const 
     job.luts = luts;
     job.settings = params;
     job.report = report;
-    job.twelve_luts = (const struct sb_image(*)[SB_PRODUCT_COUNT])twelve_luts;
     for (int t = 0; t < TRIPLES; t++) {
         job.spectral[t] = scene->atmosphere;
         for (int c = 0; c < 3; c++)
@@ -462,12 +467,9 @@ enum sb_result sb_sky_error_run(struct sb_vk *vk, const char *scene_name, const 
 done:
     sb_orders_ref_destroy(&orders);
     sb_orders_ref_destroy(&grid);
-    sb_image_finish(&luts[SB_PRODUCT_ORDERS]);
-    for (int i = 0; i < SB_ATMOSPHERE_PRODUCT_COUNT; i++) {
+    sb_spectral_destroy(&spectral);
+    for (int i = 0; i < SB_PRODUCT_COUNT; i++)
         sb_image_finish(&luts[i]);
-        for (int t = 0; t < 4; t++)
-            sb_image_finish(&twelve_luts[t][i]);
-    }
     return res;
 }
 
@@ -477,7 +479,8 @@ static const char *channel_name(int c)
 }
 
 static const char *const scheme_names[SB_SKY_ERROR_SCHEME_COUNT] = {
-    "primaries", "converted", "traced_primaries", "traced_converted", "wavelengths_6", "wavelengths_12", "skybake_12"};
+    "primaries",      "converted",  "traced_primaries",  "traced_converted", "wavelengths_6",
+    "wavelengths_12", "skybake_12", "product_primaries", "product_12"};
 
 static cJSON *triple(const double v[3])
 {
@@ -597,10 +600,12 @@ void sb_sky_error_print(const struct sb_sky_error_report *reports, int count, bo
         printf("  colour against the spectral path tracer (%d wavelengths, 360 to 830 nm, %d paths each; CIEDE2000 "
                "mean / max):\n  skybake's sky and the three-channel path tracer's, each read as Rec.709 primaries or\n"
                "  converted (sb_channels_to_rec709); the spectral trace itself read at 6 and 12 wavelengths;\n"
-               "  skybake's model at 12 wavelengths:\n",
+               "  skybake's model at 12 wavelengths; the sky with the orders product as primaries and at 12\n"
+               "  wavelengths (the spectral products, as skyview draws them):\n",
                SB_SPECTRUM_COUNT, r->spectral_paths);
-        printf("  %8s %15s %15s %15s %15s %15s %15s %15s %9s\n", "sun deg", "primaries", "converted", "traced prim.",
-               "traced conv.", "6 wavelengths", "12 wavelengths", "skybake at 12", "noise");
+        printf("  %8s %15s %15s %15s %15s %15s %15s %15s %15s %15s %9s\n", "sun deg", "primaries", "converted",
+               "traced prim.", "traced conv.", "6 wavelengths", "12 wavelengths", "skybake at 12", "orders prim.",
+               "orders at 12", "noise");
         for (int s = 0; s < r->sun_count; s++) {
             const struct sb_sky_error_sun *sun = &r->suns[s];
             printf("  %8.4g", sun->elevation_deg);

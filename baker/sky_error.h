@@ -65,7 +65,8 @@ struct sb_sky_error_direction {
     double std_error[3];                      /* the reference's standard error */
     double orders[3];                         /* the sky with orders 2 and up from orders_ref.h */
     double product[3];                        /* skybake's sky with the orders product (orders.h) */
-    double skybake_12[12];                    /* skybake's model at SB_SKY_ERROR_SKYBAKE_12's wavelengths */
+    double skybake_12[12];                    /* skybake's model at the 12 wavelengths (sb_spectral_nm) */
+    double product_12[12];                    /* its sky with the spectral orders, as skyview draws it */
     double spectral[SB_SPECTRUM_COUNT];       /* the spectral path tracer, per wavelength */
     double spectral_error[SB_SPECTRUM_COUNT]; /* its standard error */
 };
@@ -76,14 +77,20 @@ enum sb_sky_error_scheme {
     SB_SKY_ERROR_CONVERTED,        /* skybake's sky through sb_channels_to_rec709 */
     SB_SKY_ERROR_TRACED_PRIMARIES, /* the three-channel path tracer's, as primaries */
     SB_SKY_ERROR_TRACED_CONVERTED, /* the three-channel path tracer's, converted */
-    /* The spectral trace itself read at 6 or 12 of its wavelengths, evenly
-     * spread from 380 to 810 nm, linear between them and flat beyond: the
-     * error of a runtime of that many wavelengths whose light were exact */
+    /* The spectral trace itself read at 6 of its wavelengths (evenly spread
+     * from 380 to 810 nm) or at the spectral products' 12 (380 to 820 nm
+     * every 40), linear between them and flat beyond: the error of a
+     * runtime of that many wavelengths whose light were exact */
     SB_SKY_ERROR_WAVELENGTHS_6,
     SB_SKY_ERROR_WAVELENGTHS_12,
     /* skybake's model (its LUTs baked for each wavelength, read as the
      * runtime reads them) at those 12 wavelengths, linear between them */
     SB_SKY_ERROR_SKYBAKE_12,
+    /* the sky with the orders product, as primaries (skyview's colour with
+     * three-channel products), and at 12 wavelengths from the spectral
+     * products (skyview's with them: spectral_orders) */
+    SB_SKY_ERROR_PRODUCT_PRIMARIES,
+    SB_SKY_ERROR_PRODUCT_12,
     SB_SKY_ERROR_SCHEME_COUNT,
 };
 

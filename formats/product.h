@@ -57,10 +57,12 @@ struct sb_product_format {
     const char *parameterization; /* mapping id, see docs/pack.md */
     int since_version;            /* the first format version holding the product */
     enum sb_storage storage;
-    const char *pixel_type; /* the manifest's pixel_type: "float32", "float16" */
-    int half_since;         /* a probe product stored as float16 from this format version on, float32 before; 0 */
-    const char *extension;  /* of its file: "exr", "vdb" */
-    bool nonnegative;       /* every value >= 0 (a radiance): a reader refuses a negative one */
+    const char *pixel_type;   /* the manifest's pixel_type: "float32", "float16" */
+    int half_since;           /* a probe product stored as float16 from this format version on, float32 before; 0 */
+    const char *extension;    /* of its file: "exr", "vdb" */
+    bool nonnegative;         /* every value >= 0 (a radiance): a reader refuses a negative one */
+    bool named_only;          /* baked only when a scene names it, not by default */
+    const char *no_tolerance; /* why a scene's tolerance does not apply to it (its family's, else); NULL */
     enum sb_family family;
 };
 

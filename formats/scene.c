@@ -61,6 +61,13 @@ static enum sb_result tolerance_value(const cJSON *item, const char *source, con
     return SB_OK;
 }
 
+/* Why a tolerance does not apply to product `id`, NULL where it does. */
+static const char *no_tolerance(enum sb_product_id id)
+{
+    const char *why = sb_product_format(id)->no_tolerance;
+    return why ? why : sb_family_format(sb_product_format(id)->family)->no_tolerance;
+}
+
 /* "tolerance": a number for every product, or an object of product names. */
 static enum sb_result parse_tolerance(const cJSON *item, struct sb_scene *scene, const char *source)
 {
@@ -68,7 +75,7 @@ static enum sb_result parse_tolerance(const cJSON *item, struct sb_scene *scene,
         double v;
         enum sb_result res = tolerance_value(item, source, "tolerance", &v);
         for (int p = 0; p < SB_PRODUCT_COUNT && !res; p++)
-            if (!sb_family_format(sb_product_format((enum sb_product_id)p)->family)->no_tolerance)
+            if (!no_tolerance((enum sb_product_id)p))
                 scene->tolerance[p] = v;
         return res;
     }
@@ -87,7 +94,7 @@ static enum sb_result parse_tolerance(const cJSON *item, struct sb_scene *scene,
             sb_error("%s: %s: unknown product", source, path);
             return SB_ERR_UNKNOWN_PRODUCT;
         }
-        const char *why = sb_family_format(sb_product_format(id)->family)->no_tolerance;
+        const char *why = no_tolerance(id);
         if (why) {
             sb_error("%s: %s: %s", source, path, why);
             return SB_ERR_OUT_OF_RANGE;
@@ -232,7 +239,8 @@ static enum sb_result parse_root(const cJSON *root, struct sb_scene *scene, cons
     }
     if (!have_products)
         for (int p = 0; p < SB_PRODUCT_COUNT; p++)
-            scene->wants[p] = sb_family_format(sb_product_format((enum sb_product_id)p)->family)->default_products;
+            scene->wants[p] = sb_family_format(sb_product_format((enum sb_product_id)p)->family)->default_products &&
+                              !sb_product_format((enum sb_product_id)p)->named_only;
     for (int f = 0; f < SB_FAMILY_COUNT; f++) {
         const struct sb_family_format *family = sb_family_format((enum sb_family)f);
         if (family->validate && (res = family->validate(scene, source)))

@@ -287,3 +287,43 @@ void sb_channels_to_rec709(const double solar_rgb[3], double m[3][3])
         for (int c = 0; c < 3; c++)
             m[r][c] *= solar_rgb[c] > 0.0 ? solar_rgb[r] / solar_rgb[c] : 0.0;
 }
+
+double sb_spectral_nm(int i)
+{
+    return 380.0 + 40.0 * i;
+}
+
+void sb_spectral_band(const struct sb_atmosphere_params *p, int band, struct sb_atmosphere_params *out)
+{
+    *out = *p;
+    for (int c = 0; c < 3; c++)
+        sb_atmosphere_at_wavelength(p, sb_spectral_nm(3 * band + c), c, out);
+}
+
+void sb_samples_to_xyz(const double *radiance, const double *nm, int n, double xyz[3])
+{
+    double spectrum[SB_SPECTRUM_COUNT];
+    for (int k = 0, j = 0; k < SB_SPECTRUM_COUNT; k++) {
+        double at = sb_spectrum_nm(k);
+        while (j + 2 < n && nm[j + 1] <= at)
+            j++;
+        double f = fmin(fmax((at - nm[j]) / (nm[j + 1] - nm[j]), 0.0), 1.0);
+        double lo = radiance[j] / sb_solar_spectrum(nm[j]), hi = radiance[j + 1] / sb_solar_spectrum(nm[j + 1]);
+        spectrum[k] = (lo + f * (hi - lo)) * sb_solar_spectrum(at);
+    }
+    sb_spectrum_to_xyz(spectrum, xyz);
+}
+
+void sb_spectral_to_rec709(const double solar_rgb[3], double k[SB_SPECTRAL_WAVELENGTHS][3])
+{
+    double nm[SB_SPECTRAL_WAVELENGTHS], to_rgb[3][3];
+    for (int i = 0; i < SB_SPECTRAL_WAVELENGTHS; i++)
+        nm[i] = sb_spectral_nm(i);
+    sb_sun_xyz_to_rec709(solar_rgb, to_rgb);
+    for (int i = 0; i < SB_SPECTRAL_WAVELENGTHS; i++) {
+        double unit[SB_SPECTRAL_WAVELENGTHS] = {0}, xyz[3];
+        unit[i] = 1.0;
+        sb_samples_to_xyz(unit, nm, SB_SPECTRAL_WAVELENGTHS, xyz);
+        sb_mat3_apply(to_rgb, xyz, k[i]);
+    }
+}

@@ -23,6 +23,7 @@
 #ifndef SB_PHYSICS_SPECTRUM_H
 #define SB_PHYSICS_SPECTRUM_H
 
+#include "config.h"
 #include "scene.h"
 
 #define SB_SPECTRUM_FIRST_NM 360.0
@@ -75,5 +76,29 @@ void sb_sun_xyz_to_rec709(const double solar_rgb[3], double m[3][3]);
  * it is: m (solar_rgb) = solar_rgb.
  */
 void sb_channels_to_rec709(const double solar_rgb[3], double m[3][3]);
+
+/*
+ * The sky at 12 wavelengths (the spectral products, docs/pack.md): 380 to
+ * 820 nm every 40 nm, in SB_SPECTRAL_BANDS bands of three, band b's channel
+ * c wavelength 3 b + c; each band a scene of its own (the rules above), so
+ * every three-channel kernel bakes and draws it unchanged.
+ */
+#define SB_SPECTRAL_WAVELENGTHS (3 * SB_SPECTRAL_BANDS)
+
+/* Wavelength i of the 12, nm. */
+double sb_spectral_nm(int i);
+
+/* The scene's atmosphere at band b's three wavelengths. */
+void sb_spectral_band(const struct sb_atmosphere_params *p, int band, struct sb_atmosphere_params *out);
+
+/* XYZ of radiances sampled at n ascending wavelengths nm[] (on the spectral
+ * grid): the transfer (radiance over the sun's spectrum) linear between
+ * them, flat beyond, times the sun's spectrum, through the observer. */
+void sb_samples_to_xyz(const double *radiance, const double *nm, int n, double xyz[3]);
+
+/* The 12 wavelengths' radiances (each band's sun the measured spectrum) to
+ * the runtime's linear Rec.709 under the scene's sun: rgb = sum over i of
+ * k[i] L_i (sb_samples_to_xyz, then sb_sun_xyz_to_rec709). */
+void sb_spectral_to_rec709(const double solar_rgb[3], double k[SB_SPECTRAL_WAVELENGTHS][3]);
 
 #endif

@@ -150,6 +150,11 @@
 #define SB_ORDERS_MU_S 24
 #define SB_ORDERS_NU 4
 
+/* The spectral products (format version 15): the sky at 12 wavelengths in
+ * bands of three (physics/spectrum.h), each band a scene of three channels
+ * baked and drawn by the three-channel kernels. */
+#define SB_SPECTRAL_BANDS 4
+
 /* Gauss-Legendre order of one segment of a ray integral (see atmosphere.glsl). */
 #define SB_RAY_GL_ORDER 4
 /* Upper bound on the altitude levels that cut a ray into segments. */

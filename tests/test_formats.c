@@ -735,6 +735,19 @@ static void edit_version_13(cJSON *r)
 {
     cJSON_ReplaceItemInObject(r, "format_version", cJSON_CreateNumber(13));
 }
+/* Version 14 with every product but the spectral ones: it opens. */
+static void edit_version_14(cJSON *r)
+{
+    cJSON_ReplaceItemInObject(r, "format_version", cJSON_CreateNumber(14));
+    cJSON *artifacts = cJSON_GetObjectItem(r, "artifacts");
+    for (int i = cJSON_GetArraySize(artifacts) - 1; i >= 0; i--)
+        if (!strncmp(cJSON_GetObjectItem(cJSON_GetArrayItem(artifacts, i), "name")->valuestring, "spectral_", 9))
+            cJSON_DeleteItemFromArray(artifacts, i);
+}
+static void edit_version_14_listing(cJSON *r)
+{
+    cJSON_ReplaceItemInObject(r, "format_version", cJSON_CreateNumber(14));
+}
 /* What version 1 wrote: no cloud products (in the scene or the pack), no
  * file_hash; the scene's hash recomputed for the scene without clouds. */
 static void edit_make_version_1(cJSON *r)
@@ -914,6 +927,15 @@ static void test_pack_reader(void)
         CHECK(sb_exr_write(nan_path, &nan_image, NULL, 0) == SB_OK, "write an orders table holding %s",
               k ? "a negative value" : "Inf");
         sb_image_finish(&nan_image);
+        /* the same at 12 wavelengths, the value in the last band */
+        const struct sb_image *spectral = &images[SB_PRODUCT_SPECTRAL_ORDERS];
+        snprintf(nan_path, sizeof(nan_path), "%s/%s.exr", pack_root, k ? "spectral_negative" : "spectral_inf");
+        sb_image_init(&nan_image, spectral->width, spectral->height, spectral->channel_count);
+        sb_image_set_channel_names(&nan_image, sb_product_format(SB_PRODUCT_SPECTRAL_ORDERS)->channel_names);
+        nan_image.data[spectral->channel_count * 777 + 10] = k ? -1.0f : INFINITY;
+        CHECK(sb_exr_write(nan_path, &nan_image, NULL, 0) == SB_OK, "write a spectral orders table holding %s",
+              k ? "a negative value" : "Inf");
+        sb_image_finish(&nan_image);
     }
 
     struct sb_pack *pack = calloc(1, sizeof(*pack));
@@ -967,7 +989,7 @@ static void test_pack_reader(void)
         {"format version 1, as version 1 wrote it", edit_make_version_1,
          "rm cloud_shape.vdb cloud_detail.vdb cloud_curl.exr weather.exr sky_visibility.sbprobes sky_bounce.sbprobes "
          "dfg.exr reflection_cubes.exr reflection_probes.sbprobes sun_bounce.sbprobes reflection_surfaces.exr "
-         "orders.exr",
+         "orders.exr spectral_transmittance.exr spectral_irradiance_ground.exr spectral_orders.exr",
          SB_OK, false},
         {"format version 2 listing sky_visibility", edit_version_2, NULL, SB_ERR_UNKNOWN_PRODUCT, false},
         {"format version 3 listing sky_bounce", edit_version_3, NULL, SB_ERR_UNKNOWN_PRODUCT, false},
@@ -982,6 +1004,20 @@ static void test_pack_reader(void)
         {"orders holding Inf, vouched for", NULL, "cp ../orders_inf.exr orders.exr", SB_ERR_NUMERIC, true},
         {"orders holding a negative radiance, vouched for", NULL, "cp ../orders_negative.exr orders.exr",
          SB_ERR_NUMERIC, true},
+        {"format version 14 listing the spectral products", edit_version_14_listing, NULL, SB_ERR_UNKNOWN_PRODUCT,
+         false},
+        {"format version 14 without them", edit_version_14,
+         "rm spectral_transmittance.exr spectral_irradiance_ground.exr spectral_orders.exr", SB_OK, false},
+        {"spectral orders truncated, vouched for", NULL,
+         "head -c 5000 spectral_orders.exr > t && mv t spectral_orders.exr", SB_ERR_EXR, true},
+        {"spectral orders replaced by the orders' file (3 wavelengths), vouched for", NULL,
+         "cp orders.exr spectral_orders.exr", SB_ERR_BAD_IMAGE, true},
+        {"spectral transmittance replaced by the transmittance's file, vouched for", NULL,
+         "cp transmittance.exr spectral_transmittance.exr", SB_ERR_BAD_IMAGE, true},
+        {"spectral orders holding Inf, vouched for", NULL, "cp ../spectral_inf.exr spectral_orders.exr", SB_ERR_NUMERIC,
+         true},
+        {"spectral orders holding a negative radiance, vouched for", NULL,
+         "cp ../spectral_negative.exr spectral_orders.exr", SB_ERR_NUMERIC, true},
         {"surfaces file truncated, vouched for", NULL,
          "head -c 4000 reflection_surfaces.exr > t && mv t reflection_surfaces.exr", SB_ERR_EXR, true},
         {"surfaces replaced by the cubes' file, vouched for", NULL, "cp reflection_cubes.exr reflection_surfaces.exr",

@@ -163,10 +163,54 @@ static void test_channels(void)
     CHECK(e < 1e-12, "a piecewise linear transfer: %.3g", e);
 }
 
+/* The 12 wavelengths' reading (the spectral products' colour): the sun
+ * itself, a grey transfer, comes out as the scene's sun; any transfer
+ * linear between the 12 and flat beyond comes out as its spectrum shows
+ * through the observer, built here on the 10 nm grid directly. */
+static void test_twelve(void)
+{
+    const double sun[3] = {1.474, 1.8504, 1.91198};
+    double k[SB_SPECTRAL_WAVELENGTHS][3], L[SB_SPECTRAL_WAVELENGTHS], transfer[SB_SPECTRAL_WAVELENGTHS];
+    sb_spectral_to_rec709(sun, k);
+    for (int i = 0; i < SB_SPECTRAL_WAVELENGTHS; i++) {
+        CHECK(i == 0 || sb_spectral_nm(i) > sb_spectral_nm(i - 1), "the wavelengths ascend");
+        transfer[i] = 0.3 + 0.25 * sin(0.9 * i) + 0.02 * i;
+    }
+    for (int grey = 1; grey >= 0; grey--) {
+        double rgb[3] = {0, 0, 0}, want[3], xyz[3], to_rgb[3][3], s[SB_SPECTRUM_COUNT];
+        for (int i = 0; i < SB_SPECTRAL_WAVELENGTHS; i++)
+            L[i] = sb_solar_spectrum(sb_spectral_nm(i)) * (grey ? 0.7 : transfer[i]);
+        for (int i = 0; i < SB_SPECTRAL_WAVELENGTHS; i++)
+            for (int c = 0; c < 3; c++)
+                rgb[c] += k[i][c] * L[i];
+        for (int j = 0; j < SB_SPECTRUM_COUNT; j++) {
+            double nm = sb_spectrum_nm(j), t = grey ? 0.7 : transfer[0];
+            for (int i = 0; !grey && i < SB_SPECTRAL_WAVELENGTHS; i++)
+                if (nm >= sb_spectral_nm(i))
+                    t = i + 1 < SB_SPECTRAL_WAVELENGTHS && nm < sb_spectral_nm(i + 1)
+                            ? transfer[i] + (nm - sb_spectral_nm(i)) / (sb_spectral_nm(i + 1) - sb_spectral_nm(i)) *
+                                                (transfer[i + 1] - transfer[i])
+                            : transfer[i];
+            s[j] = sb_solar_spectrum(nm) * t;
+        }
+        sb_spectrum_to_xyz(s, xyz);
+        sb_sun_xyz_to_rec709(sun, to_rgb);
+        sb_mat3_apply(to_rgb, xyz, want);
+        if (grey)
+            for (int c = 0; c < 3; c++)
+                CHECK(fabs(want[c] - 0.7 * sun[c]) < 1e-12, "a grey transfer on the grid is the sun");
+        double e = fmax(fmax(fabs(rgb[0] - want[0]), fabs(rgb[1] - want[1])), fabs(rgb[2] - want[2]));
+        printf("12 wavelengths to Rec.709, %s transfer: (%.5f %.5f %.5f), exact within %.2g\n",
+               grey ? "a grey" : "a varying", rgb[0], rgb[1], rgb[2], e);
+        CHECK(e < 1e-12, "%s transfer through the 12 wavelengths' reading: %.3g", grey ? "a grey" : "a varying", e);
+    }
+}
+
 int main(void)
 {
     test_observer();
     test_media();
     test_channels();
+    test_twelve();
     return test_finish("spectrum");
 }
