@@ -327,3 +327,20 @@ void sb_spectral_to_rec709(const double solar_rgb[3], double k[SB_SPECTRAL_WAVEL
         sb_mat3_apply(to_rgb, xyz, k[i]);
     }
 }
+
+enum sb_result sb_spectral_band_image(const struct sb_image *spectral, enum sb_product_id base, int b,
+                                      struct sb_image *band)
+{
+    uint32_t channels = sb_product_format(base)->channel_count, texels = spectral->width * spectral->height;
+    if (spectral->channel_count != channels * SB_SPECTRAL_BANDS || b < 0 || b >= SB_SPECTRAL_BANDS)
+        return SB_ERR_USAGE;
+    enum sb_result res = sb_image_init(band, spectral->width, spectral->height, channels);
+    if (res)
+        return res;
+    sb_image_set_channel_names(band, sb_product_format(base)->channel_names);
+    for (uint32_t t = 0; t < texels; t++)
+        for (uint32_t ch = 0; ch < channels; ch++)
+            band->data[(size_t)t * channels + ch] =
+                spectral->data[(size_t)t * spectral->channel_count + ch / 3 * (3 * SB_SPECTRAL_BANDS) + 3 * b + ch % 3];
+    return SB_OK;
+}

@@ -24,6 +24,8 @@
 #define SB_PHYSICS_SPECTRUM_H
 
 #include "config.h"
+#include "image.h"
+#include "product.h"
 #include "scene.h"
 
 #define SB_SPECTRUM_FIRST_NM 360.0
@@ -100,5 +102,12 @@ void sb_samples_to_xyz(const double *radiance, const double *nm, int n, double x
  * the runtime's linear Rec.709 under the scene's sun: rgb = sum over i of
  * k[i] L_i (sb_samples_to_xyz, then sb_sun_xyz_to_rec709). */
 void sb_spectral_to_rec709(const double solar_rgb[3], double k[SB_SPECTRAL_WAVELENGTHS][3]);
+
+/* Band b's three wavelengths of a spectral product's image as its
+ * three-channel product `base` holds a scene's channels (base channel
+ * g * 3 + c from the spectral product's g * 12 + 3 b + c: docs/pack.md),
+ * into *band (initialised here; the caller finishes it). */
+enum sb_result sb_spectral_band_image(const struct sb_image *spectral, enum sb_product_id base, int b,
+                                      struct sb_image *band);
 
 #endif

@@ -14,30 +14,65 @@
 #include "physics.h"
 #include "renderer_internal.h"
 #include "scene.h"
+#include "spectrum.h"
 
-/* A sampled RGBA32F texture of width x height texels from `data`, `channels`
- * floats (3 or more) a texel: the first three, alpha 0. */
-static enum sb_result upload_rgba32f(struct sb_renderer *r, const float *data, uint32_t channels, uint32_t width,
-                                     uint32_t height, const char *name, struct sb_texture *texture)
+/* A sampled RGBA32F texture of width x height texels in `layers` layers
+ * (a 2D array when `array`) from data[layer]: `channels` floats (3 or
+ * more) a texel, the first three its rgb (alpha 0). */
+static enum sb_result upload_rgba32f(struct sb_renderer *r, const float *const *data, uint32_t layers, bool array,
+                                     uint32_t channels, uint32_t width, uint32_t height, const char *name,
+                                     struct sb_texture *texture)
 {
     size_t texels = (size_t)width * height;
-    float *rgba = channels == 4 ? NULL : malloc(texels * 4 * sizeof(float));
-    if (channels != 4 && !rgba)
+    float *rgba = malloc(texels * layers * 4 * sizeof(float));
+    if (!rgba)
         return SB_ERR_NOMEM;
-    for (size_t i = 0; rgba && i < texels; i++)
-        for (uint32_t c = 0; c < 4; c++)
-            rgba[4 * i + c] = c < 3 ? data[i * channels + c] : 0.0f;
+    for (uint32_t l = 0; l < layers; l++)
+        for (size_t i = 0; i < texels; i++)
+            for (uint32_t c = 0; c < 4; c++)
+                rgba[4 * (l * texels + i) + c] = c < 3 ? data[l][i * channels + c] : 0.0f;
     struct sb_texture_params p = {
         .width = width,
         .height = height,
+        .layers = layers,
+        .array = array,
         .format = VK_FORMAT_R32G32B32A32_SFLOAT,
         .usage = VK_IMAGE_USAGE_SAMPLED_BIT | VK_IMAGE_USAGE_TRANSFER_DST_BIT,
         .name = name,
     };
     enum sb_result res = sb_texture_create(r->vk, &p, texture);
     if (!res)
-        res = sb_texture_upload(r->vk, texture, rgba ? rgba : data, texels * 4 * sizeof(float), 4 * sizeof(float));
+        res = sb_texture_upload(r->vk, texture, rgba, texels * layers * 4 * sizeof(float), 4 * sizeof(float));
     free(rgba);
+    return res;
+}
+
+/* Product `id`'s lookup form (physics.h), `rows` rows, for layer 0 and,
+ * with the bands, each band's from spectral product `spectral` in layer
+ * 1 + b, uploaded as a 2D array. */
+static enum sb_result upload_layers(struct sb_renderer *r, const struct sb_pack *pack, enum sb_product_id id,
+                                    enum sb_product_id spectral, uint32_t rows, const char *name,
+                                    struct sb_texture *texture)
+{
+    uint32_t layers = r->constants.bands ? 1 + SB_SPECTRAL_BANDS : 1;
+    size_t floats = sb_lookup_float_count(id);
+    float *lookup = malloc(floats * layers * sizeof(float));
+    const float *data[1 + SB_SPECTRAL_BANDS];
+    if (!lookup)
+        return SB_ERR_NOMEM;
+    enum sb_result res = SB_OK;
+    for (uint32_t l = 0; l < layers && !res; l++) {
+        struct sb_image band = {0};
+        data[l] = lookup + l * floats;
+        if (l > 0)
+            res = sb_spectral_band_image(&pack->images[spectral], id, (int)l - 1, &band);
+        if (!res)
+            sb_lookup_fill(id, l > 0 ? &band : &pack->images[id], lookup + l * floats);
+        sb_image_finish(&band);
+    }
+    if (!res)
+        res = upload_rgba32f(r, data, layers, true, 3, pack->images[id].width, rows, name, texture);
+    free(lookup);
     return res;
 }
 
@@ -67,59 +102,89 @@ enum sb_result sb_atmosphere_upload(struct sb_renderer *r, const struct sb_pack 
     r->ground_radius_km = atm->ground_radius_km;
     r->thickness_km = gpu.radii[3];
 
-    const struct sb_image *t = &pack->images[SB_PRODUCT_TRANSMITTANCE];
-    enum sb_result res = sb_renderer_upload(r, &gpu, sizeof(gpu), "atmosphere parameters", &r->atmosphere);
+    /* The spectral products, where the pack has all three and the orders:
+     * the sky at 12 wavelengths in four bands of three (view.glsl). */
+    bool spectral = pack->present[SB_PRODUCT_SPECTRAL_TRANSMITTANCE] &&
+                    pack->present[SB_PRODUCT_SPECTRAL_IRRADIANCE_GROUND] && pack->present[SB_PRODUCT_SPECTRAL_ORDERS];
+    r->constants.orders = pack->present[SB_PRODUCT_ORDERS];
+    VkFormatProperties rgba32f;
+    vkGetPhysicalDeviceFormatProperties(r->vk->physical_device, VK_FORMAT_R32G32B32A32_SFLOAT, &rgba32f);
+    if ((r->constants.orders || spectral) &&
+        !(rgba32f.optimalTilingFeatures & VK_FORMAT_FEATURE_SAMPLED_IMAGE_FILTER_LINEAR_BIT)) {
+        /* optional in Vulkan; the shaders read the orders bilinearly (view.glsl) */
+        sb_warn("skyview: this device cannot filter RGBA32F textures: the pack's orders are not used (Hillaire's "
+                "multiple scattering instead)");
+        r->constants.orders = false;
+        spectral = false;
+    }
+    if (spectral && !r->constants.orders)
+        sb_warn("skyview: the pack has the spectral products but not the orders: its sky is drawn in three channels");
+    r->constants.bands = spectral && r->constants.orders;
+    struct sb_atmosphere_gpu layers[1 + SB_SPECTRAL_BANDS];
+    layers[0] = gpu;
+    for (int b = 0; r->constants.bands && b < SB_SPECTRAL_BANDS; b++) {
+        struct sb_atmosphere_params band;
+        sb_spectral_band(atm, b, &band);
+        sb_atmosphere_gpu_pack(&band, &layers[1 + b]);
+    }
+    double k[SB_SPECTRAL_WAVELENGTHS][3];
+    sb_spectral_to_rec709(atm->solar_irradiance, k);
+    for (int i = 0; i < SB_SPECTRAL_WAVELENGTHS; i++)
+        for (int c = 0; c < 4; c++)
+            r->spectral_rgb[i][c] = c < 3 && r->constants.bands ? (float)k[i][c] : 0.0f;
+
+    enum sb_result res = sb_renderer_upload(r, layers, (r->constants.bands ? 1 + SB_SPECTRAL_BANDS : 1) * sizeof(gpu),
+                                            "atmosphere parameters", &r->atmosphere);
     /* Each as RGBA32F (atmosphere.glsl, SB_ATMOSPHERE_TEXTURES): the
      * transmittance LUT's and the ground irradiance's lookup forms; psi_ms
      * refined. */
-    float *depth = res ? NULL : malloc(sb_lookup_float_count(SB_PRODUCT_TRANSMITTANCE) * sizeof(float));
-    if (!res && !depth)
-        res = SB_ERR_NOMEM;
-    if (!res) {
-        sb_lookup_fill(SB_PRODUCT_TRANSMITTANCE, t, depth);
-        res = upload_rgba32f(r, depth, 3, t->width, t->height, "transmittance (optical depth)", &r->transmittance);
-    }
-    free(depth);
+    if (!res)
+        res = upload_layers(r, pack, SB_PRODUCT_TRANSMITTANCE, SB_PRODUCT_SPECTRAL_TRANSMITTANCE,
+                            pack->images[SB_PRODUCT_TRANSMITTANCE].height, "transmittance (optical depth)",
+                            &r->transmittance);
     float *refined = res ? NULL : malloc(sb_multiscattering_refined_float_count() * sizeof(float));
     if (!res && !refined)
         res = SB_ERR_NOMEM;
     if (!res) {
         sb_multiscattering_refined_fill(&pack->images[SB_PRODUCT_MULTISCATTERING], refined);
-        res = upload_rgba32f(r, refined, 4, SB_MULTISCATTERING_REFINED_SIZE, SB_MULTISCATTERING_REFINED_SIZE,
-                             "multiscattering (refined)", &r->multiscattering);
+        res = upload_rgba32f(r, (const float *const[1]){refined}, 1, false, 4, SB_MULTISCATTERING_REFINED_SIZE,
+                             SB_MULTISCATTERING_REFINED_SIZE, "multiscattering (refined)", &r->multiscattering);
     }
     free(refined);
     /* The orders product, where the pack has it (every view kernel is
-     * specialized on it: pass.c), else a 1 x 1 stand-in nothing reads. */
-    const struct sb_image *orders = &pack->images[SB_PRODUCT_ORDERS];
-    r->has_orders = !res && pack->present[SB_PRODUCT_ORDERS];
-    VkFormatProperties rgba32f;
-    vkGetPhysicalDeviceFormatProperties(r->vk->physical_device, VK_FORMAT_R32G32B32A32_SFLOAT, &rgba32f);
-    if (r->has_orders && !(rgba32f.optimalTilingFeatures & VK_FORMAT_FEATURE_SAMPLED_IMAGE_FILTER_LINEAR_BIT)) {
-        /* optional in Vulkan; the shaders read the orders bilinearly (view.glsl) */
-        sb_warn("skyview: this device cannot filter RGBA32F textures: the pack's orders are not used (Hillaire's "
-                "multiple scattering instead)");
-        r->has_orders = false;
-    }
+     * specialized on it: pass.c), else a 1 x 1 stand-in nothing reads; with
+     * the bands, each band's in a layer of its own. */
     memset(&r->orders_grid, 0, sizeof(r->orders_grid));
-    if (r->has_orders) {
+    if (!res && r->constants.orders) {
         sb_orders_grid_pack(atm, SB_ORDERS_R, SB_ORDERS_MU, SB_ORDERS_MU_S, SB_ORDERS_NU, &r->orders_grid);
-        res = upload_rgba32f(r, orders->data, 3, orders->width, orders->height, "orders", &r->orders);
+        const struct sb_image *orders = &pack->images[SB_PRODUCT_ORDERS];
+        struct sb_image bands[SB_SPECTRAL_BANDS] = {{0}};
+        const float *data[1 + SB_SPECTRAL_BANDS] = {orders->data};
+        uint32_t orders_layers = r->constants.bands ? 1 + SB_SPECTRAL_BANDS : 1;
+        for (uint32_t l = 1; l < orders_layers && !res; l++) {
+            res = sb_spectral_band_image(&pack->images[SB_PRODUCT_SPECTRAL_ORDERS], SB_PRODUCT_ORDERS, (int)l - 1,
+                                         &bands[l - 1]);
+            data[l] = bands[l - 1].data;
+        }
+        if (!res)
+            res = upload_rgba32f(r, data, orders_layers, true, 3, orders->width, orders->height, "orders", &r->orders);
+        for (int b = 0; b < SB_SPECTRAL_BANDS; b++)
+            sb_image_finish(&bands[b]);
     } else if (!res) {
         const float none[3] = {0, 0, 0};
-        res = upload_rgba32f(r, none, 3, 1, 1, "orders (none)", &r->orders);
+        res = upload_rgba32f(r, (const float *const[1]){none}, 1, true, 3, 1, 1, "orders (none)", &r->orders);
     }
-    r->specialization_entry =
+    r->specialization_entries[0] =
         (VkSpecializationMapEntry){.constantID = SB_VIEW_CONSTANT_ORDERS, .offset = 0, .size = sizeof(VkBool32)};
-    r->specialization = (VkSpecializationInfo){.mapEntryCount = 1,
-                                               .pMapEntries = &r->specialization_entry,
-                                               .dataSize = sizeof(VkBool32),
-                                               .pData = &r->has_orders};
-    float ground[SB_IRRADIANCE_WIDTH * 2 * 3]; /* two rows (physics.h) */
-    assert(sb_lookup_float_count(SB_PRODUCT_IRRADIANCE_GROUND) == sizeof(ground) / sizeof(ground[0]));
-    if (!res) {
-        sb_lookup_fill(SB_PRODUCT_IRRADIANCE_GROUND, &pack->images[SB_PRODUCT_IRRADIANCE_GROUND], ground);
-        res = upload_rgba32f(r, ground, 3, SB_IRRADIANCE_WIDTH, 2, "irradiance_ground (lookup)", &r->irradiance_ground);
-    }
+    r->specialization_entries[1] = (VkSpecializationMapEntry){
+        .constantID = SB_VIEW_CONSTANT_BANDS, .offset = sizeof(VkBool32), .size = sizeof(VkBool32)};
+    r->specialization = (VkSpecializationInfo){.mapEntryCount = 2,
+                                               .pMapEntries = r->specialization_entries,
+                                               .dataSize = sizeof(r->constants),
+                                               .pData = &r->constants};
+    assert(sb_lookup_float_count(SB_PRODUCT_IRRADIANCE_GROUND) == SB_IRRADIANCE_WIDTH * 2 * 3); /* two rows */
+    if (!res)
+        res = upload_layers(r, pack, SB_PRODUCT_IRRADIANCE_GROUND, SB_PRODUCT_SPECTRAL_IRRADIANCE_GROUND, 2,
+                            "irradiance_ground (lookup)", &r->irradiance_ground);
     return res;
 }

@@ -477,6 +477,7 @@ static void fill_frame(struct sb_renderer *r, const struct sb_view *v, struct sb
     memcpy(f->orders_size, r->orders_grid.size, sizeof(f->orders_size));
     memcpy(f->orders_heights, r->orders_grid.heights, sizeof(f->orders_heights));
     memcpy(f->orders_mu_s, r->orders_grid.mu_s, sizeof(f->orders_mu_s));
+    memcpy(f->spectral_rgb, r->spectral_rgb, sizeof(f->spectral_rgb));
 }
 
 /* A readback: the whole of an image into a host-visible buffer. */

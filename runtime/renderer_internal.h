@@ -61,14 +61,20 @@ struct sb_renderer {
                                               reflections pass */
 
     /* The renderer's resources, in the graph's table under their names. */
-    struct sb_buffer atmosphere;                                         /* "atmosphere" */
-    struct sb_texture transmittance, multiscattering, irradiance_ground; /* "transmittance", ...: RGBA32F, the
-                                                                            LUT; the refined and lookup forms */
-    struct sb_texture orders;            /* "orders": the orders product as RGBA32F, or a 1 x 1 stand-in */
-    struct sb_orders_push orders_grid;   /* its grid (zeros: the pack has none) */
-    VkSpecializationInfo specialization; /* every view kernel's (SB_VIEW_CONSTANT_ORDERS, pass.c) */
-    VkSpecializationMapEntry specialization_entry;
-    VkBool32 has_orders;
+    struct sb_buffer atmosphere; /* "atmosphere" */
+    /* "transmittance", ...: RGBA32F, the LUT; the refined and lookup forms. The transmittance, the
+     * ground's irradiance and the orders are 2D arrays: the scene's three channels in layer 0, and
+     * with the spectral products, band b's three wavelengths in layer 1 + b (atmosphere.glsl) */
+    struct sb_texture transmittance, multiscattering, irradiance_ground;
+    struct sb_texture orders;                     /* "orders": the orders product as RGBA32F, or a 1 x 1 stand-in */
+    struct sb_orders_push orders_grid;            /* its grid (zeros: the pack has none) */
+    float spectral_rgb[3 * SB_SPECTRAL_BANDS][4]; /* the 12 wavelengths to Rec.709 (frame.glsl) */
+    VkSpecializationInfo specialization;          /* every view kernel's (SB_VIEW_CONSTANT_*, pass.c) */
+    VkSpecializationMapEntry specialization_entries[2];
+    struct {
+        VkBool32 orders; /* the pack has the orders (SB_VIEW_CONSTANT_ORDERS) */
+        VkBool32 bands;  /* and the spectral products: the sky at 12 wavelengths (SB_VIEW_CONSTANT_BANDS) */
+    } constants;
     struct sb_buffer frame, vertices, exposure; /* "frame", "vertices", "exposure" */
     struct sb_buffer bvh_nodes, bvh_triangles;  /* "bvh nodes", "bvh triangles": the world's BVH when traced
                                                    or relighting reflections */

@@ -667,13 +667,7 @@ static void test_spectral(struct sb_vk *vk)
                 CHECK(sb_spectral_band_lut(spectral, b, d, &lut, NULL) == SB_OK, "band %d's %s", b, sb_product_name(d));
                 inputs[d] = *lut; /* borrowed */
             }
-            /* band b of the product, as the three-channel product holds it */
-            uint32_t channels = sb_product_format(base)->channel_count, texels = image.width * image.height;
-            sb_image_init(&band, image.width, image.height, channels);
-            for (uint32_t t = 0; t < texels; t++)
-                for (uint32_t ch = 0; ch < channels; ch++)
-                    band.data[t * channels + ch] =
-                        image.data[t * image.channel_count + ch / 3 * (3 * SB_SPECTRAL_BANDS) + 3 * b + ch % 3];
+            CHECK(sb_spectral_band_image(&image, base, b, &band) == SB_OK, "band %d of %s", b, sb_product_name(ids[i]));
             struct sb_accuracy_ref *ref = NULL;
             struct sb_error e = {0};
             CHECK(sb_accuracy_ref_create(p, base, 0, 0, 0, inputs, &ref) == SB_OK, "band %d's reference", b);

@@ -66,7 +66,7 @@ check "info --json" expect_exit 0 "$skybake" info "$tmp/a" --json
 check "info --json has the manifest's hashes" test "$(hashes "$tmp/out" | tr -d ' ,\t')" = "$(hashes "$tmp/a/manifest.json" | tr -d ' ,\t')"
 check "info needs a pack" expect_exit 2 "$skybake" info
 check "info refuses what is not a pack" expect_exit 2 "$skybake" info "$root/data"
-check "manifest has format_version 14" grep -Eq '"format_version":[[:space:]]*14,' "$tmp/a/manifest.json"
+check "manifest has format_version 15" grep -Eq '"format_version":[[:space:]]*15,' "$tmp/a/manifest.json"
 check "no cloud products unless asked for" test ! -e "$tmp/a/cloud_shape.vdb"
 
 # verify: exit 0 when all holds; else 1, naming every problem.
@@ -341,8 +341,8 @@ sys.exit(0 if s["hillaire"]["rms_rel"] > s["tolerance"] == 0.05 and s["orders"] 
 check "sky-error runs" expect_exit 0 "$skybake" sky-error "$scene" --paths 64 --sun 30 --sun -4 --json -q
 check "sky-error reports both suns" test "$(grep -c '"elevation_deg"' "$tmp/out")" = 2
 check "sky-error reports 16 directions per sun" test "$(grep -c '"zenith_deg"' "$tmp/out")" = 32
-# per sun: against the three-channel path tracer and, seven ways, the spectral one
-check "sky-error reports each sun's colour error" test "$(grep -c '"ciede2000_mean"' "$tmp/out")" = 16
+# per sun: against the three-channel path tracer and, nine ways, the spectral one
+check "sky-error reports each sun's colour error" test "$(grep -c '"ciede2000_mean"' "$tmp/out")" = 20
 check "sky-error reports the colour against the spectral path tracer" \
     test "$(grep -c '"traced_converted"' "$tmp/out")" = 2
 check "sky-error reports each view's spectrum" test "$(grep -c '"spectral_std_error"' "$tmp/out")" = 32

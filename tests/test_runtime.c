@@ -28,6 +28,7 @@
 #include "renderer.h"
 #include "scene.h"
 #include "shadows.h"
+#include "spectrum.h"
 #include "transform.h"
 #include "world.h"
 
@@ -1184,9 +1185,16 @@ struct sky_case {
     double exact[3]; /* the sun's transmittance integrated; with the orders, Hillaire's sky instead */
 };
 
-/* The pack the sky-view is compared on, and with the orders product, its grid. */
+/* The pack the sky-view is compared on, and with the orders product, its
+ * grid; with the spectral products, each band's scene and images (the
+ * transmittance, the ground's irradiance and the orders) and what takes
+ * the 12 wavelengths to the frame's colour. */
 static const struct sb_pack *sky_pack;
 static struct sb_orders_ref *sky_orders;
+static int sky_bands; /* 0, or SB_SPECTRAL_BANDS */
+static struct sb_atmosphere_params sky_band_params[SB_SPECTRAL_BANDS];
+static struct sb_image sky_band_images[SB_SPECTRAL_BANDS][SB_PRODUCT_COUNT];
+static double sky_k[SB_SPECTRAL_WAVELENGTHS][3];
 
 /* Compare on pack p from now on (sky_compare_end ends it). */
 static void sky_compare_begin(const struct sb_pack *p)
@@ -1194,11 +1202,40 @@ static void sky_compare_begin(const struct sb_pack *p)
     sky_pack = p;
     sky_orders =
         p->present[SB_PRODUCT_ORDERS] ? sb_orders_grid_create(&p->scene->atmosphere, &sb_orders_product_grid) : NULL;
+    sky_bands = sky_orders && p->present[SB_PRODUCT_SPECTRAL_ORDERS] ? SB_SPECTRAL_BANDS : 0;
+    static const enum sb_product_id spectral[] = {SB_PRODUCT_SPECTRAL_TRANSMITTANCE,
+                                                  SB_PRODUCT_SPECTRAL_IRRADIANCE_GROUND, SB_PRODUCT_SPECTRAL_ORDERS};
+    for (int b = 0; b < sky_bands; b++) {
+        sb_spectral_band(&p->scene->atmosphere, b, &sky_band_params[b]);
+        for (int i = 0; i < 3; i++) {
+            enum sb_product_id base = i == 0   ? SB_PRODUCT_TRANSMITTANCE
+                                      : i == 1 ? SB_PRODUCT_IRRADIANCE_GROUND
+                                               : SB_PRODUCT_ORDERS;
+            CHECK(sb_spectral_band_image(&p->images[spectral[i]], base, b, &sky_band_images[b][base]) == SB_OK,
+                  "band %d of %s", b, sb_product_name(spectral[i]));
+        }
+    }
+    sb_spectral_to_rec709(p->scene->atmosphere.solar_irradiance, sky_k);
 }
 
 static void sky_compare_end(void)
 {
     sb_orders_ref_destroy(&sky_orders);
+    for (int b = 0; b < SB_SPECTRAL_BANDS; b++)
+        for (int i = 0; i < SB_PRODUCT_COUNT; i++)
+            sb_image_finish(&sky_band_images[b][i]);
+    sky_bands = 0;
+}
+
+/* Each band's value (band[b]) summed to the frame's colour. */
+static void bands_to_rgb(const double band[SB_SPECTRAL_BANDS][3], double rgb[3])
+{
+    for (int c = 0; c < 3; c++) {
+        rgb[c] = 0;
+        for (int b = 0; b < SB_SPECTRAL_BANDS; b++)
+            for (int j = 0; j < 3; j++)
+                rgb[c] += sky_k[3 * b + j][c] * band[b][j];
+    }
 }
 
 static void sky_reference(void *user, int i)
@@ -1206,6 +1243,16 @@ static void sky_reference(void *user, int i)
     struct sky_case *c = (struct sky_case *)user + i;
     const struct sb_image *lut = sky_pack->images;
     const struct sb_atmosphere_params *p = &sky_pack->scene->atmosphere;
+    if (sky_bands) { /* exact: the orders' sky in the scene's three channels */
+        double band[SB_SPECTRAL_BANDS][3];
+        for (int b = 0; b < sky_bands; b++)
+            sb_orders_product_sky(&sky_band_params[b], sky_orders, &sky_band_images[b][SB_PRODUCT_ORDERS],
+                                  &sky_band_images[b][SB_PRODUCT_TRANSMITTANCE], c->h, c->mu, c->mu_s, c->nu, band[b]);
+        bands_to_rgb(band, c->ref);
+        sb_orders_product_sky(p, sky_orders, &lut[SB_PRODUCT_ORDERS], &lut[SB_PRODUCT_TRANSMITTANCE], c->h, c->mu,
+                              c->mu_s, c->nu, c->exact);
+        return;
+    }
     sb_ref_sky_radiance(p, c->h, c->mu, c->mu_s, c->nu, sky_orders ? &lut[SB_PRODUCT_TRANSMITTANCE] : NULL,
                         &lut[SB_PRODUCT_MULTISCATTERING], &lut[SB_PRODUCT_IRRADIANCE_GROUND], NULL, c->exact);
     if (sky_orders)
@@ -1270,7 +1317,13 @@ static void test_sky_view_of(struct sb_renderer *r, const struct sb_pack *p, dou
            "ref %.6g)\n",
            sun_elevation_deg, worst, nrows * ncols, worst_i % ncols, rows[worst_i / ncols], worst_c,
            cases[worst_i].gpu[worst_c], cases[worst_i].ref[worst_c]);
-    if (orders) {
+    if (sky_bands) {
+        printf("  (at 12 wavelengths: the orders' sky in three channels differs by up to %.3g)\n", lut_effect);
+        CHECK(lut_effect > 3 * tolerance,
+              "the sky at 12 wavelengths differs from three channels' (%.3g) beyond 3 "
+              "times the bound",
+              lut_effect);
+    } else if (orders) {
         printf("  (with the orders: Hillaire's LUTs would move the fp64 sky by up to %.3g)\n", lut_effect);
         CHECK(lut_effect > 3 * tolerance, "the orders' sky differs from Hillaire's (%.3g) beyond 3 times the bound",
               lut_effect);
@@ -1304,16 +1357,15 @@ struct aerial_case {
  * runtime reads it), and multiple scattering from psi_ms, or with the
  * orders from their table, the eye's value less the slice's through the
  * transmittance between (as the runtime takes it). */
-static void aerial_reference(void *user, int i)
+static void aerial_band(const struct sb_atmosphere_params *p, const struct sb_image *lut, const struct aerial_case *c,
+                        double L[3])
 {
-    struct aerial_case *c = (struct aerial_case *)user + i;
-    const struct sb_atmosphere_params *p = &sky_pack->scene->atmosphere;
-    const struct sb_image *lut = sky_pack->images;
-    double R = p->ground_radius_km, r0 = R + c->h, L[3] = {0, 0, 0};
+    double R = p->ground_radius_km, r0 = R + c->h;
     double pr = sb_ref_phase_rayleigh(c->nu), pm = sb_ref_phase_mie(p->mie_g, c->nu);
     enum { PIECES = 32, NODES = 8 };
     double gx[NODES], gw[NODES];
     sb_ref_gauss_legendre(NODES, -1, 1, gx, gw);
+    L[0] = L[1] = L[2] = 0;
     for (int k = 0; k < PIECES; k++) {
         double a = c->t * k / PIECES, b = c->t * (k + 1) / PIECES;
         for (int n = 0; n < NODES; n++) {
@@ -1343,7 +1395,21 @@ static void aerial_reference(void *user, int i)
         for (int ch = 0; ch < 3; ch++)
             L[ch] += fmax(near[ch] - exp(-depth[ch]) * far[ch], 0.0);
     }
-    memcpy(c->ref, L, sizeof(L));
+}
+
+/* The scene's three channels, or with the spectral products each band's
+ * summed to the frame's colour. */
+static void aerial_reference(void *user, int i)
+{
+    struct aerial_case *c = (struct aerial_case *)user + i;
+    if (!sky_bands) {
+        aerial_band(&sky_pack->scene->atmosphere, sky_pack->images, c, c->ref);
+        return;
+    }
+    double band[SB_SPECTRAL_BANDS][3];
+    for (int b = 0; b < sky_bands; b++)
+        aerial_band(&sky_band_params[b], sky_band_images[b], c, band[b]);
+    bands_to_rgb(band, c->ref);
 }
 
 /* The aerial-perspective volume of `r` (rendering pack `p`), columns of
@@ -1399,8 +1465,11 @@ static void test_aerial_of(struct sb_renderer *r, const struct sb_pack *p, doubl
     const struct aerial_case *w = &cases[worst_i];
     printf("aerial perspective, sun at %g deg%s: max rel error %.3g over %d texels (view mu %.3f, %.2f km, "
            "channel %d: gpu %.6g, ref %.6g)\n",
-           sun_elevation_deg, orders ? ", with the orders" : "", worst, NC * NS, w->mu, w->t, worst_c, w->gpu[worst_c],
-           w->ref[worst_c]);
+           sun_elevation_deg,
+           sky_bands ? ", at 12 wavelengths"
+           : orders  ? ", with the orders"
+                     : "",
+           worst, NC * NS, w->mu, w->t, worst_c, w->gpu[worst_c], w->ref[worst_c]);
     CHECK(worst <= tolerance, "aerial perspective with the sun at %g deg within %g of fp64 (max %.3g)%s",
           sun_elevation_deg, tolerance, worst, orders ? ", with the orders" : "");
     sky_compare_end();
@@ -1444,6 +1513,49 @@ static void test_orders_sky(const char *dir)
     }
     sb_renderer_destroy(&r);
     sb_pack_close(&orders_pack);
+}
+
+/* A pack with the spectral products: skyview draws the sky at their 12
+ * wavelengths, band by band (view.glsl), held to the same sky in fp64 (each
+ * band's sky on its own images, through sb_spectral_to_rec709), which
+ * must differ from the three channels' beyond the bound; the frame is
+ * finite. */
+static void test_spectral_sky(const char *dir)
+{
+    char path[300];
+    snprintf(path, sizeof(path), "%s/spectral-pack", dir);
+    struct sb_scene *scene = calloc(1, sizeof(*scene));
+    struct sb_pack spectral_pack = {0};
+    struct sb_bake_report report;
+    const char *json = "{\"atmosphere\":{\"preset\":\"earth\"},\"products\":[\"transmittance\",\"multiscattering\","
+                       "\"irradiance_ground\",\"orders\",\"spectral_orders\"]}";
+    bool ok = scene && sb_scene_parse(json, strlen(json), "spectral scene", scene) == SB_OK &&
+              sb_bake_scene(vk, scene, path, NULL, &report) == SB_OK && sb_pack_open(path, &spectral_pack) == SB_OK;
+    CHECK(ok && spectral_pack.present[SB_PRODUCT_SPECTRAL_TRANSMITTANCE] &&
+              spectral_pack.present[SB_PRODUCT_SPECTRAL_IRRADIANCE_GROUND] &&
+              spectral_pack.present[SB_PRODUCT_SPECTRAL_ORDERS],
+          "a pack with the spectral products (spectral_orders brings the other two)");
+    free(scene);
+    struct sb_renderer *r = NULL;
+    struct sb_renderer_params rp = {.width = W, .height = H, .shadow_size = 1024};
+    if (ok)
+        CHECK(sb_renderer_create(vk, &spectral_pack, &world, &rp, &r) == SB_OK, "a renderer of it");
+    if (r) {
+        test_sky_view_of(r, &spectral_pack, 45.0, 2e-3);
+        test_sky_view_of(r, &spectral_pack, 3.0, 1e-2);
+        test_aerial_of(r, &spectral_pack, 30.0, 1e-2);
+        test_aerial_of(r, &spectral_pack, 3.0, 1e-2);
+        struct sb_view v = base_view();
+        v.sun_elevation = -4.0 * DEG;
+        if (render(r, &v)) {
+            float *rgb = malloc(sizeof(float) * 3 * W * H);
+            sb_renderer_hdr(r, rgb);
+            check_finite(rgb, "the frame at 12 wavelengths");
+            free(rgb);
+        }
+    }
+    sb_renderer_destroy(&r);
+    sb_pack_close(&spectral_pack);
 }
 
 static void test_above_atmosphere(struct sb_renderer *r)
@@ -3021,6 +3133,7 @@ int main(int argc, char **argv)
     }
     sb_renderer_destroy(&r);
     test_orders_sky(dir);
+    test_spectral_sky(dir);
     test_probes(dir);
     test_leak(dir);
     test_reflections(dir, world_path);

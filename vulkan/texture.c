@@ -46,9 +46,9 @@ enum sb_result sb_texture_create(struct sb_vk *vk, const struct sb_texture_param
         goto cleanup;
     VK(vkBindImageMemory(vk->device, t->image, t->memory, 0));
 
-    VkImageViewType whole_type = t->depth > 1    ? VK_IMAGE_VIEW_TYPE_3D
-                                 : t->layers > 1 ? VK_IMAGE_VIEW_TYPE_2D_ARRAY
-                                                 : VK_IMAGE_VIEW_TYPE_2D;
+    VkImageViewType whole_type = t->depth > 1                     ? VK_IMAGE_VIEW_TYPE_3D
+                                 : t->layers > 1 || params->array ? VK_IMAGE_VIEW_TYPE_2D_ARRAY
+                                                                  : VK_IMAGE_VIEW_TYPE_2D;
     VkImageViewCreateInfo view = {
         .sType = VK_STRUCTURE_TYPE_IMAGE_VIEW_CREATE_INFO,
         .image = t->image,

@@ -9,6 +9,7 @@
 #ifndef SB_VK_TEXTURE_H
 #define SB_VK_TEXTURE_H
 
+#include <stdbool.h>
 #include <stdint.h>
 
 #include "context.h"
@@ -19,6 +20,7 @@ struct sb_texture_params {
     uint32_t width, height;
     uint32_t depth;  /* 0 or 1: 2D; more: 3D */
     uint32_t layers; /* 0 or 1: one layer; more: a 2D array */
+    bool array;      /* a 2D array however many layers (a shader's sampler2DArray) */
     uint32_t mips;   /* 0: 1 */
     VkFormat format;
     VkImageUsageFlags usage;

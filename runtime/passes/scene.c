@@ -115,15 +115,21 @@ static enum sb_result create_raster(struct sb_renderer *r, struct scene *s)
     sb_pass_use(r, SB_NO_BINDING, sb_pass_find(r, "depth"), SB_USE_DEPTH_TARGET);
     /* scene.frag's specialization: what the pack and the world hold */
     bool generic = r->params.generic_shaders;
-    const VkBool32 has[5] = {generic || r->probe_count > 0, generic || r->reflection_count > 0,
-                             generic || r->textures.count > 0, generic || r->emissive_count > 0, r->has_orders};
-    VkSpecializationMapEntry entries[5];
-    for (uint32_t i = 0; i < 5; i++) /* the last, every view kernel's: the orders (pass.c) */
-        entries[i] = (VkSpecializationMapEntry){.constantID = i < 4 ? i : SB_VIEW_CONSTANT_ORDERS,
+    const VkBool32 has[6] = {generic || r->probe_count > 0,
+                             generic || r->reflection_count > 0,
+                             generic || r->textures.count > 0,
+                             generic || r->emissive_count > 0,
+                             r->constants.orders,
+                             r->constants.bands};
+    VkSpecializationMapEntry entries[6];
+    for (uint32_t i = 0; i < 6; i++) /* the last two, every view kernel's: the orders, the bands (pass.c) */
+        entries[i] = (VkSpecializationMapEntry){.constantID = i < 4    ? i
+                                                              : i == 4 ? SB_VIEW_CONSTANT_ORDERS
+                                                                       : SB_VIEW_CONSTANT_BANDS,
                                                 .offset = i * sizeof(VkBool32),
                                                 .size = sizeof(VkBool32)};
     const VkSpecializationInfo specialization = {
-        .mapEntryCount = 5, .pMapEntries = entries, .dataSize = sizeof(has), .pData = has};
+        .mapEntryCount = 6, .pMapEntries = entries, .dataSize = sizeof(has), .pData = has};
     struct sb_graphics_pipeline_params params = {
         .fragment_specialization = &specialization,
         .vertex_spirv = r->draw_group_count ? sb_spv_scene_vert_instanced : sb_spv_scene_vert,

@@ -21,9 +21,22 @@
 
 const float PI = 3.14159265358979;
 
+#ifdef SB_ATMOSPHERE_TEXTURES
+/* skyview's: the scene's three channels in layer 0 and, with the spectral
+ * products, band b's three wavelengths in layer 1 + b, of the parameters
+ * and of the transmittance's and the ground irradiance's textures (view.glsl
+ * draws the sky band by band: sky_radiance_rgb). A kernel that never sets
+ * atm_band reads layer 0, as it did before. */
+layout(std430, set = 0, binding = SB_BINDING_ATMOSPHERE) readonly buffer AtmosphereBuffer {
+    sb_atmosphere_gpu atm_layers[];
+};
+int atm_band = 0;
+#define atm atm_layers[atm_band]
+#else
 layout(std430, set = 0, binding = SB_BINDING_ATMOSPHERE) readonly buffer AtmosphereBuffer {
     sb_atmosphere_gpu atm;
 };
+#endif
 /*
  * The bakes read the transmittance LUT and the lookup forms of
  * multiscattering and irradiance_ground (config.h) from storage buffers.
@@ -41,7 +54,7 @@ layout(std430, set = 0, binding = SB_BINDING_ATMOSPHERE) readonly buffer Atmosph
 #ifndef SB_MULTISCATTERING_REFINED
 #error "the refined psi_ms is the only form bound as a texture"
 #endif
-layout(set = 0, binding = SB_BINDING_TRANSMITTANCE) uniform sampler2D transmittance_texture;
+layout(set = 0, binding = SB_BINDING_TRANSMITTANCE) uniform sampler2DArray transmittance_texture;
 layout(set = 0, binding = SB_BINDING_MULTISCATTERING) uniform sampler2D multiscattering_texture;
 #else
 layout(std430, set = 0, binding = SB_BINDING_TRANSMITTANCE) readonly buffer TransmittanceBuffer {
@@ -63,7 +76,7 @@ shared vec4 multiscattering_shared[SB_MULTISCATTERING_LOOKUP_TEXELS];
 #define SB_MULTISCATTERING_LOG(k) multiscattering_log[k].rgb
 #endif
 #ifdef SB_ATMOSPHERE_TEXTURES
-layout(set = 0, binding = SB_BINDING_IRRADIANCE_GROUND) uniform sampler2D ground_irradiance_texture;
+layout(set = 0, binding = SB_BINDING_IRRADIANCE_GROUND) uniform sampler2DArray ground_irradiance_texture;
 #else
 layout(std430, set = 0, binding = SB_BINDING_IRRADIANCE_GROUND) readonly buffer IrradianceGroundBuffer {
     float ground_irradiance_log[];
@@ -518,7 +531,7 @@ vec3 transmittance_to_top(float h, float mu)
 vec3 transmittance_depth_texel(int x, int y)
 {
 #ifdef SB_ATMOSPHERE_TEXTURES
-    return texelFetch(transmittance_texture, ivec2(x, y), 0).rgb;
+    return texelFetch(transmittance_texture, ivec3(x, y, atm_band), 0).rgb;
 #else
     int k = (y * SB_TRANSMITTANCE_WIDTH + x) * 3;
     return vec3(transmittance_lut[k], transmittance_lut[k + 1], transmittance_lut[k + 2]);
@@ -633,7 +646,7 @@ vec3 ground_irradiance_row(int row, float mu_s)
     vec3 sum = vec3(0.0);
     for (int i = 0; i < 4; i++) {
 #ifdef SB_ATMOSPHERE_TEXTURES
-        sum += w[i] * texelFetch(ground_irradiance_texture, ivec2(clamp(x0 + i, 0, n - 1), row), 0).rgb;
+        sum += w[i] * texelFetch(ground_irradiance_texture, ivec3(clamp(x0 + i, 0, n - 1), row, atm_band), 0).rgb;
 #else
         int k = (row * n + clamp(x0 + i, 0, n - 1)) * 3;
         sum += w[i] * vec3(ground_irradiance_log[k], ground_irradiance_log[k + 1], ground_irradiance_log[k + 2]);

@@ -51,28 +51,41 @@ void aerial_perspective(vec2 uv, vec3 offset, out vec3 inscatter, out vec3 trans
     float r0 = length(p0);
     float h0 = max(r0 - ground_radius(), 0.0);
     float mu = dot(p0, d) / r0;
-    vec3 l = frame.sun_direction.xyz;
-    float mu_s = dot(p0, l) / r0, nu = dot(d, l);
+    /* with the spectral products, band by band (view.glsl) */
+    const int bands = SB_VIEW_BANDS ? SB_SPECTRAL_BANDS : 1;
     bool ms = !orders_present(); /* else orders 2 and up from the orders product */
-    RayIntegrals ri = ray_integrals_begin();
-    integrate_ray_to(ri, h0, mu, mu_s, nu, d_km - entry, ms);
-    vec3 L = atm.solar_irradiance.rgb * (ri.sun_rayleigh * phase_rayleigh(nu) + ri.sun_mie * phase_mie(nu)) +
-             ri.ms_rayleigh + ri.ms_mie;
-    if (!ms)
-        L += orders_between(orders_eye(h0, mu, mu_s, nu), h0, mu, mu_s, nu, d_km - entry, ri.transmittance);
-    transmittance = ri.transmittance;
-    for (int i = 0; i < moon_lights(); i++) {
-        l = frame.moon_direction.xyz;
-        mu_s = dot(p0, l) / r0;
-        nu = dot(d, l);
-        ri = ray_integrals_begin();
+    vec3 L = vec3(0.0), L_moon = vec3(0.0), band_t[SB_SPECTRAL_BANDS];
+    for (int b = 0; b < bands; b++) {
+        atm_band = SB_VIEW_BANDS ? 1 + b : 0;
+        vec3 l = frame.sun_direction.xyz;
+        float mu_s = dot(p0, l) / r0, nu = dot(d, l);
+        RayIntegrals ri = ray_integrals_begin();
         integrate_ray_to(ri, h0, mu, mu_s, nu, d_km - entry, ms);
-        vec3 Lm = atm.solar_irradiance.rgb * (ri.sun_rayleigh * phase_rayleigh(nu) + ri.sun_mie * phase_mie(nu)) +
+        vec3 Lb = atm.solar_irradiance.rgb * (ri.sun_rayleigh * phase_rayleigh(nu) + ri.sun_mie * phase_mie(nu)) +
                   ri.ms_rayleigh + ri.ms_mie;
         if (!ms)
-            Lm += orders_between(orders_eye(h0, mu, mu_s, nu), h0, mu, mu_s, nu, d_km - entry, ri.transmittance);
-        L += Lm * frame.moon_light.rgb;
+            Lb += orders_between(orders_eye(h0, mu, mu_s, nu), h0, mu, mu_s, nu, d_km - entry, ri.transmittance);
+        band_t[b] = ri.transmittance;
+        for (int i = 0; i < moon_lights(); i++) {
+            l = frame.moon_direction.xyz;
+            mu_s = dot(p0, l) / r0;
+            nu = dot(d, l);
+            ri = ray_integrals_begin();
+            integrate_ray_to(ri, h0, mu, mu_s, nu, d_km - entry, ms);
+            vec3 Lm = atm.solar_irradiance.rgb * (ri.sun_rayleigh * phase_rayleigh(nu) + ri.sun_mie * phase_mie(nu)) +
+                      ri.ms_rayleigh + ri.ms_mie;
+            if (!ms)
+                Lm += orders_between(orders_eye(h0, mu, mu_s, nu), h0, mu, mu_s, nu, d_km - entry, ri.transmittance);
+            if (SB_VIEW_BANDS)
+                L_moon += band_to_rgb(b) * Lm;
+            else
+                Lb += Lm * frame.moon_light.rgb;
+        }
+        L += SB_VIEW_BANDS ? band_to_rgb(b) * Lb : Lb;
     }
+    atm_band = 0;
+    L += frame.moon_light.rgb * L_moon;
+    transmittance = SB_VIEW_BANDS ? bands_transmittance_rgb(band_t) : band_t[0];
     inscatter = L * frame.aerial.y;
 #endif
 }

@@ -40,8 +40,8 @@
 #define SB_CLOUD_LAYER_GLSL
 
 #include "clouds_gpu.h"
+#include "view.glsl" /* before phase.glsl: its atmosphere.glsl is skyview's */
 #include "phase.glsl"
-#include "view.glsl"
 #include "view_gpu.h"
 
 layout(std430, set = 0, binding = SB_VIEW_BINDING_CLOUDS) readonly buffer CloudBuffer {
@@ -157,7 +157,7 @@ float cloud_light_depth(vec3 q, vec3 l, float h_km, float mu_s, int steps, float
 vec3 cloud_light(vec3 q, vec3 up, vec3 l, vec3 key, float h_km, float f, float nu, int light_steps, float jitter)
 {
     float mu_s = dot(up, l);
-    vec3 sun = key * sun_transmittance(h_km, mu_s);
+    vec3 sun = key * sun_transmittance_rgb(h_km, mu_s);
     float octaves = 0.0;
     if (max(sun.r, max(sun.g, sun.b)) > 0.0) {
         float tau = cloud_light_depth(q, l, h_km, mu_s, light_steps, jitter);

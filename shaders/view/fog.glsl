@@ -19,8 +19,8 @@
 #define SB_FOG_GLSL
 
 #include "fog_gpu.h"
+#include "view.glsl" /* before phase.glsl: its atmosphere.glsl is skyview's */
 #include "phase.glsl"
-#include "view.glsl"
 #include "view_gpu.h"
 
 layout(std430, set = 0, binding = SB_VIEW_BINDING_FOG) readonly buffer FogBuffer {
@@ -80,7 +80,7 @@ void fog_light(vec3 offset, vec3 p, out vec3 sun, out vec3 ambient)
     float h = max(r - ground_radius(), 0.0);
     float mu_s = dot(up, key_direction());
     float tau_sun = height_fog_extinction(p.y) / (fog.medium.z * max(mu_s, 1e-4)); /* H >= 1 m: z > 0 */
-    sun = atm.solar_irradiance.rgb * key_color() * sun_transmittance(h, mu_s) * (exp(-tau_sun) * frame.aerial.y);
+    sun = atm.solar_irradiance.rgb * key_color() * sun_transmittance_rgb(h, mu_s) * (exp(-tau_sun) * frame.aerial.y);
     vec3 e_up, e_down;
     sky_irradiance(up, e_up, e_down);
 #ifdef SB_FOG_PROBES

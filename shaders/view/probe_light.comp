@@ -53,7 +53,7 @@ void main()
     for (int k = 0; k < SB_PROBE_SH; k++)
         v_sun += v[k] * ys[k];
     v_sun = clamp(v_sun, 0.0, 1.0);
-    vec3 e_sun = atm.solar_irradiance.rgb * key_color() * sun_transmittance(0.0, dot(up, l));
+    vec3 e_sun = atm.solar_irradiance.rgb * key_color() * sun_transmittance_rgb(0.0, dot(up, l));
     const float Y0 = 0.28209479177387814;
     vec3 e_mean = PI * vl[0] * Y0 + e_sun * (0.25 * v_sun);
     float hit = clamp(1.0 - v[0] * Y0, 0.0, 1.0); /* the hit fraction: 1 - V's mean */

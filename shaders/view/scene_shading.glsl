@@ -88,7 +88,7 @@ vec4 scene_shade(vec3 offset, vec3 n, vec3 ng, vec3 albedo, vec2 metallic_roughn
     vec3 F = f0 + (1.0 - f0) * pow(max(1.0 - l_dot_h, 0.0), 5.0); /* pow of a negative is undefined */
     vec3 brdf = diffuse_color / PI + D * V * F;
 
-    vec3 e_sun = atm.solar_irradiance.rgb * key_color() * sun_transmittance(h, mu_s);
+    vec3 e_sun = atm.solar_irradiance.rgb * key_color() * sun_transmittance_rgb(h, mu_s);
     float clouds_t = cloud_sun_transmittance(offset + frame.camera_m.xyz);
     if (frame.size.w == SB_DEBUG_CLOUD_SHADOW)
         return vec4(vec3(clouds_t * frame.aerial.y), 1.0); /* read back divided by the scale */

@@ -42,7 +42,7 @@ void main()
         for (int i = 0; i < moon_lights(); i++)
             L += textureLod(sky_view, vec3(sky_view_uv_toward(d, frame.moon_direction.xyz), 1.0), 0.0).rgb;
         if (!ray_hits_ground(h, mu))
-            view_t = transmittance_lut_sample(h, mu);
+            view_t = transmittance_rgb(h, mu);
     }
 #else
     {
@@ -55,10 +55,10 @@ void main()
             for (int i = 0; i < sky_light_count(); i++) {
                 vec3 l = light_direction(i);
                 float mu_s = clamp(dot(p0, l) / r0, -1.0, 1.0);
-                L += sky_radiance(h0, mu, mu_s, clamp(dot(d, l), -1.0, 1.0)) * light_color(i) * frame.aerial.y;
+                L += sky_radiance_rgb(h0, mu, mu_s, clamp(dot(d, l), -1.0, 1.0)) * light_color(i) * frame.aerial.y;
             }
             if (!ray_hits_ground(h0, mu))
-                view_t = transmittance_lut_sample(h0, mu);
+                view_t = transmittance_rgb(h0, mu);
         } else {
             view_t = vec3(1.0);
         }

@@ -24,7 +24,7 @@ vec3 sky_light_radiance(vec3 d)
             L += textureLod(sky_view, vec3(sky_view_uv_toward(d, l), float(i)), 0.0).rgb / frame.aerial.y;
         } else {
             float mu = clamp(dot(up, d), -1.0, 1.0), mu_s = clamp(dot(up, l), -1.0, 1.0);
-            L += sky_radiance(0.0, mu, mu_s, clamp(dot(d, l), -1.0, 1.0)) * light_color(i);
+            L += sky_radiance_rgb(0.0, mu, mu_s, clamp(dot(d, l), -1.0, 1.0)) * light_color(i);
         }
     }
     return L;

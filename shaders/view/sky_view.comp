@@ -26,6 +26,6 @@ void main()
     float mu_s = clamp(dot(up, light_direction(light)), -1.0, 1.0);
     float sin_v = sin(angles.y), sin_s = sqrt(max(1.0 - mu_s * mu_s, 0.0));
     float nu = clamp(mu * mu_s + sin_v * sin_s * cos(angles.x), -1.0, 1.0);
-    vec3 L = sky_radiance(h, mu, mu_s, nu) * light_color(light) * frame.aerial.y;
+    vec3 L = sky_radiance_rgb(h, mu, mu_s, nu) * light_color(light) * frame.aerial.y;
     imageStore(sky_view_out, ivec3(texel, light), vec4(fp16_safe(L), 1.0));
 }

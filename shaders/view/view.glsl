@@ -20,6 +20,9 @@
  * every kernel): orders 2 and up come from it, not from psi_ms. */
 layout(constant_id = SB_VIEW_CONSTANT_ORDERS) const bool SB_VIEW_ORDERS = false;
 bool orders_present() { return SB_VIEW_ORDERS; }
+/* True when it has the spectral products too (they come with the orders):
+ * the sky is drawn at their 12 wavelengths (sky_radiance_rgb). */
+layout(constant_id = SB_VIEW_CONSTANT_BANDS) const bool SB_VIEW_BANDS = false;
 
 #include "sky_radiance.glsl"
 
@@ -33,12 +36,12 @@ bool orders_present() { return SB_VIEW_ORDERS; }
 #define SB_ORDERS_GRID_MU_S frame.orders_mu_s
 #include "orders.glsl"
 
-layout(set = 0, binding = SB_VIEW_BINDING_ORDERS) uniform sampler2D orders_texture;
+layout(set = 0, binding = SB_VIEW_BINDING_ORDERS) uniform sampler2DArray orders_texture;
 
 vec3 orders_texel(uint i)
 {
     uint w = SB_ORDERS_GRID_SIZE.z * SB_ORDERS_GRID_SIZE.w;
-    return texelFetch(orders_texture, ivec2(int(i % w), int(i / w)), 0).rgb;
+    return texelFetch(orders_texture, ivec3(int(i % w), int(i / w), atm_band), 0).rgb;
 }
 
 /* The same multilinear read with the sampler's bilinear filter doing mu and
@@ -49,14 +52,15 @@ vec3 orders_sky(float h, float mu, float mu_s, float nu, bool ground)
 {
     OrdersCell c = orders_cell(h, mu, mu_s, nu, ground);
     uvec4 s = SB_ORDERS_GRID_SIZE, n = orders_node(c.base);
-    vec2 texel = 1.0 / vec2(textureSize(orders_texture, 0));
+    vec2 texel = 1.0 / vec2(textureSize(orders_texture, 0).xy);
     float x = float(n.z * s.w + n.w) + c.a.z + 0.5, y = float(n.x * s.y + n.y) + c.a.y + 0.5;
     vec2 step_s = vec2(float(s.w), 0.0), step_r = vec2(0.0, float(s.y));
     vec2 p = vec2(x, y);
-    vec3 v0 = mix(textureLod(orders_texture, p * texel, 0.0).rgb,
-                  textureLod(orders_texture, (p + step_r) * texel, 0.0).rgb, c.a.x);
-    vec3 v1 = mix(textureLod(orders_texture, (p + step_s) * texel, 0.0).rgb,
-                  textureLod(orders_texture, (p + step_s + step_r) * texel, 0.0).rgb, c.a.x);
+    float layer = float(atm_band);
+    vec3 v0 = mix(textureLod(orders_texture, vec3(p * texel, layer), 0.0).rgb,
+                  textureLod(orders_texture, vec3((p + step_r) * texel, layer), 0.0).rgb, c.a.x);
+    vec3 v1 = mix(textureLod(orders_texture, vec3((p + step_s) * texel, layer), 0.0).rgb,
+                  textureLod(orders_texture, vec3((p + step_s + step_r) * texel, layer), 0.0).rgb, c.a.x);
     return orders_blend_mu_s(v0, v1, c.as, c.twilight);
 }
 
@@ -82,6 +86,72 @@ vec3 orders_between(vec3 at_eye, float h, float mu, float mu_s, float nu, float 
     float r0 = ground_radius() + h, h1 = altitude_along(h, mu, t), r1 = ground_radius() + h1;
     float mu1 = clamp((r0 * mu + t) / r1, -1.0, 1.0), mu_s1 = clamp((r0 * mu_s + t * nu) / r1, -1.0, 1.0);
     return max(at_eye - t_to * orders_sky(h1, mu1, mu_s1, nu, ray_hits_ground(h, mu)), vec3(0.0));
+}
+
+/* ---- The sky at 12 wavelengths (the spectral products) ----------------------- */
+/* Band b's (0 to 3) three wavelengths to linear Rec.709 (the frame's
+ * spectral_rgb): a band's radiance, computed as a scene's three channels
+ * are, adds M L to the colour. */
+mat3 band_to_rgb(int b)
+{
+    return mat3(frame.spectral_rgb[3 * b].rgb, frame.spectral_rgb[3 * b + 1].rgb, frame.spectral_rgb[3 * b + 2].rgb);
+}
+
+/* sky_radiance as the frame shows it, linear Rec.709 in the scene's units:
+ * the scene's three channels, or with the spectral products each band's
+ * sky (its medium, transmittance, ground and orders: layer 1 + b) summed
+ * through band_to_rgb. */
+vec3 sky_radiance_rgb(float h, float mu, float mu_s, float nu)
+{
+    if (!SB_VIEW_BANDS)
+        return sky_radiance(h, mu, mu_s, nu);
+    vec3 L = vec3(0.0);
+    for (int b = 0; b < SB_SPECTRAL_BANDS; b++) {
+        atm_band = 1 + b;
+        L += band_to_rgb(b) * sky_radiance(h, mu, mu_s, nu);
+    }
+    atm_band = 0;
+    return L;
+}
+
+/* A transmittance as a colour: what white light (the scene's sun) keeps of
+ * each channel, given T at each band (band_t[b], layer 1 + b's): the sun's
+ * spectrum through the bands, read as Rec.709, over the sun's colour. */
+vec3 bands_transmittance_rgb(vec3 band_t[SB_SPECTRAL_BANDS])
+{
+    vec3 rgb = vec3(0.0);
+    for (int b = 0; b < SB_SPECTRAL_BANDS; b++)
+        rgb += band_to_rgb(b) * (band_t[b] * atm_layers[1 + b].solar_irradiance.rgb);
+    return rgb / max(atm_layers[0].solar_irradiance.rgb, vec3(1e-30));
+}
+
+/* The transmittance LUT read as the frame shows it (as sky_radiance_rgb). */
+vec3 transmittance_rgb(float h, float mu)
+{
+    if (!SB_VIEW_BANDS)
+        return transmittance_lut_sample(h, mu);
+    vec3 band_t[SB_SPECTRAL_BANDS];
+    for (int b = 0; b < SB_SPECTRAL_BANDS; b++) {
+        atm_band = 1 + b;
+        band_t[b] = transmittance_lut_sample(h, mu);
+    }
+    atm_band = 0;
+    return bands_transmittance_rgb(band_t);
+}
+
+/* The sun's transmittance to altitude h (cosine mu_s), as the frame shows
+ * it: what lights the world, the fog and the clouds. */
+vec3 sun_transmittance_rgb(float h, float mu_s)
+{
+    if (!SB_VIEW_BANDS)
+        return sun_transmittance(h, mu_s);
+    vec3 band_t[SB_SPECTRAL_BANDS];
+    for (int b = 0; b < SB_SPECTRAL_BANDS; b++) {
+        atm_band = 1 + b;
+        band_t[b] = sun_transmittance(h, mu_s);
+    }
+    atm_band = 0;
+    return bands_transmittance_rgb(band_t);
 }
 
 layout(push_constant) uniform ViewPush {
