@@ -78,8 +78,8 @@ enum sb_sky_error_scheme {
     SB_SKY_ERROR_TRACED_PRIMARIES, /* the three-channel path tracer's, as primaries */
     SB_SKY_ERROR_TRACED_CONVERTED, /* the three-channel path tracer's, converted */
     /* The spectral trace itself read at 6 of its wavelengths (evenly spread
-     * from 380 to 810 nm) or at the spectral products' 12 (380 to 820 nm
-     * every 40), linear between them and flat beyond: the error of a
+     * from 380 to 810 nm) or at the spectral products' 12 (400 to 670 nm,
+     * sb_spectral_nm), linear between them and flat beyond: the error of a
      * runtime of that many wavelengths whose light were exact */
     SB_SKY_ERROR_WAVELENGTHS_6,
     SB_SKY_ERROR_WAVELENGTHS_12,

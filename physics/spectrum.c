@@ -288,9 +288,14 @@ void sb_channels_to_rec709(const double solar_rgb[3], double m[3][3])
             m[r][c] *= solar_rgb[c] > 0.0 ? solar_rgb[r] / solar_rgb[c] : 0.0;
 }
 
+/* Dense (20 nm) where the observer's functions and the twilight's spectrum
+ * (ozone's Chappuis band) change most, 30 to 40 nm at the ends: chosen by
+ * measurement (tests/test_wavelengths.c). */
+static const double spectral_nm[SB_SPECTRAL_WAVELENGTHS] = {400, 430, 460, 480, 500, 520, 540, 560, 580, 600, 630, 670};
+
 double sb_spectral_nm(int i)
 {
-    return 380.0 + 40.0 * i;
+    return spectral_nm[i];
 }
 
 void sb_spectral_band(const struct sb_atmosphere_params *p, int band, struct sb_atmosphere_params *out)

@@ -80,14 +80,15 @@ void sb_sun_xyz_to_rec709(const double solar_rgb[3], double m[3][3]);
 void sb_channels_to_rec709(const double solar_rgb[3], double m[3][3]);
 
 /*
- * The sky at 12 wavelengths (the spectral products, docs/pack.md): 380 to
- * 820 nm every 40 nm, in SB_SPECTRAL_BANDS bands of three, band b's channel
- * c wavelength 3 b + c; each band a scene of its own (the rules above), so
- * every three-channel kernel bakes and draws it unchanged.
+ * The sky at 12 wavelengths (the spectral products, docs/pack.md): 400,
+ * 430, 460, then every 20 nm to 600, 630 and 670 nm, in SB_SPECTRAL_BANDS
+ * bands of three, band b's channel c wavelength 3 b + c; each band a scene
+ * of its own (the rules above), so every three-channel kernel bakes and
+ * draws it unchanged.
  */
 #define SB_SPECTRAL_WAVELENGTHS (3 * SB_SPECTRAL_BANDS)
 
-/* Wavelength i of the 12, nm. */
+/* Wavelength i of the 12, nm (ascending, on the spectral grid). */
 double sb_spectral_nm(int i);
 
 /* The scene's atmosphere at band b's three wavelengths. */

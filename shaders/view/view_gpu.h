@@ -46,10 +46,10 @@
                                                distance from the camera (m) */
 #define SB_VIEW_BINDING_SCENE_HISTORY 61    /* struct sb_scene_history_gpu */
 #define SB_VIEW_BINDING_KEY_LIGHT 65        /* image2D rgba16f: the raster scene's key light direct share a pixel */
-#define SB_VIEW_BINDING_ORDERS 66           /* sampler2DArray (linear): the orders product (config.h), its image's texels as
-                                               RGBA32F, filtered in mu and nu (view.glsl); a layer for the scene's
-                                               channels, and with the spectral products one a band; a 1 x 1 stand-in
-                                               without it */
+#define SB_VIEW_BINDING_ORDERS 66           /* sampler2DArray (linear): the orders product (config.h), its image's
+                                               texels as RGBA32F, filtered in mu and nu (view.glsl); a layer for the
+                                               scene's channels, and with the spectral products one a band; a 1 x 1
+                                               stand-in without it */
 /* The specialization constants every view kernel takes (runtime/pass.c):
  * true when the pack has the orders product, which then gives orders 2
  * and up instead of Hillaire's psi_ms (view.glsl); true when it has the
@@ -199,8 +199,9 @@ struct sb_frame_gpu {
     SB_UVEC4(orders_size);     /* the orders product's grid (config.h's sb_orders_push: size, heights, */
     SB_VEC4(orders_heights);   /* mu_s); zeros when the pack has none */
     SB_VEC4(orders_mu_s);
-    SB_VEC4(spectral_rgb[3 * SB_SPECTRAL_BANDS]); /* rgb: wavelength i of the spectral products' 12 to linear Rec.709 under the
-                                  scene's sun (physics/spectrum.h's sb_spectral_to_rec709); zeros without them */
+    /* rgb: wavelength i of the spectral products' 12 to linear Rec.709 under the scene's sun
+     * (physics/spectrum.h's sb_spectral_to_rec709); zeros without them */
+    SB_VEC4(spectral_rgb[3 * SB_SPECTRAL_BANDS]);
 };
 
 /* What exposure.comp keeps between frames, after the histogram's bins. */
