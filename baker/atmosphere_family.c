@@ -145,11 +145,40 @@ static int orders_suns(const struct sb_scene *scene, double suns[4])
     return 4;
 }
 
-static void orders_key(const struct sb_scene *scene, struct sb_key_text *key)
+/* The orders' grid and their stopping rule, for a key. */
+static void orders_grid_key(struct sb_key_text *key)
 {
     struct sb_orders_settings s = sb_orders_settings_resolve(&sb_orders_product_grid);
-    char code[SB_HASH_HEX_SIZE];
     sb_key_add(key, " grid %dx%dx%dx%d orders %d until %a", s.r, s.mu, s.mu_s, s.nu, s.max_order, s.tolerance);
+}
+
+static void orders_code_key(struct sb_key_text *key)
+{
+    char code[SB_HASH_HEX_SIZE];
+    sb_orders_code_hash(code);
+    sb_key_add(key, " code %s", code);
+}
+
+/* What the artifact's settings say of an orders bake, after `first` (the
+ * object's opening fields, "{" for none); the grid's altitude ratio where
+ * it is not NAN. */
+static void orders_settings(struct sb_artifact *a, const char *first, const struct sb_orders_result *r,
+                            double height_ratio)
+{
+    struct sb_orders_settings s = sb_orders_settings_resolve(&sb_orders_product_grid);
+    int n = snprintf(a->settings_json, sizeof(a->settings_json), "%s\"r\":%d,\"mu\":%d,\"mu_s\":%d,\"nu\":%d", first,
+                     s.r, s.mu, s.mu_s, s.nu);
+    if (!isnan(height_ratio) && n > 0 && (size_t)n < sizeof(a->settings_json))
+        n += snprintf(a->settings_json + n, sizeof(a->settings_json) - (size_t)n, ",\"height_ratio\":%.17g",
+                      height_ratio);
+    if (n > 0 && (size_t)n < sizeof(a->settings_json))
+        snprintf(a->settings_json + n, sizeof(a->settings_json) - (size_t)n,
+                 ",\"orders\":%d,\"last_share\":%.6g,\"until\":%.17g}", r->orders, r->last_share, s.tolerance);
+}
+
+static void orders_key(const struct sb_scene *scene, struct sb_key_text *key)
+{
+    orders_grid_key(key);
     if (scene->tolerance[SB_PRODUCT_ORDERS] > 0) {
         double suns[4];
         int n = orders_suns(scene, suns);
@@ -157,8 +186,7 @@ static void orders_key(const struct sb_scene *scene, struct sb_key_text *key)
         for (int i = 0; i < n; i++)
             sb_key_add(key, " sun %a", suns[i]);
     }
-    sb_orders_code_hash(code);
-    sb_key_add(key, " code %s", code);
+    orders_code_key(key);
 }
 
 /*
@@ -176,11 +204,7 @@ static enum sb_result orders_bake(struct sb_atmosphere_baker *baker, struct sb_v
         return res;
     a->gpu_ms = r.gpu_ms;
     struct sb_orders_settings s = sb_orders_settings_resolve(&sb_orders_product_grid);
-    snprintf(a->settings_json, sizeof(a->settings_json),
-             "{\"r\":%d,\"mu\":%d,\"mu_s\":%d,\"nu\":%d,\"height_ratio\":%.17g,\"orders\":%d,\"last_share\":%.6g,"
-             "\"until\":%.17g}",
-             s.r, s.mu, s.mu_s, s.nu, sb_orders_height_ratio(&scene->atmosphere, s.r), r.orders, r.last_share,
-             s.tolerance);
+    orders_settings(a, "{", &r, sb_orders_height_ratio(&scene->atmosphere, s.r));
     double tolerance = scene->tolerance[SB_PRODUCT_ORDERS];
     if (tolerance <= 0)
         return SB_OK;
@@ -213,14 +237,12 @@ static void spectral_key(const struct sb_scene *scene, enum sb_product_id id, st
         sb_spectral_band(&scene->atmosphere, b, &band);
         sb_key_add(key, " band %d at %a %a %a nm", b, sb_spectral_nm(3 * b), sb_spectral_nm(3 * b + 1),
                    sb_spectral_nm(3 * b + 2));
-        key_params(SB_PRODUCT_IRRADIANCE_SKY, &band, key);
+        key_params(base, &band, key);
     }
     char settings[1024], code[SB_HASH_HEX_SIZE];
     if (base == SB_PRODUCT_ORDERS) {
-        struct sb_orders_settings s = sb_orders_settings_resolve(&sb_orders_product_grid);
-        sb_key_add(key, " grid %dx%dx%dx%d orders %d until %a", s.r, s.mu, s.mu_s, s.nu, s.max_order, s.tolerance);
-        sb_orders_code_hash(code);
-        sb_key_add(key, " code %s", code);
+        orders_grid_key(key);
+        orders_code_key(key);
     }
     /* the LUTs each band's bake of `base` reads, and its own */
     for (enum sb_product_id p = SB_PRODUCT_TRANSMITTANCE; p <= SB_PRODUCT_IRRADIANCE_GROUND && p <= base; p++) {
@@ -287,16 +309,16 @@ static enum sb_result spectral_bake(struct atmosphere_state *state, struct sb_vk
     struct sb_orders_result orders;
     if ((res = sb_spectral_bake(state->spectral, id, image, &a->gpu_ms, &orders)))
         return res;
-    char nm[128] = "";
-    for (int i = 0, n = 0; i < SB_SPECTRAL_WAVELENGTHS; i++)
-        n += snprintf(nm + n, sizeof(nm) - (size_t)n, "%s%g", i ? "," : "", sb_spectral_nm(i));
-    snprintf(a->settings_json, sizeof(a->settings_json), "{\"bands\":%d,\"nm\":[%s]}", SB_SPECTRAL_BANDS, nm);
+    char head[160];
+    int n = snprintf(head, sizeof(head), "{\"bands\":%d,\"nm\":[", SB_SPECTRAL_BANDS);
+    for (int i = 0; i < SB_SPECTRAL_WAVELENGTHS; i++)
+        n += snprintf(head + n, sizeof(head) - (size_t)n, "%s%g", i ? "," : "", sb_spectral_nm(i));
+    snprintf(head + n, sizeof(head) - (size_t)n, "]");
     if (sb_spectral_base(id) == SB_PRODUCT_ORDERS) {
-        struct sb_orders_settings s = sb_orders_settings_resolve(&sb_orders_product_grid);
-        sb_settings_json_add(a->settings_json, sizeof(a->settings_json),
-                             ",\"r\":%d,\"mu\":%d,\"mu_s\":%d,\"nu\":%d,\"orders\":%d,\"last_share\":%.6g,"
-                             "\"until\":%.17g",
-                             s.r, s.mu, s.mu_s, s.nu, orders.orders, orders.last_share, s.tolerance);
+        strncat(head, ",", sizeof(head) - strlen(head) - 1);
+        orders_settings(a, head, &orders, NAN);
+    } else {
+        snprintf(a->settings_json, sizeof(a->settings_json), "%s}", head);
     }
     return SB_OK;
 }

@@ -112,6 +112,10 @@ enum sb_result sb_spectral_bake(struct sb_spectral *s, enum sb_product_id id, st
     const struct sb_image *bands[SB_SPECTRAL_BANDS];
     for (int b = 0; b < SB_SPECTRAL_BANDS && !res; b++)
         res = sb_spectral_band_lut(s, b, base, &bands[b], &ms);
+    for (int b = 0; b < SB_SPECTRAL_BANDS && !res; b++)
+        if (bands[b]->width != f->width || bands[b]->height != f->height ||
+            bands[b]->channel_count * SB_SPECTRAL_BANDS != f->channel_count)
+            res = SB_ERR_USAGE; /* products.def's rows and the three-channel bakes disagree */
     if (!res)
         res = sb_image_init(image, f->width, f->height, f->channel_count);
     if (res)

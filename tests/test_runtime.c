@@ -1476,86 +1476,58 @@ static void test_aerial_of(struct sb_renderer *r, const struct sb_pack *p, doubl
     free(volume);
 }
 
-/* A pack with the orders product: skyview's sky-view LUT takes orders 2
- * and up from it (view.glsl), against the same sky in fp64 on the same
- * table; the frame is finite. */
-static void test_orders_sky(const char *dir)
+/* A pack of the earth with `products` (a JSON array's items), `present`
+ * among them: skyview's sky-view LUT and aerial perspective against the
+ * same sky in fp64 (test_sky_view_of, test_aerial_of: the bounds of
+ * Hillaire's sky above), and its frame at a sun of `frame_sun` degrees
+ * finite. */
+static void test_pack_sky(const char *dir, const char *what, const char *products, enum sb_product_id present,
+                          double frame_sun)
 {
-    char path[300];
-    snprintf(path, sizeof(path), "%s/orders-pack", dir);
+    char path[300], json[512];
+    snprintf(path, sizeof(path), "%s/%s-pack", dir, sb_product_name(present));
+    snprintf(json, sizeof(json), "{\"atmosphere\":{\"preset\":\"earth\"},\"products\":[%s]}", products);
     struct sb_scene *scene = calloc(1, sizeof(*scene));
-    struct sb_pack orders_pack = {0};
+    struct sb_pack sky_of_pack = {0};
     struct sb_bake_report report;
-    const char *json = "{\"atmosphere\":{\"preset\":\"earth\"},\"products\":[\"transmittance\",\"multiscattering\","
-                       "\"irradiance_ground\",\"orders\"]}";
-    bool ok = scene && sb_scene_parse(json, strlen(json), "orders scene", scene) == SB_OK &&
-              sb_bake_scene(vk, scene, path, NULL, &report) == SB_OK && sb_pack_open(path, &orders_pack) == SB_OK;
-    CHECK(ok && orders_pack.present[SB_PRODUCT_ORDERS], "a pack with the orders");
+    bool ok = scene && sb_scene_parse(json, strlen(json), what, scene) == SB_OK &&
+              sb_bake_scene(vk, scene, path, NULL, &report) == SB_OK && sb_pack_open(path, &sky_of_pack) == SB_OK;
+    CHECK(ok && sky_of_pack.present[present], "a pack %s", what);
     free(scene);
     struct sb_renderer *r = NULL;
     struct sb_renderer_params rp = {.width = W, .height = H, .shadow_size = 1024};
     if (ok)
-        CHECK(sb_renderer_create(vk, &orders_pack, &world, &rp, &r) == SB_OK, "a renderer of it");
+        CHECK(sb_renderer_create(vk, &sky_of_pack, &world, &rp, &r) == SB_OK, "a renderer of it");
     if (r) {
-        /* the bounds of Hillaire's sky-view above */
-        test_sky_view_of(r, &orders_pack, 45.0, 2e-3);
-        test_sky_view_of(r, &orders_pack, 3.0, 1e-2);
-        test_aerial_of(r, &orders_pack, 30.0, 1e-2);
-        test_aerial_of(r, &orders_pack, 3.0, 1e-2);
+        test_sky_view_of(r, &sky_of_pack, 45.0, 2e-3);
+        test_sky_view_of(r, &sky_of_pack, 3.0, 1e-2);
+        test_aerial_of(r, &sky_of_pack, 30.0, 1e-2);
+        test_aerial_of(r, &sky_of_pack, 3.0, 1e-2);
         struct sb_view v = base_view();
-        v.sun_elevation = 3.0 * DEG;
+        v.sun_elevation = frame_sun * DEG;
         if (render(r, &v)) {
             float *rgb = malloc(sizeof(float) * 3 * W * H);
             sb_renderer_hdr(r, rgb);
-            check_finite(rgb, "the frame with the orders");
+            check_finite(rgb, what);
             free(rgb);
         }
     }
     sb_renderer_destroy(&r);
-    sb_pack_close(&orders_pack);
+    sb_pack_close(&sky_of_pack);
 }
 
-/* A pack with the spectral products: skyview draws the sky at their 12
- * wavelengths, band by band (view.glsl), held to the same sky in fp64 (each
- * band's sky on its own images, through sb_spectral_to_rec709), which
- * must differ from the three channels' beyond the bound; the frame is
- * finite. */
-static void test_spectral_sky(const char *dir)
+/* A pack with the orders product: skyview takes orders 2 and up from it
+ * (view.glsl). With the spectral products too (spectral_orders brings the
+ * other two): skyview draws the sky at their 12 wavelengths, band by band,
+ * held to each band's sky in fp64 summed through sb_spectral_to_rec709,
+ * which must differ from the three channels' beyond the bound. */
+static void test_orders_sky(const char *dir)
 {
-    char path[300];
-    snprintf(path, sizeof(path), "%s/spectral-pack", dir);
-    struct sb_scene *scene = calloc(1, sizeof(*scene));
-    struct sb_pack spectral_pack = {0};
-    struct sb_bake_report report;
-    const char *json = "{\"atmosphere\":{\"preset\":\"earth\"},\"products\":[\"transmittance\",\"multiscattering\","
-                       "\"irradiance_ground\",\"orders\",\"spectral_orders\"]}";
-    bool ok = scene && sb_scene_parse(json, strlen(json), "spectral scene", scene) == SB_OK &&
-              sb_bake_scene(vk, scene, path, NULL, &report) == SB_OK && sb_pack_open(path, &spectral_pack) == SB_OK;
-    CHECK(ok && spectral_pack.present[SB_PRODUCT_SPECTRAL_TRANSMITTANCE] &&
-              spectral_pack.present[SB_PRODUCT_SPECTRAL_IRRADIANCE_GROUND] &&
-              spectral_pack.present[SB_PRODUCT_SPECTRAL_ORDERS],
-          "a pack with the spectral products (spectral_orders brings the other two)");
-    free(scene);
-    struct sb_renderer *r = NULL;
-    struct sb_renderer_params rp = {.width = W, .height = H, .shadow_size = 1024};
-    if (ok)
-        CHECK(sb_renderer_create(vk, &spectral_pack, &world, &rp, &r) == SB_OK, "a renderer of it");
-    if (r) {
-        test_sky_view_of(r, &spectral_pack, 45.0, 2e-3);
-        test_sky_view_of(r, &spectral_pack, 3.0, 1e-2);
-        test_aerial_of(r, &spectral_pack, 30.0, 1e-2);
-        test_aerial_of(r, &spectral_pack, 3.0, 1e-2);
-        struct sb_view v = base_view();
-        v.sun_elevation = -4.0 * DEG;
-        if (render(r, &v)) {
-            float *rgb = malloc(sizeof(float) * 3 * W * H);
-            sb_renderer_hdr(r, rgb);
-            check_finite(rgb, "the frame at 12 wavelengths");
-            free(rgb);
-        }
-    }
-    sb_renderer_destroy(&r);
-    sb_pack_close(&spectral_pack);
+    const char *orders = "\"transmittance\",\"multiscattering\",\"irradiance_ground\",\"orders\"";
+    char spectral[256];
+    snprintf(spectral, sizeof(spectral), "%s,\"spectral_orders\"", orders);
+    test_pack_sky(dir, "with the orders", orders, SB_PRODUCT_ORDERS, 3.0);
+    test_pack_sky(dir, "with the spectral products", spectral, SB_PRODUCT_SPECTRAL_ORDERS, -4.0);
 }
 
 static void test_above_atmosphere(struct sb_renderer *r)
@@ -3133,7 +3105,6 @@ int main(int argc, char **argv)
     }
     sb_renderer_destroy(&r);
     test_orders_sky(dir);
-    test_spectral_sky(dir);
     test_probes(dir);
     test_leak(dir);
     test_reflections(dir, world_path);

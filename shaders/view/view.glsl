@@ -145,13 +145,8 @@ vec3 sun_transmittance_rgb(float h, float mu_s)
 {
     if (!SB_VIEW_BANDS)
         return sun_transmittance(h, mu_s);
-    vec3 band_t[SB_SPECTRAL_BANDS];
-    for (int b = 0; b < SB_SPECTRAL_BANDS; b++) {
-        atm_band = 1 + b;
-        band_t[b] = sun_transmittance(h, mu_s);
-    }
-    atm_band = 0;
-    return bands_transmittance_rgb(band_t);
+    /* sun_transmittance's, band by band (SB_SUN_TRANSMITTANCE_LUT) */
+    return ray_hits_ground(h, mu_s) ? vec3(0.0) : transmittance_rgb(h, mu_s);
 }
 
 layout(push_constant) uniform ViewPush {
