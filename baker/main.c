@@ -417,7 +417,8 @@ static bool parse_number(const char *text, double lo, double hi, double *out)
 
 static int cmd_sky_error(int argc, char **argv)
 {
-    const char *scenes[16];
+    /* the scenes' paths, gathered at the front of argv (each at or before
+     * its own slot): any number of them */
     int scene_count = 0;
     struct sb_vk_params vk_params = sb_vk_params_from_env();
     struct sb_sky_error_params params = {.seed = 1};
@@ -472,13 +473,12 @@ static int cmd_sky_error(int argc, char **argv)
             fprintf(stderr, "skybake: unknown or incomplete option '%s'\n", a);
             usage(stderr);
             return EXIT_USAGE;
-        } else if (scene_count < 16) {
-            scenes[scene_count++] = a;
         } else {
-            fprintf(stderr, "skybake: sky-error takes at most 16 scenes\n");
-            return EXIT_USAGE;
+            argv[scene_count++] = argv[i];
         }
     }
+    const char *preset = "the earth preset";
+    const char *const *scenes = scene_count ? (const char *const *)argv : &preset;
     struct sb_scene *loaded = calloc((size_t)(scene_count ? scene_count : 1), sizeof(*loaded));
     struct sb_sky_error_report *reports = calloc((size_t)(scene_count ? scene_count : 1), sizeof(*reports));
     int rc = EXIT_USAGE;
@@ -490,7 +490,7 @@ static int cmd_sky_error(int argc, char **argv)
     if (!scene_count) {
         sb_atmosphere_preset_earth(&loaded[0].atmosphere);
         loaded[0].view = (struct sb_scene_view){0.002, 30, 150};
-        scenes[scene_count++] = "the earth preset";
+        scene_count = 1;
     }
 
     struct sb_vk *vk = NULL;

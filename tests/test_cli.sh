@@ -350,6 +350,12 @@ check "sky-error reports each view's spectrum" test "$(grep -c '"spectral_std_er
 check "sky-error values are finite" test -z "$(grep -Ei 'nan|inf|null' "$tmp/out")"
 check "sky-error reports the orders product's sky" test "$(grep -c '"product_rms_rel"' "$tmp/out")" = 2
 check "and every view's" test "$(grep -c '"product"' "$tmp/out")" = 32
+check "and at 12 wavelengths, each sun" test "$(grep -c '"product_12"' "$tmp/out")" = 2
+# any number of scenes: all are read before the first is baked, so the
+# 20th, missing, is named at once
+check "sky-error takes more than 16 scenes" expect_exit 2 "$skybake" sky-error \
+    $(for k in $(seq 19); do printf '%s ' "$scene"; done) "$tmp/no-such-scene.json"
+check "and names the one it cannot read" grep -q "no-such-scene.json" "$tmp/err"
 # the orders' reference on a small grid: its section, every view's sky
 check "sky-error --orders runs" expect_exit 0 "$skybake" sky-error "$scene" --paths 64 --sun 30 --orders-grid 4,8,4,4 \
     --json -q
