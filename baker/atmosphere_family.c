@@ -120,13 +120,15 @@ static uint32_t atmosphere_depends_on(enum sb_product_id id)
     case SB_PRODUCT_ORDERS:
         return BIT(SB_PRODUCT_TRANSMITTANCE) | BIT(SB_PRODUCT_MULTISCATTERING) | BIT(SB_PRODUCT_IRRADIANCE_GROUND);
     /* The spectral products bake what they read for themselves
-     * (spectral.h); a runtime draws the three together. */
+     * (spectral.h); a runtime draws the three together, and with the
+     * orders (and what they read): naming spectral_orders brings them all. */
     case SB_PRODUCT_SPECTRAL_TRANSMITTANCE:
         return 0;
     case SB_PRODUCT_SPECTRAL_IRRADIANCE_GROUND:
         return BIT(SB_PRODUCT_SPECTRAL_TRANSMITTANCE);
     case SB_PRODUCT_SPECTRAL_ORDERS:
-        return BIT(SB_PRODUCT_SPECTRAL_TRANSMITTANCE) | BIT(SB_PRODUCT_SPECTRAL_IRRADIANCE_GROUND);
+        return BIT(SB_PRODUCT_ORDERS) | BIT(SB_PRODUCT_SPECTRAL_TRANSMITTANCE) |
+               BIT(SB_PRODUCT_SPECTRAL_IRRADIANCE_GROUND);
     default:
         return sb_atmosphere_product(id)->depends_on;
     }
