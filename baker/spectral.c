@@ -125,7 +125,7 @@ enum sb_result sb_spectral_bake(struct sb_spectral *s, enum sb_product_id id, st
     for (int b = 0; b < SB_SPECTRAL_BANDS; b++)
         for (uint32_t i = 0; i < texels; i++)
             for (uint32_t ch = 0; ch < base_channels; ch++)
-                image->data[(size_t)i * f->channel_count + ch / 3 * (3 * SB_SPECTRAL_BANDS) + 3 * b + ch % 3] =
+                image->data[(size_t)i * f->channel_count + sb_spectral_channel(ch, (int)b)] =
                     bands[b]->data[(size_t)i * base_channels + ch];
     if (gpu_ms)
         *gpu_ms = ms;

@@ -346,6 +346,6 @@ enum sb_result sb_spectral_band_image(const struct sb_image *spectral, enum sb_p
     for (uint32_t t = 0; t < texels; t++)
         for (uint32_t ch = 0; ch < channels; ch++)
             band->data[(size_t)t * channels + ch] =
-                spectral->data[(size_t)t * spectral->channel_count + ch / 3 * (3 * SB_SPECTRAL_BANDS) + 3 * b + ch % 3];
+                spectral->data[(size_t)t * spectral->channel_count + sb_spectral_channel(ch, b)];
     return SB_OK;
 }

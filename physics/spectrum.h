@@ -104,6 +104,14 @@ void sb_samples_to_xyz(const double *radiance, const double *nm, int n, double x
  * k[i] L_i (sb_samples_to_xyz, then sb_sun_xyz_to_rec709). */
 void sb_spectral_to_rec709(const double solar_rgb[3], double k[SB_SPECTRAL_WAVELENGTHS][3]);
 
+/* The spectral product's channel that holds channel `base_channel` of its
+ * three-channel product for band b (docs/pack.md): g * 12 + 3 b + c for
+ * base channel g * 3 + c. */
+static inline uint32_t sb_spectral_channel(uint32_t base_channel, int b)
+{
+    return base_channel / 3 * (3 * SB_SPECTRAL_BANDS) + 3 * (uint32_t)b + base_channel % 3;
+}
+
 /* Band b's three wavelengths of a spectral product's image as its
  * three-channel product `base` holds a scene's channels (base channel
  * g * 3 + c from the spectral product's g * 12 + 3 b + c: docs/pack.md),

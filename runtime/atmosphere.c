@@ -112,8 +112,9 @@ enum sb_result sb_atmosphere_upload(struct sb_renderer *r, const struct sb_pack 
     if ((r->constants.orders || spectral) &&
         !(rgba32f.optimalTilingFeatures & VK_FORMAT_FEATURE_SAMPLED_IMAGE_FILTER_LINEAR_BIT)) {
         /* optional in Vulkan; the shaders read the orders bilinearly (view.glsl) */
-        sb_warn("skyview: this device cannot filter RGBA32F textures: the pack's orders are not used (Hillaire's "
-                "multiple scattering instead)");
+        sb_warn("skyview: this device cannot filter RGBA32F textures: the pack's orders%s are not used (Hillaire's "
+                "multiple scattering, in three channels, instead)",
+                spectral ? " and spectral products" : "");
         r->constants.orders = false;
         spectral = false;
     }
