@@ -262,10 +262,11 @@ static double phi_of(double mu, double mu_s, double nu)
     return s > 1e-12 ? acos(clamp1((nu - mu * mu_s) / s)) : 0.0;
 }
 
-/* Between two mu_s nodes: linear by day; geometric where both lie below
- * the horizon (twilight falls exponentially there, and a line between its
- * nodes would lift it). */
-static double blend_mu_s(double a, double b, double f, bool twilight)
+/* Between two nodes in mu_s or nu: linear by day; geometric at twilight
+ * (both mu_s nodes below the horizon) where both are positive: twilight
+ * falls exponentially with the sun's depth and, through the limb, with its
+ * azimuth, and a line between nodes would lift it. */
+static double blend_twilight(double a, double b, double f, bool twilight)
 {
     if (f == 0.0)
         return a;
@@ -293,22 +294,24 @@ static void lookup_any(const struct sb_orders_ref *o, const double *table, const
     int im = (int)fmu < lo + half - 2 ? (int)fmu : lo + half - 2;
     double am = fmu - im;
     out[0] = out[1] = out[2] = 0.0;
-    /* linear in r, mu and nu; geometric in mu_s, where twilight falls
-     * exponentially (linear where a node is 0) */
+    /* linear in r and mu; in mu_s, then nu, by blend_twilight */
     for (int dr = 0; dr < 2; dr++) {
         double wr = dr ? ar : 1 - ar;
-        for (int dm = 0; dm < 2; dm++)
+        for (int dm = 0; dm < 2; dm++) {
+            double w = wr * (dm ? am : 1 - am), v[2][3];
+            if (w == 0.0)
+                continue;
             for (int dn = 0; dn < 2; dn++) {
-                double w = wr * (dm ? am : 1 - am) * (dn ? an : 1 - an);
-                if (w == 0.0)
-                    continue;
                 size_t i0 = 3 * node_index(o, ir + dr, im + dm, ims, inu + dn);
                 size_t i1 = 3 * node_index(o, ir + dr, im + dm, ims + 1, inu + dn);
                 for (int c = 0; c < 3; c++) {
                     double v0 = table ? table[i0 + c] : ftable[i0 + c], v1 = table ? table[i1 + c] : ftable[i1 + c];
-                    out[c] += w * blend_mu_s(v0, v1, as, twilight);
+                    v[dn][c] = blend_twilight(v0, v1, as, twilight);
                 }
             }
+            for (int c = 0; c < 3; c++)
+                out[c] += w * blend_twilight(v[0][c], v[1][c], an, twilight);
+        }
     }
 }
 
@@ -394,7 +397,7 @@ static void ground_irradiance(const struct sb_orders_ref *o, const double *table
     int i = f < o->nmus - 2 ? (int)f : o->nmus - 2;
     double a = f - i;
     for (int c = 0; c < 3; c++)
-        out[c] = blend_mu_s(table[3 * i + c], table[3 * (i + 1) + c], a, mu_s_of(o, i + 1) <= 0.0);
+        out[c] = blend_twilight(table[3 * i + c], table[3 * (i + 1) + c], a, mu_s_of(o, i + 1) <= 0.0);
 }
 
 /* Order k - 1's radiance reaching (r, mu') with (mu_s, nu'): from the air
@@ -430,6 +433,19 @@ struct order_job {
     const double *ground_previous; /* order k - 2's ground irradiance; NULL: the direct sun */
 };
 
+/* The scattering density J = s_r J_r + s_m J_m (J_r, J_m: the in-radiance
+ * weighed by each phase function) is kept divided by the scattering
+ * s_r + s_m, and multiplied by it again where it is read: J falls with the
+ * air's density, some 8 km a factor e, which the altitude nodes could not
+ * follow linearly (views through the limb from above read 5 to 10% high),
+ * while J / s changes only with the light. Where the air does not scatter,
+ * the two parts count alike. */
+static double density_per_scattering(double s_r, double s_m, double j_r, double j_m)
+{
+    double s = s_r + s_m;
+    return s > 0 ? (s_r * j_r + s_m * j_m) / s : 0.5 * (j_r + j_m);
+}
+
 static void density_row(void *user, int row)
 {
     struct order_job *job = user;
@@ -443,7 +459,7 @@ static void density_row(void *user, int row)
         double view[3] = {sv, 0.0, mu}, sun[3] = {ss * cos(phi_s), ss * sin(phi_s), mu_s};
         struct sb_ref_medium m;
         sb_ref_medium(&o->p, fmax(r - o->R, 0.0), &m);
-        double horizon = -sqrt(fmax(r * r - o->R * o->R, 0.0)) / r, j[3] = {0, 0, 0};
+        double horizon = -sqrt(fmax(r * r - o->R * o->R, 0.0)) / r, jr[3] = {0, 0, 0}, jm[3] = {0, 0, 0};
         for (int side = 0; side < 2; side++) {
             int n = side ? SPHERE_SKY : SPHERE_GROUND;
             const double *gx = side ? o->gl_sky_x : o->gl_ground_x, *gw = side ? o->gl_sky_w : o->gl_ground_w;
@@ -459,7 +475,7 @@ static void density_row(void *user, int row)
                     previous_radiance(o, job->k, r, mu_in, mu_s, nu_in, job->ground_previous, l);
                     double w = w_mu * 2 * ORD_PI / SPHERE_PHI * sb_ref_phase_rayleigh(cos_scatter);
                     for (int c = 0; c < 3; c++)
-                        j[c] += w * m.rayleigh[c] * l[c];
+                        jr[c] += w * l[c];
                 }
             }
         }
@@ -487,10 +503,12 @@ static void density_row(void *user, int row)
                 previous_radiance(o, job->k, r, mu_in, mu_s, nu_in, job->ground_previous, l);
                 double w = w_u / MIE_PHI * ratio;
                 for (int c = 0; c < 3; c++)
-                    j[c] += w * m.mie[c] * l[c];
+                    jm[c] += w * l[c];
             }
         }
-        memcpy(&o->density[3 * i], j, sizeof(j));
+        /* kept per unit of scattering (density_per_scattering) */
+        for (int c = 0; c < 3; c++)
+            o->density[3 * i + c] = density_per_scattering(m.rayleigh[c], m.mie[c], jr[c], jm[c]);
     }
 }
 
@@ -517,8 +535,10 @@ static void order_row(void *user, int row)
                 double mu_t = clamp1((r * mu + t) / rt), mu_s_t = clamp1((r * mu_s + t * nu) / rt), tv[3], jt[3];
                 transmittance_along(o, r, mu, ground, t, tv);
                 lookup(o, o->density, rt, mu_t, mu_s_t, nu, ground, jt);
+                struct sb_ref_medium m;
+                sb_ref_medium(&o->p, fmax(rt - o->R, 0.0), &m);
                 for (int c = 0; c < 3; c++)
-                    s[c] += w * tv[c] * jt[c];
+                    s[c] += w * tv[c] * (m.rayleigh[c] + m.mie[c]) * jt[c];
             }
         }
         memcpy(&o->order[3 * i], s, sizeof(s));
@@ -733,7 +753,8 @@ void sb_orders_table_ground(const struct sb_orders_ref *o, const float *table, d
     double f = mu_s_coord(o, mu_s);
     int i = f < o->nmus - 2 ? (int)f : o->nmus - 2;
     for (int c = 0; c < 3; c++)
-        out[c] = blend_mu_s(row[3 * i * o->nnu + c], row[3 * (i + 1) * o->nnu + c], f - i, mu_s_of(o, i + 1) <= 0.0);
+        out[c] =
+            blend_twilight(row[3 * i * o->nnu + c], row[3 * (i + 1) * o->nnu + c], f - i, mu_s_of(o, i + 1) <= 0.0);
 }
 
 void sb_orders_ref_sky(const struct sb_orders_ref *o, double h, double mu, double mu_s, double nu, double out[3],

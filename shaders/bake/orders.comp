@@ -11,7 +11,10 @@
 //   it) into workgroup memory, then gives each of its (mu, nu) nodes order
 //   k's scattering density: Rayleigh's and Mie's phase functions against
 //   those directions, Mie's normalised by its own sum (so that however
-//   narrow its peak, a uniform sky is integrated exactly). Workgroups at
+//   narrow its peak, a uniform sky is integrated exactly), kept per unit
+//   of the air's scattering (it falls with the air, which the altitude
+//   nodes cannot follow linearly; the scatter stage multiplies the
+//   scattering back where it reads). Workgroups at
 //   the ground also integrate the upper hemisphere into the ground's
 //   irradiance of order k - 1;
 // 2 scatter: a node an invocation, order k along its view, the density
@@ -82,7 +85,7 @@ vec3 ground_irradiance(uint j, float mu_s)
         return atm.solar_irradiance.rgb * sun_transmittance(0.0, mu_s) * max(mu_s, 0.0);
     OrdersMuS c = orders_mu_s_cell(mu_s);
     uint k = j * orders.size.z + c.i;
-    return orders_blend_mu_s(ground_table[k].rgb, ground_table[k + 1u].rgb, c.f, c.twilight);
+    return orders_blend(ground_table[k].rgb, ground_table[k + 1u].rgb, c.f, c.twilight);
 }
 
 /* Transmittance from altitude h along mu (ending on the ground) to the ground. */
@@ -171,7 +174,11 @@ void main()
             mie += (L.w * pm) * L.rgb;
             mie_weight += L.w * pm;
         }
+        /* per unit of scattering (the reference's density_per_scattering):
+         * the scatter stage multiplies by the air's scattering where it reads */
+        vec3 s = m.scattering_rayleigh + m.scattering_mie;
         vec3 J = m.scattering_rayleigh * rayleigh + m.scattering_mie * mie / max(mie_weight, 1e-30);
+        J = mix(0.5 * (rayleigh + mie / max(mie_weight, 1e-30)), J / max(s, vec3(1e-30)), greaterThan(s, vec3(0.0)));
         density_table[orders_index(ir, imu, ims, inu)] = vec4(J, 0.0);
     }
 }
@@ -205,7 +212,8 @@ void main()
                 float r = ground_radius() + hs[k];
                 float mu_k = clamp((r0 * mu + ts[k]) / r, -1.0, 1.0);
                 float mu_s_k = clamp((r0 * mu_s + ts[k] * nu) / r, -1.0, 1.0);
-                L += tw[k] * read_density(orders_cell(hs[k], mu_k, mu_s_k, nu, ground));
+                L += tw[k] * (m[k].scattering_rayleigh + m[k].scattering_mie)
+                   * read_density(orders_cell(hs[k], mu_k, mu_s_k, nu, ground));
             }
             ray_advance(tau, half_len, m);
             t0 = t1;

@@ -121,9 +121,12 @@ float orders_nu(float mu, float mu_s, float phi)
     return clamp(mu * mu_s + sqrt(max((1.0 - mu * mu) * (1.0 - mu_s * mu_s), 0.0)) * cos(phi), -1.0, 1.0);
 }
 
-/* Between two mu_s nodes: linear by day; geometric where both lie below
- * the horizon and are positive (twilight falls exponentially there). */
-vec3 orders_blend_mu_s(vec3 a, vec3 b, float f, bool twilight)
+/* Between two nodes in mu_s or nu: linear by day; geometric at twilight
+ * (both mu_s nodes below the horizon) where both are positive: twilight
+ * falls exponentially with the sun's depth and, seen through the limb,
+ * with its azimuth, and a line between nodes would lift it (from space at
+ * -4 degrees the limb read 23% rms high, with geometric azimuths 2.3%). */
+vec3 orders_blend(vec3 a, vec3 b, float f, bool twilight)
 {
     vec3 lin = mix(a, b, f);
     if (!twilight)
@@ -135,7 +138,7 @@ vec3 orders_blend_mu_s(vec3 a, vec3 b, float f, bool twilight)
 }
 
 /* Where mu_s falls between two nodes: the lower node, the fraction to the
- * next, and whether both lie below the horizon (orders_blend_mu_s). */
+ * next, and whether both lie below the horizon (orders_blend). */
 struct OrdersMuS {
     uint i;
     float f;
@@ -177,23 +180,22 @@ OrdersCell orders_cell(float h, float mu, float mu_s, float nu, bool ground)
 }
 
 /* A function `name`(OrdersCell) reading a table of nodes through TABLE(i)
- * (a vec3 at node i): linear in r, mu and nu, geometric in mu_s below the
- * horizon. */
-#define SB_ORDERS_READ(name, TABLE)                                                               \
-    vec3 name(OrdersCell c)                                                                       \
-    {                                                                                             \
-        uvec4 s = SB_ORDERS_GRID_SIZE;                                                                    \
-        uint sr = s.y * s.z * s.w, sm = s.z * s.w, ss = s.w;                                      \
-        vec3 out_value = vec3(0.0);                                                               \
-        for (uint dr = 0u; dr < 2u; dr++)                                                         \
-            for (uint dm = 0u; dm < 2u; dm++)                                                     \
-                for (uint dn = 0u; dn < 2u; dn++) {                                               \
-                    float w = (dr == 1u ? c.a.x : 1.0 - c.a.x) * (dm == 1u ? c.a.y : 1.0 - c.a.y) \
-                            * (dn == 1u ? c.a.z : 1.0 - c.a.z);                                   \
-                    uint i = c.base + dr * sr + dm * sm + dn;                                     \
-                    out_value += w * orders_blend_mu_s(TABLE(i), TABLE(i + ss), c.as, c.twilight); \
-                }                                                                                 \
-        return out_value;                                                                         \
+ * (a vec3 at node i): linear in r and mu, in mu_s and nu by orders_blend. */
+#define SB_ORDERS_READ(name, TABLE)                                                              \
+    vec3 name(OrdersCell c)                                                                      \
+    {                                                                                            \
+        uvec4 s = SB_ORDERS_GRID_SIZE;                                                           \
+        uint sr = s.y * s.z * s.w, sm = s.z * s.w, ss = s.w;                                     \
+        vec3 out_value = vec3(0.0);                                                              \
+        for (uint dr = 0u; dr < 2u; dr++)                                                        \
+            for (uint dm = 0u; dm < 2u; dm++) {                                                  \
+                float w = (dr == 1u ? c.a.x : 1.0 - c.a.x) * (dm == 1u ? c.a.y : 1.0 - c.a.y);   \
+                uint i = c.base + dr * sr + dm * sm;                                             \
+                vec3 v0 = orders_blend(TABLE(i), TABLE(i + ss), c.as, c.twilight);               \
+                vec3 v1 = orders_blend(TABLE(i + 1u), TABLE(i + 1u + ss), c.as, c.twilight);     \
+                out_value += w * orders_blend(v0, v1, c.a.z, c.twilight);                        \
+            }                                                                                    \
+        return out_value;                                                                        \
     }
 
 #endif

@@ -44,13 +44,19 @@ vec3 orders_texel(uint i)
     return texelFetch(orders_texture, ivec3(int(i % w), int(i / w), atm_band), 0).rgb;
 }
 
-/* The same multilinear read with the sampler's bilinear filter doing mu and
- * nu (adjacent texels of a node's row and column; the sampler is linear):
- * 4 reads instead of 16. The filter's weights are fixed-point on some GPUs
- * (8 bits on NVIDIA's): within 1/512 of a step between neighbours. */
+SB_ORDERS_READ(orders_read_texels, orders_texel)
+
+/* The table's read (orders.glsl's SB_ORDERS_READ); by day with the
+ * sampler's bilinear filter doing mu and nu (adjacent texels of a node's
+ * row and column; the sampler is linear): 4 reads instead of 16. The
+ * filter's weights are fixed-point on some GPUs (8 bits on NVIDIA's):
+ * within 1/512 of a step between neighbours. At twilight nu is geometric,
+ * which the filter cannot do: 16 reads. */
 vec3 orders_sky(float h, float mu, float mu_s, float nu, bool ground)
 {
     OrdersCell c = orders_cell(h, mu, mu_s, nu, ground);
+    if (c.twilight)
+        return orders_read_texels(c);
     uvec4 s = SB_ORDERS_GRID_SIZE, n = orders_node(c.base);
     vec2 texel = 1.0 / vec2(textureSize(orders_texture, 0).xy);
     float x = float(n.z * s.w + n.w) + c.a.z + 0.5, y = float(n.x * s.y + n.y) + c.a.y + 0.5;
@@ -61,7 +67,7 @@ vec3 orders_sky(float h, float mu, float mu_s, float nu, bool ground)
                   textureLod(orders_texture, vec3((p + step_r) * texel, layer), 0.0).rgb, c.a.x);
     vec3 v1 = mix(textureLod(orders_texture, vec3((p + step_s) * texel, layer), 0.0).rgb,
                   textureLod(orders_texture, vec3((p + step_s + step_r) * texel, layer), 0.0).rgb, c.a.x);
-    return orders_blend_mu_s(v0, v1, c.as, c.twilight);
+    return orders_blend(v0, v1, c.as, c.twilight);
 }
 
 /* The ground's irradiance from the sky (the table's last row). */
@@ -69,7 +75,7 @@ vec3 orders_ground_sky(float mu_s)
 {
     OrdersMuS c = orders_mu_s_cell(mu_s);
     uint k = orders_node_count() + c.i * SB_ORDERS_GRID_SIZE.w; /* a row of nu texels a mu_s node */
-    return orders_blend_mu_s(orders_texel(k), orders_texel(k + SB_ORDERS_GRID_SIZE.w), c.f, c.twilight);
+    return orders_blend(orders_texel(k), orders_texel(k + SB_ORDERS_GRID_SIZE.w), c.f, c.twilight);
 }
 
 /* Orders 2 and up scattered into the view from altitude h (cosine mu, the
