@@ -121,6 +121,7 @@ enum sb_result sb_atmosphere_upload(struct sb_renderer *r, const struct sb_pack 
     if (spectral && !r->constants.orders)
         sb_warn("skyview: the pack has the spectral products but not the orders: its sky is drawn in three channels");
     r->constants.bands = spectral && r->constants.orders;
+    r->constants.band_lanes = r->constants.bands ? SB_SPECTRAL_BANDS : 1;
     struct sb_atmosphere_gpu layers[1 + SB_SPECTRAL_BANDS];
     layers[0] = gpu;
     for (int b = 0; r->constants.bands && b < SB_SPECTRAL_BANDS; b++) {
@@ -179,7 +180,9 @@ enum sb_result sb_atmosphere_upload(struct sb_renderer *r, const struct sb_pack 
         (VkSpecializationMapEntry){.constantID = SB_VIEW_CONSTANT_ORDERS, .offset = 0, .size = sizeof(VkBool32)};
     r->specialization_entries[1] = (VkSpecializationMapEntry){
         .constantID = SB_VIEW_CONSTANT_BANDS, .offset = sizeof(VkBool32), .size = sizeof(VkBool32)};
-    r->specialization = (VkSpecializationInfo){.mapEntryCount = 2,
+    r->specialization_entries[2] = (VkSpecializationMapEntry){
+        .constantID = SB_VIEW_CONSTANT_BAND_LANES, .offset = 2 * sizeof(VkBool32), .size = sizeof(uint32_t)};
+    r->specialization = (VkSpecializationInfo){.mapEntryCount = 3,
                                                .pMapEntries = r->specialization_entries,
                                                .dataSize = sizeof(r->constants),
                                                .pData = &r->constants};

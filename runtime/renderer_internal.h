@@ -70,10 +70,11 @@ struct sb_renderer {
     struct sb_orders_push orders_grid;            /* its grid (zeros: the pack has none) */
     float spectral_rgb[3 * SB_SPECTRAL_BANDS][4]; /* the 12 wavelengths to Rec.709 (frame.glsl) */
     VkSpecializationInfo specialization;          /* every view kernel's (SB_VIEW_CONSTANT_*, pass.c) */
-    VkSpecializationMapEntry specialization_entries[2];
+    VkSpecializationMapEntry specialization_entries[3];
     struct {
-        VkBool32 orders; /* the pack has the orders (SB_VIEW_CONSTANT_ORDERS) */
-        VkBool32 bands;  /* and the spectral products: the sky at 12 wavelengths (SB_VIEW_CONSTANT_BANDS) */
+        VkBool32 orders;     /* the pack has the orders (SB_VIEW_CONSTANT_ORDERS) */
+        VkBool32 bands;      /* and the spectral products: the sky at 12 wavelengths (SB_VIEW_CONSTANT_BANDS) */
+        uint32_t band_lanes; /* SB_SPECTRAL_BANDS with them, else 1 (SB_VIEW_CONSTANT_BAND_LANES) */
     } constants;
     struct sb_buffer frame, vertices, exposure; /* "frame", "vertices", "exposure" */
     struct sb_buffer bvh_nodes, bvh_triangles;  /* "bvh nodes", "bvh triangles": the world's BVH when traced

@@ -6,10 +6,13 @@
  */
 #include <stdlib.h>
 
+#include "log.h"
 #include "renderer_internal.h"
 
 #include "aerial_perspective.spv.h"
 #include "aerial_perspective_moon.spv.h"
+#include "aerial_perspective_moon_quads.spv.h"
+#include "aerial_perspective_quads.spv.h"
 
 struct aerial {
     struct sb_texture scattering, transmittance;
@@ -37,6 +40,22 @@ static enum sb_result aerial_create(struct sb_renderer *r)
     sb_pass_use(r, SB_VIEW_BINDING_AERIAL_OUT, sb_graph_image(r, "aerial", &a->scattering), SB_USE_STORE);
     sb_pass_use(r, SB_VIEW_BINDING_AERIAL_T_OUT, sb_graph_image(r, "aerial transmittance", &a->transmittance),
                 SB_USE_STORE);
+    /* with the spectral products a column's four bands share their light
+     * within a quad where a compute shader's subgroups can (else at a
+     * barrier a slice: aerial_perspective.comp) */
+    bool quads = r->constants.bands && (r->vk->compute_subgroup_ops & VK_SUBGROUP_FEATURE_QUAD_BIT);
+    sb_debug("aerial perspective: %s", !r->constants.bands ? "a column an invocation"
+                                       : quads             ? "a band an invocation, summed by quads"
+                                                           : "a band an invocation, summed in workgroup memory");
+    if (quads) {
+        res = sb_renderer_kernel(r, sb_spv_aerial_perspective_quads, sizeof(sb_spv_aerial_perspective_quads),
+                                 "aerial perspective (quads)", &a->kernel[0]);
+        if (!res)
+            res = sb_renderer_kernel(r, sb_spv_aerial_perspective_moon_quads,
+                                     sizeof(sb_spv_aerial_perspective_moon_quads),
+                                     "aerial perspective (the moon, quads)", &a->kernel[1]);
+        return res;
+    }
     res = sb_renderer_kernel(r, sb_spv_aerial_perspective, sizeof(sb_spv_aerial_perspective), "aerial perspective",
                              &a->kernel[0]);
     if (!res)

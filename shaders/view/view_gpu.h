@@ -54,9 +54,12 @@
  * true when the pack has the orders product, which then gives orders 2
  * and up instead of Hillaire's psi_ms (view.glsl); true when it has the
  * spectral products too, the sky then drawn at their 12 wavelengths, a
- * band of three at a time (view.glsl's sky_radiance_rgb). */
+ * band of three at a time (view.glsl's sky_radiance_rgb); and the bands
+ * a kernel may give lanes of its own (1, or SB_SPECTRAL_BANDS with the
+ * spectral products: the aerial perspective's workgroup depth). */
 #define SB_VIEW_CONSTANT_ORDERS 8
 #define SB_VIEW_CONSTANT_BANDS 9
+#define SB_VIEW_CONSTANT_BAND_LANES 10
 /* Contact shadows (contact_shadows.comp): steps and reach of the march
  * toward the key light (a fraction of the pixel's distance, at most
  * SB_CONTACT_MAX_M), the thickness a surface is taken to have behind the
