@@ -10,8 +10,9 @@
 static enum sb_log_level log_level = SB_LOG_INFO;
 static sb_log_sink log_sink;
 static void *log_user;
-static bool progress_shown; /* a progress line is on the terminal, not yet ended */
-static bool status_shown;   /* a status line is on the terminal */
+static const char *log_program = "skybake"; /* sb_log_set_program */
+static bool progress_shown;                 /* a progress line is on the terminal, not yet ended */
+static bool status_shown;                   /* a status line is on the terminal */
 
 static bool terminal_lines(void)
 {
@@ -24,6 +25,11 @@ static void clear_status(void)
     if (status_shown)
         fputs("\r\033[K", stderr);
     status_shown = false;
+}
+
+void sb_log_set_program(const char *name)
+{
+    log_program = name;
 }
 
 void sb_log_set_level(enum sb_log_level level)
@@ -59,7 +65,7 @@ void sb_log(enum sb_log_level level, const char *fmt, ...)
     if (level == SB_LOG_INFO)
         fprintf(stderr, "%s\n", buf);
     else
-        fprintf(stderr, "skybake: %s: %s\n", names[level], buf);
+        fprintf(stderr, "%s: %s: %s\n", log_program, names[level], buf);
 }
 
 double sb_now_s(void)

@@ -19,6 +19,9 @@ typedef void (*sb_log_sink)(void *user, enum sb_log_level level, const char *mes
 void sb_log_set_level(enum sb_log_level level);
 /* Replace the stderr sink; NULL restores it. */
 void sb_log_set_sink(sb_log_sink sink, void *user);
+/* The program that the stderr sink names before each message (a static
+ * string). Default: "skybake". */
+void sb_log_set_program(const char *name);
 
 #if defined(__GNUC__)
 __attribute__((format(printf, 2, 3)))

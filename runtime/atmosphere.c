@@ -112,14 +112,14 @@ enum sb_result sb_atmosphere_upload(struct sb_renderer *r, const struct sb_pack 
     if ((r->constants.orders || spectral) &&
         !(rgba32f.optimalTilingFeatures & VK_FORMAT_FEATURE_SAMPLED_IMAGE_FILTER_LINEAR_BIT)) {
         /* optional in Vulkan; the shaders read the orders bilinearly (view.glsl) */
-        sb_warn("skyview: this device cannot filter RGBA32F textures: the pack's orders%s are not used (Hillaire's "
+        sb_warn("this device cannot filter RGBA32F textures: the pack's orders%s are not used (Hillaire's "
                 "multiple scattering, in three channels, instead)",
                 spectral ? " and spectral products" : "");
         r->constants.orders = false;
         spectral = false;
     }
     if (spectral && !r->constants.orders)
-        sb_warn("skyview: the pack has the spectral products but not the orders: its sky is drawn in three channels");
+        sb_warn("the pack has the spectral products but not the orders: its sky is drawn in three channels");
     r->constants.bands = spectral && r->constants.orders;
     r->constants.band_lanes = r->constants.bands ? SB_SPECTRAL_BANDS : 1;
     struct sb_atmosphere_gpu layers[1 + SB_SPECTRAL_BANDS];

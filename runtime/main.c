@@ -1172,6 +1172,7 @@ done:
 
 int main(int argc, char **argv)
 {
+    sb_log_set_program("skyview");
     if (argc < 2) {
         usage(stderr);
         return EXIT_USAGE;

@@ -27,7 +27,7 @@ sb_resource sb_pass_find(struct sb_renderer *r, const char *name)
 {
     sb_resource id = sb_graph_find(r, name);
     if (!id)
-        sb_error("skyview: the %s pass uses \"%s\", which no earlier pass made", r->pass_name, name);
+        sb_error("the %s pass uses \"%s\", which no earlier pass made", r->pass_name, name);
     assert(id);
     return id;
 }
