@@ -879,16 +879,25 @@ static int compare_doubles(const void *a, const void *b)
 }
 
 /* The geometric mean of the exposed luminance over the middle 80% of the
- * pixels, which is what the meter aims at mid grey. */
-static double exposed_middle(struct sb_renderer *r)
+ * pixels, which is what the meter aims at mid grey; with lit_only, of the
+ * pixels that are not black (from orbit, the planet without space). */
+static double exposed_middle_of(struct sb_renderer *r, bool lit_only)
 {
     float *rgb = frame_rgb(r);
     float state[4];
     sb_renderer_exposure(r, state);
     double *lum = malloc(sizeof(double) * W * H);
-    for (int i = 0; i < W * H; i++)
-        lum[i] = luminance(rgb + 3 * i) * state[1];
-    int n = W * H;
+    int n = 0;
+    for (int i = 0; i < W * H; i++) {
+        double l = luminance(rgb + 3 * i) * state[1];
+        if (!lit_only || l > 0.0)
+            lum[n++] = l;
+    }
+    if (n == 0) {
+        free(lum);
+        free(rgb);
+        return 0.0;
+    }
     qsort(lum, (size_t)n, sizeof(double), compare_doubles);
     double sum = 0.0;
     int count = 0;
@@ -897,6 +906,11 @@ static double exposed_middle(struct sb_renderer *r)
     free(lum);
     free(rgb);
     return exp2(sum / count);
+}
+
+static double exposed_middle(struct sb_renderer *r)
+{
+    return exposed_middle_of(r, false);
 }
 
 /* Where the meter puts the frame's middle: mid grey, less the dim light's
@@ -949,6 +963,27 @@ static void test_exposure(struct sb_renderer *r)
               "a moonless night adapts to the range's bottom, EV100 %g, not %.4f", SB_EXPOSURE_MIN_EV100,
               sb_renderer_ev100(r, dark[0]));
     }
+    /* From orbit (1100 km up, looking 28 degrees down at the limb) about
+     * half the frame is black space, which the meter leaves out: the lit
+     * planet ends up at mid grey, not some 14 stops over it. */
+    v = base_view();
+    v.camera_m[1] = 1.1e6;
+    v.pitch = -28.0 * DEG;
+    v.yaw = v.sun_azimuth;
+    v.fov_y = 60.0 * DEG;
+    if (render(r, &v)) {
+        float orbit[4];
+        sb_renderer_exposure(r, orbit);
+        double middle = exposed_middle_of(r, true), want = expected_middle(r, orbit);
+        printf("exposure from orbit: EV100 %.2f over %.0f%% of the frame; the planet exposed at %.3f\n",
+               sb_renderer_ev100(r, orbit[0]), 100.0 * orbit[3] / (0.8 * W * H), middle);
+        CHECK(middle > want / 1.5 && middle < want * 1.5,
+              "from orbit the planet ends up at %.4f, not within 1.5x of %.4f (EV100 %.2f)", middle, want,
+              sb_renderer_ev100(r, orbit[0]));
+        CHECK(orbit[3] < 0.8 * 0.9 * W * H, "from orbit the meter leaves space out: %.0f pixels in its window of %d",
+              orbit[3], W * H);
+    }
+    v = base_view();
     const float *noon_state = states[0];
     CHECK(states[1][1] > 20.0 * noon_state[1], "dusk is exposed %.1fx more than noon (at least 20x)",
           states[1][1] / noon_state[1]);

@@ -24,7 +24,9 @@ void main()
     barrier();
     if (i != 0u)
         return;
-    float total = float(frame.size.x) * float(frame.size.y);
+    float total = 0.0; /* the metered pixels (histogram.comp leaves space out) */
+    for (uint b = 0u; b < SB_HISTOGRAM_BINS; b++)
+        total += float(counts[b]);
     float low = frame.exposure.z * total, high = frame.exposure.w * total;
     float below = 0.0, weight = 0.0, sum = 0.0;
     for (uint b = 0u; b < SB_HISTOGRAM_BINS; b++) {

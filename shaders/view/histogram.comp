@@ -2,7 +2,10 @@
 /* Log-luminance histogram of the frame (before exposure): bin 0 holds
  * luminance below 2^exposure.x (and black), bins 1 to 255 split
  * [exposure.x, exposure.x + exposure.y] evenly in log2. Counts go to shared
- * memory first, then once per workgroup to the buffer. */
+ * memory first, then once per workgroup to the buffer. A pixel that sees
+ * only space (a camera above the atmosphere, its ray missing it) is left
+ * out: from orbit half a frame can be black space, which dragged the
+ * meter's mean some 14 stops under the lit planet and left it white. */
 #extension GL_GOOGLE_include_directive : require
 #include "view_gpu.h"
 
@@ -16,12 +19,27 @@ layout(set = 0, binding = SB_VIEW_BINDING_HDR, rgba16f) uniform readonly image2D
 
 shared uint local_bins[SB_HISTOGRAM_BINS];
 
+/* True when the pixel's ray, from a camera above the atmosphere (top
+ * radius frame.aerial.z), misses it. */
+bool sees_space(ivec2 pixel)
+{
+    vec3 p = frame.camera_km.xyz;
+    float c = dot(p, p) - frame.aerial.z * frame.aerial.z;
+    if (c <= 0.0)
+        return false;
+    vec2 uv = (vec2(pixel) + 0.5) / vec2(frame.size.xy);
+    vec4 q = frame.inv_view_proj * vec4(uv * 2.0 - 1.0, 0.5, 1.0);
+    vec3 d = normalize(q.xyz / q.w);
+    float b = dot(p, d);
+    return b >= 0.0 || b * b < c;
+}
+
 void main()
 {
     local_bins[gl_LocalInvocationIndex] = 0u;
     barrier();
     ivec2 pixel = ivec2(gl_GlobalInvocationID.xy);
-    if (all(lessThan(uvec2(pixel), frame.size.xy))) {
+    if (all(lessThan(uvec2(pixel), frame.size.xy)) && !sees_space(pixel)) {
         /* Radiance as stored, back in the scene's units. */
         float lum = dot(imageLoad(hdr, pixel).rgb, vec3(SB_LUMINANCE_RGB)) / frame.aerial.y;
         uint bin = 0u;
