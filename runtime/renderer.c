@@ -452,7 +452,7 @@ static void fill_frame(struct sb_renderer *r, const struct sb_view *v, struct sb
     store4(f->camera_forward, forward[0], forward[1], forward[2], cos(sun_radius));
     store4(f->sun_direction, sun[0], sun[1], sun[2], sun_radius);
     store4(f->shadow, 0.1, 1.5, r->params.shadow_size, 1.0);
-    store4(f->aerial, SB_AERIAL_FAR_KM, r->frame_scale, r->ground_radius_km + r->thickness_km, 0.0);
+    store4(f->aerial, SB_AERIAL_FAR_KM, r->frame_scale, 0.0, 0.0);
     /* Bins 1 to 255 span 2^-34 to 2^12 of the solar irradiance's units
      * (0.18 stops a bin): from a moonless night's sky to beyond the sun-lit
      * snow. The meter adapts within the EV range (renderer.h). */

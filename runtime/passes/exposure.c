@@ -21,7 +21,7 @@ static enum sb_result exposure_create(struct sb_renderer *r)
     if (!e)
         return SB_ERR_NOMEM;
     sb_pass_set_data(r, e);
-    sb_pass_use(r, SB_VIEW_BINDING_FRAME, sb_pass_find(r, "frame"), SB_USE_LOAD);
+    sb_pass_read_atmosphere(r); /* the frame, and the atmosphere's top: histogram.comp leaves space out */
     sb_pass_use(r, SB_VIEW_BINDING_EXPOSURE, sb_pass_find(r, "exposure"), SB_USE_LOAD_STORE);
     sb_pass_use(r, SB_VIEW_BINDING_HDR, sb_pass_find(r, "hdr"), SB_USE_LOAD);
     enum sb_result res = sb_renderer_kernel(r, sb_spv_histogram, sizeof(sb_spv_histogram), "histogram", &e->histogram);

@@ -7,10 +7,11 @@
  * out: from orbit half a frame can be black space, which dragged the
  * meter's mean some 14 stops under the lit planet and left it white. */
 #extension GL_GOOGLE_include_directive : require
+#define SB_MOONLESS /* no light is read */
 #include "view_gpu.h"
+#include "view.glsl"
 
 layout(local_size_x = 16, local_size_y = 16) in;
-#include "frame.glsl"
 layout(std430, set = 0, binding = SB_VIEW_BINDING_EXPOSURE) buffer ExposureBuffer {
     uint bins[SB_HISTOGRAM_BINS];
     sb_exposure_gpu exposure;
@@ -19,19 +20,10 @@ layout(set = 0, binding = SB_VIEW_BINDING_HDR, rgba16f) uniform readonly image2D
 
 shared uint local_bins[SB_HISTOGRAM_BINS];
 
-/* True when the pixel's ray, from a camera above the atmosphere (top
- * radius frame.aerial.z), misses it. */
+/* True when the pixel's ray, from a camera above the atmosphere, misses it. */
 bool sees_space(ivec2 pixel)
 {
-    vec3 p = frame.camera_km.xyz;
-    float c = dot(p, p) - frame.aerial.z * frame.aerial.z;
-    if (c <= 0.0)
-        return false;
-    vec2 uv = (vec2(pixel) + 0.5) / vec2(frame.size.xy);
-    vec4 q = frame.inv_view_proj * vec4(uv * 2.0 - 1.0, 0.5, 1.0);
-    vec3 d = normalize(q.xyz / q.w);
-    float b = dot(p, d);
-    return b >= 0.0 || b * b < c;
+    return atmosphere_entry(frame.camera_km.xyz, view_ray((vec2(pixel) + 0.5) / vec2(frame.size.xy))) < 0.0;
 }
 
 void main()

@@ -67,7 +67,7 @@ vec3 orders_sky(float h, float mu, float mu_s, float nu, bool ground)
                   textureLod(orders_texture, vec3((p + step_r) * texel, layer), 0.0).rgb, c.a.x);
     vec3 v1 = mix(textureLod(orders_texture, vec3((p + step_s) * texel, layer), 0.0).rgb,
                   textureLod(orders_texture, vec3((p + step_s + step_r) * texel, layer), 0.0).rgb, c.a.x);
-    return orders_blend(v0, v1, c.as, c.twilight);
+    return mix(v0, v1, c.as); /* by day orders_blend is this */
 }
 
 /* The ground's irradiance from the sky (the table's last row). */

@@ -189,9 +189,7 @@ struct sb_frame_gpu {
     SB_VEC4(shadow);           /* x: blend band (fraction of a cascade), y: normal offset (texels),
                                   z: shadow map size (texels), w: 1 to use shadows */
     SB_VEC4(aerial);           /* x: the volume's far distance (km); y: radiance scale (what the frame's
-                                  radiance is multiplied by before storage); z: the atmosphere's top
-                                  radius (km), which the exposure's meter needs (histogram.comp);
-                                  w: unused */
+                                  radiance is multiplied by before storage); zw: unused */
     SB_VEC4(exposure);         /* x: log2 luminance at bin 1, y: log2 range of bins 1..255,
                                   z, w: low and high percentile of the metering window */
     SB_VEC4(meter);            /* x, y: the adapted log2 luminance's range (the EV range's, in the pack's
