@@ -13,6 +13,7 @@
 #define TABLE_SPLIT 8 /* intervals of the view ray's optical-depth table per piece */
 #define ROULETTE 0.2  /* of the first vertex's throughput */
 #define BATCHES 16
+#define GUIDE_G 0.5 /* Mie's |g| from which sunlight_ahead() draws directions about the sun too */
 
 /* ---- Random numbers: xoshiro256** seeded through splitmix64 ------------------- */
 
@@ -90,6 +91,7 @@ static void around(const double n[3], double c, double phi, double out[3])
 struct tracer {
     const struct sb_atmosphere_params *p;
     int channel, max_order;
+    bool guided; /* next-event estimation one vertex ahead, from directions about the sun (continue_path) */
     double R, top;
     double sun[3];
     double rayleigh, mie_scattering, mie_extinction, ozone; /* per km at density 1 */
@@ -122,9 +124,8 @@ static struct coefficients coefficients_at(const struct tracer *tr, double h)
 static double majorant(const struct tracer *tr, double lo, double hi)
 {
     const struct sb_atmosphere_params *p = tr->p;
-    double oz = p->ozone_center_km >= lo && p->ozone_center_km <= hi
-                    ? 1.0
-                    : fmax(ozone_density(p, lo), ozone_density(p, hi));
+    double oz =
+        p->ozone_center_km >= lo && p->ozone_center_km <= hi ? 1.0 : fmax(ozone_density(p, lo), ozone_density(p, hi));
     double bound = tr->rayleigh * exp(-lo / p->rayleigh_scale_height_km) +
                    tr->mie_extinction * exp(-lo / p->mie_scale_height_km) + tr->ozone * oz;
     return bound * (1.0 + 1e-9); /* the point's altitude may round below lo */
@@ -152,12 +153,21 @@ static double phase_mie(double g, double nu)
     return henyey_greenstein(g, nu) * cornette_shanks_over_hg(g, nu);
 }
 
+/* The cosine to the axis of a direction drawn from Henyey-Greenstein g at quantile u. */
+static double sample_henyey_greenstein(double g, double u)
+{
+    if (fabs(g) < 1e-6)
+        return 2.0 * u - 1.0;
+    double s = (1.0 - g * g) / (1.0 - g + 2.0 * g * u);
+    return fmax(-1.0, fmin(1.0, (1.0 + g * g - s * s) / (2.0 * g)));
+}
+
 /* ---- Rays --------------------------------------------------------------------- */
 
 struct ray {
-    double r, mu;   /* the origin's radius and the direction's cosine to the vertical there */
-    double t_end;   /* to the ground or the top */
-    bool ground;    /* the ray ends on the ground */
+    double r, mu;          /* the origin's radius and the direction's cosine to the vertical there */
+    double t_end;          /* to the ground or the top */
+    bool ground;           /* the ray ends on the ground */
     double cuts[MAX_CUTS]; /* 0, where the ray crosses a level or grazes its lowest point, t_end */
     int cut_count;
 };
@@ -247,6 +257,84 @@ static double sunlight(const struct tracer *tr, double r, double mu_s)
     return tr->p->solar_irradiance[tr->channel] * t[tr->channel];
 }
 
+/* The scattering function of a vertex, in the air with coefficients m or
+ * on the ground (its cosine: the albedo is in the throughput), and the
+ * density scatter() draws directions from there, for the path that came
+ * along dir and leaves along next. */
+static double scattering_function(const struct tracer *tr, const struct coefficients *m, bool on_ground,
+                                  const double up[3], const double dir[3], const double next[3], double *pdf)
+{
+    if (on_ground)
+        return *pdf = fmax(dot(up, next), 0.0) / PT_PI;
+    double c = dot(dir, next), scattering = m->rayleigh + m->mie, gm = tr->p->mie_g;
+    *pdf = (m->rayleigh * phase_rayleigh(c) + m->mie * henyey_greenstein(gm, c)) / scattering;
+    return (m->rayleigh * phase_rayleigh(c) + m->mie * phase_mie(gm, c)) / scattering;
+}
+
+/* Henyey-Greenstein about the sun: where Mie's peak lights the air. */
+static double about_sun_pdf(const struct tracer *tr, const double d[3])
+{
+    return henyey_greenstein(tr->p->mie_g, dot(d, tr->sun));
+}
+
+/* The direction a path leaves a vertex by: the ground's cosine, or the
+ * air's phase functions (Rayleigh's exactly, Cornette-Shanks' from
+ * Henyey-Greenstein's), in proportion to their scattering. Returns the
+ * scattering function over that density, and the density in *pdf. */
+static double scatter(const struct tracer *tr, struct rng *g, const struct coefficients *m, bool on_ground,
+                      const double up[3], const double dir[3], double next[3], double *pdf)
+{
+    double phi = 2.0 * PT_PI * rng_next(g);
+    if (on_ground) {
+        around(up, sqrt(rng_next(g)), phi, next);
+    } else if (rng_next(g) * (m->rayleigh + m->mie) < m->rayleigh) {
+        /* Invert the CDF (c^3 + 3c + 4) / 8 of 1 + c^2 (Cardano). */
+        double z = 4.0 * rng_next(g) - 2.0, a = cbrt(fabs(z) + sqrt(z * z + 1.0));
+        around(dir, copysign(a - 1.0 / a, z), phi, next);
+    } else {
+        around(dir, sample_henyey_greenstein(tr->p->mie_g, rng_next(g)), phi, next);
+    }
+    double value = scattering_function(tr, m, on_ground, up, dir, next, pdf);
+    return value > 0 ? value / *pdf : 0.0;
+}
+
+/*
+ * Next-event estimation one vertex ahead. A strong Mie peak (|g| near 1)
+ * makes the sunlight at a vertex rare and large: it comes from the few
+ * paths whose last direction lies in the peak about the sun. So the
+ * direction to the next vertex is drawn two ways: by scatter() (which also
+ * carries the path on) and from Henyey-Greenstein about the sun; the
+ * sunlight at the next vertex in the air counts from each with the balance
+ * heuristic's weight (Veach 1997), the ground's from the first alone.
+ * Returns this second draw's share per unit of the path's throughput at the
+ * vertex x (m, on_ground, up: as scatter's), reached along dir.
+ */
+static double sunlight_ahead(const struct tracer *tr, struct rng *g, const double x[3], const struct coefficients *m,
+                             bool on_ground, const double up[3], const double dir[3])
+{
+    const struct sb_atmosphere_params *p = tr->p;
+    double d[3], pdf;
+    around(tr->sun, sample_henyey_greenstein(p->mie_g, rng_next(g)), 2.0 * PT_PI * rng_next(g), d);
+    double value = scattering_function(tr, m, on_ground, up, dir, d, &pdf);
+    if (!(value > 0))
+        return 0.0;
+    double weight = value / (pdf + about_sun_pdf(tr, d));
+    struct ray ray;
+    ray_init(tr, length(x), dot(up, d), &ray);
+    double t = track(tr, &ray, g);
+    if (t < 0)
+        return 0.0; /* space, or the ground: counted from the first draw */
+    double y[3];
+    for (int i = 0; i < 3; i++)
+        y[i] = x[i] + t * d[i];
+    double ry = length(y), nu = dot(d, tr->sun);
+    double in = sunlight(tr, ry, dot(y, tr->sun) / ry);
+    if (!(in > 0))
+        return 0.0;
+    struct coefficients at = coefficients_at(tr, fmax(ry - tr->R, 0.0));
+    return weight * in * (at.rayleigh * phase_rayleigh(nu) + at.mie * phase_mie(p->mie_g, nu)) / at.extinction;
+}
+
 /*
  * Carry on a path whose next vertex is at x (in the medium, or on the ground
  * when `on_ground`), reached along `dir` with `throughput`; returns the
@@ -257,16 +345,17 @@ static double continue_path(const struct tracer *tr, struct rng *g, double x[3],
 {
     const struct sb_atmosphere_params *p = tr->p;
     double radiance = 0.0, roulette = ROULETTE * throughput;
+    double nee_weight = 1.0; /* of the sunlight at a vertex in the air, reached by scatter()'s direction */
     for (int order = 1;; order++) {
         double r = length(x), up[3] = {x[0] / r, x[1] / r, x[2] / r}, next[3];
+        struct coefficients m = {0};
         if (on_ground) {
             double albedo = p->ground_albedo[tr->channel], mu_s = dot(up, tr->sun);
             if (mu_s > 0)
                 radiance += throughput * albedo / PT_PI * mu_s * sunlight(tr, tr->R, mu_s);
             throughput *= albedo;
-            around(up, sqrt(rng_next(g)), 2.0 * PT_PI * rng_next(g), next);
         } else {
-            struct coefficients m = coefficients_at(tr, fmax(r - tr->R, 0.0));
+            m = coefficients_at(tr, fmax(r - tr->R, 0.0));
             double scattering = m.rayleigh + m.mie;
             if (!(scattering > 0))
                 break;
@@ -274,27 +363,17 @@ static double continue_path(const struct tracer *tr, struct rng *g, double x[3],
             double nu = dot(dir, tr->sun);
             double in = sunlight(tr, r, dot(up, tr->sun));
             if (in > 0)
-                radiance += throughput * in * (m.rayleigh * phase_rayleigh(nu) + m.mie * phase_mie(p->mie_g, nu)) /
-                            scattering;
-            double phi = 2.0 * PT_PI * rng_next(g), c;
-            if (rng_next(g) * scattering < m.rayleigh) {
-                /* Invert the CDF (c^3 + 3c + 4) / 8 of 1 + c^2 (Cardano). */
-                double z = 4.0 * rng_next(g) - 2.0, a = cbrt(fabs(z) + sqrt(z * z + 1.0));
-                c = copysign(a - 1.0 / a, z);
-            } else {
-                double gm = p->mie_g, u = rng_next(g);
-                if (fabs(gm) < 1e-6) {
-                    c = 2.0 * u - 1.0;
-                    throughput *= 4.0 * PT_PI * phase_mie(gm, c);
-                } else {
-                    double s = (1.0 - gm * gm) / (1.0 - gm + 2.0 * gm * u);
-                    c = fmax(-1.0, fmin(1.0, (1.0 + gm * gm - s * s) / (2.0 * gm)));
-                    throughput *= cornette_shanks_over_hg(gm, c);
-                }
-            }
-            around(dir, c, phi, next);
+                radiance += nee_weight * throughput * in *
+                            (m.rayleigh * phase_rayleigh(nu) + m.mie * phase_mie(p->mie_g, nu)) / scattering;
         }
         if ((tr->max_order && order >= tr->max_order) || !(throughput > 0))
+            break;
+        if (tr->guided)
+            radiance += throughput * sunlight_ahead(tr, g, x, &m, on_ground, up, dir);
+        double pdf;
+        throughput *= scatter(tr, g, &m, on_ground, up, dir, next, &pdf);
+        nee_weight = tr->guided ? pdf / (pdf + about_sun_pdf(tr, next)) : 1.0;
+        if (!(throughput > 0))
             break;
         if (throughput < roulette) {
             double survive = throughput / roulette;
@@ -404,8 +483,8 @@ static bool depth_table_init(const struct tracer *tr, const struct ray *ray, con
  * exponential of its (linear) optical depth. Returns the throughput
  * T(0, t) sigma_t(t) / pdf(t), with the exact optical depth to t.
  */
-static double sample_view_ray(const struct tracer *tr, const struct ray *ray, const struct depth_table *table,
-                              double u, double *t_out)
+static double sample_view_ray(const struct tracer *tr, const struct ray *ray, const struct depth_table *table, double u,
+                              double *t_out)
 {
     double total = table->mass[table->count - 1], target = u * total;
     int lo = 0, hi = table->count - 1;
@@ -433,13 +512,14 @@ static double sample_view_ray(const struct tracer *tr, const struct ray *ray, co
     return exp(-tau) * coefficients_at(tr, altitude_at(tr, ray, t)).extinction / pdf;
 }
 
-static void tracer_init(struct tracer *tr, const struct sb_atmosphere_params *p, int channel, int max_order,
-                        double mu_s)
+static void tracer_init(struct tracer *tr, const struct sb_atmosphere_params *p, int channel,
+                        const struct sb_pathtrace_params *params, double mu_s)
 {
     *tr = (struct tracer){
         .p = p,
         .channel = channel,
-        .max_order = max_order,
+        .max_order = params ? params->max_order : 0,
+        .guided = !(params && params->unguided) && p->mie_scattering_per_km[channel] > 0 && fabs(p->mie_g) >= GUIDE_G,
         .R = p->ground_radius_km,
         .top = p->top_radius_km,
         .sun = {sqrt(fmax(1.0 - mu_s * mu_s, 0.0)), 0.0, mu_s},
@@ -471,7 +551,7 @@ struct sb_pathtrace_result sb_pathtrace_radiance(const struct sb_atmosphere_para
     uint64_t seed = params ? params->seed : 0;
     double mu = fmax(-1.0, fmin(1.0, view->mu)), mu_s = fmax(-1.0, fmin(1.0, view->mu_s));
     struct tracer tr;
-    tracer_init(&tr, p, channel, params ? params->max_order : 0, mu_s);
+    tracer_init(&tr, p, channel, params, mu_s);
 
     /* The camera at (0, 0, r), the sun in the xz plane, the view at the
      * azimuth that gives nu. */
@@ -500,10 +580,10 @@ struct sb_pathtrace_result sb_pathtrace_radiance(const struct sb_atmosphere_para
     double total = table.tau[table.count - 1];
     bool collides = table.mass[table.count - 1] > 0;
 
-    uint64_t stream = mix(mix(mix(mix(mix(seed, double_bits(view->altitude_km)), double_bits(view->mu)),
-                                  double_bits(view->mu_s)),
-                              double_bits(view->nu)),
-                          (uint64_t)channel);
+    uint64_t stream =
+        mix(mix(mix(mix(mix(seed, double_bits(view->altitude_km)), double_bits(view->mu)), double_bits(view->mu_s)),
+                double_bits(view->nu)),
+            (uint64_t)channel);
     /* Independent batches, each stratified over the view ray on its own:
      * the spread of their means estimates the error of the whole mean
      * (the paths of one stratified batch are not independent). */

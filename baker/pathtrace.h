@@ -20,7 +20,11 @@
  * - after that, free paths by delta tracking against a majorant per piece
  *   of the ray (the density at the piece's lowest point);
  * - at every vertex, next-event estimation toward the sun, with the sun's
- *   transmittance integrated exactly (sb_ref_transmittance);
+ *   transmittance integrated exactly (sb_ref_transmittance); where Mie's
+ *   peak is strong (|g| >= 0.5) the next vertex's sunlight is also drawn
+ *   from a direction about the sun, both draws weighed by the balance
+ *   heuristic: the peak's light no longer rests on the rare paths that
+ *   happen to travel along it;
  * - scattering directions from the phase functions: Rayleigh exactly,
  *   Cornette-Shanks from Henyey-Greenstein of the same g, weighted by the
  *   ratio of the two (at most 3 / (2 + g^2)); the ground cosine-weighted;
@@ -34,6 +38,7 @@
 #ifndef SB_BAKER_PATHTRACE_H
 #define SB_BAKER_PATHTRACE_H
 
+#include <stdbool.h>
 #include <stdint.h>
 
 #include "scene.h"
@@ -50,10 +55,11 @@ struct sb_pathtrace_params {
     uint64_t seed;
     int paths;     /* per view and channel; 0: 4096 */
     int max_order; /* vertices (scattering events and ground bounces) per path; 0: all */
+    bool unguided; /* no directions drawn about the sun (the same mean, noisier; for tests) */
 };
 
 struct sb_pathtrace_result {
-    double radiance; /* the mean over the paths, in solar_irradiance's unit per steradian */
+    double radiance;  /* the mean over the paths, in solar_irradiance's unit per steradian */
     double std_error; /* its standard error, from the spread of 16 independent batches of
                          the paths (infinite for fewer than 32 paths) */
 };
