@@ -980,8 +980,9 @@ static void test_exposure(struct sb_renderer *r)
         CHECK(middle > want / 1.5 && middle < want * 1.5,
               "from orbit the planet ends up at %.4f, not within 1.5x of %.4f (EV100 %.2f)", middle, want,
               sb_renderer_ev100(r, orbit[0]));
-        CHECK(orbit[3] < 0.8 * 0.9 * W * H, "from orbit the meter leaves space out: %.0f pixels in its window of %d",
-              orbit[3], W * H);
+        CHECK(orbit[3] < 0.8 * 0.9 * W * H,
+              "from orbit the meter leaves space out: %.0f pixels in its window, the frame's 80%% is %.0f", orbit[3],
+              0.8 * W * H);
     }
     v = base_view();
     const float *noon_state = states[0];
