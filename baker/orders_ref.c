@@ -43,6 +43,7 @@ struct sb_orders_ref {
     double *density, *order, *previous, *sum;
     /* the ground's irradiance by mu_s node: the sky's orders 1 and up */
     double *ground, *ground_order;
+    bool log_azimuth; /* views read the sun's azimuth log-trigonometrically (sb_orders_log_azimuth) */
     int orders;
     double last_share;
     double gl_ray_x[GL_RAY], gl_ray_w[GL_RAY];
@@ -273,10 +274,30 @@ static double blend_twilight(double a, double b, double f, bool twilight)
     return twilight && a > 0.0 && b > 0.0 ? a * pow(b / a, f) : a + f * (b - a);
 }
 
+/* The weights of the sun's azimuth phi at the n azimuth nodes (phi_j = pi j
+ * / (n - 1)) in the trigonometric interpolation of an even function
+ * through them: the cardinal functions of the 2 (n - 1) points about the
+ * circle, each node counting for its mirror image too. */
+static void azimuth_weights(int n, double phi, double w[])
+{
+    int M = 2 * (n - 1);
+    for (int j = 0; j < n; j++) {
+        double pj = ORD_PI * j / (n - 1), d = 1.0 + cos(0.5 * M * phi) * cos(0.5 * M * pj);
+        for (int m = 1; m < M / 2; m++)
+            d += 2.0 * cos(m * phi) * cos(m * pj);
+        w[j] = (j == 0 || j == n - 1 ? 1.0 : 2.0) * d / M;
+    }
+}
+
 /* A table (rgb per node, fp64 or, with table NULL, fp32) read at (r, mu,
- * mu_s, nu), multilinear. */
+ * mu_s, nu): linear in r and mu, in mu_s and then nu by blend_twilight.
+ * A view's read (`view`) where the grid says so (log_azimuth), by day:
+ * multilinear in r, mu and mu_s at every azimuth node, then across the
+ * azimuth log-trigonometrically through them all (exact for exp(a + b cos
+ * phi + c cos 2 phi + ...)), kept between the two nodes about phi; where a
+ * node is not positive, linearly. */
 static void lookup_any(const struct sb_orders_ref *o, const double *table, const float *ftable, double r, double mu,
-                       double mu_s, double nu, bool ground, double out[3])
+                       double mu_s, double nu, bool ground, bool view, double out[3])
 {
     double fr = progression_index(&o->heights, r - o->R);
     int ir = fr < o->nr - 2 ? (int)fr : o->nr - 2;
@@ -285,40 +306,61 @@ static void lookup_any(const struct sb_orders_ref *o, const double *table, const
     int ims = fmus < o->nmus - 2 ? (int)fmus : o->nmus - 2;
     double as = fmus - ims;
     bool twilight = mu_s_of(o, ims + 1) <= 0.0;
-    double fnu = phi_of(mu, mu_s, nu) / ORD_PI * (o->nnu - 1);
+    double phi = phi_of(mu, mu_s, nu), fnu = phi / ORD_PI * (o->nnu - 1);
     int inu = fnu < o->nnu - 2 ? (int)fnu : o->nnu - 2;
     double an = fnu - inu;
+    bool log_read = view && o->log_azimuth && !twilight;
+    int first = log_read ? 0 : inu, last = log_read ? o->nnu - 1 : inu + 1;
     int half = o->nmu / 2, lo = ground ? 0 : half;
     /* the ray's length fraction, read at both radii (Bruneton's texture coordinate) */
     double fmu = mu_coord(o, r, mu, ground);
     int im = (int)fmu < lo + half - 2 ? (int)fmu : lo + half - 2;
-    double am = fmu - im;
+    double am = fmu - im, u[SB_ORDERS_MAX_NODES][3];
+    if (log_read)
+        memset(u, 0, 3 * sizeof(double) * (size_t)o->nnu);
     out[0] = out[1] = out[2] = 0.0;
-    /* linear in r and mu; in mu_s, then nu, by blend_twilight */
     for (int dr = 0; dr < 2; dr++) {
         double wr = dr ? ar : 1 - ar;
         for (int dm = 0; dm < 2; dm++) {
             double w = wr * (dm ? am : 1 - am), v[2][3];
             if (w == 0.0)
                 continue;
-            for (int dn = 0; dn < 2; dn++) {
-                size_t i0 = 3 * node_index(o, ir + dr, im + dm, ims, inu + dn);
-                size_t i1 = 3 * node_index(o, ir + dr, im + dm, ims + 1, inu + dn);
+            for (int j = first; j <= last; j++) {
+                size_t i0 = 3 * node_index(o, ir + dr, im + dm, ims, j);
+                size_t i1 = 3 * node_index(o, ir + dr, im + dm, ims + 1, j);
                 for (int c = 0; c < 3; c++) {
                     double v0 = table ? table[i0 + c] : ftable[i0 + c], v1 = table ? table[i1 + c] : ftable[i1 + c];
-                    v[dn][c] = blend_twilight(v0, v1, as, twilight);
+                    double x = blend_twilight(v0, v1, as, twilight);
+                    if (log_read)
+                        u[j][c] += w * x;
+                    if (j == inu || j == inu + 1)
+                        v[j - inu][c] = x;
                 }
             }
             for (int c = 0; c < 3; c++)
                 out[c] += w * blend_twilight(v[0][c], v[1][c], an, twilight);
         }
     }
+    if (!log_read)
+        return;
+    double wt[SB_ORDERS_MAX_NODES];
+    azimuth_weights(o->nnu, phi, wt);
+    for (int c = 0; c < 3; c++) {
+        double lg = 0.0;
+        bool positive = true;
+        for (int j = 0; j < o->nnu && positive; j++) {
+            positive = u[j][c] > 0.0;
+            lg += positive ? wt[j] * log(u[j][c]) : 0.0;
+        }
+        if (positive)
+            out[c] = fmin(fmax(exp(lg), fmin(u[inu][c], u[inu + 1][c])), fmax(u[inu][c], u[inu + 1][c]));
+    }
 }
 
 static void lookup(const struct sb_orders_ref *o, const double *table, double r, double mu, double mu_s, double nu,
                    bool ground, double out[3])
 {
-    lookup_any(o, table, NULL, r, mu, mu_s, nu, ground, out);
+    lookup_any(o, table, NULL, r, mu, mu_s, nu, ground, false, out);
 }
 
 /* ---- Single scattering -------------------------------------------------------- */
@@ -604,6 +646,7 @@ static void grid_init(struct sb_orders_ref *o, const struct sb_atmosphere_params
     o->H = sqrt(o->top * o->top - o->R * o->R);
     o->heights = heights_of(p, o->nr);
     o->mu_s_min = -o->H / o->top;
+    o->log_azimuth = sb_orders_log_azimuth(p);
     o->level_count = sb_atmosphere_levels(p, o->levels);
     sb_ref_gauss_legendre(GL_RAY, -1, 1, o->gl_ray_x, o->gl_ray_w);
     sb_ref_gauss_legendre(SPHERE_GROUND, -1, 1, o->gl_ground_x, o->gl_ground_w);
@@ -739,7 +782,7 @@ void sb_orders_table_read(const struct sb_orders_ref *o, const float *table, dou
     double r = o->R + fmax(h, 0.0);
     out[0] = out[1] = out[2] = 0.0;
     if (enter_atmosphere(o, &r, &mu, &mu_s, nu))
-        lookup_any(o, NULL, table, r, mu, mu_s, nu, hits_ground(o, r, mu), out);
+        lookup_any(o, NULL, table, r, mu, mu_s, nu, hits_ground(o, r, mu), true, out);
 }
 
 void sb_orders_ref_ground(const struct sb_orders_ref *o, int imus, double out[3])
@@ -769,7 +812,7 @@ void sb_orders_ref_sky(const struct sb_orders_ref *o, double h, double mu, doubl
     double ray[3], mie[3], ms[3];
     bool ground = hits_ground(o, r, mu);
     single_along(o, r, mu, ground, mu_s, nu, ray, mie);
-    lookup(o, o->sum, r, mu, mu_s, nu, ground, ms);
+    lookup_any(o, o->sum, NULL, r, mu, mu_s, nu, ground, true, ms);
     for (int c = 0; c < 3; c++)
         out[c] = sb_ref_phase_rayleigh(nu) * ray[c] + sb_ref_phase_mie(o->p.mie_g, nu) * mie[c] + ms[c];
     if (multiple)

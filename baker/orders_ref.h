@@ -29,7 +29,11 @@
  *   horizon, where twilight falls exponentially;
  * - nu: the sun's azimuth about the vertical from the view's, uniform over
  *   [0, pi] (every node a real direction).
- * Between nodes, multilinear otherwise. The density's integral over the
+ * Between nodes, multilinear otherwise. A view's read of the sum (the
+ * sky's, and sb_orders_table_read's), where Mie outscatters Rayleigh at
+ * the ground (sb_orders_log_azimuth: a dust's forward peak), takes the
+ * azimuth by day log-trigonometrically through every azimuth node instead,
+ * kept between the two about it (the orders' own reads stay linear). The density's integral over the
  * sphere takes Rayleigh's part on Gauss-Legendre nodes on either side of
  * the horizon, and Mie's at quantiles of Henyey-Greenstein's scattering
  * angle about the view (weighted by Cornette-Shanks over it), so that a

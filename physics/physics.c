@@ -41,6 +41,14 @@ double sb_orders_height_ratio(const struct sb_atmosphere_params *p, int nr)
     return 0.5 * (lo + hi);
 }
 
+bool sb_orders_log_azimuth(const struct sb_atmosphere_params *p)
+{
+    for (int c = 0; c < 3; c++)
+        if (!(p->mie_scattering_per_km[c] > p->rayleigh_scattering_per_km[c]))
+            return false;
+    return true;
+}
+
 void sb_orders_grid_pack(const struct sb_atmosphere_params *p, int nr, int nmu, int nmus, int nnu,
                          struct sb_orders_push *out)
 {
@@ -56,6 +64,7 @@ void sb_orders_grid_pack(const struct sb_atmosphere_params *p, int nr, int nmu, 
     out->heights[3] = (float)(top - R);
     out->mu_s[0] = (float)(-sqrt(top * top - R * R) / top);
     out->mu_s[1] = (float)SB_ORDERS_MU_S_SPLIT;
+    out->mu_s[2] = sb_orders_log_azimuth(p) ? 1.0f : 0.0f;
 }
 
 void sb_atmosphere_gpu_pack(const struct sb_atmosphere_params *p, struct sb_atmosphere_gpu *g)

@@ -8,6 +8,7 @@
 #ifndef SB_PHYSICS_PHYSICS_H
 #define SB_PHYSICS_PHYSICS_H
 
+#include <stdbool.h>
 #include <stddef.h>
 
 #include "config.h"
@@ -28,8 +29,20 @@ void sb_atmosphere_gpu_pack(const struct sb_atmosphere_params *params, struct sb
  * smaller scale height (q = 1: uniform, where that would be coarser). */
 double sb_orders_height_ratio(const struct sb_atmosphere_params *params, int nr);
 
+/* Whether a view reads the orders' table across the sun's azimuth
+ * log-trigonometrically (through every azimuth node, exact for
+ * exp(a + b cos phi + c cos 2 phi + ...)) rather than linearly between the
+ * two nodes about it: where Mie scatters more than Rayleigh at the ground
+ * in every channel. A dust's orders 2 and up peak toward the sun like
+ * exp(k cos phi), which a line between nodes 60 degrees apart lifts across
+ * the sun (mars read 17 to 38% high there); where Rayleigh's smooth light
+ * dominates, the line is the better read (docs/accuracy.md, "The orders'
+ * azimuths by the medium"). */
+bool sb_orders_log_azimuth(const struct sb_atmosphere_params *params);
+
 /* The grid of nr x nmu x nmus x nnu nodes as the orders' kernels and
- * skyview's passes take it (config.h's sb_orders_push; order 0). */
+ * skyview's passes take it (config.h's sb_orders_push; order 0), of the
+ * scene's atmosphere (a spectral band's grid is its scene's). */
 void sb_orders_grid_pack(const struct sb_atmosphere_params *params, int nr, int nmu, int nmus, int nnu,
                          struct sb_orders_push *out);
 

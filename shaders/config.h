@@ -582,7 +582,8 @@ struct sb_prefilter_push {
 struct sb_orders_push {
     SB_UVEC4(size);    /* nodes in r, mu (even: two halves), mu_s, nu */
     SB_VEC4(heights);  /* the altitudes' progression: q, ln q, q^n - 1 (n = size.x - 1), thickness */
-    SB_VEC4(mu_s);     /* the lowest mu_s node, the split (SB_ORDERS_MU_S_SPLIT), unused, unused */
+    SB_VEC4(mu_s);     /* the lowest mu_s node, the split (SB_ORDERS_MU_S_SPLIT), 1 where views read the
+                          sun's azimuth log-trigonometrically (sb_orders_log_azimuth) else 0, unused */
     SB_UINT order;     /* k, the order being computed (2 and up) */
     SB_UINT pad0, pad1, pad2;
 };

@@ -14,11 +14,14 @@
  * views: a check at GRID_ERROR tells them apart.
  */
 #include <math.h>
+#include <stdint.h>
 #include <stdio.h>
+#include <stdlib.h>
 
 #include "harness.h"
 #include "orders_ref.h"
 #include "pathtrace.h"
+#include "physics.h"
 #include "scene.h"
 
 #define PATHS 16384
@@ -28,6 +31,83 @@ static const struct sb_orders_settings coarse = {.r = 12, .mu = 48, .mu_s = 16, 
 
 static const double views[][2] = {{0, 0}, {60, 0}, {80, 180}, {87, 90}, {87, 0}, {120, 180}};
 static const double suns[] = {30, 5};
+
+/* A view's read across the sun's azimuth (orders_ref.h): where Mie
+ * outscatters Rayleigh, log-trigonometric through every azimuth node, exact
+ * for exp(a + b cos phi + c cos 2 phi + d cos 3 phi) on 4 nodes, and kept
+ * between the two nodes about phi; elsewhere linear between them. A table
+ * constant but for the azimuth is read at random views by day. */
+static double azimuth_profile(const double k[4], double phi)
+{
+    return exp(k[0] + k[1] * cos(phi) + k[2] * cos(2 * phi) + k[3] * cos(3 * phi));
+}
+
+static double uniform(uint64_t *state)
+{
+    *state = *state * 6364136223846793005ULL + 1442695040888963407ULL;
+    return (double)(*state >> 11) * 0x1p-53;
+}
+
+static void check_azimuth_reads(void)
+{
+    struct sb_atmosphere_params mars, earth;
+    sb_atmosphere_preset_mars(&mars);
+    sb_atmosphere_preset_earth(&earth);
+    CHECK(sb_orders_log_azimuth(&mars) && !sb_orders_log_azimuth(&earth),
+          "mars's dust reads the azimuth log-trigonometrically, the earth's air linearly");
+    const struct sb_orders_settings s = {.r = 16, .mu = 64, .mu_s = 24, .nu = 4};
+    size_t nodes = (size_t)s.r * s.mu * s.mu_s * s.nu;
+    float *table = malloc(3 * nodes * sizeof(float));
+    struct sb_orders_ref *grid[2] = {sb_orders_grid_create(&mars, &s), sb_orders_grid_create(&earth, &s)};
+    CHECK(table && grid[0] && grid[1], "memory");
+    if (!table || !grid[0] || !grid[1])
+        goto done;
+    const double k[4] = {0.3, 1.7, -0.4, 0.2}, peak[4] = {100, 1, 1, 1};
+    uint64_t rng = 7;
+    for (int profile = 0; profile < 3; profile++) {
+        /* 0: the smooth profile; 1: a node at 0 (no logarithm: linear); 2: a peak at phi = 0 */
+        double node[4];
+        for (int j = 0; j < 4; j++)
+            node[j] = profile == 2 ? peak[j] : profile == 1 && j == 3 ? 0.0 : azimuth_profile(k, M_PI * j / 3);
+        for (size_t i = 0; i < nodes; i++)
+            for (int c = 0; c < 3; c++)
+                table[3 * i + c] = (float)(node[i % 4] * (1 + c));
+        double worst[2] = {0, 0}, far_from_line = 0;
+        for (int t = 0; t < 2000; t++) {
+            double h = 40 * uniform(&rng), mu = 2 * uniform(&rng) - 1;
+            double mu_s = 0.15 + 0.85 * uniform(&rng), phi = M_PI * uniform(&rng);
+            double nu = mu * mu_s + sqrt((1 - mu * mu) * (1 - mu_s * mu_s)) * cos(phi), f = phi * 3 / M_PI;
+            int i = f < 2 ? (int)f : 2;
+            double line = node[i] + (f - i) * (node[i + 1] - node[i]);
+            /* the peak: between nodes 1 and 3 its ringing is clamped to the nodes' 1; -1: within the nodes */
+            double want[2] = {profile == 0 ? azimuth_profile(k, phi) : profile == 1 || i > 0 ? line : -1, line};
+            for (int g = 0; g < 2; g++) {
+                double got[3];
+                sb_orders_table_read(grid[g], table, h, mu, mu_s, nu, got);
+                if (want[g] < 0) /* beside the peak: within the two nodes */
+                    CHECK(got[1] >= 2 * fmin(node[0], node[1]) * (1 - 1e-6) &&
+                              got[1] <= 2 * fmax(node[0], node[1]) * (1 + 1e-6),
+                          "azimuth %.1f: %g outside its nodes", phi * 180 / M_PI, got[1]);
+                else
+                    for (int c = 0; c < 3; c++)
+                        worst[g] = fmax(worst[g], fabs(got[c] / ((1 + c) * want[g]) - 1));
+                if (g == 0)
+                    far_from_line = fmax(far_from_line, fabs(got[0] / line - 1));
+            }
+        }
+        printf("azimuth reads, profile %d: log-trigonometric within %.2g, linear within %.2g, %.2g off the line\n",
+               profile, worst[0], worst[1], far_from_line);
+        CHECK(worst[0] <= 1e-6 && worst[1] <= 1e-6, "profile %d: the reads %.3g and %.3g off what they state", profile,
+              worst[0], worst[1]);
+        if (profile == 0)
+            CHECK(far_from_line > 0.1, "the smooth profile is %.3g off the line at most: the test tells nothing",
+                  far_from_line);
+    }
+done:
+    free(table);
+    sb_orders_ref_destroy(&grid[0]);
+    sb_orders_ref_destroy(&grid[1]);
+}
 
 static void compare(const char *what, const struct sb_atmosphere_params *p, const struct sb_orders_ref *ref,
                     int max_order)
@@ -60,6 +140,7 @@ static void compare(const char *what, const struct sb_atmosphere_params *p, cons
 
 int main(void)
 {
+    check_azimuth_reads();
     struct sb_atmosphere_params earth;
     sb_atmosphere_preset_earth(&earth);
     struct sb_orders_settings two = coarse;

@@ -1512,17 +1512,17 @@ static void test_aerial_of(struct sb_renderer *r, const struct sb_pack *p, doubl
     free(volume);
 }
 
-/* A pack of the earth with `products` (a JSON array's items), `present`
- * among them: skyview's sky-view LUT and aerial perspective against the
- * same sky in fp64 (test_sky_view_of, test_aerial_of: the bounds of
- * Hillaire's sky above), and its frame at a sun of `frame_sun` degrees
- * finite. */
-static void test_pack_sky(const char *dir, const char *what, const char *products, enum sb_product_id present,
-                          double frame_sun)
+/* A pack of the atmosphere `preset` with `products` (a JSON array's
+ * items), `present` among them: skyview's sky-view LUT and aerial
+ * perspective against the same sky in fp64 (test_sky_view_of,
+ * test_aerial_of: the bounds of Hillaire's sky above), and its frame at a
+ * sun of `frame_sun` degrees finite. */
+static void test_pack_sky(const char *dir, const char *preset, const char *what, const char *products,
+                          enum sb_product_id present, double frame_sun)
 {
     char path[300], json[512];
-    snprintf(path, sizeof(path), "%s/%s-pack", dir, sb_product_name(present));
-    snprintf(json, sizeof(json), "{\"atmosphere\":{\"preset\":\"earth\"},\"products\":[%s]}", products);
+    snprintf(path, sizeof(path), "%s/%s-%s-pack", dir, preset, sb_product_name(present));
+    snprintf(json, sizeof(json), "{\"atmosphere\":{\"preset\":\"%s\"},\"products\":[%s]}", preset, products);
     struct sb_scene *scene = calloc(1, sizeof(*scene));
     struct sb_pack sky_of_pack = {0};
     struct sb_bake_report report;
@@ -1560,9 +1560,11 @@ static void test_pack_sky(const char *dir, const char *what, const char *product
 static void test_orders_sky(const char *dir)
 {
     const char *orders = "\"transmittance\",\"multiscattering\",\"irradiance_ground\",\"orders\"";
-    test_pack_sky(dir, "with the orders", orders, SB_PRODUCT_ORDERS, 3.0);
+    test_pack_sky(dir, "earth", "with the orders", orders, SB_PRODUCT_ORDERS, 3.0);
+    /* mars's dust: the azimuth read log-trigonometrically (sb_orders_log_azimuth) */
+    test_pack_sky(dir, "mars", "of mars with the orders", orders, SB_PRODUCT_ORDERS, 3.0);
     /* named alone, it brings everything skyview draws it with */
-    test_pack_sky(dir, "with the spectral products", "\"spectral_orders\"", SB_PRODUCT_SPECTRAL_ORDERS, -4.0);
+    test_pack_sky(dir, "earth", "with the spectral products", "\"spectral_orders\"", SB_PRODUCT_SPECTRAL_ORDERS, -4.0);
 }
 
 static void test_above_atmosphere(struct sb_renderer *r)

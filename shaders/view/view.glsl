@@ -46,6 +46,58 @@ vec3 orders_texel(uint i)
 
 SB_ORDERS_READ(orders_read_texels, orders_texel)
 
+/* The weights of the SB_ORDERS_NU azimuth nodes (the runtime's grid:
+ * runtime/atmosphere.c) at the sun's azimuth phi in the trigonometric
+ * interpolation through them (baker/orders_ref.c's azimuth_weights): the
+ * cardinal functions of 2 (n - 1) points about the circle, a node counting
+ * for its mirror image too; cos(m phi) by Chebyshev's recurrence, the
+ * nodes' cosines constants. */
+void orders_azimuth_weights(float phi, out float w[SB_ORDERS_NU])
+{
+    const uint n = SB_ORDERS_NU, M = 2u * (n - 1u);
+    float cm[M / 2u + 1u];
+    cm[0] = 1.0;
+    cm[1] = cos(phi);
+    for (uint m = 2u; m <= M / 2u; m++)
+        cm[m] = 2.0 * cm[1] * cm[m - 1u] - cm[m - 2u];
+    for (uint j = 0u; j < n; j++) {
+        float d = 1.0 + cm[M / 2u] * cos(PI * float(M / 2u * j) / float(n - 1u));
+        for (uint m = 1u; m < M / 2u; m++)
+            d += 2.0 * cm[m] * cos(PI * float(m * j) / float(n - 1u));
+        w[j] = (j == 0u || j == n - 1u ? 1.0 : 2.0) * d / float(M);
+    }
+}
+
+/* By day where the grid says so (orders_mu_s.z: sb_orders_log_azimuth, a
+ * dust's forward peak), the sun's azimuth log-trigonometrically through
+ * every azimuth node, kept between the two about it, linearly where a node
+ * is not positive (orders_ref.h): the sampler filters mu alone, 4 reads a
+ * node. */
+vec3 orders_sky_log_azimuth(OrdersCell c)
+{
+    uvec4 s = SB_ORDERS_GRID_SIZE, n = orders_node(c.base);
+    vec2 texel = 1.0 / vec2(textureSize(orders_texture, 0).xy);
+    vec2 step_s = vec2(float(s.w), 0.0), step_r = vec2(0.0, float(s.y));
+    float y = float(n.x * s.y + n.y) + c.a.y + 0.5, layer = float(atm_band);
+    float w[SB_ORDERS_NU];
+    orders_azimuth_weights((float(n.w) + c.a.z) * PI / float(SB_ORDERS_NU - 1u), w);
+    vec3 lg = vec3(0.0), a = vec3(0.0), b = vec3(0.0);
+    bvec3 positive = bvec3(true);
+    for (uint j = 0u; j < SB_ORDERS_NU; j++) {
+        vec2 p = vec2(float(n.z * s.w + j) + 0.5, y);
+        vec3 u0 = mix(textureLod(orders_texture, vec3(p * texel, layer), 0.0).rgb,
+                      textureLod(orders_texture, vec3((p + step_r) * texel, layer), 0.0).rgb, c.a.x);
+        vec3 u1 = mix(textureLod(orders_texture, vec3((p + step_s) * texel, layer), 0.0).rgb,
+                      textureLod(orders_texture, vec3((p + step_s + step_r) * texel, layer), 0.0).rgb, c.a.x);
+        vec3 u = mix(u0, u1, c.as);
+        positive = bvec3(uvec3(positive) & uvec3(greaterThan(u, vec3(0.0))));
+        lg += w[j] * log(max(u, vec3(1e-30)));
+        a = j == n.w ? u : a;
+        b = j == n.w + 1u ? u : b;
+    }
+    return mix(mix(a, b, c.a.z), clamp(exp(lg), min(a, b), max(a, b)), positive);
+}
+
 /* The table's read (orders.glsl's SB_ORDERS_READ); by day with the
  * sampler's bilinear filter doing mu and nu (adjacent texels of a node's
  * row and column; the sampler is linear): 4 reads instead of 16. The
@@ -57,6 +109,8 @@ vec3 orders_sky(float h, float mu, float mu_s, float nu, bool ground)
     OrdersCell c = orders_cell(h, mu, mu_s, nu, ground);
     if (c.twilight)
         return orders_read_texels(c);
+    if (SB_ORDERS_GRID_MU_S.z > 0.5)
+        return orders_sky_log_azimuth(c);
     uvec4 s = SB_ORDERS_GRID_SIZE, n = orders_node(c.base);
     vec2 texel = 1.0 / vec2(textureSize(orders_texture, 0).xy);
     float x = float(n.z * s.w + n.w) + c.a.z + 0.5, y = float(n.x * s.y + n.y) + c.a.y + 0.5;
