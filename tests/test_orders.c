@@ -12,6 +12,10 @@
  * standard error to be small, so that a check cannot pass by being noisy.
  * Hillaire's approximation is off by 6.5 to 27% at these suns' worst
  * views: a check at GRID_ERROR tells them apart.
+ *
+ * First, a view's read of a table across the sun's azimuth, where the
+ * medium makes it log-trigonometric (mars) and where it stays linear (the
+ * earth), against what each states, on a table made to tell them apart.
  */
 #include <math.h>
 #include <stdint.h>
