@@ -103,7 +103,8 @@ vec3 orders_sky_log_azimuth(OrdersCell c)
  * row and column; the sampler is linear): 4 reads instead of 16. The
  * filter's weights are fixed-point on some GPUs (8 bits on NVIDIA's):
  * within 1/512 of a step between neighbours. At twilight nu is geometric,
- * which the filter cannot do: 16 reads. */
+ * which the filter cannot do: 16 reads; so is a dust's day
+ * (orders_sky_log_azimuth). */
 vec3 orders_sky(float h, float mu, float mu_s, float nu, bool ground)
 {
     OrdersCell c = orders_cell(h, mu, mu_s, nu, ground);
