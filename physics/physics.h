@@ -30,8 +30,8 @@ void sb_atmosphere_gpu_pack(const struct sb_atmosphere_params *params, struct sb
 double sb_orders_height_ratio(const struct sb_atmosphere_params *params, int nr);
 
 /* Whether a view reads the orders' table across the sun's azimuth
- * log-trigonometrically (through every azimuth node, exact for
- * exp(a + b cos phi + c cos 2 phi + ...)) rather than linearly between the
+ * log-trigonometrically (through all n azimuth nodes, exact for the
+ * exponential of any sum of cos(k phi), k < n) rather than linearly between the
  * two nodes about it: where Mie scatters more than Rayleigh at the ground
  * in every channel. A dust's orders 2 and up peak toward the sun like
  * exp(k cos phi), which a line between nodes 60 degrees apart lifts across

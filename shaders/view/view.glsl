@@ -68,6 +68,22 @@ void orders_azimuth_weights(float phi, out float w[SB_ORDERS_NU])
     }
 }
 
+/* By day, the table at texel position p (in texels; the sampler filters
+ * across whatever fraction p holds, mu's and nu's or mu's alone) of cell
+ * c's lower r and mu_s nodes, linear in r and mu_s over the cell: 4 reads. */
+vec3 orders_day_texels(OrdersCell c, vec2 p)
+{
+    uvec4 s = SB_ORDERS_GRID_SIZE;
+    vec2 texel = 1.0 / vec2(textureSize(orders_texture, 0).xy);
+    vec2 step_s = vec2(float(s.w), 0.0), step_r = vec2(0.0, float(s.y));
+    float layer = float(atm_band);
+    vec3 v0 = mix(textureLod(orders_texture, vec3(p * texel, layer), 0.0).rgb,
+                  textureLod(orders_texture, vec3((p + step_r) * texel, layer), 0.0).rgb, c.a.x);
+    vec3 v1 = mix(textureLod(orders_texture, vec3((p + step_s) * texel, layer), 0.0).rgb,
+                  textureLod(orders_texture, vec3((p + step_s + step_r) * texel, layer), 0.0).rgb, c.a.x);
+    return mix(v0, v1, c.as); /* by day orders_blend is this */
+}
+
 /* By day where the grid says so (orders_mu_s.z: sb_orders_log_azimuth, a
  * dust's forward peak), the sun's azimuth log-trigonometrically through
  * every azimuth node, kept between the two about it, linearly where a node
@@ -76,20 +92,13 @@ void orders_azimuth_weights(float phi, out float w[SB_ORDERS_NU])
 vec3 orders_sky_log_azimuth(OrdersCell c)
 {
     uvec4 s = SB_ORDERS_GRID_SIZE, n = orders_node(c.base);
-    vec2 texel = 1.0 / vec2(textureSize(orders_texture, 0).xy);
-    vec2 step_s = vec2(float(s.w), 0.0), step_r = vec2(0.0, float(s.y));
-    float y = float(n.x * s.y + n.y) + c.a.y + 0.5, layer = float(atm_band);
+    float y = float(n.x * s.y + n.y) + c.a.y + 0.5;
     float w[SB_ORDERS_NU];
     orders_azimuth_weights((float(n.w) + c.a.z) * PI / float(SB_ORDERS_NU - 1u), w);
     vec3 lg = vec3(0.0), a = vec3(0.0), b = vec3(0.0);
     bvec3 positive = bvec3(true);
     for (uint j = 0u; j < SB_ORDERS_NU; j++) {
-        vec2 p = vec2(float(n.z * s.w + j) + 0.5, y);
-        vec3 u0 = mix(textureLod(orders_texture, vec3(p * texel, layer), 0.0).rgb,
-                      textureLod(orders_texture, vec3((p + step_r) * texel, layer), 0.0).rgb, c.a.x);
-        vec3 u1 = mix(textureLod(orders_texture, vec3((p + step_s) * texel, layer), 0.0).rgb,
-                      textureLod(orders_texture, vec3((p + step_s + step_r) * texel, layer), 0.0).rgb, c.a.x);
-        vec3 u = mix(u0, u1, c.as);
+        vec3 u = orders_day_texels(c, vec2(float(n.z * s.w + j) + 0.5, y));
         positive = bvec3(uvec3(positive) & uvec3(greaterThan(u, vec3(0.0))));
         lg += w[j] * log(max(u, vec3(1e-30)));
         a = j == n.w ? u : a;
@@ -113,16 +122,7 @@ vec3 orders_sky(float h, float mu, float mu_s, float nu, bool ground)
     if (SB_ORDERS_GRID_MU_S.z > 0.5)
         return orders_sky_log_azimuth(c);
     uvec4 s = SB_ORDERS_GRID_SIZE, n = orders_node(c.base);
-    vec2 texel = 1.0 / vec2(textureSize(orders_texture, 0).xy);
-    float x = float(n.z * s.w + n.w) + c.a.z + 0.5, y = float(n.x * s.y + n.y) + c.a.y + 0.5;
-    vec2 step_s = vec2(float(s.w), 0.0), step_r = vec2(0.0, float(s.y));
-    vec2 p = vec2(x, y);
-    float layer = float(atm_band);
-    vec3 v0 = mix(textureLod(orders_texture, vec3(p * texel, layer), 0.0).rgb,
-                  textureLod(orders_texture, vec3((p + step_r) * texel, layer), 0.0).rgb, c.a.x);
-    vec3 v1 = mix(textureLod(orders_texture, vec3((p + step_s) * texel, layer), 0.0).rgb,
-                  textureLod(orders_texture, vec3((p + step_s + step_r) * texel, layer), 0.0).rgb, c.a.x);
-    return mix(v0, v1, c.as); /* by day orders_blend is this */
+    return orders_day_texels(c, vec2(float(n.z * s.w + n.w) + c.a.z + 0.5, float(n.x * s.y + n.y) + c.a.y + 0.5));
 }
 
 /* The ground's irradiance from the sky (the table's last row). */
