@@ -148,9 +148,10 @@ static int orders_suns(const struct sb_scene *scene, double suns[4])
 }
 
 /* The orders' grid and their stopping rule, for a key. */
-static void orders_grid_key(struct sb_key_text *key)
+static void orders_grid_key(const struct sb_scene *scene, struct sb_key_text *key)
 {
-    struct sb_orders_settings s = sb_orders_settings_resolve(&sb_orders_product_grid);
+    struct sb_orders_settings grid = sb_orders_product_grid(&scene->atmosphere);
+    struct sb_orders_settings s = sb_orders_settings_resolve(&grid);
     sb_key_add(key, " grid %dx%dx%dx%d orders %d until %a", s.r, s.mu, s.mu_s, s.nu, s.max_order, s.tolerance);
 }
 
@@ -164,10 +165,10 @@ static void orders_code_key(struct sb_key_text *key)
 /* What the artifact's settings say of an orders bake, after `first` (the
  * object's opening fields, "{" for none); the grid's altitude ratio where
  * it is not NAN. */
-static void orders_settings(struct sb_artifact *a, const char *first, const struct sb_orders_result *r,
-                            double height_ratio)
+static void orders_settings(struct sb_artifact *a, const char *first, const struct sb_orders_settings *grid,
+                            const struct sb_orders_result *r, double height_ratio)
 {
-    struct sb_orders_settings s = sb_orders_settings_resolve(&sb_orders_product_grid);
+    struct sb_orders_settings s = sb_orders_settings_resolve(grid);
     int n = snprintf(a->settings_json, sizeof(a->settings_json), "%s\"r\":%d,\"mu\":%d,\"mu_s\":%d,\"nu\":%d", first,
                      s.r, s.mu, s.mu_s, s.nu);
     if (!isnan(height_ratio) && n > 0 && (size_t)n < sizeof(a->settings_json))
@@ -180,7 +181,7 @@ static void orders_settings(struct sb_artifact *a, const char *first, const stru
 
 static void orders_key(const struct sb_scene *scene, struct sb_key_text *key)
 {
-    orders_grid_key(key);
+    orders_grid_key(scene, key);
     if (scene->tolerance[SB_PRODUCT_ORDERS] > 0) {
         double suns[4];
         int n = orders_suns(scene, suns);
@@ -201,12 +202,13 @@ static enum sb_result orders_bake(struct sb_atmosphere_baker *baker, struct sb_v
                                   struct sb_artifact *a)
 {
     struct sb_orders_result r;
-    enum sb_result res = sb_orders_bake(vk, baker, &scene->atmosphere, &sb_orders_product_grid, image, &r);
+    struct sb_orders_settings grid = sb_orders_product_grid(&scene->atmosphere);
+    enum sb_result res = sb_orders_bake(vk, baker, &scene->atmosphere, &grid, image, &r);
     if (res)
         return res;
     a->gpu_ms = r.gpu_ms;
-    struct sb_orders_settings s = sb_orders_settings_resolve(&sb_orders_product_grid);
-    orders_settings(a, "{", &r, sb_orders_height_ratio(&scene->atmosphere, s.r));
+    struct sb_orders_settings s = sb_orders_settings_resolve(&grid);
+    orders_settings(a, "{", &grid, &r, sb_orders_height_ratio(&scene->atmosphere, s.r));
     double tolerance = scene->tolerance[SB_PRODUCT_ORDERS];
     if (tolerance <= 0)
         return SB_OK;
@@ -243,7 +245,7 @@ static void spectral_key(const struct sb_scene *scene, enum sb_product_id id, st
     }
     char settings[1024], code[SB_HASH_HEX_SIZE];
     if (base == SB_PRODUCT_ORDERS) {
-        orders_grid_key(key);
+        orders_grid_key(scene, key);
         orders_code_key(key);
     }
     /* the LUTs each band's bake of `base` reads, and its own */
@@ -318,7 +320,8 @@ static enum sb_result spectral_bake(struct atmosphere_state *state, struct sb_vk
     snprintf(head + n, sizeof(head) - (size_t)n, "]");
     if (sb_spectral_base(id) == SB_PRODUCT_ORDERS) {
         strncat(head, ",", sizeof(head) - strlen(head) - 1);
-        orders_settings(a, head, &orders, NAN);
+        struct sb_orders_settings grid = sb_orders_product_grid(&scene->atmosphere);
+        orders_settings(a, head, &grid, &orders, NAN);
     } else {
         snprintf(a->settings_json, sizeof(a->settings_json), "%s}", head);
     }

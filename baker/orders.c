@@ -24,8 +24,11 @@ enum { SINGLE, DENSITY, SCATTER, KERNEL_COUNT };
 static const struct sb_pipeline_params kernels[KERNEL_COUNT] = {KERNEL(single), KERNEL(density), KERNEL(scatter)};
 #undef KERNEL
 
-const struct sb_orders_settings sb_orders_product_grid = {
-    .r = SB_ORDERS_R, .mu = SB_ORDERS_MU, .mu_s = SB_ORDERS_MU_S, .nu = SB_ORDERS_NU};
+struct sb_orders_settings sb_orders_product_grid(const struct sb_atmosphere_params *p)
+{
+    return (struct sb_orders_settings){
+        .r = SB_ORDERS_R, .mu = sb_orders_mu_nodes(p), .mu_s = SB_ORDERS_MU_S, .nu = SB_ORDERS_NU};
+}
 
 uint32_t sb_orders_kernels(struct sb_pipeline_params out[KERNEL_COUNT])
 {
@@ -212,7 +215,8 @@ void sb_orders_hillaire_error(const struct sb_atmosphere_params *p, const struct
                               const struct sb_image *orders, double altitude_km, const double *suns_deg, int sun_count,
                               double *rms, double *worst)
 {
-    struct sb_orders_ref *g = sb_orders_grid_create(p, &sb_orders_product_grid);
+    struct sb_orders_settings grid = sb_orders_product_grid(p);
+    struct sb_orders_ref *g = sb_orders_grid_create(p, &grid);
     double sum2 = 0, largest = 0;
     int n = 0;
     for (int s = 0; g && s < sun_count; s++) {

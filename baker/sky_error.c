@@ -397,7 +397,8 @@ enum sb_result sb_sky_error_run(struct sb_vk *vk, const char *scene_name, const 
     struct sb_image luts[SB_PRODUCT_COUNT] = {0};
     struct sb_spectral *spectral = NULL;
     struct sb_atmosphere_baker *baker = NULL;
-    struct sb_orders_ref *grid = sb_orders_grid_create(&scene->atmosphere, &sb_orders_product_grid);
+    struct sb_orders_settings product_grid = sb_orders_product_grid(&scene->atmosphere);
+    struct sb_orders_ref *grid = sb_orders_grid_create(&scene->atmosphere, &product_grid);
     enum sb_result res = grid ? SB_OK : SB_ERR_NOMEM;
     job.grid = grid;
     if (!res)
@@ -408,9 +409,9 @@ enum sb_result sb_sky_error_run(struct sb_vk *vk, const char *scene_name, const 
         res = sb_atmosphere_bake(baker, needed[i], NULL, &luts[needed[i]], NULL, NULL);
     if (!res) { /* the orders product, as a bake makes it */
         struct sb_orders_result orders_result;
-        res = sb_orders_bake(vk, baker, &scene->atmosphere, &sb_orders_product_grid, &luts[SB_PRODUCT_ORDERS],
-                             &orders_result);
+        res = sb_orders_bake(vk, baker, &scene->atmosphere, &product_grid, &luts[SB_PRODUCT_ORDERS], &orders_result);
         report->product_orders = orders_result.orders;
+        report->product_mu = product_grid.mu;
         report->product_gpu_ms = orders_result.gpu_ms;
     }
     sb_atmosphere_baker_destroy(&baker);
@@ -571,7 +572,7 @@ void sb_sky_error_print(const struct sb_sky_error_report *reports, int count, bo
                    channel_name(sun->worst_channel));
         }
         printf("  with the orders product (%d orders; %dx%dx%dx%d nodes), as skybake shows it:\n", r->product_orders,
-               SB_ORDERS_R, SB_ORDERS_MU, SB_ORDERS_MU_S, SB_ORDERS_NU);
+               SB_ORDERS_R, r->product_mu, SB_ORDERS_MU_S, SB_ORDERS_NU);
         printf("  %8s %9s %9s %9s %15s\n", "sun deg", "max rel", "rms rel", "mean rel", "CIEDE2000");
         for (int s = 0; s < r->sun_count; s++) {
             const struct sb_sky_error_sun *sun = &r->suns[s];

@@ -137,6 +137,7 @@ struct sb_sky_error_report {
     int orders;          /* with params.orders: the orders the reference summed, */
     double orders_s;     /* and its wall time */
     int product_orders;  /* the orders product's orders */
+    int product_mu;      /* its grid's mu nodes (sb_orders_product_grid) */
     double product_gpu_ms;
 };
 

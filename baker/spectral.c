@@ -8,6 +8,7 @@
 
 struct sb_spectral {
     struct sb_vk *vk;
+    struct sb_orders_settings orders_grid; /* the scene's (sb_orders_product_grid), every band's */
     struct sb_atmosphere_params bands[SB_SPECTRAL_BANDS];
     struct sb_atmosphere_baker *bakers[SB_SPECTRAL_BANDS];
     struct sb_image luts[SB_SPECTRAL_BANDS][SB_PRODUCT_COUNT]; /* by three-channel id; empty until baked */
@@ -21,6 +22,7 @@ enum sb_result sb_spectral_create(struct sb_vk *vk, const struct sb_atmosphere_p
     if (!s)
         return SB_ERR_NOMEM;
     s->vk = vk;
+    s->orders_grid = sb_orders_product_grid(p);
     enum sb_result res = SB_OK;
     for (int b = 0; b < SB_SPECTRAL_BANDS && !res; b++) {
         sb_spectral_band(p, b, &s->bands[b]);
@@ -83,8 +85,7 @@ enum sb_result sb_spectral_band_lut(struct sb_spectral *s, int band, enum sb_pro
             return res;
         double ms = 0;
         if (id == SB_PRODUCT_ORDERS) {
-            res = sb_orders_bake(s->vk, s->bakers[band], &s->bands[band], &sb_orders_product_grid, image,
-                                 &s->orders[band]);
+            res = sb_orders_bake(s->vk, s->bakers[band], &s->bands[band], &s->orders_grid, image, &s->orders[band]);
             ms = s->orders[band].gpu_ms;
         } else {
             res = sb_atmosphere_bake(s->bakers[band], id, NULL, image, NULL, &ms);

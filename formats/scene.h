@@ -255,6 +255,17 @@ void sb_atmosphere_preset_earth(struct sb_atmosphere_params *params);
 /* A thin, dusty Mars-like atmosphere (illustrative values, see scene.c). */
 void sb_atmosphere_preset_mars(struct sb_atmosphere_params *params);
 
+/* Whether Mie scatters more than Rayleigh at the ground in every channel
+ * (mars's dust, the haze; not the earth, whose red is 41% Mie): such an
+ * atmosphere's orders are read across the sun's azimuth
+ * log-trigonometrically (physics.h's sb_orders_log_azimuth) and kept on
+ * SB_ORDERS_MU_DUST view cosines (sb_orders_mu_nodes). */
+bool sb_atmosphere_dusty(const struct sb_atmosphere_params *params);
+
+/* The orders product's mu nodes for an atmosphere: SB_ORDERS_MU_DUST where
+ * it is dusty, else SB_ORDERS_MU. */
+int sb_orders_mu_nodes(const struct sb_atmosphere_params *params);
+
 /* Read and validate a scene file. On failure the scene is left zeroed. */
 enum sb_result sb_scene_load(const char *path, struct sb_scene *scene);
 

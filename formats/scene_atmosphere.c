@@ -9,6 +9,7 @@
 #include <stdio.h>
 #include <string.h>
 
+#include "config.h"
 #include "family.h"
 #include "json.h"
 #include "log.h"
@@ -257,8 +258,29 @@ cJSON *sb_atmosphere_section_json(const struct sb_scene *scene)
     return atm;
 }
 
+bool sb_atmosphere_dusty(const struct sb_atmosphere_params *p)
+{
+    for (int c = 0; c < 3; c++)
+        if (!(p->mie_scattering_per_km[c] > p->rayleigh_scattering_per_km[c]))
+            return false;
+    return true;
+}
+
+int sb_orders_mu_nodes(const struct sb_atmosphere_params *p)
+{
+    return sb_atmosphere_dusty(p) ? SB_ORDERS_MU_DUST : SB_ORDERS_MU;
+}
+
+/* The orders' rows follow the atmosphere's mu nodes (a dust's zenith). */
+static void atmosphere_product_shape(const struct sb_scene *scene, enum sb_product_id id, uint32_t shape[3])
+{
+    if (id == SB_PRODUCT_ORDERS || id == SB_PRODUCT_SPECTRAL_ORDERS)
+        shape[1] = (uint32_t)(SB_ORDERS_R * sb_orders_mu_nodes(&scene->atmosphere) + 1);
+}
+
 /* The scene's core: scene.c reads and writes the section itself, first. */
 const struct sb_family_format sb_atmosphere_family_format = {
     .name = "atmosphere",
     .default_products = true,
+    .product_shape = atmosphere_product_shape,
 };

@@ -43,10 +43,7 @@ double sb_orders_height_ratio(const struct sb_atmosphere_params *p, int nr)
 
 bool sb_orders_log_azimuth(const struct sb_atmosphere_params *p)
 {
-    for (int c = 0; c < 3; c++)
-        if (!(p->mie_scattering_per_km[c] > p->rayleigh_scattering_per_km[c]))
-            return false;
-    return true;
+    return sb_atmosphere_dusty(p);
 }
 
 void sb_orders_grid_pack(const struct sb_atmosphere_params *p, int nr, int nmu, int nmus, int nnu,

@@ -147,6 +147,7 @@
  * nodes in r, mu (two halves), mu_s and nu. */
 #define SB_ORDERS_R 16
 #define SB_ORDERS_MU 64
+#define SB_ORDERS_MU_DUST 128 /* where the atmosphere is dusty (sb_atmosphere_dusty): the zenith's cell */
 #define SB_ORDERS_MU_S 24
 #define SB_ORDERS_NU 4
 

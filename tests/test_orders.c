@@ -15,13 +15,15 @@
  *
  * First, a view's read of a table across the sun's azimuth, where the
  * medium makes it log-trigonometric (mars) and where it stays linear (the
- * earth), against what each states, on a table made to tell them apart.
+ * earth), against what each states, on a table made to tell them apart;
+ * and a dust's grid of twice the view cosines.
  */
 #include <math.h>
 #include <stdint.h>
 #include <stdio.h>
 #include <stdlib.h>
 
+#include "../formats/family.h" /* the formats' half (sb_product_shape), not the baker's */
 #include "harness.h"
 #include "orders_ref.h"
 #include "pathtrace.h"
@@ -59,6 +61,14 @@ static void check_azimuth_reads(void)
     sb_atmosphere_preset_earth(&earth);
     CHECK(sb_orders_log_azimuth(&mars) && !sb_orders_log_azimuth(&earth),
           "mars's dust reads the azimuth log-trigonometrically, the earth's air linearly");
+    /* and a dust keeps twice the view cosines (the zenith's cell), which the pack's shape follows */
+    struct sb_scene scene = {.atmosphere = mars};
+    uint32_t shape[3];
+    sb_product_shape(&scene, SB_PRODUCT_ORDERS, shape);
+    CHECK(sb_orders_mu_nodes(&mars) == SB_ORDERS_MU_DUST && sb_orders_mu_nodes(&earth) == SB_ORDERS_MU &&
+              shape[1] == SB_ORDERS_R * SB_ORDERS_MU_DUST + 1,
+          "mars's orders on %d mu nodes (%u rows), the earth's on %d", sb_orders_mu_nodes(&mars), shape[1],
+          sb_orders_mu_nodes(&earth));
     const struct sb_orders_settings s = {.r = 16, .mu = 64, .mu_s = 24, .nu = 4};
     size_t nodes = (size_t)s.r * s.mu * s.mu_s * s.nu;
     float *table = malloc(3 * nodes * sizeof(float));
