@@ -258,12 +258,15 @@ void sb_atmosphere_preset_mars(struct sb_atmosphere_params *params);
 /* Whether Mie scatters more than Rayleigh at the ground in every channel
  * (mars's dust, the haze; not the earth, whose red is 41% Mie): such an
  * atmosphere's orders are read across the sun's azimuth
- * log-trigonometrically (physics.h's sb_orders_log_azimuth) and kept on
- * SB_ORDERS_MU_DUST view cosines (sb_orders_mu_nodes). */
+ * log-trigonometrically (physics.h's sb_orders_log_azimuth). */
 bool sb_atmosphere_dusty(const struct sb_atmosphere_params *params);
 
 /* The orders product's mu nodes for an atmosphere: SB_ORDERS_MU_DUST where
- * it is dusty, else SB_ORDERS_MU. */
+ * it is dusty and its phase broad (|g| below SB_ORDERS_DUST_MAX_G; mars's
+ * 0.65: a dust's light that changes over tens of degrees, which 64 nodes
+ * read on a line across the zenith's 38 degree cell), else SB_ORDERS_MU.
+ * A peaked phase (the haze's 0.99) keeps 64: its peak is beyond any mu
+ * grid, and on 128 nodes the haze measured the same (docs/accuracy.md). */
 int sb_orders_mu_nodes(const struct sb_atmosphere_params *params);
 
 /* Read and validate a scene file. On failure the scene is left zeroed. */

@@ -268,7 +268,7 @@ bool sb_atmosphere_dusty(const struct sb_atmosphere_params *p)
 
 int sb_orders_mu_nodes(const struct sb_atmosphere_params *p)
 {
-    return sb_atmosphere_dusty(p) ? SB_ORDERS_MU_DUST : SB_ORDERS_MU;
+    return sb_atmosphere_dusty(p) && fabs(p->mie_g) < SB_ORDERS_DUST_MAX_G ? SB_ORDERS_MU_DUST : SB_ORDERS_MU;
 }
 
 /* The orders' rows follow the atmosphere's mu nodes (a dust's zenith). */

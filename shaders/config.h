@@ -147,7 +147,8 @@
  * nodes in r, mu (two halves), mu_s and nu. */
 #define SB_ORDERS_R 16
 #define SB_ORDERS_MU 64
-#define SB_ORDERS_MU_DUST 128 /* where the atmosphere is dusty (sb_atmosphere_dusty): the zenith's cell */
+#define SB_ORDERS_MU_DUST 128 /* a broad dust's (sb_orders_mu_nodes): the zenith's cell */
+#define SB_ORDERS_DUST_MAX_G 0.85 /* broad: |g| below it (a peak beyond, the cap's SB_CAP_MIN_G, no mu grid reads) */
 #define SB_ORDERS_MU_S 24
 #define SB_ORDERS_NU 4
 

@@ -61,14 +61,21 @@ static void check_azimuth_reads(void)
     sb_atmosphere_preset_earth(&earth);
     CHECK(sb_orders_log_azimuth(&mars) && !sb_orders_log_azimuth(&earth),
           "mars's dust reads the azimuth log-trigonometrically, the earth's air linearly");
-    /* and a dust keeps twice the view cosines (the zenith's cell), which the pack's shape follows */
+    /* and a broad dust keeps twice the view cosines (the zenith's cell),
+     * which the pack's shape follows; a peaked haze (data/scenes/haze.json)
+     * is read log-trigonometrically but keeps the earth's cosines */
+    struct sb_atmosphere_params haze = earth;
+    for (int c = 0; c < 3; c++)
+        haze.mie_scattering_per_km[c] = 0.07992;
+    haze.mie_g = 0.99;
     struct sb_scene scene = {.atmosphere = mars};
     uint32_t shape[3];
     sb_product_shape(&scene, SB_PRODUCT_ORDERS, shape);
     CHECK(sb_orders_mu_nodes(&mars) == SB_ORDERS_MU_DUST && sb_orders_mu_nodes(&earth) == SB_ORDERS_MU &&
+              sb_orders_log_azimuth(&haze) && sb_orders_mu_nodes(&haze) == SB_ORDERS_MU &&
               shape[1] == SB_ORDERS_R * SB_ORDERS_MU_DUST + 1,
-          "mars's orders on %d mu nodes (%u rows), the earth's on %d", sb_orders_mu_nodes(&mars), shape[1],
-          sb_orders_mu_nodes(&earth));
+          "mars's orders on %d mu nodes (%u rows), the earth's on %d, the haze's on %d", sb_orders_mu_nodes(&mars),
+          shape[1], sb_orders_mu_nodes(&earth), sb_orders_mu_nodes(&haze));
     const struct sb_orders_settings s = {.r = 16, .mu = 64, .mu_s = 24, .nu = 4};
     size_t nodes = (size_t)s.r * s.mu * s.mu_s * s.nu;
     float *table = malloc(3 * nodes * sizeof(float));
