@@ -148,7 +148,7 @@
 #define SB_ORDERS_R 16
 #define SB_ORDERS_MU 64
 #define SB_ORDERS_MU_DUST 128 /* a broad dust's (sb_orders_mu_nodes): the zenith's cell */
-#define SB_ORDERS_DUST_MAX_G 0.85 /* broad: |g| below it (a peak beyond, the cap's SB_CAP_MIN_G, no mu grid reads) */
+#define SB_ORDERS_DUST_MAX_G 0.85 /* broad: |g| below it; above, as for the cap's SB_CAP_MIN_G, a peak no mu grid reads */
 #define SB_ORDERS_MU_S 24
 #define SB_ORDERS_NU 4
 

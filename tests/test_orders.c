@@ -16,7 +16,7 @@
  * First, a view's read of a table across the sun's azimuth, where the
  * medium makes it log-trigonometric (mars) and where it stays linear (the
  * earth), against what each states, on a table made to tell them apart;
- * and a dust's grid of twice the view cosines.
+ * and a broad dust's grid of twice the view cosines, a peaked haze's not.
  */
 #include <math.h>
 #include <stdint.h>
