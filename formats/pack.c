@@ -537,7 +537,9 @@ static enum sb_result manifest_expect_int(const cJSON *object, const char *key, 
     if (!item)
         return res;
     if (item->valuedouble != (double)expect) {
-        sb_error("%s: %s%s: %s has %u, the manifest says %g", source, where, key, product, expect, item->valuedouble);
+        sb_error("%s: %s%s: %s has %u for the pack's scene, the manifest says %g (an older skybake's, or not "
+                 "this scene's: bake the pack again)",
+                 source, where, key, product, expect, item->valuedouble);
         return SB_ERR_BAD_IMAGE;
     }
     return SB_OK;
