@@ -411,7 +411,7 @@ enum sb_result sb_sky_error_run(struct sb_vk *vk, const char *scene_name, const 
         struct sb_orders_result orders_result;
         res = sb_orders_bake(vk, baker, &scene->atmosphere, &product_grid, &luts[SB_PRODUCT_ORDERS], &orders_result);
         report->product_orders = orders_result.orders;
-        report->product_mu = product_grid.mu;
+        report->product_grid = product_grid;
         report->product_gpu_ms = orders_result.gpu_ms;
     }
     sb_atmosphere_baker_destroy(&baker);
@@ -501,6 +501,8 @@ void sb_sky_error_print(const struct sb_sky_error_report *reports, int count, bo
             cJSON_AddNumberToObject(o, "spectral_paths", r->spectral_paths);
             cJSON_AddNumberToObject(o, "path_trace_s", r->path_trace_s);
             cJSON_AddNumberToObject(o, "product_orders", r->product_orders);
+            const int grid[4] = {r->product_grid.r, r->product_grid.mu, r->product_grid.mu_s, r->product_grid.nu};
+            cJSON_AddItemToObject(o, "product_grid", cJSON_CreateIntArray(grid, 4));
             cJSON *suns = cJSON_AddArrayToObject(o, "suns");
             for (int s = 0; s < r->sun_count; s++) {
                 const struct sb_sky_error_sun *sun = &r->suns[s];
@@ -572,7 +574,7 @@ void sb_sky_error_print(const struct sb_sky_error_report *reports, int count, bo
                    channel_name(sun->worst_channel));
         }
         printf("  with the orders product (%d orders; %dx%dx%dx%d nodes), as skybake shows it:\n", r->product_orders,
-               SB_ORDERS_R, r->product_mu, SB_ORDERS_MU_S, SB_ORDERS_NU);
+               r->product_grid.r, r->product_grid.mu, r->product_grid.mu_s, r->product_grid.nu);
         printf("  %8s %9s %9s %9s %15s\n", "sun deg", "max rel", "rms rel", "mean rel", "CIEDE2000");
         for (int s = 0; s < r->sun_count; s++) {
             const struct sb_sky_error_sun *sun = &r->suns[s];

@@ -137,7 +137,8 @@ struct sb_sky_error_report {
     int orders;          /* with params.orders: the orders the reference summed, */
     double orders_s;     /* and its wall time */
     int product_orders;  /* the orders product's orders */
-    int product_mu;      /* its grid's mu nodes (sb_orders_product_grid) */
+    /* on the scene's grid (sb_orders_product_grid) */
+    struct sb_orders_settings product_grid;
     double product_gpu_ms;
 };
 
