@@ -9,6 +9,7 @@
 #include "family.h"
 #include "log.h"
 #include "parallel.h"
+#include "pipeline.h"
 #include "skybake_version.h"
 
 static uint32_t depends_on(enum sb_product_id id)
@@ -280,7 +281,8 @@ enum sb_result sb_bake_scene(struct sb_vk *vk, const struct sb_scene *scene, con
 
 cleanup:
     sb_status(NULL);
-    sb_pipelines_release(vk);
+    if (sb_compute_pipelines_unused(vk))
+        sb_debug("pipelines: %u kernels compiled ahead were not used", sb_compute_pipelines_unused(vk));
     free(scene_json);
     sb_pack_close(old);
     free(old);

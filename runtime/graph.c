@@ -5,6 +5,7 @@
 #include <string.h>
 
 #include "log.h"
+#include "pipeline.h"
 #include "renderer_internal.h"
 
 #define PREVIOUS_BIT 0x80000000u
@@ -151,7 +152,6 @@ enum sb_result sb_pass_layout(struct sb_renderer *r, VkPipelineLayout *out)
     enum sb_result res = SB_OK;
     struct sb_graph_pass *p = creating(r);
     if (!p->layout) {
-        struct sb_vk *vk = r->vk;
         VkDescriptorSetLayoutBinding bindings[SB_GRAPH_MAX_USES];
         uint32_t n = 0;
         for (uint32_t u = 0; u < p->use_count; u++)
@@ -162,21 +162,9 @@ enum sb_result sb_pass_layout(struct sb_renderer *r, VkPipelineLayout *out)
                     .descriptorCount = 1,
                     .stageFlags = VK_SHADER_STAGE_ALL,
                 };
-        VkDescriptorSetLayoutCreateInfo set_info = {
-            .sType = VK_STRUCTURE_TYPE_DESCRIPTOR_SET_LAYOUT_CREATE_INFO,
-            .bindingCount = n,
-            .pBindings = bindings,
-        };
-        VK(vkCreateDescriptorSetLayout(vk->device, &set_info, NULL, &p->set_layout));
-        VkPushConstantRange range = {.stageFlags = VK_SHADER_STAGE_ALL, .size = sizeof(struct sb_view_push)};
-        VkPipelineLayoutCreateInfo layout_info = {
-            .sType = VK_STRUCTURE_TYPE_PIPELINE_LAYOUT_CREATE_INFO,
-            .setLayoutCount = 1,
-            .pSetLayouts = &p->set_layout,
-            .pushConstantRangeCount = 1,
-            .pPushConstantRanges = &range,
-        };
-        VK(vkCreatePipelineLayout(vk->device, &layout_info, NULL, &p->layout));
+        if ((res = sb_vk_layout(r->vk, bindings, n, VK_SHADER_STAGE_ALL, sizeof(struct sb_view_push), &p->set_layout,
+                                &p->layout)))
+            goto cleanup;
         if (!p->set_count)
             p->set_count = 1;
     }
@@ -294,13 +282,7 @@ void sb_graph_destroy(struct sb_renderer *r)
     VkDevice d = r->vk->device;
     if (g->pool)
         vkDestroyDescriptorPool(d, g->pool, NULL);
-    for (int i = 0; g->passes && i < SB_PASS_COUNT; i++) {
-        if (g->passes[i].layout)
-            vkDestroyPipelineLayout(d, g->passes[i].layout, NULL);
-        if (g->passes[i].set_layout)
-            vkDestroyDescriptorSetLayout(d, g->passes[i].set_layout, NULL);
-    }
-    free(g->passes);
+    free(g->passes); /* the passes' layouts are the context's */
     memset(g, 0, sizeof(*g));
 }
 

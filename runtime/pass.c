@@ -103,12 +103,8 @@ enum sb_result sb_renderer_kernel(struct sb_renderer *r, const uint32_t *spirv, 
     return res ? res : sb_compute_pipeline_create(r->vk, layout, spirv, spirv_size, &r->specialization, name, pipeline);
 }
 
-void sb_renderer_release(struct sb_renderer *r, const VkPipeline *pipelines, size_t pipeline_count,
-                         struct sb_texture *const *textures, size_t texture_count)
+void sb_renderer_release(struct sb_renderer *r, struct sb_texture *const *textures, size_t texture_count)
 {
-    for (size_t i = 0; i < pipeline_count; i++)
-        if (pipelines[i])
-            vkDestroyPipeline(r->vk->device, pipelines[i], NULL);
     for (size_t i = 0; i < texture_count; i++)
         sb_texture_destroy(r->vk, textures[i]);
 }
@@ -166,10 +162,7 @@ enum sb_result sb_pass_frame_kernel(struct sb_renderer *r, const uint32_t *spirv
 
 void sb_pass_frame_kernel_destroy(struct sb_renderer *r)
 {
-    VkPipeline *kernel = sb_pass_data(r);
-    if (kernel)
-        sb_renderer_release(r, kernel, 1, NULL, 0);
-    free(kernel);
+    free(sb_pass_data(r)); /* its kernel is the context's */
 }
 
 void sb_pass_frame_kernel_record(struct sb_renderer *r)

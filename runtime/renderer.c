@@ -267,7 +267,7 @@ void sb_renderer_destroy(struct sb_renderer **pr)
         vkDestroySampler(d, r->repeat, NULL);
     struct sb_texture *const textures[] = {
         &r->transmittance, &r->multiscattering, &r->irradiance_ground, &r->orders, &r->hdr, &r->depth, &r->ldr};
-    sb_renderer_release(r, NULL, 0, textures, sizeof(textures) / sizeof(textures[0]));
+    sb_renderer_release(r, textures, sizeof(textures) / sizeof(textures[0]));
     struct sb_buffer *buffers[] = {&r->atmosphere, &r->frame,      &r->exposure,      &r->read_ldr,   &r->read_hdr,
                                    &r->read_post,  &r->post_input, &r->read_sky_view, &r->read_aerial};
     for (size_t i = 0; i < sizeof(buffers) / sizeof(buffers[0]); i++)

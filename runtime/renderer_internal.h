@@ -207,10 +207,10 @@ enum sb_result sb_pass_frame_kernel(struct sb_renderer *r, const uint32_t *spirv
 void sb_pass_frame_kernel_destroy(struct sb_renderer *r);
 void sb_pass_frame_kernel_record(struct sb_renderer *r);
 
-/* Destroy what a pass made: its pipelines (VK_NULL_HANDLE ones skipped) and
- * textures (zeroed ones accepted). */
-void sb_renderer_release(struct sb_renderer *r, const VkPipeline *pipelines, size_t pipeline_count,
-                         struct sb_texture *const *textures, size_t texture_count);
+/* Destroy a pass's textures (zeroed ones accepted). Its kernels, layouts
+ * and pipelines are the context's (vulkan/pipeline.h): a pass never
+ * destroys them. */
+void sb_renderer_release(struct sb_renderer *r, struct sb_texture *const *textures, size_t texture_count);
 
 /* A full memory barrier: every earlier command's writes before every later
  * command (between the steps of a pass; graph.c). */

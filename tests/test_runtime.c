@@ -25,6 +25,7 @@
 #include "pack.h"
 #include "parallel.h"
 #include "physics.h"
+#include "pipeline.h"
 #include "renderer.h"
 #include "scene.h"
 #include "shadows.h"
@@ -3127,6 +3128,14 @@ int main(int argc, char **argv)
     if (pack.scene && world.vertices)
         CHECK(sb_renderer_create(vk, &pack, &world, &rp, &r) == SB_OK, "renderer");
     if (r) {
+        /* a renderer made again on the same context compiles nothing: its
+         * layouts and pipelines are the context's (vulkan/pipeline.h) */
+        uint32_t held = sb_vk_pipeline_count(vk);
+        struct sb_renderer *again = NULL;
+        CHECK(sb_renderer_create(vk, &pack, &world, &rp, &again) == SB_OK, "the renderer again");
+        CHECK(held > 0 && sb_vk_pipeline_count(vk) == held, "made again: %u pipelines held, %u before",
+              sb_vk_pipeline_count(vk), held);
+        sb_renderer_destroy(&again);
         test_sky_colours(r);
         test_shadows(r);
         test_shadow_boxes(r, &rp);

@@ -1,5 +1,7 @@
 /*
- * vulkan/: the validation the other GPU tests rely on. With validation on,
+ * vulkan/: the context's layouts and pipelines, each made once for what
+ * defines it and kept by the context (pipeline.h); and the validation the
+ * other GPU tests rely on. With validation on,
  * synchronisation validation is part of it: two writes of one buffer with
  * no barrier between them are a message (on lavapipe too, whose queue runs
  * in order and would never show the race), the same writes with a barrier
@@ -9,9 +11,12 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "clouds.h"
 #include "compute.h"
+#include "dfg.h"
 #include "harness_vk.h"
 #include "log.h"
+#include "pipeline.h"
 
 static void quiet(void *user, enum sb_log_level level, const char *message)
 {
@@ -43,6 +48,66 @@ static unsigned two_writes(struct sb_vk *vk, struct sb_buffer *buffer, bool barr
     return sb_vk_validation_messages(vk) - before;
 }
 
+/* Made once for what defines them: the same definition gives the same
+ * handles, without a compile; a different one, others. */
+static void test_context_pipelines(struct sb_vk *vk)
+{
+    const struct sb_pipeline_params kernel = sb_dfg_kernel();
+    const VkDescriptorSetLayoutBinding binding = {
+        .binding = 0,
+        .descriptorType = VK_DESCRIPTOR_TYPE_STORAGE_BUFFER,
+        .descriptorCount = 1,
+        .stageFlags = VK_SHADER_STAGE_COMPUTE_BIT,
+    };
+    VkDescriptorSetLayout sets[3];
+    VkPipelineLayout layouts[3];
+    CHECK(sb_vk_layout(vk, &binding, 1, VK_SHADER_STAGE_COMPUTE_BIT, 16, &sets[0], &layouts[0]) == SB_OK &&
+              sb_vk_layout(vk, &binding, 1, VK_SHADER_STAGE_COMPUTE_BIT, 16, &sets[1], &layouts[1]) == SB_OK &&
+              sb_vk_layout(vk, &binding, 1, VK_SHADER_STAGE_COMPUTE_BIT, 32, &sets[2], &layouts[2]) == SB_OK,
+          "three layouts");
+    CHECK(sets[0] == sets[1] && layouts[0] == layouts[1], "a layout asked for twice is one");
+    CHECK(layouts[2] != layouts[0], "push constants of another size: another layout");
+
+    /* the DFG kernel on a layout of its own, its constant 0 specialised or not */
+    struct sb_pipeline p[2];
+    CHECK(sb_pipeline_create(vk, &kernel, &p[0]) == SB_OK, "the DFG kernel");
+    uint32_t held = sb_vk_pipeline_count(vk);
+    CHECK(sb_pipeline_create(vk, &kernel, &p[1]) == SB_OK, "the DFG kernel again");
+    CHECK(p[1].pipeline == p[0].pipeline && p[1].layout == p[0].layout && p[1].set != p[0].set,
+          "the same kernel again: its pipeline and layouts, a set of its own");
+    CHECK(sb_vk_pipeline_count(vk) == held, "and no compile: %u pipelines held, %u before", sb_vk_pipeline_count(vk),
+          held);
+    sb_pipeline_destroy(vk, &p[1]);
+    uint32_t values[2] = {1, 2};
+    const VkSpecializationMapEntry entry = {.constantID = 0, .offset = 0, .size = sizeof(uint32_t)};
+    VkPipeline special[3] = {VK_NULL_HANDLE};
+    for (int i = 0; i < 3; i++) {
+        const VkSpecializationInfo info = {
+            .mapEntryCount = 1, .pMapEntries = &entry, .dataSize = sizeof(uint32_t), .pData = &values[i & 1]};
+        CHECK(sb_compute_pipeline_create(vk, p[0].layout, kernel.spirv, kernel.spirv_size, &info, "specialised",
+                                         &special[i]) == SB_OK,
+              "specialised %d", i);
+    }
+    CHECK(special[0] != p[0].pipeline && special[1] != special[0], "another specialisation: another pipeline");
+    CHECK(special[2] == special[0], "the same one again: the same pipeline");
+    CHECK(sb_vk_pipeline_count(vk) == held + 2, "two compiles for three specialised: %u held, %u before",
+          sb_vk_pipeline_count(vk), held);
+
+    /* compiled ahead: found, not compiled again; listed twice, compiled once */
+    const struct sb_pipeline_params ahead[2] = {sb_cloud_kernel(SB_PRODUCT_CLOUD_SHAPE),
+                                                sb_cloud_kernel(SB_PRODUCT_CLOUD_SHAPE)};
+    held = sb_vk_pipeline_count(vk);
+    sb_pipelines_prepare(vk, ahead, 2, 2);
+    CHECK(sb_vk_pipeline_count(vk) == held + 1, "a kernel listed twice compiles once ahead: %u held, %u before",
+          sb_vk_pipeline_count(vk), held);
+    struct sb_pipeline taken;
+    CHECK(sb_pipeline_create(vk, &ahead[0], &taken) == SB_OK, "the kernel compiled ahead");
+    CHECK(sb_vk_pipeline_count(vk) == held + 1, "found where it was compiled ahead: %u held, %u before",
+          sb_vk_pipeline_count(vk), held);
+    sb_pipeline_destroy(vk, &taken);
+    sb_pipeline_destroy(vk, &p[0]);
+}
+
 int main(void)
 {
     const char *env = getenv("SKYBAKE_VALIDATE");
@@ -63,6 +128,10 @@ int main(void)
         CHECK(hazards > 0, "two writes with no barrier: %u messages (synchronisation validation is off?)", hazards);
     }
     sb_buffer_destroy(vk, &buffer);
+    unsigned messages = sb_vk_validation_messages(vk);
+    test_context_pipelines(vk);
+    CHECK(sb_vk_validation_messages(vk) == messages, "the context's pipelines: %u validation messages",
+          sb_vk_validation_messages(vk) - messages);
     sb_vk_destroy(&vk);
     return test_finish("vulkan");
 }

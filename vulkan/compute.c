@@ -1,8 +1,6 @@
 #include "compute.h"
 
 #include <math.h>
-#include <pthread.h>
-#include <stdatomic.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -111,12 +109,11 @@ void sb_buffer_destroy(struct sb_vk *vk, struct sb_buffer *b)
     memset(b, 0, sizeof(*b));
 }
 
-/* A kernel's descriptor set layout (storage buffers 0..binding_count-1)
- * and pipeline layout. */
-static enum sb_result create_layouts(struct sb_vk *vk, const struct sb_pipeline_params *params,
-                                     VkDescriptorSetLayout *set_layout, VkPipelineLayout *layout)
+/* A kernel's layouts: storage buffers at bindings 0..binding_count-1 and
+ * push_size bytes of push constants, the context's. */
+static enum sb_result kernel_layout(struct sb_vk *vk, const struct sb_pipeline_params *params,
+                                    VkDescriptorSetLayout *set_layout, VkPipelineLayout *layout)
 {
-    enum sb_result res = SB_OK;
     VkDescriptorSetLayoutBinding bindings[16];
     if (params->binding_count > 16)
         return SB_ERR_OUT_OF_RANGE;
@@ -127,132 +124,27 @@ static enum sb_result create_layouts(struct sb_vk *vk, const struct sb_pipeline_
             .descriptorCount = 1,
             .stageFlags = VK_SHADER_STAGE_COMPUTE_BIT,
         };
-    VkDescriptorSetLayoutCreateInfo set_info = {
-        .sType = VK_STRUCTURE_TYPE_DESCRIPTOR_SET_LAYOUT_CREATE_INFO,
-        .bindingCount = params->binding_count,
-        .pBindings = bindings,
-    };
-    VK(vkCreateDescriptorSetLayout(vk->device, &set_info, NULL, set_layout));
-    VkPushConstantRange range = {.stageFlags = VK_SHADER_STAGE_COMPUTE_BIT, .size = params->push_size};
-    VkPipelineLayoutCreateInfo layout_info = {
-        .sType = VK_STRUCTURE_TYPE_PIPELINE_LAYOUT_CREATE_INFO,
-        .setLayoutCount = 1,
-        .pSetLayouts = set_layout,
-        .pushConstantRangeCount = params->push_size ? 1 : 0,
-        .pPushConstantRanges = &range,
-    };
-    VK(vkCreatePipelineLayout(vk->device, &layout_info, NULL, layout));
-cleanup:
-    return res;
-}
-
-/* Compile threads at most (a driver's compiler seldom scales further). */
-#define SB_PREPARE_THREADS_MAX 32
-
-/* A kernel compiled ahead (sb_pipelines_prepare), until taken. */
-struct sb_prepared_pipeline {
-    struct sb_pipeline_params params;
-    VkDescriptorSetLayout set_layout;
-    VkPipelineLayout layout;
-    VkPipeline pipeline;
-};
-
-static bool same_kernel(const struct sb_pipeline_params *a, const struct sb_pipeline_params *b)
-{
-    return a->spirv == b->spirv && a->spirv_size == b->spirv_size && a->binding_count == b->binding_count &&
-           a->push_size == b->push_size;
-}
-
-/* Take the prepared pipeline of `params`' kernel into `p`: false when none was. */
-static bool take_prepared(struct sb_vk *vk, const struct sb_pipeline_params *params, struct sb_pipeline *p)
-{
-    for (uint32_t i = 0; i < vk->prepared_count; i++) {
-        struct sb_prepared_pipeline *k = &vk->prepared[i];
-        if (!k->pipeline || !same_kernel(&k->params, params))
-            continue;
-        p->set_layout = k->set_layout;
-        p->layout = k->layout;
-        p->pipeline = k->pipeline;
-        *k = vk->prepared[--vk->prepared_count];
-        sb_compute_pipeline_named(vk, p->pipeline, params->name);
-        sb_debug("pipeline %s: compiled ahead", params->name);
-        return true;
-    }
-    return false;
-}
-
-struct prepare_job {
-    struct sb_vk *vk;
-    atomic_uint next;
-};
-
-static void *prepare_thread(void *user)
-{
-    struct prepare_job *job = user;
-    struct sb_vk *vk = job->vk;
-    for (uint32_t i; (i = atomic_fetch_add(&job->next, 1)) < vk->prepared_count;) {
-        struct sb_prepared_pipeline *k = &vk->prepared[i];
-        if (create_layouts(vk, &k->params, &k->set_layout, &k->layout) ||
-            sb_compute_pipeline_compile(vk, k->layout, k->params.spirv, k->params.spirv_size, NULL, &k->pipeline))
-            k->pipeline = VK_NULL_HANDLE; /* sb_pipeline_create compiles it again */
-    }
-    return NULL;
+    return sb_vk_layout(vk, bindings, params->binding_count, VK_SHADER_STAGE_COMPUTE_BIT, params->push_size, set_layout,
+                        layout);
 }
 
 void sb_pipelines_prepare(struct sb_vk *vk, const struct sb_pipeline_params *params, uint32_t count, int threads)
 {
-    sb_pipelines_release(vk);
-    vk->prepared = calloc(count ? count : 1, sizeof(*vk->prepared));
-    if (!vk->prepared)
+    struct sb_compute_kernel *kernels = calloc(count ? count : 1, sizeof(*kernels));
+    if (!kernels)
         return; /* each compiles when created */
+    uint32_t n = 0;
     for (uint32_t i = 0; i < count; i++) {
-        bool listed = false;
-        for (uint32_t j = 0; j < vk->prepared_count && !listed; j++)
-            listed = same_kernel(&vk->prepared[j].params, &params[i]);
-        if (!listed)
-            vk->prepared[vk->prepared_count++].params = params[i];
-    }
-    double t0 = sb_now_s();
-    struct prepare_job job = {.vk = vk};
-    pthread_t pool[SB_PREPARE_THREADS_MAX];
-    int started = 0;
-    threads = threads < 1 ? 1 : threads > SB_PREPARE_THREADS_MAX ? SB_PREPARE_THREADS_MAX : threads;
-    for (int t = 1; t < threads && (uint32_t)t < vk->prepared_count; t++)
-        if (!pthread_create(&pool[started], NULL, prepare_thread, &job))
-            started++;
-    prepare_thread(&job);
-    for (int t = 0; t < started; t++)
-        pthread_join(pool[t], NULL);
-    /* what failed goes, so that sb_pipeline_create compiles it itself */
-    for (uint32_t i = 0; i < vk->prepared_count;) {
-        struct sb_prepared_pipeline *k = &vk->prepared[i];
-        if (k->pipeline) {
-            i++;
-            continue;
+        VkDescriptorSetLayout set_layout;
+        struct sb_compute_kernel *k = &kernels[n];
+        if (!kernel_layout(vk, &params[i], &set_layout, &k->layout)) {
+            k->spirv = params[i].spirv;
+            k->spirv_size = params[i].spirv_size;
+            n++;
         }
-        if (k->layout)
-            vkDestroyPipelineLayout(vk->device, k->layout, NULL);
-        if (k->set_layout)
-            vkDestroyDescriptorSetLayout(vk->device, k->set_layout, NULL);
-        *k = vk->prepared[--vk->prepared_count];
     }
-    sb_debug("pipelines: %u kernels compiled ahead on %d threads in %.1f ms", vk->prepared_count, started + 1,
-             1e3 * (sb_now_s() - t0));
-}
-
-void sb_pipelines_release(struct sb_vk *vk)
-{
-    if (vk->prepared_count)
-        sb_debug("pipelines: %u kernels compiled ahead were not used", vk->prepared_count);
-    for (uint32_t i = 0; i < vk->prepared_count; i++) {
-        struct sb_prepared_pipeline *k = &vk->prepared[i];
-        vkDestroyPipeline(vk->device, k->pipeline, NULL);
-        vkDestroyPipelineLayout(vk->device, k->layout, NULL);
-        vkDestroyDescriptorSetLayout(vk->device, k->set_layout, NULL);
-    }
-    free(vk->prepared);
-    vk->prepared = NULL;
-    vk->prepared_count = 0;
+    sb_compute_pipelines_prepare(vk, kernels, n, threads);
+    free(kernels);
 }
 
 enum sb_result sb_pipeline_create(struct sb_vk *vk, const struct sb_pipeline_params *params, struct sb_pipeline *p)
@@ -261,10 +153,9 @@ enum sb_result sb_pipeline_create(struct sb_vk *vk, const struct sb_pipeline_par
     memset(p, 0, sizeof(*p));
     p->binding_count = params->binding_count;
     p->push_size = params->push_size;
-    if (!take_prepared(vk, params, p) &&
-        ((res = create_layouts(vk, params, &p->set_layout, &p->layout)) ||
-         (res = sb_compute_pipeline_create(vk, p->layout, params->spirv, params->spirv_size, NULL, params->name,
-                                           &p->pipeline))))
+    if ((res = kernel_layout(vk, params, &p->set_layout, &p->layout)) ||
+        (res = sb_compute_pipeline_create(vk, p->layout, params->spirv, params->spirv_size, NULL, params->name,
+                                          &p->pipeline)))
         goto cleanup;
 
     VkDescriptorPoolSize pool_size = {
@@ -296,13 +187,7 @@ void sb_pipeline_destroy(struct sb_vk *vk, struct sb_pipeline *p)
 {
     if (p->descriptor_pool)
         vkDestroyDescriptorPool(vk->device, p->descriptor_pool, NULL);
-    if (p->pipeline)
-        vkDestroyPipeline(vk->device, p->pipeline, NULL);
-    if (p->layout)
-        vkDestroyPipelineLayout(vk->device, p->layout, NULL);
-    if (p->set_layout)
-        vkDestroyDescriptorSetLayout(vk->device, p->set_layout, NULL);
-    memset(p, 0, sizeof(*p));
+    memset(p, 0, sizeof(*p)); /* its layouts and pipeline are the context's */
 }
 
 void sb_pipeline_bind(struct sb_vk *vk, struct sb_pipeline *p, const struct sb_buffer *const *buffers)

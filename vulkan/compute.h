@@ -36,6 +36,8 @@ void sb_buffer_destroy(struct sb_vk *vk, struct sb_buffer *buffer);
  */
 enum sb_result sb_buffer_read(struct sb_vk *vk, const struct sb_buffer *buffer, void *out);
 
+/* A kernel and its own descriptor set: the layouts and the pipeline are the
+ * context's (pipeline.h), the set and its pool the sb_pipeline's. */
 struct sb_pipeline {
     VkDescriptorSetLayout set_layout;
     VkPipelineLayout layout;
@@ -49,28 +51,22 @@ struct sb_pipeline {
 struct sb_pipeline_params {
     const uint32_t *spirv;  /* SPIR-V words, entry point "main" */
     size_t spirv_size;      /* in bytes */
-    uint32_t binding_count; /* storage buffers at bindings 0..count-1 of set 0 */
+    uint32_t binding_count; /* storage buffers at bindings 0..count-1 of set 0 (at most 16) */
     uint32_t push_size;     /* bytes of push constants, 0 for none */
     const char *name;       /* debug name */
 };
 
 enum sb_result sb_pipeline_create(struct sb_vk *vk, const struct sb_pipeline_params *params,
                                   struct sb_pipeline *pipeline);
+/* Free the pipeline's set; accepts a zeroed one. */
 void sb_pipeline_destroy(struct sb_vk *vk, struct sb_pipeline *pipeline);
 
 /*
- * Compile kernels ahead, on up to `threads` threads at once: a driver's
- * first compile of a large kernel takes up to a second, and a bake creates
- * its kernels one after another. sb_pipeline_create then takes a prepared
- * pipeline (the same SPIR-V words, size, bindings and push size) instead of
- * compiling it, once; a kernel listed twice is compiled once, and what is
- * never taken is freed with the context. A kernel that fails to compile
- * here is compiled again by sb_pipeline_create.
+ * Compile kernels ahead, on up to `threads` threads at once
+ * (sb_compute_pipelines_prepare): sb_pipeline_create then finds them
+ * compiled.
  */
 void sb_pipelines_prepare(struct sb_vk *vk, const struct sb_pipeline_params *params, uint32_t count, int threads);
-
-/* Free the prepared pipelines nothing took (sb_vk_destroy does). */
-void sb_pipelines_release(struct sb_vk *vk);
 
 /* Point binding i at buffers[i] for every binding of the pipeline. */
 void sb_pipeline_bind(struct sb_vk *vk, struct sb_pipeline *pipeline, const struct sb_buffer *const *buffers);

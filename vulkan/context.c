@@ -7,6 +7,7 @@
 
 #include "compute.h"
 #include "log.h"
+#include "pipeline.h"
 
 #define VALIDATION_LAYER "VK_LAYER_KHRONOS_validation"
 
@@ -378,7 +379,7 @@ void sb_vk_destroy(struct sb_vk **pvk)
         return;
     if (vk->device) {
         vkDeviceWaitIdle(vk->device);
-        sb_pipelines_release(vk);
+        sb_vk_pipelines_finish(vk);
         if (vk->command_pool)
             vkDestroyCommandPool(vk->device, vk->command_pool, NULL);
         vkDestroyDevice(vk->device, NULL);

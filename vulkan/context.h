@@ -63,8 +63,7 @@ struct sb_vk {
     double timestamp_period_ns;
     unsigned validation_messages;
     PFN_vkSetDebugUtilsObjectNameEXT set_object_name;
-    struct sb_prepared_pipeline *prepared; /* sb_pipelines_prepare's, until taken */
-    uint32_t prepared_count;
+    struct sb_vk_cache *cache; /* the layouts and pipelines made on it (pipeline.h) */
 };
 
 /*

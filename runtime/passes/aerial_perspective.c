@@ -70,7 +70,7 @@ static void aerial_destroy(struct sb_renderer *r)
     if (!a)
         return;
     struct sb_texture *const textures[] = {&a->scattering, &a->transmittance};
-    sb_renderer_release(r, a->kernel, 2, textures, 2);
+    sb_renderer_release(r, textures, 2);
     free(a);
 }
 

@@ -67,7 +67,7 @@ static void bloom_destroy(struct sb_renderer *r)
     if (!b)
         return;
     struct sb_texture *chain = &b->chain;
-    sb_renderer_release(r, (const VkPipeline[]){b->down, b->up}, 2, &chain, 1);
+    sb_renderer_release(r, &chain, 1);
     free(b);
 }
 

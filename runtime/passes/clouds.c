@@ -167,11 +167,9 @@ static void clouds_destroy(struct sb_renderer *r)
     struct sb_clouds *c = layer(r);
     if (!c)
         return;
-    const VkPipeline pipelines[] = {c->shadow_kernel, c->trace_kernel[0], c->trace_kernel[1], c->resolve_kernel};
     struct sb_texture *const textures[] = {&c->shape, &c->detail, &c->curl,   &c->weather, &c->shadow,
                                            &c->trace, &c->depth,  &c->out[0], &c->out[1]};
-    sb_renderer_release(r, pipelines, sizeof(pipelines) / sizeof(pipelines[0]), textures,
-                        sizeof(textures) / sizeof(textures[0]));
+    sb_renderer_release(r, textures, sizeof(textures) / sizeof(textures[0]));
     sb_buffer_destroy(r->vk, &c->params);
     free(c);
 }

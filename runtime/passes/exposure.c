@@ -35,7 +35,6 @@ static void exposure_destroy(struct sb_renderer *r)
     struct exposure *e = sb_pass_data(r);
     if (!e)
         return;
-    sb_renderer_release(r, (const VkPipeline[]){e->histogram, e->exposure}, 2, NULL, 0);
     free(e);
 }
 

@@ -135,10 +135,8 @@ static void fog_destroy(struct sb_renderer *r)
     struct sb_fog *f = sb_pass_data(r);
     if (!f)
         return;
-    const VkPipeline pipelines[] = {f->inject, f->integrate};
     struct sb_texture *const textures[] = {&f->light[0], &f->light[1], &f->integrated, &f->noise};
-    sb_renderer_release(r, pipelines, sizeof(pipelines) / sizeof(pipelines[0]), textures,
-                        sizeof(textures) / sizeof(textures[0]));
+    sb_renderer_release(r, textures, sizeof(textures) / sizeof(textures[0]));
     sb_buffer_destroy(r->vk, &f->params);
     free(f);
 }

@@ -50,7 +50,6 @@ static void grade_linear_destroy(struct sb_renderer *r)
     struct grade_linear *g = sb_pass_data(r);
     if (!g)
         return;
-    sb_renderer_release(r, &g->kernel, 1, NULL, 0);
     sb_buffer_destroy(r->vk, &g->lut);
     sb_buffer_destroy(r->vk, &g->grading);
     free(g);

@@ -92,8 +92,6 @@ static void local_tonemap_destroy(struct sb_renderer *r)
     struct sb_local_tonemap *t = sb_pass_data(r);
     if (!t)
         return;
-    sb_renderer_release(r, (const VkPipeline[]){t->grid_kernel, t->pivot_kernel, t->blur_kernel, t->apply_kernel}, 4,
-                        NULL, 0);
     sb_buffer_destroy(r->vk, &t->params);
     sb_buffer_destroy(r->vk, &t->grid);
     free(t);

@@ -281,7 +281,6 @@ static void probes_destroy(struct sb_renderer *r)
     struct probes *s = sb_pass_data(r);
     if (!s)
         return;
-    sb_renderer_release(r, (const VkPipeline[]){s->sky_kernel, s->light_kernel}, 2, NULL, 0);
     sb_buffer_destroy(r->vk, &s->probes);
     sb_buffer_destroy(r->vk, &s->light);
     sb_buffer_destroy(r->vk, &s->detail);

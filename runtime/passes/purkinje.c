@@ -51,7 +51,6 @@ static void purkinje_destroy(struct sb_renderer *r)
     struct sb_purkinje *p = sb_pass_data(r);
     if (!p)
         return;
-    sb_renderer_release(r, &p->kernel, 1, NULL, 0);
     sb_buffer_destroy(r->vk, &p->params);
     free(p);
 }

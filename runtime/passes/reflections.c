@@ -242,7 +242,6 @@ static void reflections_destroy(struct sb_renderer *r)
     struct reflections *s = sb_pass_data(r);
     if (!s)
         return;
-    sb_renderer_release(r, (const VkPipeline[]){s->relight_kernel, s->chain_kernel, s->filter_kernel}, 3, NULL, 0);
     struct sb_buffer *buffers[] = {&s->reflections, &s->cubes, &s->surfaces, &s->chain, &s->relight};
     for (size_t i = 0; i < sizeof(buffers) / sizeof(buffers[0]); i++)
         sb_buffer_destroy(r->vk, buffers[i]);

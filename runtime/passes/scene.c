@@ -184,9 +184,8 @@ static void scene_destroy(struct sb_renderer *r)
     struct scene *s = sb_pass_data(r);
     if (!s)
         return;
-    const VkPipeline pipelines[] = {s->raster[0], s->raster[1], s->traced[0], s->traced[1]};
     struct sb_texture *textures[3] = {&s->sun_history[0], &s->sun_history[1], &s->key_light};
-    sb_renderer_release(r, pipelines, 4, textures, 3);
+    sb_renderer_release(r, textures, 3);
     sb_buffer_destroy(r->vk, &s->history);
     free(s);
 }

@@ -67,7 +67,7 @@ static void shadows_destroy(struct sb_renderer *r)
     if (!s)
         return;
     struct sb_texture *maps = &s->maps;
-    sb_renderer_release(r, &s->pipeline, 1, &maps, 1);
+    sb_renderer_release(r, &maps, 1);
     free(s);
 }
 

@@ -43,8 +43,6 @@ static void sky_destroy(struct sb_renderer *r)
     struct sky *s = sb_pass_data(r);
     if (!s)
         return;
-    sb_renderer_release(r, (const VkPipeline[]){s->inside[0], s->inside[1], s->from_space[0], s->from_space[1]}, 4,
-                        NULL, 0);
     free(s);
 }
 

@@ -38,7 +38,7 @@ static void sky_view_destroy(struct sb_renderer *r)
     if (!s)
         return;
     struct sb_texture *lut = &s->lut;
-    sb_renderer_release(r, &s->kernel, 1, &lut, 1);
+    sb_renderer_release(r, &lut, 1);
     free(s);
 }
 
