@@ -8,6 +8,7 @@
 #include <sys/mman.h>
 #include <xxhash.h>
 
+#include "array.h"
 #include "log.h"
 #include "parallel.h"
 
@@ -638,24 +639,10 @@ static void write_triangles(void *user, int chunk)
     }
 }
 
-/* Room for one more of `count` items of `size` in *array. */
-static bool grow(void **array, uint32_t count, uint32_t *capacity, size_t size)
-{
-    if (count < *capacity)
-        return true;
-    uint32_t more = *capacity ? 2 * *capacity : 64;
-    void *grown = realloc(*array, more * size);
-    if (!grown)
-        return false;
-    *array = grown;
-    *capacity = more;
-    return true;
-}
-
 /* A top node: a task's root, or room for a split's children. */
 static enum sb_result add_task(struct builder *b, const struct range *r)
 {
-    if (!grow((void **)&b->tasks, b->task_count, &b->task_capacity, sizeof(*b->tasks)))
+    if (!sb_array_grow((void **)&b->tasks, b->task_count, &b->task_capacity, sizeof(*b->tasks)))
         return SB_ERR_NOMEM;
     b->top_task[r->node] = (int32_t)b->task_count;
     b->tasks[b->task_count++] = (struct task){.range = *r};

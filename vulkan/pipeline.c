@@ -8,6 +8,7 @@
 #include <string.h>
 #include <xxhash.h>
 
+#include "array.h"
 #include "log.h"
 
 /* ---- The context's layouts and pipelines ------------------------------------------ */
@@ -40,20 +41,6 @@ static struct sb_vk_cache *cache(struct sb_vk *vk)
     if (!vk->cache)
         vk->cache = calloc(1, sizeof(*vk->cache));
     return vk->cache;
-}
-
-/* Grow *items (of `size` bytes each) to hold one more. */
-static bool reserve(void **items, uint32_t count, uint32_t *capacity, size_t size)
-{
-    if (count < *capacity)
-        return true;
-    uint32_t grown = *capacity ? 2 * *capacity : 64;
-    void *more = realloc(*items, grown * size);
-    if (!more)
-        return false;
-    *items = more;
-    *capacity = grown;
-    return true;
 }
 
 static void hash_u64(XXH3_state_t *st, uint64_t v)
@@ -128,7 +115,7 @@ static struct sb_vk_cached_pipeline *find_pipeline(struct sb_vk *vk, XXH128_hash
 static struct sb_vk_cached_pipeline *keep_pipeline(struct sb_vk *vk, XXH128_hash_t key, VkPipeline pipeline)
 {
     struct sb_vk_cache *c = cache(vk);
-    if (!c || !reserve((void **)&c->pipelines, c->pipeline_count, &c->pipeline_capacity, sizeof(*c->pipelines))) {
+    if (!c || !sb_array_grow((void **)&c->pipelines, c->pipeline_count, &c->pipeline_capacity, sizeof(*c->pipelines))) {
         vkDestroyPipeline(vk->device, pipeline, NULL);
         return NULL;
     }
@@ -166,7 +153,7 @@ enum sb_result sb_vk_layout(struct sb_vk *vk, const VkDescriptorSetLayoutBinding
             *layout = c->layouts[i].layout;
             return SB_OK;
         }
-    if (!reserve((void **)&c->layouts, c->layout_count, &c->layout_capacity, sizeof(*c->layouts)))
+    if (!sb_array_grow((void **)&c->layouts, c->layout_count, &c->layout_capacity, sizeof(*c->layouts)))
         return SB_ERR_NOMEM;
     struct sb_vk_cached_layout *kept = &c->layouts[c->layout_count];
     *kept = (struct sb_vk_cached_layout){.key = key};
