@@ -301,13 +301,15 @@ cleanup:
     return res;
 }
 
-static void name_pipeline(struct sb_vk *vk, struct sb_vk_cached_pipeline *kept, const char *name)
+/* Name it for its first caller; a compute pipeline's statistics logged then
+ * too (only those capture them: VK_PIPELINE_CREATE_CAPTURE_STATISTICS_BIT_KHR). */
+static void name_pipeline(struct sb_vk *vk, struct sb_vk_cached_pipeline *kept, const char *name, bool compute)
 {
     if (kept->named)
         return;
     kept->named = true;
     sb_vk_name(vk, VK_OBJECT_TYPE_PIPELINE, (uint64_t)kept->pipeline, name);
-    if (vk->statistics)
+    if (compute && vk->statistics)
         log_statistics(vk, kept->pipeline, name);
 }
 
@@ -332,7 +334,7 @@ enum sb_result sb_compute_pipeline_create(struct sb_vk *vk, VkPipelineLayout lay
     } else if (kept->ahead && !kept->named) {
         sb_debug("pipeline %s: compiled ahead", name);
     }
-    name_pipeline(vk, kept, name);
+    name_pipeline(vk, kept, name, true);
     *pipeline = kept->pipeline;
     return SB_OK;
 }
@@ -552,7 +554,7 @@ enum sb_result sb_graphics_pipeline_create(struct sb_vk *vk, const struct sb_gra
         if (!(kept = keep_pipeline(vk, key, compiled)))
             return SB_ERR_NOMEM;
     }
-    name_pipeline(vk, kept, params->name);
+    name_pipeline(vk, kept, params->name, false);
     *pipeline = kept->pipeline;
     return SB_OK;
 }
