@@ -26,8 +26,11 @@ static const struct sb_pipeline_params kernels[KERNEL_COUNT] = {KERNEL(single), 
 
 struct sb_orders_settings sb_orders_product_grid(const struct sb_atmosphere_params *p)
 {
-    return (struct sb_orders_settings){
-        .r = SB_ORDERS_R, .mu = sb_orders_mu_nodes(p), .mu_s = SB_ORDERS_MU_S, .nu = SB_ORDERS_NU};
+    return (struct sb_orders_settings){.r = SB_ORDERS_R,
+                                       .mu = sb_orders_mu_nodes(p),
+                                       .mu_s = SB_ORDERS_MU_S,
+                                       .nu = sb_orders_nu_nodes(p),
+                                       .tolerance = SB_ORDERS_TOLERANCE};
 }
 
 uint32_t sb_orders_kernels(struct sb_pipeline_params out[KERNEL_COUNT])
@@ -44,8 +47,8 @@ void sb_orders_code_hash(char out[SB_HASH_HEX_SIZE])
         sb_hash_bytes(kernels[i].spirv, kernels[i].spirv_size, text + n);
         n += SB_HASH_HEX_SIZE - 1;
     }
-    snprintf(text + n, sizeof(text) - n, " directions %d %d %d", SB_ORDERS_DIRECTIONS_GROUND, SB_ORDERS_DIRECTIONS_SKY,
-             SB_ORDERS_DIRECTIONS_PHI);
+    snprintf(text + n, sizeof(text) - n, " directions %d %d %d tail %a", SB_ORDERS_DIRECTIONS_GROUND,
+             SB_ORDERS_DIRECTIONS_SKY, SB_ORDERS_DIRECTIONS_PHI, SB_ORDERS_TAIL_MAX_RATIO);
     sb_hash_bytes(text, strlen(text), out);
 }
 
@@ -81,13 +84,17 @@ enum sb_result sb_orders_bake(struct sb_vk *vk, struct sb_atmosphere_baker *bake
     struct sb_orders_push push;
     sb_orders_grid_pack(p, s.r, s.mu, s.mu_s, s.nu, &push);
     size_t n = (size_t)s.r * s.mu * s.mu_s * s.nu, vec4 = 4 * sizeof(float);
-    struct sb_buffer single = {0}, previous = {0}, density = {0}, sum = {0}, ground = {0}, stats = {0}, dummy = {0};
+    /* order k's radiance in previous[k % 2]: the last two orders are there
+     * at the end, for the tail */
+    struct sb_buffer single = {0}, previous[2] = {{0}}, density = {0}, sum = {0}, ground = {0}, stats = {0},
+                     dummy = {0};
     struct sb_pipeline pipelines[KERNEL_COUNT] = {0};
-    float *table = NULL;
+    float *table = NULL, *last = NULL; /* the last two orders' radiance */
     enum sb_result res;
     if ((res = sb_image_init(image, (uint32_t)(s.mu_s * s.nu), (uint32_t)(s.r * s.mu + 1), 3)) ||
         (res = sb_buffer_create(vk, 2 * n * vec4, "orders single", &single)) ||
-        (res = sb_buffer_create(vk, n * vec4, "orders previous", &previous)) ||
+        (res = sb_buffer_create(vk, n * vec4, "orders previous", &previous[0])) ||
+        (res = sb_buffer_create(vk, n * vec4, "orders previous", &previous[1])) ||
         (res = sb_buffer_create(vk, n * vec4, "orders density", &density)) ||
         (res = sb_buffer_create(vk, n * vec4, "orders sum", &sum)) ||
         (res = sb_buffer_create(vk, (size_t)(SB_ORDERS_MAX_ORDER + 1) * s.mu_s * vec4, "orders ground", &ground)) ||
@@ -101,7 +108,7 @@ enum sb_result sb_orders_bake(struct sb_vk *vk, struct sb_atmosphere_baker *bake
     sb_atmosphere_bind_inputs(baker, bindings);
     bindings[SB_BINDING_MULTISCATTERING] = bindings[SB_BINDING_IRRADIANCE_GROUND] = &dummy;
     bindings[SB_ORDERS_BINDING_SINGLE] = &single;
-    bindings[SB_ORDERS_BINDING_PREVIOUS] = &previous;
+    bindings[SB_ORDERS_BINDING_PREVIOUS] = &previous[0];
     bindings[SB_ORDERS_BINDING_DENSITY] = &density;
     bindings[SB_ORDERS_BINDING_SUM] = &sum;
     bindings[SB_ORDERS_BINDING_GROUND] = &ground;
@@ -120,6 +127,10 @@ enum sb_result sb_orders_bake(struct sb_vk *vk, struct sb_atmosphere_baker *bake
         sb_status("orders: order %d", k);
         push.order = (uint32_t)k;
         memset(stats.mapped, 0, 16);
+        bindings[SB_ORDERS_BINDING_PREVIOUS] = &previous[(k - 1) % 2];
+        sb_pipeline_bind(vk, &pipelines[DENSITY], bindings);
+        bindings[SB_ORDERS_BINDING_PREVIOUS] = &previous[k % 2];
+        sb_pipeline_bind(vk, &pipelines[SCATTER], bindings);
         if ((res = sb_dispatch(vk, &pipelines[DENSITY], &push, (uint32_t)s.r, (uint32_t)s.mu_s, 1, &ms)))
             goto done;
         result->gpu_ms += ms;
@@ -144,6 +155,25 @@ enum sb_result sb_orders_bake(struct sb_vk *vk, struct sb_atmosphere_baker *bake
     if (result->last_share >= s.tolerance)
         sb_warn("orders: order %d still adds %.3g of the sum's largest value (tolerance %g)", result->orders,
                 result->last_share, s.tolerance);
+    /* the tail: the last order's sum over the nodes to the one's before, in the nodes' order */
+    int last_order = result->orders;
+    if (!(last = malloc(2 * n * vec4))) {
+        res = SB_ERR_NOMEM;
+        goto done;
+    }
+    if ((res = sb_buffer_read(vk, &previous[last_order % 2], last)) ||
+        (last_order > 2 && (res = sb_buffer_read(vk, &previous[(last_order - 1) % 2], last + 4 * n))))
+        goto done;
+    for (int c = 0; c < 3; c++) {
+        double last_sum = 0.0, before_sum = 0.0;
+        for (size_t i = 0; last_order > 2 && i < n; i++) {
+            last_sum += last[4 * i + c];
+            before_sum += last[4 * (n + i) + c];
+        }
+        result->tail[c] = last_order > 2 ? sb_orders_tail_factor(last_sum, before_sum) : 0.0;
+    }
+    sb_debug("orders: the tail after order %d: %.4g %.4g %.4g times its radiance", result->orders, result->tail[0],
+             result->tail[1], result->tail[2]);
     size_t ground_floats = (size_t)(SB_ORDERS_MAX_ORDER + 1) * s.mu_s * 4;
     if (!(table = malloc(n * vec4 + ground_floats * sizeof(float)))) {
         res = SB_ERR_NOMEM;
@@ -158,12 +188,13 @@ enum sb_result sb_orders_bake(struct sb_vk *vk, struct sb_atmosphere_baker *bake
             double e = 0;
             for (int j = 1; j < result->orders; j++)
                 e += table[4 * (n + (size_t)j * s.mu_s + i) + c];
+            e += result->tail[c] * table[4 * (n + (size_t)(result->orders - 1) * s.mu_s + i) + c];
             for (int k = 0; k < s.nu; k++)
                 image->data[3 * (n + (size_t)i * s.nu + k) + c] = (float)e;
         }
     for (size_t i = 0; i < n + (size_t)s.mu_s * s.nu; i++)
         for (int c = 0; c < 3; c++) {
-            float v = i < n ? table[4 * i + c] : image->data[3 * i + c];
+            float v = i < n ? (float)(table[4 * i + c] + result->tail[c] * last[4 * i + c]) : image->data[3 * i + c];
             if (!isfinite(v) || v < 0) {
                 sb_error("orders: node %zu channel %d is %g; nothing was baked", i, c, v);
                 res = SB_ERR_NUMERIC;
@@ -174,9 +205,10 @@ enum sb_result sb_orders_bake(struct sb_vk *vk, struct sb_atmosphere_baker *bake
 done:
     sb_status(NULL);
     free(table);
+    free(last);
     for (int k = 0; k < KERNEL_COUNT; k++)
         sb_pipeline_destroy(vk, &pipelines[k]);
-    struct sb_buffer *buffers[] = {&single, &previous, &density, &sum, &ground, &stats, &dummy};
+    struct sb_buffer *buffers[] = {&single, &previous[0], &previous[1], &density, &sum, &ground, &stats, &dummy};
     for (size_t i = 0; i < sizeof(buffers) / sizeof(buffers[0]); i++)
         sb_buffer_destroy(vk, buffers[i]);
     if (res)

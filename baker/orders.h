@@ -6,7 +6,8 @@
  * order the scattering density (the previous order's radiance over the
  * sphere, against the phase functions) and its integral along each node's
  * view; orders are added until one adds less than the settings' tolerance
- * of the sum's largest value. The ground's irradiance of each order lights
+ * of the sum's largest value, and the orders after the last as its tail
+ * (sb_orders_tail_factor, on the host: the sums of the last two orders). The ground's irradiance of each order lights
  * the next but one.
  *
  * The image: rgb radiance (solar_irradiance's unit per steradian) of
@@ -32,6 +33,7 @@ struct sb_orders_settings sb_orders_product_grid(const struct sb_atmosphere_para
 struct sb_orders_result {
     int orders;        /* the last order computed */
     double last_share; /* its largest value over the sum's */
+    double tail[3];    /* the factor of its radiance added for the orders after it (orders_ref.h) */
     double gpu_ms;
 };
 

@@ -46,6 +46,7 @@ struct sb_orders_ref {
     bool log_azimuth; /* views read the sun's azimuth log-trigonometrically (sb_orders_log_azimuth) */
     int orders;
     double last_share;
+    double tail[3]; /* the last order's factor for the orders after it (sb_orders_tail_factor) */
     double gl_ray_x[GL_RAY], gl_ray_w[GL_RAY];
     double gl_ground_x[SPHERE_GROUND], gl_ground_w[SPHERE_GROUND];
     double gl_sky_x[SPHERE_SKY], gl_sky_w[SPHERE_SKY];
@@ -718,17 +719,27 @@ struct sb_orders_ref *sb_orders_ref_create(const struct sb_atmosphere_params *p,
         sb_parallel_for(o->nmus, ground_row, &job);
         memcpy(e2, e1, ground_bytes);
         memcpy(e1, o->ground_order, ground_bytes);
-        double largest = 0.0, total = 0.0;
+        double largest = 0.0, total = 0.0, last[3] = {0, 0, 0}, before[3] = {0, 0, 0};
         for (size_t i = 0; i < 3 * n; i++) {
             o->sum[i] += o->order[i];
             largest = fmax(largest, o->order[i]);
             total = fmax(total, o->sum[i]);
+            last[i % 3] += o->order[i];
+            before[i % 3] += o->previous[i];
         }
         memcpy(o->previous, o->order, 3 * n * sizeof(double));
         o->orders = k;
         o->last_share = total > 0 ? largest / total : 0.0;
-        if (o->last_share < tolerance)
+        if (o->last_share < tolerance || k == max_order) {
+            /* the orders after k, as the product adds them (orders.h) */
+            for (int c = 0; c < 3; c++)
+                o->tail[c] = sb_orders_tail_factor(last[c], before[c]);
+            for (size_t i = 0; i < 3 * n; i++)
+                o->sum[i] += o->tail[i % 3] * o->order[i];
+            for (int i = 0; i < 3 * o->nmus; i++)
+                o->ground[i] += o->tail[i % 3] * e2[i];
             break;
+        }
     }
     free(e1);
     sb_status(NULL);
@@ -743,6 +754,13 @@ void sb_orders_ref_destroy(struct sb_orders_ref **ref)
     free((*ref)->single_r);
     free(*ref);
     *ref = NULL;
+}
+
+double sb_orders_tail_factor(double last, double before)
+{
+    double rho = before > 0.0 && last > 0.0 ? last / before : 0.0;
+    rho = fmin(rho, SB_ORDERS_TAIL_MAX_RATIO);
+    return rho / (1.0 - rho);
 }
 
 int sb_orders_ref_orders(const struct sb_orders_ref *ref)

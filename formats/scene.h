@@ -269,6 +269,13 @@ bool sb_atmosphere_dusty(const struct sb_atmosphere_params *params);
  * grid, and on 128 nodes the haze measured the same (docs/accuracy.md). */
 int sb_orders_mu_nodes(const struct sb_atmosphere_params *params);
 
+/* The orders' azimuth nodes: SB_ORDERS_NU_DUST where a view reads them
+ * log-trigonometrically (sb_atmosphere_dusty: through every node, which
+ * view.glsl's read of a dust is written for), else SB_ORDERS_NU (twice as
+ * many: on 4, the earth at 4 and 6 degrees below the horizon read 4.5 and
+ * 9% rms low, on 8 about 2%, docs/accuracy.md). */
+int sb_orders_nu_nodes(const struct sb_atmosphere_params *params);
+
 /* Read and validate a scene file. On failure the scene is left zeroed. */
 enum sb_result sb_scene_load(const char *path, struct sb_scene *scene);
 

@@ -271,11 +271,19 @@ int sb_orders_mu_nodes(const struct sb_atmosphere_params *p)
     return sb_atmosphere_dusty(p) && fabs(p->mie_g) < SB_ORDERS_DUST_MAX_G ? SB_ORDERS_MU_DUST : SB_ORDERS_MU;
 }
 
-/* The orders' rows follow the atmosphere's mu nodes (a dust's zenith). */
+int sb_orders_nu_nodes(const struct sb_atmosphere_params *p)
+{
+    return sb_atmosphere_dusty(p) ? SB_ORDERS_NU_DUST : SB_ORDERS_NU;
+}
+
+/* The orders' rows follow the atmosphere's mu nodes (a dust's zenith), its
+ * columns its azimuth nodes. */
 static void atmosphere_product_shape(const struct sb_scene *scene, enum sb_product_id id, uint32_t shape[3])
 {
-    if (id == SB_PRODUCT_ORDERS || id == SB_PRODUCT_SPECTRAL_ORDERS)
+    if (id == SB_PRODUCT_ORDERS || id == SB_PRODUCT_SPECTRAL_ORDERS) {
+        shape[0] = (uint32_t)(SB_ORDERS_MU_S * sb_orders_nu_nodes(&scene->atmosphere));
         shape[1] = (uint32_t)(SB_ORDERS_R * sb_orders_mu_nodes(&scene->atmosphere) + 1);
+    }
 }
 
 /* The scene's core: scene.c reads and writes the section itself, first. */

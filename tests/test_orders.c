@@ -76,6 +76,16 @@ static void check_azimuth_reads(void)
               shape[1] == SB_ORDERS_R * SB_ORDERS_MU_DUST + 1,
           "mars's orders on %d mu nodes (%u rows), the earth's on %d, the haze's on %d", sb_orders_mu_nodes(&mars),
           shape[1], sb_orders_mu_nodes(&earth), sb_orders_mu_nodes(&haze));
+    /* the earth's air takes the sun's azimuth on twice the dusts' nodes
+     * (twilight), and the pack's width follows */
+    uint32_t earth_shape[3];
+    struct sb_scene earth_scene = {.atmosphere = earth};
+    sb_product_shape(&earth_scene, SB_PRODUCT_ORDERS, earth_shape);
+    CHECK(sb_orders_nu_nodes(&earth) == SB_ORDERS_NU && sb_orders_nu_nodes(&mars) == SB_ORDERS_NU_DUST &&
+              sb_orders_nu_nodes(&haze) == SB_ORDERS_NU_DUST && SB_ORDERS_NU > SB_ORDERS_NU_DUST &&
+              earth_shape[0] == SB_ORDERS_MU_S * SB_ORDERS_NU && shape[0] == SB_ORDERS_MU_S * SB_ORDERS_NU_DUST,
+          "the earth's orders on %d azimuth nodes (%u columns), mars's on %d (%u), the haze's on %d",
+          sb_orders_nu_nodes(&earth), earth_shape[0], sb_orders_nu_nodes(&mars), shape[0], sb_orders_nu_nodes(&haze));
     const struct sb_orders_settings s = {.r = 16, .mu = 64, .mu_s = 24, .nu = 4};
     size_t nodes = (size_t)s.r * s.mu * s.mu_s * s.nu;
     float *table = malloc(3 * nodes * sizeof(float));

@@ -46,15 +46,15 @@ vec3 orders_texel(uint i)
 
 SB_ORDERS_READ(orders_read_texels, orders_texel)
 
-/* The weights of the SB_ORDERS_NU azimuth nodes (the runtime's grid:
+/* The weights of the SB_ORDERS_NU_DUST azimuth nodes (the runtime's grid:
  * runtime/atmosphere.c) at the sun's azimuth phi in the trigonometric
  * interpolation through them (baker/orders_ref.c's azimuth_weights): the
  * cardinal functions of 2 (n - 1) points about the circle, a node counting
  * for its mirror image too; cos(m phi) by Chebyshev's recurrence, the
  * nodes' cosines constants. */
-void orders_azimuth_weights(float phi, out float w[SB_ORDERS_NU])
+void orders_azimuth_weights(float phi, out float w[SB_ORDERS_NU_DUST])
 {
-    const uint n = SB_ORDERS_NU, M = 2u * (n - 1u);
+    const uint n = SB_ORDERS_NU_DUST, M = 2u * (n - 1u);
     float cm[M / 2u + 1u];
     cm[0] = 1.0;
     cm[1] = cos(phi);
@@ -93,11 +93,11 @@ vec3 orders_sky_log_azimuth(OrdersCell c)
 {
     uvec4 s = SB_ORDERS_GRID_SIZE, n = orders_node(c.base);
     float y = float(n.x * s.y + n.y) + c.a.y + 0.5;
-    float w[SB_ORDERS_NU];
-    orders_azimuth_weights((float(n.w) + c.a.z) * PI / float(SB_ORDERS_NU - 1u), w);
+    float w[SB_ORDERS_NU_DUST];
+    orders_azimuth_weights((float(n.w) + c.a.z) * PI / float(SB_ORDERS_NU_DUST - 1u), w);
     vec3 lg = vec3(0.0), a = vec3(0.0), b = vec3(0.0);
     bvec3 positive = bvec3(true);
-    for (uint j = 0u; j < SB_ORDERS_NU; j++) {
+    for (uint j = 0u; j < SB_ORDERS_NU_DUST; j++) {
         vec3 u = orders_day_texels(c, vec2(float(n.z * s.w + j) + 0.5, y));
         positive = bvec3(uvec3(positive) & uvec3(greaterThan(u, vec3(0.0))));
         lg += w[j] * log(max(u, vec3(1e-30)));
