@@ -176,7 +176,8 @@ static void orders_settings(struct sb_artifact *a, const char *first, const stru
                       height_ratio);
     if (n > 0 && (size_t)n < sizeof(a->settings_json))
         snprintf(a->settings_json + n, sizeof(a->settings_json) - (size_t)n,
-                 ",\"orders\":%d,\"last_share\":%.6g,\"until\":%.17g}", r->orders, r->last_share, s.tolerance);
+                 ",\"orders\":%d,\"last_share\":%.6g,\"until\":%.17g,\"tail\":[%.6g,%.6g,%.6g]}", r->orders,
+                 r->last_share, s.tolerance, r->tail[0], r->tail[1], r->tail[2]);
 }
 
 static void orders_key(const struct sb_scene *scene, struct sb_key_text *key)

@@ -164,14 +164,14 @@ enum sb_result sb_orders_bake(struct sb_vk *vk, struct sb_atmosphere_baker *bake
     if ((res = sb_buffer_read(vk, &previous[last_order % 2], last)) ||
         (last_order > 2 && (res = sb_buffer_read(vk, &previous[(last_order - 1) % 2], last + 4 * n))))
         goto done;
-    for (int c = 0; c < 3; c++) {
-        double last_sum = 0.0, before_sum = 0.0;
-        for (size_t i = 0; last_order > 2 && i < n; i++) {
-            last_sum += last[4 * i + c];
-            before_sum += last[4 * (n + i) + c];
+    double last_sum[3] = {0, 0, 0}, before_sum[3] = {0, 0, 0};
+    for (size_t i = 0; last_order > 2 && i < n; i++)
+        for (int c = 0; c < 3; c++) {
+            last_sum[c] += last[4 * i + c];
+            before_sum[c] += last[4 * (n + i) + c];
         }
-        result->tail[c] = last_order > 2 ? sb_orders_tail_factor(last_sum, before_sum) : 0.0;
-    }
+    for (int c = 0; c < 3; c++) /* 0 at order 2: no order before it */
+        result->tail[c] = sb_orders_tail_factor(last_sum[c], before_sum[c]);
     sb_debug("orders: the tail after order %d: %.4g %.4g %.4g times its radiance", result->orders, result->tail[0],
              result->tail[1], result->tail[2]);
     size_t ground_floats = (size_t)(SB_ORDERS_MAX_ORDER + 1) * s.mu_s * 4;

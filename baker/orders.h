@@ -7,8 +7,8 @@
  * sphere, against the phase functions) and its integral along each node's
  * view; orders are added until one adds less than the settings' tolerance
  * of the sum's largest value, and the orders after the last as its tail
- * (sb_orders_tail_factor, on the host: the sums of the last two orders). The ground's irradiance of each order lights
- * the next but one.
+ * (sb_orders_tail_factor, on the host: the sums of the last two orders).
+ * The ground's irradiance of each order lights the next but one.
  *
  * The image: rgb radiance (solar_irradiance's unit per steradian) of
  * orders 2 and up, node (ir, imu, imus, inu) at texel

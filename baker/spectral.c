@@ -1,5 +1,6 @@
 #include "spectral.h"
 
+#include <math.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -113,16 +114,18 @@ enum sb_result sb_spectral_bake(struct sb_spectral *s, enum sb_product_id id, st
     const struct sb_image *bands[SB_SPECTRAL_BANDS];
     for (int b = 0; b < SB_SPECTRAL_BANDS && !res; b++)
         res = sb_spectral_band_lut(s, b, base, &bands[b], &ms);
+    /* the bands' shape: products.def's, or the scene's where the atmosphere
+     * family sets it (the orders of a dust: sb_orders_nu_nodes, _mu_nodes) */
     for (int b = 0; b < SB_SPECTRAL_BANDS && !res; b++)
-        if (bands[b]->width != f->width || bands[b]->height != f->height ||
+        if (bands[b]->width != bands[0]->width || bands[b]->height != bands[0]->height ||
             bands[b]->channel_count * SB_SPECTRAL_BANDS != f->channel_count)
-            res = SB_ERR_USAGE; /* products.def's rows and the three-channel bakes disagree */
+            res = SB_ERR_USAGE; /* products.def's channels and the three-channel bakes disagree */
     if (!res)
-        res = sb_image_init(image, f->width, f->height, f->channel_count);
+        res = sb_image_init(image, bands[0]->width, bands[0]->height, f->channel_count);
     if (res)
         return res;
     sb_image_set_channel_names(image, f->channel_names);
-    uint32_t base_channels = bands[0]->channel_count, texels = f->width * f->height;
+    uint32_t base_channels = bands[0]->channel_count, texels = image->width * image->height;
     for (int b = 0; b < SB_SPECTRAL_BANDS; b++)
         for (uint32_t i = 0; i < texels; i++)
             for (uint32_t ch = 0; ch < base_channels; ch++)
@@ -137,6 +140,8 @@ enum sb_result sb_spectral_bake(struct sb_spectral *s, enum sb_product_id id, st
                 orders->orders = s->orders[b].orders;
             if (s->orders[b].last_share > orders->last_share)
                 orders->last_share = s->orders[b].last_share;
+            for (int c = 0; c < 3; c++)
+                orders->tail[c] = fmax(orders->tail[c], s->orders[b].tail[c]);
             orders->gpu_ms += s->orders[b].gpu_ms;
         }
     }

@@ -336,6 +336,12 @@ a = [x for x in json.load(open(sys.argv[1]))["artifacts"] if x["name"] == "order
 s = a["settings"]
 sys.exit(0 if s["hillaire"]["rms_rel"] > s["tolerance"] == 0.05 and s["orders"] >= 4 else 1)
 ' "$tmp/orders_haze/manifest.json"
+check "and the tail that stands for the orders after the last, a factor a channel" python3 -c '
+import json, sys
+a = [x for x in json.load(open(sys.argv[1]))["artifacts"] if x["name"] == "orders"][0]
+s = a["settings"]
+sys.exit(0 if s["until"] == 0.02 and len(s["tail"]) == 3 and all(0 < t <= 9 for t in s["tail"]) else 1)
+' "$tmp/orders_haze/manifest.json"
 
 # sky-error: the runtime's sky against the path tracer.
 check "sky-error runs" expect_exit 0 "$skybake" sky-error "$scene" --paths 64 --sun 30 --sun -4 --json -q

@@ -11,7 +11,9 @@
  */
 #include <math.h>
 #include <stdio.h>
+#include <string.h>
 
+#include "../formats/family.h" /* the formats' half (sb_product_shape), not the baker's */
 #include "atmosphere.h"
 #include "config.h"
 #include "harness.h"
@@ -20,6 +22,8 @@
 #include "orders.h"
 #include "orders_ref.h"
 #include "scene.h"
+#include "spectral.h"
+#include "spectrum.h"
 
 static void compare(const char *what, struct sb_vk *vk, const struct sb_atmosphere_params *p,
                     const struct sb_orders_settings *grid, double bound_rms, double bound_worst, double bound_ground)
@@ -133,6 +137,36 @@ static void tail(const char *what, struct sb_vk *vk, const struct sb_atmosphere_
     sb_atmosphere_baker_destroy(&baker);
 }
 
+/* A dust's orders at 12 wavelengths take its scene's shape (4 azimuth
+ * nodes where the earth's air has 8: sb_orders_nu_nodes), each band
+ * the three-channel bake of that band's atmosphere. */
+static void spectral_shape(const char *what, struct sb_vk *vk, const struct sb_atmosphere_params *p)
+{
+    struct sb_spectral *spectral = NULL;
+    struct sb_image image = {0};
+    struct sb_scene scene = {.atmosphere = *p};
+    uint32_t shape[3];
+    sb_product_shape(&scene, SB_PRODUCT_SPECTRAL_ORDERS, shape);
+    CHECK(sb_spectral_create(vk, p, &spectral) == SB_OK, "%s: the bands' bakers", what);
+    CHECK(spectral && sb_spectral_bake(spectral, SB_PRODUCT_SPECTRAL_ORDERS, &image, NULL, NULL) == SB_OK,
+          "%s: spectral_orders bakes", what);
+    CHECK(image.width == shape[0] && image.height == shape[1], "%s: spectral_orders %ux%u, the scene's %ux%u", what,
+          image.width, image.height, shape[0], shape[1]);
+    for (int b = 0; image.data && b < SB_SPECTRAL_BANDS; b++) {
+        const struct sb_image *lut = NULL;
+        struct sb_image band = {0};
+        CHECK(sb_spectral_band_lut(spectral, b, SB_PRODUCT_ORDERS, &lut, NULL) == SB_OK &&
+                  sb_spectral_band_image(&image, SB_PRODUCT_ORDERS, b, &band) == SB_OK,
+              "%s: band %d", what, b);
+        CHECK(lut && band.data && lut->width == band.width && lut->height == band.height &&
+                  !memcmp(lut->data, band.data, sizeof(float) * 3 * band.width * band.height),
+              "%s: band %d holds its three-channel bake", what, b);
+        sb_image_finish(&band);
+    }
+    sb_image_finish(&image);
+    sb_spectral_destroy(&spectral);
+}
+
 int main(void)
 {
     struct sb_vk *vk = NULL;
@@ -146,6 +180,13 @@ int main(void)
     sb_atmosphere_preset_mars(&mars);
     tail("earth", vk, &earth, &coarse, 1e-4);
     tail("mars", vk, &mars, &coarse, 1e-3);
+    struct sb_atmosphere_params haze = earth; /* data/scenes/haze.json */
+    for (int c = 0; c < 3; c++) {
+        haze.mie_scattering_per_km[c] = 0.07992;
+        haze.mie_absorption_per_km[c] = 0.00888;
+    }
+    haze.mie_g = 0.99;
+    spectral_shape("the haze", vk, &haze);
     sb_vk_destroy(&vk);
     return test_finish("orders_gpu");
 }

@@ -9,8 +9,8 @@
  * context owns them until sb_vk_destroy, so a renderer or a bake made again
  * on the same context compiles nothing it compiled before (a driver's
  * compile is most of the cost of creating a renderer: on lavapipe 80 ms a
- * pipeline on average over the runtime test). Never destroy what these functions return. For the context's
- * thread, like the context.
+ * pipeline on average over the runtime test). Never destroy what these
+ * functions return. For the context's thread, like the context.
  */
 #ifndef SB_VK_PIPELINE_H
 #define SB_VK_PIPELINE_H
