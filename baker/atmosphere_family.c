@@ -152,7 +152,8 @@ static void orders_grid_key(const struct sb_scene *scene, struct sb_key_text *ke
 {
     struct sb_orders_settings grid = sb_orders_product_grid(&scene->atmosphere);
     struct sb_orders_settings s = sb_orders_settings_resolve(&grid);
-    sb_key_add(key, " grid %dx%dx%dx%d orders %d until %a", s.r, s.mu, s.mu_s, s.nu, s.max_order, s.tolerance);
+    sb_key_add(key, " grid %dx%dx%dx%d nu power %a orders %d until %a", s.r, s.mu, s.mu_s, s.nu,
+               sb_orders_azimuth_power(&scene->atmosphere), s.max_order, s.tolerance);
 }
 
 static void orders_code_key(struct sb_key_text *key)
@@ -162,15 +163,17 @@ static void orders_code_key(struct sb_key_text *key)
     sb_key_add(key, " code %s", code);
 }
 
-/* What the artifact's settings say of an orders bake, after `first` (the
- * object's opening fields, "{" for none); the grid's altitude ratio where
- * it is not NAN. */
-static void orders_settings(struct sb_artifact *a, const char *first, const struct sb_orders_settings *grid,
-                            const struct sb_orders_result *r, double height_ratio)
+/* What the artifact's settings say of an orders bake of `p`, after `first`
+ * (the object's opening fields, "{" for none); the grid's altitude ratio
+ * where it is not NAN. */
+static void orders_settings(struct sb_artifact *a, const char *first, const struct sb_atmosphere_params *p,
+                            const struct sb_orders_settings *grid, const struct sb_orders_result *r,
+                            double height_ratio)
 {
     struct sb_orders_settings s = sb_orders_settings_resolve(grid);
-    int n = snprintf(a->settings_json, sizeof(a->settings_json), "%s\"r\":%d,\"mu\":%d,\"mu_s\":%d,\"nu\":%d", first,
-                     s.r, s.mu, s.mu_s, s.nu);
+    int n = snprintf(a->settings_json, sizeof(a->settings_json),
+                     "%s\"r\":%d,\"mu\":%d,\"mu_s\":%d,\"nu\":%d,\"nu_power\":%.17g", first, s.r, s.mu, s.mu_s, s.nu,
+                     sb_orders_azimuth_power(p));
     if (!isnan(height_ratio) && n > 0 && (size_t)n < sizeof(a->settings_json))
         n += snprintf(a->settings_json + n, sizeof(a->settings_json) - (size_t)n, ",\"height_ratio\":%.17g",
                       height_ratio);
@@ -209,7 +212,7 @@ static enum sb_result orders_bake(struct sb_atmosphere_baker *baker, struct sb_v
         return res;
     a->gpu_ms = r.gpu_ms;
     struct sb_orders_settings s = sb_orders_settings_resolve(&grid);
-    orders_settings(a, "{", &grid, &r, sb_orders_height_ratio(&scene->atmosphere, s.r));
+    orders_settings(a, "{", &scene->atmosphere, &grid, &r, sb_orders_height_ratio(&scene->atmosphere, s.r));
     double tolerance = scene->tolerance[SB_PRODUCT_ORDERS];
     if (tolerance <= 0)
         return SB_OK;
@@ -322,7 +325,7 @@ static enum sb_result spectral_bake(struct atmosphere_state *state, struct sb_vk
     if (sb_spectral_base(id) == SB_PRODUCT_ORDERS) {
         strncat(head, ",", sizeof(head) - strlen(head) - 1);
         struct sb_orders_settings grid = sb_orders_product_grid(&scene->atmosphere);
-        orders_settings(a, head, &grid, &orders, NAN);
+        orders_settings(a, head, &scene->atmosphere, &grid, &orders, NAN);
     } else {
         snprintf(a->settings_json, sizeof(a->settings_json), "%s}", head);
     }

@@ -28,7 +28,7 @@ struct sb_orders_settings sb_orders_product_grid(const struct sb_atmosphere_para
 {
     return (struct sb_orders_settings){.r = SB_ORDERS_R,
                                        .mu = sb_orders_mu_nodes(p),
-                                       .mu_s = SB_ORDERS_MU_S,
+                                       .mu_s = sb_orders_mu_s_nodes(p),
                                        .nu = sb_orders_nu_nodes(p),
                                        .tolerance = SB_ORDERS_TOLERANCE};
 }

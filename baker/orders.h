@@ -26,8 +26,8 @@
 #include "orders_ref.h"
 
 /* The product's grid for an atmosphere (config.h's SB_ORDERS_*, format
- * version 14; a dust's mu nodes: sb_orders_mu_nodes). A spectral band's is
- * its scene's. */
+ * version 14; a dust's nodes: sb_orders_mu_nodes, _mu_s_nodes, _nu_nodes). A
+ * spectral band's is its scene's. */
 struct sb_orders_settings sb_orders_product_grid(const struct sb_atmosphere_params *scene_atmosphere);
 
 struct sb_orders_result {

@@ -43,6 +43,7 @@ struct sb_orders_ref {
     double *density, *order, *previous, *sum;
     /* the ground's irradiance by mu_s node: the sky's orders 1 and up */
     double *ground, *ground_order;
+    double nu_power;  /* the azimuth nodes' pi x^p (sb_orders_azimuth_power) */
     bool log_azimuth; /* views read the sun's azimuth log-trigonometrically (sb_orders_log_azimuth) */
     int orders;
     double last_share;
@@ -264,6 +265,18 @@ static double phi_of(double mu, double mu_s, double nu)
     return s > 1e-12 ? acos(clamp1((nu - mu * mu_s) / s)) : 0.0;
 }
 
+/* The sun's azimuth at nu node inu, and the continuous node index of phi. */
+static double node_phi(const struct sb_orders_ref *o, int inu)
+{
+    return o->nu_power == 1.0 ? ORD_PI * inu / (o->nnu - 1) : ORD_PI * pow((double)inu / (o->nnu - 1), o->nu_power);
+}
+
+static double phi_coord(const struct sb_orders_ref *o, double phi)
+{
+    double x = fmin(fmax(phi / ORD_PI, 0.0), 1.0);
+    return (o->nnu - 1) * (o->nu_power == 1.0 ? x : pow(x, 1.0 / o->nu_power));
+}
+
 /* Between two nodes in mu_s or nu: linear by day; geometric at twilight
  * (both mu_s nodes below the horizon) where both are positive: twilight
  * falls exponentially with the sun's depth and, through the limb, with its
@@ -307,7 +320,7 @@ static void lookup_any(const struct sb_orders_ref *o, const double *table, const
     int ims = fmus < o->nmus - 2 ? (int)fmus : o->nmus - 2;
     double as = fmus - ims;
     bool twilight = mu_s_of(o, ims + 1) <= 0.0;
-    double phi = phi_of(mu, mu_s, nu), fnu = phi / ORD_PI * (o->nnu - 1);
+    double phi = phi_of(mu, mu_s, nu), fnu = phi_coord(o, phi);
     int inu = fnu < o->nnu - 2 ? (int)fnu : o->nnu - 2;
     double an = fnu - inu;
     bool log_read = view && o->log_azimuth && !twilight;
@@ -401,7 +414,7 @@ static void node_view(const struct sb_orders_ref *o, size_t index, double *r, do
     *r = radius_of(o, ir);
     *mu = mu_of(o, *r, imu);
     *mu_s = mu_s_of(o, ims);
-    *nu = nu_of(*mu, *mu_s, ORD_PI * inu / (o->nnu - 1));
+    *nu = nu_of(*mu, *mu_s, node_phi(o, inu));
 }
 
 static bool node_ground(const struct sb_orders_ref *o, size_t index)
@@ -498,7 +511,7 @@ static void density_row(void *user, int row)
         double r, mu, mu_s, nu;
         node_view(o, i, &r, &mu, &mu_s, &nu);
         double sv = sqrt(fmax(1 - mu * mu, 0.0)), ss = sqrt(fmax(1 - mu_s * mu_s, 0.0));
-        double phi_s = ORD_PI * (double)(i % (size_t)o->nnu) / (o->nnu - 1);
+        double phi_s = node_phi(o, (int)(i % (size_t)o->nnu));
         double view[3] = {sv, 0.0, mu}, sun[3] = {ss * cos(phi_s), ss * sin(phi_s), mu_s};
         struct sb_ref_medium m;
         sb_ref_medium(&o->p, fmax(r - o->R, 0.0), &m);
@@ -648,6 +661,7 @@ static void grid_init(struct sb_orders_ref *o, const struct sb_atmosphere_params
     o->heights = heights_of(p, o->nr);
     o->mu_s_min = -o->H / o->top;
     o->log_azimuth = sb_orders_log_azimuth(p);
+    o->nu_power = (float)sb_orders_azimuth_power(p); /* as the GPU's grid holds it */
     o->level_count = sb_atmosphere_levels(p, o->levels);
     sb_ref_gauss_legendre(GL_RAY, -1, 1, o->gl_ray_x, o->gl_ray_w);
     sb_ref_gauss_legendre(SPHERE_GROUND, -1, 1, o->gl_ground_x, o->gl_ground_w);

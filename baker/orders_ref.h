@@ -31,8 +31,11 @@
  *   below it no point of the atmosphere sees the sun) to 0.1, the rest on
  *   to 1; read linearly, but geometrically between two nodes below the
  *   horizon, where twilight falls exponentially;
- * - nu: the sun's azimuth about the vertical from the view's, uniform over
- *   [0, pi] (every node a real direction).
+ * - nu: the sun's azimuth about the vertical from the view's, over [0, pi]
+ *   (every node a real direction) at pi x^p, x uniform, p the
+ *   atmosphere's (sb_orders_azimuth_power: 2 for the air, its nodes close
+ *   about the sun where twilight's light is; 1 for a dust), read linearly
+ *   in x.
  * Between nodes, multilinear otherwise. A view's read of the sum (the
  * sky's, and sb_orders_table_read's), where Mie outscatters Rayleigh at
  * the ground (sb_orders_log_azimuth: a dust's forward peak), takes the

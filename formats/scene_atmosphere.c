@@ -271,17 +271,22 @@ int sb_orders_mu_nodes(const struct sb_atmosphere_params *p)
     return sb_atmosphere_dusty(p) && fabs(p->mie_g) < SB_ORDERS_DUST_MAX_G ? SB_ORDERS_MU_DUST : SB_ORDERS_MU;
 }
 
+int sb_orders_mu_s_nodes(const struct sb_atmosphere_params *p)
+{
+    return sb_atmosphere_dusty(p) ? SB_ORDERS_MU_S_DUST : SB_ORDERS_MU_S;
+}
+
 int sb_orders_nu_nodes(const struct sb_atmosphere_params *p)
 {
     return sb_atmosphere_dusty(p) ? SB_ORDERS_NU_DUST : SB_ORDERS_NU;
 }
 
 /* The orders' rows follow the atmosphere's mu nodes (a dust's zenith), its
- * columns its azimuth nodes. */
+ * columns its sun cosine and azimuth nodes. */
 static void atmosphere_product_shape(const struct sb_scene *scene, enum sb_product_id id, uint32_t shape[3])
 {
     if (id == SB_PRODUCT_ORDERS || id == SB_PRODUCT_SPECTRAL_ORDERS) {
-        shape[0] = (uint32_t)(SB_ORDERS_MU_S * sb_orders_nu_nodes(&scene->atmosphere));
+        shape[0] = (uint32_t)(sb_orders_mu_s_nodes(&scene->atmosphere) * sb_orders_nu_nodes(&scene->atmosphere));
         shape[1] = (uint32_t)(SB_ORDERS_R * sb_orders_mu_nodes(&scene->atmosphere) + 1);
     }
 }

@@ -46,6 +46,11 @@ bool sb_orders_log_azimuth(const struct sb_atmosphere_params *p)
     return sb_atmosphere_dusty(p);
 }
 
+double sb_orders_azimuth_power(const struct sb_atmosphere_params *p)
+{
+    return sb_orders_log_azimuth(p) ? 1.0 : SB_ORDERS_NU_POWER;
+}
+
 void sb_orders_grid_pack(const struct sb_atmosphere_params *p, int nr, int nmu, int nmus, int nnu,
                          struct sb_orders_push *out)
 {
@@ -62,6 +67,7 @@ void sb_orders_grid_pack(const struct sb_atmosphere_params *p, int nr, int nmu, 
     out->mu_s[0] = (float)(-sqrt(top * top - R * R) / top);
     out->mu_s[1] = (float)SB_ORDERS_MU_S_SPLIT;
     out->mu_s[2] = sb_orders_log_azimuth(p) ? 1.0f : 0.0f;
+    out->mu_s[3] = (float)sb_orders_azimuth_power(p);
 }
 
 void sb_atmosphere_gpu_pack(const struct sb_atmosphere_params *p, struct sb_atmosphere_gpu *g)

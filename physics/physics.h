@@ -39,6 +39,10 @@ double sb_orders_height_ratio(const struct sb_atmosphere_params *params, int nr)
  * dominates, the line is the better read (docs/accuracy.md, "The orders'
  * azimuths by the medium"). */
 bool sb_orders_log_azimuth(const struct sb_atmosphere_params *params);
+/* The power p of the orders' azimuth nodes, phi_j = pi (j / (n - 1))^p: 1
+ * (uniform) where views read them log-trigonometrically, which needs
+ * uniform nodes, else SB_ORDERS_NU_POWER. */
+double sb_orders_azimuth_power(const struct sb_atmosphere_params *params);
 
 /* The grid of nr x nmu x nmus x nnu nodes as the orders' kernels and
  * skyview's passes take it (config.h's sb_orders_push; order 0), of the

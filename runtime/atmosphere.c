@@ -158,8 +158,8 @@ enum sb_result sb_atmosphere_upload(struct sb_renderer *r, const struct sb_pack 
      * the bands, each band's in a layer of its own. */
     memset(&r->orders_grid, 0, sizeof(r->orders_grid));
     if (!res && r->constants.orders) {
-        sb_orders_grid_pack(atm, SB_ORDERS_R, sb_orders_mu_nodes(atm), SB_ORDERS_MU_S, sb_orders_nu_nodes(atm),
-                            &r->orders_grid);
+        sb_orders_grid_pack(atm, SB_ORDERS_R, sb_orders_mu_nodes(atm), sb_orders_mu_s_nodes(atm),
+                            sb_orders_nu_nodes(atm), &r->orders_grid);
         const struct sb_image *orders = &pack->images[SB_PRODUCT_ORDERS];
         struct sb_image bands[SB_SPECTRAL_BANDS] = {{0}};
         const float *data[1 + SB_SPECTRAL_BANDS] = {orders->data};

@@ -149,9 +149,14 @@
 #define SB_ORDERS_MU 64
 #define SB_ORDERS_MU_DUST 128 /* a broad dust's (sb_orders_mu_nodes): the zenith's cell */
 #define SB_ORDERS_DUST_MAX_G 0.85 /* broad: |g| below it; above, as for the cap's SB_CAP_MIN_G, a peak no mu grid reads */
-#define SB_ORDERS_MU_S 24
-#define SB_ORDERS_NU 8      /* the sun's azimuth: twilight's light falls steeply with it (sb_orders_nu_nodes) */
-#define SB_ORDERS_NU_DUST 4 /* a dust's, read log-trigonometrically through all of them (sb_orders_log_azimuth) */
+#define SB_ORDERS_MU_S 36      /* the air's (sb_orders_mu_s_nodes): half of them below 0.1, at twilight */
+#define SB_ORDERS_MU_S_DUST 24 /* a dust's */
+#define SB_ORDERS_NU 8         /* the sun's azimuth: twilight's light falls steeply with it (sb_orders_nu_nodes) */
+#define SB_ORDERS_NU_DUST 4    /* a dust's, read log-trigonometrically through all of them (sb_orders_log_azimuth) */
+/* The air's azimuth nodes at pi x^p, x uniform (sb_orders_azimuth_power):
+ * close about the sun, where twilight's light is (0, 3.7, 15, 33, 59, 92,
+ * 132, 180 degrees). */
+#define SB_ORDERS_NU_POWER 2.0
 /* The orders' tail (baker/orders_ref.h): the ratio of an order to the one
  * before is taken at most this (the tail then 9 times the last order). */
 #define SB_ORDERS_TAIL_MAX_RATIO 0.9
@@ -594,7 +599,8 @@ struct sb_orders_push {
     SB_UVEC4(size);    /* nodes in r, mu (even: two halves), mu_s, nu */
     SB_VEC4(heights);  /* the altitudes' progression: q, ln q, q^n - 1 (n = size.x - 1), thickness */
     SB_VEC4(mu_s);     /* the lowest mu_s node, the split (SB_ORDERS_MU_S_SPLIT), 1 where views read the
-                          sun's azimuth log-trigonometrically (sb_orders_log_azimuth) else 0, unused */
+                          sun's azimuth log-trigonometrically (sb_orders_log_azimuth) else 0, the azimuth
+                          nodes' power (sb_orders_azimuth_power) */
     SB_UINT order;     /* k, the order being computed (2 and up) */
     SB_UINT pad0, pad1, pad2;
 };

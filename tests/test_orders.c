@@ -76,16 +76,24 @@ static void check_azimuth_reads(void)
               shape[1] == SB_ORDERS_R * SB_ORDERS_MU_DUST + 1,
           "mars's orders on %d mu nodes (%u rows), the earth's on %d, the haze's on %d", sb_orders_mu_nodes(&mars),
           shape[1], sb_orders_mu_nodes(&earth), sb_orders_mu_nodes(&haze));
-    /* the earth's air takes the sun's azimuth on twice the dusts' nodes
-     * (twilight), and the pack's width follows */
+    /* the earth's air takes the sun's azimuth on twice the dusts' nodes,
+     * closer about the sun, and its cosine on more (twilight); the pack's
+     * width follows */
     uint32_t earth_shape[3];
     struct sb_scene earth_scene = {.atmosphere = earth};
     sb_product_shape(&earth_scene, SB_PRODUCT_ORDERS, earth_shape);
     CHECK(sb_orders_nu_nodes(&earth) == SB_ORDERS_NU && sb_orders_nu_nodes(&mars) == SB_ORDERS_NU_DUST &&
-              sb_orders_nu_nodes(&haze) == SB_ORDERS_NU_DUST && earth_shape[0] == SB_ORDERS_MU_S * SB_ORDERS_NU &&
-              shape[0] == SB_ORDERS_MU_S * SB_ORDERS_NU_DUST,
-          "the earth's orders on %d azimuth nodes (%u columns), mars's on %d (%u), the haze's on %d",
-          sb_orders_nu_nodes(&earth), earth_shape[0], sb_orders_nu_nodes(&mars), shape[0], sb_orders_nu_nodes(&haze));
+              sb_orders_nu_nodes(&haze) == SB_ORDERS_NU_DUST && sb_orders_mu_s_nodes(&earth) == SB_ORDERS_MU_S &&
+              sb_orders_mu_s_nodes(&mars) == SB_ORDERS_MU_S_DUST &&
+              sb_orders_mu_s_nodes(&haze) == SB_ORDERS_MU_S_DUST && earth_shape[0] == SB_ORDERS_MU_S * SB_ORDERS_NU &&
+              shape[0] == SB_ORDERS_MU_S_DUST * SB_ORDERS_NU_DUST &&
+              sb_orders_azimuth_power(&earth) == SB_ORDERS_NU_POWER && sb_orders_azimuth_power(&mars) == 1.0 &&
+              sb_orders_azimuth_power(&haze) == 1.0,
+          "the earth's orders on %d x %d sun cosine and azimuth nodes at power %g (%u columns), mars's on %d x %d at "
+          "%g (%u), the haze's on %d x %d at %g",
+          sb_orders_mu_s_nodes(&earth), sb_orders_nu_nodes(&earth), sb_orders_azimuth_power(&earth), earth_shape[0],
+          sb_orders_mu_s_nodes(&mars), sb_orders_nu_nodes(&mars), sb_orders_azimuth_power(&mars), shape[0],
+          sb_orders_mu_s_nodes(&haze), sb_orders_nu_nodes(&haze), sb_orders_azimuth_power(&haze));
     const struct sb_orders_settings s = {.r = 16, .mu = 64, .mu_s = 24, .nu = 4};
     size_t nodes = (size_t)s.r * s.mu * s.mu_s * s.nu;
     float *table = malloc(3 * nodes * sizeof(float));
@@ -110,8 +118,12 @@ static void check_azimuth_reads(void)
             double nu = mu * mu_s + sqrt((1 - mu * mu) * (1 - mu_s * mu_s)) * cos(phi), f = phi * 3 / M_PI;
             int i = f < 2 ? (int)f : 2;
             double line = node[i] + (f - i) * (node[i + 1] - node[i]);
+            /* the earth's nodes at pi (j / 3)^p: linear between them in their index */
+            double fe = 3 * pow(phi / M_PI, 1 / SB_ORDERS_NU_POWER);
+            int ie = fe < 2 ? (int)fe : 2;
+            double line_earth = node[ie] + (fe - ie) * (node[ie + 1] - node[ie]);
             /* the peak: between nodes 1 and 3 its ringing is clamped to the nodes' 1; -1: within the nodes */
-            double want[2] = {profile == 0 ? azimuth_profile(k, phi) : profile == 1 || i > 0 ? line : -1, line};
+            double want[2] = {profile == 0 ? azimuth_profile(k, phi) : profile == 1 || i > 0 ? line : -1, line_earth};
             for (int g = 0; g < 2; g++) {
                 double got[3];
                 sb_orders_table_read(grid[g], table, h, mu, mu_s, nu, got);

@@ -42,7 +42,7 @@ void node_view(uint index, out float h, out float mu, out float mu_s, out float 
     h = orders_altitude(n.x);
     mu = orders_mu(h, n.y);
     mu_s = orders_mu_s(n.z);
-    nu = orders_nu(mu, mu_s, PI * float(n.w) / float(orders.size.w - 1u));
+    nu = orders_nu(mu, mu_s, orders_node_phi(n.w));
     ground = n.y < orders.size.y / 2u;
 }
 
@@ -160,7 +160,7 @@ void main()
     for (uint j = t; j < per_slice; j += SB_ORDERS_THREADS) {
         uint imu = j / orders.size.w, inu = j % orders.size.w;
         float mu = orders_mu(h, imu), sv = sqrt(max(1.0 - mu * mu, 0.0));
-        float phi_s = PI * float(inu) / float(orders.size.w - 1u);
+        float phi_s = orders_node_phi(inu);
         vec3 rayleigh = vec3(0.0), mie = vec3(0.0);
         float mie_weight = 0.0;
         for (uint d = 0u; d < SB_ORDERS_DIRECTIONS; d++) {

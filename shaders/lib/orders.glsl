@@ -121,6 +121,21 @@ float orders_nu(float mu, float mu_s, float phi)
     return clamp(mu * mu_s + sqrt(max((1.0 - mu * mu) * (1.0 - mu_s * mu_s), 0.0)) * cos(phi), -1.0, 1.0);
 }
 
+/* The sun's azimuth at nu node inu: pi x^p, x = inu / (n - 1), p the grid's
+ * (SB_ORDERS_GRID_MU_S.w; 1 where views read it log-trigonometrically). */
+float orders_node_phi(uint inu)
+{
+    float n = float(SB_ORDERS_GRID_SIZE.w - 1u), p = SB_ORDERS_GRID_MU_S.w;
+    return p == 1.0 ? PI * float(inu) / n : PI * pow(float(inu) / n, p);
+}
+
+/* The continuous nu node index of the sun's azimuth phi. */
+float orders_phi_coord(float phi)
+{
+    float n = float(SB_ORDERS_GRID_SIZE.w - 1u), p = SB_ORDERS_GRID_MU_S.w, x = clamp(phi / PI, 0.0, 1.0);
+    return n * (p == 1.0 ? x : pow(x, 1.0 / p));
+}
+
 /* Between two nodes in mu_s or nu: linear by day; geometric at twilight
  * (both mu_s nodes below the horizon) where both are positive: twilight
  * falls exponentially with the sun's depth and, seen through the limb,
@@ -167,7 +182,7 @@ OrdersCell orders_cell(float h, float mu, float mu_s, float nu, bool ground)
     float fr = orders_altitude_coord(h);
     uint ir = min(uint(fr), s.x - 2u);
     OrdersMuS ms = orders_mu_s_cell(mu_s);
-    float fn = orders_phi(mu, mu_s, nu) / PI * float(s.w - 1u);
+    float fn = orders_phi_coord(orders_phi(mu, mu_s, nu));
     uint inu = min(uint(fn), s.w - 2u);
     uint lo = ground ? 0u : s.y / 2u;
     float fm = orders_mu_coord(h, mu, ground);
