@@ -53,15 +53,16 @@ content_hash_of() { # manifest product: that artifact's content hash
     python3 -c 'import json, sys
 print(next(a["content_hash"] for a in json.load(open(sys.argv[1]))["artifacts"] if a["name"] == sys.argv[2]))' "$1" "$2"
 }
-check "five artifacts" test "$(hashes "$tmp/a/manifest.json" | wc -l)" = 5
+check "four artifacts: what skyview reads" test "$(hashes "$tmp/a/manifest.json" | wc -l)" = 4
 check "hashes equal across thread counts" test "$(hashes "$tmp/a/manifest.json")" = "$(hashes "$tmp/b/manifest.json")"
 check "hashes equal in --json and manifest" test "$(hashes "$tmp/a.json" | tr -d ' ,')" = "$(hashes "$tmp/a/manifest.json" | tr -d ' ,')"
-for f in manifest.json transmittance.exr multiscattering.exr irradiance_ground.exr irradiance_sky.exr orders.exr; do
+for f in manifest.json transmittance.exr multiscattering.exr irradiance_ground.exr orders.exr; do
     check "pack holds $f" test -s "$tmp/a/$f"
 done
+check "no irradiance_sky unless asked for" test ! -e "$tmp/a/irradiance_sky.exr"
 check "info on a pack" expect_exit 0 "$skybake" info "$tmp/a"
 check "info names the device" grep -q "^device: " "$tmp/out"
-check "info lists the four products" test "$(grep -Ec '^(transmittance|multiscattering|irradiance_ground|irradiance_sky) ' "$tmp/out")" = 4
+check "info lists the four products" test "$(grep -Ec '^(transmittance|multiscattering|irradiance_ground|orders) ' "$tmp/out")" = 4
 check "info --json" expect_exit 0 "$skybake" info "$tmp/a" --json
 check "info --json has the manifest's hashes" test "$(hashes "$tmp/out" | tr -d ' ,\t')" = "$(hashes "$tmp/a/manifest.json" | tr -d ' ,\t')"
 check "info needs a pack" expect_exit 2 "$skybake" info
@@ -74,11 +75,11 @@ check "verify a pack" expect_exit 0 "$skybake" verify "$tmp/a"
 check "verify says verified" grep -q "verified" "$tmp/out"
 cp -r "$tmp/a" "$tmp/broken"
 head -c 3000 "$tmp/a/transmittance.exr" >"$tmp/broken/transmittance.exr"
-rm "$tmp/broken/irradiance_sky.exr"
+rm "$tmp/broken/irradiance_ground.exr"
 echo stray >"$tmp/broken/notes.txt"
 check "verify a broken pack is exit 1" expect_exit 1 "$skybake" verify "$tmp/broken"
 check "verify names the truncated file" grep -q "broken/transmittance.exr" "$tmp/err"
-check "verify names the missing file" grep -q "irradiance_sky.exr" "$tmp/err"
+check "verify names the missing file" grep -q "irradiance_ground.exr" "$tmp/err"
 check "verify names the unlisted file" grep -q "notes.txt: not listed" "$tmp/err"
 check "verify counts three problems" grep -q "3 problems" "$tmp/out"
 check "verify --json lists them" expect_exit 1 "$skybake" verify "$tmp/broken" --json
@@ -89,7 +90,7 @@ check "verify needs a pack" expect_exit 2 "$skybake" verify
 # diff: the exit code says identical (0), within --tol (1), different (5),
 # missing (6); 2 for a pack that does not verify.
 check "diff of packs baked with 1 and 2 threads" expect_exit 0 "$skybake" diff "$tmp/a" "$tmp/b"
-check "diff says identical for each product" test "$(grep -Ec "^[a-z_]+ +identical$" "$tmp/out")" = 5
+check "diff says identical for each product" test "$(grep -Ec "^[a-z_]+ +identical$" "$tmp/out")" = 4
 check "diff against a broken pack is exit 2" expect_exit 2 "$skybake" diff "$tmp/a" "$tmp/broken"
 check "diff refuses a negative --tol" expect_exit 2 "$skybake" diff "$tmp/a" "$tmp/b" --tol -1
 
@@ -232,8 +233,7 @@ check "the default bake records no tolerance" test -z "$(grep -o tolerance "$tmp
 # The same products at other settings: diff within and beyond a tolerance,
 # and a pack holding fewer products.
 cp -r "$tmp/a" "$tmp/tonly"
-rm "$tmp/tonly/multiscattering.exr" "$tmp/tonly/irradiance_ground.exr" "$tmp/tonly/irradiance_sky.exr" \
-    "$tmp/tonly/orders.exr"
+rm "$tmp/tonly/multiscattering.exr" "$tmp/tonly/irradiance_ground.exr" "$tmp/tonly/orders.exr"
 python3 -c 'import json, sys
 p = sys.argv[1] + "/manifest.json"
 m = json.load(open(p))
@@ -247,7 +247,7 @@ check "diff beyond --tol 1e-7 is exit 5" expect_exit 5 "$skybake" diff "$tmp/ton
 check "diff --json says different" expect_exit 5 "$skybake" diff "$tmp/tonly" "$tmp/tol" --tol 1e-7 --json
 check "diff --json outcome" grep -Eq '"outcome":[[:space:]]*"different"' "$tmp/out"
 check "diff with products missing is exit 6" expect_exit 6 "$skybake" diff "$tmp/a" "$tmp/tol" --tol 1
-check "diff names what is missing" test "$(grep -c "missing from B" "$tmp/out")" = 4
+check "diff names what is missing" test "$(grep -c "missing from B" "$tmp/out")" = 3
 printf '{"atmosphere":{"preset":"earth"},"products":["transmittance"],"tolerance":1e-7}' >"$tmp/tight.json"
 check "unreachable tolerance is exit 2" expect_exit 2 "$skybake" bake "$tmp/tight.json" -o "$tmp/tight"
 check "unreachable tolerance names the best reachable" grep -q "best reachable is" "$tmp/err"

@@ -415,12 +415,14 @@ static void test_scenes(void)
 
     /* Without clouds asked for or given, the normalised scene has no
      * "clouds" (its hash is what format version 1 gave) and the atmosphere's
-     * products are wanted; the cloud parameters are the defaults, resolved
-     * in full when asked for, and read back to the same form. */
+     * products skyview reads are wanted, irradiance_sky not (it is baked
+     * only when named); the cloud parameters are the defaults, resolved in
+     * full when asked for, and read back to the same form. */
     CHECK(sb_scene_parse(ja, strlen(ja), "a", &a) == SB_OK, "parse");
     na = sb_scene_normalized_json(&a);
-    CHECK(na && !strstr(na, "clouds") && a.wants[SB_PRODUCT_IRRADIANCE_SKY] && !a.wants[SB_PRODUCT_CLOUD_SHAPE] &&
-              !a.wants[SB_PRODUCT_WEATHER],
+    CHECK(na && !strstr(na, "clouds") && a.wants[SB_PRODUCT_TRANSMITTANCE] && a.wants[SB_PRODUCT_MULTISCATTERING] &&
+              a.wants[SB_PRODUCT_IRRADIANCE_GROUND] && a.wants[SB_PRODUCT_ORDERS] &&
+              !a.wants[SB_PRODUCT_IRRADIANCE_SKY] && !a.wants[SB_PRODUCT_CLOUD_SHAPE] && !a.wants[SB_PRODUCT_WEATHER],
           "an atmosphere scene: %s", na);
     free(na);
     const char *jc = EARTH "\"products\":[\"cloud_detail\"],\"clouds\":{\"cloud_detail\":{\"size\":48}}}";
