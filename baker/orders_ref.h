@@ -38,7 +38,8 @@
  *   in x.
  * Between nodes, multilinear otherwise. A view's read of the sum (the
  * sky's, and sb_orders_table_read's), where Mie outscatters Rayleigh at
- * the ground (sb_orders_log_azimuth: a dust's forward peak), takes the
+ * the ground with a peaked phase (sb_orders_log_azimuth: a peaked dust's
+ * forward peak, the haze), takes the
  * azimuth by day log-trigonometrically through every azimuth node instead,
  * kept between the two about it (the orders' own reads stay linear). The density's integral over the
  * sphere takes Rayleigh's part on Gauss-Legendre nodes on either side of

@@ -256,10 +256,14 @@ void sb_atmosphere_preset_earth(struct sb_atmosphere_params *params);
 void sb_atmosphere_preset_mars(struct sb_atmosphere_params *params);
 
 /* Whether Mie scatters more than Rayleigh at the ground in every channel
- * (mars's dust, the haze; not the earth, whose red is 41% Mie): such an
- * atmosphere's orders are read across the sun's azimuth
- * log-trigonometrically (physics.h's sb_orders_log_azimuth). */
+ * (mars's dust, the haze; not the earth, whose red is 41% Mie). */
 bool sb_atmosphere_dusty(const struct sb_atmosphere_params *params);
+
+/* Whether it is a dust with a peaked phase as well (|g| at least
+ * SB_ORDERS_DUST_MAX_G: the haze, not mars): such an atmosphere's orders
+ * are read across the sun's azimuth log-trigonometrically by day
+ * (physics.h's sb_orders_log_azimuth), on 4 uniform nodes. */
+bool sb_atmosphere_peaked_dust(const struct sb_atmosphere_params *params);
 
 /* The orders product's mu nodes for an atmosphere: SB_ORDERS_MU_DUST where
  * it is dusty and its phase broad (|g| below SB_ORDERS_DUST_MAX_G; mars's
@@ -270,10 +274,11 @@ bool sb_atmosphere_dusty(const struct sb_atmosphere_params *params);
 int sb_orders_mu_nodes(const struct sb_atmosphere_params *params);
 
 /* The orders' azimuth nodes: SB_ORDERS_NU_DUST where a view reads them
- * log-trigonometrically (sb_atmosphere_dusty: through every node, which
- * view.glsl's read of a dust is written for), else SB_ORDERS_NU (twice as
+ * log-trigonometrically (sb_atmosphere_peaked_dust: through every node,
+ * which view.glsl's read is written for), else SB_ORDERS_NU (twice as
  * many: on 4, the earth at 4 and 6 degrees below the horizon read 4.5 and
- * 9% rms low, on 8 about 2%, docs/accuracy.md). */
+ * 9% rms low, on 8 about 2%; mars at 4 below 13.8% and 4.6%, read
+ * linearly on 8 close about the sun: docs/accuracy.md). */
 int sb_orders_nu_nodes(const struct sb_atmosphere_params *params);
 
 /* The orders' sun cosine nodes: SB_ORDERS_MU_S for the air (half of them

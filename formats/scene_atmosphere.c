@@ -266,6 +266,11 @@ bool sb_atmosphere_dusty(const struct sb_atmosphere_params *p)
     return true;
 }
 
+bool sb_atmosphere_peaked_dust(const struct sb_atmosphere_params *p)
+{
+    return sb_atmosphere_dusty(p) && fabs(p->mie_g) >= SB_ORDERS_DUST_MAX_G;
+}
+
 int sb_orders_mu_nodes(const struct sb_atmosphere_params *p)
 {
     return sb_atmosphere_dusty(p) && fabs(p->mie_g) < SB_ORDERS_DUST_MAX_G ? SB_ORDERS_MU_DUST : SB_ORDERS_MU;
@@ -278,7 +283,7 @@ int sb_orders_mu_s_nodes(const struct sb_atmosphere_params *p)
 
 int sb_orders_nu_nodes(const struct sb_atmosphere_params *p)
 {
-    return sb_atmosphere_dusty(p) ? SB_ORDERS_NU_DUST : SB_ORDERS_NU;
+    return sb_atmosphere_peaked_dust(p) ? SB_ORDERS_NU_DUST : SB_ORDERS_NU;
 }
 
 /* The orders' rows follow the atmosphere's mu nodes (a dust's zenith), its

@@ -43,7 +43,7 @@ double sb_orders_height_ratio(const struct sb_atmosphere_params *p, int nr)
 
 bool sb_orders_log_azimuth(const struct sb_atmosphere_params *p)
 {
-    return sb_atmosphere_dusty(p);
+    return sb_atmosphere_peaked_dust(p);
 }
 
 double sb_orders_azimuth_power(const struct sb_atmosphere_params *p)

@@ -33,11 +33,13 @@ double sb_orders_height_ratio(const struct sb_atmosphere_params *params, int nr)
  * log-trigonometrically (through all n azimuth nodes, exact for the
  * exponential of any sum of cos(k phi), k < n) rather than linearly between the
  * two nodes about it: where Mie scatters more than Rayleigh at the ground
- * in every channel. A dust's orders 2 and up peak toward the sun like
- * exp(k cos phi), which a line between nodes 60 degrees apart lifts across
- * the sun (mars read 17 to 38% high there); where Rayleigh's smooth light
- * dominates, the line is the better read (docs/accuracy.md, "The orders'
- * azimuths by the medium"). */
+ * in every channel and its phase is peaked (sb_atmosphere_peaked_dust: the
+ * haze). A dust's orders 2 and up peak toward the sun like exp(k cos phi),
+ * which a line between nodes 60 degrees apart lifts across the sun (mars
+ * read 17 to 38% high there); where Rayleigh's smooth light dominates, the
+ * line is the better read (docs/accuracy.md, "The orders' azimuths by the
+ * medium"), and so it is for a broad dust (mars) on the air's 8 nodes
+ * close about the sun, which its twilight needs ("Mars's twilight"). */
 bool sb_orders_log_azimuth(const struct sb_atmosphere_params *params);
 /* The power p of the orders' azimuth nodes, phi_j = pi (j / (n - 1))^p: 1
  * (uniform) where views read them log-trigonometrically, which needs

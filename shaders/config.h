@@ -150,9 +150,9 @@
 #define SB_ORDERS_MU_DUST 128 /* a broad dust's (sb_orders_mu_nodes): the zenith's cell */
 #define SB_ORDERS_DUST_MAX_G 0.85 /* broad: |g| below it; above, as for the cap's SB_CAP_MIN_G, a peak no mu grid reads */
 #define SB_ORDERS_MU_S 36      /* the air's (sb_orders_mu_s_nodes): half of them below 0.1, at twilight */
-#define SB_ORDERS_MU_S_DUST 24 /* a dust's */
-#define SB_ORDERS_NU 8         /* the sun's azimuth: twilight's light falls steeply with it (sb_orders_nu_nodes) */
-#define SB_ORDERS_NU_DUST 4    /* a dust's, read log-trigonometrically through all of them (sb_orders_log_azimuth) */
+#define SB_ORDERS_MU_S_DUST 24 /* a dust's (mars's, the haze's) */
+#define SB_ORDERS_NU 8         /* the sun's azimuth (the air's, a broad dust's): twilight's light falls steeply with it */
+#define SB_ORDERS_NU_DUST 4    /* a peaked dust's, read log-trigonometrically through all (sb_orders_log_azimuth) */
 /* The air's azimuth nodes at pi x^p, x uniform (sb_orders_azimuth_power):
  * close about the sun, where twilight's light is (0, 3.7, 15, 33, 59, 92,
  * 132, 180 degrees). */

@@ -14,9 +14,10 @@
  * views: a check at GRID_ERROR tells them apart.
  *
  * First, a view's read of a table across the sun's azimuth, where the
- * medium makes it log-trigonometric (mars) and where it stays linear (the
- * earth), against what each states, on a table made to tell them apart;
- * and a broad dust's grid of twice the view cosines, a peaked haze's not.
+ * medium makes it log-trigonometric (the haze's peaked dust) and where it
+ * stays linear (the earth, mars), against what each states, on a table
+ * made to tell them apart; and a broad dust's grid of twice the view
+ * cosines, a peaked haze's not.
  */
 #include <math.h>
 #include <stdint.h>
@@ -41,8 +42,9 @@ static const double suns[] = {30, 5};
 /* A view's read across the sun's azimuth (orders_ref.h): where Mie
  * outscatters Rayleigh, log-trigonometric through every azimuth node, exact
  * for exp(a + b cos phi + c cos 2 phi + d cos 3 phi) on 4 nodes, and kept
- * between the two nodes about phi; elsewhere linear between them. A table
- * constant but for the azimuth is read at random views by day. */
+ * between the two nodes about phi; elsewhere linear between them (in the
+ * nodes' coordinate). A table constant but for the azimuth is read at
+ * random views by day. */
 static double azimuth_profile(const double k[4], double phi)
 {
     return exp(k[0] + k[1] * cos(phi) + k[2] * cos(2 * phi) + k[3] * cos(3 * phi));
@@ -59,15 +61,16 @@ static void check_azimuth_reads(void)
     struct sb_atmosphere_params mars, earth;
     sb_atmosphere_preset_mars(&mars);
     sb_atmosphere_preset_earth(&earth);
-    CHECK(sb_orders_log_azimuth(&mars) && !sb_orders_log_azimuth(&earth),
-          "mars's dust reads the azimuth log-trigonometrically, the earth's air linearly");
-    /* and a broad dust keeps twice the view cosines (the zenith's cell),
-     * which the pack's shape follows; a peaked haze (data/scenes/haze.json)
-     * is read log-trigonometrically but keeps the earth's cosines */
+    /* a peaked dust (data/scenes/haze.json) */
     struct sb_atmosphere_params haze = earth;
     for (int c = 0; c < 3; c++)
         haze.mie_scattering_per_km[c] = 0.07992;
     haze.mie_g = 0.99;
+    CHECK(sb_orders_log_azimuth(&haze) && !sb_orders_log_azimuth(&mars) && !sb_orders_log_azimuth(&earth),
+          "the haze's peaked dust reads the azimuth log-trigonometrically, mars's broad dust and the earth's air "
+          "linearly");
+    /* and a broad dust keeps twice the view cosines (the zenith's cell),
+     * which the pack's shape follows; the haze keeps the earth's */
     struct sb_scene scene = {.atmosphere = mars};
     uint32_t shape[3];
     sb_product_shape(&scene, SB_PRODUCT_ORDERS, shape);
@@ -76,28 +79,30 @@ static void check_azimuth_reads(void)
               shape[1] == SB_ORDERS_R * SB_ORDERS_MU_DUST + 1,
           "mars's orders on %d mu nodes (%u rows), the earth's on %d, the haze's on %d", sb_orders_mu_nodes(&mars),
           shape[1], sb_orders_mu_nodes(&earth), sb_orders_mu_nodes(&haze));
-    /* the earth's air takes the sun's azimuth on twice the dusts' nodes,
-     * closer about the sun, and its cosine on more (twilight); the pack's
-     * width follows */
-    uint32_t earth_shape[3];
-    struct sb_scene earth_scene = {.atmosphere = earth};
+    /* the air and a broad dust take the sun's azimuth on twice the peaked
+     * dust's nodes, close about the sun; the air its cosine on more
+     * (twilight); the pack's width follows */
+    uint32_t earth_shape[3], haze_shape[3];
+    struct sb_scene earth_scene = {.atmosphere = earth}, haze_scene = {.atmosphere = haze};
     sb_product_shape(&earth_scene, SB_PRODUCT_ORDERS, earth_shape);
-    CHECK(sb_orders_nu_nodes(&earth) == SB_ORDERS_NU && sb_orders_nu_nodes(&mars) == SB_ORDERS_NU_DUST &&
+    sb_product_shape(&haze_scene, SB_PRODUCT_ORDERS, haze_shape);
+    CHECK(sb_orders_nu_nodes(&earth) == SB_ORDERS_NU && sb_orders_nu_nodes(&mars) == SB_ORDERS_NU &&
               sb_orders_nu_nodes(&haze) == SB_ORDERS_NU_DUST && sb_orders_mu_s_nodes(&earth) == SB_ORDERS_MU_S &&
               sb_orders_mu_s_nodes(&mars) == SB_ORDERS_MU_S_DUST &&
               sb_orders_mu_s_nodes(&haze) == SB_ORDERS_MU_S_DUST && earth_shape[0] == SB_ORDERS_MU_S * SB_ORDERS_NU &&
-              shape[0] == SB_ORDERS_MU_S_DUST * SB_ORDERS_NU_DUST &&
-              sb_orders_azimuth_power(&earth) == SB_ORDERS_NU_POWER && sb_orders_azimuth_power(&mars) == 1.0 &&
-              sb_orders_azimuth_power(&haze) == 1.0,
+              shape[0] == SB_ORDERS_MU_S_DUST * SB_ORDERS_NU &&
+              haze_shape[0] == SB_ORDERS_MU_S_DUST * SB_ORDERS_NU_DUST &&
+              sb_orders_azimuth_power(&earth) == SB_ORDERS_NU_POWER &&
+              sb_orders_azimuth_power(&mars) == SB_ORDERS_NU_POWER && sb_orders_azimuth_power(&haze) == 1.0,
           "the earth's orders on %d x %d sun cosine and azimuth nodes at power %g (%u columns), mars's on %d x %d at "
-          "%g (%u), the haze's on %d x %d at %g",
+          "%g (%u), the haze's on %d x %d at %g (%u)",
           sb_orders_mu_s_nodes(&earth), sb_orders_nu_nodes(&earth), sb_orders_azimuth_power(&earth), earth_shape[0],
           sb_orders_mu_s_nodes(&mars), sb_orders_nu_nodes(&mars), sb_orders_azimuth_power(&mars), shape[0],
-          sb_orders_mu_s_nodes(&haze), sb_orders_nu_nodes(&haze), sb_orders_azimuth_power(&haze));
+          sb_orders_mu_s_nodes(&haze), sb_orders_nu_nodes(&haze), sb_orders_azimuth_power(&haze), haze_shape[0]);
     const struct sb_orders_settings s = {.r = 16, .mu = 64, .mu_s = 24, .nu = 4};
     size_t nodes = (size_t)s.r * s.mu * s.mu_s * s.nu;
     float *table = malloc(3 * nodes * sizeof(float));
-    struct sb_orders_ref *grid[2] = {sb_orders_grid_create(&mars, &s), sb_orders_grid_create(&earth, &s)};
+    struct sb_orders_ref *grid[2] = {sb_orders_grid_create(&haze, &s), sb_orders_grid_create(&earth, &s)};
     CHECK(table && grid[0] && grid[1], "memory");
     if (!table || !grid[0] || !grid[1])
         goto done;

@@ -1530,17 +1530,17 @@ static void test_aerial_of(struct sb_renderer *r, const struct sb_pack *p, doubl
     free(volume);
 }
 
-/* A pack of the atmosphere `preset` with `products` (a JSON array's
- * items), `present` among them: skyview's sky-view LUT and aerial
+/* A pack `name` of `atmosphere` (the scene's atmosphere object's members)
+ * with `products` (a JSON array's items), `present` among them: skyview's sky-view LUT and aerial
  * perspective against the same sky in fp64 (test_sky_view_of,
  * test_aerial_of: the bounds of Hillaire's sky above), and its frame at a
  * sun of `frame_sun` degrees finite. */
-static void test_pack_sky(const char *dir, const char *preset, const char *what, const char *products,
-                          enum sb_product_id present, double frame_sun)
+static void test_pack_sky(const char *dir, const char *name, const char *atmosphere, const char *what,
+                          const char *products, enum sb_product_id present, double frame_sun)
 {
     char path[300], json[512];
-    snprintf(path, sizeof(path), "%s/%s-%s-pack", dir, preset, sb_product_name(present));
-    snprintf(json, sizeof(json), "{\"atmosphere\":{\"preset\":\"%s\"},\"products\":[%s]}", preset, products);
+    snprintf(path, sizeof(path), "%s/%s-%s-pack", dir, name, sb_product_name(present));
+    snprintf(json, sizeof(json), "{\"atmosphere\":{%s},\"products\":[%s]}", atmosphere, products);
     struct sb_scene *scene = calloc(1, sizeof(*scene));
     struct sb_pack sky_of_pack = {0};
     struct sb_bake_report report;
@@ -1578,11 +1578,13 @@ static void test_pack_sky(const char *dir, const char *preset, const char *what,
 static void test_orders_sky(const char *dir)
 {
     const char *orders = "\"transmittance\",\"multiscattering\",\"irradiance_ground\",\"orders\"";
-    test_pack_sky(dir, "earth", "with the orders", orders, SB_PRODUCT_ORDERS, 3.0);
-    /* mars's dust: the azimuth read log-trigonometrically (sb_orders_log_azimuth) */
-    test_pack_sky(dir, "mars", "of mars with the orders", orders, SB_PRODUCT_ORDERS, 3.0);
+    const char *earth = "\"preset\":\"earth\"";
+    test_pack_sky(dir, "earth", earth, "with the orders", orders, SB_PRODUCT_ORDERS, 3.0);
+    /* mars's broad dust: 128 view cosines, the air's azimuth nodes */
+    test_pack_sky(dir, "mars", "\"preset\":\"mars\"", "of mars with the orders", orders, SB_PRODUCT_ORDERS, 3.0);
     /* named alone, it brings everything skyview draws it with */
-    test_pack_sky(dir, "earth", "with the spectral products", "\"spectral_orders\"", SB_PRODUCT_SPECTRAL_ORDERS, -4.0);
+    test_pack_sky(dir, "earth", earth, "with the spectral products", "\"spectral_orders\"", SB_PRODUCT_SPECTRAL_ORDERS,
+                  -4.0);
 }
 
 static void test_above_atmosphere(struct sb_renderer *r)

@@ -85,7 +85,7 @@ vec3 orders_day_texels(OrdersCell c, vec2 p)
 }
 
 /* By day where the grid says so (orders_mu_s.z: sb_orders_log_azimuth, a
- * dust's forward peak), the sun's azimuth log-trigonometrically through
+ * peaked dust's forward peak), the sun's azimuth log-trigonometrically through
  * every azimuth node, kept between the two about it, linearly where a node
  * is not positive (orders_ref.h): the sampler filters mu alone, 4 reads a
  * node. */
@@ -112,7 +112,7 @@ vec3 orders_sky_log_azimuth(OrdersCell c)
  * row and column; the sampler is linear): 4 reads instead of 16. The
  * filter's weights are fixed-point on some GPUs (8 bits on NVIDIA's):
  * within 1/512 of a step between neighbours. At twilight nu is geometric,
- * which the filter cannot do: 16 reads; so is a dust's day
+ * which the filter cannot do: 16 reads; so is a peaked dust's day
  * (orders_sky_log_azimuth). */
 vec3 orders_sky(float h, float mu, float mu_s, float nu, bool ground)
 {
