@@ -273,7 +273,7 @@ bool sb_atmosphere_peaked_dust(const struct sb_atmosphere_params *p)
 
 int sb_orders_mu_nodes(const struct sb_atmosphere_params *p)
 {
-    return sb_atmosphere_dusty(p) && fabs(p->mie_g) < SB_ORDERS_DUST_MAX_G ? SB_ORDERS_MU_DUST : SB_ORDERS_MU;
+    return sb_atmosphere_dusty(p) && !sb_atmosphere_peaked_dust(p) ? SB_ORDERS_MU_DUST : SB_ORDERS_MU;
 }
 
 int sb_orders_mu_s_nodes(const struct sb_atmosphere_params *p)
