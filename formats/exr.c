@@ -3,6 +3,7 @@
 #include <errno.h>
 #include <fcntl.h>
 #include <openexr.h>
+#include <pthread.h>
 #include <stdbool.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -13,6 +14,7 @@
 #include "exr_internal.h"
 #include "io.h"
 #include "log.h"
+#include "parallel.h"
 
 #define EXR_DEFAULT_MAX_PIXELS (64ull << 20)
 
@@ -105,14 +107,152 @@ void sb_exr_keep_raw_when_larger(exr_encode_pipeline_t *encoder)
     }
 }
 
+/*
+ * The chunks of a part, compressed on every thread and written in order.
+ * sb_parallel_for hands the indices out in increasing order; a chunk
+ * compresses as soon as it is taken, then waits for its turn (OpenEXR's
+ * yield_until_ready_fn) until every chunk before it is written. Each chunk
+ * has its own coder, so the bytes are the same whatever the thread count.
+ */
+struct chunk_writer {
+    exr_context_t ctxt;
+    const char *path;
+    int part;
+    const struct sb_exr_chunks *chunks;
+    pthread_mutex_t lock;
+    pthread_cond_t turn;
+    int written;        /* chunks in the file, in order */
+    enum sb_result res; /* the first failure; the chunks after it give up */
+};
+
+struct chunk_turn {
+    struct chunk_writer *w;
+    int index;
+    exr_result_t (*library_yield)(exr_encode_pipeline_t *);
+    exr_result_t (*library_write)(exr_encode_pipeline_t *);
+};
+
+static exr_result_t wait_for_turn(exr_encode_pipeline_t *encoder)
+{
+    struct chunk_turn *t = encoder->encoding_user_data;
+    struct chunk_writer *w = t->w;
+    pthread_mutex_lock(&w->lock);
+    while (w->written < t->index && !w->res)
+        pthread_cond_wait(&w->turn, &w->lock);
+    bool go = !w->res;
+    pthread_mutex_unlock(&w->lock);
+    return go ? t->library_yield(encoder) : EXR_ERR_INCORRECT_CHUNK;
+}
+
+static exr_result_t write_and_pass(exr_encode_pipeline_t *encoder)
+{
+    struct chunk_turn *t = encoder->encoding_user_data;
+    exr_result_t rv = t->library_write(encoder);
+    if (rv == EXR_ERR_SUCCESS) {
+        pthread_mutex_lock(&t->w->lock);
+        t->w->written++;
+        pthread_cond_broadcast(&t->w->turn);
+        pthread_mutex_unlock(&t->w->lock);
+    }
+    return rv;
+}
+
+/* Log the chunk's failure unless an earlier one stopped it. */
+static void chunk_failed(struct chunk_writer *w, const char *what, exr_result_t rv, enum sb_result plain)
+{
+    pthread_mutex_lock(&w->lock);
+    if (!w->res)
+        w->res = what ? sb_exr_fail(w->path, what, rv) : plain;
+    pthread_cond_broadcast(&w->turn);
+    pthread_mutex_unlock(&w->lock);
+}
+
+static void write_chunk(void *user, int index)
+{
+    struct chunk_writer *w = user;
+    struct chunk_turn turn = {.w = w, .index = index};
+    exr_encode_pipeline_t encoder = EXR_ENCODE_PIPELINE_INITIALIZER;
+    exr_chunk_info_t cinfo;
+    const char *what = NULL;
+    exr_result_t rv = w->chunks->info(w->chunks->user, w->ctxt, w->part, index, &cinfo);
+    if (rv != EXR_ERR_SUCCESS)
+        what = "preparing a chunk";
+    else if ((rv = exr_encoding_initialize(w->ctxt, w->part, &cinfo, &encoder)) != EXR_ERR_SUCCESS) {
+        chunk_failed(w, "starting the encoder", rv, SB_OK);
+        return;
+    }
+    if (!what && !w->chunks->point(w->chunks->user, index, encoder.channels, encoder.channel_count)) {
+        sb_error("%s: a channel of the file is not the image's", w->path);
+        chunk_failed(w, NULL, rv, SB_ERR_EXR);
+    } else if (!what && (rv = exr_encoding_choose_default_routines(w->ctxt, w->part, &encoder)) != EXR_ERR_SUCCESS)
+        what = "choosing the encoder";
+    else if (!what) {
+        sb_exr_keep_raw_when_larger(&encoder);
+        turn.library_yield = encoder.yield_until_ready_fn;
+        turn.library_write = encoder.write_fn;
+        encoder.yield_until_ready_fn = wait_for_turn;
+        encoder.write_fn = write_and_pass;
+        encoder.encoding_user_data = &turn;
+        if ((rv = exr_encoding_run(w->ctxt, w->part, &encoder)) != EXR_ERR_SUCCESS)
+            what = "encoding";
+    }
+    if (what)
+        chunk_failed(w, what, rv, SB_OK);
+    if (encoder.context)
+        exr_encoding_destroy(w->ctxt, &encoder);
+}
+
+enum sb_result sb_exr_write_chunks(exr_context_t ctxt, const char *path, int part, int count,
+                                   const struct sb_exr_chunks *chunks)
+{
+    struct chunk_writer w = {.ctxt = ctxt, .path = path, .part = part, .chunks = chunks};
+    pthread_mutex_init(&w.lock, NULL);
+    pthread_cond_init(&w.turn, NULL);
+    sb_parallel_for(count, write_chunk, &w);
+    pthread_cond_destroy(&w.turn);
+    pthread_mutex_destroy(&w.lock);
+    return w.res;
+}
+
+struct scanlines {
+    const struct sb_image *image;
+    int32_t lines_per_chunk;
+};
+
+static exr_result_t scanline_info(void *user, exr_context_t ctxt, int part, int index, exr_chunk_info_t *cinfo)
+{
+    const struct scanlines *s = user;
+    return exr_write_scanline_chunk_info(ctxt, part, index * s->lines_per_chunk, cinfo);
+}
+
+static bool point_scanlines(void *user, int index, exr_coding_channel_info_t *channels, int16_t count)
+{
+    const struct scanlines *s = user;
+    const struct sb_image *image = s->image;
+    size_t pixel_stride = (size_t)image->channel_count * sizeof(float);
+    size_t y = (size_t)index * (size_t)s->lines_per_chunk;
+    for (int16_t ch = 0; ch < count; ch++) {
+        exr_coding_channel_info_t *info = &channels[ch];
+        uint32_t src = 0;
+        while (src < image->channel_count && strcmp(image->channel_names[src], info->channel_name) != 0)
+            src++;
+        if (src == image->channel_count)
+            return false;
+        info->encode_from_ptr = (const uint8_t *)(image->data + (y * image->width) * image->channel_count + src);
+        info->user_pixel_stride = (int32_t)pixel_stride;
+        info->user_line_stride = (int32_t)(pixel_stride * image->width);
+        info->user_bytes_per_element = 4;
+        info->user_data_type = EXR_PIXEL_FLOAT;
+    }
+    return true;
+}
+
 enum sb_result sb_exr_write(const char *path, const struct sb_image *image, const struct sb_attribute *attributes,
                             int attribute_count)
 {
     exr_context_initializer_t init = EXR_DEFAULT_CONTEXT_INITIALIZER;
     init.error_handler_fn = sb_exr_error_handler;
     exr_context_t ctxt = NULL;
-    exr_encode_pipeline_t encoder;
-    bool encoder_live = false;
     enum sb_result res = SB_OK;
     exr_result_t rv;
     int part = 0;
@@ -138,47 +278,14 @@ enum sb_result sb_exr_write(const char *path, const struct sb_image *image, cons
         SB_EXR_TRY(exr_attr_set_string(ctxt, part, attributes[a].name, attributes[a].value), "setting an attribute");
     SB_EXR_TRY(exr_write_header(ctxt), "writing the header");
 
-    int32_t lines_per_chunk = 1, chunks = 0;
-    SB_EXR_TRY(exr_get_scanlines_per_chunk(ctxt, part, &lines_per_chunk), "querying chunks");
+    struct scanlines lines = {.image = image, .lines_per_chunk = 1};
+    int32_t chunks = 0;
+    SB_EXR_TRY(exr_get_scanlines_per_chunk(ctxt, part, &lines.lines_per_chunk), "querying chunks");
     SB_EXR_TRY(exr_get_chunk_count(ctxt, part, &chunks), "querying chunks");
-    size_t pixel_stride = (size_t)image->channel_count * sizeof(float);
-    for (int32_t chunk = 0; chunk < chunks; chunk++) {
-        int32_t y = chunk * lines_per_chunk;
-        exr_chunk_info_t cinfo;
-        SB_EXR_TRY(exr_write_scanline_chunk_info(ctxt, part, y, &cinfo), "preparing a chunk");
-        if (!encoder_live) {
-            SB_EXR_TRY(exr_encoding_initialize(ctxt, part, &cinfo, &encoder), "starting the encoder");
-            encoder_live = true;
-        } else {
-            SB_EXR_TRY(exr_encoding_update(ctxt, part, &cinfo, &encoder), "updating the encoder");
-        }
-        for (int16_t ch = 0; ch < encoder.channel_count; ch++) {
-            exr_coding_channel_info_t *info = &encoder.channels[ch];
-            uint32_t src = 0;
-            while (src < image->channel_count && strcmp(image->channel_names[src], info->channel_name) != 0)
-                src++;
-            if (src == image->channel_count) {
-                sb_error("%s: channel %s vanished while writing", path, info->channel_name);
-                res = SB_ERR_EXR;
-                goto cleanup;
-            }
-            info->encode_from_ptr =
-                (const uint8_t *)(image->data + ((size_t)y * image->width) * image->channel_count + src);
-            info->user_pixel_stride = (int32_t)pixel_stride;
-            info->user_line_stride = (int32_t)(pixel_stride * image->width);
-            info->user_bytes_per_element = 4;
-            info->user_data_type = EXR_PIXEL_FLOAT;
-        }
-        if (chunk == 0) {
-            SB_EXR_TRY(exr_encoding_choose_default_routines(ctxt, part, &encoder), "choosing the encoder");
-            sb_exr_keep_raw_when_larger(&encoder);
-        }
-        SB_EXR_TRY(exr_encoding_run(ctxt, part, &encoder), "encoding");
-    }
+    const struct sb_exr_chunks each = {.info = scanline_info, .point = point_scanlines, .user = &lines};
+    res = sb_exr_write_chunks(ctxt, path, part, chunks, &each);
 
 cleanup:
-    if (encoder_live)
-        exr_encoding_destroy(ctxt, &encoder);
     rv = exr_finish(&ctxt);
     if (rv != EXR_ERR_SUCCESS && res == SB_OK) {
         sb_error("%s: finishing the EXR file: %s", path, exr_get_default_error_message(rv));

@@ -5,6 +5,7 @@
 #include <openexr.h>
 #include <stdbool.h>
 #include <stdio.h>
+#include <stdlib.h>
 #include <string.h>
 #include <unistd.h>
 
@@ -98,6 +99,33 @@ static exr_result_t tile_counts(exr_const_context_t ctxt, int part, int level, i
     return rv;
 }
 
+/* One part's tiles for sb_exr_write_chunks, in the file's order. */
+struct cube_tile {
+    int32_t level, tx, ty;
+    float *base; /* the level's first pixel */
+    uint32_t width;
+    int32_t x0, y0; /* the tile's first pixel in its level */
+};
+
+struct cube_tiles {
+    const struct sb_image *image;
+    struct cube_tile *tile;
+    float tail[4 * SB_IMAGE_MAX_CHANNELS]; /* the two levels past the cube (cube_tail) */
+};
+
+static exr_result_t tile_info(void *user, exr_context_t ctxt, int part, int index, exr_chunk_info_t *cinfo)
+{
+    const struct cube_tile *t = &((const struct cube_tiles *)user)->tile[index];
+    return exr_write_tile_chunk_info(ctxt, part, t->tx, t->ty, t->level, t->level, cinfo);
+}
+
+static bool point_tile(void *user, int index, exr_coding_channel_info_t *channels, int16_t count)
+{
+    const struct cube_tiles *tiles = user;
+    const struct cube_tile *t = &tiles->tile[index];
+    return point_channels(channels, count, tiles->image, t->base, t->width, t->x0, t->y0, false);
+}
+
 static bool is_cube_image(const struct sb_image *image)
 {
     uint32_t n = image->width;
@@ -115,8 +143,6 @@ enum sb_result sb_exr_cube_write(const char *path, const struct sb_image *image,
     exr_context_initializer_t init = EXR_DEFAULT_CONTEXT_INITIALIZER;
     init.error_handler_fn = sb_exr_error_handler;
     exr_context_t ctxt = NULL;
-    exr_encode_pipeline_t encoder;
-    bool encoder_live = false;
     enum sb_result res = SB_OK;
     exr_result_t rv = exr_start_write(&ctxt, path, EXR_WRITE_FILE_DIRECTLY, &init);
     if (rv != EXR_ERR_SUCCESS) {
@@ -150,7 +176,7 @@ enum sb_result sb_exr_cube_write(const char *path, const struct sb_image *image,
                        "setting an attribute");
     }
     SB_EXR_TRY(exr_write_header(ctxt), "writing the header");
-    for (uint32_t cube = 0; cube < image->depth; cube++) {
+    for (uint32_t cube = 0; cube < image->depth && !res; cube++) {
         int part = (int)cube;
         int32_t levels_x = 0, levels_y = 0;
         SB_EXR_TRY(exr_get_tile_levels(ctxt, part, &levels_x, &levels_y), "querying levels");
@@ -160,46 +186,39 @@ enum sb_result sb_exr_cube_write(const char *path, const struct sb_image *image,
             res = SB_ERR_EXR;
             goto cleanup;
         }
-        float tail[4 * SB_IMAGE_MAX_CHANNELS];
+        int32_t count = 0;
+        SB_EXR_TRY(exr_get_chunk_count(ctxt, part, &count), "querying chunks");
+        struct cube_tiles tiles = {.image = image, .tile = calloc(count > 0 ? (size_t)count : 1, sizeof(*tiles.tile))};
+        if (!tiles.tile) {
+            res = SB_ERR_NOMEM;
+            goto cleanup;
+        }
         uint32_t last_width;
-        cube_tail(level_base(image, cube, image->levels - 1, &last_width), image->channel_count, tail);
-        for (uint32_t level = 0; level < (uint32_t)levels_x; level++) {
+        cube_tail(level_base(image, cube, image->levels - 1, &last_width), image->channel_count, tiles.tail);
+        /* The tiles in the file's order: level by level, row by row. */
+        int32_t n = 0;
+        for (uint32_t level = 0; level < (uint32_t)levels_x && !res; level++) {
             uint32_t width = 1;
             float *base = level < image->levels ? level_base(image, cube, level, &width)
-                                                : tail + (level > image->levels ? 3 * image->channel_count : 0);
+                                                : tiles.tail + (level > image->levels ? 3 * image->channel_count : 0);
             int32_t tiles_x = 0, tiles_y = 0, tw = 0, th = 0;
-            SB_EXR_TRY(tile_counts(ctxt, part, (int)level, &tiles_x, &tiles_y, &tw, &th), "querying tiles");
-            for (int32_t ty = 0; ty < tiles_y; ty++)
-                for (int32_t tx = 0; tx < tiles_x; tx++) {
-                    exr_chunk_info_t cinfo;
-                    SB_EXR_TRY(exr_write_tile_chunk_info(ctxt, part, tx, ty, (int)level, (int)level, &cinfo),
-                               "preparing a tile");
-                    bool first = !encoder_live;
-                    if (encoder_live)
-                        SB_EXR_TRY(exr_encoding_update(ctxt, part, &cinfo, &encoder), "updating the encoder");
-                    else {
-                        SB_EXR_TRY(exr_encoding_initialize(ctxt, part, &cinfo, &encoder), "starting the encoder");
-                        encoder_live = true;
-                    }
-                    if (!point_channels(encoder.channels, encoder.channel_count, image, base, width, tx * tw, ty * th,
-                                        false)) {
-                        res = SB_ERR_EXR;
-                        goto cleanup;
-                    }
-                    if (first) {
-                        SB_EXR_TRY(exr_encoding_choose_default_routines(ctxt, part, &encoder), "choosing the encoder");
-                        sb_exr_keep_raw_when_larger(&encoder);
-                    }
-                    SB_EXR_TRY(exr_encoding_run(ctxt, part, &encoder), "encoding");
-                }
+            exr_result_t trv = tile_counts(ctxt, part, (int)level, &tiles_x, &tiles_y, &tw, &th);
+            if (trv != EXR_ERR_SUCCESS)
+                res = sb_exr_fail(path, "querying tiles", trv);
+            for (int32_t ty = 0; ty < tiles_y && !res; ty++)
+                for (int32_t tx = 0; tx < tiles_x && n < count; tx++)
+                    tiles.tile[n++] = (struct cube_tile){(int32_t)level, tx, ty, base, width, tx * tw, ty * th};
         }
-        /* A coder belongs to its part. */
-        exr_encoding_destroy(ctxt, &encoder);
-        encoder_live = false;
+        if (!res && n != count) {
+            sb_error("%s: OpenEXR counts %d tiles in cube %u, skybake %d", path, count, cube, n);
+            res = SB_ERR_EXR;
+        }
+        const struct sb_exr_chunks each = {.info = tile_info, .point = point_tile, .user = &tiles};
+        if (!res)
+            res = sb_exr_write_chunks(ctxt, path, part, count, &each);
+        free(tiles.tile);
     }
 cleanup:
-    if (encoder_live)
-        exr_encoding_destroy(ctxt, &encoder);
     rv = exr_finish(&ctxt);
     if (rv != EXR_ERR_SUCCESS && res == SB_OK) {
         sb_error("%s: finishing the EXR file: %s", path, exr_get_default_error_message(rv));

@@ -8,6 +8,7 @@
 #define SB_EXR_INTERNAL_H
 
 #include <openexr.h>
+#include <stdbool.h>
 
 #include "result.h"
 
@@ -46,5 +47,26 @@ enum sb_result sb_exr_start_read(const char *path, exr_context_initializer_t *in
  * corrupt pixels (OpenEXR issue 2306, fixed in 3.4.7).
  */
 void sb_exr_keep_raw_when_larger(exr_encode_pipeline_t *encoder);
+
+/* How a writer's chunks are found: chunk `index`'s info
+ * (exr_write_scanline_chunk_info or exr_write_tile_chunk_info), and its
+ * channels pointed at the image's pixels (false: a channel the image does
+ * not have). Both are called from several threads at once. */
+struct sb_exr_chunks {
+    exr_result_t (*info)(void *user, exr_context_t ctxt, int part, int index, exr_chunk_info_t *cinfo);
+    bool (*point)(void *user, int index, exr_coding_channel_info_t *channels, int16_t count);
+    void *user;
+};
+
+/*
+ * Encode and write chunks 0 to count - 1 of `part` (the file's chunk
+ * order), after its header: compressed on sb_parallel_for's threads (ZIP
+ * is most of a large file's time), written in order, each with its own
+ * coder (sb_exr_keep_raw_when_larger's), so that the file's bytes do not
+ * depend on the thread count. Returns SB_OK or the first failure, logged
+ * naming `path`; the chunks after a failure are not written.
+ */
+enum sb_result sb_exr_write_chunks(exr_context_t ctxt, const char *path, int part, int count,
+                                   const struct sb_exr_chunks *chunks);
 
 #endif

@@ -166,6 +166,7 @@ enum sb_result sb_vk_create(const struct sb_vk_params *params, struct sb_vk **ou
 {
     enum sb_result res = SB_OK;
     *out = NULL;
+    double t_start = sb_now_s();
     struct sb_vk *vk = calloc(1, sizeof(*vk));
     if (!vk)
         return SB_ERR_NOMEM;
@@ -232,6 +233,7 @@ enum sb_result sb_vk_create(const struct sb_vk_params *params, struct sb_vk **ou
         goto cleanup;
     }
     VK(r);
+    double t_instance = sb_now_s();
     if (params->validate && debug_utils) {
         PFN_vkCreateDebugUtilsMessengerEXT create_messenger =
             (PFN_vkCreateDebugUtilsMessengerEXT)vkGetInstanceProcAddr(vk->instance, "vkCreateDebugUtilsMessengerEXT");
@@ -355,6 +357,7 @@ enum sb_result sb_vk_create(const struct sb_vk_params *params, struct sb_vk **ou
         .queueCreateInfoCount = 1,
         .pQueueCreateInfos = &queue_info,
     };
+    double t_chosen = sb_now_s();
     VK(vkCreateDevice(vk->physical_device, &device_info, NULL, &vk->device));
     vkGetDeviceQueue(vk->device, vk->queue_family, 0, &vk->queue);
     VkCommandPoolCreateInfo pool_info = {
@@ -363,7 +366,9 @@ enum sb_result sb_vk_create(const struct sb_vk_params *params, struct sb_vk **ou
         .queueFamilyIndex = vk->queue_family,
     };
     VK(vkCreateCommandPool(vk->device, &pool_info, NULL, &vk->command_pool));
-    sb_debug("device: %s (%s %s)", vk->properties.deviceName, vk->driver_name, vk->driver_info);
+    sb_debug("device: %s (%s %s); the instance in %.1f ms, the device chosen in %.1f and made in %.1f",
+             vk->properties.deviceName, vk->driver_name, vk->driver_info, 1e3 * (t_instance - t_start),
+             1e3 * (t_chosen - t_instance), 1e3 * (sb_now_s() - t_chosen));
     *out = vk;
     return SB_OK;
 
@@ -377,6 +382,7 @@ void sb_vk_destroy(struct sb_vk **pvk)
     struct sb_vk *vk = *pvk;
     if (!vk)
         return;
+    double t_start = sb_now_s();
     if (vk->device) {
         vkDeviceWaitIdle(vk->device);
         sb_vk_pipelines_finish(vk);
@@ -392,6 +398,8 @@ void sb_vk_destroy(struct sb_vk **pvk)
     }
     if (vk->instance)
         vkDestroyInstance(vk->instance, NULL);
+    if (vk->device)
+        sb_debug("device: released in %.1f ms", 1e3 * (sb_now_s() - t_start));
     free(vk);
     *pvk = NULL;
 }
