@@ -8,6 +8,7 @@
 #include <stdatomic.h>
 #include <stdlib.h>
 #include <string.h>
+#include <sys/resource.h>
 #include <sys/stat.h>
 #include <sys/wait.h>
 #include <time.h>
@@ -20,6 +21,7 @@
 #include "log.h"
 #include "lut3d.h"
 #include "pack.h"
+#include "parallel.h"
 #include "probes.h"
 #include "sandbox.h"
 #include "scene.h"
@@ -185,6 +187,70 @@ static void test_exr_cube(void)
     CHECK(accepted == 0, "%d truncated cube files were accepted", accepted);
     unlink(path);
     sb_image_finish(&img);
+}
+
+static bool files_equal(const char *a, const char *b)
+{
+    char cmd[600];
+    snprintf(cmd, sizeof(cmd), "cmp -s '%s' '%s'", a, b);
+    return system(cmd) == 0;
+}
+
+/* An image's file written at `threads` threads (sb_exr_write_chunks). */
+static enum sb_result write_at(int threads, const char *path, const struct sb_image *img, bool cube)
+{
+    sb_parallel_set_threads(threads);
+    enum sb_result res = cube ? sb_exr_cube_write(path, img, NULL, 0) : sb_exr_write(path, img, NULL, 0);
+    sb_parallel_set_threads(0);
+    return res;
+}
+
+/* The writers compress chunks on several threads and write them in order:
+ * the same bytes at one thread and at five, and a write that fails half
+ * way (a file size limit) fails cleanly, never waiting for ever. */
+static void test_exr_threads(void)
+{
+    struct sb_image img, cube, back;
+    CHECK(sb_image_init(&img, 53, 300, 3) == SB_OK, "init"); /* 19 chunks of 16 lines */
+    sb_image_set_channel_names(&img, "r,g,b");
+    uint64_t x = 0x9e3779b97f4a7c15ull;
+    for (uint64_t i = 0; i < sb_image_float_count(&img); i++) { /* random bits: ZIP keeps most chunks large */
+        x ^= x << 13, x ^= x >> 7, x ^= x << 17;
+        img.data[i] = i % 3 ? (float)(x >> 40) * 0x1p-24f : (float)i;
+    }
+    CHECK(sb_image_init_levels(&cube, 128, 6 * 128, 2, 3, sb_cube_levels(128)) == SB_OK, "cube init");
+    sb_image_set_channel_names(&cube, "R,G,B");
+    for (uint64_t i = 0; i < sb_image_float_count(&cube); i++)
+        cube.data[i] = (float)(i % 1013) * 0.25f;
+    char one[] = "/tmp/skybake-threads-XXXXXX.exr", five[] = "/tmp/skybake-threads-XXXXXX.exr";
+    close(mkstemps(one, 4));
+    close(mkstemps(five, 4));
+    for (int c = 0; c < 2; c++) {
+        const struct sb_image *im = c ? &cube : &img;
+        CHECK(write_at(1, one, im, c) == SB_OK && write_at(5, five, im, c) == SB_OK, "%s: write",
+              c ? "cube" : "scanlines");
+        CHECK(files_equal(one, five), "%s: the file at 5 threads differs from the one at 1", c ? "cube" : "scanlines");
+        enum sb_result r =
+            c ? sb_exr_cube_read(five, "R,G,B", 128, 2, &back) : sb_exr_read(five, "r,g,b", 0, &back, NULL, NULL);
+        CHECK(r == SB_OK && memcmp(back.data, im->data, sb_image_float_count(im) * sizeof(float)) == 0,
+              "%s: the file at 5 threads reads back", c ? "cube" : "scanlines");
+        sb_image_finish(&back);
+    }
+    /* A file size limit stops the writes half way through the chunks. */
+    struct rlimit was;
+    getrlimit(RLIMIT_FSIZE, &was);
+    void (*handler)(int) = signal(SIGXFSZ, SIG_IGN);
+    struct rlimit small = {64 << 10, was.rlim_max};
+    CHECK(setrlimit(RLIMIT_FSIZE, &small) == 0, "set a file size limit");
+    enum sb_result scan = write_at(5, five, &img, false), cubed = write_at(5, five, &cube, true);
+    setrlimit(RLIMIT_FSIZE, &was);
+    signal(SIGXFSZ, handler);
+    CHECK(scan == SB_ERR_IO && cubed == SB_ERR_IO, "past the limit: %s and %s, not io", sb_result_name(scan),
+          sb_result_name(cubed));
+    unlink(one);
+    unlink(five);
+    sb_image_finish(&img);
+    sb_image_finish(&cube);
 }
 
 struct scene_case {
@@ -477,13 +543,6 @@ static void test_half(void)
     CHECK(sb_image_round_to_half(&big, &bad) == SB_ERR_NUMERIC && bad == 1 && big.data[0] == 0.5f,
           "a value beyond binary16 is refused and nothing is changed");
     sb_image_finish(&big);
-}
-
-static bool files_equal(const char *a, const char *b)
-{
-    char cmd[600];
-    snprintf(cmd, sizeof(cmd), "cmp -s '%s' '%s'", a, b);
-    return system(cmd) == 0;
 }
 
 /* VDB volumes: exact at half precision, deterministic bytes, and refusals. */
@@ -2004,6 +2063,7 @@ int main(int argc, char **argv)
     test_fifos();
     test_exr_round_trip();
     test_exr_cube();
+    test_exr_threads();
     test_half();
     test_vdb();
     test_scenes();
