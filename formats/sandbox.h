@@ -4,7 +4,7 @@
  * assimp and OpenVDB are not hardened against hostile files: on this
  * machine a PLY header made assimp loop for ever, and a cut VDB made
  * OpenVDB allocate 20 GB. So their parsers run only in small helper
- * programs (skybake-import-mesh, skybake-read-vdb), started for each file
+ * programs (skybake-import-mesh, skybake-vdb), started for each file
  * under a CPU-time limit and an address-space limit; the helper writes its
  * answer into a pipe, and the parent reads it with a wall-clock deadline,
  * checking every count it receives. A hang, a crash, a limit or a helper

@@ -1,13 +1,13 @@
-// The one C++ file of skybake: OpenVDB has no C API. Everything here sits
-// behind vdb.h's two C functions; no exception leaves this file.
+// The one C++ file of skybake, since OpenVDB has no C API: the helper
+// program skybake-vdb's tasks (vdb_helper.h), the only code that runs
+// OpenVDB. No exception leaves this file.
 //
-// Bytes go through memory: the writer serialises into a buffer and writes
-// it with write(2), so that a full disk or a file size limit is reported
-// with the system's reason (std::ofstream would lose it), and the random
-// UUID OpenVDB puts in the header can be replaced with one derived from the
-// content. The reader checks the file's structure in the caller, then
-// OpenVDB parses it in a helper program (read_vdb.c, sandbox.h), which
-// checks each grid's shape in its metadata before it reads the grid.
+// The writer serialises into memory and answers the bytes, which the
+// caller writes (so that a full disk is reported with the system's
+// reason, and the random UUID OpenVDB puts in the header is replaced with
+// one derived from the content). The reader parses a file whose structure
+// the caller has checked (vdb.c), checking each grid's shape in its
+// metadata before it reads the grid.
 #include <openvdb/io/Archive.h>
 #include <openvdb/io/File.h>
 #include <openvdb/openvdb.h>
@@ -15,35 +15,30 @@
 
 #include <algorithm>
 #include <cctype>
-#include <cerrno>
 #include <cstdio>
 #include <cstring>
-#include <fcntl.h>
+#include <memory>
+#include <new>
 #include <sstream>
 #include <string>
+#include <sys/mman.h>
 #include <sys/stat.h>
 #include <unistd.h>
 
 extern "C" {
 #include "io.h"
 #include "log.h"
-#include "read_vdb.h"
 #include "sandbox.h"
-#include "vdb.h"
+#include "vdb_helper.h"
 }
+
+static_assert(openvdb::OPENVDB_FILE_VERSION == SB_VDB_FILE_VERSION,
+              "vdb_helper.h's file version is not the OpenVDB this builds with");
 
 namespace
 {
 
-constexpr uint64_t kDefaultMaxVoxels = 1ull << 28;
-constexpr uint64_t kMaxFileBytes = 1ull << 30;
 constexpr int kLeafDim = openvdb::FloatTree::LeafNodeType::DIM; // 8
-
-// The header: magic (8 bytes), file version, library major and minor
-// (4 each), the grid offsets flag (1), then the UUID as 36 characters
-// (openvdb/io/Archive.cc, writeHeader).
-constexpr size_t kUuidOffset = 8 + 4 + 4 + 4 + 1;
-constexpr size_t kUuidSize = 36;
 
 // Archive::write(std::ostream&, ..., seekable) is protected; the stream is a
 // seekable buffer, so the file gets grid offsets as io::File writes them.
@@ -56,161 +51,17 @@ class BufferWriter : public openvdb::io::Archive
     }
 };
 
-// A UUID-shaped string (8-4-4-4-12 hex digits) from the volume's content
-// hash and the attributes: the same file gives the same UUID, and two
-// different volumes differ in theirs, as tools that cache by UUID expect.
-std::string uuid_from(const sb_image *volume, const sb_attribute *attributes, int attribute_count)
-{
-    char content[SB_HASH_HEX_SIZE];
-    sb_image_content_hash(volume, content);
-    std::string text = std::string(content) + '\n';
-    for (int a = 0; a < attribute_count; a++)
-        text += std::string(attributes[a].name) + '=' + attributes[a].value + '\n';
-    char hex[SB_HASH_HEX_SIZE];
-    sb_hash_bytes(text.data(), text.size(), hex);
-    std::string h(hex, 32);
-    return h.substr(0, 8) + '-' + h.substr(8, 4) + '-' + h.substr(12, 4) + '-' + h.substr(16, 4) + '-' + h.substr(20);
-}
-
 bool looks_like_uuid(const std::string &bytes, size_t at)
 {
-    if (bytes.size() < at + kUuidSize)
+    if (bytes.size() < at + SB_VDB_UUID_SIZE)
         return false;
-    for (size_t i = 0; i < kUuidSize; i++) {
+    for (size_t i = 0; i < SB_VDB_UUID_SIZE; i++) {
         char c = bytes[at + i];
         bool dash = i == 8 || i == 13 || i == 18 || i == 23;
         if (dash ? c != '-' : !std::isxdigit(static_cast<unsigned char>(c)))
             return false;
     }
     return true;
-}
-
-// ---- the file's structure, checked before OpenVDB parses it ---------------------------
-//
-// OpenVDB trusts the lengths in a file: a VDB cut to 100 bytes made it
-// allocate 20 GB, and other cuts read lengths it never set. So the layout
-// OpenVDB's File::open walks (openvdb/io/Archive.cc, File.cc,
-// GridDescriptor.cc) is walked here first, every length and offset bounded
-// by the file: the header, the file's metadata, then each grid's
-// descriptor, whose offsets must lie in order within the file and end
-// exactly at its end. What lies inside a grid is left to OpenVDB, in a
-// sandboxed process (below).
-
-constexpr int64_t kMagic = 0x56444220;      // OPENVDB_MAGIC, " BDV"
-constexpr uint32_t kFirstFileVersion = 222; // node mask compression, the UUID, instancing
-constexpr uint32_t kMaxString = 4096, kMaxMeta = 256, kMaxMetaBytes = 1u << 20;
-
-class Cursor
-{
-  public:
-    Cursor(int fd, uint64_t size) : fd_(fd), size_(size)
-    {
-    }
-    uint64_t at() const
-    {
-        return at_;
-    }
-    bool ok() const
-    {
-        return ok_;
-    }
-    bool seek(uint64_t to)
-    {
-        return ok_ = ok_ && to <= size_ ? (at_ = to, true) : false;
-    }
-    bool bytes(void *out, uint64_t n)
-    {
-        if (!ok_ || n > size_ - at_)
-            return ok_ = false;
-        char *p = static_cast<char *>(out);
-        for (uint64_t done = 0; done < n;) {
-            ssize_t got = pread(fd_, p + done, n - done, off_t(at_ + done));
-            if (got < 0 && errno == EINTR)
-                continue;
-            if (got <= 0)
-                return ok_ = false;
-            done += uint64_t(got);
-        }
-        at_ += n;
-        return true;
-    }
-    template <typename T> T value()
-    {
-        T v{};
-        bytes(&v, sizeof(v));
-        return v;
-    }
-    // readString: a 32-bit length, then the characters
-    bool string(std::string *out, uint32_t max)
-    {
-        uint32_t n = value<uint32_t>();
-        if (!ok_ || n > max)
-            return ok_ = false;
-        out->resize(n);
-        return bytes(&(*out)[0], n);
-    }
-
-  private:
-    int fd_;
-    uint64_t size_, at_ = 0;
-    bool ok_ = true;
-};
-
-// Empty when the layout holds; else what is wrong, for "path: ...", with
-// *code SB_ERR_BAD_IMAGE for a sound VDB file of other grids, else SB_ERR_VDB.
-std::string check_structure(int fd, uint64_t size, uint32_t grids_expected, sb_result *code)
-{
-    *code = SB_ERR_VDB;
-    Cursor c(fd, size);
-    if (c.value<int64_t>() != kMagic || !c.ok())
-        return "not a VDB file (no magic number)";
-    uint32_t version = c.value<uint32_t>();
-    if (version < kFirstFileVersion || version > openvdb::OPENVDB_FILE_VERSION)
-        return "file format version " + std::to_string(version) + ", not one this reader knows (" +
-               std::to_string(kFirstFileVersion) + " to " + std::to_string(openvdb::OPENVDB_FILE_VERSION) + ")";
-    c.value<uint32_t>(); // the library's major and minor version
-    c.value<uint32_t>();
-    if (c.value<uint8_t>() != 1)
-        return "no grid offsets (skybake's files have them)";
-    std::string uuid(kUuidSize, ' ');
-    c.bytes(&uuid[0], kUuidSize);
-    if (!c.ok() || !looks_like_uuid(uuid, 0))
-        return "the header ends early or has no UUID";
-    std::string name, type;
-    uint32_t metas = c.value<uint32_t>();
-    if (!c.ok() || metas > kMaxMeta)
-        return "the file's metadata count is cut or past " + std::to_string(kMaxMeta);
-    for (uint32_t m = 0; m < metas; m++) {
-        if (!c.string(&name, kMaxString) || !c.string(&type, kMaxString))
-            return "metadata " + std::to_string(m) + ": its name or type is cut or too long";
-        uint32_t n = c.value<uint32_t>();
-        if (!c.ok() || n > kMaxMetaBytes || !c.seek(c.at() + n))
-            return "metadata \"" + name + "\": its value is cut or larger than 1 MiB";
-    }
-    int32_t grids = c.value<int32_t>();
-    if (c.ok() && grids >= 0 && uint32_t(grids) != grids_expected)
-        *code = SB_ERR_BAD_IMAGE;
-    if (!c.ok() || grids < 0 || uint32_t(grids) != grids_expected)
-        return "holds " + std::to_string(grids) + " grids, expected " + std::to_string(grids_expected) +
-               " (the channels)";
-    for (int32_t g = 0; g < grids; g++) {
-        std::string unique, parent;
-        if (!c.string(&unique, kMaxString) || !c.string(&type, kMaxString) || !c.string(&parent, kMaxString))
-            return "grid " + std::to_string(g) + ": its descriptor is cut";
-        int64_t grid_pos = c.value<int64_t>(), block_pos = c.value<int64_t>(), end_pos = c.value<int64_t>();
-        if (!c.ok() || grid_pos < int64_t(c.at()) || block_pos < grid_pos || end_pos < block_pos ||
-            uint64_t(end_pos) > size || (g + 1 == grids && uint64_t(end_pos) != size))
-            return "grid \"" + unique + "\": its offsets " + std::to_string(grid_pos) + ", " +
-                   std::to_string(block_pos) + ", " + std::to_string(end_pos) +
-                   " do not lie in order within the file's " + std::to_string(size) + " bytes";
-        c.seek(uint64_t(end_pos));
-    }
-    return std::string();
-}
-
-enum sb_result write_bytes(const char *path, const std::string &bytes)
-{
-    return sb_write_file(path, bytes.data(), bytes.size(), "VDB file");
 }
 
 openvdb::math::Transform::Ptr texture_transform(uint32_t width, uint32_t height, uint32_t depth)
@@ -243,55 +94,83 @@ openvdb::FloatGrid::Ptr channel_grid(const sb_image *v, uint32_t c)
     return grid;
 }
 
-} // namespace
-
-extern "C" enum sb_result sb_vdb_write(const char *path, const struct sb_image *volume,
-                                       const struct sb_attribute *attributes, int attribute_count)
+// The volume's grids, serialised, with the caller's UUID.
+enum sb_result write_volume(const sb_vdb_request &job, const sb_image *volume, std::string *bytes)
 {
-    int64_t bad = sb_image_find_not_half(volume);
-    if (bad >= 0) {
-        sb_error("%s: value %lld (%.9g) is not a binary16 value, which the file stores; round first", path,
-                 static_cast<long long>(bad), double(volume->data[bad]));
-        return SB_ERR_NUMERIC;
-    }
-    std::string bytes;
     try {
         openvdb::initialize();
         openvdb::GridCPtrVec grids;
         openvdb::MetaMap file_meta;
-        for (int a = 0; a < attribute_count; a++)
-            file_meta.insertMeta(attributes[a].name, openvdb::StringMetadata(attributes[a].value));
+        for (int a = 0; a < job.attribute_count; a++)
+            file_meta.insertMeta(job.attributes[a].name, openvdb::StringMetadata(job.attributes[a].value));
         for (uint32_t c = 0; c < volume->channel_count; c++) {
             openvdb::FloatGrid::Ptr grid = channel_grid(volume, c);
             grid->setName(volume->channel_names[c]);
             grid->setGridClass(openvdb::GRID_FOG_VOLUME);
             grid->setSaveFloatAsHalf(true);
             grid->setTransform(texture_transform(volume->width, volume->height, volume->depth));
-            for (int a = 0; a < attribute_count; a++)
-                grid->insertMeta(attributes[a].name, openvdb::StringMetadata(attributes[a].value));
+            for (int a = 0; a < job.attribute_count; a++)
+                grid->insertMeta(job.attributes[a].name, openvdb::StringMetadata(job.attributes[a].value));
             grids.push_back(grid);
         }
         std::ostringstream os(std::ios_base::out | std::ios_base::binary);
         BufferWriter writer;
         writer.setCompression(openvdb::io::COMPRESS_BLOSC | openvdb::io::COMPRESS_ACTIVE_MASK);
         writer.write_to(os, grids, file_meta);
-        bytes = os.str();
+        *bytes = os.str();
     } catch (const std::exception &e) {
-        sb_error("%s: OpenVDB cannot write the volume: %s", path, e.what());
+        sb_error("%s: OpenVDB cannot write the volume: %s", job.path, e.what());
         return SB_ERR_VDB;
     }
-    if (!looks_like_uuid(bytes, kUuidOffset)) {
-        sb_error("%s: OpenVDB wrote a header this build does not know (no UUID at byte %zu)", path, kUuidOffset);
+    if (!looks_like_uuid(*bytes, SB_VDB_UUID_OFFSET)) {
+        sb_error("%s: OpenVDB wrote a header this build does not know (no UUID at byte %d)", job.path,
+                 SB_VDB_UUID_OFFSET);
         return SB_ERR_VDB;
     }
-    bytes.replace(kUuidOffset, kUuidSize, uuid_from(volume, attributes, attribute_count));
-    return write_bytes(path, bytes);
+    bytes->replace(SB_VDB_UUID_OFFSET, SB_VDB_UUID_SIZE, job.uuid, SB_VDB_UUID_SIZE);
+    return SB_OK;
 }
 
-namespace
+// The helper's side of sb_vdb_write: the volume's floats mapped from the
+// caller's memory file, its shape checked against the file's size.
+int write_task(int out, const sb_vdb_request &job)
 {
+    sb_vdb_answer a = {};
+    a.magic = SB_VDB_MAGIC;
+    sb_sandbox_capture_log(a.message, sizeof(a.message));
+    sb_image volume = job.volume;
+    volume.data = nullptr;
+    uint64_t floats = 0;
+    struct stat st;
+    bool shaped = volume.width && volume.height && volume.depth && volume.channel_count &&
+                  volume.channel_count <= SB_IMAGE_MAX_CHANNELS && volume.levels <= 1 && job.attribute_count >= 0 &&
+                  job.attribute_count <= SB_FILE_MAX_ATTRIBUTES;
+    if (shaped) {
+        floats = sb_image_float_count(&volume);
+        shaped = fstat(SB_SANDBOX_FILE_FD, &st) == 0 && uint64_t(st.st_size) == floats * sizeof(float);
+    }
+    void *mapped =
+        shaped ? mmap(nullptr, floats * sizeof(float), PROT_READ, MAP_PRIVATE, SB_SANDBOX_FILE_FD, 0) : MAP_FAILED;
+    std::string bytes;
+    if (mapped == MAP_FAILED) {
+        sb_error("%s: the volume's %ux%ux%u voxels of %u channels are not what its process was given", job.path,
+                 volume.width, volume.height, volume.depth, volume.channel_count);
+        a.result = SB_ERR_VDB;
+    } else {
+        volume.data = static_cast<float *>(mapped);
+        for (uint32_t c = 0; c < volume.channel_count; c++)
+            volume.channel_names[c][SB_CHANNEL_NAME_MAX - 1] = '\0';
+        a.result = write_volume(job, &volume, &bytes);
+        munmap(mapped, floats * sizeof(float));
+    }
+    a.size = a.result ? 0 : bytes.size();
+    bool ok = sb_write_all(out, &a, sizeof(a));
+    if (!a.result && ok)
+        ok = sb_write_all(out, bytes.data(), bytes.size());
+    return ok ? 0 : 1;
+}
 
-// ---- in the helper program (read_vdb.c): OpenVDB parses ------------------------------------
+// ---- reading: OpenVDB parses ---------------------------------------------------------------
 
 std::string meta_string(const openvdb::MetaMap &meta, const char *name)
 {
@@ -421,19 +300,11 @@ enum sb_result read_grids(const char *path, const char *file_name, const char *c
     return res;
 }
 
-} // namespace
-
-// The helper's side of sb_vdb_read (read_vdb.h).
-extern "C" int sb_vdb_read_task(int out, const void *request, size_t size)
+// The helper's side of sb_vdb_read: the file is the caller's descriptor.
+int read_task(int out, const sb_vdb_request &job)
 {
-    sb_read_vdb_request job = {};
-    if (size != sizeof(job))
-        return 2;
-    std::memcpy(&job, request, sizeof(job));
-    job.path[sizeof(job.path) - 1] = '\0';
-    job.channel_order[sizeof(job.channel_order) - 1] = '\0';
-    sb_read_vdb_answer a = {};
-    a.magic = SB_READ_VDB_MAGIC;
+    sb_vdb_answer a = {};
+    a.magic = SB_VDB_MAGIC;
     sb_sandbox_capture_log(a.message, sizeof(a.message));
     char file_name[64];
     std::snprintf(file_name, sizeof(file_name), "/proc/self/fd/%d", SB_SANDBOX_FILE_FD);
@@ -443,8 +314,8 @@ extern "C" int sb_vdb_read_task(int out, const void *request, size_t size)
     // One thread: the CPU-time limit then bounds the wall time too.
     tbb::task_arena arena(1);
     arena.execute([&] {
-        a.result = read_grids(job.path, file_name, job.channel_order, job.max_voxels, &volume, attributes,
-                              &attribute_count);
+        a.result =
+            read_grids(job.path, file_name, job.channel_order, job.max_voxels, &volume, attributes, &attribute_count);
     });
     if (!a.result) {
         a.width = volume.width;
@@ -461,102 +332,21 @@ extern "C" int sb_vdb_read_task(int out, const void *request, size_t size)
     return ok ? 0 : 1;
 }
 
+} // namespace
 
-// ---- in the caller ---------------------------------------------------------------------------
-
-extern "C" enum sb_result sb_vdb_read(const char *path, const char *channel_order, uint64_t max_voxels,
-                                      struct sb_image *volume, struct sb_attribute *attributes, int *attribute_count)
+extern "C" int sb_vdb_task(int out, const void *request, size_t size)
 {
-    std::memset(volume, 0, sizeof(*volume));
-    if (attribute_count)
-        *attribute_count = 0;
-    if (!max_voxels)
-        max_voxels = kDefaultMaxVoxels;
-    sb_image names = {};
-    sb_image_set_channel_names(&names, channel_order);
-    uint32_t channels = 0;
-    while (channels < SB_IMAGE_MAX_CHANNELS && names.channel_names[channels][0])
-        channels++;
-    int fd = sb_open_regular(AT_FDCWD, path, true, nullptr);
-    if (fd < 0) {
-        sb_error("%s: cannot open the VDB file: %s", path, errno == EINVAL ? "not a regular file" : strerror(errno));
-        return SB_ERR_IO;
+    // The request is large (the volume's names); off the stack.
+    std::unique_ptr<sb_vdb_request> job(new (std::nothrow) sb_vdb_request());
+    if (!job || size != sizeof(*job))
+        return 2;
+    std::memcpy(job.get(), request, sizeof(*job));
+    job->path[sizeof(job->path) - 1] = '\0';
+    job->channel_order[sizeof(job->channel_order) - 1] = '\0';
+    job->uuid[SB_VDB_UUID_SIZE] = '\0';
+    for (sb_attribute &attribute : job->attributes) {
+        attribute.name[sizeof(attribute.name) - 1] = '\0';
+        attribute.value[sizeof(attribute.value) - 1] = '\0';
     }
-    struct stat st;
-    if (fstat(fd, &st) != 0 || static_cast<uint64_t>(st.st_size) > kMaxFileBytes) {
-        sb_error("%s: not a file of at most %llu bytes", path, static_cast<unsigned long long>(kMaxFileBytes));
-        close(fd);
-        return SB_ERR_IO;
-    }
-    sb_result code;
-    std::string wrong = check_structure(fd, uint64_t(st.st_size), channels, &code);
-    if (!wrong.empty()) {
-        sb_error("%s: %s", path, wrong.c_str());
-        close(fd);
-        return code;
-    }
-    // OpenVDB in its helper: the grids' contents are still OpenVDB's to parse.
-    // Memory for its tree and our copy: three times the volume, and room
-    // for OpenVDB's own buffers.
-    sb_read_vdb_request job = {};
-    job.max_voxels = max_voxels;
-    if (std::snprintf(job.path, sizeof(job.path), "%s", path) >= int(sizeof(job.path)) ||
-        std::snprintf(job.channel_order, sizeof(job.channel_order), "%s", channel_order) >=
-            int(sizeof(job.channel_order))) {
-        sb_error("%s: the path or the channel list is too long to read it", path);
-        close(fd);
-        return SB_ERR_IO;
-    }
-    sb_sandbox_limits limits = {};
-    limits.cpu_seconds = 60;
-    limits.address_space_bytes =
-        (128ull << 20) + 3 * std::min(max_voxels, kDefaultMaxVoxels) * channels * sizeof(float);
-    sb_sandbox box;
-    enum sb_result res = sb_sandbox_start(&box, &limits, SB_READ_VDB_HELPER, &job, sizeof(job), fd);
-    close(fd); // the helper has its copy
-    if (res)
-        return res;
-    sb_read_vdb_answer a;
-    char why[160];
-    if (!sb_sandbox_read(&box, &a, sizeof(a)) || a.magic != SB_READ_VDB_MAGIC) {
-        sb_sandbox_finish(&box, why, sizeof(why));
-        sb_error("%s: OpenVDB did not finish reading it: its process %s", path, why);
-        return SB_ERR_VDB;
-    }
-    a.message[sizeof(a.message) - 1] = '\0';
-    if (a.result) {
-        sb_sandbox_finish(&box, nullptr, 0);
-        sb_error("%s", a.message[0] ? a.message : "OpenVDB cannot read the file");
-        return unsigned(a.result) < SB_RESULT_COUNT ? sb_result(a.result) : SB_ERR_VDB;
-    }
-    sb_attribute got[SB_FILE_MAX_ATTRIBUTES];
-    uint64_t voxels = uint64_t(a.width) * a.height * a.depth;
-    if (a.channel_count != channels || !a.width || !a.height || !a.depth || voxels > max_voxels ||
-        a.attribute_count < 0 || a.attribute_count > SB_FILE_MAX_ATTRIBUTES) {
-        sb_sandbox_finish(&box, nullptr, 0);
-        sb_error("%s: the reading process answered %ux%ux%u voxels of %u channels: not what was asked", path, a.width,
-                 a.height, a.depth, a.channel_count);
-        return SB_ERR_VDB;
-    }
-    res = sb_image_init_volume(volume, a.width, a.height, a.depth, channels);
-    if (!res && !(sb_sandbox_read(&box, got, sizeof(got)) &&
-                  sb_sandbox_read(&box, volume->data, sb_image_float_count(volume) * sizeof(float)))) {
-        sb_sandbox_finish(&box, why, sizeof(why));
-        sb_error("%s: OpenVDB stopped half way: its process %s", path, why);
-        res = SB_ERR_VDB;
-    }
-    sb_sandbox_finish(&box, nullptr, 0);
-    if (res) {
-        sb_image_finish(volume);
-        return res;
-    }
-    sb_image_set_channel_names(volume, channel_order);
-    for (int i = 0; attributes && i < a.attribute_count; i++) {
-        got[i].name[sizeof(got[i].name) - 1] = '\0';
-        got[i].value[sizeof(got[i].value) - 1] = '\0';
-        attributes[i] = got[i];
-    }
-    if (attribute_count)
-        *attribute_count = attributes ? a.attribute_count : 0;
-    return SB_OK;
+    return job->task == SB_VDB_READ ? read_task(out, *job) : job->task == SB_VDB_WRITE ? write_task(out, *job) : 2;
 }

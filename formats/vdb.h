@@ -1,6 +1,7 @@
 /*
- * OpenVDB files of skybake volumes, through the one C++ file of skybake
- * (vdb.cpp), since OpenVDB has no C API.
+ * OpenVDB files of skybake volumes. OpenVDB (C++, no C API) runs only in
+ * the helper program skybake-vdb (vdb.cpp, the one C++ file of skybake;
+ * vdb_helper.h), never in the caller, whose start it slowed by 60 ms.
  *
  * A volume of C channels is C FloatGrids (VDB has no 4-vector grid), each
  * named after its channel, in channel order:
@@ -33,9 +34,10 @@ extern "C" {
  * Write `volume` to `path` (created or replaced). Every value must already
  * be a binary16 value (sb_image_round_to_half): the file stores binary16,
  * and a value that is not one is refused (SB_ERR_NUMERIC) rather than
- * silently changed. Returns SB_OK, SB_ERR_IO (naming the system's reason),
- * SB_ERR_VDB or SB_ERR_NUMERIC, logging the path and the reason.
- * Thread-safe.
+ * silently changed. The helper serialises the volume; the caller writes
+ * the file. Returns SB_OK, SB_ERR_IO (naming the system's reason, or the
+ * helper's absence), SB_ERR_VDB (OpenVDB failed, or its process) or
+ * SB_ERR_NUMERIC, logging the path and the reason. Thread-safe.
  */
 enum sb_result sb_vdb_write(const char *path, const struct sb_image *volume, const struct sb_attribute *attributes,
                             int attribute_count);
@@ -57,9 +59,9 @@ enum sb_result sb_vdb_write(const char *path, const struct sb_image *volume, con
  * OpenVDB's reader is not hardened against hostile files, so the file's
  * layout is checked first (header, metadata, each grid's offsets within the
  * file) and OpenVDB parses the grids in a helper process under CPU-time,
- * memory and wall-clock limits (sandbox.h; the program skybake-read-vdb,
- * installed beside the library in libexecdir/skybake): a crafted file gets SB_ERR_VDB,
- * never a crash or a hang of the caller.
+ * memory and wall-clock limits (sandbox.h; the program skybake-vdb,
+ * installed beside the library in libexecdir/skybake): a crafted file gets
+ * SB_ERR_VDB, never a crash or a hang of the caller.
  */
 enum sb_result sb_vdb_read(const char *path, const char *channel_order, uint64_t max_voxels, struct sb_image *volume,
                            struct sb_attribute *attributes, int *attribute_count);

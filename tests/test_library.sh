@@ -34,7 +34,7 @@ volume_hash=$(sed -n 's/.*"content_hash":[[:space:]]*"\([0-9a-f]*\)".*/\1/p' "$t
 # it finds the VDB helper only where SKYBAKE_LIBEXEC_DIR says (the shared
 # one finds it beside the library), and says so when it cannot.
 check "the static example without the helper fails" expect_exit 1 "$tmp/example_static" "$tmp/pack"
-check "naming the helper and SKYBAKE_LIBEXEC_DIR" grep -q "cannot find the helper program skybake-read-vdb.*SKYBAKE_LIBEXEC_DIR" "$tmp/err"
+check "naming the helper and SKYBAKE_LIBEXEC_DIR" grep -q "cannot find the helper program skybake-vdb.*SKYBAKE_LIBEXEC_DIR" "$tmp/err"
 for kind in shared static; do
     check "the $kind example loads the pack" expect_exit 0 env LD_LIBRARY_PATH="$build/formats" \
         SKYBAKE_LIBEXEC_DIR="$([ $kind = static ] && echo "$build/formats")" "$tmp/example_$kind" "$tmp/pack"
