@@ -155,15 +155,19 @@ enum sb_result sb_orders_bake(struct sb_vk *vk, struct sb_atmosphere_baker *bake
     if (result->last_share >= s.tolerance)
         sb_warn("orders: order %d still adds %.3g of the sum's largest value (tolerance %g)", result->orders,
                 result->last_share, s.tolerance);
-    /* the tail: the last order's sum over the nodes to the one's before, in the nodes' order */
+    /* Everything the table is made of, read back at once: the last two
+     * orders, the sum and the ground's irradiance. */
     int last_order = result->orders;
-    if (!(last = malloc(2 * n * vec4))) {
+    size_t ground_floats = (size_t)(SB_ORDERS_MAX_ORDER + 1) * s.mu_s * 4;
+    if (!(last = malloc(2 * n * vec4)) || !(table = malloc(n * vec4 + ground_floats * sizeof(float)))) {
         res = SB_ERR_NOMEM;
         goto done;
     }
-    if ((res = sb_buffer_read(vk, &previous[last_order % 2], last)) ||
-        (last_order > 2 && (res = sb_buffer_read(vk, &previous[(last_order - 1) % 2], last + 4 * n))))
+    const struct sb_buffer *reads[] = {&previous[last_order % 2], &sum, &ground, &previous[(last_order - 1) % 2]};
+    void *outs[] = {last, table, table + 4 * n, last + 4 * n};
+    if ((res = sb_buffers_read(vk, last_order > 2 ? 4 : 3, reads, outs)))
         goto done;
+    /* the tail: the last order's sum over the nodes to the one's before, in the nodes' order */
     double last_sum[3] = {0, 0, 0}, before_sum[3] = {0, 0, 0};
     for (size_t i = 0; last_order > 2 && i < n; i++)
         for (int c = 0; c < 3; c++) {
@@ -174,13 +178,6 @@ enum sb_result sb_orders_bake(struct sb_vk *vk, struct sb_atmosphere_baker *bake
         result->tail[c] = sb_orders_tail_factor(last_sum[c], before_sum[c]);
     sb_debug("orders: the tail after order %d: %.4g %.4g %.4g times its radiance", result->orders, result->tail[0],
              result->tail[1], result->tail[2]);
-    size_t ground_floats = (size_t)(SB_ORDERS_MAX_ORDER + 1) * s.mu_s * 4;
-    if (!(table = malloc(n * vec4 + ground_floats * sizeof(float)))) {
-        res = SB_ERR_NOMEM;
-        goto done;
-    }
-    if ((res = sb_buffer_read(vk, &sum, table)) || (res = sb_buffer_read(vk, &ground, table + 4 * n)))
-        goto done;
     /* the last row: the ground's irradiance from the sky, orders 1 to N - 1
      * (order j's is in the ground buffer's row j), the same at every nu */
     for (int i = 0; i < s.mu_s; i++)

@@ -41,8 +41,20 @@ cleanup:
 
 enum sb_result sb_buffer_read(struct sb_vk *vk, const struct sb_buffer *b, void *out)
 {
-    if (b->host_cached) {
-        memcpy(out, b->mapped, b->size);
+    return sb_buffers_read(vk, 1, &b, &out);
+}
+
+enum sb_result sb_buffers_read(struct sb_vk *vk, int count, const struct sb_buffer *const *buffers, void *const *outs)
+{
+    VkDeviceSize size = 0;
+    bool cached = true;
+    for (int i = 0; i < count; i++) {
+        size += (buffers[i]->size + 255) & ~(VkDeviceSize)255;
+        cached = cached && buffers[i]->host_cached;
+    }
+    if (cached || !size) {
+        for (int i = 0; i < count; i++)
+            memcpy(outs[i], buffers[i]->mapped, buffers[i]->size);
         return SB_OK;
     }
     enum sb_result res = SB_OK;
@@ -52,7 +64,7 @@ enum sb_result sb_buffer_read(struct sb_vk *vk, const struct sb_buffer *b, void 
     void *mapped = NULL;
     VkBufferCreateInfo info = {
         .sType = VK_STRUCTURE_TYPE_BUFFER_CREATE_INFO,
-        .size = b->size,
+        .size = size,
         .usage = VK_BUFFER_USAGE_TRANSFER_DST_BIT,
         .sharingMode = VK_SHARING_MODE_EXCLUSIVE,
     };
@@ -66,7 +78,8 @@ enum sb_result sb_buffer_read(struct sb_vk *vk, const struct sb_buffer *b, void 
         goto cleanup;
     if (!(flags & VK_MEMORY_PROPERTY_HOST_CACHED_BIT)) {
         /* No cached type: the staging copy would be as slow to read. */
-        memcpy(out, b->mapped, b->size);
+        for (int i = 0; i < count; i++)
+            memcpy(outs[i], buffers[i]->mapped, buffers[i]->size);
         goto cleanup;
     }
     VK(vkBindBufferMemory(vk->device, staging, memory, 0));
@@ -80,7 +93,12 @@ enum sb_result sb_buffer_read(struct sb_vk *vk, const struct sb_buffer *b, void 
     };
     vkCmdPipelineBarrier(cmd, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT | VK_PIPELINE_STAGE_HOST_BIT,
                          VK_PIPELINE_STAGE_TRANSFER_BIT, 0, 1, &before, 0, NULL, 0, NULL);
-    vkCmdCopyBuffer(cmd, b->buffer, staging, 1, &(VkBufferCopy){.size = b->size});
+    VkDeviceSize at = 0;
+    for (int i = 0; i < count; i++) {
+        vkCmdCopyBuffer(cmd, buffers[i]->buffer, staging, 1,
+                        &(VkBufferCopy){.dstOffset = at, .size = buffers[i]->size});
+        at += (buffers[i]->size + 255) & ~(VkDeviceSize)255;
+    }
     VkMemoryBarrier after = {
         .sType = VK_STRUCTURE_TYPE_MEMORY_BARRIER,
         .srcAccessMask = VK_ACCESS_TRANSFER_WRITE_BIT,
@@ -90,7 +108,11 @@ enum sb_result sb_buffer_read(struct sb_vk *vk, const struct sb_buffer *b, void 
                          NULL);
     if ((res = sb_vk_end_once(vk, cmd)))
         goto cleanup;
-    memcpy(out, mapped, b->size);
+    at = 0;
+    for (int i = 0; i < count; i++) {
+        memcpy(outs[i], (const char *)mapped + at, buffers[i]->size);
+        at += (buffers[i]->size + 255) & ~(VkDeviceSize)255;
+    }
 
 cleanup:
     if (staging)

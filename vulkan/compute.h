@@ -35,6 +35,9 @@ void sb_buffer_destroy(struct sb_vk *vk, struct sb_buffer *buffer);
  * into a cached staging buffer first.
  */
 enum sb_result sb_buffer_read(struct sb_vk *vk, const struct sb_buffer *buffer, void *out);
+/* Several buffers at once, buffers[i] into outs[i]: one staging copy, one
+ * submission and one wait for them all (a large product's last step). */
+enum sb_result sb_buffers_read(struct sb_vk *vk, int count, const struct sb_buffer *const *buffers, void *const *outs);
 
 /* A kernel and its own descriptor set: the layouts and the pipeline are the
  * context's (pipeline.h), the set and its pool the sb_pipeline's. */
