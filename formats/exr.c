@@ -157,12 +157,17 @@ static exr_result_t write_and_pass(exr_encode_pipeline_t *encoder)
     return rv;
 }
 
-/* Log the chunk's failure unless an earlier one stopped it. */
-static void chunk_failed(struct chunk_writer *w, const char *what, exr_result_t rv, enum sb_result plain)
+/* Log the chunk's failure (`what` NULL: its channels are not the
+ * image's) unless an earlier one stopped the part. */
+static void chunk_failed(struct chunk_writer *w, const char *what, exr_result_t rv)
 {
     pthread_mutex_lock(&w->lock);
-    if (!w->res)
-        w->res = what ? sb_exr_fail(w->path, what, rv) : plain;
+    if (!w->res && what)
+        w->res = sb_exr_fail(w->path, what, rv);
+    else if (!w->res) {
+        sb_error("%s: a channel of the file is not the image's", w->path);
+        w->res = SB_ERR_EXR;
+    }
     pthread_cond_broadcast(&w->turn);
     pthread_mutex_unlock(&w->lock);
 }
@@ -178,13 +183,12 @@ static void write_chunk(void *user, int index)
     if (rv != EXR_ERR_SUCCESS)
         what = "preparing a chunk";
     else if ((rv = exr_encoding_initialize(w->ctxt, w->part, &cinfo, &encoder)) != EXR_ERR_SUCCESS) {
-        chunk_failed(w, "starting the encoder", rv, SB_OK);
+        chunk_failed(w, "starting the encoder", rv);
         return;
     }
-    if (!what && !w->chunks->point(w->chunks->user, index, encoder.channels, encoder.channel_count)) {
-        sb_error("%s: a channel of the file is not the image's", w->path);
-        chunk_failed(w, NULL, rv, SB_ERR_EXR);
-    } else if (!what && (rv = exr_encoding_choose_default_routines(w->ctxt, w->part, &encoder)) != EXR_ERR_SUCCESS)
+    if (!what && !w->chunks->point(w->chunks->user, index, encoder.channels, encoder.channel_count))
+        chunk_failed(w, NULL, rv);
+    else if (!what && (rv = exr_encoding_choose_default_routines(w->ctxt, w->part, &encoder)) != EXR_ERR_SUCCESS)
         what = "choosing the encoder";
     else if (!what) {
         sb_exr_keep_raw_when_larger(&encoder);
@@ -197,7 +201,7 @@ static void write_chunk(void *user, int index)
             what = "encoding";
     }
     if (what)
-        chunk_failed(w, what, rv, SB_OK);
+        chunk_failed(w, what, rv);
     if (encoder.context)
         exr_encoding_destroy(w->ctxt, &encoder);
 }
