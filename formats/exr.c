@@ -107,6 +107,39 @@ void sb_exr_keep_raw_when_larger(exr_encode_pipeline_t *encoder)
     }
 }
 
+/* Where channel `name` is in the image, or channel_count. */
+uint32_t sb_exr_channel_index(const struct sb_image *image, const char *name)
+{
+    uint32_t c = 0;
+    while (c < image->channel_count && strcmp(image->channel_names[c], name) != 0)
+        c++;
+    return c;
+}
+
+/* Point a coder's channels at pixel (x0, y0) of a level that starts at
+ * `base` and is `width` wide, the image's channels interleaved. */
+bool sb_exr_point_channels(exr_coding_channel_info_t *channels, int16_t count, const struct sb_image *image,
+                           float *base, uint32_t width, int32_t x0, int32_t y0, bool decode)
+{
+    size_t pixel = (size_t)image->channel_count * sizeof(float);
+    base += ((size_t)y0 * width + (size_t)x0) * image->channel_count;
+    for (int16_t ch = 0; ch < count; ch++) {
+        exr_coding_channel_info_t *info = &channels[ch];
+        uint32_t c = sb_exr_channel_index(image, info->channel_name);
+        if (c == image->channel_count)
+            return false;
+        if (decode)
+            info->decode_to_ptr = (uint8_t *)(base + c);
+        else
+            info->encode_from_ptr = (const uint8_t *)(base + c);
+        info->user_pixel_stride = (int32_t)pixel;
+        info->user_line_stride = (int32_t)(pixel * width);
+        info->user_bytes_per_element = 4;
+        info->user_data_type = EXR_PIXEL_FLOAT;
+    }
+    return true;
+}
+
 /*
  * The chunks of a part, compressed on every thread and written in order.
  * sb_parallel_for hands the indices out in increasing order; a chunk
@@ -232,23 +265,8 @@ static exr_result_t scanline_info(void *user, exr_context_t ctxt, int part, int 
 static bool point_scanlines(void *user, int index, exr_coding_channel_info_t *channels, int16_t count)
 {
     const struct scanlines *s = user;
-    const struct sb_image *image = s->image;
-    size_t pixel_stride = (size_t)image->channel_count * sizeof(float);
-    size_t y = (size_t)index * (size_t)s->lines_per_chunk;
-    for (int16_t ch = 0; ch < count; ch++) {
-        exr_coding_channel_info_t *info = &channels[ch];
-        uint32_t src = 0;
-        while (src < image->channel_count && strcmp(image->channel_names[src], info->channel_name) != 0)
-            src++;
-        if (src == image->channel_count)
-            return false;
-        info->encode_from_ptr = (const uint8_t *)(image->data + (y * image->width) * image->channel_count + src);
-        info->user_pixel_stride = (int32_t)pixel_stride;
-        info->user_line_stride = (int32_t)(pixel_stride * image->width);
-        info->user_bytes_per_element = 4;
-        info->user_data_type = EXR_PIXEL_FLOAT;
-    }
-    return true;
+    return sb_exr_point_channels(channels, count, s->image, s->image->data, s->image->width, 0,
+                                 index * s->lines_per_chunk, false);
 }
 
 enum sb_result sb_exr_write(const char *path, const struct sb_image *image, const struct sb_attribute *attributes,

@@ -23,45 +23,12 @@ uint32_t sb_cube_levels(uint32_t face_size)
     return levels;
 }
 
-/* Where channel `name` is in the image, or channel_count. */
-static uint32_t channel_index(const struct sb_image *image, const char *name)
-{
-    uint32_t c = 0;
-    while (c < image->channel_count && strcmp(image->channel_names[c], name) != 0)
-        c++;
-    return c;
-}
-
 /* Where level `level` of cube `cube` starts in the image, and its width. */
 static float *level_base(const struct sb_image *image, uint32_t cube, uint32_t level, uint32_t *width)
 {
     uint32_t w = sb_image_level_size(image->width, level), h = sb_image_level_size(image->height, level);
     *width = w;
     return image->data + sb_image_level_offset(image, level) + (size_t)cube * h * w * image->channel_count;
-}
-
-/* Point a coder's channels at pixel (x0, y0) of a level that starts at
- * `base` and is `width` wide, the image's channels interleaved. */
-static bool point_channels(exr_coding_channel_info_t *channels, int16_t count, const struct sb_image *image,
-                           float *base, uint32_t width, int32_t x0, int32_t y0, bool decode)
-{
-    size_t pixel = (size_t)image->channel_count * sizeof(float);
-    base += ((size_t)y0 * width + (size_t)x0) * image->channel_count;
-    for (int16_t ch = 0; ch < count; ch++) {
-        exr_coding_channel_info_t *info = &channels[ch];
-        uint32_t c = channel_index(image, info->channel_name);
-        if (c == image->channel_count)
-            return false;
-        if (decode)
-            info->decode_to_ptr = (uint8_t *)(base + c);
-        else
-            info->encode_from_ptr = (const uint8_t *)(base + c);
-        info->user_pixel_stride = (int32_t)pixel;
-        info->user_line_stride = (int32_t)(pixel * width);
-        info->user_bytes_per_element = 4;
-        info->user_data_type = EXR_PIXEL_FLOAT;
-    }
-    return true;
 }
 
 /*
@@ -123,7 +90,7 @@ static bool point_tile(void *user, int index, exr_coding_channel_info_t *channel
 {
     const struct cube_tiles *tiles = user;
     const struct cube_tile *t = &tiles->tile[index];
-    return point_channels(channels, count, tiles->image, t->base, t->width, t->x0, t->y0, false);
+    return sb_exr_point_channels(channels, count, tiles->image, t->base, t->width, t->x0, t->y0, false);
 }
 
 static bool is_cube_image(const struct sb_image *image)
@@ -276,7 +243,7 @@ static enum sb_result check_part(exr_context_t ctxt, const char *path, int part,
     for (int c = 0; c < chlist->num_channels; c++) {
         const exr_attr_chlist_entry_t *e = &chlist->entries[c];
         if (e->x_sampling != 1 || e->y_sampling != 1 || e->pixel_type != EXR_PIXEL_FLOAT ||
-            channel_index(channels, e->name.str) == channels->channel_count) {
+            sb_exr_channel_index(channels, e->name.str) == channels->channel_count) {
             sb_error("%s: part %d: channel %s is not one of the product's FLOAT channels", path, part, e->name.str);
             return SB_ERR_BAD_IMAGE;
         }
@@ -350,7 +317,8 @@ enum sb_result sb_exr_cube_read(const char *path, const char *channel_order, uin
                         SB_EXR_TRY(exr_decoding_initialize(ctxt, part, &cinfo, &decoder), "starting the decoder");
                         decoder_live = true;
                     }
-                    if (!point_channels(decoder.channels, decoder.channel_count, image, base, width, x0, y0, true)) {
+                    if (!sb_exr_point_channels(decoder.channels, decoder.channel_count, image, base, width, x0, y0,
+                                               true)) {
                         res = SB_ERR_EXR;
                         goto cleanup;
                     }

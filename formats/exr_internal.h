@@ -10,6 +10,7 @@
 #include <openexr.h>
 #include <stdbool.h>
 
+#include "image.h"
 #include "result.h"
 
 /* For exr_context_initializer_t.error_handler_fn: keeps OpenEXR's message
@@ -47,6 +48,16 @@ enum sb_result sb_exr_start_read(const char *path, exr_context_initializer_t *in
  * corrupt pixels (OpenEXR issue 2306, fixed in 3.4.7).
  */
 void sb_exr_keep_raw_when_larger(exr_encode_pipeline_t *encoder);
+
+/* Where channel `name` is in the image, or channel_count. */
+uint32_t sb_exr_channel_index(const struct sb_image *image, const char *name);
+
+/* Point a coder's channels (encode_from_ptr, or decode_to_ptr when
+ * `decode`) at pixel (x0, y0) of a level that starts at `base` and is
+ * `width` wide, the image's channels interleaved as float. False when a
+ * channel is not the image's. */
+bool sb_exr_point_channels(exr_coding_channel_info_t *channels, int16_t count, const struct sb_image *image,
+                           float *base, uint32_t width, int32_t x0, int32_t y0, bool decode);
 
 /* How a writer's chunks are found: chunk `index`'s info
  * (exr_write_scanline_chunk_info or exr_write_tile_chunk_info), and its
