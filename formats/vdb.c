@@ -46,6 +46,41 @@ static bool uuid_from(const struct sb_image *volume, const struct sb_attribute *
     return true;
 }
 
+/*
+ * Start the helper on `job` (freed) with `fd` (closed: the helper has its
+ * copy) and read its answer's header. SB_OK: the box is open and the
+ * answer's rest follows. Otherwise the box is finished and the reason
+ * logged: the helper's own message, or how its process ended, `doing`
+ * what ("writing the volume").
+ */
+static enum sb_result ask_helper(const char *path, const struct sb_sandbox_limits *limits, struct sb_vdb_request *job,
+                                 int fd, const char *doing, struct sb_sandbox *box, struct sb_vdb_answer *a)
+{
+    enum sb_result res = sb_sandbox_start(box, limits, SB_VDB_HELPER, job, sizeof(*job), fd);
+    close(fd);
+    free(job);
+    if (res) {
+        sb_error("%s: OpenVDB's process could not start %s", path, doing);
+        return res;
+    }
+    char why[160];
+    if (!sb_sandbox_read(box, a, sizeof(*a)) || a->magic != SB_VDB_MAGIC) {
+        sb_sandbox_finish(box, why, sizeof(why));
+        sb_error("%s: OpenVDB did not finish %s: its process %s", path, doing, why);
+        return SB_ERR_VDB;
+    }
+    a->message[sizeof(a->message) - 1] = '\0';
+    if (a->result) {
+        sb_sandbox_finish(box, NULL, 0);
+        if (a->message[0])
+            sb_error("%s", a->message);
+        else
+            sb_error("%s: OpenVDB failed %s", path, doing);
+        return (unsigned)a->result < SB_RESULT_COUNT ? (enum sb_result)a->result : SB_ERR_VDB;
+    }
+    return SB_OK;
+}
+
 /* The floats of `volume` in a memory file, for the helper. */
 static int volume_file(const struct sb_image *volume)
 {
@@ -103,25 +138,11 @@ enum sb_result sb_vdb_write(const char *path, const struct sb_image *volume, con
     struct sb_sandbox_limits limits = {.cpu_seconds = 60 + (unsigned)(floats >> 22),
                                        .address_space_bytes = (256ull << 20) + 16 * floats};
     struct sb_sandbox box;
-    res = sb_sandbox_start(&box, &limits, SB_VDB_HELPER, job, sizeof(*job), fd);
-    close(fd);
-    free(job);
-    if (res)
-        return res;
     struct sb_vdb_answer a;
     char why[160];
     void *bytes = NULL;
-    if (!sb_sandbox_read(&box, &a, sizeof(a)) || a.magic != SB_VDB_MAGIC) {
-        sb_sandbox_finish(&box, why, sizeof(why));
-        sb_error("%s: OpenVDB did not finish writing the volume: its process %s", path, why);
-        return SB_ERR_VDB;
-    }
-    a.message[sizeof(a.message) - 1] = '\0';
-    if (a.result) {
-        sb_sandbox_finish(&box, NULL, 0);
-        sb_error("%s", a.message[0] ? a.message : "OpenVDB cannot write the volume");
-        return (unsigned)a.result < SB_RESULT_COUNT ? (enum sb_result)a.result : SB_ERR_VDB;
-    }
+    if ((res = ask_helper(path, &limits, job, fd, "writing the volume", &box, &a)))
+        return res;
     if (a.size < SB_VDB_UUID_OFFSET + SB_VDB_UUID_SIZE || a.size > MAX_FILE_BYTES) {
         sb_sandbox_finish(&box, NULL, 0);
         sb_error("%s: OpenVDB's process answered a file of %llu bytes (the reader takes at most %llu)", path,
@@ -356,24 +377,11 @@ enum sb_result sb_vdb_read(const char *path, const char *channel_order, uint64_t
             3 * (max_voxels < DEFAULT_MAX_VOXELS ? max_voxels : DEFAULT_MAX_VOXELS) * channels * sizeof(float),
     };
     struct sb_sandbox box;
-    enum sb_result res = sb_sandbox_start(&box, &limits, SB_VDB_HELPER, job, sizeof(*job), fd);
-    close(fd); /* the helper has its copy */
-    free(job);
-    if (res)
-        return res;
     struct sb_vdb_answer a;
     char why[160];
-    if (!sb_sandbox_read(&box, &a, sizeof(a)) || a.magic != SB_VDB_MAGIC) {
-        sb_sandbox_finish(&box, why, sizeof(why));
-        sb_error("%s: OpenVDB did not finish reading it: its process %s", path, why);
-        return SB_ERR_VDB;
-    }
-    a.message[sizeof(a.message) - 1] = '\0';
-    if (a.result) {
-        sb_sandbox_finish(&box, NULL, 0);
-        sb_error("%s", a.message[0] ? a.message : "OpenVDB cannot read the file");
-        return (unsigned)a.result < SB_RESULT_COUNT ? (enum sb_result)a.result : SB_ERR_VDB;
-    }
+    enum sb_result res = ask_helper(path, &limits, job, fd, "reading the file", &box, &a);
+    if (res)
+        return res;
     struct sb_attribute got[SB_FILE_MAX_ATTRIBUTES];
     uint64_t voxels = (uint64_t)a.width * a.height * a.depth;
     if (a.channel_count != channels || !a.width || !a.height || !a.depth || voxels > max_voxels ||

@@ -90,6 +90,14 @@ check "a full disk under a volume is exit 1" expect_exit 1 sh -c 'ulimit -f 64 &
 check "and names the reason and the VDB file" grep -Eqi "cloud_detail.vdb.*file too large" "$tmp/err"
 check "and leaves no pack" test ! -e "$tmp/fresh"
 check "and no temporary files" test -z "$(ls -d "$tmp"/fresh.tmp-* 2>/dev/null)"
+# OpenVDB writes in its helper program: without it, the volume's file and
+# the helper are named, and nothing is left.
+mkdir -p "$tmp/no-helpers"
+check "a volume without skybake-vdb is exit 1" expect_exit 1 env SKYBAKE_LIBEXEC_DIR="$tmp/no-helpers" "$skybake" bake "$tmp/volume.json" -o "$tmp/fresh"
+check "and names the helper" grep -q "cannot find the helper program skybake-vdb" "$tmp/err"
+check "and the VDB file" grep -q "cloud_detail.vdb: OpenVDB's process could not start writing the volume" "$tmp/err"
+check "and leaves no pack" test ! -e "$tmp/fresh"
+check "and no temporary files" test -z "$(ls -d "$tmp"/fresh.tmp-* 2>/dev/null)"
 
 # An unwritable parent (as an unprivileged user when run as root, since
 # root writes anywhere), a parent on a read-only file system, an output
