@@ -44,17 +44,30 @@ enum sb_result sb_buffer_read(struct sb_vk *vk, const struct sb_buffer *b, void 
     return sb_buffers_read(vk, 1, &b, &out);
 }
 
+/* Where a buffer's bytes start after those before it in a staging copy. */
+static VkDeviceSize staged(VkDeviceSize size)
+{
+    return (size + 255) & ~(VkDeviceSize)255;
+}
+
+/* Straight from the buffers' own mapping (cached, or no cached type to
+ * stage through). */
+static void copy_mapped(int count, const struct sb_buffer *const *buffers, void *const *outs)
+{
+    for (int i = 0; i < count; i++)
+        memcpy(outs[i], buffers[i]->mapped, buffers[i]->size);
+}
+
 enum sb_result sb_buffers_read(struct sb_vk *vk, int count, const struct sb_buffer *const *buffers, void *const *outs)
 {
     VkDeviceSize size = 0;
     bool cached = true;
     for (int i = 0; i < count; i++) {
-        size += (buffers[i]->size + 255) & ~(VkDeviceSize)255;
+        size += staged(buffers[i]->size);
         cached = cached && buffers[i]->host_cached;
     }
     if (cached || !size) {
-        for (int i = 0; i < count; i++)
-            memcpy(outs[i], buffers[i]->mapped, buffers[i]->size);
+        copy_mapped(count, buffers, outs);
         return SB_OK;
     }
     enum sb_result res = SB_OK;
@@ -78,8 +91,7 @@ enum sb_result sb_buffers_read(struct sb_vk *vk, int count, const struct sb_buff
         goto cleanup;
     if (!(flags & VK_MEMORY_PROPERTY_HOST_CACHED_BIT)) {
         /* No cached type: the staging copy would be as slow to read. */
-        for (int i = 0; i < count; i++)
-            memcpy(outs[i], buffers[i]->mapped, buffers[i]->size);
+        copy_mapped(count, buffers, outs);
         goto cleanup;
     }
     VK(vkBindBufferMemory(vk->device, staging, memory, 0));
@@ -97,7 +109,7 @@ enum sb_result sb_buffers_read(struct sb_vk *vk, int count, const struct sb_buff
     for (int i = 0; i < count; i++) {
         vkCmdCopyBuffer(cmd, buffers[i]->buffer, staging, 1,
                         &(VkBufferCopy){.dstOffset = at, .size = buffers[i]->size});
-        at += (buffers[i]->size + 255) & ~(VkDeviceSize)255;
+        at += staged(buffers[i]->size);
     }
     VkMemoryBarrier after = {
         .sType = VK_STRUCTURE_TYPE_MEMORY_BARRIER,
@@ -111,7 +123,7 @@ enum sb_result sb_buffers_read(struct sb_vk *vk, int count, const struct sb_buff
     at = 0;
     for (int i = 0; i < count; i++) {
         memcpy(outs[i], (const char *)mapped + at, buffers[i]->size);
-        at += (buffers[i]->size + 255) & ~(VkDeviceSize)255;
+        at += staged(buffers[i]->size);
     }
 
 cleanup:
