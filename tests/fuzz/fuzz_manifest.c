@@ -24,8 +24,14 @@ int LLVMFuzzerTestOneInput(const unsigned char *data, size_t size)
     if (!pack_dir[0]) {
         sb_log_set_sink(fuzz_quiet, NULL);
         snprintf(pack_dir, sizeof(pack_dir), "/tmp/skybake-fuzz-pack-%ld", (long)getpid());
-        if (write_synthetic_pack(pack_dir, "fuzz", NULL)) /* what corpus/manifest/ describes */
+        enum sb_result res = write_synthetic_pack(pack_dir, "fuzz", NULL); /* what corpus/manifest/ describes */
+        if (res != SB_OK) {
+            fprintf(stderr,
+                    "fuzz_manifest: cannot write the pack it reads in %s: %s (its volumes need skybake-vdb: "
+                    "meson compile -C build-fuzz fuzzers)\n",
+                    pack_dir, sb_result_description(res));
             abort();
+        }
         const char *seed = getenv("SKYBAKE_FUZZ_WRITE_SEED"); /* regenerate the seed manifest */
         if (seed) {
             char cmd[256];
