@@ -338,12 +338,29 @@ static void radiance_error(const struct sb_sky_error_sun *sun, const double floo
     *mean_rel = n ? sum / n : 0;
 }
 
+/* The floor of the relative errors: 1e-3 of the brightest view in the
+ * channel, of those at least 5 degrees from the sun. A view at the sun
+ * looks into Mie's forward peak (at g = 0.99 thousands of times the sky
+ * about it), which as the brightest raised the floor above the rest of
+ * the sky and hid the haze's errors (12.7% rms at 30 degrees read 5.4%). */
+static void error_floor(const struct sb_sky_error_sun *sun, double floor[3])
+{
+    floor[0] = floor[1] = floor[2] = 0;
+    for (int d = 0; d < SB_SKY_ERROR_DIRECTIONS; d++) {
+        const struct sb_sky_error_direction *dir = &sun->directions[d];
+        double mu, mu_s, nu;
+        sb_sky_error_cosines(dir->zenith_deg, dir->azimuth_deg, sun->elevation_deg, &mu, &mu_s, &nu);
+        if (nu > cos(5.0 * SKY_PI / 180))
+            continue;
+        for (int c = 0; c < 3; c++)
+            floor[c] = fmax(floor[c], 1e-3 * dir->path_traced[c]);
+    }
+}
+
 static void summarise(struct sb_sky_error_sun *sun, const double solar[3])
 {
-    double floor[3] = {0, 0, 0}, share = 0;
-    for (int d = 0; d < SB_SKY_ERROR_DIRECTIONS; d++)
-        for (int c = 0; c < 3; c++)
-            floor[c] = fmax(floor[c], 1e-3 * sun->directions[d].path_traced[c]);
+    double floor[3], share = 0;
+    error_floor(sun, floor);
     int lit = 0, unused_d, unused_c;
     sun->noise = 0;
     for (int d = 0; d < SB_SKY_ERROR_DIRECTIONS; d++)

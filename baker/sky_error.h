@@ -103,7 +103,8 @@ struct sb_sky_error_sun {
     double elevation_deg;
     struct sb_sky_error_direction directions[SB_SKY_ERROR_DIRECTIONS];
     /* Over directions and channels, relative to the path tracer (floored at
-     * 1e-3 of the sun's brightest value in that channel): */
+     * 1e-3 of the sun's brightest value in that channel, of the views at
+     * least 5 degrees from the sun): */
     double max_rel, rms_rel, mean_rel; /* mean_rel is signed: skybake above the reference > 0 */
     int worst_direction, worst_channel;
     double noise;                                              /* the largest 2 standard errors, relative */
