@@ -33,7 +33,8 @@ struct progression {
 struct sb_orders_ref {
     struct sb_atmosphere_params p;
     int nr, nmu, nmus, nnu;
-    double R, top, H, mu_s_min;
+    double R, top, mu_s_min;
+    double grid_top, H;         /* the grid's top (sb_orders_top_km) and the horizon's distance from it */
     struct progression heights; /* the r nodes' altitudes */
     double levels[SB_MAX_LEVELS];
     int level_count;
@@ -119,9 +120,14 @@ static double dist_ground(const struct sb_orders_ref *o, double r, double mu)
     return fmax(-r * mu - sqrt(fmax(r * r * (mu * mu - 1.0) + o->R * o->R, 0.0)), 0.0);
 }
 
+static double dist_to(double r, double mu, double top)
+{
+    return fmax(-r * mu + sqrt(fmax(r * r * (mu * mu - 1.0) + top * top, 0.0)), 0.0);
+}
+
 static double dist_top(const struct sb_orders_ref *o, double r, double mu)
 {
-    return fmax(-r * mu + sqrt(fmax(r * r * (mu * mu - 1.0) + o->top * o->top, 0.0)), 0.0);
+    return dist_to(r, mu, o->top);
 }
 
 /* Transmittance along the ray from (r, mu) to distance t on it (Bruneton's
@@ -212,7 +218,7 @@ static double mu_of(const struct sb_orders_ref *o, double r, int imu)
         double x = (double)imu / (half - 1), d_min = r - o->R, d_max = rho, d = d_min + x * (d_max - d_min);
         return d <= 0.0 ? -1.0 : clamp1(-(rho * rho + d * d) / (2.0 * r * d));
     }
-    double x = (double)(imu - half) / (half - 1), d_min = o->top - r, d_max = rho + o->H;
+    double x = (double)(imu - half) / (half - 1), d_min = o->grid_top - r, d_max = rho + o->H;
     double d = d_min + x * (d_max - d_min);
     return d <= 0.0 ? 1.0 : clamp1((o->H * o->H - rho * rho - d * d) / (2.0 * r * d));
 }
@@ -227,7 +233,7 @@ static double mu_coord(const struct sb_orders_ref *o, double r, double mu, bool 
         double x = d_max > d_min ? (d - d_min) / (d_max - d_min) : 0.0;
         return fmin(fmax(x, 0.0), 1.0) * (half - 1);
     }
-    double d_min = o->top - r, d_max = rho + o->H, d = dist_top(o, r, mu);
+    double d_min = fmax(o->grid_top - r, 0.0), d_max = rho + o->H, d = dist_to(r, mu, o->grid_top);
     double x = d_max > d_min ? (d - d_min) / (d_max - d_min) : 0.0;
     return half + fmin(fmax(x, 0.0), 1.0) * (half - 1);
 }
@@ -313,6 +319,8 @@ static void azimuth_weights(int n, double phi, double w[])
 static void lookup_any(const struct sb_orders_ref *o, const double *table, const float *ftable, double r, double mu,
                        double mu_s, double nu, bool ground, bool view, double out[3])
 {
+    if (o->grid_top < o->top) /* above the grid (a density along a ray): its top's */
+        r = fmin(r, o->grid_top);
     double fr = progression_index(&o->heights, r - o->R);
     int ir = fr < o->nr - 2 ? (int)fr : o->nr - 2;
     double ar = fr - ir;
@@ -643,7 +651,7 @@ struct sb_orders_settings sb_orders_settings_resolve(const struct sb_orders_sett
 
 static struct progression heights_of(const struct sb_atmosphere_params *p, int nr)
 {
-    return (struct progression){p->top_radius_km - p->ground_radius_km, sb_orders_height_ratio(p, nr), nr - 1};
+    return (struct progression){sb_orders_top_km(p) - p->ground_radius_km, sb_orders_height_ratio(p, nr), nr - 1};
 }
 
 /* The grid and the quadratures, no table. */
@@ -657,9 +665,10 @@ static void grid_init(struct sb_orders_ref *o, const struct sb_atmosphere_params
     o->nnu = set->nu;
     o->R = p->ground_radius_km;
     o->top = p->top_radius_km;
-    o->H = sqrt(o->top * o->top - o->R * o->R);
+    o->grid_top = sb_orders_top_km(p);
+    o->H = sqrt(o->grid_top * o->grid_top - o->R * o->R);
     o->heights = heights_of(p, o->nr);
-    o->mu_s_min = -o->H / o->top;
+    o->mu_s_min = -o->H / o->grid_top;
     o->log_azimuth = sb_orders_log_azimuth(p);
     o->nu_power = (float)sb_orders_azimuth_power(p); /* as the GPU's grid holds it */
     o->level_count = sb_atmosphere_levels(p, o->levels);
@@ -792,19 +801,20 @@ void sb_orders_ref_node(const struct sb_orders_ref *o, int ir, int imu, int imus
     memcpy(out, &o->sum[3 * node_index(o, ir, imu, imus, inu)], 3 * sizeof(double));
 }
 
-/* A view from above the atmosphere as the one from where it enters it;
+/* A view from above the grid's top as the one from where it enters it;
  * false where it misses. */
 static bool enter_atmosphere(const struct sb_orders_ref *o, double *r, double *mu, double *mu_s, double nu)
 {
-    if (*r <= o->top)
+    double top = o->grid_top;
+    if (*r <= top)
         return true;
-    double b = *r * *mu, disc = b * b - (*r - o->top) * (*r + o->top);
+    double b = *r * *mu, disc = b * b - (*r - top) * (*r + top);
     if (*mu >= 0.0 || disc < 0.0)
         return false;
-    double t = (*r - o->top) * (*r + o->top) / (-b + sqrt(disc));
-    *mu = clamp1((*r * *mu + t) / o->top);
-    *mu_s = clamp1((*r * *mu_s + t * nu) / o->top);
-    *r = o->top;
+    double t = (*r - top) * (*r + top) / (-b + sqrt(disc));
+    *mu = clamp1((*r * *mu + t) / top);
+    *mu_s = clamp1((*r * *mu_s + t * nu) / top);
+    *r = top;
     return true;
 }
 

@@ -20,15 +20,21 @@
  * order K - 1. The ground's irradiance of every order is kept
  * too, so that a view that ends on the ground can be lit by all of it.
  *
- * The grid (all nodes on the edges of their ranges):
+ * The grid (all nodes on the edges of their ranges) ends at its top,
+ * sb_orders_top_km: the atmosphere's, or lower where the air above it holds
+ * under 1e-6 of its column (the thick atmosphere's grid ends 110 km up);
+ * its nodes' rays run on through the air to the atmosphere's top, reading
+ * the table above the grid at its top, and a view from above the grid
+ * reads it where it enters it:
  * - r: altitudes in a geometric progression from the ground to the top, the
  *   first step a quarter of the smaller scale height (the nodes follow the
  *   air however thick the atmosphere);
  * - mu: two halves, rays that end on the ground and rays that leave the
- *   atmosphere, each uniform in the ray's length between its extremes
- *   (straight down or up, and the horizon), as Bruneton's mapping;
+ *   grid, each uniform in the ray's length to the ground or the grid's top
+ *   between its extremes (straight down or up, and the horizon), as
+ *   Bruneton's mapping;
  * - mu_s: half the nodes uniform from -H / top (H = sqrt(top^2 - R^2):
- *   below it no point of the atmosphere sees the sun) to 0.1, the rest on
+ *   below it no point of the grid sees the sun) to 0.1, the rest on
  *   to 1; read linearly, but geometrically between two nodes below the
  *   horizon, where twilight falls exponentially;
  * - nu: the sun's azimuth about the vertical from the view's, over [0, pi]

@@ -23,9 +23,27 @@ static void put3(float dst[4], const double src[3], double w)
     dst[3] = (float)w;
 }
 
+static bool any3(const double v[3])
+{
+    return v[0] > 0 || v[1] > 0 || v[2] > 0;
+}
+
+double sb_orders_top_km(const struct sb_atmosphere_params *p)
+{
+    const double air_left = 1e-6; /* of each species' column, above the grid */
+    double scale_heights = log(1.0 / air_left), h = 0.0;
+    if (any3(p->rayleigh_scattering_per_km))
+        h = fmax(h, scale_heights * p->rayleigh_scale_height_km);
+    if (any3(p->mie_scattering_per_km) || any3(p->mie_absorption_per_km))
+        h = fmax(h, scale_heights * p->mie_scale_height_km);
+    if (any3(p->ozone_absorption_per_km))
+        h = fmax(h, p->ozone_center_km + p->ozone_half_width_km);
+    return h > 0.0 ? fmin(p->top_radius_km, p->ground_radius_km + h) : p->top_radius_km;
+}
+
 double sb_orders_height_ratio(const struct sb_atmosphere_params *p, int nr)
 {
-    double Z = p->top_radius_km - p->ground_radius_km;
+    double Z = sb_orders_top_km(p) - p->ground_radius_km;
     double first = 0.25 * fmin(p->rayleigh_scale_height_km, p->mie_scale_height_km);
     int n = nr - 1;
     if (n < 1 || first * n >= Z * (1 - 1e-12))
@@ -54,7 +72,7 @@ double sb_orders_azimuth_power(const struct sb_atmosphere_params *p)
 void sb_orders_grid_pack(const struct sb_atmosphere_params *p, int nr, int nmu, int nmus, int nnu,
                          struct sb_orders_push *out)
 {
-    double q = sb_orders_height_ratio(p, nr), R = p->ground_radius_km, top = p->top_radius_km;
+    double q = sb_orders_height_ratio(p, nr), R = p->ground_radius_km, top = sb_orders_top_km(p);
     memset(out, 0, sizeof(*out));
     out->size[0] = (uint32_t)nr;
     out->size[1] = (uint32_t)nmu;

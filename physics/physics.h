@@ -23,10 +23,22 @@ void sb_gauss_legendre_node(int k, int n, double a, double b, double *x, double 
 /* Fill the std430 image of the parameters (config.h) from validated ones. */
 void sb_atmosphere_gpu_pack(const struct sb_atmosphere_params *params, struct sb_atmosphere_gpu *gpu);
 
+/* The radius (km) at which the orders' grid ends: the atmosphere's top, or
+ * lower where above it every species holds under 1e-6 of its vertical
+ * column (Rayleigh and Mie from 13.8 scale heights, ozone above its tent).
+ * Its nodes in r, in the rays' lengths and in mu_s (whose lowest is the
+ * sun's last light on that top) then lie where the air is: an atmosphere
+ * as thick as its planet's radius took them thousands of kilometres up,
+ * and read twilight 4 times coarser in mu_s and the horizon 6 times
+ * coarser in mu than the earth's grid (docs/accuracy.md). Its nodes' rays
+ * still run through all of the air to the top. */
+double sb_orders_top_km(const struct sb_atmosphere_params *params);
+
 /* The orders' grid (baker/orders_ref.h states it): the ratio q of its
- * altitudes' geometric progression, h_i = Z (q^i - 1) / (q^n - 1) over the
- * atmosphere's thickness Z with n = nr - 1, the first step a quarter of the
- * smaller scale height (q = 1: uniform, where that would be coarser). */
+ * altitudes' geometric progression, h_i = Z (q^i - 1) / (q^n - 1) over its
+ * thickness Z (sb_orders_top_km's, less the ground's radius) with n = nr -
+ * 1, the first step a quarter of the smaller scale height (q = 1: uniform,
+ * where that would be coarser). */
 double sb_orders_height_ratio(const struct sb_atmosphere_params *params, int nr);
 
 /* Whether a view reads the orders' table across the sun's azimuth

@@ -182,6 +182,12 @@ int main(void)
     sb_atmosphere_preset_earth(&earth);
     const struct sb_orders_settings coarse = {.r = 12, .mu = 48, .mu_s = 16, .nu = 6};
     compare("earth", vk, &earth, &coarse, 0.015, 0.25, 0.02);
+    /* as thick as its planet's radius: the grid ends 110.5 km up, where the
+     * air above holds under 1e-6 of its column (sb_orders_top_km), and the
+     * nodes' rays run on to the top 6360 km up */
+    struct sb_atmosphere_params thick = earth;
+    thick.top_radius_km = 2 * thick.ground_radius_km;
+    compare("the thick atmosphere", vk, &thick, &coarse, 0.015, 0.25, 0.02);
     struct sb_atmosphere_params mars;
     sb_atmosphere_preset_mars(&mars);
     tail("earth", vk, &earth, &coarse, 1e-4);

@@ -56,6 +56,30 @@ float orders_altitude_coord(float h)
     return clamp(i, 0.0, n);
 }
 
+/* The grid's top (physics.h's sb_orders_top_km), as a thickness: the
+ * atmosphere's, or lower where the air above it holds under 1e-6 of its
+ * column. Its rays still run to the atmosphere's top. */
+float orders_thickness() { return SB_ORDERS_GRID_HEIGHTS.w; }
+bool orders_below_top() { return orders_thickness() < atmosphere_thickness(); }
+
+/* From the ground to the horizon seen from the grid's top (the
+ * atmosphere's own values where the grid ends at its top: the same bits). */
+float orders_horizon_top()
+{
+    float Z = orders_thickness();
+    return orders_below_top() ? sqrt(Z * (2.0 * ground_radius() + Z)) : horizon_top();
+}
+
+/* Distance along (h, mu) to the grid's top (0 from above it). */
+float orders_distance_to_top(float h, float mu)
+{
+    if (!orders_below_top())
+        return distance_to_top(h, mu);
+    float r = ground_radius() + h, Z = orders_thickness();
+    float above = max(Z - h, 0.0) * (ground_radius() + Z + r); /* top^2 - r^2 */
+    return max(-r * mu + sqrt(max(above + r * r * mu * mu, 0.0)), 0.0);
+}
+
 /* mu at node imu at altitude h: the first half of the nodes end on the
  * ground, uniform in the ray's length between straight down and the
  * horizon; the second leave the atmosphere, from straight up to the
@@ -63,12 +87,12 @@ float orders_altitude_coord(float h)
 float orders_mu(float h, uint imu)
 {
     uint half_count = SB_ORDERS_GRID_SIZE.y / 2u;
-    float R = ground_radius(), r = R + h, rho = horizon_distance(h), H = horizon_top();
+    float R = ground_radius(), r = R + h, rho = horizon_distance(h), H = orders_horizon_top();
     if (imu < half_count) {
         float x = float(imu) / float(half_count - 1u), d = h + x * (rho - h);
         return d <= 0.0 ? -1.0 : clamp(-(rho * rho + d * d) / (2.0 * r * d), -1.0, 1.0);
     }
-    float x = float(imu - half_count) / float(half_count - 1u), d_min = atmosphere_thickness() - h;
+    float x = float(imu - half_count) / float(half_count - 1u), d_min = orders_thickness() - h;
     float d = d_min + x * (rho + H - d_min);
     return d <= 0.0 ? 1.0 : clamp((H * H - rho * rho - d * d) / (2.0 * r * d), -1.0, 1.0);
 }
@@ -77,19 +101,19 @@ float orders_mu(float h, uint imu)
 float orders_mu_coord(float h, float mu, bool ground)
 {
     float half_count = float(SB_ORDERS_GRID_SIZE.y / 2u);
-    float rho = horizon_distance(h), H = horizon_top();
+    float rho = horizon_distance(h), H = orders_horizon_top();
     if (ground) {
         float d_min = h, d_max = rho, d = distance_to_ground(h, mu);
         float x = d_max > d_min ? (d - d_min) / (d_max - d_min) : 0.0;
         return clamp(x, 0.0, 1.0) * (half_count - 1.0);
     }
-    float d_min = max(atmosphere_thickness() - h, 0.0), d_max = rho + H, d = distance_to_top(h, mu);
+    float d_min = max(orders_thickness() - h, 0.0), d_max = rho + H, d = orders_distance_to_top(h, mu);
     float x = d_max > d_min ? (d - d_min) / (d_max - d_min) : 0.0;
     return half_count + clamp(x, 0.0, 1.0) * (half_count - 1.0);
 }
 
 /* mu_s at node imus: half the nodes from the lowest (below it no point of
- * the atmosphere sees the sun) to SB_ORDERS_MU_S_SPLIT, the rest on to 1. */
+ * the grid sees the sun) to SB_ORDERS_MU_S_SPLIT, the rest on to 1. */
 float orders_mu_s(uint imus)
 {
     uint low = SB_ORDERS_GRID_SIZE.z / 2u;
@@ -179,6 +203,8 @@ OrdersCell orders_cell(float h, float mu, float mu_s, float nu, bool ground)
 {
     uvec4 s = SB_ORDERS_GRID_SIZE;
     OrdersCell c;
+    if (orders_below_top()) /* above the grid (a density along a ray): its top's */
+        h = min(h, orders_thickness());
     float fr = orders_altitude_coord(h);
     uint ir = min(uint(fr), s.x - 2u);
     OrdersMuS ms = orders_mu_s_cell(mu_s);

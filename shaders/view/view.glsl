@@ -116,6 +116,16 @@ vec3 orders_sky_log_azimuth(OrdersCell c)
  * (orders_sky_log_azimuth). */
 vec3 orders_sky(float h, float mu, float mu_s, float nu, bool ground)
 {
+    if (orders_below_top() && h > orders_thickness()) { /* from above the grid: where the view enters it */
+        float Z = orders_thickness(), r = ground_radius() + h, top = ground_radius() + Z;
+        float b = r * mu, c2 = (r - top) * (r + top), disc = b * b - c2;
+        if (mu >= 0.0 || disc < 0.0)
+            return vec3(0.0);
+        float t = c2 / (-b + sqrt(disc));
+        mu = clamp((r * mu + t) / top, -1.0, 1.0);
+        mu_s = clamp((r * mu_s + t * nu) / top, -1.0, 1.0);
+        h = Z;
+    }
     OrdersCell c = orders_cell(h, mu, mu_s, nu, ground);
     if (c.twilight)
         return orders_read_texels(c);
