@@ -6,6 +6,7 @@
  * makes the sun's largest channel 1.
  */
 #include <assert.h>
+#include <cJSON.h>
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
@@ -76,6 +77,50 @@ static enum sb_result upload_layers(struct sb_renderer *r, const struct sb_pack 
     return res;
 }
 
+/* The orders' grid an artifact was baked on, as its settings record it,
+ * against the one this build reads (sb_orders_grid_pack): its top and its
+ * azimuth nodes' power. A pack of another grid, same in shape, would be
+ * read between the wrong nodes without a word. A field a build before it
+ * did not write stands for the grid that build had: the atmosphere's top,
+ * uniform azimuths. */
+static enum sb_result orders_grid_check(const struct sb_artifact *a, const struct sb_atmosphere_params *atm)
+{
+    struct {
+        const char *field, *what, *unit;
+        double before, now;
+    } grid[] = {
+        {"top_km", "ending at radius", " km", atm->top_radius_km, sb_orders_top_km(atm)},
+        {"nu_power", "with azimuth nodes at the power", "", 1.0, sb_orders_azimuth_power(atm)},
+    };
+    cJSON *settings = cJSON_Parse(a->settings_json[0] ? a->settings_json : "{}");
+    enum sb_result res = SB_OK;
+    for (size_t i = 0; i < sizeof(grid) / sizeof(grid[0]) && !res; i++) {
+        const cJSON *v = cJSON_GetObjectItemCaseSensitive(settings, grid[i].field);
+        double baked = cJSON_IsNumber(v) ? v->valuedouble : grid[i].before;
+        if (fabs(baked - grid[i].now) > 1e-9 * fabs(grid[i].now)) {
+            sb_error(
+                "%s: baked on a grid of the orders %s %.9g%s (settings.%s), where this build reads them %s %.9g%s: "
+                "rebake needed",
+                a->file, grid[i].what, baked, grid[i].unit, grid[i].field, grid[i].what, grid[i].now, grid[i].unit);
+            res = SB_ERR_VERSION;
+        }
+    }
+    cJSON_Delete(settings);
+    return res;
+}
+
+enum sb_result sb_renderer_check_pack(const struct sb_pack *pack)
+{
+    static const enum sb_product_id tables[] = {SB_PRODUCT_ORDERS, SB_PRODUCT_SPECTRAL_ORDERS};
+    for (size_t i = 0; i < sizeof(tables) / sizeof(tables[0]); i++) {
+        enum sb_result res =
+            pack->present[tables[i]] ? orders_grid_check(&pack->artifacts[tables[i]], &pack->scene->atmosphere) : SB_OK;
+        if (res)
+            return res;
+    }
+    return SB_OK;
+}
+
 enum sb_result sb_atmosphere_upload(struct sb_renderer *r, const struct sb_pack *pack)
 {
     static const enum sb_product_id needed[] = {SB_PRODUCT_TRANSMITTANCE, SB_PRODUCT_MULTISCATTERING,
@@ -87,6 +132,9 @@ enum sb_result sb_atmosphere_upload(struct sb_renderer *r, const struct sb_pack 
             return SB_ERR_USAGE;
         }
     const struct sb_atmosphere_params *atm = &pack->scene->atmosphere;
+    enum sb_result grid = sb_renderer_check_pack(pack);
+    if (grid)
+        return grid;
     struct sb_atmosphere_gpu gpu;
     sb_atmosphere_gpu_pack(atm, &gpu);
     double sun_max = fmax(atm->solar_irradiance[0], fmax(atm->solar_irradiance[1], atm->solar_irradiance[2]));

@@ -978,6 +978,11 @@ static int run(const struct options *o)
         sb_error("%s: refused; nothing was rendered", o->pack);
         return EXIT_USAGE;
     }
+    if (sb_renderer_check_pack(&pack)) {
+        sb_error("%s: refused; nothing was rendered", o->pack);
+        sb_pack_close(&pack);
+        return EXIT_USAGE;
+    }
     struct sb_world world;
     struct sb_renderer_params params = o->params;
     if (o->sheet_step_h > 0.0 && !params.width) {
@@ -1067,7 +1072,7 @@ static int run(const struct options *o)
     sb_info("skyview %s: %s on %s (%s)", SKYBAKE_VERSION, o->pack, vk->properties.deviceName, vk->driver_name);
     res = sb_renderer_create(vk, &pack, &world, &params, &r);
     if (res) {
-        code = res == SB_ERR_USAGE ? EXIT_USAGE : EXIT_RENDER_FAILED;
+        code = res == SB_ERR_USAGE || res == SB_ERR_VERSION ? EXIT_USAGE : EXIT_RENDER_FAILED;
         goto done;
     }
     if (o->window) {

@@ -199,10 +199,20 @@ struct sb_frame_timings {
 struct sb_renderer;
 
 /*
+ * Whether this build can draw `pack`'s orders tables (orders and
+ * spectral_orders): the grid their settings record (`top_km`, `nu_power`;
+ * docs/pack.md) is the one it reads; SB_ERR_VERSION naming the field
+ * otherwise ("rebake needed": the same shape read between the wrong
+ * nodes). No device needed; sb_renderer_create checks it too.
+ */
+enum sb_result sb_renderer_check_pack(const struct sb_pack *pack);
+
+/*
  * Create a renderer for `pack` (which must hold transmittance,
  * multiscattering and irradiance_ground; SB_ERR_USAGE naming the missing
- * product otherwise) and `world` (copied; both may be freed afterwards).
- * `vk` must have been created with graphics.
+ * product otherwise; orders on the grid this build reads,
+ * sb_renderer_check_pack) and `world` (copied; both may be freed
+ * afterwards). `vk` must have been created with graphics.
  */
 enum sb_result sb_renderer_create(struct sb_vk *vk, const struct sb_pack *pack, const struct sb_world *world,
                                   const struct sb_renderer_params *params, struct sb_renderer **renderer);

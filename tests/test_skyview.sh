@@ -306,6 +306,15 @@ next=$(($(sed -n 's/.*"format_version":[[:space:]]*\([0-9]*\).*/\1/p' "$tmp/pack
 sed -i "s/\"format_version\":[[:space:]]*[0-9]*/\"format_version\": $next/" "$tmp/future/manifest.json"
 check "an unknown format version is refused" expect_exit 2 "$skyview" "$tmp/future" -o "$tmp/x"
 check "the message says rebake" grep -q "rebake needed" "$tmp/err"
+# an orders table baked on another grid (the same shape): refused, not read between the wrong nodes
+printf '{"version":1,"name":"orders","atmosphere":{"preset":"earth"},"products":["orders"]}' >"$tmp/orders.json"
+check "bake a pack with the orders" expect_exit 0 "$skybake" bake "$tmp/orders.json" -o "$tmp/grid" -q
+check "which skyview reads" expect_exit 0 "$skyview" "$tmp/grid" -o "$tmp/grid-frame" $small
+sed -i 's/"top_km":[[:space:]]*[0-9.e+]*/"top_km": 12720/' "$tmp/grid/manifest.json"
+check "the orders' grid is recorded" grep -q '"top_km": 12720' "$tmp/grid/manifest.json"
+check "an orders table of another grid is refused" expect_exit 2 "$skyview" "$tmp/grid" -o "$tmp/x"
+check "the message names the field and says rebake" grep -q "orders.exr: baked on a grid .*settings.top_km.*rebake needed" "$tmp/err"
+check "nothing was written" test ! -e "$tmp/x"
 check "a pack without multiscattering is refused" expect_exit 2 "$skyview" "$tmp/thin" -o "$tmp/x"
 check "the message names multiscattering" grep -q "multiscattering" "$tmp/err"
 check "a directory that is not a pack is refused" expect_exit 2 "$skyview" "$tmp" -o "$tmp/x"
