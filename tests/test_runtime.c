@@ -1301,11 +1301,12 @@ static void sky_reference(void *user, int i)
 }
 
 /* The relative error of `gpu`, a half the renderer stored at `scale`
- * times the radiance, from `ref`, beyond the half's own rounding (half
+ * times the radiance, from `ref` (relative to ref, or to `floor` where ref
+ * is below it), beyond the half's own rounding (half
  * its spacing: 2^-11 of a binade, 2^-25 among the subnormals below 2^-14,
  * where the near slices of a low sun's aerial perspective fall): the
  * storage's precision is not the sum's error. */
-static double stored_error(double gpu, double ref, double scale)
+static double stored_error(double gpu, double ref, double scale, double floor)
 {
     double x = fabs(ref) * scale, step = 0x1p-24;
     if (x >= 0x1p-14) {
@@ -1313,7 +1314,7 @@ static double stored_error(double gpu, double ref, double scale)
         frexp(x, &e); /* x in [2^(e-1), 2^e) */
         step = ldexp(1.0, e - 11);
     }
-    return fmax(fabs(gpu - ref) - 0.5 * step / scale, 0.0) / fmax(ref, 1e-30);
+    return fmax(fabs(gpu - ref) - 0.5 * step / scale, 0.0) / fmax(ref, fmax(floor, 1e-30));
 }
 
 /* The sky-view LUT of `r` (rendering pack `p`) at a sun, from the camera
@@ -1369,8 +1370,7 @@ static void test_sky_view_from(struct sb_renderer *r, const struct sb_pack *p, d
             /* relative down to a millionth of the brightest texel: from 300 km
              * up the thick atmosphere's zenith is 1e-10 of its horizon, air
              * at e^-37 of the ground's, whose fp32 sum is not the read's error */
-            double e = stored_error(cases[i].gpu[c], cases[i].ref[c], scale) * fmax(cases[i].ref[c], 1e-30) /
-                       fmax(cases[i].ref[c], 1e-6 * brightest[c]);
+            double e = stored_error(cases[i].gpu[c], cases[i].ref[c], scale, 1e-6 * brightest[c]);
             if (e > worst) {
                 worst = e;
                 worst_i = i;
@@ -1525,7 +1525,7 @@ static void test_aerial_of(struct sb_renderer *r, const struct sb_pack *p, doubl
     int worst_i = 0, worst_c = 0;
     for (int i = 0; i < NC * NS; i++)
         for (int c = 0; c < 3; c++) {
-            double e = stored_error(cases[i].gpu[c], cases[i].ref[c], scale);
+            double e = stored_error(cases[i].gpu[c], cases[i].ref[c], scale, 0.0);
             if (e > worst) {
                 worst = e;
                 worst_i = i;

@@ -189,12 +189,19 @@ bool ray_hits_ground(float h, float mu)
     return mu < 0.0 && r * r * mu * mu >= h * (2.0 * ground_radius() + h);
 }
 
-float distance_to_top(float h, float mu)
+/* Distance along (h, mu) to the sphere `thickness` above the ground, of
+ * radius `top` (0 from above it), without cancellation looking up. */
+float distance_to_sphere(float h, float mu, float thickness, float top)
 {
     float r = ground_radius() + h;
-    float above = max(atmosphere_thickness() - h, 0.0) * (top_radius() + r); /* top^2 - r^2 */
+    float above = max(thickness - h, 0.0) * (top + r); /* top^2 - r^2 */
     float disc = sqrt(above + r * r * mu * mu);
     return mu >= 0.0 ? above / max(r * mu + disc, 1e-30) : disc - r * mu;
+}
+
+float distance_to_top(float h, float mu)
+{
+    return distance_to_sphere(h, mu, atmosphere_thickness(), top_radius());
 }
 
 float distance_to_ground(float h, float mu)

@@ -73,11 +73,8 @@ float orders_horizon_top()
 /* Distance along (h, mu) to the grid's top (0 from above it). */
 float orders_distance_to_top(float h, float mu)
 {
-    if (!orders_below_top())
-        return distance_to_top(h, mu);
-    float r = ground_radius() + h, Z = orders_thickness();
-    float above = max(Z - h, 0.0) * (ground_radius() + Z + r); /* top^2 - r^2 */
-    return max(-r * mu + sqrt(max(above + r * r * mu * mu, 0.0)), 0.0);
+    float Z = orders_thickness();
+    return orders_below_top() ? distance_to_sphere(h, mu, Z, ground_radius() + Z) : distance_to_top(h, mu);
 }
 
 /* mu at node imu at altitude h: the first half of the nodes end on the
