@@ -152,9 +152,10 @@ static void orders_grid_key(const struct sb_scene *scene, struct sb_key_text *ke
 {
     struct sb_orders_settings grid = sb_orders_product_grid(&scene->atmosphere);
     struct sb_orders_settings s = sb_orders_settings_resolve(&grid);
-    sb_key_add(key, " grid %dx%dx%dx%d nu power %a top %a orders %d until %a", s.r, s.mu, s.mu_s, s.nu,
+    struct sb_atmosphere_params medium;
+    sb_key_add(key, " grid %dx%dx%dx%d nu power %a top %a orders %d until %a delta-M %a", s.r, s.mu, s.mu_s, s.nu,
                sb_orders_azimuth_power(&scene->atmosphere), sb_orders_top_km(&scene->atmosphere), s.max_order,
-               s.tolerance);
+               s.tolerance, sb_orders_medium(&scene->atmosphere, &medium));
 }
 
 static void orders_code_key(struct sb_key_text *key)
@@ -172,9 +173,11 @@ static void orders_settings(struct sb_artifact *a, const char *first, const stru
                             double height_ratio)
 {
     struct sb_orders_settings s = sb_orders_settings_resolve(grid);
+    struct sb_atmosphere_params medium;
     int n = snprintf(a->settings_json, sizeof(a->settings_json),
-                     "%s\"r\":%d,\"mu\":%d,\"mu_s\":%d,\"nu\":%d,\"nu_power\":%.17g,\"top_km\":%.17g", first, s.r, s.mu,
-                     s.mu_s, s.nu, sb_orders_azimuth_power(p), sb_orders_top_km(p));
+                     "%s\"r\":%d,\"mu\":%d,\"mu_s\":%d,\"nu\":%d,\"nu_power\":%.17g,\"top_km\":%.17g,\"delta_m\":%.17g",
+                     first, s.r, s.mu, s.mu_s, s.nu, sb_orders_azimuth_power(p), sb_orders_top_km(p),
+                     sb_orders_medium(p, &medium));
     if (!isnan(height_ratio) && n > 0 && (size_t)n < sizeof(a->settings_json))
         n += snprintf(a->settings_json + n, sizeof(a->settings_json) - (size_t)n, ",\"height_ratio\":%.17g",
                       height_ratio);

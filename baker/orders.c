@@ -69,6 +69,49 @@ static float float_of(uint32_t bits)
     return f;
 }
 
+/*
+ * Where the orders are computed in a delta-M scaled medium (sb_orders_medium,
+ * a fraction f of Mie's scattering carried on as unscattered light), the
+ * light that fraction carries forward and the air then scatters once: the
+ * runtime draws single scattering in the atmosphere itself, with Mie's whole
+ * phase, so the table adds, at each node, single scattering in the medium
+ * (its transmittance, its smooth phase) less the same smooth scattering in
+ * the atmosphere's transmittance; and on the ground row, the sun the
+ * peak carries to the ground. `single`: the medium's single scattering
+ * kernel's output (2 n vec4, Rayleigh's then Mie's, without their phase),
+ * then the atmosphere's; out: rgb per node, then per mu_s node.
+ */
+static bool delta_m_light(const struct sb_atmosphere_params *p, const struct sb_atmosphere_params *medium, double f,
+                          const struct sb_orders_settings *s, const float *single, double *out)
+{
+    struct sb_orders_ref *grid = sb_orders_grid_create(p, s);
+    if (!grid)
+        return false;
+    size_t n = (size_t)s->r * s->mu * s->mu_s * s->nu;
+    const float *scaled = single, *whole = single + 8 * n;
+    for (size_t i = 0; i < n; i++) {
+        double h, mu, mu_s, nu;
+        sb_orders_grid_node(grid, i, &h, &mu, &mu_s, &nu);
+        double pr = sb_ref_phase_rayleigh(nu), pm = sb_ref_phase_mie(medium->mie_g, nu);
+        for (int c = 0; c < 3; c++) {
+            double rayleigh = (double)scaled[4 * i + c] - whole[4 * i + c];
+            double mie = (double)scaled[4 * (n + i) + c] - (1.0 - f) * whole[4 * (n + i) + c];
+            out[3 * i + c] = fmax(pr * rayleigh + pm * mie, 0.0);
+        }
+    }
+    for (int i = 0; i < s->mu_s; i++) {
+        double mu_s = sb_orders_grid_mu_s(grid, i), t_medium[3] = {0, 0, 0}, t[3] = {0, 0, 0};
+        if (mu_s > 0) {
+            sb_ref_transmittance(medium, p->ground_radius_km, mu_s, 2, t_medium);
+            sb_ref_transmittance(p, p->ground_radius_km, mu_s, 2, t);
+        }
+        for (int c = 0; c < 3; c++)
+            out[3 * (n + (size_t)i) + c] = p->solar_irradiance[c] * fmax(t_medium[c] - t[c], 0.0) * fmax(mu_s, 0.0);
+    }
+    sb_orders_ref_destroy(&grid);
+    return true;
+}
+
 enum sb_result sb_orders_bake(struct sb_vk *vk, struct sb_atmosphere_baker *baker, const struct sb_atmosphere_params *p,
                               const struct sb_orders_settings *settings, struct sb_image *image,
                               struct sb_orders_result *result)
@@ -87,9 +130,15 @@ enum sb_result sb_orders_bake(struct sb_vk *vk, struct sb_atmosphere_baker *bake
     /* order k's radiance in previous[k % 2]: the last two orders are there
      * at the end, for the tail */
     struct sb_buffer single = {0}, previous[2] = {{0}}, density = {0}, sum = {0}, ground = {0}, stats = {0},
-                     dummy = {0};
+                     dummy = {0}, single_whole = {0};
     struct sb_pipeline pipelines[KERNEL_COUNT] = {0};
     float *table = NULL, *last = NULL; /* the last two orders' radiance */
+    /* a peaked Mie's orders in its delta-M medium, in a baker of their own */
+    struct sb_atmosphere_params medium;
+    double f = sb_orders_medium(p, &medium), ms = 0;
+    struct sb_atmosphere_baker *scaled = NULL;
+    float *singles = NULL;
+    double *forward = NULL; /* delta_m_light's */
     enum sb_result res;
     if ((res = sb_image_init(image, (uint32_t)(s.mu_s * s.nu), (uint32_t)(s.r * s.mu + 1), 3)) ||
         (res = sb_buffer_create(vk, 2 * n * vec4, "orders single", &single)) ||
@@ -101,6 +150,17 @@ enum sb_result sb_orders_bake(struct sb_vk *vk, struct sb_atmosphere_baker *bake
         (res = sb_buffer_create(vk, 16, "orders stats", &stats)) ||
         (res = sb_buffer_create(vk, 16, "orders unused", &dummy)))
         goto done;
+    if (f > 0) {
+        struct sb_image t = {0};
+        if ((res = sb_atmosphere_baker_create(vk, &medium, &scaled)) ||
+            (res = sb_atmosphere_bake(scaled, SB_PRODUCT_TRANSMITTANCE, NULL, &t, NULL, &ms)) ||
+            (res = sb_buffer_create(vk, 2 * n * vec4, "orders single (atmosphere)", &single_whole))) {
+            sb_image_finish(&t);
+            goto done;
+        }
+        sb_image_finish(&t);
+        result->gpu_ms += ms;
+    }
     sb_image_set_channel_names(image, "r,g,b");
     const struct sb_buffer *bindings[SB_ORDERS_BINDING_COUNT];
     for (int i = 0; i < SB_ORDERS_BINDING_COUNT; i++)
@@ -119,7 +179,18 @@ enum sb_result sb_orders_bake(struct sb_vk *vk, struct sb_atmosphere_baker *bake
         sb_pipeline_bind(vk, &pipelines[k], bindings);
     }
     uint32_t node_groups = (uint32_t)((n + SB_ORDERS_THREADS - 1) / SB_ORDERS_THREADS);
-    double ms = 0;
+    if (scaled) { /* single scattering in the atmosphere itself first, then all in the medium */
+        bindings[SB_ORDERS_BINDING_SINGLE] = &single_whole;
+        sb_pipeline_bind(vk, &pipelines[SINGLE], bindings);
+        if ((res = sb_dispatch(vk, &pipelines[SINGLE], &push, node_groups, 1, 1, &ms)))
+            goto done;
+        result->gpu_ms += ms;
+        sb_atmosphere_bind_inputs(scaled, bindings);
+        bindings[SB_BINDING_MULTISCATTERING] = bindings[SB_BINDING_IRRADIANCE_GROUND] = &dummy;
+        bindings[SB_ORDERS_BINDING_SINGLE] = &single;
+        for (int k = 0; k < KERNEL_COUNT; k++)
+            sb_pipeline_bind(vk, &pipelines[k], bindings);
+    }
     if ((res = sb_dispatch(vk, &pipelines[SINGLE], &push, node_groups, 1, 1, &ms)))
         goto done;
     result->gpu_ms += ms;
@@ -167,6 +238,20 @@ enum sb_result sb_orders_bake(struct sb_vk *vk, struct sb_atmosphere_baker *bake
     void *outs[] = {last, table, table + 4 * n, last + 4 * n};
     if ((res = sb_buffers_read(vk, last_order > 2 ? 4 : 3, reads, outs)))
         goto done;
+    if (scaled) {
+        const struct sb_buffer *single_reads[] = {&single, &single_whole};
+        if (!(singles = malloc(4 * n * vec4)) || !(forward = malloc(3 * (n + (size_t)s.mu_s) * sizeof(double)))) {
+            res = SB_ERR_NOMEM;
+            goto done;
+        }
+        void *single_outs[] = {singles, singles + 8 * n};
+        if ((res = sb_buffers_read(vk, 2, single_reads, single_outs)))
+            goto done;
+        if (!delta_m_light(p, &medium, f, &s, singles, forward)) {
+            res = SB_ERR_NOMEM;
+            goto done;
+        }
+    }
     /* the tail: the last order's sum over the nodes to the one's before, in the nodes' order */
     double last_sum[3] = {0, 0, 0}, before_sum[3] = {0, 0, 0};
     for (size_t i = 0; last_order > 2 && i < n; i++)
@@ -186,12 +271,16 @@ enum sb_result sb_orders_bake(struct sb_vk *vk, struct sb_atmosphere_baker *bake
             for (int j = 1; j < result->orders; j++)
                 e += table[4 * (n + (size_t)j * s.mu_s + i) + c];
             e += result->tail[c] * table[4 * (n + (size_t)(result->orders - 1) * s.mu_s + i) + c];
+            if (forward)
+                e += forward[3 * (n + (size_t)i) + c];
             for (int k = 0; k < s.nu; k++)
                 image->data[3 * (n + (size_t)i * s.nu + k) + c] = (float)e;
         }
     for (size_t i = 0; i < n + (size_t)s.mu_s * s.nu; i++)
         for (int c = 0; c < 3; c++) {
-            float v = i < n ? (float)(table[4 * i + c] + result->tail[c] * last[4 * i + c]) : image->data[3 * i + c];
+            float v = i < n ? (float)(table[4 * i + c] + result->tail[c] * last[4 * i + c] +
+                                      (forward ? forward[3 * i + c] : 0.0))
+                            : image->data[3 * i + c];
             if (!isfinite(v) || v < 0) {
                 sb_error("orders: node %zu channel %d is %g; nothing was baked", i, c, v);
                 res = SB_ERR_NUMERIC;
@@ -203,11 +292,15 @@ done:
     sb_status(NULL);
     free(table);
     free(last);
+    free(singles);
+    free(forward);
     for (int k = 0; k < KERNEL_COUNT; k++)
         sb_pipeline_destroy(vk, &pipelines[k]);
-    struct sb_buffer *buffers[] = {&single, &previous[0], &previous[1], &density, &sum, &ground, &stats, &dummy};
+    struct sb_buffer *buffers[] = {&single, &previous[0], &previous[1], &density,     &sum,
+                                   &ground, &stats,       &dummy,       &single_whole};
     for (size_t i = 0; i < sizeof(buffers) / sizeof(buffers[0]); i++)
         sb_buffer_destroy(vk, buffers[i]);
+    sb_atmosphere_baker_destroy(&scaled);
     if (res)
         sb_image_finish(image);
     return res;

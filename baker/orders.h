@@ -8,7 +8,11 @@
  * view; orders are added until one adds less than the settings' tolerance
  * of the sum's largest value, and the orders after the last as its tail
  * (sb_orders_tail_factor, on the host: the sums of the last two orders).
- * The ground's irradiance of each order lights the next but one.
+ * The ground's irradiance of each order lights the next but one. Where
+ * Mie's phase is a narrow peak (sb_orders_medium) the orders are computed
+ * in its delta-M medium, with a transmittance LUT of the medium's own, and
+ * the table adds the light the peak carries forward that the air then
+ * scatters once (docs/pack.md).
  *
  * The image: rgb radiance (solar_irradiance's unit per steradian) of
  * orders 2 and up, node (ir, imu, imus, inu) at texel

@@ -689,14 +689,15 @@ struct sb_orders_ref *sb_orders_grid_create(const struct sb_atmosphere_params *p
     return o;
 }
 
-struct sb_orders_ref *sb_orders_ref_create(const struct sb_atmosphere_params *p, const struct sb_orders_settings *s)
+/* The grid of `p` with its tables allocated and single scattering at its
+ * nodes, computed in `medium` (p itself, or its delta-M scaling). */
+static struct sb_orders_ref *ref_single(const struct sb_atmosphere_params *p, const struct sb_atmosphere_params *medium,
+                                        const struct sb_orders_settings *s)
 {
     struct sb_orders_ref *o = sb_orders_grid_create(p, s);
     if (!o)
         return NULL;
-    struct sb_orders_settings set = sb_orders_settings_resolve(s);
-    int max_order = set.max_order;
-    double tolerance = set.tolerance;
+    o->p = *medium;
     size_t n = node_count(o);
     o->depth = malloc((size_t)DEPTH_W * DEPTH_H * 3 * sizeof(double));
     double *block = calloc(6 * 3 * n + 2 * 3 * (size_t)o->nmus, sizeof(double));
@@ -716,17 +717,22 @@ struct sb_orders_ref *sb_orders_ref_create(const struct sb_atmosphere_params *p,
 
     sb_status("multiple scattering by orders: single scattering");
     sb_parallel_for(DEPTH_H, depth_row, o);
+    sb_parallel_for(o->nr * o->nmu, single_row, o);
+    return o;
+}
+
+/* Orders 2 and up from the single scattering at the nodes; false on failure (memory). */
+static bool ref_orders(struct sb_orders_ref *o, int max_order, double tolerance)
+{
+    size_t n = node_count(o);
     int rows = o->nr * o->nmu;
-    sb_parallel_for(rows, single_row, o);
     /* the ground's irradiance from single scattering: order 1 */
     struct order_job job = {o, 1, NULL};
     sb_parallel_for(o->nmus, ground_row, &job);
     /* the ground's irradiance of orders k - 1 and k - 2 (E_0, the direct sun, is NULL) */
     double *e1 = calloc(6 * (size_t)o->nmus, sizeof(double)), *e2 = e1 ? e1 + 3 * o->nmus : NULL;
-    if (!e1) {
-        sb_orders_ref_destroy(&o);
-        return NULL;
-    }
+    if (!e1)
+        return false;
     size_t ground_bytes = 3 * (size_t)o->nmus * sizeof(double);
     memcpy(e1, o->ground_order, ground_bytes);
     for (int k = 2; k <= max_order; k++) {
@@ -765,6 +771,56 @@ struct sb_orders_ref *sb_orders_ref_create(const struct sb_atmosphere_params *p,
         }
     }
     free(e1);
+    return true;
+}
+
+/*
+ * A peaked Mie's orders computed in its delta-M medium `m` (f of Mie's
+ * scattering carried forward as unscattered light) become the
+ * atmosphere's `o`: its table is m's orders, plus the light the peak
+ * carries forward that the air then scatters once (m's single scattering,
+ * its transmittance and smooth phase, less the same smooth scattering in
+ * o's transmittance: o's sky draws single scattering with Mie's whole
+ * phase), its ground row m's plus the sun the peak carries to the ground.
+ */
+static void ref_take_delta_m(struct sb_orders_ref *o, const struct sb_orders_ref *m, double f)
+{
+    size_t n = node_count(o);
+    for (size_t i = 0; i < n; i++) {
+        double r, mu, mu_s, nu;
+        node_view(o, i, &r, &mu, &mu_s, &nu);
+        double pr = sb_ref_phase_rayleigh(nu), pm = sb_ref_phase_mie(m->p.mie_g, nu);
+        for (int c = 0; c < 3; c++) {
+            size_t k = 3 * i + c;
+            double forward = pr * (m->single_r[k] - o->single_r[k]) + pm * (m->single_m[k] - (1 - f) * o->single_m[k]);
+            o->sum[k] = m->sum[k] + fmax(forward, 0.0);
+        }
+    }
+    for (int i = 0; i < o->nmus; i++) {
+        double mu_s = mu_s_of(o, i), t_m[3], t_o[3];
+        sunlight(m, o->R, mu_s, t_m);
+        sunlight(o, o->R, mu_s, t_o);
+        for (int c = 0; c < 3; c++)
+            o->ground[3 * i + c] = m->ground[3 * i + c] + fmax(t_m[c] - t_o[c], 0.0) * fmax(mu_s, 0.0);
+    }
+    o->orders = m->orders;
+    o->last_share = m->last_share;
+    memcpy(o->tail, m->tail, sizeof(o->tail));
+}
+
+struct sb_orders_ref *sb_orders_ref_create(const struct sb_atmosphere_params *p, const struct sb_orders_settings *s)
+{
+    struct sb_orders_settings set = sb_orders_settings_resolve(s);
+    struct sb_atmosphere_params medium;
+    double f = sb_orders_medium(p, &medium);
+    struct sb_orders_ref *o = ref_single(p, p, s), *m = NULL;
+    if (o && f > 0 && !(m = ref_single(p, &medium, s)))
+        sb_orders_ref_destroy(&o);
+    if (o && !ref_orders(m ? m : o, set.max_order, set.tolerance))
+        sb_orders_ref_destroy(&o);
+    if (o && m)
+        ref_take_delta_m(o, m, f);
+    sb_orders_ref_destroy(&m);
     sb_status(NULL);
     return o;
 }
@@ -794,6 +850,18 @@ int sb_orders_ref_orders(const struct sb_orders_ref *ref)
 double sb_orders_ref_last_share(const struct sb_orders_ref *ref)
 {
     return ref->last_share;
+}
+
+void sb_orders_grid_node(const struct sb_orders_ref *o, size_t index, double *h, double *mu, double *mu_s, double *nu)
+{
+    double r;
+    node_view(o, index, &r, mu, mu_s, nu);
+    *h = r - o->R;
+}
+
+double sb_orders_grid_mu_s(const struct sb_orders_ref *o, int imus)
+{
+    return mu_s_of(o, imus);
 }
 
 void sb_orders_ref_node(const struct sb_orders_ref *o, int ir, int imu, int imus, int inu, double out[3])

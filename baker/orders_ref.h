@@ -59,6 +59,14 @@
  * 1.8e-5 and 2.2e-2).
  * The sun is a point: its light stops where the planet hides its centre,
  * as in the path tracer.
+ *
+ * Where Mie's phase is a narrow forward peak (sb_orders_medium: g at least
+ * SB_ORDERS_DELTA_M_G) the orders are computed in its delta-M medium on
+ * the medium's grid, and the table adds the light the peak carries forward
+ * that the air then scatters once (single scattering in the medium less
+ * the same smooth scattering in the atmosphere's transmittance), the
+ * ground's row the sun the peak carries to the ground; the sky
+ * (sb_orders_ref_sky) draws single scattering in the atmosphere itself.
  */
 #ifndef SB_BAKER_ORDERS_REF_H
 #define SB_BAKER_ORDERS_REF_H
@@ -82,6 +90,13 @@ struct sb_orders_ref; /* opaque */
  * orders product's image holds; destroyed as a reference is. NULL on
  * failure (memory). */
 struct sb_orders_ref *sb_orders_grid_create(const struct sb_atmosphere_params *p, const struct sb_orders_settings *s);
+
+/* Node `index`'s view, in the table's node order (ir, imu, imus, inu,
+ * the last fastest): its altitude (km) and cosines; and the sun cosine of
+ * mu_s node imus (the ground row's). */
+void sb_orders_grid_node(const struct sb_orders_ref *grid, size_t index, double *h, double *mu, double *mu_s,
+                         double *nu);
+double sb_orders_grid_mu_s(const struct sb_orders_ref *grid, int imus);
 
 /* Orders 2 and up seen from altitude h along (mu, mu_s, nu), read from
  * `table` (rgb a node, the product's texel order) as the reference reads

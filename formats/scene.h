@@ -265,6 +265,16 @@ bool sb_atmosphere_dusty(const struct sb_atmosphere_params *params);
  * (physics.h's sb_orders_log_azimuth), on 4 uniform nodes. */
 bool sb_atmosphere_peaked_dust(const struct sb_atmosphere_params *params);
 
+/* The medium in which the orders product computes orders 2 and up: the
+ * atmosphere itself (returns 0), or, where Mie's phase is a narrow
+ * forward peak (g at least SB_ORDERS_DELTA_M_G: the haze), its delta-M
+ * scaling (Wiscombe 1977): the peak's share f = g^2 of Mie's scattering
+ * carried on as unscattered light (its extinction less f times its
+ * scattering), the rest scattering with g / (1 + g); returns f. The
+ * orders' grid (the functions below) follows this medium, whose light the
+ * table holds. */
+double sb_orders_medium(const struct sb_atmosphere_params *params, struct sb_atmosphere_params *medium);
+
 /* The orders product's mu nodes for an atmosphere: SB_ORDERS_MU_DUST where
  * it is dusty and its phase broad (|g| below SB_ORDERS_DUST_MAX_G; mars's
  * 0.65: a dust's light that changes over tens of degrees, which 64 nodes

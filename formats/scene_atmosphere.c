@@ -271,19 +271,37 @@ bool sb_atmosphere_peaked_dust(const struct sb_atmosphere_params *p)
     return sb_atmosphere_dusty(p) && fabs(p->mie_g) >= SB_ORDERS_DUST_MAX_G;
 }
 
+double sb_orders_medium(const struct sb_atmosphere_params *p, struct sb_atmosphere_params *medium)
+{
+    *medium = *p;
+    if (!(p->mie_g >= SB_ORDERS_DELTA_M_G))
+        return 0.0;
+    double f = p->mie_g * p->mie_g;
+    for (int c = 0; c < 3; c++)
+        medium->mie_scattering_per_km[c] = p->mie_scattering_per_km[c] * (1.0 - f);
+    medium->mie_g = p->mie_g / (1.0 + p->mie_g);
+    return f;
+}
+
 int sb_orders_mu_nodes(const struct sb_atmosphere_params *p)
 {
-    return sb_atmosphere_dusty(p) && !sb_atmosphere_peaked_dust(p) ? SB_ORDERS_MU_DUST : SB_ORDERS_MU;
+    struct sb_atmosphere_params m;
+    sb_orders_medium(p, &m);
+    return sb_atmosphere_dusty(&m) && !sb_atmosphere_peaked_dust(&m) ? SB_ORDERS_MU_DUST : SB_ORDERS_MU;
 }
 
 int sb_orders_mu_s_nodes(const struct sb_atmosphere_params *p)
 {
-    return sb_atmosphere_dusty(p) ? SB_ORDERS_MU_S_DUST : SB_ORDERS_MU_S;
+    struct sb_atmosphere_params m;
+    sb_orders_medium(p, &m);
+    return sb_atmosphere_dusty(&m) ? SB_ORDERS_MU_S_DUST : SB_ORDERS_MU_S;
 }
 
 int sb_orders_nu_nodes(const struct sb_atmosphere_params *p)
 {
-    return sb_atmosphere_peaked_dust(p) ? SB_ORDERS_NU_DUST : SB_ORDERS_NU;
+    struct sb_atmosphere_params m;
+    sb_orders_medium(p, &m);
+    return sb_atmosphere_peaked_dust(&m) ? SB_ORDERS_NU_DUST : SB_ORDERS_NU;
 }
 
 /* The orders' rows follow the atmosphere's mu nodes (a dust's zenith), its

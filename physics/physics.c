@@ -61,7 +61,9 @@ double sb_orders_height_ratio(const struct sb_atmosphere_params *p, int nr)
 
 bool sb_orders_log_azimuth(const struct sb_atmosphere_params *p)
 {
-    return sb_atmosphere_peaked_dust(p);
+    struct sb_atmosphere_params m;
+    sb_orders_medium(p, &m);
+    return sb_atmosphere_peaked_dust(&m);
 }
 
 double sb_orders_azimuth_power(const struct sb_atmosphere_params *p)

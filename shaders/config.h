@@ -153,6 +153,11 @@
 #define SB_ORDERS_MU_S_DUST 24 /* a dust's (mars's, the haze's) */
 #define SB_ORDERS_NU 8         /* the sun's azimuth (the air's, a broad dust's): twilight's light falls steeply with it */
 #define SB_ORDERS_NU_DUST 4    /* a peaked dust's, read log-trigonometrically through all (sb_orders_log_azimuth) */
+/* Mie's phase from which the orders are computed delta-M scaled
+ * (sb_orders_medium): a forward peak narrower than the density's
+ * directions, which at g 0.8 (the earth) and 0.65 (mars) the scaling
+ * models worse than the directions do (docs/accuracy.md). */
+#define SB_ORDERS_DELTA_M_G 0.9
 /* The air's azimuth nodes at pi x^p, x uniform (sb_orders_azimuth_power):
  * close about the sun, where twilight's light is (0, 3.7, 15, 33, 59, 92,
  * 132, 180 degrees). */

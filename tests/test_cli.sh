@@ -342,12 +342,12 @@ a = [x for x in json.load(open(sys.argv[1]))["artifacts"] if x["name"] == "order
 s = a["settings"]
 sys.exit(0 if s["until"] == 0.02 and len(s["tail"]) == 3 and all(0 < t <= 9 for t in s["tail"]) else 1)
 ' "$tmp/orders_haze/manifest.json"
-check "the grid: the haze's (a dust's) 24 x 4 uniform nodes, the earth's 36 x 8 close about the sun" python3 -c '
+check "the grid: the haze's orders delta-M scaled (g 0.99: f = g^2), on the air's 36 x 8 nodes close about the sun as the earth's" python3 -c '
 import json, sys
 def grid(pack):
     s = [x for x in json.load(open(pack + "/manifest.json"))["artifacts"] if x["name"] == "orders"][0]["settings"]
-    return s["mu_s"], s["nu"], s["nu_power"]
-sys.exit(0 if grid(sys.argv[1]) == (24, 4, 1) and grid(sys.argv[2]) == (36, 8, 2) else 1)
+    return s["mu_s"], s["nu"], s["nu_power"], round(s["delta_m"], 12)
+sys.exit(0 if grid(sys.argv[1]) == (36, 8, 2, 0.9801) and grid(sys.argv[2]) == (36, 8, 2, 0) else 1)
 ' "$tmp/orders_haze" "$tmp/a"
 
 # sky-error: the runtime's sky against the path tracer.

@@ -61,11 +61,12 @@ static void check_azimuth_reads(void)
     struct sb_atmosphere_params mars, earth;
     sb_atmosphere_preset_mars(&mars);
     sb_atmosphere_preset_earth(&earth);
-    /* a peaked dust (data/scenes/haze.json) */
+    /* a peaked dust: data/scenes/haze.json's at g 0.87, under
+     * SB_ORDERS_DELTA_M_G, whose orders are computed as they are */
     struct sb_atmosphere_params haze = earth;
     for (int c = 0; c < 3; c++)
         haze.mie_scattering_per_km[c] = 0.07992;
-    haze.mie_g = 0.99;
+    haze.mie_g = 0.87;
     CHECK(sb_orders_log_azimuth(&haze) && !sb_orders_log_azimuth(&mars) && !sb_orders_log_azimuth(&earth),
           "the haze's peaked dust reads the azimuth log-trigonometrically, mars's broad dust and the earth's air "
           "linearly");
@@ -99,6 +100,25 @@ static void check_azimuth_reads(void)
           sb_orders_mu_s_nodes(&earth), sb_orders_nu_nodes(&earth), sb_orders_azimuth_power(&earth), earth_shape[0],
           sb_orders_mu_s_nodes(&mars), sb_orders_nu_nodes(&mars), sb_orders_azimuth_power(&mars), shape[0],
           sb_orders_mu_s_nodes(&haze), sb_orders_nu_nodes(&haze), sb_orders_azimuth_power(&haze), haze_shape[0]);
+    /* at g 0.99 (the haze itself) the orders are computed delta-M scaled,
+     * in a medium of g 0.99 / 1.99 that scatters 2% of Mie's light: the air's
+     * grid, read linearly; never at g 0.8 (the earth), 0.65 (mars) or
+     * backward */
+    struct sb_atmosphere_params peaked = haze, medium, backward = haze;
+    peaked.mie_g = 0.99;
+    backward.mie_g = -0.99;
+    double share = sb_orders_medium(&peaked, &medium);
+    CHECK(fabs(share - 0.9801) < 1e-12 && fabs(medium.mie_g - 0.99 / 1.99) < 1e-12 &&
+              fabs(medium.mie_scattering_per_km[1] - 0.07992 * 0.0199) < 1e-12 &&
+              medium.mie_absorption_per_km[1] == peaked.mie_absorption_per_km[1] && !sb_orders_log_azimuth(&peaked) &&
+              sb_orders_mu_s_nodes(&peaked) == SB_ORDERS_MU_S && sb_orders_nu_nodes(&peaked) == SB_ORDERS_NU &&
+              sb_orders_azimuth_power(&peaked) == SB_ORDERS_NU_POWER,
+          "g 0.99's delta-M: f %g, g %g, the air's grid (%d x %d at power %g)", share, medium.mie_g,
+          sb_orders_mu_s_nodes(&peaked), sb_orders_nu_nodes(&peaked), sb_orders_azimuth_power(&peaked));
+    CHECK(sb_orders_medium(&earth, &medium) == 0 && sb_orders_medium(&mars, &medium) == 0 &&
+              sb_orders_medium(&haze, &medium) == 0 && sb_orders_medium(&backward, &medium) == 0 &&
+              medium.mie_g == -0.99,
+          "no delta-M below g %g", SB_ORDERS_DELTA_M_G);
     const struct sb_orders_settings s = {.r = 16, .mu = 64, .mu_s = 24, .nu = 4};
     size_t nodes = (size_t)s.r * s.mu * s.mu_s * s.nu;
     float *table = malloc(3 * nodes * sizeof(float));
