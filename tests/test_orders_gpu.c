@@ -200,7 +200,7 @@ int main(void)
     haze.mie_g = 0.99;
     /* its orders in the delta-M medium (sb_orders_medium), on a smaller
      * grid (the reference 27 s, not 120). Measured: rms 0.54%, the ground's
-     * row 0.16%, the worst 37% in red at the lowest sun cosine node, looking
+     * row 0.17%, the worst 37% in red at the lowest sun cosine node, looking
      * up toward the sun from the grid's upper nodes, at 0.6 of the floor. That node is
      * the forward light (orders.c's delta_m_light), single scattering in
      * the medium less the same in the atmosphere, whose twilight grazing
