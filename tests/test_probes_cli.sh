@@ -406,7 +406,7 @@ level() { # the moving hut's x
     printf '{"version":1,"ground":false,"instances":[{"file":"ground.obj"},{"file":"hut.json","translate_m":[-30,0,-30]},{"file":"hut.json","translate_m":[%s,0,10]},{"file":"hut.json","translate_m":[30,0,-20]},{"file":"room_only.obj","translate_m":[-30,0,25]}]}' "$1" >"$tmp/tiles-world.json"
 }
 level 20
-printf '{"version":1,"name":"tiles","atmosphere":{"preset":"earth"},"products":["sky_visibility","sky_bounce","sun_bounce"],"world":{"file":"tiles-world.json"},"probes":{"spacing_m":4,"layers_m":[1.5,6],"rays":256,"bounce_rays":64,"bounce_secondary":8,"sun_rays":64,"detail_spacing_m":1,"tile_m":16,"reach_m":4}}' >"$tmp/tiles.json"
+printf '{"version":1,"name":"tiles","atmosphere":{"preset":"earth"},"products":["sky_visibility","sky_bounce","sun_bounce"],"world":{"file":"tiles-world.json"},"probes":{"spacing_m":4,"layers_m":[1.5,6],"rays":64,"bounce_rays":64,"bounce_secondary":8,"sun_rays":64,"detail_spacing_m":1,"tile_m":16,"reach_m":4}}' >"$tmp/tiles.json"
 check "bake a level in tiles" expect_exit 0 "$skybake" bake "$tmp/tiles.json" -o "$tmp/tiles"
 check "every tile baked" grep -q "sky_visibility: \([0-9]*\) tiles: \1 baked, 0 kept" "$tmp/err"
 check "with detail" grep -q "([1-9][0-9]* in detail)" "$tmp/err"

@@ -1550,12 +1550,14 @@ static void test_aerial_of(struct sb_renderer *r, const struct sb_pack *p, doubl
  * with `products` (a JSON array's items), `present` among them: skyview's sky-view LUT and aerial
  * perspective against the same sky in fp64 (test_sky_view_of,
  * test_aerial_of: the bounds of Hillaire's sky above), and its frame at a
- * sun of `frame_sun` degrees finite. */
+ * sun of `frame_sun` degrees finite. The pack is baked into `name`'s
+ * directory, reusing what an earlier call baked there under the same keys
+ * (the same atmosphere's orders, with and without the spectral products). */
 static void test_pack_sky(const char *dir, const char *name, const char *atmosphere, const char *what,
                           const char *products, enum sb_product_id present, double frame_sun, double above_km)
 {
     char path[300], json[512];
-    snprintf(path, sizeof(path), "%s/%s-%s-pack", dir, name, sb_product_name(present));
+    snprintf(path, sizeof(path), "%s/%s-sky-pack", dir, name);
     snprintf(json, sizeof(json), "{\"atmosphere\":{%s},\"products\":[%s]}", atmosphere, products);
     struct sb_scene *scene = calloc(1, sizeof(*scene));
     struct sb_pack sky_of_pack = {0};
@@ -1563,6 +1565,12 @@ static void test_pack_sky(const char *dir, const char *name, const char *atmosph
     bool ok = scene && sb_scene_parse(json, strlen(json), what, scene) == SB_OK &&
               sb_bake_scene(vk, scene, path, NULL, &report) == SB_OK && sb_pack_open(path, &sky_of_pack) == SB_OK;
     CHECK(ok && sky_of_pack.present[present], "a pack %s", what);
+    /* the spectral products' pack: only the spectral products baked, the
+     * earth's orders taken from the pack before (the bake graph's reuse) */
+    if (ok && present == SB_PRODUCT_SPECTRAL_ORDERS)
+        for (int i = 0; i < report.artifact_count; i++)
+            if (report.artifacts[i].product == SB_PRODUCT_ORDERS)
+                CHECK(report.reused[i], "the orders of the pack before reused (its key unchanged)");
     free(scene);
     struct sb_renderer *r = NULL;
     struct sb_renderer_params rp = {.width = W, .height = H, .shadow_size = 1024};
