@@ -14,14 +14,17 @@
 #include "physics.h"
 #include "sky_error.h"
 
-#define KERNEL(stage)                                                                                                  \
+#define KERNEL(stage, texels)                                                                                          \
     {                                                                                                                  \
         .spirv = sb_spv_orders_##stage, .spirv_size = sizeof(sb_spv_orders_##stage),                                   \
-        .binding_count = SB_ORDERS_BINDING_COUNT, .push_size = sizeof(struct sb_orders_push),                          \
-        .name = "orders " #stage,                                                                                      \
+        .binding_count = SB_ORDERS_BINDING_COUNT, .texel_bindings = (texels),                                          \
+        .push_size = sizeof(struct sb_orders_push), .name = "orders " #stage,                                          \
     }
 enum { SINGLE, DENSITY, SCATTER, KERNEL_COUNT };
-static const struct sb_pipeline_params kernels[KERNEL_COUNT] = {KERNEL(single), KERNEL(density), KERNEL(scatter)};
+/* The scatter stage reads the density as texels (sb_buffer_create_texels):
+ * 16 nodes a sample, at nodes that differ per invocation */
+static const struct sb_pipeline_params kernels[KERNEL_COUNT] = {KERNEL(single, 0), KERNEL(density, 0),
+                                                                KERNEL(scatter, 1u << SB_ORDERS_BINDING_DENSITY)};
 #undef KERNEL
 
 struct sb_orders_settings sb_orders_product_grid(const struct sb_atmosphere_params *p)
@@ -124,6 +127,11 @@ enum sb_result sb_orders_bake(struct sb_vk *vk, struct sb_atmosphere_baker *bake
                  SB_ORDERS_MAX_NODES, SB_ORDERS_MAX_ORDER, s.r, s.mu, s.mu_s, s.nu, s.max_order, s.tolerance);
         return SB_ERR_USAGE;
     }
+    if (vk->properties.limits.maxComputeSharedMemorySize < SB_ORDERS_DENSITY_SHARED_BYTES) {
+        sb_error("orders: the density kernel needs %d bytes of workgroup memory, the device offers %u",
+                 SB_ORDERS_DENSITY_SHARED_BYTES, vk->properties.limits.maxComputeSharedMemorySize);
+        return SB_ERR_DEVICE_LIMIT;
+    }
     struct sb_orders_push push;
     sb_orders_grid_pack(p, s.r, s.mu, s.mu_s, s.nu, &push);
     size_t n = (size_t)s.r * s.mu * s.mu_s * s.nu, vec4 = 4 * sizeof(float);
@@ -144,7 +152,7 @@ enum sb_result sb_orders_bake(struct sb_vk *vk, struct sb_atmosphere_baker *bake
         (res = sb_buffer_create(vk, 2 * n * vec4, "orders single", &single)) ||
         (res = sb_buffer_create(vk, n * vec4, "orders previous", &previous[0])) ||
         (res = sb_buffer_create(vk, n * vec4, "orders previous", &previous[1])) ||
-        (res = sb_buffer_create(vk, n * vec4, "orders density", &density)) ||
+        (res = sb_buffer_create_texels(vk, n * vec4, "orders density", &density)) ||
         (res = sb_buffer_create(vk, n * vec4, "orders sum", &sum)) ||
         (res = sb_buffer_create(vk, (size_t)(SB_ORDERS_MAX_ORDER + 1) * s.mu_s * vec4, "orders ground", &ground)) ||
         (res = sb_buffer_create(vk, 16, "orders stats", &stats)) ||
@@ -202,11 +210,12 @@ enum sb_result sb_orders_bake(struct sb_vk *vk, struct sb_atmosphere_baker *bake
         sb_pipeline_bind(vk, &pipelines[DENSITY], bindings);
         bindings[SB_ORDERS_BINDING_PREVIOUS] = &previous[k % 2];
         sb_pipeline_bind(vk, &pipelines[SCATTER], bindings);
-        if ((res = sb_dispatch(vk, &pipelines[DENSITY], &push, (uint32_t)s.r, (uint32_t)s.mu_s, 1, &ms)))
+        if ((res = sb_dispatch(vk, &pipelines[DENSITY], &push, (uint32_t)s.r,
+                               (uint32_t)((s.mu_s + SB_ORDERS_DENSITY_SUNS - 1) / SB_ORDERS_DENSITY_SUNS), 1, &ms)))
             goto done;
         result->gpu_ms += ms;
         double density_ms = ms;
-        if ((res = sb_dispatch(vk, &pipelines[SCATTER], &push, node_groups, 1, 1, &ms)))
+        if ((res = sb_dispatch(vk, &pipelines[SCATTER], &push, (uint32_t)s.mu, (uint32_t)s.r, 1, &ms)))
             goto done;
         result->gpu_ms += ms;
         const uint32_t *largest = stats.mapped;

@@ -596,6 +596,13 @@ struct sb_prefilter_push {
 #define SB_ORDERS_DIRECTIONS \
     ((SB_ORDERS_DIRECTIONS_GROUND + SB_ORDERS_DIRECTIONS_SKY) * SB_ORDERS_DIRECTIONS_PHI)
 #define SB_ORDERS_THREADS 64
+/* The density stage's mu_s nodes a workgroup: its phase functions do not
+ * depend on the sun, so each is weighed once for them all. 4 of them, the
+ * directions' radiance 18 KiB of workgroup memory and their vectors 6:
+ * within llvmpipe's 32 KiB and a GPU's 48, not the 16 every device offers
+ * (the baker checks). */
+#define SB_ORDERS_DENSITY_SUNS 4
+#define SB_ORDERS_DENSITY_SHARED_BYTES (16 * SB_ORDERS_DIRECTIONS + 12 * SB_ORDERS_DENSITY_SUNS * SB_ORDERS_DIRECTIONS)
 /* The most orders a bake computes, and the most nodes in each dimension. */
 #define SB_ORDERS_MAX_ORDER 32
 #define SB_ORDERS_MAX_NODES 256

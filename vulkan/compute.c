@@ -8,17 +8,23 @@
 #include "pipeline.h"
 #include "warm_up.spv.h"
 
-enum sb_result sb_buffer_create(struct sb_vk *vk, VkDeviceSize size, const char *name, struct sb_buffer *b)
+static enum sb_result buffer_create(struct sb_vk *vk, VkDeviceSize size, const char *name, bool texels,
+                                    struct sb_buffer *b)
 {
     enum sb_result res = SB_OK;
     memset(b, 0, sizeof(*b));
     VkBufferCreateInfo info = {
         .sType = VK_STRUCTURE_TYPE_BUFFER_CREATE_INFO,
         .size = size,
-        .usage =
-            VK_BUFFER_USAGE_STORAGE_BUFFER_BIT | VK_BUFFER_USAGE_TRANSFER_SRC_BIT | VK_BUFFER_USAGE_TRANSFER_DST_BIT,
+        .usage = VK_BUFFER_USAGE_STORAGE_BUFFER_BIT | VK_BUFFER_USAGE_TRANSFER_SRC_BIT |
+                 VK_BUFFER_USAGE_TRANSFER_DST_BIT | (texels ? VK_BUFFER_USAGE_UNIFORM_TEXEL_BUFFER_BIT : 0),
         .sharingMode = VK_SHARING_MODE_EXCLUSIVE,
     };
+    if (texels && size / 16 > vk->properties.limits.maxTexelBufferElements) {
+        sb_error("%s: %llu texels, over the device's %u in a texel buffer", name, (unsigned long long)(size / 16),
+                 vk->properties.limits.maxTexelBufferElements);
+        return SB_ERR_DEVICE_LIMIT;
+    }
     VK(vkCreateBuffer(vk->device, &info, NULL, &b->buffer));
     sb_vk_name(vk, VK_OBJECT_TYPE_BUFFER, (uint64_t)b->buffer, name);
     VkMemoryRequirements req;
@@ -32,11 +38,30 @@ enum sb_result sb_buffer_create(struct sb_vk *vk, VkDeviceSize size, const char 
     VK(vkMapMemory(vk->device, b->memory, 0, VK_WHOLE_SIZE, 0, &b->mapped));
     memset(b->mapped, 0, size);
     b->size = size;
+    if (texels) {
+        VkBufferViewCreateInfo view = {
+            .sType = VK_STRUCTURE_TYPE_BUFFER_VIEW_CREATE_INFO,
+            .buffer = b->buffer,
+            .format = VK_FORMAT_R32G32B32A32_SFLOAT,
+            .range = size / 16 * 16,
+        };
+        VK(vkCreateBufferView(vk->device, &view, NULL, &b->texels));
+    }
     return SB_OK;
 
 cleanup:
     sb_buffer_destroy(vk, b);
     return res;
+}
+
+enum sb_result sb_buffer_create(struct sb_vk *vk, VkDeviceSize size, const char *name, struct sb_buffer *b)
+{
+    return buffer_create(vk, size, name, false, b);
+}
+
+enum sb_result sb_buffer_create_texels(struct sb_vk *vk, VkDeviceSize size, const char *name, struct sb_buffer *b)
+{
+    return buffer_create(vk, size, name, true, b);
 }
 
 enum sb_result sb_buffer_read(struct sb_vk *vk, const struct sb_buffer *b, void *out)
@@ -136,6 +161,8 @@ cleanup:
 
 void sb_buffer_destroy(struct sb_vk *vk, struct sb_buffer *b)
 {
+    if (b->texels)
+        vkDestroyBufferView(vk->device, b->texels, NULL);
     if (b->buffer)
         vkDestroyBuffer(vk->device, b->buffer, NULL);
     if (b->memory)
@@ -143,8 +170,14 @@ void sb_buffer_destroy(struct sb_vk *vk, struct sb_buffer *b)
     memset(b, 0, sizeof(*b));
 }
 
-/* A kernel's layouts: storage buffers at bindings 0..binding_count-1 and
- * push_size bytes of push constants, the context's. */
+static VkDescriptorType binding_type(const struct sb_pipeline_params *params, uint32_t i)
+{
+    return params->texel_bindings >> i & 1u ? VK_DESCRIPTOR_TYPE_UNIFORM_TEXEL_BUFFER
+                                            : VK_DESCRIPTOR_TYPE_STORAGE_BUFFER;
+}
+
+/* A kernel's layouts: storage (or texel) buffers at bindings
+ * 0..binding_count-1 and push_size bytes of push constants, the context's. */
 static enum sb_result kernel_layout(struct sb_vk *vk, const struct sb_pipeline_params *params,
                                     VkDescriptorSetLayout *set_layout, VkPipelineLayout *layout)
 {
@@ -154,7 +187,7 @@ static enum sb_result kernel_layout(struct sb_vk *vk, const struct sb_pipeline_p
     for (uint32_t i = 0; i < params->binding_count; i++)
         bindings[i] = (VkDescriptorSetLayoutBinding){
             .binding = i,
-            .descriptorType = VK_DESCRIPTOR_TYPE_STORAGE_BUFFER,
+            .descriptorType = binding_type(params, i),
             .descriptorCount = 1,
             .stageFlags = VK_SHADER_STAGE_COMPUTE_BIT,
         };
@@ -186,21 +219,24 @@ enum sb_result sb_pipeline_create(struct sb_vk *vk, const struct sb_pipeline_par
     enum sb_result res = SB_OK;
     memset(p, 0, sizeof(*p));
     p->binding_count = params->binding_count;
+    p->texel_bindings = params->texel_bindings;
     p->push_size = params->push_size;
     if ((res = kernel_layout(vk, params, &p->set_layout, &p->layout)) ||
         (res = sb_compute_pipeline_create(vk, p->layout, params->spirv, params->spirv_size, NULL, params->name,
                                           &p->pipeline)))
         goto cleanup;
 
-    VkDescriptorPoolSize pool_size = {
-        .type = VK_DESCRIPTOR_TYPE_STORAGE_BUFFER,
-        .descriptorCount = params->binding_count ? params->binding_count : 1,
+    VkDescriptorPoolSize pool_sizes[2] = {
+        {.type = VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, .descriptorCount = 1},
+        {.type = VK_DESCRIPTOR_TYPE_UNIFORM_TEXEL_BUFFER, .descriptorCount = 1},
     };
+    for (uint32_t i = 0; i < params->binding_count; i++)
+        pool_sizes[binding_type(params, i) == VK_DESCRIPTOR_TYPE_UNIFORM_TEXEL_BUFFER].descriptorCount++;
     VkDescriptorPoolCreateInfo pool_info = {
         .sType = VK_STRUCTURE_TYPE_DESCRIPTOR_POOL_CREATE_INFO,
         .maxSets = 1,
-        .poolSizeCount = 1,
-        .pPoolSizes = &pool_size,
+        .poolSizeCount = 2,
+        .pPoolSizes = pool_sizes,
     };
     VK(vkCreateDescriptorPool(vk->device, &pool_info, NULL, &p->descriptor_pool));
     VkDescriptorSetAllocateInfo set_alloc = {
@@ -229,14 +265,16 @@ void sb_pipeline_bind(struct sb_vk *vk, struct sb_pipeline *p, const struct sb_b
     VkDescriptorBufferInfo infos[16];
     VkWriteDescriptorSet writes[16];
     for (uint32_t i = 0; i < p->binding_count; i++) {
+        bool texels = p->texel_bindings >> i & 1u;
         infos[i] = (VkDescriptorBufferInfo){.buffer = buffers[i]->buffer, .range = VK_WHOLE_SIZE};
         writes[i] = (VkWriteDescriptorSet){
             .sType = VK_STRUCTURE_TYPE_WRITE_DESCRIPTOR_SET,
             .dstSet = p->set,
             .dstBinding = i,
             .descriptorCount = 1,
-            .descriptorType = VK_DESCRIPTOR_TYPE_STORAGE_BUFFER,
-            .pBufferInfo = &infos[i],
+            .descriptorType = texels ? VK_DESCRIPTOR_TYPE_UNIFORM_TEXEL_BUFFER : VK_DESCRIPTOR_TYPE_STORAGE_BUFFER,
+            .pBufferInfo = texels ? NULL : &infos[i],
+            .pTexelBufferView = texels ? &buffers[i]->texels : NULL,
         };
     }
     vkUpdateDescriptorSets(vk->device, p->binding_count, writes, 0, NULL);

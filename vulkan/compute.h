@@ -18,12 +18,24 @@ struct sb_buffer {
     VkBuffer buffer;
     VkDeviceMemory memory;
     VkDeviceSize size;
-    void *mapped;     /* persistently mapped, coherent */
-    bool host_cached; /* the host reads `mapped` at memory speed */
+    void *mapped;        /* persistently mapped, coherent */
+    bool host_cached;    /* the host reads `mapped` at memory speed */
+    VkBufferView texels; /* its vec4 texels (sb_buffer_create_texels), or none */
 };
 
 /* A zero-filled storage buffer of `size` bytes (> 0). */
 enum sb_result sb_buffer_create(struct sb_vk *vk, VkDeviceSize size, const char *name, struct sb_buffer *buffer);
+/*
+ * The same, that kernels may also read as texels: RGBA32F, each 16 bytes
+ * of it, at a binding of sb_pipeline_params's texel_bindings
+ * (`uniform samplerBuffer`, texelFetch). Such a read fetches a whole vec4
+ * at once: where a kernel gathers at addresses that differ per invocation,
+ * llvmpipe loads a storage buffer one component of one invocation at a
+ * time, behind a bounds check each, and fetches a texel as one vector
+ * load an invocation. SB_ERR_DEVICE_LIMIT where the device cannot hold
+ * size / 16 texels in one view.
+ */
+enum sb_result sb_buffer_create_texels(struct sb_vk *vk, VkDeviceSize size, const char *name, struct sb_buffer *buffer);
 /* Free a buffer; accepts a zeroed one. */
 void sb_buffer_destroy(struct sb_vk *vk, struct sb_buffer *buffer);
 
@@ -48,15 +60,17 @@ struct sb_pipeline {
     VkDescriptorPool descriptor_pool;
     VkDescriptorSet set;
     uint32_t binding_count;
+    uint32_t texel_bindings;
     uint32_t push_size;
 };
 
 struct sb_pipeline_params {
-    const uint32_t *spirv;  /* SPIR-V words, entry point "main" */
-    size_t spirv_size;      /* in bytes */
-    uint32_t binding_count; /* storage buffers at bindings 0..count-1 of set 0 (at most 16) */
-    uint32_t push_size;     /* bytes of push constants, 0 for none */
-    const char *name;       /* debug name */
+    const uint32_t *spirv;   /* SPIR-V words, entry point "main" */
+    size_t spirv_size;       /* in bytes */
+    uint32_t binding_count;  /* storage buffers at bindings 0..count-1 of set 0 (at most 16) */
+    uint32_t texel_bindings; /* those of them that are texel buffers instead (bit i: binding i) */
+    uint32_t push_size;      /* bytes of push constants, 0 for none */
+    const char *name;        /* debug name */
 };
 
 enum sb_result sb_pipeline_create(struct sb_vk *vk, const struct sb_pipeline_params *params,
@@ -71,7 +85,8 @@ void sb_pipeline_destroy(struct sb_vk *vk, struct sb_pipeline *pipeline);
  */
 void sb_pipelines_prepare(struct sb_vk *vk, const struct sb_pipeline_params *params, uint32_t count, int threads);
 
-/* Point binding i at buffers[i] for every binding of the pipeline. */
+/* Point binding i at buffers[i] for every binding of the pipeline (a
+ * texel binding at the buffer's texels, which it must have). */
 void sb_pipeline_bind(struct sb_vk *vk, struct sb_pipeline *pipeline, const struct sb_buffer *const *buffers);
 
 /*

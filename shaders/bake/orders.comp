@@ -4,8 +4,9 @@
 // 0 single: a node an invocation, single scattering along its view without
 //   the phase functions, Rayleigh's and Mie's apart (atmosphere.glsl's
 //   integrate_ray, the sun read from the transmittance LUT);
-// 1 density: a workgroup a (r, mu_s) pair. It reads order k - 1's radiance
-//   at SB_ORDERS_DIRECTIONS directions about the point (the single
+// 1 density: a workgroup an altitude and SB_ORDERS_DENSITY_SUNS suns
+//   (mu_s nodes). It reads order k - 1's radiance
+//   at SB_ORDERS_DIRECTIONS directions about the point at each sun (the single
 //   scattering tables with their phase functions for k = 2, else the last
 //   order's, plus the ground lit by order k - 2 where a direction ends on
 //   it) into workgroup memory, then gives each of its (mu, nu) nodes order
@@ -17,9 +18,12 @@
 //   scattering back where it reads). Workgroups at
 //   the ground also integrate the upper hemisphere into the ground's
 //   irradiance of order k - 1;
-// 2 scatter: a node an invocation, order k along its view, the density
-//   integrated with the transmittance by atmosphere.glsl's segments; adds
-//   it to the sum and keeps the largest values.
+// 2 scatter: a workgroup a view (r, mu). One invocation walks the view
+//   once, by atmosphere.glsl's segments: its samples' distances, cells in
+//   r and mu and weights (the transmittance times the air's scattering)
+//   into workgroup memory; then each of its (mu_s, nu) nodes integrates
+//   order k along it from the density at those samples, adds it to the
+//   sum and keeps the largest values.
 #extension GL_GOOGLE_include_directive : require
 #define SB_SUN_TRANSMITTANCE_LUT
 #include "config.h"
@@ -30,7 +34,13 @@ layout(local_size_x = SB_ORDERS_THREADS) in;
 
 layout(std430, set = 0, binding = SB_ORDERS_BINDING_SINGLE) buffer SingleBuffer { vec4 single_table[]; };
 layout(std430, set = 0, binding = SB_ORDERS_BINDING_PREVIOUS) buffer PreviousBuffer { vec4 previous_table[]; };
+/* the scatter stage's 16 nodes a sample, at nodes that differ per
+ * invocation: texels, a vec4 a fetch (compute.h's sb_buffer_create_texels) */
+#if SB_ORDERS_STAGE == 2
+layout(set = 0, binding = SB_ORDERS_BINDING_DENSITY) uniform samplerBuffer density_texels;
+#else
 layout(std430, set = 0, binding = SB_ORDERS_BINDING_DENSITY) buffer DensityBuffer { vec4 density_table[]; };
+#endif
 layout(std430, set = 0, binding = SB_ORDERS_BINDING_SUM) buffer SumBuffer { vec4 sum_table[]; };
 layout(std430, set = 0, binding = SB_ORDERS_BINDING_GROUND) buffer GroundBuffer { vec4 ground_table[]; };
 layout(std430, set = 0, binding = SB_ORDERS_BINDING_STATS) buffer StatsBuffer { uint stats[]; };
@@ -75,8 +85,13 @@ SB_ORDERS_READ(read_single_rayleigh, SINGLE_RAYLEIGH)
 SB_ORDERS_READ(read_single_mie, SINGLE_MIE)
 SB_ORDERS_READ(read_previous, PREVIOUS)
 
-shared vec4 dir_radiance[SB_ORDERS_DIRECTIONS]; /* rgb; w: the direction's weight */
-shared vec4 dir_vector[SB_ORDERS_DIRECTIONS];   /* cos(zenith), sin(zenith), azimuth from the sun's */
+/* The directions about the point (cos(zenith), sin(zenith), azimuth from
+ * the sun's, weight) and the radiance from each at each of the workgroup's
+ * suns, a channel an array. */
+#define DIRECTIONS SB_ORDERS_DIRECTIONS
+#define SUNS SB_ORDERS_DENSITY_SUNS
+shared vec4 dir_vector[DIRECTIONS];
+shared float dir_red[SUNS * DIRECTIONS], dir_green[SUNS * DIRECTIONS], dir_blue[SUNS * DIRECTIONS];
 
 /* The ground's irradiance of order j at sun cosine mu_s (j = 0: the sun's). */
 vec3 ground_irradiance(uint j, float mu_s)
@@ -126,11 +141,11 @@ float phase_mie_fast(float c, float g, float ag, float k)
 
 void main()
 {
-    uint ir = gl_WorkGroupID.x, ims = gl_WorkGroupID.y, t = gl_LocalInvocationID.x;
-    float h = orders_altitude(ir), mu_s = orders_mu_s(ims), r = ground_radius() + h;
-    float ss = sqrt(max(1.0 - mu_s * mu_s, 0.0));
+    uint ir = gl_WorkGroupID.x, ims0 = gl_WorkGroupID.y * SUNS, t = gl_LocalInvocationID.x;
+    uint suns = min(orders.size.z - ims0, uint(SUNS));
+    float h = orders_altitude(ir), r = ground_radius() + h;
     float horizon = -horizon_distance(h) / r;
-    for (uint d = t; d < SB_ORDERS_DIRECTIONS; d += SB_ORDERS_THREADS) {
+    for (uint d = t; d < DIRECTIONS; d += SB_ORDERS_THREADS) {
         uint q = d / SB_ORDERS_DIRECTIONS_PHI, f = d % SB_ORDERS_DIRECTIONS_PHI;
         bool sky = q >= SB_ORDERS_DIRECTIONS_GROUND;
         float mu_in, w_mu;
@@ -140,19 +155,26 @@ void main()
             gauss_legendre(int(q), SB_ORDERS_DIRECTIONS_GROUND, -1.0, horizon, mu_in, w_mu);
         float phi = PI * (float(f) + 0.5) / float(SB_ORDERS_DIRECTIONS_PHI);
         float s_in = sqrt(max(1.0 - mu_in * mu_in, 0.0));
-        float nu_in = clamp(mu_in * mu_s + s_in * ss * cos(phi), -1.0, 1.0);
-        vec3 L = previous_radiance(h, mu_in, mu_s, nu_in);
-        dir_radiance[d] = vec4(L, w_mu * PI / float(SB_ORDERS_DIRECTIONS_PHI));
-        dir_vector[d] = vec4(mu_in, s_in, phi, 0.0);
+        dir_vector[d] = vec4(mu_in, s_in, phi, w_mu * PI / float(SB_ORDERS_DIRECTIONS_PHI));
+        for (uint m = 0u; m < suns; m++) {
+            float mu_s = orders_mu_s(ims0 + m), ss = sqrt(max(1.0 - mu_s * mu_s, 0.0));
+            float nu_in = clamp(mu_in * mu_s + s_in * ss * cos(phi), -1.0, 1.0);
+            vec3 L = previous_radiance(h, mu_in, mu_s, nu_in);
+            dir_red[m * DIRECTIONS + d] = L.r;
+            dir_green[m * DIRECTIONS + d] = L.g;
+            dir_blue[m * DIRECTIONS + d] = L.b;
+        }
     }
     barrier();
     /* the ground's irradiance of order k - 1, from the upper hemisphere
      * (the horizon is at mu = 0 there); both mirror images */
-    if (ir == 0u && t == 0u) {
+    if (ir == 0u && t < suns) {
         vec3 e = vec3(0.0);
-        for (uint d = SB_ORDERS_DIRECTIONS_GROUND * SB_ORDERS_DIRECTIONS_PHI; d < SB_ORDERS_DIRECTIONS; d++)
-            e += 2.0 * dir_radiance[d].w * dir_vector[d].x * dir_radiance[d].rgb;
-        ground_table[(orders.order - 1u) * orders.size.z + ims] = vec4(e, 0.0);
+        for (uint d = SB_ORDERS_DIRECTIONS_GROUND * SB_ORDERS_DIRECTIONS_PHI; d < DIRECTIONS; d++) {
+            uint i = t * DIRECTIONS + d;
+            e += 2.0 * dir_vector[d].w * dir_vector[d].x * vec3(dir_red[i], dir_green[i], dir_blue[i]);
+        }
+        ground_table[(orders.order - 1u) * orders.size.z + ims0 + t] = vec4(e, 0.0);
     }
     Medium m = medium_at(h);
     float g = atm.mie_extinction.w, ag = abs(g), k_mie = 3.0 / (8.0 * PI) * (1.0 - g * g) / (2.0 + g * g);
@@ -161,69 +183,102 @@ void main()
         uint imu = j / orders.size.w, inu = j % orders.size.w;
         float mu = orders_mu(h, imu), sv = sqrt(max(1.0 - mu * mu, 0.0));
         float phi_s = orders_node_phi(inu);
-        vec3 rayleigh = vec3(0.0), mie = vec3(0.0);
+        /* the phase functions are the sun's alone: once for all the suns */
+        vec3 rayleigh[SUNS], mie[SUNS];
+        for (uint k = 0u; k < SUNS; k++)
+            rayleigh[k] = mie[k] = vec3(0.0);
         float mie_weight = 0.0;
-        for (uint d = 0u; d < SB_ORDERS_DIRECTIONS; d++) {
-            vec4 v = dir_vector[d], L = dir_radiance[d];
+        for (uint d = 0u; d < DIRECTIONS; d++) {
+            vec4 v = dir_vector[d];
             float a = mu * v.x, b = sv * v.y;
             float c_plus = clamp(a + b * cos(v.z - phi_s), -1.0, 1.0);
             float c_minus = clamp(a + b * cos(v.z + phi_s), -1.0, 1.0);
             float pr = phase_rayleigh(c_plus) + phase_rayleigh(c_minus);
             float pm = phase_mie_fast(c_plus, g, ag, k_mie) + phase_mie_fast(c_minus, g, ag, k_mie);
-            rayleigh += (L.w * pr) * L.rgb;
-            mie += (L.w * pm) * L.rgb;
-            mie_weight += L.w * pm;
+            for (uint k = 0u; k < SUNS; k++) {
+                uint i = k * DIRECTIONS + d;
+                vec3 L = vec3(dir_red[i], dir_green[i], dir_blue[i]);
+                rayleigh[k] += (v.w * pr) * L;
+                mie[k] += (v.w * pm) * L;
+            }
+            mie_weight += v.w * pm;
         }
         /* per unit of scattering (the reference's density_per_scattering):
          * the scatter stage multiplies by the air's scattering where it reads */
         vec3 s = m.scattering_rayleigh + m.scattering_mie;
-        vec3 J = m.scattering_rayleigh * rayleigh + m.scattering_mie * mie / max(mie_weight, 1e-30);
-        J = mix(0.5 * (rayleigh + mie / max(mie_weight, 1e-30)), J / max(s, vec3(1e-30)), greaterThan(s, vec3(0.0)));
-        density_table[orders_index(ir, imu, ims, inu)] = vec4(J, 0.0);
+        for (uint k = 0u; k < suns; k++) {
+            vec3 J = m.scattering_rayleigh * rayleigh[k] + m.scattering_mie * mie[k] / max(mie_weight, 1e-30);
+            J = mix(0.5 * (rayleigh[k] + mie[k] / max(mie_weight, 1e-30)), J / max(s, vec3(1e-30)),
+                    greaterThan(s, vec3(0.0)));
+            density_table[orders_index(ir, imu, ims0 + k, inu)] = vec4(J, 0.0);
+        }
     }
 }
 
 #else
 
-#define DENSITY(i) density_table[i].rgb
+#define DENSITY(i) texelFetch(density_texels, int(i)).rgb
 SB_ORDERS_READ(read_density, DENSITY)
+
+/* The view's samples: Gauss-Legendre 4 on each segment between its level
+ * cuts, at most one segment more than the cuts. */
+#define SAMPLES (4 * (2 * SB_RAY_CUT_LEVELS + 1))
+shared vec4 sample_at[SAMPLES];     /* t, r, mu there, the fraction in r */
+shared vec4 sample_weight[SAMPLES]; /* T(x, y) sigma_s(y) times the quadrature's weight; the fraction in mu */
+shared uint sample_base[SAMPLES];   /* the view cell's node */
+shared uint sample_count;
 
 void main()
 {
-    uint i = gl_GlobalInvocationID.x, n = orders_node_count();
-    if (i >= n)
-        return;
-    float h, mu, mu_s, nu;
-    bool ground;
-    node_view(i, h, mu, mu_s, nu, ground);
-    vec3 L = vec3(0.0);
-    if (!(ground && h <= 0.0)) {
-        float t_end = ground ? distance_to_ground(h, mu) : distance_to_top(h, mu), r0 = ground_radius() + h;
-        RayCuts cuts = ray_level_cuts(h, mu); /* the density has no shadow edge of its own */
-        vec3 tau = vec3(0.0);
-        for (float t0 = 0.0; t0 < t_end;) {
-            float t1 = ray_next_cut(cuts, t0, t_end), half_len = 0.5 * (t1 - t0);
-            float ts[4], hs[4];
-            Medium m[4];
-            vec3 tw[4];
-            ray_segment_nodes(h, mu, t0, t1, ts, hs, m);
-            ray_node_weights(tau, half_len, m, tw);
-            for (int k = 0; k < 4; k++) {
-                float r = ground_radius() + hs[k];
-                float mu_k = clamp((r0 * mu + ts[k]) / r, -1.0, 1.0);
-                float mu_s_k = clamp((r0 * mu_s + ts[k] * nu) / r, -1.0, 1.0);
-                L += tw[k] * (m[k].scattering_rayleigh + m[k].scattering_mie)
-                   * read_density(orders_cell(hs[k], mu_k, mu_s_k, nu, ground));
+    uint ir = gl_WorkGroupID.y, imu = gl_WorkGroupID.x, t = gl_LocalInvocationID.x;
+    float h = orders_altitude(ir), mu = orders_mu(h, imu), r0 = ground_radius() + h;
+    bool ground = imu < orders.size.y / 2u;
+    /* the view's walk, once: its segments, media and transmittance */
+    if (t == 0u) {
+        uint n = 0u;
+        if (!(ground && h <= 0.0)) {
+            float t_end = ground ? distance_to_ground(h, mu) : distance_to_top(h, mu);
+            RayCuts cuts = ray_level_cuts(h, mu); /* the density has no shadow edge of its own */
+            vec3 tau = vec3(0.0);
+            for (float t0 = 0.0; t0 < t_end && n + 4u <= SAMPLES;) {
+                float t1 = ray_next_cut(cuts, t0, t_end), half_len = 0.5 * (t1 - t0);
+                float ts[4], hs[4];
+                Medium m[4];
+                vec3 tw[4];
+                ray_segment_nodes(h, mu, t0, t1, ts, hs, m);
+                ray_node_weights(tau, half_len, m, tw);
+                for (int k = 0; k < 4; k++, n++) {
+                    float r = ground_radius() + hs[k];
+                    float mu_k = clamp((r0 * mu + ts[k]) / r, -1.0, 1.0);
+                    OrdersViewCell v = orders_view_cell(hs[k], mu_k, ground);
+                    sample_at[n] = vec4(ts[k], r, mu_k, v.a.x);
+                    sample_weight[n] = vec4(tw[k] * (m[k].scattering_rayleigh + m[k].scattering_mie), v.a.y);
+                    sample_base[n] = v.base;
+                }
+                ray_advance(tau, half_len, m);
+                t0 = t1;
             }
-            ray_advance(tau, half_len, m);
-            t0 = t1;
         }
+        sample_count = n;
     }
-    previous_table[i] = vec4(L, 0.0);
-    vec3 sum = sum_table[i].rgb + L;
-    sum_table[i] = vec4(sum, 0.0);
-    atomicMax(stats[0], floatBitsToUint(max(L.r, max(L.g, L.b))));
-    atomicMax(stats[1], floatBitsToUint(max(sum.r, max(sum.g, sum.b))));
+    barrier();
+    uint n = sample_count, per_view = orders.size.z * orders.size.w;
+    for (uint j = t; j < per_view; j += SB_ORDERS_THREADS) {
+        uint ims = j / orders.size.w, inu = j % orders.size.w;
+        float mu_s = orders_mu_s(ims), nu = orders_nu(mu, mu_s, orders_node_phi(inu));
+        vec3 L = vec3(0.0);
+        for (uint k = 0u; k < n; k++) {
+            vec4 at = sample_at[k], w = sample_weight[k];
+            float mu_s_k = clamp((r0 * mu_s + at.x * nu) / at.y, -1.0, 1.0);
+            L += w.rgb * read_density(orders_sun_cell(OrdersViewCell(sample_base[k], vec2(at.w, w.w)), at.z, mu_s_k, nu));
+        }
+        uint i = orders_index(ir, imu, ims, inu);
+        previous_table[i] = vec4(L, 0.0);
+        vec3 sum = sum_table[i].rgb + L;
+        sum_table[i] = vec4(sum, 0.0);
+        atomicMax(stats[0], floatBitsToUint(max(L.r, max(L.g, L.b))));
+        atomicMax(stats[1], floatBitsToUint(max(sum.r, max(sum.g, sum.b))));
+    }
 }
 
 #endif

@@ -196,25 +196,43 @@ struct OrdersCell {
     bool twilight;
 };
 
-OrdersCell orders_cell(float h, float mu, float mu_s, float nu, bool ground)
+/* The part of a cell the view alone gives (r and mu): what every sun a
+ * node of that view has shares. */
+struct OrdersViewCell {
+    uint base; /* node (ir, im, 0, 0) */
+    vec2 a;    /* fractions in r and mu */
+};
+
+OrdersViewCell orders_view_cell(float h, float mu, bool ground)
 {
     uvec4 s = SB_ORDERS_GRID_SIZE;
-    OrdersCell c;
     if (orders_below_top()) /* above the grid (a density along a ray): its top's */
         h = min(h, orders_thickness());
     float fr = orders_altitude_coord(h);
     uint ir = min(uint(fr), s.x - 2u);
-    OrdersMuS ms = orders_mu_s_cell(mu_s);
-    float fn = orders_phi_coord(orders_phi(mu, mu_s, nu));
-    uint inu = min(uint(fn), s.w - 2u);
     uint lo = ground ? 0u : s.y / 2u;
     float fm = orders_mu_coord(h, mu, ground);
     uint im = min(uint(fm), lo + s.y / 2u - 2u);
-    c.base = orders_index(ir, im, ms.i, inu);
-    c.a = vec3(fr - float(ir), fm - float(im), fn - float(inu));
+    return OrdersViewCell(orders_index(ir, im, 0u, 0u), vec2(fr - float(ir), fm - float(im)));
+}
+
+/* The cell of view cell v (at the view's cosine mu) for the sun at (mu_s, nu). */
+OrdersCell orders_sun_cell(OrdersViewCell v, float mu, float mu_s, float nu)
+{
+    OrdersMuS ms = orders_mu_s_cell(mu_s);
+    float fn = orders_phi_coord(orders_phi(mu, mu_s, nu));
+    uint inu = min(uint(fn), SB_ORDERS_GRID_SIZE.w - 2u);
+    OrdersCell c;
+    c.base = v.base + ms.i * SB_ORDERS_GRID_SIZE.w + inu;
+    c.a = vec3(v.a, fn - float(inu));
     c.as = ms.f;
     c.twilight = ms.twilight;
     return c;
+}
+
+OrdersCell orders_cell(float h, float mu, float mu_s, float nu, bool ground)
+{
+    return orders_sun_cell(orders_view_cell(h, mu, ground), mu, mu_s, nu);
 }
 
 /* A function `name`(OrdersCell) reading a table of nodes through TABLE(i)
