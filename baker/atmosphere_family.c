@@ -376,6 +376,7 @@ static uint32_t atmosphere_kernels(void *state, const struct sb_scene *scene, en
                                    struct sb_pipeline_params out[SB_FAMILY_KERNELS_MAX])
 {
     _Static_assert(SB_ATMOSPHERE_KERNELS_MAX <= SB_FAMILY_KERNELS_MAX, "room for the atmosphere's kernels");
+    _Static_assert(SB_ORDERS_KERNEL_COUNT <= SB_FAMILY_KERNELS_MAX, "room for the orders' kernels");
     struct atmosphere_state *st = state;
     enum sb_product_id base = sb_spectral_base(id);
     if (base != SB_PRODUCT_COUNT) /* the three-channel kernels, for each band */

@@ -9,8 +9,10 @@
 #include "config.h"
 #include "log.h"
 #include "orders_density.spv.h"
+#include "orders_directions.spv.h"
 #include "orders_scatter.spv.h"
 #include "orders_single.spv.h"
+#include "orders_views.spv.h"
 #include "physics.h"
 #include "sky_error.h"
 
@@ -20,11 +22,13 @@
         .binding_count = SB_ORDERS_BINDING_COUNT, .texel_bindings = (texels),                                          \
         .push_size = sizeof(struct sb_orders_push), .name = "orders " #stage,                                          \
     }
-enum { SINGLE, DENSITY, SCATTER, KERNEL_COUNT };
-/* The scatter stage reads the density as texels (sb_buffer_create_texels):
- * 16 nodes a sample, at nodes that differ per invocation */
-static const struct sb_pipeline_params kernels[KERNEL_COUNT] = {KERNEL(single, 0), KERNEL(density, 0),
-                                                                KERNEL(scatter, 1u << SB_ORDERS_BINDING_DENSITY)};
+enum { SINGLE, VIEWS, DIRECTIONS, DENSITY, SCATTER, KERNEL_COUNT };
+_Static_assert(KERNEL_COUNT == SB_ORDERS_KERNEL_COUNT, "the stages");
+/* the density stage reads the directions, the scatter stage the views and
+ * the density, as texels (sb_buffer_create_texels; orders.comp says why) */
+static const struct sb_pipeline_params kernels[KERNEL_COUNT] = {
+    KERNEL(single, 0), KERNEL(views, 0), KERNEL(directions, 0), KERNEL(density, 1u << SB_ORDERS_BINDING_DIRECTIONS),
+    KERNEL(scatter, 1u << SB_ORDERS_BINDING_DENSITY | 1u << SB_ORDERS_BINDING_VIEWS)};
 #undef KERNEL
 
 struct sb_orders_settings sb_orders_product_grid(const struct sb_atmosphere_params *p)
@@ -127,18 +131,14 @@ enum sb_result sb_orders_bake(struct sb_vk *vk, struct sb_atmosphere_baker *bake
                  SB_ORDERS_MAX_NODES, SB_ORDERS_MAX_ORDER, s.r, s.mu, s.mu_s, s.nu, s.max_order, s.tolerance);
         return SB_ERR_USAGE;
     }
-    if (vk->properties.limits.maxComputeSharedMemorySize < SB_ORDERS_DENSITY_SHARED_BYTES) {
-        sb_error("orders: the density kernel needs %d bytes of workgroup memory, the device offers %u",
-                 SB_ORDERS_DENSITY_SHARED_BYTES, vk->properties.limits.maxComputeSharedMemorySize);
-        return SB_ERR_DEVICE_LIMIT;
-    }
     struct sb_orders_push push;
     sb_orders_grid_pack(p, s.r, s.mu, s.mu_s, s.nu, &push);
     size_t n = (size_t)s.r * s.mu * s.mu_s * s.nu, vec4 = 4 * sizeof(float);
+    uint32_t sun_groups = (uint32_t)((s.mu_s + SB_ORDERS_DENSITY_SUNS - 1) / SB_ORDERS_DENSITY_SUNS);
     /* order k's radiance in previous[k % 2]: the last two orders are there
      * at the end, for the tail */
     struct sb_buffer single = {0}, previous[2] = {{0}}, density = {0}, sum = {0}, ground = {0}, stats = {0},
-                     dummy = {0}, single_whole = {0};
+                     directions = {0}, views = {0}, dummy = {0}, single_whole = {0};
     struct sb_pipeline pipelines[KERNEL_COUNT] = {0};
     float *table = NULL, *last = NULL; /* the last two orders' radiance */
     /* a peaked Mie's orders in its delta-M medium, in a baker of their own */
@@ -156,6 +156,10 @@ enum sb_result sb_orders_bake(struct sb_vk *vk, struct sb_atmosphere_baker *bake
         (res = sb_buffer_create(vk, n * vec4, "orders sum", &sum)) ||
         (res = sb_buffer_create(vk, (size_t)(SB_ORDERS_MAX_ORDER + 1) * s.mu_s * vec4, "orders ground", &ground)) ||
         (res = sb_buffer_create(vk, 16, "orders stats", &stats)) ||
+        (res = sb_buffer_create_texels(vk, (size_t)s.r * sun_groups * SB_ORDERS_DIRECTIONS * 4 * vec4,
+                                       "orders directions", &directions)) ||
+        (res = sb_buffer_create_texels(vk, (size_t)s.r * s.mu * (1 + 3 * SB_ORDERS_VIEW_SAMPLES) * vec4, "orders views",
+                                       &views)) ||
         (res = sb_buffer_create(vk, 16, "orders unused", &dummy)))
         goto done;
     if (f > 0) {
@@ -181,6 +185,8 @@ enum sb_result sb_orders_bake(struct sb_vk *vk, struct sb_atmosphere_baker *bake
     bindings[SB_ORDERS_BINDING_SUM] = &sum;
     bindings[SB_ORDERS_BINDING_GROUND] = &ground;
     bindings[SB_ORDERS_BINDING_STATS] = &stats;
+    bindings[SB_ORDERS_BINDING_DIRECTIONS] = &directions;
+    bindings[SB_ORDERS_BINDING_VIEWS] = &views;
     for (int k = 0; k < KERNEL_COUNT; k++) {
         if ((res = sb_pipeline_create(vk, &kernels[k], &pipelines[k])))
             goto done;
@@ -202,19 +208,27 @@ enum sb_result sb_orders_bake(struct sb_vk *vk, struct sb_atmosphere_baker *bake
     if ((res = sb_dispatch(vk, &pipelines[SINGLE], &push, node_groups, 1, 1, &ms)))
         goto done;
     result->gpu_ms += ms;
+    /* the views' samples, the same for every order */
+    if ((res = sb_dispatch(vk, &pipelines[VIEWS], &push,
+                           (uint32_t)((s.r * s.mu + SB_ORDERS_THREADS - 1) / SB_ORDERS_THREADS), 1, 1, &ms)))
+        goto done;
+    result->gpu_ms += ms;
     for (int k = 2; k <= s.max_order; k++) {
         sb_status("orders: order %d", k);
         push.order = (uint32_t)k;
         memset(stats.mapped, 0, 16);
         bindings[SB_ORDERS_BINDING_PREVIOUS] = &previous[(k - 1) % 2];
-        sb_pipeline_bind(vk, &pipelines[DENSITY], bindings);
+        sb_pipeline_bind(vk, &pipelines[DIRECTIONS], bindings);
         bindings[SB_ORDERS_BINDING_PREVIOUS] = &previous[k % 2];
         sb_pipeline_bind(vk, &pipelines[SCATTER], bindings);
-        if ((res = sb_dispatch(vk, &pipelines[DENSITY], &push, (uint32_t)s.r,
-                               (uint32_t)((s.mu_s + SB_ORDERS_DENSITY_SUNS - 1) / SB_ORDERS_DENSITY_SUNS), 1, &ms)))
+        if ((res = sb_dispatch(vk, &pipelines[DIRECTIONS], &push, (uint32_t)s.r, sun_groups, 1, &ms)))
             goto done;
         result->gpu_ms += ms;
         double density_ms = ms;
+        if ((res = sb_dispatch(vk, &pipelines[DENSITY], &push, (uint32_t)s.r, sun_groups, 1, &ms)))
+            goto done;
+        result->gpu_ms += ms;
+        density_ms += ms;
         if ((res = sb_dispatch(vk, &pipelines[SCATTER], &push, (uint32_t)s.mu, (uint32_t)s.r, 1, &ms)))
             goto done;
         result->gpu_ms += ms;
@@ -305,8 +319,8 @@ done:
     free(forward);
     for (int k = 0; k < KERNEL_COUNT; k++)
         sb_pipeline_destroy(vk, &pipelines[k]);
-    struct sb_buffer *buffers[] = {&single, &previous[0], &previous[1], &density,     &sum,
-                                   &ground, &stats,       &dummy,       &single_whole};
+    struct sb_buffer *buffers[] = {&single, &previous[0], &previous[1],  &density,    &sum,  &ground,
+                                   &stats,  &dummy,       &single_whole, &directions, &views};
     for (size_t i = 0; i < sizeof(buffers) / sizeof(buffers[0]); i++)
         sb_buffer_destroy(vk, buffers[i]);
     sb_atmosphere_baker_destroy(&scaled);

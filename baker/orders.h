@@ -70,8 +70,9 @@ void sb_orders_hillaire_error(const struct sb_atmosphere_params *p, const struct
                               const struct sb_image *orders, double altitude_km, const double *suns_deg, int sun_count,
                               double *rms, double *worst);
 
-/* The kernels sb_orders_bake makes; returns their count (3). */
-uint32_t sb_orders_kernels(struct sb_pipeline_params out[3]);
+/* The kernels sb_orders_bake makes (its stages, orders.comp); returns their count. */
+#define SB_ORDERS_KERNEL_COUNT 5
+uint32_t sb_orders_kernels(struct sb_pipeline_params out[SB_ORDERS_KERNEL_COUNT]);
 
 /* XXH3-128 of the kernels' SPIR-V, for the product's bake key. */
 void sb_orders_code_hash(char out[SB_HASH_HEX_SIZE]);

@@ -586,7 +586,12 @@ struct sb_prefilter_push {
 #define SB_ORDERS_BINDING_SUM 11     /* orders 2 to k: the product */
 #define SB_ORDERS_BINDING_GROUND 12  /* the ground's irradiance of order j at mu_s node i: vec4 [j * nmus + i] */
 #define SB_ORDERS_BINDING_STATS 13   /* uint: the largest value of this order, of the sum (float bits) */
-#define SB_ORDERS_BINDING_COUNT 14
+#define SB_ORDERS_BINDING_DIRECTIONS 14 /* the directions about each point, at four suns (orders.comp) */
+#define SB_ORDERS_BINDING_VIEWS 15      /* each view's samples (orders.comp) */
+/* A view's samples at most: Gauss-Legendre 4 on each segment between its
+ * level cuts, at most one segment more than the cuts (two a level). */
+#define SB_ORDERS_VIEW_SAMPLES (4 * (2 * SB_MAX_LEVELS + 1))
+#define SB_ORDERS_BINDING_COUNT 16
 /* The density's directions at a node (orders.comp): Gauss-Legendre in
  * cos(zenith) below and above the horizon, midpoints in azimuth from the
  * sun's over [0, pi] (each standing for its mirror image too). */
@@ -596,13 +601,10 @@ struct sb_prefilter_push {
 #define SB_ORDERS_DIRECTIONS \
     ((SB_ORDERS_DIRECTIONS_GROUND + SB_ORDERS_DIRECTIONS_SKY) * SB_ORDERS_DIRECTIONS_PHI)
 #define SB_ORDERS_THREADS 64
-/* The density stage's mu_s nodes a workgroup: its phase functions do not
- * depend on the sun, so each is weighed once for them all. 4 of them, the
- * directions' radiance 18 KiB of workgroup memory and their vectors 6:
- * within llvmpipe's 32 KiB and a GPU's 48, not the 16 every device offers
- * (the baker checks). */
+/* The directions' and the density's mu_s nodes a workgroup: the
+ * components of a vec4 (orders.comp). The phase functions do not depend on
+ * the sun, so the density weighs each once for them all. */
 #define SB_ORDERS_DENSITY_SUNS 4
-#define SB_ORDERS_DENSITY_SHARED_BYTES (16 * SB_ORDERS_DIRECTIONS + 12 * SB_ORDERS_DENSITY_SUNS * SB_ORDERS_DIRECTIONS)
 /* The most orders a bake computes, and the most nodes in each dimension. */
 #define SB_ORDERS_MAX_ORDER 32
 #define SB_ORDERS_MAX_NODES 256
