@@ -94,6 +94,12 @@ uint directions_index(uint d, uint c)
     return ((gl_WorkGroupID.x * gl_NumWorkGroups.y + gl_WorkGroupID.y) * DIRECTIONS + d) * 4u + c;
 }
 
+/* Stages 2 to 4 share a workgroup's items (directions or nodes) among
+ * the workgroups along z: a GPU wants an invocation an item, llvmpipe
+ * hardly minds. */
+uint first_item() { return gl_WorkGroupID.z * SB_ORDERS_THREADS + gl_LocalInvocationID.x; }
+uint item_stride() { return gl_NumWorkGroups.z * SB_ORDERS_THREADS; }
+
 /* A node's view. */
 void node_view(uint index, out float h, out float mu, out float mu_s, out float nu, out bool ground)
 {
@@ -215,7 +221,7 @@ void main()
     uint suns = min(orders.size.z - ims0, uint(SB_ORDERS_DENSITY_SUNS));
     float h = orders_altitude(ir), r = ground_radius() + h;
     float horizon = -horizon_distance(h) / r;
-    for (uint d = t; d < DIRECTIONS; d += SB_ORDERS_THREADS) {
+    for (uint d = first_item(); d < DIRECTIONS; d += item_stride()) {
         uint q = d / SB_ORDERS_DIRECTIONS_PHI, f = d % SB_ORDERS_DIRECTIONS_PHI;
         bool sky = q >= SB_ORDERS_DIRECTIONS_GROUND;
         float mu_in, w_mu;
@@ -257,7 +263,7 @@ void main()
     float h = orders_altitude(ir);
     /* the ground's irradiance of order k - 1, from the upper hemisphere
      * (the horizon is at mu = 0 there); both mirror images */
-    if (ir == 0u && t < suns) {
+    if (ir == 0u && gl_WorkGroupID.z == 0u && t < suns) {
         vec3 e = vec3(0.0);
         for (uint d = SB_ORDERS_DIRECTIONS_GROUND * SB_ORDERS_DIRECTIONS_PHI; d < DIRECTIONS; d++) {
             vec4 v = texelFetch(directions_texels, int(directions_index(d, 0u)));
@@ -271,7 +277,7 @@ void main()
     Medium m = medium_at(h);
     float g = atm.mie_extinction.w, ag = abs(g), k_mie = 3.0 / (8.0 * PI) * (1.0 - g * g) / (2.0 + g * g);
     uint per_slice = orders.size.y * orders.size.w;
-    for (uint j = t; j < per_slice; j += SB_ORDERS_THREADS) {
+    for (uint j = first_item(); j < per_slice; j += item_stride()) {
         uint imu = j / orders.size.w, inu = j % orders.size.w;
         float mu = orders_mu(h, imu), sv = sqrt(max(1.0 - mu * mu, 0.0));
         float phi_s = orders_node_phi(inu);
@@ -320,7 +326,7 @@ void main()
     uint ir = gl_WorkGroupID.y, imu = gl_WorkGroupID.x, t = gl_LocalInvocationID.x, at = views_index(ir, imu);
     float h = orders_altitude(ir), mu = orders_mu(h, imu), r0 = ground_radius() + h;
     uint n = uint(texelFetch(views_texels, int(at)).x), per_view = orders.size.z * orders.size.w;
-    for (uint j = t; j < per_view; j += SB_ORDERS_THREADS) {
+    for (uint j = first_item(); j < per_view; j += item_stride()) {
         uint ims = j / orders.size.w, inu = j % orders.size.w;
         float mu_s = orders_mu_s(ims), nu = orders_nu(mu, mu_s, orders_node_phi(inu));
         vec3 L = vec3(0.0);
