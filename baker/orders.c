@@ -76,8 +76,8 @@ static bool grid_ok(const struct sb_orders_settings *s)
     for (int i = 0; i < 4; i++)
         if (n[i] < 2 || n[i] > SB_ORDERS_MAX_NODES)
             return false;
-    return s->mu >= 4 && s->max_order >= 2 && s->max_order <= SB_ORDERS_MAX_ORDER && s->tolerance > 0 &&
-           s->tolerance < 1;
+    return (double)s->r * s->mu * s->mu_s * s->nu <= SB_ORDERS_MAX_GRID_NODES && s->mu >= 4 && s->max_order >= 2 &&
+           s->max_order <= SB_ORDERS_MAX_ORDER && s->tolerance > 0 && s->tolerance < 1;
 }
 
 static float float_of(uint32_t bits)
@@ -137,9 +137,11 @@ enum sb_result sb_orders_bake(struct sb_vk *vk, struct sb_atmosphere_baker *bake
     struct sb_orders_settings s = sb_orders_settings_resolve(settings);
     memset(result, 0, sizeof(*result));
     if (!grid_ok(&s)) {
-        sb_error("orders: the grid must have 2 to %d nodes a dimension (mu even, at least 4) and 2 to %d orders "
-                 "under a tolerance in (0, 1); got %dx%dx%dx%d, %d orders, %g",
-                 SB_ORDERS_MAX_NODES, SB_ORDERS_MAX_ORDER, s.r, s.mu, s.mu_s, s.nu, s.max_order, s.tolerance);
+        sb_error("orders: the grid must have 2 to %d nodes a dimension (mu even, at least 4), at most %d in all, and 2 "
+                 "to %d "
+                 "orders under a tolerance in (0, 1); got %dx%dx%dx%d, %d orders, %g",
+                 SB_ORDERS_MAX_NODES, SB_ORDERS_MAX_GRID_NODES, SB_ORDERS_MAX_ORDER, s.r, s.mu, s.mu_s, s.nu,
+                 s.max_order, s.tolerance);
         return SB_ERR_USAGE;
     }
     struct sb_orders_push push;

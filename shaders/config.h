@@ -591,6 +591,8 @@ struct sb_prefilter_push {
 /* A view's samples at most: Gauss-Legendre 4 on each segment between its
  * level cuts, at most one segment more than the cuts (two a level). */
 #define SB_ORDERS_VIEW_SAMPLES (4 * (2 * SB_MAX_LEVELS + 1))
+/* Nodes in all at most: the views keep a node's index as a float, exact to 2^24. */
+#define SB_ORDERS_MAX_GRID_NODES (1 << 24)
 #define SB_ORDERS_BINDING_COUNT 16
 /* The density's directions at a node (orders.comp): Gauss-Legendre in
  * cos(zenith) below and above the horizon, midpoints in azimuth from the

@@ -181,6 +181,13 @@ int main(void)
     struct sb_atmosphere_params earth;
     sb_atmosphere_preset_earth(&earth);
     const struct sb_orders_settings coarse = {.r = 12, .mu = 48, .mu_s = 16, .nu = 6};
+    { /* each dimension within its bound, twice 2^24 nodes in all: refused before anything is made */
+        const struct sb_orders_settings huge = {.r = 256, .mu = 256, .mu_s = 256, .nu = 2};
+        struct sb_image table = {0};
+        struct sb_orders_result result;
+        CHECK(sb_orders_bake(vk, NULL, &earth, &huge, &table, &result) == SB_ERR_USAGE && !table.data,
+              "a grid over %d nodes in all: refused", SB_ORDERS_MAX_GRID_NODES);
+    }
     compare("earth", vk, &earth, &coarse, 0.015, 0.25, 0.02);
     /* as thick as its planet's radius: the grid ends 110.5 km up, where the
      * air above holds under 1e-6 of its column (sb_orders_top_km), and the

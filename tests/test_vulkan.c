@@ -6,8 +6,11 @@
  * no barrier between them are a message (on lavapipe too, whose queue runs
  * in order and would never show the race), the same writes with a barrier
  * are none. Without this, a pass or a dispatch missing its barrier would
- * pass every test here and flicker on a GPU.
+ * pass every test here and flicker on a GPU. And texel buffers
+ * (sb_buffer_create_texels): a kernel's fetches give back the bits the
+ * host wrote.
  */
+#include <math.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -17,6 +20,7 @@
 #include "harness_vk.h"
 #include "log.h"
 #include "pipeline.h"
+#include "texels_probe.spv.h"
 
 static void quiet(void *user, enum sb_log_level level, const char *message)
 {
@@ -108,6 +112,54 @@ static void test_context_pipelines(struct sb_vk *vk)
     sb_pipeline_destroy(vk, &p[0]);
 }
 
+/* A texel binding beside a storage one: tests/texels_probe.comp copies
+ * texels fetched at scattered indices, and one that every invocation
+ * fetches, into the storage buffer; each must be the host's bits. */
+static void test_texels(struct sb_vk *vk)
+{
+    enum { N = 1000 };
+    const struct sb_pipeline_params kernel = {
+        .spirv = sb_spv_texels_probe,
+        .spirv_size = sizeof(sb_spv_texels_probe),
+        .binding_count = 2,
+        .texel_bindings = 1u << 0,
+        .push_size = sizeof(uint32_t),
+        .name = "texels probe",
+    };
+    struct sb_buffer texels = {0}, copies = {0};
+    struct sb_pipeline p = {0};
+    float *got = malloc(2 * N * 4 * sizeof(float));
+    bool ok = got && sb_buffer_create_texels(vk, N * 4 * sizeof(float), "texels", &texels) == SB_OK &&
+              sb_buffer_create(vk, 2 * N * 4 * sizeof(float), "copies", &copies) == SB_OK &&
+              sb_pipeline_create(vk, &kernel, &p) == SB_OK;
+    CHECK(ok, "a texel buffer and its kernel");
+    if (!ok)
+        goto done;
+    float *in = texels.mapped;
+    for (int i = 0; i < 4 * N; i++) /* every value another, some far from 1 */
+        in[i] = ldexpf(1.0f + (float)i / (4 * N), i % 61 - 30) * (i % 3 == 1 ? -1.0f : 1.0f);
+    const struct sb_buffer *bound[2] = {&texels, &copies};
+    sb_pipeline_bind(vk, &p, bound);
+    uint32_t n = N;
+    double ms;
+    ok = sb_dispatch(vk, &p, &n, (N + 63) / 64, 1, 1, &ms) == SB_OK && sb_buffer_read(vk, &copies, got) == SB_OK;
+    CHECK(ok, "the texels copied");
+    if (!ok)
+        goto done;
+    int wrong = 0;
+    for (int i = 0; i < N; i++)
+        for (int c = 0; c < 4; c++) {
+            wrong += memcmp(&got[4 * i + c], &in[4 * (i * 7919 % N) + c], sizeof(float)) != 0;
+            wrong += memcmp(&got[4 * (N + i) + c], &in[4 * (N - 1) + c], sizeof(float)) != 0;
+        }
+    CHECK(wrong == 0, "texels fetched at scattered and at one index: %d of %d values not the host's", wrong, 8 * N);
+done:
+    free(got);
+    sb_pipeline_destroy(vk, &p);
+    sb_buffer_destroy(vk, &texels);
+    sb_buffer_destroy(vk, &copies);
+}
+
 int main(void)
 {
     const char *env = getenv("SKYBAKE_VALIDATE");
@@ -131,6 +183,10 @@ int main(void)
     unsigned messages = sb_vk_validation_messages(vk);
     test_context_pipelines(vk);
     CHECK(sb_vk_validation_messages(vk) == messages, "the context's pipelines: %u validation messages",
+          sb_vk_validation_messages(vk) - messages);
+    messages = sb_vk_validation_messages(vk);
+    test_texels(vk);
+    CHECK(sb_vk_validation_messages(vk) == messages, "texel buffers: %u validation messages",
           sb_vk_validation_messages(vk) - messages);
     sb_vk_destroy(&vk);
     return test_finish("vulkan");
